@@ -1,0 +1,82 @@
+/* isoprop: reading raw input volumes (headerless raw, NRRD, MetaImage) plane by plane.
+ *
+ * ip_input_describe() works out where the samples are and how they are laid out, from a file
+ * name of the form NAME_XxYxZ_TYPE.raw, from a NRRD header (.nrrd attached, .nhdr detached;
+ * raw or gzip encoding) or from a MetaImage header (.mhd with its data file), and from explicit
+ * overrides. A reader then streams z-planes in order with bounded memory.
+ */
+#ifndef ISOPROP_INPUT_H
+#define ISOPROP_INPUT_H
+
+#include <stdint.h>
+
+#include "isoprop/status.h"
+#include "isoprop/volume.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IP_PATH_MAX 4096
+
+typedef enum ip_encoding {
+    IP_ENCODING_RAW = 0,
+    IP_ENCODING_GZIP = 1
+} ip_encoding;
+
+/* Where a volume's samples are and how to read them. */
+typedef struct ip_input_desc {
+    char path[IP_PATH_MAX];      /* the file the user named (header or raw) */
+    char data_path[IP_PATH_MAX]; /* the file that holds the samples */
+    uint64_t data_offset;        /* byte offset of the first sample in data_path */
+    uint32_t dims[3];            /* samples along x, y, z; each >= 2 */
+    ip_type type;
+    int big_endian;              /* 1 when the stored samples are big-endian */
+    double spacing[3];           /* world units between samples; default 1,1,1 */
+    ip_encoding encoding;
+} ip_input_desc;
+
+/* Values given on the command line; each applies only where its has_ flag is set, and wins
+ * over the file name and over any header. */
+typedef struct ip_input_overrides {
+    int has_dims;
+    uint32_t dims[3];
+    int has_type;
+    ip_type type;
+    int has_endian;
+    int big_endian;
+    int has_spacing;
+    double spacing[3];
+} ip_input_overrides;
+
+/*! ip_input_describe() : fills *out for the volume at `path`.
+ *  `overrides` may be NULL. Checks everything that can be checked before reading samples:
+ *  a dimension under 2, an unknown type, an unreadable or malformed header, a missing data
+ *  file, and (raw encoding) a data size that does not equal dims x type size.
+ *  @return IP_OK, or IP_ERR_INPUT / IP_ERR_IO with err->message naming the file and the
+ *  problem in one line. */
+ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
+                            ip_input_desc *out, ip_error *err);
+
+/* A sequential plane reader. Not thread-safe; one owner at a time. */
+typedef struct ip_input_reader ip_input_reader;
+
+/*! ip_input_open() : opens a reader positioned at plane z = 0. *out is owned by the caller
+ *  and released with ip_input_close(). @return IP_OK, IP_ERR_IO or IP_ERR_NOMEM. */
+ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_error *err);
+
+/*! ip_input_read_planes() : reads the next `count` z-planes into `dst`, which must hold
+ *  count * dims[0] * dims[1] samples; samples arrive in the host's byte order.
+ *  A gzip stream that ends early or is longer than the dims is reported as IP_ERR_INPUT;
+ *  float32 samples that are NaN or infinite are reported as IP_ERR_INPUT naming the sample.
+ *  @return IP_OK, IP_ERR_IO or IP_ERR_INPUT. */
+ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count,
+                               ip_error *err);
+
+/*! ip_input_close() : releases the reader (NULL is allowed). */
+void ip_input_close(ip_input_reader *reader);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

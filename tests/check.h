@@ -1,0 +1,67 @@
+/* A tiny test harness: CHECK records a failure and goes on; main() returns test_summary(). */
+#ifndef ISOPROP_TEST_CHECK_H
+#define ISOPROP_TEST_CHECK_H
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int test_checks_passed;
+static int test_checks_failed;
+
+#define CHECK(cond)                                                                  \
+    do {                                                                             \
+        if (cond) {                                                                  \
+            test_checks_passed++;                                                    \
+        } else {                                                                     \
+            test_checks_failed++;                                                    \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
+        }                                                                            \
+    } while (0)
+
+#define CHECK_MSG(cond, ...)                                                         \
+    do {                                                                             \
+        if (cond) {                                                                  \
+            test_checks_passed++;                                                    \
+        } else {                                                                     \
+            test_checks_failed++;                                                    \
+            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond); \
+            fprintf(stderr, __VA_ARGS__);                                            \
+            fputc('\n', stderr);                                                     \
+        }                                                                            \
+    } while (0)
+
+/* Fatal precondition: stops the test program at once. */
+#define REQUIRE(cond)                                                                  \
+    do {                                                                               \
+        if (!(cond)) {                                                                 \
+            fprintf(stderr, "%s:%d: REQUIRE failed: %s\n", __FILE__, __LINE__, #cond); \
+            exit(1);                                                                   \
+        }                                                                              \
+    } while (0)
+
+#define CHECK_CONTAINS(text, needle) \
+    CHECK_MSG(strstr((text), (needle)) != NULL, "\"%s\" lacks \"%s\"", (text), (needle))
+
+static inline int test_summary(const char *name)
+{
+    printf("%s: %d passed, %d failed\n", name, test_checks_passed, test_checks_failed);
+    return test_checks_failed == 0 ? 0 : 1;
+}
+
+/* A scratch folder for this test program, created on demand: $IP_TEST_TMP/<name>. */
+static inline const char *test_tmp_dir(const char *name)
+{
+    static char dir[4096];
+    const char *base = getenv("IP_TEST_TMP");
+    char cmd[4300];
+    snprintf(dir, sizeof dir, "%s/%s", base ? base : "/tmp/isoprop-test", name);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", dir, dir);
+    if (system(cmd) != 0) {
+        fprintf(stderr, "cannot create %s\n", dir);
+        exit(1);
+    }
+    return dir;
+}
+
+#endif
