@@ -54,7 +54,7 @@ static inline const char *test_tmp_dir(const char *name)
 {
     static char dir[4096];
     const char *base = getenv("IP_TEST_TMP");
-    char cmd[4300];
+    char cmd[2 * sizeof dir + 64];
     snprintf(dir, sizeof dir, "%s/%s", base ? base : "/tmp/isoprop-test", name);
     snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", dir, dir);
     if (system(cmd) != 0) {

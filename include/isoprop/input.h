@@ -37,7 +37,11 @@ typedef struct ip_input_desc {
 } ip_input_desc;
 
 /* Values given on the command line; each applies only where its has_ flag is set, and wins
- * over the file name and over any header. */
+ * over the file name and over any header. A header field that an override replaces is not
+ * read at all (has_dims covers NRRD dimension/sizes and MetaImage NDims/DimSize, has_spacing
+ * covers spacings/space directions and ElementSpacing/ElementSize), so an override can stand
+ * in for a header value this library cannot use. Where the data start, their encoding and
+ * their data file always come from the header. */
 typedef struct ip_input_overrides {
     int has_dims;
     uint32_t dims[3];
@@ -50,11 +54,16 @@ typedef struct ip_input_overrides {
 } ip_input_overrides;
 
 /*! ip_input_describe() : fills *out for the volume at `path`.
- *  `overrides` may be NULL. Checks everything that can be checked before reading samples:
- *  a dimension under 2, an unknown type, an unreadable or malformed header, a missing data
- *  file, and (raw encoding) a data size that does not equal dims x type size.
+ *  `overrides` may be NULL. The extension picks the format: .nrrd/.nhdr NRRD, .mhd/.mha
+ *  MetaImage, anything else headerless raw (little-endian, spacing 1,1,1, dims and type from
+ *  a base name NAME_XxYxZ_TYPE.raw or from the overrides). Checks everything that can be
+ *  checked before reading samples: a dimension under 2 (or at or above 2^31), an unknown
+ *  type, an unreadable or malformed header, a missing data file, a size past 2^63 bytes, and
+ *  (raw encoding) a data size that does not equal dims x type size; the length of gzip data
+ *  is checked by the reader. Reentrant; *out is untouched on failure.
  *  @return IP_OK, or IP_ERR_INPUT / IP_ERR_IO with err->message naming the file and the
- *  problem in one line. */
+ *  problem in one line; IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an
+ *  override type that is not an ip_type. */
 ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
                             ip_input_desc *out, ip_error *err);
 
@@ -62,14 +71,19 @@ ip_status ip_input_describe(const char *path, const ip_input_overrides *override
 typedef struct ip_input_reader ip_input_reader;
 
 /*! ip_input_open() : opens a reader positioned at plane z = 0. *out is owned by the caller
- *  and released with ip_input_close(). @return IP_OK, IP_ERR_IO or IP_ERR_NOMEM. */
+ *  and released with ip_input_close(). Gzip streams use a fixed 256 KiB input buffer and
+ *  inflate straight into the caller's planes. @return IP_OK, IP_ERR_IO or IP_ERR_NOMEM;
+ *  IP_ERR_ARGUMENT for NULL arguments or a desc without type and dims. */
 ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_error *err);
 
 /*! ip_input_read_planes() : reads the next `count` z-planes into `dst`, which must hold
  *  count * dims[0] * dims[1] samples; samples arrive in the host's byte order.
- *  A gzip stream that ends early or is longer than the dims is reported as IP_ERR_INPUT;
- *  float32 samples that are NaN or infinite are reported as IP_ERR_INPUT naming the sample.
- *  @return IP_OK, IP_ERR_IO or IP_ERR_INPUT. */
+ *  A gzip stream that ends early or is longer than the dims is reported as IP_ERR_INPUT (the
+ *  end is checked by the call that reads the last plane); float32 samples that are NaN or
+ *  infinite are reported as IP_ERR_INPUT naming the sample as (x,y,z). After any error the
+ *  reader only repeats it. count 0 reads nothing.
+ *  @return IP_OK, IP_ERR_IO or IP_ERR_INPUT; IP_ERR_ARGUMENT for reading past the last plane
+ *  or a NULL reader or dst. */
 ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count,
                                ip_error *err);
 

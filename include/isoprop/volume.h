@@ -25,6 +25,11 @@ typedef enum ip_type {
 
 #define IP_TYPE_COUNT 4
 
+/* Longest path the library stores, in bytes (including the terminating NUL). */
+#ifndef IP_PATH_MAX
+#define IP_PATH_MAX 4096
+#endif
+
 /*! ip_type_size() : bytes per sample of `type` (1, 2 or 4); 0 for an unknown type. */
 size_t ip_type_size(ip_type type);
 

@@ -1,0 +1,67 @@
+/* isoprop: bricking a raw volume into a brick file, streaming, with bounded memory.
+ *
+ * The input is read once, plane by plane. Each pyramid level keeps one slab of B+1 planes;
+ * when a slab is full its layer of bricks is summarised and compressed on all threads and
+ * appended to an unnamed spill file. At the end the payloads are copied into the output in
+ * Morton order, followed by the summary section and the header. The output appears under its
+ * name only when complete (see docs/format.md and src/atomic_file.h).
+ */
+#ifndef ISOPROP_BRICKER_H
+#define ISOPROP_BRICKER_H
+
+#include <stdint.h>
+
+#include "isoprop/input.h"
+#include "isoprop/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Returns nonzero to cancel the run (e.g. after Ctrl-C). Called from the calling thread. */
+typedef int (*ip_progress_fn)(void *user, uint64_t done_bytes, uint64_t total_bytes);
+
+typedef struct ip_brick_options {
+    uint32_t brick_edge;      /* B, cells per brick edge; default IP_DEFAULT_BRICK_EDGE */
+    uint32_t subblock_edge;   /* s, cells per sub-block edge; default IP_DEFAULT_SUBBLOCK_EDGE */
+    int lz4_level;            /* IP_LZ4_FAST (default) or an LZ4HC level 1..12 */
+    unsigned threads;         /* compression threads; 0 = every online core */
+    uint64_t memory_limit;    /* bytes of working memory allowed; 0 = no limit */
+    int force;                /* replace an existing output */
+    ip_progress_fn progress;  /* may be NULL */
+    void *progress_user;
+} ip_brick_options;
+
+typedef struct ip_brick_report {
+    uint64_t input_bytes;     /* dims x type size */
+    uint64_t file_bytes;      /* size of the brick file written */
+    uint64_t bricks;          /* all levels */
+    uint64_t bricks_constant, bricks_compressed, bricks_raw;
+    uint32_t levels;
+    unsigned threads;
+    double seconds;           /* wall time of the whole run */
+    uint64_t memory_planned;  /* working memory the run reserved for itself, bytes */
+    uint64_t peak_rss;        /* the process's peak resident set at the end (VmHWM), bytes */
+} ip_brick_report;
+
+/*! ip_brick_options_default() : fills `options` with the defaults above. */
+void ip_brick_options_default(ip_brick_options *options);
+
+/*! ip_brick_memory_needed() : working memory (bytes) a run with `options` needs for `input`.
+ *  @return IP_OK, or an error for options the layout rejects. */
+ip_status ip_brick_memory_needed(const ip_input_desc *input, const ip_brick_options *options,
+                                 uint64_t *bytes, ip_error *err);
+
+/*! ip_brick_volume() : bricks `input` into a new brick file at `out_path`. On any failure,
+ *  cancellation included, nothing is left at out_path (an existing file there is untouched).
+ *  `report` (may be NULL) is filled on success.
+ *  @return IP_OK, IP_ERR_EXISTS, IP_ERR_LIMIT (memory_limit too small: the message says how
+ *  much is needed), IP_ERR_INPUT, IP_ERR_IO, IP_ERR_NOMEM or IP_ERR_CANCELLED. */
+ip_status ip_brick_volume(const ip_input_desc *input, const char *out_path,
+                          const ip_brick_options *options, ip_brick_report *report,
+                          ip_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,58 @@
+/* isoprop: encoding and decoding of one brick's payload.
+ *
+ * A brick is stored as a constant (no payload), raw little-endian samples, or one LZ4 block of
+ * the samples after reversible filters (a predictor, then byte shuffle for wide types). The
+ * encoder tries no predictor, the delta predictor and the median edge predictor, and keeps the
+ * smallest result (the median predictor only when it wins clearly, as it decodes slower); a
+ * brick that does not shrink is stored raw. Every function here is pure: thread-safe on distinct buffers.
+ */
+#ifndef ISOPROP_CODEC_H
+#define ISOPROP_CODEC_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "isoprop/format.h"
+#include "isoprop/status.h"
+#include "isoprop/volume.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Compression effort: IP_LZ4_FAST is LZ4's default; 1..12 are LZ4HC levels. */
+#define IP_LZ4_FAST 0
+#define IP_LZ4_HC_DEFAULT 9
+
+/*! ip_brick_encode_bound() : the largest payload ip_brick_encode() can write for `count`
+ *  samples of `type`, in bytes. */
+size_t ip_brick_encode_bound(size_t count, ip_type type);
+
+/*! ip_brick_work_size() : bytes of scratch memory ip_brick_encode()/ip_brick_decode() need
+ *  for `count` samples of `type`. */
+size_t ip_brick_work_size(size_t count, ip_type type);
+
+/*! ip_brick_encode() : encodes a brick of extent[0] x extent[1] x extent[2] samples (host
+ *  byte order, x fastest) of `type`.
+ *  Writes the payload to `out` (ip_brick_encode_bound() bytes, caller-owned) and sets
+ *  entry->encoding, filters, stored_size and checksum (entry->offset is left to the caller).
+ *  `work` is caller-owned scratch of ip_brick_work_size() bytes. `level` is IP_LZ4_FAST or an
+ *  LZ4HC level. A constant brick writes nothing: its value is the brick's min in the summary.
+ *  @return IP_OK or IP_ERR_ARGUMENT. */
+ip_status ip_brick_encode(const void *samples, const uint32_t extent[3], ip_type type,
+                          int level, void *out, void *work, ip_brick_entry *entry);
+
+/*! ip_brick_decode() : decodes a payload described by `entry` into `dst` (the brick's
+ *  extent[0] x extent[1] x extent[2] samples of `type`, host byte order, caller-owned). A constant brick is filled with `constant_value`.
+ *  Does not check the checksum (see ip_format_checksum()). `work` is scratch of
+ *  ip_brick_work_size() bytes. Safe against malformed payloads: never reads or writes out of
+ *  bounds. @return IP_OK, or IP_ERR_CORRUPT when the payload does not decode to exactly
+ *  count samples. */
+ip_status ip_brick_decode(const ip_brick_entry *entry, const void *payload,
+                          const uint32_t extent[3], ip_type type, float constant_value, void *dst,
+                          void *work);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,79 @@
+/* isoprop: a brick file opened for reading.
+ *
+ * ip_store_open() maps the file read-only and validates its header, summary checksum and
+ * directory (ip_format_parse()); after that every summary (level table, brick and sub-block
+ * ranges, octree nodes) is available without touching any brick payload. Reading a brick
+ * verifies its checksum and decodes it. A store is immutable after opening: every function
+ * here is safe to call from many threads at once.
+ */
+#ifndef ISOPROP_STORE_H
+#define ISOPROP_STORE_H
+
+#include <stdint.h>
+
+#include "isoprop/format.h"
+#include "isoprop/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ip_store ip_store;
+
+/*! ip_store_open() : opens and validates the brick file at `path`. *out is owned by the
+ *  caller and released with ip_store_close().
+ *  @return IP_OK, IP_ERR_IO, IP_ERR_FORMAT, IP_ERR_CHECKSUM, IP_ERR_UNSUPPORTED or
+ *  IP_ERR_NOMEM, with err->message naming the file and the problem. */
+ip_status ip_store_open(const char *path, ip_store **out, ip_error *err);
+
+/*! ip_store_close() : unmaps and frees the store (NULL is allowed). No brick pointer or
+ *  summary pointer obtained from it may be used afterwards. */
+void ip_store_close(ip_store *store);
+
+/*! ip_store_layout() : the file's layout (dims, type, levels, offsets); owned by the store. */
+const ip_layout *ip_store_layout(const ip_store *store);
+
+/*! ip_store_path() : the path the store was opened with. */
+const char *ip_store_path(const ip_store *store);
+
+/*! ip_store_brick_entry() : directory entry of global brick `g` (< brick_count). */
+void ip_store_brick_entry(const ip_store *store, uint64_t g, ip_brick_entry *entry);
+
+/*! ip_store_brick_range() : min and max over the corners of every cell of brick `g`. */
+void ip_store_brick_range(const ip_store *store, uint64_t g, float range[2]);
+
+/*! ip_store_subblock_ranges() : the (B/s)^3 sub-block ranges of brick `g`, 2 floats each
+ *  (min, max; x fastest); an empty sub-block is [+inf, -inf]. Owned by the store. */
+const float *ip_store_subblock_ranges(const ip_store *store, uint64_t g);
+
+/*! ip_store_node_range() : range of octree node `node` at `depth` (1..octree_depth) of
+ *  `level`; depth 0 is the brick itself. Owned by the store. */
+const float *ip_store_node_range(const ip_store *store, uint32_t level, uint32_t depth,
+                                 const uint32_t node[3]);
+
+/*! ip_store_brick_samples() : number of samples of brick `g` (its extent's product). */
+uint64_t ip_store_brick_samples(const ip_store *store, uint64_t g);
+
+/*! ip_store_read_brick() : verifies the checksum of brick `g` and decodes it into `dst`
+ *  (ip_store_brick_samples() samples of the file's type, host byte order, x fastest; the
+ *  extent is ip_brick_extent()). `work` is scratch of ip_brick_work_size() bytes for the
+ *  largest brick. Both buffers are the caller's.
+ *  @return IP_OK, IP_ERR_CHECKSUM or IP_ERR_CORRUPT naming the brick, its level and
+ *  coordinates. */
+ip_status ip_store_read_brick(const ip_store *store, uint64_t g, void *dst, void *work,
+                              ip_error *err);
+
+/*! ip_store_verify_brick() : ip_store_read_brick(), then recomputes the brick's range and
+ *  sub-block ranges from the decoded samples and compares them with the summary section.
+ *  @return IP_OK, or IP_ERR_CHECKSUM / IP_ERR_CORRUPT naming the brick. */
+ip_status ip_store_verify_brick(const ip_store *store, uint64_t g, void *dst, void *work,
+                                ip_error *err);
+
+/*! ip_store_verify_octree() : recomputes every octree node from the brick ranges and compares.
+ *  @return IP_OK or IP_ERR_CORRUPT naming the first wrong node. */
+ip_status ip_store_verify_octree(const ip_store *store, ip_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

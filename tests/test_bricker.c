@@ -1,0 +1,347 @@
+/* Bricking round trips: every sample of every brick of every level, and every summary,
+ * recomputed from the raw input; plus determinism, cancellation and memory limits. */
+#include <dirent.h>
+#include <math.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "isoprop/bricker.h"
+#include "isoprop/codec.h"
+#include "isoprop/generate.h"
+#include "isoprop/input.h"
+#include "isoprop/store.h"
+
+/* A test volume: samples as floats, plus the raw bytes written to disk. */
+typedef struct volume {
+    uint32_t dims[3];
+    ip_type type;
+    float *values;
+} volume;
+
+static float sample_at(const volume *v, uint32_t x, uint32_t y, uint32_t z)
+{
+    return v->values[x + (size_t)v->dims[0] * (y + (size_t)v->dims[1] * z)];
+}
+
+/* Smooth structure, flat regions and noise, representable exactly in every type. */
+static float pattern(uint32_t x, uint32_t y, uint32_t z, ip_type type, int constant)
+{
+    if (constant)
+        return type == IP_INT16 ? -77.0f : 77.0f;
+    double r = sqrt((double)(x * x + y * y + z * z));
+    double v = 100.0 + 90.0 * sin(r * 0.31) * cos(z * 0.17);
+    if (x > 20 && y > 20)
+        v = 3.0; /* a flat region: constant bricks */
+    v += (double)((x * 7919u + y * 104729u + z * 1299709u) % 5u);
+    if (type == IP_INT16)
+        v -= 150.0;
+    if (type == IP_UINT16)
+        v *= 250.0;
+    if (type == IP_FLOAT32)
+        return (float)(v * 0.01);
+    return (float)floor(v);
+}
+
+static void write_value(void *dst, size_t i, ip_type type, float v)
+{
+    switch (type) {
+    case IP_UINT8: ((uint8_t *)dst)[i] = (uint8_t)v; break;
+    case IP_UINT16: ((uint16_t *)dst)[i] = (uint16_t)v; break;
+    case IP_INT16: ((int16_t *)dst)[i] = (int16_t)v; break;
+    case IP_FLOAT32: ((float *)dst)[i] = v; break;
+    }
+}
+
+static volume make_volume(const char *dir, const uint32_t dims[3], ip_type type, int constant,
+                          char *path, size_t path_size)
+{
+    volume v = {{dims[0], dims[1], dims[2]}, type, NULL};
+    size_t n = (size_t)dims[0] * dims[1] * dims[2];
+    v.values = malloc(n * sizeof(float));
+    unsigned char *raw = malloc(n * ip_type_size(type));
+    REQUIRE(v.values && raw);
+    for (uint32_t z = 0, i = 0; z < dims[2]; z++)
+        for (uint32_t y = 0; y < dims[1]; y++)
+            for (uint32_t x = 0; x < dims[0]; x++, i++) {
+                v.values[i] = pattern(x, y, z, type, constant);
+                write_value(raw, i, type, v.values[i]);
+            }
+    char name[256];
+    REQUIRE(ip_raw_file_name(name, sizeof name, constant ? "flat" : "vol", dims, type) == IP_OK);
+    snprintf(path, path_size, "%s/%s", dir, name);
+    FILE *f = fopen(path, "wb");
+    REQUIRE(f && fwrite(raw, ip_type_size(type), n, f) == n && fclose(f) == 0);
+    free(raw);
+    return v;
+}
+
+/* Independent min/max of the inclusive box [lo, hi] of a brick of `extent` floats. */
+static void box_range(const float *v, const uint32_t extent[3], const uint32_t lo[3],
+                      const uint32_t hi[3], float *min, float *max)
+{
+    *min = INFINITY;
+    *max = -INFINITY;
+    for (uint32_t z = lo[2]; z <= hi[2]; z++)
+        for (uint32_t y = lo[1]; y <= hi[1]; y++)
+            for (uint32_t x = lo[0]; x <= hi[0]; x++) {
+                float s = v[x + (size_t)extent[0] * (y + (size_t)extent[1] * z)];
+                *min = fminf(*min, s);
+                *max = fmaxf(*max, s);
+            }
+}
+
+/* Checks every brick of every level against the source, and every summary. */
+static void check_file(const char *ibv, const volume *v)
+{
+    ip_store *s;
+    ip_error err;
+    REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
+    const ip_layout *l = ip_store_layout(s);
+    size_t most = (size_t)(l->brick_edge + 1) * (l->brick_edge + 1) * (l->brick_edge + 1);
+    float *dst = malloc(most * 4);
+    void *work = malloc(ip_brick_work_size(most, l->type));
+    float *sub = malloc(sizeof(float) * 2 * ip_layout_subblocks_per_brick(l));
+    float *want = malloc(most * sizeof(float));
+    REQUIRE(dst && work && sub && want);
+    CHECK(l->type == v->type && l->dims[0] == v->dims[0] && l->dims[2] == v->dims[2]);
+    CHECK(l->levels[l->level_count - 1].brick_count == 1);
+    int sample_errors = 0, range_errors = 0;
+    for (uint64_t g = 0; g < l->brick_count; g++) {
+        uint32_t level, brick[3], origin[3], extent[3];
+        ip_brick_coords(l, g, &level, brick);
+        ip_brick_extent(l, level, brick, origin, extent);
+        CHECK(ip_store_read_brick(s, g, dst, work, &err) == IP_OK);
+        uint32_t per = l->brick_edge / l->subblock_edge;
+        for (uint32_t z = 0; z < extent[2]; z++)
+            for (uint32_t y = 0; y < extent[1]; y++)
+                for (uint32_t x = 0; x < extent[0]; x++) {
+                    size_t i = x + (size_t)extent[0] * (y + (size_t)extent[1] * z);
+                    want[i] = sample_at(v, ip_level_sample_index(v->dims[0], level, origin[0] + x),
+                                        ip_level_sample_index(v->dims[1], level, origin[1] + y),
+                                        ip_level_sample_index(v->dims[2], level, origin[2] + z));
+                    if (ip_sample_get(dst, l->type, i) != want[i])
+                        sample_errors++;
+                }
+        float lo, hi;
+        uint32_t all_lo[3] = {0, 0, 0}, all_hi[3] = {extent[0] - 1, extent[1] - 1, extent[2] - 1};
+        box_range(want, extent, all_lo, all_hi, &lo, &hi);
+        for (uint32_t cz = 0, j = 0; cz < per; cz++)
+            for (uint32_t cy = 0; cy < per; cy++)
+                for (uint32_t cx = 0; cx < per; cx++, j += 2) {
+                    uint32_t c[3] = {cx, cy, cz}, b0[3], b1[3];
+                    int empty = 0;
+                    for (int a = 0; a < 3; a++) {
+                        b0[a] = c[a] * l->subblock_edge;
+                        b1[a] = b0[a] + l->subblock_edge < extent[a] - 1 ? b0[a] + l->subblock_edge
+                                                                          : extent[a] - 1;
+                        empty |= b0[a] >= extent[a] - 1;
+                    }
+                    if (empty)
+                        sub[j] = INFINITY, sub[j + 1] = -INFINITY;
+                    else
+                        box_range(want, extent, b0, b1, &sub[j], &sub[j + 1]);
+                }
+        float range[2];
+        ip_store_brick_range(s, g, range);
+        if (range[0] != lo || range[1] != hi)
+            range_errors++;
+        const float *stored = ip_store_subblock_ranges(s, g);
+        for (uint32_t i = 0; i < 2 * per * per * per; i++)
+            if (stored[i] != sub[i])
+                range_errors++;
+        ip_brick_entry e;
+        ip_store_brick_entry(s, g, &e);
+        if ((e.encoding == IP_BRICK_CONSTANT) != (lo == hi))
+            range_errors++;
+    }
+    CHECK_MSG(sample_errors == 0, "%s: %d samples differ", ibv, sample_errors);
+    CHECK_MSG(range_errors == 0, "%s: %d summaries differ", ibv, range_errors);
+    CHECK(ip_store_verify_octree(s, &err) == IP_OK);
+    float level_lo = INFINITY, level_hi = -INFINITY;
+    for (size_t i = 0; i < (size_t)v->dims[0] * v->dims[1] * v->dims[2]; i++)
+        level_lo = fminf(level_lo, v->values[i]), level_hi = fmaxf(level_hi, v->values[i]);
+    CHECK(l->value_min == level_lo && l->value_max == level_hi);
+    free(dst);
+    free(work);
+    free(sub);
+    free(want);
+    ip_store_close(s);
+}
+
+static int brick_file(const char *raw, const char *ibv, uint32_t b, uint32_t s, unsigned threads,
+                      ip_brick_report *report)
+{
+    ip_input_desc desc;
+    ip_error err;
+    ip_brick_options o;
+    if (ip_input_describe(raw, NULL, &desc, &err) != IP_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return -1;
+    }
+    ip_brick_options_default(&o);
+    o.brick_edge = b;
+    o.subblock_edge = s;
+    o.threads = threads;
+    o.force = 1;
+    if (ip_brick_volume(&desc, ibv, &o, report, &err) != IP_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return -1;
+    }
+    return 0;
+}
+
+static void round_trip(const char *dir, uint32_t x, uint32_t y, uint32_t z, ip_type type,
+                       int constant, uint32_t b, uint32_t s)
+{
+    char raw[4096], ibv[4200];
+    uint32_t dims[3] = {x, y, z};
+    volume v = make_volume(dir, dims, type, constant, raw, sizeof raw);
+    snprintf(ibv, sizeof ibv, "%s.b%u.ibv", raw, b);
+    ip_brick_report r;
+    CHECK_MSG(brick_file(raw, ibv, b, s, 2, &r) == 0, "%s", raw);
+    check_file(ibv, &v);
+    if (constant)
+        CHECK(r.bricks_constant == r.bricks);
+    free(v.values);
+}
+
+static int read_file(const char *path, unsigned char **data, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return -1;
+    fseek(f, 0, SEEK_END);
+    *size = (size_t)ftell(f);
+    fseek(f, 0, SEEK_SET);
+    *data = malloc(*size ? *size : 1);
+    size_t got = fread(*data, 1, *size, f);
+    fclose(f);
+    return got == *size ? 0 : -1;
+}
+
+static void test_deterministic(const char *dir)
+{
+    char raw[4096], a[4200], b[4200];
+    uint32_t dims[3] = {70, 41, 37};
+    volume v = make_volume(dir, dims, IP_UINT16, 0, raw, sizeof raw);
+    snprintf(a, sizeof a, "%s/t1.ibv", dir);
+    snprintf(b, sizeof b, "%s/t3.ibv", dir);
+    REQUIRE(brick_file(raw, a, 8, 4, 1, NULL) == 0 && brick_file(raw, b, 8, 4, 3, NULL) == 0);
+    unsigned char *da, *db;
+    size_t sa, sb;
+    REQUIRE(read_file(a, &da, &sa) == 0 && read_file(b, &db, &sb) == 0);
+    CHECK(sa == sb && memcmp(da, db, sa) == 0);
+    free(da);
+    free(db);
+    free(v.values);
+}
+
+static int cancel_half(void *user, uint64_t done, uint64_t total)
+{
+    (void)user;
+    return done * 2 >= total;
+}
+
+static int count_entries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    for (struct dirent *e; d && (e = readdir(d));)
+        n += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+    if (d)
+        closedir(d);
+    return n;
+}
+
+static void test_cancel_and_limits(const char *dir)
+{
+    char sub[4200], raw[4096], out[4400];
+    snprintf(sub, sizeof sub, "%s/cancel", dir);
+    mkdir(sub, 0777);
+    uint32_t dims[3] = {50, 40, 90};
+    volume v = make_volume(sub, dims, IP_UINT8, 0, raw, sizeof raw);
+    snprintf(out, sizeof out, "%s/out.ibv", sub);
+    ip_input_desc desc;
+    ip_error err;
+    ip_brick_options o;
+    REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
+    ip_brick_options_default(&o);
+    o.brick_edge = 8;
+    o.progress = cancel_half;
+    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_ERR_CANCELLED);
+    CHECK(access(out, F_OK) != 0);
+    CHECK(count_entries(sub) == 1); /* only the input: no temporary or spill file left */
+
+    o.progress = NULL;
+    o.memory_limit = 1024;
+    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_ERR_LIMIT);
+    CHECK_CONTAINS(err.message, "MiB");
+    CHECK(access(out, F_OK) != 0);
+
+    o.memory_limit = 0;
+    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_OK);
+    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_ERR_EXISTS);
+    CHECK_CONTAINS(err.message, "out.ibv");
+    o.force = 1;
+    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_OK);
+    CHECK(count_entries(sub) == 2);
+    free(v.values);
+}
+
+static void test_shared_data(const char *dir)
+{
+    const char *data = getenv("IP_SKIP_SHARED_DATA") ? NULL : getenv("IP_SHARED_DATA");
+    DIR *d = data ? opendir(data) : NULL;
+    if (!d) {
+        printf("test_bricker: skipping the shared volumes: %s is absent\n",
+               data ? data : "IP_SHARED_DATA");
+        return;
+    }
+    for (struct dirent *e; (e = readdir(d));) {
+        size_t len = strlen(e->d_name);
+        if (len < 5 || strcmp(e->d_name + len - 4, ".raw") != 0)
+            continue;
+        char raw[4096], ibv[4400];
+        snprintf(raw, sizeof raw, "%s/%s", data, e->d_name);
+        snprintf(ibv, sizeof ibv, "%s/%s.ibv", dir, e->d_name);
+        ip_input_desc desc;
+        ip_error err;
+        REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
+        volume v = {{desc.dims[0], desc.dims[1], desc.dims[2]}, desc.type, NULL};
+        size_t n = (size_t)v.dims[0] * v.dims[1] * v.dims[2];
+        unsigned char *bytes = malloc(n * ip_type_size(v.type));
+        v.values = malloc(n * sizeof(float));
+        ip_input_reader *reader;
+        REQUIRE(bytes && v.values && ip_input_open(&desc, &reader, &err) == IP_OK);
+        REQUIRE(ip_input_read_planes(reader, bytes, v.dims[2], &err) == IP_OK);
+        ip_input_close(reader);
+        for (size_t i = 0; i < n; i++)
+            v.values[i] = ip_sample_get(bytes, v.type, i);
+        free(bytes);
+        CHECK_MSG(brick_file(raw, ibv, IP_DEFAULT_BRICK_EDGE, IP_DEFAULT_SUBBLOCK_EDGE, 2, NULL) == 0,
+                  "%s", raw);
+        check_file(ibv, &v);
+        unlink(ibv);
+        free(v.values);
+        printf("test_bricker: round trip of %s\n", e->d_name);
+    }
+    closedir(d);
+}
+
+int main(void)
+{
+    const char *dir = test_tmp_dir("test_bricker");
+    for (int t = 0; t < IP_TYPE_COUNT; t++) {
+        round_trip(dir, 2, 2, 2, (ip_type)t, 0, 32, 8);        /* tiny */
+        round_trip(dir, 103, 94, 161, (ip_type)t, 0, 32, 8);   /* odd dims */
+        round_trip(dir, 33, 17, 9, (ip_type)t, 0, 8, 2);       /* cells a multiple of B */
+        round_trip(dir, 32, 16, 8, (ip_type)t, 0, 8, 2);       /* samples a multiple of B */
+        round_trip(dir, 40, 30, 20, (ip_type)t, 1, 8, 4);      /* constant */
+        round_trip(dir, 37, 2, 29, (ip_type)t, 0, 4, 4);       /* flat axis, many levels */
+    }
+    test_deterministic(dir);
+    test_cancel_and_limits(dir);
+    test_shared_data(dir);
+    return test_summary("test_bricker");
+}

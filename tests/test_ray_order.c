@@ -1,0 +1,331 @@
+/* Progressive ray order: every pixel exactly once, centre first, evenly spread prefixes.
+ * "test_ray_order --bench W H" times a full walk of a W x H image. */
+#include <math.h>
+#include <stdint.h>
+
+#include "check.h"
+#include "internal.h"
+#include "isoprop/ray_order.h"
+
+/* Walks the whole order; checks bounds, repeats and the end. Returns the number of pixels. */
+static uint64_t walk_once(uint32_t w, uint32_t h, uint64_t *hash)
+{
+    ip_ray_order order;
+    REQUIRE(ip_ray_order_init(&order, w, h) == IP_OK);
+    unsigned char *seen = calloc((size_t)w * h, 1);
+    REQUIRE(seen);
+    uint64_t n = 0, repeats = 0, outside = 0;
+    uint32_t x, y, last_level = 0, level_went_back = 0;
+    *hash = 1469598103934665603ull;
+    while (ip_ray_order_next(&order, &x, &y)) {
+        if (x >= w || y >= h) {
+            outside++;
+            continue;
+        }
+        repeats += seen[(size_t)y * w + x]++ != 0;
+        if (n == 0)
+            CHECK_MSG(x == w / 2 && y == h / 2, "%ux%u: first ray (%u, %u)", w, h, x, y);
+        level_went_back += ip_ray_order_level(&order) < last_level;
+        last_level = ip_ray_order_level(&order);
+        *hash = (*hash ^ ((uint64_t)x << 32 | y)) * 1099511628211ull;
+        n++;
+    }
+    CHECK_MSG(outside == 0 && repeats == 0, "%ux%u: %llu outside, %llu repeats", w, h,
+              (unsigned long long)outside, (unsigned long long)repeats);
+    CHECK_MSG(n == (uint64_t)w * h, "%ux%u: %llu pixels", w, h, (unsigned long long)n);
+    CHECK(ip_ray_order_count(&order) == (uint64_t)w * h && ip_ray_order_emitted(&order) == n);
+    CHECK(level_went_back == 0);
+    x = y = 12345;
+    CHECK(ip_ray_order_next(&order, &x, &y) == 0 && x == 12345 && y == 12345);
+    free(seen);
+    return n;
+}
+
+static void test_every_pixel_once(void)
+{
+    static const uint32_t sizes[][2] = {
+        {1, 1},  {1, 7},   {7, 1},   {2, 2},   {3, 5},    {5, 3},     {16, 16},    {17, 13},
+        {33, 2}, {1, 1000}, {1000, 1}, {640, 480}, {1600, 1200}, {1920, 1080}, {255, 257},
+    };
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
+        uint64_t first, second;
+        walk_once(sizes[i][0], sizes[i][1], &first);
+        walk_once(sizes[i][0], sizes[i][1], &second);
+        CHECK_MSG(first == second, "%ux%u: not deterministic", sizes[i][0], sizes[i][1]);
+    }
+}
+
+static void test_first_rays(void)
+{
+    /* 16 x 16: the centre, then the 4 quadrant centres in Bayer order, then the 16 sub-quadrant
+     * centres starting with the lattice of every other one. */
+    static const uint32_t expected[][2] = {{8, 8}, {4, 4}, {12, 12}, {12, 4}, {4, 12},
+                                           {2, 2}, {10, 10}, {10, 2}, {2, 10}, {6, 6}};
+    ip_ray_order order;
+    REQUIRE(ip_ray_order_init(&order, 16, 16) == IP_OK);
+    for (size_t i = 0; i < sizeof expected / sizeof expected[0]; i++) {
+        uint32_t x = 0, y = 0;
+        CHECK(ip_ray_order_next(&order, &x, &y) == 1);
+        CHECK_MSG(x == expected[i][0] && y == expected[i][1], "ray %zu is (%u, %u)", i, x, y);
+        CHECK(ip_ray_order_level(&order) == (i == 0 ? 0u : i < 5 ? 1u : 2u));
+    }
+    /* Reset replays the same order. */
+    ip_ray_order_reset(&order);
+    CHECK(ip_ray_order_emitted(&order) == 0);
+    uint32_t x = 0, y = 0;
+    CHECK(ip_ray_order_next(&order, &x, &y) == 1 && x == 8 && y == 8);
+    /* A single row: the centre, then the quarter points. */
+    REQUIRE(ip_ray_order_init(&order, 8, 1) == IP_OK);
+    static const uint32_t row[8] = {4, 2, 6, 1, 5, 3, 7, 0};
+    for (int i = 0; i < 8; i++) {
+        CHECK(ip_ray_order_next(&order, &x, &y) == 1 && y == 0);
+        CHECK_MSG(x == row[i], "8x1 ray %d is %u", i, x);
+    }
+}
+
+static void test_bad_arguments(void)
+{
+    ip_ray_order order;
+    CHECK(ip_ray_order_init(NULL, 4, 4) == IP_ERR_ARGUMENT);
+    CHECK(ip_ray_order_init(&order, 0, 4) == IP_ERR_ARGUMENT);
+    CHECK(ip_ray_order_init(&order, 4, 0) == IP_ERR_ARGUMENT);
+    CHECK(ip_ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE + 1, 4) == IP_ERR_ARGUMENT);
+    CHECK(ip_ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE, 1) == IP_OK);
+    uint32_t x, y;
+    CHECK(ip_ray_order_next(&order, &x, &y) == 1 && x == IP_RAY_ORDER_MAX_SIDE / 2 && y == 0);
+    CHECK(ip_ray_order_count(&order) == IP_RAY_ORDER_MAX_SIDE);
+}
+
+/* Exact squared Euclidean distance transform along one line: the lower envelope of the
+ * parabolas (q - p)^2 + f[p]; v holds the envelope's parabolas, z the boundaries between them. */
+static void distance_1d(const double *f, double *d, int n, int *v, double *z)
+{
+    int k = 0;
+    v[0] = 0;
+    z[0] = -HUGE_VAL;
+    z[1] = HUGE_VAL;
+    for (int q = 1; q < n; q++) {
+        double s;
+        for (;;) {
+            int p = v[k];
+            s = ((f[q] + (double)q * q) - (f[p] + (double)p * p)) / (2.0 * (q - p));
+            if (s > z[k])
+                break;
+            k--;
+        }
+        k++;
+        v[k] = q;
+        z[k] = s;
+        z[k + 1] = HUGE_VAL;
+    }
+    k = 0;
+    for (int q = 0; q < n; q++) {
+        while (z[k + 1] < q)
+            k++;
+        double dq = q - v[k];
+        d[q] = dq * dq + f[v[k]];
+    }
+}
+
+/* Largest distance in pixels from any pixel to a cast one (cast[i] != 0). */
+static double max_distance(const unsigned char *cast, uint32_t w, uint32_t h)
+{
+    uint32_t n = w > h ? w : h;
+    double *grid = malloc((size_t)w * h * sizeof *grid);
+    double *f = malloc(n * sizeof *f), *d = malloc(n * sizeof *d), *z = malloc((n + 1) * sizeof *z);
+    int *v = malloc(n * sizeof *v);
+    REQUIRE(grid && f && d && z && v);
+    /* Beyond any real squared distance, yet small enough that sums stay exact. */
+    const double far = 4.0 * ((double)w * w + (double)h * h) + 1.0;
+    for (uint32_t x = 0; x < w; x++) {
+        for (uint32_t y = 0; y < h; y++)
+            f[y] = cast[(size_t)y * w + x] ? 0.0 : far;
+        distance_1d(f, d, (int)h, v, z);
+        for (uint32_t y = 0; y < h; y++)
+            grid[(size_t)y * w + x] = d[y];
+    }
+    double worst = 0.0;
+    for (uint32_t y = 0; y < h; y++) {
+        distance_1d(&grid[(size_t)y * w], d, (int)w, v, z);
+        for (uint32_t x = 0; x < w; x++)
+            if (d[x] > worst)
+                worst = d[x];
+    }
+    free(grid);
+    free(f);
+    free(d);
+    free(z);
+    free(v);
+    return sqrt(worst);
+}
+
+/* Largest chessboard distance max(|dx|, |dy|) from any pixel to a cast one: two raster passes
+ * over the 8-neighbourhood, which are exact for this metric. */
+static uint32_t max_chessboard_distance(const unsigned char *cast, uint32_t w, uint32_t h)
+{
+    uint32_t *d = malloc((size_t)w * h * sizeof *d);
+    REQUIRE(d);
+    const uint32_t far = w + h;
+    for (size_t i = 0; i < (size_t)w * h; i++)
+        d[i] = cast[i] ? 0 : far;
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t r = 0; r < h; r++) {
+            uint32_t y = pass ? h - 1 - r : r;
+            int dy = pass ? 1 : -1;
+            for (uint32_t c = 0; c < w; c++) {
+                uint32_t x = pass ? w - 1 - c : c;
+                uint32_t best = d[(size_t)y * w + x];
+                /* The neighbours already visited in this pass. */
+                static const int dx_of[4] = {-1, 0, 1, -1};
+                for (int k = 0; k < 4; k++) {
+                    int nx = (int)x + (pass ? -dx_of[k] : dx_of[k]);
+                    int ny = k == 3 ? (int)y : (int)y + dy;
+                    if (nx < 0 || ny < 0 || nx >= (int)w || ny >= (int)h)
+                        continue;
+                    uint32_t via = d[(size_t)ny * w + (uint32_t)nx] + 1;
+                    if (via < best)
+                        best = via;
+                }
+                d[(size_t)y * w + x] = best;
+            }
+        }
+    }
+    uint32_t worst = 0;
+    for (size_t i = 0; i < (size_t)w * h; i++)
+        if (d[i] > worst)
+            worst = d[i];
+    free(d);
+    return worst;
+}
+
+/* Brute force, to check the distance transforms themselves on small images. */
+static double max_distance_brute(const unsigned char *cast, uint32_t w, uint32_t h,
+                                 int chessboard)
+{
+    double worst = 0.0;
+    for (uint32_t py = 0; py < h; py++)
+        for (uint32_t px = 0; px < w; px++) {
+            double best = HUGE_VAL;
+            for (uint32_t y = 0; y < h; y++)
+                for (uint32_t x = 0; x < w; x++)
+                    if (cast[(size_t)y * w + x]) {
+                        double dx = fabs((double)x - px), dy = fabs((double)y - py);
+                        double dist = chessboard ? (dx > dy ? dx : dy) : sqrt(dx * dx + dy * dy);
+                        if (dist < best)
+                            best = dist;
+                    }
+            if (best > worst)
+                worst = best;
+        }
+    return worst;
+}
+
+/* ceil(side / 2^k): the largest cell of level k along a side, at least 1. */
+static uint32_t cell_size(uint32_t side, uint32_t k)
+{
+    if (k >= 32)
+        return 1;
+    uint32_t size = (uint32_t)(((uint64_t)side + (1ull << k) - 1) >> k);
+    return size < 1 ? 1 : size;
+}
+
+/* The asserted bounds, with S = max(W, H):
+ *  - after the first 4^k rays, the chessboard distance max(|dx|, |dy|) from every pixel to a cast
+ *    ray is <= ceil(S / 2^k), which is W / 2^k for square power-of-two images, and the
+ *    Euclidean distance is <= sqrt(2) times that. (Levels 0..k-1 are complete by then; the
+ *    Euclidean W / 2^k itself is out of reach for any order that starts with the centre and the
+ *    quadrant centres: after 4 rays one quadrant is still empty and its far corner is
+ *    sqrt((W/2)^2 + (W/2 - 1)^2) from the centre.)
+ *  - once level k is complete, each pixel is within floor(c / 2) of its cell's centre along each
+ *    axis, c being the largest level-k cell along that axis: the Euclidean distance is at most
+ *    sqrt(floor(cw / 2)^2 + floor(ch / 2)^2). */
+static void test_spread(uint32_t w, uint32_t h)
+{
+    ip_ray_order order;
+    REQUIRE(ip_ray_order_init(&order, w, h) == IP_OK);
+    unsigned char *cast = calloc((size_t)w * h, 1);
+    REQUIRE(cast);
+    uint32_t side = w > h ? w : h;
+    uint64_t emitted = 0, next_checkpoint = 1;
+    uint32_t x, y, k = 0, level = 0;
+    printf("%ux%u, after 4^k rays (chessboard/euclidean):", w, h);
+    int more = ip_ray_order_next(&order, &x, &y);
+    while (more) {
+        cast[(size_t)y * w + x] = 1;
+        emitted++;
+        if (emitted == next_checkpoint) {
+            uint32_t chess = max_chessboard_distance(cast, w, h);
+            double euclid = max_distance(cast, w, h), bound = cell_size(side, k);
+            printf(" %u/%.2f", chess, euclid);
+            CHECK_MSG(chess <= bound, "%ux%u after 4^%u rays: chessboard %u > %.0f", w, h, k,
+                      chess, bound);
+            CHECK_MSG(euclid <= sqrt(2.0) * bound + 1e-9, "%ux%u after 4^%u rays: %.3f > %.3f",
+                      w, h, k, euclid, sqrt(2.0) * bound);
+            next_checkpoint *= 4;
+            k++;
+        }
+        more = ip_ray_order_next(&order, &x, &y);
+        if (!more || ip_ray_order_level(&order) != level) {
+            uint32_t cw = cell_size(w, level), ch = cell_size(h, level);
+            double bound = sqrt((double)(cw / 2) * (cw / 2) + (double)(ch / 2) * (ch / 2));
+            double worst = max_distance(cast, w, h);
+            CHECK_MSG(worst <= bound + 1e-9, "%ux%u level %u: %.3f > %.3f", w, h, level, worst,
+                      bound);
+            level = ip_ray_order_level(&order);
+        }
+    }
+    printf("\n");
+    free(cast);
+}
+
+static void test_distance_transform(void)
+{
+    uint64_t state = 3;
+    for (int trial = 0; trial < 20; trial++) {
+        uint32_t w = 5 + (uint32_t)trial, h = 23 - (uint32_t)trial / 2;
+        unsigned char *cast = calloc((size_t)w * h, 1);
+        REQUIRE(cast);
+        for (int i = 0; i < 1 + trial; i++) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            cast[(state >> 33) % ((uint64_t)w * h)] = 1;
+        }
+        CHECK(fabs(max_distance(cast, w, h) - max_distance_brute(cast, w, h, 0)) < 1e-9);
+        CHECK(max_chessboard_distance(cast, w, h) == (uint32_t)max_distance_brute(cast, w, h, 1));
+        free(cast);
+    }
+}
+
+static int bench(uint32_t w, uint32_t h)
+{
+    ip_ray_order order;
+    if (ip_ray_order_init(&order, w, h) != IP_OK)
+        return 1;
+    uint64_t sum = 0, n = 0;
+    uint32_t x, y;
+    double start = ip_now_seconds();
+    while (ip_ray_order_next(&order, &x, &y)) {
+        sum += x ^ y;
+        n++;
+    }
+    double seconds = ip_now_seconds() - start;
+    printf("%ux%u: %llu pixels in %.4f s: %.1f M pixels/s (checksum %llu)\n", w, h,
+           (unsigned long long)n, seconds, n / seconds / 1e6, (unsigned long long)sum);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 3 && strcmp(argv[1], "--bench") == 0)
+        return bench((uint32_t)atoi(argv[2]), (uint32_t)atoi(argv[3]));
+    test_every_pixel_once();
+    test_first_rays();
+    test_bad_arguments();
+    test_distance_transform();
+    test_spread(64, 64);
+    test_spread(256, 256);
+    test_spread(256, 128);
+    test_spread(17, 13);
+    test_spread(640, 480);
+    test_spread(1, 100);
+    return test_summary("test_ray_order");
+}

@@ -1,0 +1,118 @@
+# isobrick and isoinfo end to end: bad input, atomic output, verification, JSON keys.
+. "$(dirname "$0")/lib.sh"
+
+# A small real input: 40x30x20 uint16 from a generator, named by convention.
+"$bin/isogen" sphere --dims 40x30x20 --type uint16 -o "$work/" --quiet
+raw=sphere_40x30x20_uint16.raw
+check "isogen wrote $raw" test -s "$raw"
+
+# --- good runs ---
+run_capture "$bin/isobrick" "$raw" -o good.ibv --brick-size 8 --threads 2
+check "isobrick succeeds" test "$rc" = 0
+check "summary names the output" grep -q "wrote good.ibv" "$work/.out"
+check "summary has the ratio" grep -q "ratio" "$work/.out"
+check "summary has the peak RSS" grep -q "peak RSS" "$work/.out"
+run_capture "$bin/isoinfo" --verify good.ibv
+check "verify passes on a good file" test "$rc" = 0
+run_capture "$bin/isoinfo" --json good.ibv
+for key in dims type spacing brick_size levels bricks bricks_constant bytes_raw bytes_file \
+           compression_ratio value_min value_max; do
+    check "isoinfo --json has \"$key\"" grep -q "\"$key\":" "$work/.out"
+done
+check "json dims" grep -q '"dims": \[40, 30, 20\]' "$work/.out"
+check "json type" grep -q '"type": "uint16"' "$work/.out"
+check "json brick size" grep -q '"brick_size": 8' "$work/.out"
+check "json raw bytes" grep -q '"bytes_raw": 48000' "$work/.out"
+
+# default output folder bricks/
+run_capture "$bin/isobrick" "$raw" --quiet
+check "default output bricks/NAME.ibv" test -s bricks/sphere_40x30x20_uint16.ibv
+check "quiet prints nothing" test -z "$out$err"
+
+# --- bad input: one line naming the file and the problem, non-zero exit, no output ---
+head -c 47999 "$raw" >short_40x30x20_uint16.raw
+expect_error 1 "short_40x30x20_uint16.raw" "$bin/isobrick" short_40x30x20_uint16.raw -o short.ibv
+check "size error states the sizes" sh -c 'printf "%s" "$0" | grep -q 47999' "$err"
+check "no output after a size error" test ! -e short.ibv
+cp "$raw" weird_40x30x20_uint64.raw
+expect_error 1 "uint64" "$bin/isobrick" weird_40x30x20_uint64.raw -o weird.ibv
+check "no output after an unknown type" test ! -e weird.ibv
+head -c 2400 "$raw" >flat_40x30x1_uint16.raw
+expect_error 1 "flat_40x30x1_uint16.raw" "$bin/isobrick" flat_40x30x1_uint16.raw -o flat.ibv
+check "no output after a dimension under 2" test ! -e flat.ibv
+printf 'NRRD0004\ntype: ushort\ndimension: 3\nsizes: 40 30\n\n' >bad.nrrd
+expect_error 1 "bad.nrrd" "$bin/isobrick" bad.nrrd -o badnrrd.ibv
+check "no output after an unreadable header" test ! -e badnrrd.ibv
+expect_error 1 "nothere.raw" "$bin/isobrick" nothere.raw -o nothere.ibv
+expect_error 2 "--dims" "$bin/isobrick" "$raw" --dims 40x30 -o x.ibv
+expect_error 2 "unknown" "$bin/isobrick" "$raw" --frobnicate
+expect_error 1 "brick edge" "$bin/isobrick" "$raw" --brick-size 12 -o b12.ibv
+check "no output after a bad brick size" test ! -e b12.ibv
+
+# --- existing output: kept without --force, replaced with it ---
+cp good.ibv keep.ibv
+expect_error 1 "exists" "$bin/isobrick" "$raw" -o keep.ibv --quiet
+check "existing output untouched" cmp -s good.ibv keep.ibv
+run_capture "$bin/isobrick" "$raw" -o keep.ibv --quiet --force --brick-size 4 --subblock-size 4
+check "--force replaces" test "$rc" = 0
+check "--force wrote the new file" sh -c '! cmp -s good.ibv keep.ibv'
+
+# --- memory cap ---
+expect_error 1 "MiB" "$bin/isobrick" "$raw" -o capped.ibv --mem-mb 1 --brick-size 256
+check "no output when the memory cap is too small" test ! -e capped.ibv
+
+# --- a failed write (file size limit, as when the disk fills): nothing is left ---
+"$bin/isogen" gyroid --dims 96x96x96 --type uint16 -o "$work/" --quiet
+run_capture sh -c "trap '' XFSZ; ulimit -f 64; exec \"$bin/isobrick\" gyroid_96x96x96_uint16.raw -o full.ibv"
+check "a write failure is an error" test "$rc" != 0
+check "a write failure names the output" sh -c 'printf "%s" "$0" | grep -q full.ibv' "$err"
+check "a write failure leaves no output" test ! -e full.ibv
+check "a write failure leaves no temporary" sh -c '! ls -a | grep -q "\.tmp"'
+
+# --- killed mid-run: no output, nothing half-written ---
+"$bin/isogen" gyroid --dims 400x400x400 --type uint16 -o "$work/" --quiet
+big=gyroid_400x400x400_uint16.raw
+timeout -s KILL 0.3 "$bin/isobrick" "$big" -o killed.ibv --quiet --threads 1
+rc=$?
+if [ "$rc" = 137 ]; then
+    check "a killed run leaves no output" test ! -e killed.ibv
+else
+    check "a run that finished is whole" "$bin/isoinfo" --verify killed.ibv
+fi
+timeout -s INT 0.3 "$bin/isobrick" "$big" -o interrupted.ibv --quiet --threads 1 2>"$work/.err"
+rc=$?
+if [ "$rc" != 0 ]; then
+    check "an interrupted run leaves no output" test ! -e interrupted.ibv
+    check "an interrupted run says so" grep -q "cancelled" "$work/.err"
+else
+    check "a run that finished is whole" "$bin/isoinfo" --verify interrupted.ibv
+fi
+check "no temporary files remain" sh -c '! ls -a | grep -q -e "\.tmp" -e spill'
+rm -f "$big"
+
+# --- damaged brick files ---
+size=$(stat -c %s good.ibv)
+head -c $((size - 100)) good.ibv >truncated.ibv
+expect_error 1 "truncated.ibv" "$bin/isoinfo" --verify truncated.ibv
+check "truncation is named" grep -q "truncated" "$work/.err"
+head -c 100 good.ibv >stub.ibv
+expect_error 1 "too short" "$bin/isoinfo" stub.ibv
+# flip one bit inside the first brick payload (just after the 256-byte header)
+cp good.ibv flipped.ibv
+printf '\001' | dd of=flipped.ibv bs=1 seek=300 conv=notrunc 2>/dev/null
+byte=$(od -An -tu1 -j300 -N1 good.ibv | tr -d ' ')
+newbyte=$(( byte ^ 1 ))
+printf "$(printf '\\%03o' "$newbyte")" | dd of=flipped.ibv bs=1 seek=300 conv=notrunc 2>/dev/null
+check "the flipped file differs by one byte" test "$(cmp -l good.ibv flipped.ibv | wc -l)" = 1
+run_capture "$bin/isoinfo" flipped.ibv
+check "a payload flip passes the open checks" test "$rc" = 0
+expect_error 1 "brick" "$bin/isoinfo" --verify flipped.ibv
+check "verify names the checksum" grep -q "checksum mismatch" "$work/.err"
+# a flip in the summary section fails on open
+cp good.ibv summary.ibv
+printf 'Z' | dd of=summary.ibv bs=1 seek=$((size - 10)) conv=notrunc 2>/dev/null
+expect_error 1 "summary section checksum" "$bin/isoinfo" summary.ibv
+cp good.ibv header.ibv
+printf 'Z' | dd of=header.ibv bs=1 seek=20 conv=notrunc 2>/dev/null
+expect_error 1 "header checksum" "$bin/isoinfo" header.ibv
+finish

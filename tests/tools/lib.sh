@@ -1,0 +1,50 @@
+# Helpers for the end-to-end tests of the programs. Source it; call finish at the end.
+# IP_BIN: folder with the programs; IP_TEST_TMP: scratch space; IP_SHARED_DATA: real volumes.
+set -u
+passed=0
+failed=0
+test_name=$(basename "$0" .sh)
+bin=${IP_BIN:?IP_BIN must name the build folder}
+work=${IP_TEST_TMP:-/tmp/isoprop-test}/tool_$test_name
+rm -rf "$work"
+mkdir -p "$work"
+cd "$work" || exit 1
+
+ok() { passed=$((passed + 1)); }
+bad() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
+
+# check DESCRIPTION COMMAND...: passes when COMMAND succeeds.
+check() {
+    desc=$1
+    shift
+    if "$@"; then ok; else bad "$desc"; fi
+}
+
+# run_capture COMMAND...: runs it, keeps stdout in $out, stderr in $err, status in $rc.
+run_capture() {
+    "$@" >"$work/.out" 2>"$work/.err"
+    rc=$?
+    out=$(cat "$work/.out")
+    err=$(cat "$work/.err")
+}
+
+# expect_error CODE TEXT COMMAND...: the command exits with CODE and prints one line on stderr
+# that contains TEXT.
+expect_error() {
+    code=$1
+    text=$2
+    shift 2
+    run_capture "$@"
+    lines=$(printf '%s\n' "$err" | grep -c .)
+    if [ "$rc" = "$code" ] && [ "$lines" = 1 ] && printf '%s' "$err" | grep -qF -- "$text"; then
+        ok
+    else
+        bad "expected exit $code and one line with '$text' from: $* (got $rc: $err)"
+    fi
+}
+
+finish() {
+    echo "$test_name: $passed passed, $failed failed"
+    [ "$failed" = 0 ]
+    exit $?
+}

@@ -1,0 +1,173 @@
+/* isoinfo: describe a brick file (.ibv), as text or JSON, and verify it. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "isoprop/codec.h"
+#include "isoprop/store.h"
+#include "tool_common.h"
+
+static const char usage[] =
+    "usage: isoinfo FILE.ibv [--json] [--verify]\n"
+    "Prints the header, levels, brick counts, compression ratio, value range and summary size.\n"
+    "  --json     print the same as one JSON object\n"
+    "  --verify   check every checksum, decode every brick and compare it with its summaries;\n"
+    "             exits 1 and names the first bad brick\n";
+
+typedef struct file_facts {
+    uint64_t constant, compressed, raw, payload_bytes, raw_bytes;
+    uint64_t level_payload[IP_MAX_LEVELS];
+} file_facts;
+
+static void gather_facts(const ip_store *s, file_facts *f)
+{
+    const ip_layout *l = ip_store_layout(s);
+    memset(f, 0, sizeof *f);
+    for (uint64_t g = 0; g < l->brick_count; g++) {
+        ip_brick_entry e;
+        ip_store_brick_entry(s, g, &e);
+        f->constant += e.encoding == IP_BRICK_CONSTANT;
+        f->raw += e.encoding == IP_BRICK_RAW;
+        f->compressed += e.encoding == IP_BRICK_LZ4;
+        f->payload_bytes += e.stored_size;
+    }
+    for (uint32_t k = 0; k < l->level_count; k++)
+        for (uint64_t i = 0; i < l->levels[k].brick_count; i++) {
+            ip_brick_entry e;
+            ip_store_brick_entry(s, l->levels[k].first_brick + i, &e);
+            f->level_payload[k] += e.stored_size;
+        }
+    f->raw_bytes = (uint64_t)l->dims[0] * l->dims[1] * l->dims[2] * ip_type_size(l->type);
+}
+
+static void print_text(const ip_store *s, const file_facts *f)
+{
+    const ip_layout *l = ip_store_layout(s);
+    char a[32], b[32], c[32];
+    printf("%s\n", ip_store_path(s));
+    printf("  format        version %u\n", IP_FORMAT_VERSION);
+    printf("  dims          %u x %u x %u samples, %s\n", l->dims[0], l->dims[1], l->dims[2],
+           ip_type_name(l->type));
+    printf("  spacing       %g, %g, %g\n", l->spacing[0], l->spacing[1], l->spacing[2]);
+    printf("  value range   %g .. %g\n", (double)l->value_min, (double)l->value_max);
+    printf("  bricks        %u^3 cells, sub-blocks %u^3 cells\n", l->brick_edge, l->subblock_edge);
+    printf("  brick count   %llu: %llu constant, %llu compressed, %llu raw\n",
+           (unsigned long long)l->brick_count, (unsigned long long)f->constant,
+           (unsigned long long)f->compressed, (unsigned long long)f->raw);
+    printf("  size          %s raw, %s file, ratio %.2fx\n",
+           tool_format_bytes(a, sizeof a, (double)f->raw_bytes),
+           tool_format_bytes(b, sizeof b, (double)l->file_size),
+           (double)f->raw_bytes / (double)l->file_size);
+    printf("  summary       %s (%llu bytes at offset %llu)\n",
+           tool_format_bytes(c, sizeof c, (double)l->summary_size),
+           (unsigned long long)l->summary_size, (unsigned long long)l->summary_offset);
+    printf("  levels        %u\n", l->level_count);
+    for (uint32_t k = 0; k < l->level_count; k++) {
+        const ip_level_layout *lv = &l->levels[k];
+        char p[32];
+        printf("    %2u: %u x %u x %u samples, %u x %u x %u bricks, %s payload, values %g .. %g\n",
+               k, lv->dims[0], lv->dims[1], lv->dims[2], lv->bricks[0], lv->bricks[1],
+               lv->bricks[2], tool_format_bytes(p, sizeof p, (double)f->level_payload[k]),
+               (double)lv->value_min, (double)lv->value_max);
+    }
+}
+
+static void print_json(const ip_store *s, const file_facts *f)
+{
+    const ip_layout *l = ip_store_layout(s);
+    printf("{\"file\": ");
+    tool_json_string(stdout, ip_store_path(s));
+    printf(", \"format_version\": %u", IP_FORMAT_VERSION);
+    printf(", \"dims\": [%u, %u, %u]", l->dims[0], l->dims[1], l->dims[2]);
+    printf(", \"type\": \"%s\"", ip_type_name(l->type));
+    printf(", \"spacing\": [%.17g, %.17g, %.17g]", l->spacing[0], l->spacing[1], l->spacing[2]);
+    printf(", \"brick_size\": %u, \"subblock_size\": %u", l->brick_edge, l->subblock_edge);
+    printf(", \"levels\": %u", l->level_count);
+    printf(", \"bricks\": %llu, \"bricks_constant\": %llu, \"bricks_compressed\": %llu, "
+           "\"bricks_raw\": %llu",
+           (unsigned long long)l->brick_count, (unsigned long long)f->constant,
+           (unsigned long long)f->compressed, (unsigned long long)f->raw);
+    printf(", \"bytes_raw\": %llu, \"bytes_file\": %llu, \"bytes_payload\": %llu, "
+           "\"bytes_summary\": %llu",
+           (unsigned long long)f->raw_bytes, (unsigned long long)l->file_size,
+           (unsigned long long)f->payload_bytes, (unsigned long long)l->summary_size);
+    printf(", \"compression_ratio\": %.4f", (double)f->raw_bytes / (double)l->file_size);
+    printf(", \"value_min\": %.9g, \"value_max\": %.9g", (double)l->value_min,
+           (double)l->value_max);
+    printf(", \"level_info\": [");
+    for (uint32_t k = 0; k < l->level_count; k++) {
+        const ip_level_layout *lv = &l->levels[k];
+        printf("%s{\"level\": %u, \"dims\": [%u, %u, %u], \"bricks\": [%u, %u, %u], "
+               "\"bytes_payload\": %llu, \"value_min\": %.9g, \"value_max\": %.9g}",
+               k ? ", " : "", k, lv->dims[0], lv->dims[1], lv->dims[2], lv->bricks[0],
+               lv->bricks[1], lv->bricks[2], (unsigned long long)f->level_payload[k],
+               (double)lv->value_min, (double)lv->value_max);
+    }
+    printf("]}\n");
+}
+
+static int verify(const ip_store *s, int quiet)
+{
+    const ip_layout *l = ip_store_layout(s);
+    size_t most = (size_t)(l->brick_edge + 1) * (l->brick_edge + 1) * (l->brick_edge + 1);
+    void *dst = malloc(most * ip_type_size(l->type));
+    void *work = malloc(ip_brick_work_size(most, l->type));
+    ip_error err;
+    ip_error_clear(&err);
+    int rc = 0;
+    if (!dst || !work) {
+        fprintf(stderr, "isoinfo: out of memory\n");
+        rc = 1;
+    }
+    for (uint64_t g = 0; rc == 0 && g < l->brick_count; g++)
+        if (ip_store_verify_brick(s, g, dst, work, &err) != IP_OK)
+            rc = tool_fail("isoinfo", &err);
+    if (rc == 0 && ip_store_verify_octree(s, &err) != IP_OK)
+        rc = tool_fail("isoinfo", &err);
+    if (rc == 0 && !quiet)
+        fprintf(stderr, "isoinfo: %s: verified %llu bricks, their summaries and the octree\n",
+                ip_store_path(s), (unsigned long long)l->brick_count);
+    free(dst);
+    free(work);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    const char *path = NULL;
+    int json = 0, check = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
+            fputs(usage, stdout);
+            return 0;
+        } else if (!strcmp(argv[i], "--json")) {
+            json = 1;
+        } else if (!strcmp(argv[i], "--verify")) {
+            check = 1;
+        } else if (argv[i][0] == '-') {
+            return tool_usage_error("isoinfo", "unknown option '%s'", argv[i]);
+        } else if (!path) {
+            path = argv[i];
+        } else {
+            return tool_usage_error("isoinfo", "more than one file ('%s')", argv[i]);
+        }
+    }
+    if (!path)
+        return tool_usage_error("isoinfo", "no file");
+    ip_store *store;
+    ip_error err;
+    ip_error_clear(&err);
+    if (ip_store_open(path, &store, &err) != IP_OK)
+        return tool_fail("isoinfo", &err);
+    file_facts facts;
+    gather_facts(store, &facts);
+    int rc = check ? verify(store, json) : 0;
+    if (rc == 0) {
+        if (json)
+            print_json(store, &facts);
+        else
+            print_text(store, &facts);
+    }
+    ip_store_close(store);
+    return rc;
+}
