@@ -15,8 +15,8 @@
 #include "internal.h"
 #include "isoprop/input.h"
 
-/* Dims at or above this are refused, as ip_dims_parse() refuses them on the command line:
- * the layers above index samples with signed 32-bit coordinates. */
+/* Dims at or above this are refused, as ip_dims_parse() refuses them, so that every volume
+ * a header or a name describes could also be described on the command line. */
 #define IP_INPUT_DIM_LIMIT (UINT64_C(1) << 31)
 
 typedef enum input_kind {
@@ -288,7 +288,8 @@ static ip_status check_data_file(ip_input_desc *desc, int data_at_end, uint64_t 
     return IP_OK;
 }
 
-/* Both raw kinds fail the same way when nothing says what the bytes are. */
+/* Only a raw file gets here without dims or type: the header parsers report their missing
+ * fields themselves. */
 static ip_status require_layout(const ip_input_desc *desc, const ip_header_found *found,
                                 ip_error *err)
 {

@@ -143,7 +143,6 @@ static int parse_vector_norm(const char **p, double *norm)
 {
     const char *s = *p;
     double sum = 0.0;
-    int components = 0;
     if (*s++ != '(')
         return -1;
     for (;;) {
@@ -152,7 +151,6 @@ static int parse_vector_norm(const char **p, double *norm)
         if (end == s)
             return -1;
         sum += v * v;
-        components++;
         s = end;
         while (*s == ' ' || *s == '\t')
             s++;
@@ -162,7 +160,7 @@ static int parse_vector_norm(const char **p, double *norm)
             return -1;
     }
     *p = s + 1;
-    *norm = components > 0 ? sqrt(sum) : NAN;
+    *norm = sqrt(sum);
     return 0;
 }
 

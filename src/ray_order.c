@@ -1,6 +1,4 @@
 /* Progressive ray order: a breadth-first quadtree over the screen, Bayer order within a level. */
-#include <stddef.h>
-
 #include "isoprop/ray_order.h"
 
 /* Levels needed until a side is cut into cells of at most one pixel: ceil(log2(side)). */
@@ -63,11 +61,11 @@ static void set_bit(uint32_t *v, uint32_t bit, uint32_t value)
 /* Steps to the next cell of the level in Bayer order, keeping the cell's coordinates in step
  * with its position so that no cell is decoded from scratch (amortised O(1) per cell).
  *
- * Split s of the level (coarsest first) is the high bit s of the cell index along each axis,
- * and is driven by the next low bits of the position: a base-4 digit while both axes split,
- * mapped so that 0, 1, 2, 3 visit (low, low), (high, high), (high, low), (low, high); then one
- * bit per split of the axis that goes on. Counting up the position is a carry running from the
- * coarsest split toward the finer ones. */
+ * Split s of the level (0 = coarsest) sets bit n - 1 - s of the cell index along each axis that
+ * splits there (n being that axis's splits at this level), and is driven by the next low bits of
+ * the position: a base-4 digit while both axes split, mapped so that 0, 1, 2, 3 visit
+ * (low, low), (high, high), (high, low), (low, high); then one bit per split of the axis that
+ * goes on. Counting up the position is a carry running from the coarsest split to finer ones. */
 static void next_cell(ip_ray_order *order, uint32_t nx, uint32_t ny)
 {
     static const uint8_t digit_x[4] = {0, 1, 1, 0}, digit_y[4] = {0, 1, 0, 1};

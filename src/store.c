@@ -113,6 +113,11 @@ const char *ip_store_path(const ip_store *s)
     return s->path;
 }
 
+const unsigned char *ip_store_mapping(const ip_store *s)
+{
+    return s->map;
+}
+
 void ip_store_brick_entry(const ip_store *s, uint64_t g, ip_brick_entry *entry)
 {
     ip_directory_entry_decode(s->summary + s->offsets.directory + g * IP_DIRECTORY_ENTRY_SIZE,
@@ -179,12 +184,9 @@ static int same_range(const float *a, const float *b)
     return a[0] == b[0] && a[1] == b[1];
 }
 
-ip_status ip_store_verify_brick(const ip_store *s, uint64_t g, void *dst, void *work,
-                                ip_error *err)
+ip_status ip_store_check_summary(const ip_store *s, uint64_t g, const void *samples,
+                                 ip_error *err)
 {
-    ip_status st = ip_store_read_brick(s, g, dst, work, err);
-    if (st != IP_OK)
-        return st;
     uint32_t level, brick[3], origin[3], extent[3];
     ip_brick_coords(&s->layout, g, &level, brick);
     ip_brick_extent(&s->layout, level, brick, origin, extent);
@@ -192,7 +194,7 @@ ip_status ip_store_verify_brick(const ip_store *s, uint64_t g, void *dst, void *
     float *sub = malloc(2 * sizeof(float) * s->subblocks);
     if (!sub)
         return ip_fail(err, IP_ERR_NOMEM, "%s: out of memory", s->path);
-    ip_brick_summarise(dst, s->layout.type, extent, s->layout.brick_edge,
+    ip_brick_summarise(samples, s->layout.type, extent, s->layout.brick_edge,
                        s->layout.subblock_edge, range, sub);
     const float *stored = ip_store_subblock_ranges(s, g);
     int ok = same_range(range, &s->ranges[2 * g]);
@@ -200,6 +202,13 @@ ip_status ip_store_verify_brick(const ip_store *s, uint64_t g, void *dst, void *
         ok = same_range(&sub[2 * i], &stored[2 * i]);
     free(sub);
     return ok ? IP_OK : brick_fail(s, g, IP_ERR_CORRUPT, err, "samples disagree with the summary");
+}
+
+ip_status ip_store_verify_brick(const ip_store *s, uint64_t g, void *dst, void *work,
+                                ip_error *err)
+{
+    ip_status st = ip_store_read_brick(s, g, dst, work, err);
+    return st == IP_OK ? ip_store_check_summary(s, g, dst, err) : st;
 }
 
 ip_status ip_store_verify_octree(const ip_store *s, ip_error *err)

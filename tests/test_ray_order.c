@@ -55,6 +55,83 @@ static void test_every_pixel_once(void)
     }
 }
 
+/* The order as specified, the slow way: every cell of every level decoded from scratch, and a
+ * bitmap of the pixels cast so far instead of the iterator's reasoning about coarser centres. */
+static void reference_order(uint32_t w, uint32_t h, uint32_t (*out)[2])
+{
+    uint32_t kx = 0, ky = 0;
+    while ((1ull << kx) < w)
+        kx++;
+    while ((1ull << ky) < h)
+        ky++;
+    unsigned char *seen = calloc((size_t)w * h, 1);
+    REQUIRE(seen);
+    static const uint32_t digit_x[4] = {0, 1, 1, 0}, digit_y[4] = {0, 1, 0, 1};
+    size_t n = 0;
+    for (uint32_t level = 0; level <= (kx > ky ? kx : ky); level++) {
+        uint32_t nx = level < kx ? level : kx, ny = level < ky ? level : ky;
+        uint32_t both = nx < ny ? nx : ny, splits = nx > ny ? nx : ny;
+        for (uint64_t position = 0; position < (1ull << (nx + ny)); position++) {
+            uint64_t p = position;
+            uint32_t cx = 0, cy = 0;
+            for (uint32_t s = 0; s < both; s++, p >>= 2) {
+                cx |= digit_x[p & 3] << (nx - 1 - s);
+                cy |= digit_y[p & 3] << (ny - 1 - s);
+            }
+            for (uint32_t s = both; s < splits; s++, p >>= 1) {
+                if (nx > both)
+                    cx |= (uint32_t)(p & 1) << (nx - 1 - s);
+                else
+                    cy |= (uint32_t)(p & 1) << (ny - 1 - s);
+            }
+            uint64_t x0 = (uint64_t)cx * w >> nx, x1 = (uint64_t)(cx + 1) * w >> nx;
+            uint64_t y0 = (uint64_t)cy * h >> ny, y1 = (uint64_t)(cy + 1) * h >> ny;
+            if (x0 == x1 || y0 == y1)
+                continue;
+            uint32_t px = (uint32_t)((x0 + x1) / 2), py = (uint32_t)((y0 + y1) / 2);
+            if (seen[(size_t)py * w + px])
+                continue;
+            seen[(size_t)py * w + px] = 1;
+            out[n][0] = px;
+            out[n][1] = py;
+            n++;
+        }
+    }
+    REQUIRE(n == (size_t)w * h);
+    free(seen);
+}
+
+static int same_as_reference(uint32_t w, uint32_t h)
+{
+    uint32_t(*expected)[2] = malloc((size_t)w * h * sizeof *expected);
+    REQUIRE(expected);
+    reference_order(w, h, expected);
+    ip_ray_order order;
+    REQUIRE(ip_ray_order_init(&order, w, h) == IP_OK);
+    int same = 1;
+    uint32_t x, y;
+    for (size_t i = 0; i < (size_t)w * h && same; i++)
+        same = ip_ray_order_next(&order, &x, &y) && x == expected[i][0] && y == expected[i][1];
+    free(expected);
+    return same && !ip_ray_order_next(&order, &x, &y);
+}
+
+static void test_matches_reference(void)
+{
+    int mismatches = 0;
+    for (uint32_t w = 1; w <= 40; w++)
+        for (uint32_t h = 1; h <= 40; h++)
+            if (!same_as_reference(w, h)) {
+                mismatches++;
+                fprintf(stderr, "%ux%u differs from the reference order\n", w, h);
+            }
+    CHECK(mismatches == 0);
+    static const uint32_t sizes[][2] = {{640, 480}, {255, 257}, {1000, 3}, {129, 1025}};
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
+        CHECK_MSG(same_as_reference(sizes[i][0], sizes[i][1]), "%ux%u", sizes[i][0],
+                  sizes[i][1]);
+}
+
 static void test_first_rays(void)
 {
     /* 16 x 16: the centre, then the 4 quadrant centres in Bayer order, then the 16 sub-quadrant
@@ -318,6 +395,7 @@ int main(int argc, char **argv)
     if (argc > 3 && strcmp(argv[1], "--bench") == 0)
         return bench((uint32_t)atoi(argv[2]), (uint32_t)atoi(argv[3]));
     test_every_pixel_once();
+    test_matches_reference();
     test_first_rays();
     test_bad_arguments();
     test_distance_transform();

@@ -172,7 +172,9 @@ static void print_summary(const ip_brick_report *r, const char *out)
            (unsigned long long)r->bricks_compressed, (unsigned long long)r->bricks_raw);
     printf("  time        %.2f s, %.1f MB/s on %u threads\n", r->seconds,
            r->seconds > 0 ? (double)r->input_bytes / r->seconds / 1e6 : 0.0, r->threads);
-    printf("  peak RSS    %s\n", tool_format_bytes(rss_b, sizeof rss_b, (double)r->peak_rss));
+    printf("  peak RSS    %s (working memory planned: %s)\n",
+           tool_format_bytes(rss_b, sizeof rss_b, (double)r->peak_rss),
+           tool_format_bytes(in_b, sizeof in_b, (double)r->memory_planned));
 }
 
 int main(int argc, char **argv)

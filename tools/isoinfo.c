@@ -3,16 +3,20 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "isoprop/cache.h"
 #include "isoprop/codec.h"
 #include "isoprop/store.h"
 #include "tool_common.h"
 
 static const char usage[] =
-    "usage: isoinfo FILE.ibv [--json] [--verify]\n"
+    "usage: isoinfo FILE.ibv [--json] [--verify] [--cache-mb N] [--stats FILE.json]\n"
     "Prints the header, levels, brick counts, compression ratio, value range and summary size.\n"
     "  --json     print the same as one JSON object\n"
     "  --verify   check every checksum, decode every brick and compare it with its summaries;\n"
-    "             exits 1 and names the first bad brick\n";
+    "             exits 1 and names the first bad brick; reads through the brick cache and\n"
+    "             prints its statistics on exit\n"
+    "  --cache-mb N     brick cache budget in MiB (default 512, or a quarter of RAM if less)\n"
+    "  --stats FILE     write the cache statistics as JSON (a \"cache\" object)\n";
 
 typedef struct file_facts {
     uint64_t constant, compressed, raw, payload_bytes, raw_bytes;
@@ -106,36 +110,34 @@ static void print_json(const ip_store *s, const file_facts *f)
     printf("]}\n");
 }
 
-static int verify(const ip_store *s, int quiet)
+/* Reads every brick through the cache, checking checksums and summaries, then the octree. */
+static int verify(const ip_store *s, ip_cache *cache, int quiet)
 {
     const ip_layout *l = ip_store_layout(s);
-    size_t most = (size_t)(l->brick_edge + 1) * (l->brick_edge + 1) * (l->brick_edge + 1);
-    void *dst = malloc(most * ip_type_size(l->type));
-    void *work = malloc(ip_brick_work_size(most, l->type));
     ip_error err;
     ip_error_clear(&err);
-    int rc = 0;
-    if (!dst || !work) {
-        fprintf(stderr, "isoinfo: out of memory\n");
-        rc = 1;
+    for (uint64_t g = 0; g < l->brick_count; g++) {
+        ip_brick b;
+        if (ip_cache_pin_brick(cache, g, &b, &err) != IP_OK)
+            return tool_fail("isoinfo", &err);
+        ip_status st = ip_store_check_summary(s, g, b.samples, &err);
+        ip_cache_unpin_brick(cache, &b);
+        if (st != IP_OK)
+            return tool_fail("isoinfo", &err);
     }
-    for (uint64_t g = 0; rc == 0 && g < l->brick_count; g++)
-        if (ip_store_verify_brick(s, g, dst, work, &err) != IP_OK)
-            rc = tool_fail("isoinfo", &err);
-    if (rc == 0 && ip_store_verify_octree(s, &err) != IP_OK)
-        rc = tool_fail("isoinfo", &err);
-    if (rc == 0 && !quiet)
+    if (ip_store_verify_octree(s, &err) != IP_OK)
+        return tool_fail("isoinfo", &err);
+    if (!quiet)
         fprintf(stderr, "isoinfo: %s: verified %llu bricks, their summaries and the octree\n",
                 ip_store_path(s), (unsigned long long)l->brick_count);
-    free(dst);
-    free(work);
-    return rc;
+    return 0;
 }
 
 int main(int argc, char **argv)
 {
-    const char *path = NULL;
+    const char *path = NULL, *stats_path = NULL;
     int json = 0, check = 0;
+    uint64_t budget = ip_cache_default_budget();
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
             fputs(usage, stdout);
@@ -144,6 +146,11 @@ int main(int argc, char **argv)
             json = 1;
         } else if (!strcmp(argv[i], "--verify")) {
             check = 1;
+        } else if (!strcmp(argv[i], "--cache-mb") && i + 1 < argc) {
+            if (tool_parse_cache_mb(argv[++i], &budget) != 0)
+                return tool_usage_error("isoinfo", "bad --cache-mb '%s'", argv[i]);
+        } else if (!strcmp(argv[i], "--stats") && i + 1 < argc) {
+            stats_path = argv[++i];
         } else if (argv[i][0] == '-') {
             return tool_usage_error("isoinfo", "unknown option '%s'", argv[i]);
         } else if (!path) {
@@ -159,15 +166,29 @@ int main(int argc, char **argv)
     ip_error_clear(&err);
     if (ip_store_open(path, &store, &err) != IP_OK)
         return tool_fail("isoinfo", &err);
+    ip_cache *cache;
+    if (ip_cache_create(store, budget, &cache, &err) != IP_OK) {
+        ip_store_close(store);
+        return tool_fail("isoinfo", &err);
+    }
     file_facts facts;
     gather_facts(store, &facts);
-    int rc = check ? verify(store, json) : 0;
+    int rc = check ? verify(store, cache, json) : 0;
+    ip_cache_stats stats;
+    ip_cache_get_stats(cache, &stats);
+    uint64_t summary_bytes = ip_store_layout(store)->summary_size;
+    if (check && !json)
+        tool_print_cache_table(stderr, &stats, summary_bytes);
+    if (stats_path && tool_write_stats_file("isoinfo", stats_path, &stats, summary_bytes, NULL,
+                                            NULL) != 0)
+        rc = 1;
     if (rc == 0) {
         if (json)
             print_json(store, &facts);
         else
             print_text(store, &facts);
     }
+    ip_cache_destroy(cache);
     ip_store_close(store);
     return rc;
 }

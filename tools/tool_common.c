@@ -92,3 +92,121 @@ const char *tool_format_bytes(char *buf, size_t size, double bytes)
     snprintf(buf, size, u == 0 ? "%.0f %s" : "%.1f %s", bytes, units[u]);
     return buf;
 }
+
+#include <unistd.h>
+
+/* Peak resident set of this process (VmHWM), in bytes; 0 when unknown. */
+static uint64_t peak_rss(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    uint64_t kib = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, "VmHWM:", 6) == 0)
+            kib = strtoull(line + 6, NULL, 10);
+    if (f)
+        fclose(f);
+    return kib * 1024u;
+}
+
+int tool_parse_cache_mb(const char *text, uint64_t *bytes)
+{
+    uint64_t mb;
+    if (tool_parse_u64(text, &mb) != 0 || mb < 1 || mb > (1ull << 30))
+        return -1;
+    *bytes = mb << 20;
+    return 0;
+}
+
+static double hit_rate(const ip_cache_stats *s)
+{
+    uint64_t all = s->hits + s->misses;
+    return all ? (double)s->hits / (double)all : 0.0;
+}
+
+void tool_print_cache_table(FILE *out, const ip_cache_stats *s, uint64_t summary_bytes)
+{
+    char a[32], b[32], c[32], d[32], e[32];
+    fprintf(out, "cache statistics\n");
+    fprintf(out, "  budget          %s\n", tool_format_bytes(a, sizeof a, (double)s->budget_bytes));
+    fprintf(out, "  resident        %s now, %s at peak, %llu bricks\n",
+            tool_format_bytes(b, sizeof b, (double)s->resident_bytes),
+            tool_format_bytes(c, sizeof c, (double)s->resident_peak_bytes),
+            (unsigned long long)s->resident_bricks);
+    fprintf(out, "  pins            %llu hits, %llu misses (hit rate %.1f %%), %llu evictions\n",
+            (unsigned long long)s->hits, (unsigned long long)s->misses, 100.0 * hit_rate(s),
+            (unsigned long long)s->evictions);
+    fprintf(out, "  decoded         %s from %s in %.3f s\n",
+            tool_format_bytes(d, sizeof d, (double)s->bytes_decompressed),
+            tool_format_bytes(e, sizeof e, (double)s->bytes_read), s->decode_seconds);
+    fprintf(out, "  bricks touched  %llu of %llu", (unsigned long long)s->bricks_touched,
+            (unsigned long long)s->bricks_total);
+    for (uint32_t k = 0; k < s->levels; k++)
+        fprintf(out, "%s L%u %llu/%llu", k ? "," : " (", k,
+                (unsigned long long)s->level[k].bricks_touched,
+                (unsigned long long)s->level[k].bricks_total);
+    fprintf(out, "%s\n", s->levels ? ")" : "");
+    if (s->over_budget_pins || s->errors)
+        fprintf(out, "  warnings        %llu loads over budget (all resident bricks pinned), "
+                     "%llu bad bricks\n",
+                (unsigned long long)s->over_budget_pins, (unsigned long long)s->errors);
+    fprintf(out, "  summaries       %s\n", tool_format_bytes(a, sizeof a, (double)summary_bytes));
+    fprintf(out, "  peak RSS        %s\n", tool_format_bytes(b, sizeof b, (double)peak_rss()));
+}
+
+void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_bytes)
+{
+    fprintf(out, "\"budget_bytes\": %llu, \"resident_bytes\": %llu, "
+                 "\"resident_peak_bytes\": %llu, \"resident_bricks\": %llu, ",
+            (unsigned long long)s->budget_bytes, (unsigned long long)s->resident_bytes,
+            (unsigned long long)s->resident_peak_bytes, (unsigned long long)s->resident_bricks);
+    fprintf(out, "\"hits\": %llu, \"misses\": %llu, \"evictions\": %llu, \"waits\": %llu, "
+                 "\"hit_rate\": %.6f, ",
+            (unsigned long long)s->hits, (unsigned long long)s->misses,
+            (unsigned long long)s->evictions, (unsigned long long)s->waits, hit_rate(s));
+    fprintf(out, "\"bytes_decompressed\": %llu, \"bytes_read\": %llu, \"decode_seconds\": %.6f, ",
+            (unsigned long long)s->bytes_decompressed, (unsigned long long)s->bytes_read,
+            s->decode_seconds);
+    fprintf(out, "\"over_budget_pins\": %llu, \"pinned_bytes\": %llu, \"errors\": %llu, ",
+            (unsigned long long)s->over_budget_pins, (unsigned long long)s->pinned_bytes,
+            (unsigned long long)s->errors);
+    fprintf(out, "\"bricks_touched\": %llu, \"bricks_total\": %llu, \"levels\": [",
+            (unsigned long long)s->bricks_touched, (unsigned long long)s->bricks_total);
+    for (uint32_t k = 0; k < s->levels; k++)
+        fprintf(out, "%s{\"level\": %u, \"bricks_touched\": %llu, \"bricks_total\": %llu, "
+                     "\"misses\": %llu}",
+                k ? ", " : "", k, (unsigned long long)s->level[k].bricks_touched,
+                (unsigned long long)s->level[k].bricks_total,
+                (unsigned long long)s->level[k].misses);
+    fprintf(out, "], \"summary_bytes\": %llu, \"peak_rss_bytes\": %llu",
+            (unsigned long long)summary_bytes, (unsigned long long)peak_rss());
+}
+
+int tool_write_stats_file(const char *program, const char *path, const ip_cache_stats *s,
+                          uint64_t summary_bytes, void (*extra)(FILE *out, void *user),
+                          void *user)
+{
+    char temp[4200];
+    snprintf(temp, sizeof temp, "%s.tmp.%ld", path, (long)getpid());
+    FILE *out = fopen(temp, "w");
+    if (!out) {
+        fprintf(stderr, "%s: %s: cannot write: %s\n", program, path, strerror(errno));
+        return -1;
+    }
+    fprintf(out, "{\"cache\": {");
+    tool_write_cache_json(out, s, summary_bytes);
+    fprintf(out, "}");
+    if (extra) {
+        fprintf(out, ", ");
+        extra(out, user);
+    }
+    fprintf(out, "}\n");
+    int failed = ferror(out);
+    failed |= fclose(out) != 0;
+    if (failed || rename(temp, path) != 0) {
+        fprintf(stderr, "%s: %s: cannot write: %s\n", program, path, strerror(errno));
+        unlink(temp);
+        return -1;
+    }
+    return 0;
+}

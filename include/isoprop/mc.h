@@ -22,8 +22,16 @@
  * separate the two inside corners on such a face (the outside corners join across it). The rule
  * reads only the 4 signs of the face, and the two cells sharing a face see the same 4 signs, so
  * they draw the same segments on it: meshes from these tables have no cracks. The price is that a
- * case and its complement are not mirror images when an ambiguous face is involved (the complement
- * of "two diagonal corners" is a tunnel, not two corner caps), so their triangle counts may differ.
+ * case and its complement are not mirror images when an ambiguous face is involved: two inside
+ * corners on a face diagonal give two corner caps (2 triangles), while two outside corners there
+ * are joined by one hexagon (4 triangles). So the triangle counts of a case and its complement
+ * differ in 88 of the 256 cases; without an ambiguous face they are always equal.
+ *
+ * Triangles. The face segments of a case join into closed outlines; each is fanned from the
+ * first of its vertices whose fan has no diagonal lying on a cell face. A diagonal on a face
+ * could be drawn by the neighbour across that face too, leaving 4 triangles on one edge; with
+ * none, every edge of a welded mesh (away from the volume's boundary) is shared by exactly 2
+ * triangles, once in each direction.
  *
  * Winding. Every triangle (a, b, c) is counter-clockwise seen from outside (from values < iso):
  * its geometric normal (b - a) x (c - a) points from the inside region (>= iso) toward the outside,

@@ -36,6 +36,10 @@ const ip_layout *ip_store_layout(const ip_store *store);
 /*! ip_store_path() : the path the store was opened with. */
 const char *ip_store_path(const ip_store *store);
 
+/*! ip_store_mapping() : the first byte of the read-only mapping of the whole file (e.g. to
+ *  madvise pages away after a decode); owned by the store, never written. */
+const unsigned char *ip_store_mapping(const ip_store *store);
+
 /*! ip_store_brick_entry() : directory entry of global brick `g` (< brick_count). */
 void ip_store_brick_entry(const ip_store *store, uint64_t g, ip_brick_entry *entry);
 
@@ -62,6 +66,12 @@ uint64_t ip_store_brick_samples(const ip_store *store, uint64_t g);
  *  coordinates. */
 ip_status ip_store_read_brick(const ip_store *store, uint64_t g, void *dst, void *work,
                               ip_error *err);
+
+/*! ip_store_check_summary() : recomputes the range and sub-block ranges of brick `g` from its
+ *  decoded `samples` (as ip_store_read_brick() or the cache give them) and compares them with
+ *  the summary section. @return IP_OK, or IP_ERR_CORRUPT naming the brick. */
+ip_status ip_store_check_summary(const ip_store *store, uint64_t g, const void *samples,
+                                 ip_error *err);
 
 /*! ip_store_verify_brick() : ip_store_read_brick(), then recomputes the brick's range and
  *  sub-block ranges from the decoded samples and compares them with the summary section.

@@ -1,0 +1,96 @@
+/* isoprop: the brick cache: decoded bricks in memory, up to a byte budget, least recently
+ * used evicted first.
+ *
+ * ip_cache_pin_brick() returns a brick's decoded samples, loading and decoding it on a miss
+ * (its checksum is verified then), and pins it: a pinned brick is never evicted until its
+ * caller unpins it. When the pinned bricks alone exceed the budget the cache goes over budget
+ * rather than fail, and counts it (ip_cache_stats.over_budget_pins).
+ *
+ * Threads: every function may be called from many threads at once. A hit takes no lock (an
+ * atomic pin on the brick's slot); misses on different bricks decode in parallel; two threads
+ * that miss on the same brick decode it once (the second waits for the first). Eviction is
+ * exact LRU over the last pin time of each unpinned brick.
+ *
+ * Memory: resident bytes are the decoded bricks; the compressed pages of the mapping that a
+ * decode touched are released right after it (madvise), so the process holds the budget, the
+ * summaries and a fixed overhead, whatever the file's size.
+ */
+#ifndef ISOPROP_CACHE_H
+#define ISOPROP_CACHE_H
+
+#include <stdint.h>
+
+#include "isoprop/status.h"
+#include "isoprop/store.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ip_cache ip_cache;
+
+/* A pinned, decoded brick. Owned by the cache; valid until ip_cache_unpin_brick(). */
+typedef struct ip_brick {
+    const void *samples;  /* extent[0] * extent[1] * extent[2] samples, host order, x fastest */
+    uint32_t extent[3];   /* samples along each axis, the + face layer included */
+    uint32_t origin[3];   /* level coordinates of sample (0,0,0) */
+    uint32_t level;
+    uint64_t index;       /* global brick index */
+} ip_brick;
+
+typedef struct ip_cache_level_stats {
+    uint64_t bricks_total;    /* bricks of this level in the file */
+    uint64_t bricks_touched;  /* distinct bricks of this level pinned at least once */
+    uint64_t misses;          /* decodes of this level's bricks */
+} ip_cache_level_stats;
+
+typedef struct ip_cache_stats {
+    uint64_t budget_bytes;
+    uint64_t resident_bytes;       /* decoded bytes held now */
+    uint64_t resident_peak_bytes;  /* most decoded bytes held at once */
+    uint64_t resident_bricks;
+    uint64_t hits, misses, evictions;
+    uint64_t waits;                /* misses that waited for another thread's decode */
+    uint64_t bytes_decompressed;   /* decoded bytes produced by misses */
+    uint64_t bytes_read;           /* compressed payload bytes read by misses */
+    double decode_seconds;         /* time in checksum + decode, summed over threads */
+    uint64_t over_budget_pins;     /* loads that found every resident brick pinned */
+    uint64_t pinned_bytes;         /* decoded bytes pinned now */
+    uint64_t errors;               /* loads that failed their checksum or decode */
+    uint64_t bricks_touched, bricks_total;
+    uint32_t levels;
+    ip_cache_level_stats level[32];
+} ip_cache_stats;
+
+/*! ip_cache_default_budget() : 512 MiB, or a quarter of the machine's RAM if smaller; bytes. */
+uint64_t ip_cache_default_budget(void);
+
+/*! ip_cache_create() : a cache over `store` (which must outlive it) holding up to
+ *  `budget_bytes` of decoded bricks. *out is owned by the caller, released with
+ *  ip_cache_destroy(). @return IP_OK, IP_ERR_ARGUMENT (budget 0) or IP_ERR_NOMEM. */
+ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache **out,
+                          ip_error *err);
+
+/*! ip_cache_destroy() : frees every brick; no brick may still be pinned. NULL is allowed. */
+void ip_cache_destroy(ip_cache *cache);
+
+/*! ip_cache_pin_brick() : pins global brick `g` and fills *brick. On a miss the brick is read
+ *  from the mapping, its checksum verified and decoded; a bad brick is reported (IP_ERR_CHECKSUM
+ *  or IP_ERR_CORRUPT naming it) and nothing is pinned, and the caller may go on with other
+ *  bricks. @return IP_OK, IP_ERR_CHECKSUM, IP_ERR_CORRUPT, IP_ERR_ARGUMENT or IP_ERR_NOMEM. */
+ip_status ip_cache_pin_brick(ip_cache *cache, uint64_t g, ip_brick *brick, ip_error *err);
+
+/*! ip_cache_unpin_brick() : releases one pin taken by ip_cache_pin_brick(). */
+void ip_cache_unpin_brick(ip_cache *cache, const ip_brick *brick);
+
+/*! ip_cache_get_stats() : a snapshot of the counters (consistent per counter, not across them
+ *  while other threads work). */
+void ip_cache_get_stats(const ip_cache *cache, ip_cache_stats *stats);
+
+/*! ip_cache_store() : the store the cache reads from. */
+const ip_store *ip_cache_store(const ip_cache *cache);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,322 @@
+/* The brick cache: exact LRU counts against a reference model, pinning over budget,
+ * a corrupted brick, and many threads pinning at once (decode-once, counts that agree). */
+#include <pthread.h>
+#include <stdatomic.h>
+#include <sys/stat.h>
+
+#include "check.h"
+#include "isoprop/bricker.h"
+#include "isoprop/cache.h"
+#include "isoprop/generate.h"
+#include "isoprop/store.h"
+
+#define BRICK_BYTES 729 /* 9^3 uint8 samples: every level-0 brick of the test volume */
+
+/* 33^3 uint8 samples, B = 8: 4x4x4 full level-0 bricks, then the pyramid. Sample value
+ * depends on the brick so contents can be checked. */
+static void make_file(const char *dir, char *ibv, size_t size)
+{
+    char raw[8192];
+    snprintf(raw, sizeof raw, "%s/cells_33x33x33_uint8.raw", dir);
+    snprintf(ibv, size, "%s/cells.ibv", dir);
+    FILE *f = fopen(raw, "wb");
+    REQUIRE(f);
+    for (int z = 0; z < 33; z++)
+        for (int y = 0; y < 33; y++)
+            for (int x = 0; x < 33; x++)
+                fputc((x * 3 + y * 5 + z * 7) % 251, f);
+    REQUIRE(fclose(f) == 0);
+    ip_input_desc desc;
+    ip_brick_options o;
+    ip_error err;
+    REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
+    ip_brick_options_default(&o);
+    o.brick_edge = 8;
+    o.subblock_edge = 4;
+    o.force = 1;
+    REQUIRE(ip_brick_volume(&desc, ibv, &o, NULL, &err) == IP_OK);
+}
+
+static int expected_sample(const ip_brick *b, uint32_t x, uint32_t y, uint32_t z)
+{
+    uint32_t step = 1u << b->level, gx = (b->origin[0] + x) * step, gy = (b->origin[1] + y) * step,
+             gz = (b->origin[2] + z) * step;
+    gx = gx > 32 ? 32 : gx, gy = gy > 32 ? 32 : gy, gz = gz > 32 ? 32 : gz;
+    return (int)((gx * 3 + gy * 5 + gz * 7) % 251);
+}
+
+static int brick_ok(const ip_brick *b)
+{
+    const uint8_t *s = b->samples;
+    uint32_t last[3] = {b->extent[0] - 1, b->extent[1] - 1, b->extent[2] - 1};
+    return s[0] == expected_sample(b, 0, 0, 0) &&
+           s[last[0] + b->extent[0] * (last[1] + b->extent[1] * last[2])] ==
+               expected_sample(b, last[0], last[1], last[2]);
+}
+
+/* ---- a reference LRU: an array ordered from least to most recently used ---- */
+typedef struct lru_model {
+    uint64_t items[64];
+    int count, capacity;
+    uint64_t hits, misses, evictions;
+} lru_model;
+
+static void model_access(lru_model *m, uint64_t g)
+{
+    int found = -1;
+    for (int i = 0; i < m->count; i++)
+        if (m->items[i] == g)
+            found = i;
+    if (found >= 0) {
+        m->hits++;
+        memmove(&m->items[found], &m->items[found + 1], (size_t)(m->count - found - 1) * 8);
+        m->count--;
+    } else {
+        m->misses++;
+        if (m->count == m->capacity) {
+            memmove(&m->items[0], &m->items[1], (size_t)(m->count - 1) * 8);
+            m->count--;
+            m->evictions++;
+        }
+    }
+    m->items[m->count++] = g;
+}
+
+static void pin_unpin(ip_cache *c, uint64_t g)
+{
+    ip_brick b;
+    ip_error err;
+    REQUIRE(ip_cache_pin_brick(c, g, &b, &err) == IP_OK);
+    CHECK(b.index == g && brick_ok(&b));
+    ip_cache_unpin_brick(c, &b);
+}
+
+static void test_scripted_lru(const ip_store *s)
+{
+    ip_cache *c;
+    ip_cache_stats st;
+    REQUIRE(ip_cache_create(s, 4 * BRICK_BYTES, &c, NULL) == IP_OK);
+    /* 0 1 2 3 miss; 0 hit; 4 miss evicts 1; 1 miss evicts 2; 0 hit; 3 hit; 2 miss evicts 4 */
+    const uint64_t script[] = {0, 1, 2, 3, 0, 4, 1, 0, 3, 2};
+    for (size_t i = 0; i < sizeof script / sizeof script[0]; i++)
+        pin_unpin(c, script[i]);
+    ip_cache_get_stats(c, &st);
+    CHECK_MSG(st.hits == 3 && st.misses == 7 && st.evictions == 3,
+              "hits %llu misses %llu evictions %llu", (unsigned long long)st.hits,
+              (unsigned long long)st.misses, (unsigned long long)st.evictions);
+    CHECK(st.resident_bytes == 4 * BRICK_BYTES && st.resident_peak_bytes == 4 * BRICK_BYTES);
+    CHECK(st.bricks_touched == 5 && st.bytes_decompressed == 7 * BRICK_BYTES);
+    CHECK(st.pinned_bytes == 0 && st.over_budget_pins == 0);
+    /* brick 4 was evicted last: asking again is a miss; brick 2 (just used) is a hit */
+    pin_unpin(c, 2);
+    pin_unpin(c, 4);
+    ip_cache_get_stats(c, &st);
+    CHECK(st.hits == 4 && st.misses == 8 && st.evictions == 4);
+    ip_cache_destroy(c);
+
+    /* a long pseudo-random sequence against the model, for several budgets */
+    for (int capacity = 1; capacity <= 9; capacity += 4) {
+        lru_model m = {{0}, 0, capacity, 0, 0, 0};
+        REQUIRE(ip_cache_create(s, (uint64_t)capacity * BRICK_BYTES, &c, NULL) == IP_OK);
+        uint64_t x = 12345;
+        for (int i = 0; i < 5000; i++) {
+            x = x * 6364136223846793005ull + 1442695040888963407ull;
+            uint64_t g = (x >> 33) % 12; /* a working set a little larger than the budget */
+            model_access(&m, g);
+            pin_unpin(c, g);
+        }
+        ip_cache_get_stats(c, &st);
+        CHECK_MSG(st.hits == m.hits && st.misses == m.misses && st.evictions == m.evictions,
+                  "capacity %d: cache %llu/%llu/%llu model %llu/%llu/%llu", capacity,
+                  (unsigned long long)st.hits, (unsigned long long)st.misses,
+                  (unsigned long long)st.evictions, (unsigned long long)m.hits,
+                  (unsigned long long)m.misses, (unsigned long long)m.evictions);
+        CHECK(st.resident_peak_bytes <= (uint64_t)capacity * BRICK_BYTES);
+        ip_cache_destroy(c);
+    }
+}
+
+static void test_pinning(const ip_store *s)
+{
+    ip_cache *c;
+    ip_cache_stats st;
+    ip_brick held[5];
+    ip_error err;
+    REQUIRE(ip_cache_create(s, 4 * BRICK_BYTES, &c, NULL) == IP_OK);
+    for (uint64_t g = 0; g < 5; g++)
+        REQUIRE(ip_cache_pin_brick(c, g, &held[g], &err) == IP_OK);
+    ip_cache_get_stats(c, &st);
+    CHECK(st.over_budget_pins == 1); /* the fifth found every resident brick pinned */
+    CHECK(st.resident_bytes == 5 * BRICK_BYTES && st.pinned_bytes == 5 * BRICK_BYTES);
+    CHECK(st.evictions == 0);
+    /* pinned bricks survive other traffic */
+    pin_unpin(c, 6);
+    pin_unpin(c, 7);
+    int intact = 1;
+    for (int i = 0; i < 5; i++)
+        intact &= brick_ok(&held[i]) && held[i].index == (uint64_t)i;
+    CHECK(intact);
+    /* a second pin of a pinned brick is a hit on the same samples */
+    ip_brick again;
+    REQUIRE(ip_cache_pin_brick(c, 2, &again, &err) == IP_OK);
+    CHECK(again.samples == held[2].samples);
+    ip_cache_unpin_brick(c, &again);
+    for (int i = 0; i < 5; i++)
+        ip_cache_unpin_brick(c, &held[i]);
+    ip_cache_get_stats(c, &st);
+    CHECK(st.pinned_bytes == 0);
+    /* unpinned, the next miss brings the cache back within its budget */
+    pin_unpin(c, 20);
+    ip_cache_get_stats(c, &st);
+    CHECK_MSG(st.resident_bytes <= 4 * BRICK_BYTES, "resident %llu",
+              (unsigned long long)st.resident_bytes);
+    ip_cache_destroy(c);
+}
+
+static void test_corrupt_brick(const char *dir, const char *ibv)
+{
+    char bad[4200];
+    snprintf(bad, sizeof bad, "%s/corrupt.ibv", dir);
+    char cmd[9000];
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", ibv, bad);
+    REQUIRE(system(cmd) == 0);
+    ip_store *s;
+    ip_error err;
+    REQUIRE(ip_store_open(bad, &s, &err) == IP_OK);
+    /* flip a byte in the middle of brick 21's payload (a level-0 brick inside the volume) */
+    ip_brick_entry e;
+    ip_store_brick_entry(s, 21, &e);
+    REQUIRE(e.stored_size > 0);
+    ip_store_close(s);
+    FILE *f = fopen(bad, "r+b");
+    REQUIRE(f && fseek(f, (long)(e.offset + e.stored_size / 2), SEEK_SET) == 0);
+    int byte = fgetc(f);
+    REQUIRE(fseek(f, (long)(e.offset + e.stored_size / 2), SEEK_SET) == 0);
+    fputc(byte ^ 0x40, f);
+    fclose(f);
+    REQUIRE(ip_store_open(bad, &s, &err) == IP_OK); /* the summary is intact */
+    ip_cache *c;
+    REQUIRE(ip_cache_create(s, 1 << 20, &c, NULL) == IP_OK);
+    ip_brick b;
+    CHECK(ip_cache_pin_brick(c, 21, &b, &err) == IP_ERR_CHECKSUM);
+    CHECK_CONTAINS(err.message, "corrupt.ibv");
+    CHECK_CONTAINS(err.message, "brick 21");
+    int others = 1;
+    for (uint64_t g = 0; g < ip_store_layout(s)->brick_count; g++) {
+        if (g == 21)
+            continue;
+        if (ip_cache_pin_brick(c, g, &b, &err) != IP_OK || !brick_ok(&b))
+            others = 0;
+        else
+            ip_cache_unpin_brick(c, &b);
+    }
+    CHECK(others);
+    ip_cache_stats st;
+    ip_cache_get_stats(c, &st);
+    CHECK(st.errors == 1 && st.misses == ip_store_layout(s)->brick_count - 1);
+    CHECK(ip_cache_pin_brick(c, 21, &b, &err) == IP_ERR_CHECKSUM); /* still reported */
+    ip_cache_destroy(c);
+    ip_store_close(s);
+}
+
+/* ---- threads ---- */
+typedef struct hammer {
+    ip_cache *cache;
+    uint64_t bricks;
+    int seed, rounds;
+    atomic_int bad;
+    atomic_uint_fast64_t pins;
+} hammer;
+
+static void *hammer_thread(void *p)
+{
+    hammer *h = p;
+    uint64_t x = (uint64_t)h->seed * 7919u + 1;
+    ip_error err;
+    for (int i = 0; i < h->rounds; i++) {
+        x = x * 6364136223846793005ull + 1442695040888963407ull;
+        uint64_t g = (x >> 33) % h->bricks;
+        ip_brick b[2];
+        int n = 1 + (int)((x >> 20) & 1); /* sometimes hold two bricks at once */
+        for (int k = 0; k < n; k++) {
+            if (ip_cache_pin_brick(h->cache, (g + (uint64_t)k) % h->bricks, &b[k], &err) != IP_OK ||
+                !brick_ok(&b[k]))
+                atomic_store(&h->bad, 1);
+            atomic_fetch_add(&h->pins, 1);
+        }
+        for (int k = 0; k < n; k++)
+            ip_cache_unpin_brick(h->cache, &b[k]);
+    }
+    return NULL;
+}
+
+static void run_hammer(const ip_store *s, uint64_t budget, int threads, int rounds,
+                       ip_cache_stats *st, int *bad, uint64_t *pins)
+{
+    ip_cache *cache;
+    REQUIRE(ip_cache_create(s, budget, &cache, NULL) == IP_OK);
+    pthread_t t[16];
+    hammer each[16];
+    for (int i = 0; i < threads; i++) {
+        memset(&each[i], 0, sizeof each[i]);
+        each[i].cache = cache;
+        each[i].bricks = ip_store_layout(s)->brick_count;
+        each[i].rounds = rounds;
+        each[i].seed = i + 1;
+        atomic_init(&each[i].bad, 0);
+        atomic_init(&each[i].pins, 0);
+        REQUIRE(pthread_create(&t[i], NULL, hammer_thread, &each[i]) == 0);
+    }
+    *bad = 0;
+    *pins = 0;
+    for (int i = 0; i < threads; i++) {
+        pthread_join(t[i], NULL);
+        *bad |= atomic_load(&each[i].bad);
+        *pins += atomic_load(&each[i].pins);
+    }
+    ip_cache_get_stats(cache, st);
+    ip_cache_destroy(cache);
+}
+
+static void test_threads(const ip_store *s)
+{
+    const ip_layout *l = ip_store_layout(s);
+    ip_cache_stats st;
+    int bad;
+    uint64_t pins;
+    /* a budget that holds everything: every brick is decoded exactly once, however many
+     * threads miss on it together */
+    run_hammer(s, 64ull << 20, 8, 3000, &st, &bad, &pins);
+    CHECK(!bad);
+    CHECK(st.hits + st.misses == pins);
+    CHECK_MSG(st.misses == st.bricks_touched, "misses %llu touched %llu",
+              (unsigned long long)st.misses, (unsigned long long)st.bricks_touched);
+    CHECK(st.bricks_touched == l->brick_count && st.evictions == 0 && st.errors == 0);
+    CHECK(st.pinned_bytes == 0);
+    /* a budget for a sixth of the bricks: constant eviction under contention */
+    run_hammer(s, 12 * BRICK_BYTES, 8, 3000, &st, &bad, &pins);
+    CHECK(!bad);
+    CHECK(st.hits + st.misses == pins);
+    CHECK(st.misses == st.resident_bricks + st.evictions);
+    CHECK(st.pinned_bytes == 0 && st.errors == 0);
+    CHECK_MSG(st.resident_bytes <= 12 * BRICK_BYTES || st.over_budget_pins > 0,
+              "resident %llu", (unsigned long long)st.resident_bytes);
+    CHECK(st.resident_peak_bytes <= (12 + 16) * BRICK_BYTES); /* budget + what 8 threads pin */
+}
+
+int main(void)
+{
+    const char *dir = test_tmp_dir("test_cache");
+    char ibv[4200];
+    make_file(dir, ibv, sizeof ibv);
+    ip_store *s;
+    ip_error err;
+    REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
+    REQUIRE(ip_store_layout(s)->levels[0].brick_count == 64);
+    test_scripted_lru(s);
+    test_pinning(s);
+    test_threads(s);
+    ip_store_close(s);
+    test_corrupt_brick(dir, ibv);
+    return test_summary("test_cache");
+}

@@ -1,0 +1,33 @@
+# Bounded memory: every brick of a 1 GiB volume read through a 32 MiB cache keeps the
+# process's peak RSS under budget + summaries + 64 MiB, whatever the file's size.
+. "$(dirname "$0")/lib.sh"
+
+if [ -n "${IP_SANITIZE:-}" ]; then
+    echo "cache_memory: skipped: peak RSS is not meaningful under sanitizers (${IP_SANITIZE})"
+    exit 77
+fi
+"$bin/isogen" gyroid --dims 1024x1024x512 --type uint16 -o "$work/" --quiet
+raw=gyroid_1024x1024x512_uint16.raw
+check "the input is 1 GiB" test "$(stat -c %s "$raw")" = 1073741824
+"$bin/isobrick" "$raw" -o big.ibv --quiet
+rm -f "$raw"
+file_bytes=$(stat -c %s big.ibv)
+check "the brick file is larger than the slack under test" test "$file_bytes" -gt $((256 << 20))
+run_capture "$bin/isoinfo" --verify big.ibv --cache-mb 32 --stats stats.json
+check "reading every brick succeeds" test "$rc" = 0
+json=$(cat stats.json)
+value() { printf '%s' "$json" | sed "s/.*\"$1\": \([0-9.]*\).*/\1/"; }
+budget=$(value budget_bytes)
+summary=$(value summary_bytes)
+peak=$(value peak_rss_bytes)
+touched=$(value bricks_touched)
+total=$(value bricks_total)
+resident_peak=$(value resident_peak_bytes)
+limit=$((budget + summary + (64 << 20)))
+echo "cache_memory: file $((file_bytes >> 20)) MiB, budget $((budget >> 20)) MiB, summaries $((summary >> 20)) MiB, peak RSS $((peak >> 20)) MiB, limit $((limit >> 20)) MiB"
+check "budget is 32 MiB" test "$budget" = $((32 << 20))
+check "every brick was read" test "$touched" = "$total"
+check "decoded bricks stayed within the budget" test "$resident_peak" -le "$budget"
+check "peak RSS $peak <= budget + summaries + 64 MiB = $limit" test "$peak" -le "$limit"
+check "the stats table was printed" grep -q "cache statistics" "$work/.err"
+finish
