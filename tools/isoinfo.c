@@ -178,7 +178,7 @@ int main(int argc, char **argv)
     ip_cache_get_stats(cache, &stats);
     uint64_t summary_bytes = ip_store_layout(store)->summary_size;
     if (check && !json)
-        tool_print_cache_table(stderr, &stats, summary_bytes);
+        tool_print_cache_table(stdout, &stats, summary_bytes);
     if (stats_path && tool_write_stats_file("isoinfo", stats_path, &stats, summary_bytes, NULL,
                                             NULL) != 0)
         rc = 1;

@@ -29,5 +29,5 @@ check "budget is 32 MiB" test "$budget" = $((32 << 20))
 check "every brick was read" test "$touched" = "$total"
 check "decoded bricks stayed within the budget" test "$resident_peak" -le "$budget"
 check "peak RSS $peak <= budget + summaries + 64 MiB = $limit" test "$peak" -le "$limit"
-check "the stats table was printed" grep -q "cache statistics" "$work/.err"
+check "the stats table was printed" grep -q "cache statistics" "$work/.out"
 finish
