@@ -63,7 +63,7 @@ typedef struct ip_input_overrides {
  *  is checked by the reader. Reentrant; *out is untouched on failure.
  *  @return IP_OK, or IP_ERR_INPUT / IP_ERR_IO with err->message naming the file and the
  *  problem in one line; IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an
- *  override type that is not an ip_type. */
+ *  override type that is not an ip_type; IP_ERR_NOMEM when an allocation fails. */
 ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
                             ip_input_desc *out, ip_error *err);
 
@@ -82,7 +82,8 @@ ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_err
  *  end is checked by the call that reads the last plane); float32 samples that are NaN or
  *  infinite are reported as IP_ERR_INPUT naming the sample as (x,y,z). After any error the
  *  reader only repeats it. count 0 reads nothing.
- *  @return IP_OK, IP_ERR_IO or IP_ERR_INPUT; IP_ERR_ARGUMENT for reading past the last plane
+ *  @return IP_OK, IP_ERR_IO or IP_ERR_INPUT; IP_ERR_NOMEM when zlib runs out of memory;
+ *  IP_ERR_ARGUMENT for reading past the last plane
  *  or a NULL reader or dst. */
 ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count,
                                ip_error *err);

@@ -1,0 +1,106 @@
+/* isoprop: progressive view-dependent isosurface extraction (Liu, Finkelstein, Li).
+ *
+ * ip_engine_begin() fixes a view and an isovalue; each ip_engine_step() casts the next rays of
+ * the progressive order (centre first, then the centres of quadrants, ...). A ray walks the
+ * min/max octree front to back, from the root through bricks and sub-blocks to cells, entering
+ * only nodes whose range holds the isovalue, and stops at the first cell whose marching-cubes
+ * triangles it really hits: the seed. Unless already extracted, the seed's surface is
+ * propagated breadth-first into face neighbours that share a sign change, while they stay
+ * within the cut-off angle of the seed's ray, do not fold back (the angle to the ray must not
+ * drop below the largest angle among their predecessors by more than a tolerance) and lie in
+ * the view frustum. Extracted cells are triangulated with marching cubes and appended to the
+ * engine's mesh. Once every pixel has had its ray, the image of the mesh equals the image of
+ * the full isosurface.
+ *
+ * Ray seeding reads only the summaries until it reaches a candidate cell; bricks are pinned
+ * through the cache as seeding descends into them and as propagation crosses their faces.
+ *
+ * Threads: an engine is driven by one thread; ip_engine_cancel() may be called from any other.
+ */
+#ifndef ISOPROP_ENGINE_H
+#define ISOPROP_ENGINE_H
+
+#include <stdint.h>
+
+#include "isoprop/cache.h"
+#include "isoprop/camera.h"
+#include "isoprop/mesh.h"
+#include "isoprop/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IP_DEFAULT_CUTOFF_DEGREES 1.81   /* the paper's cut-off angle */
+#define IP_DEFAULT_FOLDBACK_DEGREES 0.25 /* fold-back tolerance */
+
+typedef struct ip_engine_options {
+    double cutoff_degrees;    /* propagation cut-off angle around the seed's ray */
+    double foldback_degrees;  /* fold-back tolerance */
+} ip_engine_options;
+
+/* Counters and times, per step or in total. Times are wall seconds, split as the paper does. */
+typedef struct ip_engine_counts {
+    uint64_t rays;            /* rays cast */
+    uint64_t seeds;           /* rays whose seed cell was new and started a propagation */
+    uint64_t cells;           /* cells extracted (triangulated) */
+    uint64_t triangles;
+    double intersection_seconds; /* ray seeding: octree walks and ray-triangle tests */
+    double propagation_seconds;  /* queue, neighbour and criteria work */
+    double extraction_seconds;   /* marching cubes: samples, gradients, triangles */
+    double rendering_seconds;    /* reported by the caller, ip_engine_add_rendering_time() */
+} ip_engine_counts;
+
+typedef struct ip_engine ip_engine;
+
+/*! ip_engine_options_default() : the paper's cut-off (1.81 degrees) and a 0.25 degree
+ *  fold-back tolerance. */
+void ip_engine_options_default(ip_engine_options *options);
+
+/*! ip_engine_create() : an engine reading through `cache` (which must outlive it). *out is the
+ *  caller's, released with ip_engine_destroy(). @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM. */
+ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
+                           ip_error *err);
+
+/*! ip_engine_destroy() : frees the engine and its mesh; NULL is allowed. */
+void ip_engine_destroy(ip_engine *engine);
+
+/*! ip_engine_begin() : starts over with a new view and isovalue: drops the mesh, the visited
+ *  cells and the ray order, and clears a pending cancel. @return IP_OK or IP_ERR_ARGUMENT. */
+ip_status ip_engine_begin(ip_engine *engine, const ip_camera *camera, float iso, ip_error *err);
+
+/*! ip_engine_step() : casts up to `max_rays` more rays (0: no limit) for at most `max_seconds`
+ *  (0: no limit; checked between rays), appending new triangles to the mesh. `counts` (may be
+ *  NULL) receives what this step did. @return IP_OK, IP_ERR_CANCELLED after ip_engine_cancel(),
+ *  or the error of a brick that could not be read (IP_ERR_CHECKSUM, IP_ERR_CORRUPT, naming it);
+ *  the mesh keeps what was extracted before. */
+ip_status ip_engine_step(ip_engine *engine, uint64_t max_rays, double max_seconds,
+                         ip_engine_counts *counts, ip_error *err);
+
+/*! ip_engine_done() : 1 once every pixel has had its ray. */
+int ip_engine_done(const ip_engine *engine);
+
+/*! ip_engine_cancel() : asks a running or later step to stop at the next ray (any thread). */
+void ip_engine_cancel(ip_engine *engine);
+
+/*! ip_engine_mesh() : the triangles extracted since ip_engine_begin(), in extraction order;
+ *  owned by the engine, valid until the next begin, step or destroy. */
+const ip_mesh *ip_engine_mesh(const ip_engine *engine);
+
+/*! ip_engine_totals() : counts and times since ip_engine_begin(). */
+void ip_engine_totals(const ip_engine *engine, ip_engine_counts *counts);
+
+/*! ip_engine_add_rendering_time() : adds the caller's rendering time to the totals. */
+void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
+
+/*! ip_extract_full() : triangulates every active cell of level `level`, brick by brick, skipping
+ *  bricks and sub-blocks whose summary range excludes `iso`; the oracle and the baseline.
+ *  Triangles equal those of the progressive engine for the same cells. Appends to `mesh`.
+ *  @return IP_OK or a brick read error. */
+ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, ip_mesh *mesh,
+                          ip_engine_counts *counts, ip_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

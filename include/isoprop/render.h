@@ -1,0 +1,170 @@
+/* isoprop: rendering of extracted meshes, on the GPU (OpenGL 3.3 core) and in software.
+ *
+ * Both renderers draw the same picture of an ip_mesh seen by an ip_camera (see camera.h for
+ * the pixel conventions): triangles are clipped to the near and far planes that
+ * ip_camera_depth_range() gives for the volume's world box, the nearest surface wins each
+ * pixel, and a covered pixel is shaded from the normal interpolated across its triangle:
+ *
+ *     c      = |dot(n, v)| / |n|      (two-sided: n is flipped toward the eye; c = 1 if n = 0)
+ *     colour = surface * (ambient + diffuse * c) + specular * c^shininess, clamped to [0, 1]
+ *
+ * where v is the unit vector from the surface point to the eye: a headlight, so the light
+ * and the half vector both equal v. An empty pixel of image row y (0 = top) shows
+ * mix(background_top, background_bottom, (y + 0.5) / height). Colours go to 8 bits as
+ * round(255 * value), alpha is 255 everywhere, and images are stored top row first, 4 bytes
+ * (R, G, B, A) per pixel.
+ *
+ * The software rasterizer ip_raster_mesh() is the exact, deterministic reference: the engine
+ * tests compare images pixel by pixel with it. The GPU renderer matches it up to silhouette
+ * pixels and a few levels of rounding (see tests/test_render.c for the measured tolerances).
+ */
+#ifndef ISOPROP_RENDER_H
+#define ISOPROP_RENDER_H
+
+#include <stdint.h>
+
+#include "isoprop/camera.h"
+#include "isoprop/mesh.h"
+#include "isoprop/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The shading parameters shared by both renderers; colours are 0..1 per channel. */
+typedef struct ip_shading {
+    float surface[3];           /* the surface colour (a light bone/ivory) */
+    float ambient;              /* light a surface gets when seen edge-on */
+    float diffuse;              /* Lambert weight of the headlight */
+    float specular;             /* weight of the white highlight */
+    float shininess;            /* exponent of the highlight */
+    float background_top[3];    /* background colour of the top image row */
+    float background_bottom[3]; /* background colour of the bottom image row */
+} ip_shading;
+
+/*! ip_shading_default() : the parameters both renderers use. Thread-safe. */
+void ip_shading_default(ip_shading *shading);
+
+/*! ip_raster_mesh() : renders `mesh` in software, the reference for the GPU renderer.
+ *  `camera` gives the image size (width x height pixels) and the view; near and far planes
+ *  come from ip_camera_depth_range(camera, lo, hi), lo and hi being the world box of the
+ *  volume (world units). A pixel is covered by a triangle when its centre (x + 0.5, y + 0.5)
+ *  lies inside the triangle's projection, vertices being snapped to 1/256 pixel; a centre
+ *  exactly on an edge belongs to the triangle only for a top or a left edge, so triangles
+ *  that share an edge cover each pixel once, without gaps. Depth is compared exactly in
+ *  double precision (1 / view depth, interpolated); the nearest triangle wins, and on equal
+ *  depth the lower triangle index wins (as OpenGL's GL_LESS with triangles drawn in order).
+ *  Degenerate triangles (zero projected area) cover nothing.
+ *  `triangle_index` (may be NULL): width * height entries, top row first, filled with the
+ *  index in `mesh` of the triangle each pixel shows, or UINT32_MAX where it shows none.
+ *  `rgba` (may be NULL): width * height * 4 bytes, filled with the shaded image described at
+ *  the top of this header. Both buffers are owned by the caller.
+ *  Single-threaded; reentrant (no shared state), so calls may run concurrently.
+ *  @return IP_OK, IP_ERR_ARGUMENT (bad camera, image over 65536 pixels a side, mesh with
+ *  UINT32_MAX triangles or more) or IP_ERR_NOMEM (working buffers: about 12 bytes a pixel,
+ *  24 with rgba). */
+ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
+                         const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
+                         ip_error *err);
+
+/*! ip_png_write() : writes an image given as width * height * 4 bytes (RGBA, top row first)
+ *  as an 8-bit PNG: RGB when every alpha is 255, RGBA otherwise. The file appears only once
+ *  complete (atomic); an existing `path` is replaced only when `force` is non-zero.
+ *  Reentrant. @return IP_OK, IP_ERR_EXISTS, IP_ERR_ARGUMENT (an empty image), IP_ERR_NOMEM
+ *  or IP_ERR_IO. */
+ip_status ip_png_write(const char *path, const uint8_t *rgba, uint32_t width, uint32_t height,
+                       int force, ip_error *err);
+
+/* A headless OpenGL 3.3 core context: EGL on Mesa's surfaceless platform (no window, no
+ * display server; llvmpipe where no GPU is present). It has no default framebuffer: draw into
+ * a framebuffer object. The EGL display is process-wide and, once initialised, is left
+ * initialised, because terminating it would destroy every other context on it. */
+typedef struct ip_gl_context ip_gl_context;
+
+/*! ip_gl_context_create_headless() : creates the context and makes it current on the calling
+ *  thread. @return IP_OK, IP_ERR_UNSUPPORTED (no EGL, no surfaceless platform, no OpenGL 3.3
+ *  core: the message says which) or IP_ERR_NOMEM; *out is NULL on failure. */
+ip_status ip_gl_context_create_headless(ip_gl_context **out, ip_error *err);
+
+/*! ip_gl_context_make_current() : makes the context current on the calling thread (a no-op
+ *  when it already is). A context is current on one thread at most: release it on the other
+ *  thread first (ip_gl_context_release()). @return IP_OK or IP_ERR_UNSUPPORTED. */
+ip_status ip_gl_context_make_current(ip_gl_context *context, ip_error *err);
+
+/*! ip_gl_context_release() : makes no context current on the calling thread if `context`
+ *  is the current one there. */
+void ip_gl_context_release(ip_gl_context *context);
+
+/*! ip_gl_context_destroy() : destroys the context (NULL is a no-op); call it from the thread
+ *  where the context is current, or from any thread if it is current nowhere. */
+void ip_gl_context_destroy(ip_gl_context *context);
+
+/* The GPU renderer: holds the mesh in GPU buffers and draws it with the shading above.
+ * Every call must come from the thread where its OpenGL context is current (a headless
+ * renderer makes its own context current on the calling thread at each call); a renderer is
+ * not thread-safe. OpenGL state a call changes: the bound framebuffers, vertex array,
+ * program and array buffer, the viewport, depth test (on, GL_LESS, writes on), face culling,
+ * blending and scissor test (off), and the pack alignment. */
+typedef struct ip_renderer ip_renderer;
+
+/*! ip_renderer_create_headless() : a renderer with its own headless context and an
+ *  off-screen framebuffer of width x height pixels (RGBA8 colour, 24-bit depth).
+ *  @return IP_OK, IP_ERR_ARGUMENT (a size of 0 or over the GL limit), IP_ERR_UNSUPPORTED
+ *  (no headless OpenGL 3.3 core here) or IP_ERR_NOMEM; *out is NULL on failure. */
+ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip_renderer **out,
+                                      ip_error *err);
+
+/*! ip_renderer_create_current() : a renderer on the OpenGL 3.3 core (or later) context that
+ *  is current on the calling thread (for example a window's), drawing into `framebuffer` (0:
+ *  the default framebuffer) of width x height pixels. The caller keeps the context current
+ *  for every later call, destroy included, and owns the framebuffer.
+ *  @return IP_OK, IP_ERR_ARGUMENT, IP_ERR_UNSUPPORTED (no current context, or older than 3.3
+ *  core) or IP_ERR_NOMEM. */
+ip_status ip_renderer_create_current(uint32_t width, uint32_t height, uint32_t framebuffer,
+                                     ip_renderer **out, ip_error *err);
+
+/*! ip_renderer_resize() : changes the image size (pixels). A headless renderer reallocates
+ *  its off-screen framebuffer; otherwise the caller has resized its framebuffer already.
+ *  @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM (the old size remains). */
+ip_status ip_renderer_resize(ip_renderer *renderer, uint32_t width, uint32_t height,
+                             ip_error *err);
+
+/*! ip_renderer_upload() : appends the triangles [first_triangle, mesh->triangle_count) of
+ *  `mesh` to the renderer's GPU buffers. The buffers grow geometrically, copying what they
+ *  hold on the GPU, so what was uploaded before is never sent again. The caller keeps `mesh`
+ *  (it is read during the call only) and decides what to append: passing the count uploaded
+ *  so far appends exactly the triangles added since.
+ *  @return IP_OK, IP_ERR_ARGUMENT (first_triangle > mesh->triangle_count) or IP_ERR_NOMEM
+ *  (GPU memory; nothing of this call is kept). */
+ip_status ip_renderer_upload(ip_renderer *renderer, const ip_mesh *mesh,
+                             uint64_t first_triangle, ip_error *err);
+
+/*! ip_renderer_clear_mesh() : forgets every uploaded triangle, keeping the GPU buffers. */
+void ip_renderer_clear_mesh(ip_renderer *renderer);
+
+/*! ip_renderer_triangle_count() : the number of triangles uploaded and not cleared. */
+uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
+
+/*! ip_renderer_draw() : draws the background and the uploaded triangles in upload order,
+ *  seen by `camera` (whose width and height must be the renderer's), with near and far planes
+ *  from ip_camera_depth_range(camera, lo, hi) for the volume's world box [lo, hi].
+ *  The image is complete when the call returns from the caller's point of view (OpenGL may
+ *  still be working: ip_renderer_read_rgba() waits for it).
+ *  @return IP_OK, IP_ERR_ARGUMENT (bad camera, size mismatch) or IP_ERR_UNSUPPORTED (an
+ *  OpenGL error, named in the message). */
+ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera, const double lo[3],
+                           const double hi[3], ip_error *err);
+
+/*! ip_renderer_read_rgba() : copies the image drawn last into `rgba` (width * height * 4
+ *  bytes, caller-owned), top row first, waiting for OpenGL to finish.
+ *  @return IP_OK or IP_ERR_UNSUPPORTED (an OpenGL error). */
+ip_status ip_renderer_read_rgba(ip_renderer *renderer, uint8_t *rgba, ip_error *err);
+
+/*! ip_renderer_destroy() : frees the GPU objects and, for a headless renderer, its context
+ *  (NULL is a no-op). A renderer on the caller's context needs that context current. */
+void ip_renderer_destroy(ip_renderer *renderer);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

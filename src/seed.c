@@ -1,0 +1,253 @@
+/* Ray seeding through the min/max octree: root -> bricks -> sub-blocks -> cells, front to back. */
+#include <math.h>
+#include <string.h>
+
+#include "seed.h"
+
+/* The ray in the level's index space, where cell (i, j, k) is the box [i, i+1] x ... . The
+ * parameter t stays the world distance along the ray. */
+typedef struct index_ray {
+    double origin[3], dir[3];
+    const double *world_origin, *world_dir;
+} index_ray;
+
+/* Clips the ray to the index box [lo, hi]; returns 0 when it misses it or only behind t0. */
+static int clip(const index_ray *r, const double lo[3], const double hi[3], double *t0,
+                double *t1)
+{
+    double a = *t0, b = *t1;
+    for (int k = 0; k < 3; k++) {
+        if (r->dir[k] == 0.0) {
+            if (r->origin[k] < lo[k] || r->origin[k] > hi[k])
+                return 0;
+            continue;
+        }
+        double inv = 1.0 / r->dir[k];
+        double ta = (lo[k] - r->origin[k]) * inv, tb = (hi[k] - r->origin[k]) * inv;
+        if (ta > tb) {
+            double t = ta;
+            ta = tb;
+            tb = t;
+        }
+        a = ta > a ? ta : a;
+        b = tb < b ? tb : b;
+    }
+    *t0 = a;
+    *t1 = b;
+    return a <= b;
+}
+
+/* A 3D DDA over a grid of `n` cells of edge `edge` (index units) starting at `base`. */
+typedef struct dda {
+    int32_t i[3], n[3], step[3];
+    double t_max[3], t_delta[3], t, t_end;
+} dda;
+
+static void dda_init(dda *d, const index_ray *r, const double base[3], double edge,
+                     const uint32_t n[3], double t0, double t1)
+{
+    double mid = t0; /* the entry point: nudge inwards along the ray */
+    double len = fmax(fabs(r->dir[0]), fmax(fabs(r->dir[1]), fabs(r->dir[2])));
+    mid += 1e-9 * edge / (len > 0 ? len : 1);
+    if (mid > t1)
+        mid = 0.5 * (t0 + t1);
+    for (int k = 0; k < 3; k++) {
+        double p = r->origin[k] + mid * r->dir[k];
+        int32_t c = (int32_t)floor((p - base[k]) / edge);
+        c = c < 0 ? 0 : c >= (int32_t)n[k] ? (int32_t)n[k] - 1 : c;
+        d->i[k] = c;
+        d->n[k] = (int32_t)n[k];
+        if (r->dir[k] > 0) {
+            d->step[k] = 1;
+            d->t_max[k] = (base[k] + (c + 1) * edge - r->origin[k]) / r->dir[k];
+            d->t_delta[k] = edge / r->dir[k];
+        } else if (r->dir[k] < 0) {
+            d->step[k] = -1;
+            d->t_max[k] = (base[k] + c * edge - r->origin[k]) / r->dir[k];
+            d->t_delta[k] = -edge / r->dir[k];
+        } else {
+            d->step[k] = 0;
+            d->t_max[k] = INFINITY;
+            d->t_delta[k] = INFINITY;
+        }
+    }
+    d->t = t0;
+    d->t_end = t1;
+}
+
+/* The current cell's exit parameter; advances to the next cell. Returns 0 when past the end. */
+static int dda_next(dda *d, double *exit_t)
+{
+    int k = d->t_max[0] < d->t_max[1] ? (d->t_max[0] < d->t_max[2] ? 0 : 2)
+                                      : (d->t_max[1] < d->t_max[2] ? 1 : 2);
+    *exit_t = d->t_max[k] < d->t_end ? d->t_max[k] : d->t_end;
+    if (d->t_max[k] > d->t_end || d->step[k] == 0)
+        return 0;
+    d->t = d->t_max[k];
+    d->i[k] += d->step[k];
+    d->t_max[k] += d->t_delta[k];
+    return d->i[k] >= 0 && d->i[k] < d->n[k];
+}
+
+static int active(const float *range, float iso)
+{
+    return ip_range_active(range[0], range[1], iso);
+}
+
+/* Tests the cells of one sub-block (cells [lo, hi) in level coordinates) along the ray. */
+static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], const uint32_t hi[3],
+                      double t0, double t1, uint32_t cell[3])
+{
+    double base[3] = {lo[0], lo[1], lo[2]};
+    uint32_t n[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    dda d;
+    dda_init(&d, r, base, 1.0, n, t0, t1);
+    for (;;) {
+        uint32_t c[3] = {lo[0] + (uint32_t)d.i[0], lo[1] + (uint32_t)d.i[1], lo[2] + (uint32_t)d.i[2]};
+        float values[8];
+        if (!ip_sampler_cell_values(s->sampler, c, values))
+            return -1;
+        unsigned mc = ip_mc_case(values, s->iso);
+        if (mc != 0 && mc != 255) {
+            float origin[3], size[3], ro[3], rd[3], t;
+            ip_sampler_cell_box(s->sampler, c, origin, size);
+            for (int k = 0; k < 3; k++) {
+                /* the ray from the cell's corner keeps float precision in large volumes */
+                ro[k] = (float)(r->world_origin[k] - origin[k]);
+                rd[k] = (float)r->world_dir[k];
+                origin[k] = 0.0f;
+            }
+            s->cells_tested++;
+            if (ip_mc_ray_hits_cell(values, s->iso, origin, size, ro, rd, &t)) {
+                memcpy(cell, c, sizeof c);
+                return 1;
+            }
+        }
+        double exit_t;
+        if (!dda_next(&d, &exit_t))
+            return 0;
+    }
+}
+
+/* Walks the sub-blocks of brick `b` front to back. */
+static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], double t0, double t1,
+                      uint32_t cell[3])
+{
+    const ip_layout *l = s->layout;
+    uint32_t origin[3], extent[3];
+    ip_brick_extent(l, s->level, b, origin, extent);
+    uint64_t g = ip_brick_global_index(l, s->level, b);
+    const float *ranges = ip_store_subblock_ranges(s->store, g);
+    uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
+    uint32_t n[3];
+    for (int k = 0; k < 3; k++)
+        n[k] = (extent[k] - 1 + se - 1) / se; /* sub-blocks that hold cells */
+    double base[3] = {origin[0], origin[1], origin[2]};
+    dda d;
+    dda_init(&d, r, base, se, n, t0, t1);
+    for (;;) {
+        int32_t at[3] = {d.i[0], d.i[1], d.i[2]};
+        double enter_t = d.t, exit_t;
+        int more = dda_next(&d, &exit_t);
+        uint32_t sb = (uint32_t)at[0] + per * ((uint32_t)at[1] + per * (uint32_t)at[2]);
+        if (active(&ranges[2 * sb], s->iso)) {
+            uint32_t lo[3], hi[3], last[3];
+            for (int k = 0; k < 3; k++) {
+                lo[k] = origin[k] + se * (uint32_t)at[k];
+                last[k] = origin[k] + extent[k] - 1; /* one past the brick's last cell */
+                hi[k] = lo[k] + se < last[k] ? lo[k] + se : last[k];
+            }
+            int found = walk_cells(s, r, lo, hi, enter_t, exit_t, cell);
+            if (found)
+                return found;
+        }
+        if (!more)
+            return 0;
+    }
+}
+
+typedef struct child_hit {
+    uint32_t node[3];
+    double t0, t1;
+} child_hit;
+
+/* Index box of octree node `node` at `depth` (depth 0: a brick). */
+static void node_box(const ip_seeder *s, uint32_t depth, const uint32_t node[3], double lo[3],
+                     double hi[3])
+{
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    for (int k = 0; k < 3; k++) {
+        uint64_t span = (uint64_t)s->layout->brick_edge << depth;
+        uint64_t a = node[k] * span, b = a + span, cells = lv->dims[k] - 1;
+        lo[k] = (double)a;
+        hi[k] = (double)(b < cells ? b : cells);
+    }
+}
+
+static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uint32_t node[3],
+                     double t0, double t1, uint32_t cell[3])
+{
+    if (depth == 0)
+        return walk_brick(s, r, node, t0, t1, cell);
+    child_hit hits[8];
+    int count = 0;
+    uint32_t grid[3];
+    ip_octree_grid(s->layout, s->level, depth - 1, grid);
+    for (int c = 0; c < 8; c++) {
+        uint32_t ch[3] = {2 * node[0] + (c & 1), 2 * node[1] + ((c >> 1) & 1),
+                          2 * node[2] + ((c >> 2) & 1)};
+        if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
+            continue;
+        if (!active(ip_store_node_range(s->store, s->level, depth - 1, ch), s->iso))
+            continue;
+        double lo[3], hi[3], a = t0, b = t1;
+        node_box(s, depth - 1, ch, lo, hi);
+        if (!clip(r, lo, hi, &a, &b))
+            continue;
+        int at = count++;
+        while (at > 0 && hits[at - 1].t0 > a) { /* insertion sort: front to back */
+            hits[at] = hits[at - 1];
+            at--;
+        }
+        hits[at] = (child_hit){{ch[0], ch[1], ch[2]}, a, b};
+    }
+    for (int i = 0; i < count; i++) {
+        int found = walk_node(s, r, depth - 1, hits[i].node, hits[i].t0, hits[i].t1, cell);
+        if (found)
+            return found;
+    }
+    return 0;
+}
+
+void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso)
+{
+    memset(s, 0, sizeof *s);
+    s->sampler = sampler;
+    s->store = ip_cache_store(sampler->cache);
+    s->layout = sampler->layout;
+    s->level = sampler->level;
+    s->iso = iso;
+    for (int k = 0; k < 3; k++)
+        s->scale[k] = s->layout->spacing[k] * (double)(1u << s->level);
+}
+
+int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], uint32_t cell[3])
+{
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    uint32_t root[3] = {0, 0, 0};
+    uint32_t depth = lv->octree_depth;
+    if (!active(ip_store_node_range(s->store, s->level, depth, root), s->iso))
+        return 0;
+    index_ray r;
+    for (int k = 0; k < 3; k++) {
+        r.origin[k] = eye[k] / s->scale[k];
+        r.dir[k] = dir[k] / s->scale[k];
+    }
+    r.world_origin = eye;
+    r.world_dir = dir;
+    double lo[3], hi[3], t0 = 0.0, t1 = INFINITY;
+    node_box(s, depth, root, lo, hi);
+    if (!clip(&r, lo, hi, &t0, &t1))
+        return 0;
+    return walk_node(s, &r, depth, root, t0, t1, cell);
+}

@@ -1,0 +1,466 @@
+/* Tests of the software rasterizer (coverage, fill rule, depth, clipping, shading) and PNGs. */
+#include <math.h>
+#include <png.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "check.h"
+#include "isoprop/render.h"
+
+enum { W = 64, H = 48 };
+
+static const double box_lo[3] = {-20, -20, -20}, box_hi[3] = {20, 20, 5};
+
+/* Looks down -z from z = 10: depth 10 is the plane z = 0. */
+static ip_camera front_camera(uint32_t width, uint32_t height)
+{
+    ip_camera c = {.eye = {0, 0, 10}, .target = {0, 0, 0}, .up = {0, 1, 0}, .fov_y = 60,
+                   .width = width, .height = height};
+    return c;
+}
+
+/* The world point that projects to image point (px, py) at view depth `depth`. */
+static void point_at(const ip_camera *c, double px, double py, double depth, float out[3])
+{
+    ip_camera_basis b;
+    ip_camera_basis_of(c, &b);
+    double nx = (2.0 * px / c->width - 1.0) * b.tan_half_x;
+    double ny = (1.0 - 2.0 * py / c->height) * b.tan_half_y;
+    for (int i = 0; i < 3; i++)
+        out[i] = (float)(c->eye[i] + depth * (b.forward[i] + nx * b.right[i] + ny * b.up[i]));
+}
+
+/* Appends the triangle with image points (x, y) at depth `depth`; normals face the eye. */
+static void add_screen_triangle(ip_mesh *m, const ip_camera *c, const double xy[6], double depth)
+{
+    float p[9], n[9];
+    uint64_t cell = m->triangle_count;
+    for (int k = 0; k < 3; k++) {
+        point_at(c, xy[2 * k], xy[2 * k + 1], depth, p + 3 * k);
+        n[3 * k] = 0, n[3 * k + 1] = 0, n[3 * k + 2] = 1;
+    }
+    REQUIRE(ip_mesh_append(m, p, n, &cell, 1) == IP_OK);
+}
+
+/* Coverage of one triangle alone: 1 where covered. */
+static void coverage_of(const ip_camera *c, const double xy[6], double depth, uint8_t *covered)
+{
+    ip_mesh m;
+    ip_mesh_init(&m);
+    add_screen_triangle(&m, c, xy, depth);
+    uint32_t *index = malloc((size_t)c->width * c->height * sizeof *index);
+    REQUIRE(index);
+    REQUIRE(ip_raster_mesh(&m, c, box_lo, box_hi, index, NULL, NULL) == IP_OK);
+    for (size_t i = 0; i < (size_t)c->width * c->height; i++)
+        covered[i] = index[i] == 0;
+    free(index);
+    ip_mesh_free(&m);
+}
+
+static void test_single_triangle(void)
+{
+    ip_camera c = front_camera(W, H);
+    /* vertices on pixel centres: the top and left edges pass through centres (included), the
+     * hypotenuse too (a right edge: excluded) */
+    const double orders[2][6] = {{2.5, 2.5, 10.5, 2.5, 2.5, 10.5},
+                                 {2.5, 2.5, 2.5, 10.5, 10.5, 2.5}};
+    for (int o = 0; o < 2; o++) {
+        uint8_t covered[W * H];
+        coverage_of(&c, orders[o], 10.0, covered);
+        int wrong = 0, count = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                int expected = x >= 2 && y >= 2 && x + y <= 11;
+                wrong += covered[y * W + x] != expected;
+                count += covered[y * W + x];
+            }
+        CHECK_MSG(wrong == 0, "winding %d: %d pixels differ from the fill rule", o, wrong);
+        CHECK(count == 36);
+    }
+}
+
+/* Covers the triangles one at a time; counts pixels covered twice and fills the union. */
+static int union_coverage(const ip_camera *c, const double (*tri)[6], int count, uint8_t *out)
+{
+    size_t pixels = (size_t)c->width * c->height;
+    uint8_t *one = malloc(pixels);
+    REQUIRE(one);
+    memset(out, 0, pixels);
+    int twice = 0;
+    for (int t = 0; t < count; t++) {
+        coverage_of(c, tri[t], 10.0, one);
+        for (size_t i = 0; i < pixels; i++) {
+            twice += one[i] && out[i];
+            out[i] |= one[i];
+        }
+    }
+    free(one);
+    return twice;
+}
+
+static void test_shared_edges_square(void)
+{
+    ip_camera c = front_camera(W, H);
+    const double split[2][6] = {{2.5, 2.5, 10.5, 2.5, 2.5, 10.5},
+                                {10.5, 10.5, 2.5, 10.5, 10.5, 2.5}};
+    uint8_t all[W * H];
+    CHECK(union_coverage(&c, split, 2, all) == 0);
+    int wrong = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            wrong += all[y * W + x] != (x >= 2 && x <= 9 && y >= 2 && y <= 9);
+    CHECK_MSG(wrong == 0, "%d pixels of the split square are wrong", wrong);
+}
+
+/* A convex polygon triangulated two ways (a fan from its centre, a fan from a corner) must
+ * cover the same pixels, each once. Vertices on pixel centres put many centres on edges. */
+static void check_polygon(const ip_camera *c, const double *xy, int n, double cx, double cy)
+{
+    double centre_fan[16][6], corner_fan[16][6];
+    for (int i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        double t[6] = {cx, cy, xy[2 * i], xy[2 * i + 1], xy[2 * j], xy[2 * j + 1]};
+        memcpy(centre_fan[i], t, sizeof t);
+    }
+    for (int i = 1; i + 1 < n; i++) {
+        double t[6] = {xy[0], xy[1], xy[2 * i], xy[2 * i + 1], xy[2 * i + 2], xy[2 * i + 3]};
+        memcpy(corner_fan[i - 1], t, sizeof t);
+    }
+    size_t pixels = (size_t)c->width * c->height;
+    uint8_t *a = malloc(pixels), *b = malloc(pixels);
+    REQUIRE(a && b);
+    CHECK(union_coverage(c, (const double(*)[6])centre_fan, n, a) == 0);
+    CHECK(union_coverage(c, (const double(*)[6])corner_fan, n - 2, b) == 0);
+    CHECK(memcmp(a, b, pixels) == 0);
+    free(a);
+    free(b);
+}
+
+static void test_shared_edges_polygons(void)
+{
+    ip_camera c = front_camera(W, H);
+    srand(7);
+    for (int trial = 0; trial < 40; trial++) {
+        int n = 3 + rand() % 10;
+        double xy[32], cx = 32, cy = 24, radius = 6 + rand() % 14;
+        double phase = rand() / (double)RAND_MAX;
+        int on_centres = trial % 2 == 0;
+        for (int i = 0; i < n; i++) {
+            double angle = 2 * M_PI * (i + phase) / n;
+            double x = cx + radius * cos(angle), y = cy + radius * sin(angle);
+            if (on_centres)
+                x = floor(x) + 0.5, y = floor(y) + 0.5;
+            xy[2 * i] = x;
+            xy[2 * i + 1] = y;
+        }
+        check_polygon(&c, xy, n, on_centres ? 32.5 : cx, on_centres ? 24.5 : cy);
+    }
+}
+
+static void test_depth(void)
+{
+    ip_camera c = front_camera(W, H);
+    const double big[6] = {1, 1, 60, 1, 1, 45}, small[6] = {10, 10, 30, 10, 10, 30};
+    uint32_t index[W * H];
+    for (int order = 0; order < 2; order++) {
+        ip_mesh m;
+        ip_mesh_init(&m);
+        add_screen_triangle(&m, &c, order ? small : big, order ? 8.0 : 10.0);
+        add_screen_triangle(&m, &c, order ? big : small, order ? 10.0 : 8.0);
+        REQUIRE(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, NULL) == IP_OK);
+        uint32_t near_index = order ? 0 : 1;
+        CHECK(index[15 * W + 15] == near_index); /* inside both: the nearer one */
+        CHECK(index[5 * W + 40] == 1 - near_index); /* the big one alone */
+        CHECK(index[40 * W + 40] == UINT32_MAX);
+        ip_mesh_free(&m);
+    }
+    /* equal depth: the lower index wins */
+    ip_mesh m;
+    ip_mesh_init(&m);
+    add_screen_triangle(&m, &c, small, 9.0);
+    add_screen_triangle(&m, &c, small, 9.0);
+    REQUIRE(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, NULL) == IP_OK);
+    int second = 0, first = 0;
+    for (int i = 0; i < W * H; i++) {
+        second += index[i] == 1;
+        first += index[i] == 0;
+    }
+    CHECK(first > 100 && second == 0);
+    ip_mesh_free(&m);
+}
+
+/* A cube [-1, 1]^3 with outward normals: 12 triangles, each face's normal in `face`. */
+static void build_cube(ip_mesh *m, float face[12][3])
+{
+    static const int quads[6][4][3] = {
+        {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},
+        {{-1, -1, -1}, {-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}},
+        {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},
+        {{-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}},
+        {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},
+        {{-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {1, -1, -1}}};
+    static const float normals[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
+                                        {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    ip_mesh_init(m);
+    for (int f = 0; f < 6; f++)
+        for (int half = 0; half < 2; half++) {
+            const int corner[3] = {0, half ? 2 : 1, half ? 3 : 2};
+            float p[9], n[9];
+            for (int k = 0; k < 3; k++)
+                for (int i = 0; i < 3; i++) {
+                    p[3 * k + i] = (float)quads[f][corner[k]][i];
+                    n[3 * k + i] = normals[f][i];
+                }
+            uint64_t cell = (uint64_t)f;
+            memcpy(face[2 * f + half], normals[f], sizeof normals[f]);
+            REQUIRE(ip_mesh_append(m, p, n, &cell, 1) == IP_OK);
+        }
+}
+
+/* 1 when the ray from `o` along `d` meets the box [-1, 1]^3 in front of `o`. */
+static int ray_hits_cube(const double o[3], const double d[3])
+{
+    double t0 = 0, t1 = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        double a = (-1 - o[i]) / d[i], b = (1 - o[i]) / d[i];
+        t0 = fmax(t0, fmin(a, b));
+        t1 = fmin(t1, fmax(a, b));
+    }
+    return t0 <= t1;
+}
+
+static void test_cube(void)
+{
+    ip_camera c = {.eye = {3.1, 2.3, 4.7}, .target = {0, 0, 0}, .up = {0, 0, 1}, .fov_y = 40,
+                   .width = 160, .height = 120};
+    const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+    ip_mesh m;
+    float face[12][3];
+    build_cube(&m, face);
+    size_t pixels = (size_t)c.width * c.height;
+    uint32_t *index = malloc(pixels * sizeof *index);
+    uint8_t *rgba = malloc(pixels * 4);
+    REQUIRE(index && rgba);
+    REQUIRE(ip_raster_mesh(&m, &c, lo, hi, index, rgba, NULL) == IP_OK);
+    ip_camera_basis basis;
+    ip_camera_basis_of(&c, &basis);
+    int covered = 0, back_faces = 0, ray_mismatch = 0;
+    for (uint32_t y = 0; y < c.height; y++)
+        for (uint32_t x = 0; x < c.width; x++) {
+            uint32_t t = index[y * c.width + x];
+            double ray[3];
+            ip_camera_pixel_ray(&basis, &c, x + 0.5, y + 0.5, ray);
+            ray_mismatch += ray_hits_cube(c.eye, ray) != (t != UINT32_MAX);
+            if (t == UINT32_MAX)
+                continue;
+            covered++;
+            const float *p = m.positions + 9 * t;
+            double facing = 0;
+            for (int i = 0; i < 3; i++)
+                facing += face[t][i] * (c.eye[i] - p[i]);
+            back_faces += facing <= 0;
+        }
+    CHECK(covered > 1000);
+    CHECK_MSG(back_faces == 0, "%d pixels show a back face", back_faces);
+    CHECK_MSG(ray_mismatch <= covered / 200, "%d of %d pixels disagree with ray casting",
+              ray_mismatch, covered);
+    /* shading: background rows exact, surfaces between the darkest and the brightest colour */
+    ip_shading s;
+    ip_shading_default(&s);
+    int out_of_range = 0, bad_background = 0;
+    for (uint32_t y = 0; y < c.height; y++)
+        for (uint32_t x = 0; x < c.width; x++) {
+            const uint8_t *px = rgba + 4 * ((size_t)y * c.width + x);
+            out_of_range += px[3] != 255;
+            for (int i = 0; i < 3; i++) {
+                if (index[y * c.width + x] == UINT32_MAX) {
+                    double t = (y + 0.5) / c.height;
+                    double top = s.background_top[i], bottom = s.background_bottom[i];
+                    bad_background += px[i] != (int)lround((top + t * (bottom - top)) * 255);
+                    continue;
+                }
+                double dark = 255 * s.surface[i] * s.ambient;
+                double bright = 255 * (s.surface[i] * (s.ambient + s.diffuse) + s.specular);
+                out_of_range += px[i] < floor(dark) || px[i] > ceil(fmin(bright, 255));
+            }
+        }
+    CHECK(out_of_range == 0);
+    CHECK(bad_background == 0);
+    /* two-sided lighting: inward normals give the same image */
+    uint8_t *flipped = malloc(pixels * 4);
+    REQUIRE(flipped);
+    for (uint64_t i = 0; i < 9 * m.triangle_count; i++)
+        m.normals[i] = -m.normals[i];
+    REQUIRE(ip_raster_mesh(&m, &c, lo, hi, NULL, flipped, NULL) == IP_OK);
+    CHECK(memcmp(rgba, flipped, pixels * 4) == 0);
+    free(flipped);
+    free(index);
+    free(rgba);
+    ip_mesh_free(&m);
+}
+
+static void test_head_on_shading(void)
+{
+    ip_camera c = front_camera(W, H);
+    ip_mesh m;
+    ip_mesh_init(&m);
+    const double xy[6] = {20, 10, 44, 10, 32, 40};
+    add_screen_triangle(&m, &c, xy, 10.0);
+    uint8_t rgba[W * H * 4];
+    REQUIRE(ip_raster_mesh(&m, &c, box_lo, box_hi, NULL, rgba, NULL) == IP_OK);
+    ip_shading s;
+    ip_shading_default(&s);
+    const uint8_t *centre = rgba + 4 * (24 * W + 32);
+    for (int i = 0; i < 3; i++) {
+        double bright = fmin(1.0, s.surface[i] * (s.ambient + s.diffuse) + s.specular);
+        CHECK(abs(centre[i] - (int)lround(255 * bright)) <= 1);
+    }
+    ip_mesh_free(&m);
+}
+
+/* A ground plane much larger than the view, reaching behind the eye: near-plane and
+ * guard-band clipping must leave exactly the pixels whose rays meet it. */
+static void test_clipping(void)
+{
+    ip_camera c = {.eye = {0, -5, 2}, .target = {0, 10, 0}, .up = {0, 0, 1}, .fov_y = 70,
+                   .width = 120, .height = 90};
+    const double lo[3] = {-1000, -1000, -1}, hi[3] = {1000, 1000, 1};
+    const float p[18] = {-1000, -1000, 0, 1000, -1000, 0, 1000, 1000, 0,
+                         -1000, -1000, 0, 1000, 1000, 0, -1000, 1000, 0};
+    const float n[18] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const uint64_t cells[2] = {0, 1};
+    ip_mesh m;
+    ip_mesh_init(&m);
+    REQUIRE(ip_mesh_append(&m, p, n, cells, 2) == IP_OK);
+    uint32_t index[120 * 90];
+    REQUIRE(ip_raster_mesh(&m, &c, lo, hi, index, NULL, NULL) == IP_OK);
+    ip_camera_basis b;
+    ip_camera_basis_of(&c, &b);
+    double near_plane, far_plane;
+    ip_camera_depth_range(&c, lo, hi, &near_plane, &far_plane);
+    int covered = 0, mismatch = 0;
+    for (uint32_t y = 0; y < c.height; y++)
+        for (uint32_t x = 0; x < c.width; x++) {
+            double d[3];
+            ip_camera_pixel_ray(&b, &c, x + 0.5, y + 0.5, d);
+            double t = d[2] < 0 ? -c.eye[2] / d[2] : -1;
+            double hx = c.eye[0] + t * d[0], hy = c.eye[1] + t * d[1];
+            double depth = t * (d[0] * b.forward[0] + d[1] * b.forward[1] + d[2] * b.forward[2]);
+            int hit = t > 0 && fabs(hx) <= 1000 && fabs(hy) <= 1000 && depth >= near_plane &&
+                      depth <= far_plane;
+            uint32_t i = index[y * c.width + x];
+            covered += i != UINT32_MAX;
+            mismatch += hit != (i != UINT32_MAX) || (i != UINT32_MAX && i > 1);
+        }
+    CHECK(covered > 120 * 90 / 3);
+    CHECK_MSG(mismatch <= covered / 200, "%d of %d pixels disagree with ray casting", mismatch,
+              covered);
+    /* a triangle wholly behind the eye covers nothing */
+    ip_mesh_clear(&m);
+    const float behind[9] = {-1, -20, 2, 1, -20, 2, 0, -20, 3};
+    REQUIRE(ip_mesh_append(&m, behind, n, cells, 1) == IP_OK);
+    REQUIRE(ip_raster_mesh(&m, &c, lo, hi, index, NULL, NULL) == IP_OK);
+    int any = 0;
+    for (int i = 0; i < 120 * 90; i++)
+        any += index[i] != UINT32_MAX;
+    CHECK(any == 0);
+    ip_mesh_free(&m);
+}
+
+static void test_bad_arguments(void)
+{
+    ip_mesh m;
+    ip_mesh_init(&m);
+    ip_camera c = front_camera(W, H);
+    uint32_t index[W * H];
+    ip_error err;
+    c.fov_y = 0;
+    CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err) == IP_ERR_ARGUMENT);
+    c = front_camera(70000, 2);
+    CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, NULL, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK_CONTAINS(err.message, "larger");
+    /* an empty mesh: only background */
+    c = front_camera(W, H);
+    CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err) == IP_OK);
+    int any = 0;
+    for (int i = 0; i < W * H; i++)
+        any += index[i] != UINT32_MAX;
+    CHECK(any == 0);
+}
+
+/* Reads a PNG back as RGBA with libpng; returns the pixels (malloc) and whether it had alpha. */
+static uint8_t *read_png(const char *path, uint32_t *w, uint32_t *h, int *had_alpha)
+{
+    png_image image;
+    memset(&image, 0, sizeof image);
+    image.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&image, path))
+        return NULL;
+    *had_alpha = (image.format & PNG_FORMAT_FLAG_ALPHA) != 0;
+    image.format = PNG_FORMAT_RGBA;
+    uint8_t *pixels = malloc(PNG_IMAGE_SIZE(image));
+    if (!pixels || !png_image_finish_read(&image, NULL, pixels, 0, NULL)) {
+        free(pixels);
+        png_image_free(&image);
+        return NULL;
+    }
+    *w = image.width;
+    *h = image.height;
+    return pixels;
+}
+
+static void test_png(void)
+{
+    const char *dir = test_tmp_dir("test_raster");
+    char path[4200];
+    snprintf(path, sizeof path, "%s/image.png", dir);
+    enum { PW = 37, PH = 23 };
+    uint8_t rgba[PW * PH * 4];
+    srand(3);
+    for (int opaque = 0; opaque < 2; opaque++) {
+        for (int i = 0; i < PW * PH * 4; i++)
+            rgba[i] = (uint8_t)(i % 4 == 3 && opaque ? 255 : rand() & 255);
+        ip_error err;
+        CHECK(ip_png_write(path, rgba, PW, PH, opaque, &err) == IP_OK);
+        uint32_t w = 0, h = 0;
+        int had_alpha = -1;
+        uint8_t *back = read_png(path, &w, &h, &had_alpha);
+        CHECK(back != NULL);
+        if (back) {
+            CHECK(w == PW && h == PH);
+            CHECK(had_alpha == !opaque);
+            CHECK(memcmp(back, rgba, sizeof rgba) == 0);
+        }
+        free(back);
+    }
+    /* an existing file is kept without force */
+    struct stat before, after;
+    REQUIRE(stat(path, &before) == 0);
+    ip_error err;
+    memset(rgba, 0, sizeof rgba);
+    CHECK(ip_png_write(path, rgba, PW, PH, 0, &err) == IP_ERR_EXISTS);
+    CHECK_CONTAINS(err.message, "exists");
+    REQUIRE(stat(path, &after) == 0);
+    CHECK(before.st_size == after.st_size && before.st_ino == after.st_ino);
+    CHECK(ip_png_write(path, rgba, 0, PH, 1, &err) == IP_ERR_ARGUMENT);
+    snprintf(path, sizeof path, "%s/missing/image.png", dir);
+    CHECK(ip_png_write(path, rgba, PW, PH, 0, &err) == IP_ERR_IO);
+    CHECK(stat(path, &after) != 0);
+}
+
+int main(void)
+{
+    test_single_triangle();
+    test_shared_edges_square();
+    test_shared_edges_polygons();
+    test_depth();
+    test_cube();
+    test_head_on_shading();
+    test_clipping();
+    test_bad_arguments();
+    test_png();
+    return test_summary("test_raster");
+}
