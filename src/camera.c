@@ -145,23 +145,32 @@ ip_status ip_camera_fit_axis(const double lo[3], const double hi[3], const char 
         return ip_fail(err, IP_ERR_ARGUMENT, "view '%s' is not one of +x -x +y -y +z -z",
                        axis ? axis : "");
     int a = axis[1] - 'x';
-    double sign = axis[0] == '+' ? 1.0 : -1.0, centre[3], radius = 0;
-    for (int i = 0; i < 3; i++) {
+    double sign = axis[0] == '+' ? 1.0 : -1.0, centre[3];
+    for (int i = 0; i < 3; i++)
         centre[i] = 0.5 * (lo[i] + hi[i]);
-        radius += 0.25 * (hi[i] - lo[i]) * (hi[i] - lo[i]);
-    }
-    radius = sqrt(radius);
     memset(out, 0, sizeof *out);
     out->fov_y = fov_y;
     out->width = width;
     out->height = height;
-    double half_y = fov_y * DEG / 2;
-    double half_x = atan(tan(half_y) * (double)width / (double)height);
-    double distance = radius / sin(fmin(half_x, half_y));
+    out->up[a == 2 ? 1 : 2] = 1.0;
+    /* the image's horizontal axis is the remaining one, the vertical one is up */
+    int v = a == 2 ? 1 : 2, u = 3 - a - v;
+    double tan_y = tan(fov_y * DEG / 2), tan_x = tan_y * (double)width / (double)height;
+    /* the nearest eye distance from the centre at which all 8 corners project inside the
+     * frame: a corner offset (du, dv) across and dw towards the eye needs
+     * distance >= dw + |du| / tan_x and >= dw + |dv| / tan_y */
+    double distance = 0;
+    for (int k = 0; k < 8; k++) {
+        double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
+        double du = fabs(p[u] - centre[u]), dv = fabs(p[v] - centre[v]);
+        double dw = sign * (p[a] - centre[a]);
+        distance = fmax(distance, dw + du / tan_x);
+        distance = fmax(distance, dw + dv / tan_y);
+    }
+    distance *= 1.04; /* a small margin around the volume */
     memcpy(out->target, centre, sizeof centre);
     memcpy(out->eye, centre, sizeof centre);
     out->eye[a] += sign * distance;
-    out->up[a == 2 ? 1 : 2] = 1.0;
     return ip_camera_check(out, err);
 }
 

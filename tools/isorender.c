@@ -1,0 +1,452 @@
+/* isorender: extract an isosurface progressively (or fully) and render it to PNG, headless. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "isoprop/cache.h"
+#include "isoprop/engine.h"
+#include "isoprop/render.h"
+#include "isoprop/store.h"
+#include "tool_common.h"
+
+static const char usage[] =
+    "usage: isorender FILE.ibv --iso V [options]\n"
+    "Extracts the isosurface V progressively (rays in the paper's order) and renders it to PNG\n"
+    "with OpenGL 3.3 core through EGL (no display needed).\n"
+    "  --size WxH          image size in pixels (default 1600x1200)\n"
+    "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
+    "                      (default -y; up is +z, or +y for the z views)\n"
+    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n"
+    "  --rays N            stop after N rays (default: every pixel)\n"
+    "  --time SECONDS      stop extracting after this long\n"
+    "  --cutoff DEGREES    propagation cut-off angle (default 1.81)\n"
+    "  --foldback DEGREES  fold-back tolerance (default 0.25)\n"
+    "  --full              triangulate every active cell instead (the baseline)\n"
+    "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
+    "  -o OUT.png          the image (default isorender.png)\n"
+    "  --mesh OUT.ply      also write the triangles as binary PLY\n"
+    "  --stats OUT.json    counts, times and the cache statistics as JSON\n"
+    "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct at checkpoints\n"
+    "  --software          render with the software rasterizer instead of OpenGL\n"
+    "  --force             replace existing outputs\n"
+    "  --quiet             print nothing but errors\n";
+
+typedef struct options {
+    const char *file, *out, *mesh, *stats, *progress, *view, *camera;
+    double iso, time_limit, cutoff, foldback;
+    int has_iso, full, software, force, quiet;
+    uint64_t rays, cache_bytes;
+    uint32_t width, height;
+} options;
+
+typedef struct checkpoint {
+    double time;
+    uint64_t rays, seeds, cells, triangles;
+    double final_pct;
+} checkpoint;
+
+typedef struct run {
+    options o;
+    ip_store *store;
+    ip_cache *cache;
+    ip_engine *engine;
+    ip_camera camera;
+    double lo[3], hi[3];
+    ip_mesh full_mesh;
+    const ip_mesh *mesh;
+    ip_engine_counts totals;
+    checkpoint *checkpoints;
+    size_t checkpoint_count;
+    double extraction_wall, progress_render_seconds, final_pct;
+    const char *renderer_name;
+} run;
+
+static int parse_size(const char *text, uint32_t *w, uint32_t *h)
+{
+    unsigned long a, b;
+    char x, extra;
+    if (sscanf(text, "%lu%c%lu%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') || a < 1 ||
+        b < 1 || a > 16384 || b > 16384)
+        return -1;
+    *w = (uint32_t)a;
+    *h = (uint32_t)b;
+    return 0;
+}
+
+static int parse_args(int argc, char **argv, options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->out = "isorender.png";
+    o->view = "-y";
+    o->width = 1600;
+    o->height = 1200;
+    o->cutoff = IP_DEFAULT_CUTOFF_DEGREES;
+    o->foldback = IP_DEFAULT_FOLDBACK_DEGREES;
+    o->cache_bytes = ip_cache_default_budget();
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(usage, stdout);
+            exit(0);
+        } else if (!strcmp(a, "--iso") && v) {
+            if (tool_parse_double(v, &o->iso) != 0)
+                return tool_usage_error("isorender", "--iso '%s' is not a number", v);
+            o->has_iso = 1, i++;
+        } else if (!strcmp(a, "--size") && v) {
+            if (parse_size(v, &o->width, &o->height) != 0)
+                return tool_usage_error("isorender", "--size '%s' is not WxH", v);
+            i++;
+        } else if (!strcmp(a, "--view") && v) {
+            o->view = v, i++;
+        } else if (!strcmp(a, "--camera") && v) {
+            o->camera = v, i++;
+        } else if (!strcmp(a, "--rays") && v) {
+            if (tool_parse_u64(v, &o->rays) != 0 || o->rays == 0)
+                return tool_usage_error("isorender", "--rays '%s' is not a positive count", v);
+            i++;
+        } else if (!strcmp(a, "--time") && v) {
+            if (tool_parse_double(v, &o->time_limit) != 0 || o->time_limit <= 0)
+                return tool_usage_error("isorender", "--time '%s' is not positive seconds", v);
+            i++;
+        } else if (!strcmp(a, "--cutoff") && v) {
+            if (tool_parse_double(v, &o->cutoff) != 0)
+                return tool_usage_error("isorender", "--cutoff '%s' is not a number", v);
+            i++;
+        } else if (!strcmp(a, "--foldback") && v) {
+            if (tool_parse_double(v, &o->foldback) != 0)
+                return tool_usage_error("isorender", "--foldback '%s' is not a number", v);
+            i++;
+        } else if (!strcmp(a, "--cache-mb") && v) {
+            if (tool_parse_cache_mb(v, &o->cache_bytes) != 0)
+                return tool_usage_error("isorender", "bad --cache-mb '%s'", v);
+            i++;
+        } else if (!strcmp(a, "-o") && v) {
+            o->out = v, i++;
+        } else if (!strcmp(a, "--mesh") && v) {
+            o->mesh = v, i++;
+        } else if (!strcmp(a, "--stats") && v) {
+            o->stats = v, i++;
+        } else if (!strcmp(a, "--progress") && v) {
+            o->progress = v, i++;
+        } else if (!strcmp(a, "--full")) {
+            o->full = 1;
+        } else if (!strcmp(a, "--software")) {
+            o->software = 1;
+        } else if (!strcmp(a, "--force")) {
+            o->force = 1;
+        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            o->quiet = 1;
+        } else if (a[0] == '-' && a[1]) {
+            return tool_usage_error("isorender", "unknown or incomplete option '%s'", a);
+        } else if (!o->file) {
+            o->file = a;
+        } else {
+            return tool_usage_error("isorender", "more than one file ('%s')", a);
+        }
+    }
+    if (!o->file)
+        return tool_usage_error("isorender", "no brick file");
+    if (!o->has_iso)
+        return tool_usage_error("isorender", "--iso V is required");
+    if (o->full && (o->rays || o->time_limit > 0))
+        return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
+    return 0;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static int setup_camera(run *r, ip_error *err)
+{
+    const ip_layout *l = ip_store_layout(r->store);
+    for (int a = 0; a < 3; a++) {
+        r->lo[a] = 0;
+        r->hi[a] = (l->dims[a] - 1) * l->spacing[a];
+    }
+    if (r->o.camera) {
+        r->camera.width = r->o.width;
+        r->camera.height = r->o.height;
+        if (ip_camera_parse(r->o.camera, &r->camera, err) != IP_OK)
+            return -1;
+        return ip_camera_check(&r->camera, err) == IP_OK ? 0 : -1;
+    }
+    return ip_camera_fit_axis(r->lo, r->hi, r->o.view, 30.0, r->o.width, r->o.height, &r->camera,
+                              err) == IP_OK ? 0 : -1;
+}
+
+static int add_checkpoint(run *r, double start)
+{
+    ip_engine_counts t;
+    ip_engine_totals(r->engine, &t);
+    checkpoint *grown = realloc(r->checkpoints, (r->checkpoint_count + 1) * sizeof *grown);
+    if (!grown)
+        return -1;
+    r->checkpoints = grown;
+    r->checkpoints[r->checkpoint_count++] =
+        (checkpoint){now() - start, t.rays, t.seeds, t.cells, t.triangles, 0};
+    return 0;
+}
+
+/* Casts rays until done, the ray count or the time limit, checkpointing as the count doubles. */
+static int extract_progressive(run *r, ip_error *err)
+{
+    ip_engine_options eo;
+    ip_engine_options_default(&eo);
+    eo.cutoff_degrees = r->o.cutoff;
+    eo.foldback_degrees = r->o.foldback;
+    if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK ||
+        ip_engine_begin(r->engine, &r->camera, (float)r->o.iso, err) != IP_OK)
+        return -1;
+    double start = now();
+    uint64_t target = 1, limit = r->o.rays ? r->o.rays : UINT64_MAX;
+    while (!ip_engine_done(r->engine)) {
+        ip_engine_counts t;
+        ip_engine_totals(r->engine, &t);
+        if (t.rays >= limit)
+            break;
+        double left = r->o.time_limit > 0 ? r->o.time_limit - (now() - start) : 0;
+        if (r->o.time_limit > 0 && left <= 0)
+            break;
+        uint64_t batch = (target < limit ? target : limit) - t.rays;
+        if (ip_engine_step(r->engine, batch, left, NULL, err) != IP_OK)
+            return -1;
+        if (add_checkpoint(r, start) != 0)
+            return -1;
+        target *= 2;
+    }
+    r->extraction_wall = now() - start;
+    ip_engine_totals(r->engine, &r->totals);
+    r->mesh = ip_engine_mesh(r->engine);
+    return 0;
+}
+
+static int extract_full(run *r, ip_error *err)
+{
+    double start = now();
+    ip_mesh_init(&r->full_mesh);
+    if (ip_extract_full(r->cache, (float)r->o.iso, 0, &r->full_mesh, &r->totals, err) != IP_OK)
+        return -1;
+    r->extraction_wall = now() - start;
+    r->mesh = &r->full_mesh;
+    return 0;
+}
+
+/* Final pixels of every checkpoint from one raster of the final mesh: a pixel has its final
+ * colour at a checkpoint when the triangle it finally shows was already extracted (the mesh
+ * only grows by appending, and the nearest triangle wins). */
+static int final_pixels(run *r, ip_error *err)
+{
+    double start = now();
+    size_t n = (size_t)r->camera.width * r->camera.height;
+    uint32_t *index = malloc(n * sizeof *index);
+    if (!index)
+        return -1;
+    if (ip_raster_mesh(r->mesh, &r->camera, r->lo, r->hi, index, NULL, err) != IP_OK) {
+        free(index);
+        return -1;
+    }
+    uint64_t covered = 0;
+    for (size_t c = 0; c < r->checkpoint_count; c++)
+        r->checkpoints[c].final_pct = 0;
+    uint64_t *shown = calloc(r->checkpoint_count + 1, sizeof *shown);
+    if (!shown) {
+        free(index);
+        return -1;
+    }
+    for (size_t p = 0; p < n; p++) {
+        if (index[p] == UINT32_MAX)
+            continue;
+        covered++;
+        /* the first checkpoint whose mesh holds that triangle */
+        size_t lo = 0, hi = r->checkpoint_count;
+        while (lo < hi) {
+            size_t mid = (lo + hi) / 2;
+            if (r->checkpoints[mid].triangles > index[p])
+                hi = mid;
+            else
+                lo = mid + 1;
+        }
+        shown[lo]++;
+    }
+    uint64_t running = 0;
+    for (size_t c = 0; c < r->checkpoint_count; c++) {
+        running += shown[c];
+        r->checkpoints[c].final_pct = covered ? 100.0 * (double)running / (double)covered : 100.0;
+    }
+    free(shown);
+    free(index);
+    r->progress_render_seconds = now() - start;
+    return 0;
+}
+
+static int write_progress(const run *r)
+{
+    char temp[4200];
+    snprintf(temp, sizeof temp, "%s.tmp", r->o.progress);
+    FILE *f = fopen(temp, "w");
+    if (!f) {
+        fprintf(stderr, "isorender: %s: cannot write\n", r->o.progress);
+        return -1;
+    }
+    fprintf(f, "time_s,rays,seeds,cells,triangles,final_pixel_pct\n");
+    for (size_t c = 0; c < r->checkpoint_count; c++) {
+        const checkpoint *k = &r->checkpoints[c];
+        fprintf(f, "%.6f,%llu,%llu,%llu,%llu,%.4f\n", k->time, (unsigned long long)k->rays,
+                (unsigned long long)k->seeds, (unsigned long long)k->cells,
+                (unsigned long long)k->triangles, k->final_pct);
+    }
+    int bad = ferror(f) | (fclose(f) != 0);
+    if (bad || rename(temp, r->o.progress) != 0) {
+        fprintf(stderr, "isorender: %s: cannot write\n", r->o.progress);
+        remove(temp);
+        return -1;
+    }
+    return 0;
+}
+
+/* Renders with OpenGL through EGL, or in software when asked or when no OpenGL is found. */
+static int render_image(run *r, uint8_t *rgba, ip_error *err)
+{
+    double start = now();
+    if (!r->o.software) {
+        ip_renderer *gl;
+        ip_error why;
+        if (ip_renderer_create_headless(r->camera.width, r->camera.height, &gl, &why) == IP_OK) {
+            ip_status st = ip_renderer_upload(gl, r->mesh, 0, err);
+            if (st == IP_OK)
+                st = ip_renderer_draw(gl, &r->camera, r->lo, r->hi, err);
+            if (st == IP_OK)
+                st = ip_renderer_read_rgba(gl, rgba, err);
+            ip_renderer_destroy(gl);
+            r->totals.rendering_seconds += now() - start;
+            r->renderer_name = "opengl";
+            return st == IP_OK ? 0 : -1;
+        }
+        fprintf(stderr, "isorender: no headless OpenGL (%s); rendering in software\n",
+                why.message);
+    }
+    r->renderer_name = "software";
+    int rc = ip_raster_mesh(r->mesh, &r->camera, r->lo, r->hi, NULL, rgba, err) == IP_OK ? 0 : -1;
+    r->totals.rendering_seconds += now() - start;
+    return rc;
+}
+
+static void json_counts(FILE *f, void *user)
+{
+    const run *r = user;
+    const ip_engine_counts *t = &r->totals;
+    fprintf(f, "\"file\": ");
+    tool_json_string(f, r->o.file);
+    fprintf(f, ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
+               "\"renderer\": \"%s\"",
+            r->o.iso, r->o.full ? "full" : "progressive", r->camera.width, r->camera.height,
+            r->renderer_name ? r->renderer_name : "none");
+    fprintf(f, ", \"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"target\": [%.9g, %.9g, %.9g], "
+               "\"up\": [%.9g, %.9g, %.9g], \"fov\": %.9g}",
+            r->camera.eye[0], r->camera.eye[1], r->camera.eye[2], r->camera.target[0],
+            r->camera.target[1], r->camera.target[2], r->camera.up[0], r->camera.up[1],
+            r->camera.up[2], r->camera.fov_y);
+    fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", r->o.cutoff,
+            r->o.foldback);
+    fprintf(f, ", \"rays\": %llu, \"rays_total\": %llu, \"done\": %s, \"seeds\": %llu, "
+               "\"cells\": %llu, \"triangles\": %llu",
+            (unsigned long long)t->rays,
+            (unsigned long long)r->camera.width * r->camera.height,
+            r->o.full || (r->engine && ip_engine_done(r->engine)) ? "true" : "false",
+            (unsigned long long)t->seeds, (unsigned long long)t->cells,
+            (unsigned long long)t->triangles);
+    fprintf(f, ", \"time\": {\"intersection_s\": %.6f, \"propagation_s\": %.6f, "
+               "\"extraction_s\": %.6f, \"rendering_s\": %.6f, \"extraction_wall_s\": %.6f, "
+               "\"progress_render_s\": %.6f}",
+            t->intersection_seconds, t->propagation_seconds, t->extraction_seconds,
+            t->rendering_seconds, r->extraction_wall, r->progress_render_seconds);
+    if (r->checkpoint_count)
+        fprintf(f, ", \"final_pixel_pct\": %.4f",
+                r->checkpoints[r->checkpoint_count - 1].final_pct);
+}
+
+static void print_summary(const run *r)
+{
+    const ip_engine_counts *t = &r->totals;
+    printf("%s: iso %g, %s, %ux%u\n", r->o.file, r->o.iso, r->o.full ? "full extraction" : "progressive",
+           r->camera.width, r->camera.height);
+    printf("  rays          %llu of %llu\n", (unsigned long long)t->rays,
+           (unsigned long long)r->camera.width * r->camera.height);
+    printf("  seeds         %llu\n", (unsigned long long)t->seeds);
+    printf("  cells         %llu\n", (unsigned long long)t->cells);
+    printf("  triangles     %llu\n", (unsigned long long)t->triangles);
+    printf("  time          %.3f s extraction: intersection %.3f, propagation %.3f, "
+           "marching cubes %.3f; rendering %.3f (%s)\n",
+           r->extraction_wall, t->intersection_seconds, t->propagation_seconds,
+           t->extraction_seconds, t->rendering_seconds, r->renderer_name);
+    printf("  image         %s\n", r->o.out);
+}
+
+static int finish(run *r, ip_error *err)
+{
+    size_t n = (size_t)r->camera.width * r->camera.height;
+    uint8_t *rgba = malloc(n * 4);
+    if (!rgba) {
+        fprintf(stderr, "isorender: out of memory for a %ux%u image\n", r->camera.width,
+                r->camera.height);
+        return 1;
+    }
+    int rc = render_image(r, rgba, err);
+    if (rc == 0 && ip_png_write(r->o.out, rgba, r->camera.width, r->camera.height, r->o.force,
+                                err) != IP_OK)
+        rc = -1;
+    free(rgba);
+    if (rc == 0 && r->o.mesh && ip_mesh_write_ply(r->mesh, r->o.mesh, r->o.force, err) != IP_OK)
+        rc = -1;
+    if (rc != 0)
+        return tool_fail("isorender", err);
+    if (r->o.progress && !r->o.full) {
+        if (final_pixels(r, err) != 0)
+            return tool_fail("isorender", err);
+        if (write_progress(r) != 0)
+            return 1;
+    }
+    ip_cache_stats st;
+    ip_cache_get_stats(r->cache, &st);
+    uint64_t summary = ip_store_layout(r->store)->summary_size;
+    if (!r->o.quiet) {
+        print_summary(r);
+        tool_print_cache_table(stdout, &st, summary);
+    }
+    if (r->o.stats && tool_write_stats_file("isorender", r->o.stats, &st, summary, json_counts,
+                                            r) != 0)
+        return 1;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    run r;
+    memset(&r, 0, sizeof r);
+    int rc = parse_args(argc, argv, &r.o);
+    if (rc)
+        return rc;
+    ip_error err;
+    ip_error_clear(&err);
+    if (ip_store_open(r.o.file, &r.store, &err) != IP_OK)
+        return tool_fail("isorender", &err);
+    rc = 1;
+    if (ip_cache_create(r.store, r.o.cache_bytes, &r.cache, &err) != IP_OK ||
+        setup_camera(&r, &err) != 0 ||
+        (r.o.full ? extract_full(&r, &err) : extract_progressive(&r, &err)) != 0)
+        rc = tool_fail("isorender", &err);
+    else
+        rc = finish(&r, &err);
+    ip_engine_destroy(r.engine);
+    ip_mesh_free(&r.full_mesh);
+    free(r.checkpoints);
+    ip_cache_destroy(r.cache);
+    ip_store_close(r.store);
+    return rc;
+}
