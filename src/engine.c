@@ -1,8 +1,11 @@
-/* The progressive engine: ray order, seeding, propagation, step budgets and cancellation. */
+/* The progressive engine: ray order, seeding, propagation on worker threads, step budgets,
+ * cancellation. */
 #include <math.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "internal.h"
 #include "isoprop/engine.h"
@@ -10,27 +13,53 @@
 #include "propagate.h"
 #include "seed.h"
 
+#define MAX_THREADS 64
+#define RAY_BATCH 16 /* rays a worker takes at once: small, so the order stays progressive */
+
+/* One worker's private state: its pinned bricks, its queue, its triangles. */
+typedef struct worker {
+    ip_engine *engine;
+    ip_sampler sampler;
+    ip_seeder seeder;
+    ip_propagator propagator;
+    ip_mesh mesh;
+    ip_engine_counts counts;
+    ip_status status;
+    ip_error error;
+} worker;
+
 struct ip_engine {
     ip_cache *cache;
     ip_engine_options options;
-    ip_sampler sampler;
+    unsigned threads;
+    worker *workers;
     ip_visited visited;
     ip_mesh mesh;
     ip_camera camera;
     ip_camera_basis basis;
     float iso;
     int begun;
+    pthread_mutex_t order_lock; /* the shared ray sequence */
     ip_ray_order order;
-    ip_seeder seeder;
-    ip_propagator propagator;
+    uint64_t step_rays_left;    /* rays the current step may still hand out */
+    double step_deadline;       /* 0: none */
     ip_engine_counts totals;
     atomic_int cancel;
 };
+
+unsigned ip_thread_count(unsigned requested)
+{
+    if (requested > 0)
+        return requested > MAX_THREADS ? MAX_THREADS : requested;
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1u : n > MAX_THREADS ? MAX_THREADS : (unsigned)n;
+}
 
 void ip_engine_options_default(ip_engine_options *o)
 {
     o->cutoff_degrees = IP_DEFAULT_CUTOFF_DEGREES;
     o->foldback_degrees = IP_DEFAULT_FOLDBACK_DEGREES;
+    o->threads = 0;
 }
 
 ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
@@ -46,11 +75,19 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
         return ip_fail(err, IP_ERR_NOMEM, "out of memory");
     e->cache = cache;
     e->options = *options;
+    e->threads = ip_thread_count(options->threads);
     atomic_init(&e->cancel, 0);
+    pthread_mutex_init(&e->order_lock, NULL);
     ip_mesh_init(&e->mesh);
-    const ip_layout *l = ip_store_layout(ip_cache_store(cache));
-    if (ip_sampler_init(&e->sampler, cache, 0) != IP_OK ||
-        ip_visited_init(&e->visited, l) != IP_OK) {
+    e->workers = calloc(e->threads, sizeof *e->workers);
+    ip_status st = e->workers ? ip_visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
+                              : IP_ERR_NOMEM;
+    for (unsigned t = 0; st == IP_OK && t < e->threads; t++) {
+        e->workers[t].engine = e;
+        ip_mesh_init(&e->workers[t].mesh);
+        st = ip_sampler_init(&e->workers[t].sampler, cache, 0);
+    }
+    if (st != IP_OK) {
         ip_engine_destroy(e);
         return ip_fail(err, IP_ERR_NOMEM, "out of memory");
     }
@@ -62,10 +99,15 @@ void ip_engine_destroy(ip_engine *e)
 {
     if (!e)
         return;
-    ip_propagator_free(&e->propagator);
-    ip_sampler_free(&e->sampler);
+    for (unsigned t = 0; e->workers && t < e->threads; t++) {
+        ip_propagator_free(&e->workers[t].propagator);
+        ip_sampler_free(&e->workers[t].sampler);
+        ip_mesh_free(&e->workers[t].mesh);
+    }
+    free(e->workers);
     ip_visited_free(&e->visited);
     ip_mesh_free(&e->mesh);
+    pthread_mutex_destroy(&e->order_lock);
     free(e);
 }
 
@@ -76,20 +118,24 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
         return st;
     if (!isfinite(iso))
         return ip_fail(err, IP_ERR_ARGUMENT, "the isovalue must be finite");
-    ip_sampler_release(&e->sampler);
     ip_visited_clear(&e->visited);
     ip_mesh_clear(&e->mesh);
-    ip_propagator_free(&e->propagator);
     e->camera = *camera;
     ip_camera_basis_of(&e->camera, &e->basis);
     e->iso = iso;
     memset(&e->totals, 0, sizeof e->totals);
     ip_ray_order_init(&e->order, camera->width, camera->height);
-    ip_seeder_init(&e->seeder, &e->sampler, iso);
-    e->sampler.status = IP_OK;
-    if (ip_propagator_init(&e->propagator, &e->sampler, &e->visited, &e->mesh, &e->camera, iso,
-                           &e->options) != IP_OK)
-        return ip_fail(err, IP_ERR_NOMEM, "out of memory");
+    for (unsigned t = 0; t < e->threads; t++) {
+        worker *w = &e->workers[t];
+        ip_sampler_release(&w->sampler);
+        w->sampler.status = IP_OK;
+        ip_mesh_clear(&w->mesh);
+        ip_seeder_init(&w->seeder, &w->sampler, iso, 2.0 * e->basis.tan_half_y / camera->height);
+        ip_propagator_free(&w->propagator);
+        if (ip_propagator_init(&w->propagator, &w->sampler, &e->visited, &w->mesh, &e->camera,
+                               iso, &e->options) != IP_OK)
+            return ip_fail(err, IP_ERR_NOMEM, "out of memory");
+    }
     atomic_store(&e->cancel, 0);
     e->begun = 1;
     return IP_OK;
@@ -117,58 +163,113 @@ static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
     to->rendering_seconds += from->rendering_seconds;
 }
 
-/* Casts the ray of pixel (x, y), seeding and propagating. */
-static ip_status cast_ray(ip_engine *e, uint32_t x, uint32_t y, ip_engine_counts *c)
+/* Casts the ray of pixel (x, y): extracts its seed, and the cells it nearly hit before it,
+ * propagating from each that was not extracted yet. */
+static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
 {
+    ip_engine *e = w->engine;
     double dir[3];
-    uint32_t seed[3];
+    uint32_t cells[IP_SEED_MAX_CELLS][3];
+    unsigned count;
     ip_camera_pixel_ray(&e->basis, &e->camera, x + 0.5, y + 0.5, dir);
     double t0 = ip_now_seconds();
-    int found = ip_seed_find(&e->seeder, e->camera.eye, dir, seed);
-    c->intersection_seconds += ip_now_seconds() - t0;
-    c->rays++;
+    int found = ip_seed_find(&w->seeder, e->camera.eye, dir, cells, &count);
+    w->counts.intersection_seconds += ip_now_seconds() - t0;
+    w->counts.rays++;
     if (found < 0)
-        return e->sampler.status;
-    if (found == 0)
-        return IP_OK;
-    int was = ip_visited_mark(&e->visited, 0, seed);
-    if (was < 0)
-        return IP_ERR_NOMEM;
-    if (was)
-        return IP_OK;
-    c->seeds++;
-    return ip_propagate(&e->propagator, seed, dir, c);
+        return w->sampler.status;
+    ip_status st = IP_OK;
+    for (unsigned i = 0; i < count && st == IP_OK; i++) {
+        int was = ip_visited_mark(&e->visited, 0, cells[i]);
+        if (was < 0)
+            return IP_ERR_NOMEM;
+        if (was)
+            continue;
+        w->counts.seeds++;
+        st = ip_propagate(&w->propagator, cells[i], dir, &w->counts);
+    }
+    return st;
+}
+
+/* Takes up to RAY_BATCH pixels of the shared order for this step; returns how many. */
+static unsigned take_rays(ip_engine *e, uint32_t xy[][2])
+{
+    unsigned n = 0;
+    pthread_mutex_lock(&e->order_lock);
+    int late = e->step_deadline > 0 && ip_now_seconds() >= e->step_deadline;
+    while (!late && n < RAY_BATCH && e->step_rays_left > 0 &&
+           ip_ray_order_next(&e->order, &xy[n][0], &xy[n][1])) {
+        n++;
+        e->step_rays_left--;
+    }
+    pthread_mutex_unlock(&e->order_lock);
+    return n;
+}
+
+static void *work(void *p)
+{
+    worker *w = p;
+    ip_engine *e = w->engine;
+    uint32_t xy[RAY_BATCH][2];
+    unsigned n;
+    while (w->status == IP_OK && (n = take_rays(e, xy)) > 0) {
+        for (unsigned i = 0; i < n && w->status == IP_OK; i++) {
+            if (atomic_load_explicit(&e->cancel, memory_order_relaxed)) {
+                w->status = IP_ERR_CANCELLED;
+                break;
+            }
+            w->status = cast_ray(w, xy[i][0], xy[i][1]);
+        }
+    }
+    ip_sampler_release(&w->sampler); /* let the cache evict freely between steps */
+    return NULL;
 }
 
 ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
                          ip_engine_counts *counts, ip_error *err)
 {
-    ip_engine_counts c;
-    memset(&c, 0, sizeof c);
     if (!e->begun)
         return ip_fail(err, IP_ERR_ARGUMENT, "ip_engine_step() before ip_engine_begin()");
-    double start = ip_now_seconds();
+    if (atomic_load(&e->cancel))
+        return ip_fail(err, IP_ERR_CANCELLED, "extraction cancelled");
+    e->step_rays_left = max_rays ? max_rays : UINT64_MAX;
+    e->step_deadline = max_seconds > 0 ? ip_now_seconds() + max_seconds : 0;
+    unsigned threads = e->threads;
+    if (max_rays && max_rays < (uint64_t)threads * RAY_BATCH)
+        threads = (unsigned)((max_rays + RAY_BATCH - 1) / RAY_BATCH); /* few rays: few threads */
+    pthread_t tids[MAX_THREADS];
+    unsigned started = 0;
+    for (unsigned t = 0; t < threads; t++) {
+        worker *w = &e->workers[t];
+        memset(&w->counts, 0, sizeof w->counts);
+        w->status = IP_OK;
+        w->mesh.triangle_count = 0;
+    }
+    for (unsigned t = 1; t < threads; t++)
+        if (pthread_create(&tids[started], NULL, work, &e->workers[t]) == 0)
+            started++;
+    work(&e->workers[0]);
+    for (unsigned t = 0; t < started; t++)
+        pthread_join(tids[t], NULL);
+    ip_engine_counts c;
+    memset(&c, 0, sizeof c);
     ip_status st = IP_OK;
-    uint32_t x, y;
-    for (uint64_t i = 0; max_rays == 0 || i < max_rays; i++) {
-        if (atomic_load_explicit(&e->cancel, memory_order_relaxed)) {
-            st = ip_fail(err, IP_ERR_CANCELLED, "extraction cancelled");
-            break;
-        }
-        if (max_seconds > 0 && (i & 15) == 0 && i > 0 && ip_now_seconds() - start >= max_seconds)
-            break;
-        if (!ip_ray_order_next(&e->order, &x, &y))
-            break;
-        st = cast_ray(e, x, y, &c);
-        if (st != IP_OK) {
-            if (st == IP_ERR_NOMEM)
+    for (unsigned t = 0; t < threads; t++) {
+        worker *w = &e->workers[t];
+        add_counts(&c, &w->counts);
+        if (st == IP_OK && ip_mesh_append(&e->mesh, w->mesh.positions, w->mesh.normals,
+                                          w->mesh.cells, w->mesh.triangle_count) != IP_OK)
+            st = ip_fail(err, IP_ERR_NOMEM, "out of memory");
+        if (st == IP_OK && w->status != IP_OK) {
+            st = w->status;
+            if (st == IP_ERR_CANCELLED)
+                ip_fail(err, st, "extraction cancelled");
+            else if (st == IP_ERR_NOMEM)
                 ip_fail(err, st, "out of memory");
             else if (err)
-                *err = e->sampler.error;
-            break;
+                *err = w->sampler.error;
         }
     }
-    ip_sampler_release(&e->sampler); /* let the cache evict freely between steps */
     add_counts(&e->totals, &c);
     if (counts)
         *counts = c;

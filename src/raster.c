@@ -282,6 +282,8 @@ static void clip_and_raster(raster_target *t, const raster_view *view, const vie
 {
     unsigned outside_all = (1u << PLANE_COUNT) - 1, outside_any = 0;
     for (int i = 0; i < 3; i++) {
+        if (!isfinite(tri[i].p[0]) || !isfinite(tri[i].p[1]) || !isfinite(tri[i].p[2]))
+            return;
         unsigned mask = 0;
         for (int k = 0; k < PLANE_COUNT; k++)
             mask |= (plane_value(view, k, &tri[i]) < 0 ? 1u : 0u) << k;
@@ -330,9 +332,21 @@ static void shade_image(const raster_target *t, const ip_camera *camera, uint8_t
     }
 }
 
-static ip_status check_arguments(const ip_mesh *mesh, const ip_camera *camera, ip_error *err)
+ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_error *err)
+{
+    for (int i = 0; i < 3; i++)
+        if (!isfinite(lo[i]) || !isfinite(hi[i]) || lo[i] > hi[i])
+            return ip_fail(err, IP_ERR_ARGUMENT, "render: box [%g,%g,%g]-[%g,%g,%g] is not a "
+                           "finite box with lo <= hi", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+    return IP_OK;
+}
+
+static ip_status check_arguments(const ip_mesh *mesh, const ip_camera *camera,
+                                 const double lo[3], const double hi[3], ip_error *err)
 {
     ip_status st = ip_camera_check(camera, err);
+    if (st == IP_OK)
+        st = ip_render_check_box(lo, hi, err);
     if (st != IP_OK)
         return st;
     if (camera->width > MAX_SIDE || camera->height > MAX_SIDE)
@@ -374,7 +388,7 @@ ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const dou
                          const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
                          ip_error *err)
 {
-    ip_status st = check_arguments(mesh, camera, err);
+    ip_status st = check_arguments(mesh, camera, lo, hi, err);
     if (st != IP_OK)
         return st;
     raster_target target;

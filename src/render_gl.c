@@ -452,6 +452,8 @@ ip_status ip_renderer_draw(ip_renderer *r, const ip_camera *camera, const double
                            const double hi[3], ip_error *err)
 {
     ip_status st = ip_camera_check(camera, err);
+    if (st == IP_OK)
+        st = ip_render_check_box(lo, hi, err);
     if (st != IP_OK)
         return st;
     if (camera->width != r->width || camera->height != r->height)
@@ -501,6 +503,11 @@ ip_status ip_renderer_read_rgba(ip_renderer *r, uint8_t *rgba, ip_error *err)
     if (st == IP_OK)
         flip_rows(rgba, r->width, r->height);
     return st;
+}
+
+void ip_renderer_release(ip_renderer *r)
+{
+    ip_gl_context_release(r->context);
 }
 
 void ip_renderer_destroy(ip_renderer *r)

@@ -94,9 +94,65 @@ static int active(const float *range, float iso)
     return ip_range_active(range[0], range[1], iso);
 }
 
+/* Classifies the ray against the cell's triangles as a rasteriser would classify its pixel
+ * centre: each triangle is projected centrally around the ray (point-in-triangle is the same
+ * for every central projection through the ray) and the ray's distance to its edges is
+ * measured as an angle. 2: inside a triangle by at least the margin; 1: within the margin of
+ * one; 0: neither. `ro` and `rd` are the ray in the cell's frame (corner 0 at the origin). */
+static int classify_cell(const ip_seeder *s, const float values[8], const float size[3],
+                         const double ro[3], const double rd[3])
+{
+    static const float zero[3] = {0, 0, 0};
+    ip_mc_vertex v[IP_MC_MAX_VERTICES];
+    int n = ip_mc_triangulate_cell(values, NULL, s->iso, zero, size, v);
+    /* a basis (u, w) across the ray */
+    double u[3], w[3];
+    int k = fabs(rd[0]) < fabs(rd[1]) ? (fabs(rd[0]) < fabs(rd[2]) ? 0 : 2)
+                                      : (fabs(rd[1]) < fabs(rd[2]) ? 1 : 2);
+    double axis[3] = {0, 0, 0};
+    axis[k] = 1;
+    u[0] = rd[1] * axis[2] - rd[2] * axis[1];
+    u[1] = rd[2] * axis[0] - rd[0] * axis[2];
+    u[2] = rd[0] * axis[1] - rd[1] * axis[0];
+    double un = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int i = 0; i < 3; i++)
+        u[i] /= un;
+    w[0] = rd[1] * u[2] - rd[2] * u[1];
+    w[1] = rd[2] * u[0] - rd[0] * u[2];
+    w[2] = rd[0] * u[1] - rd[1] * u[0];
+    int best = 0;
+    for (int t = 0; t < n && best < 2; t++) {
+        double p[3][2];
+        int behind = 0;
+        for (int j = 0; j < 3; j++) {
+            double d[3] = {v[3 * t + j].position[0] - ro[0], v[3 * t + j].position[1] - ro[1],
+                           v[3 * t + j].position[2] - ro[2]};
+            double depth = d[0] * rd[0] + d[1] * rd[1] + d[2] * rd[2];
+            behind |= !(depth > 0);
+            p[j][0] = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / depth;
+            p[j][1] = (d[0] * w[0] + d[1] * w[1] + d[2] * w[2]) / depth;
+        }
+        if (behind)
+            continue;
+        double area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) -
+                      (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+        double least = INFINITY;
+        for (int j = 0; j < 3; j++) {
+            const double *a = p[j], *b = p[(j + 1) % 3];
+            double ex = b[0] - a[0], ey = b[1] - a[1], len = sqrt(ex * ex + ey * ey);
+            /* signed distance of the ray (the origin) to the edge, positive inside */
+            double dist = len > 0 ? (ex * (0 - a[1]) - ey * (0 - a[0])) / len : 0;
+            least = fmin(least, area >= 0 ? dist : -dist);
+        }
+        int kind = area != 0 && least >= s->margin ? 2 : least >= -s->margin ? 1 : 0;
+        best = kind > best ? kind : best;
+    }
+    return best;
+}
+
 /* Tests the cells of one sub-block (cells [lo, hi) in level coordinates) along the ray. */
 static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], const uint32_t hi[3],
-                      double t0, double t1, uint32_t cell[3])
+                      double t0, double t1)
 {
     double base[3] = {lo[0], lo[1], lo[2]};
     uint32_t n[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
@@ -109,19 +165,17 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
             return -1;
         unsigned mc = ip_mc_case(values, s->iso);
         if (mc != 0 && mc != 255) {
-            float origin[3], size[3], ro[3], rd[3], t;
+            float origin[3], size[3];
+            double ro[3];
             ip_sampler_cell_box(s->sampler, c, origin, size);
-            for (int k = 0; k < 3; k++) {
-                /* the ray from the cell's corner keeps float precision in large volumes */
-                ro[k] = (float)(r->world_origin[k] - origin[k]);
-                rd[k] = (float)r->world_dir[k];
-                origin[k] = 0.0f;
-            }
+            for (int k = 0; k < 3; k++) /* the cell's frame keeps precision in large volumes */
+                ro[k] = r->world_origin[k] - (double)origin[k];
             s->cells_tested++;
-            if (ip_mc_ray_hits_cell(values, s->iso, origin, size, ro, rd, &t)) {
-                memcpy(cell, c, sizeof c);
+            int kind = classify_cell(s, values, size, ro, r->world_dir);
+            if (kind && s->found_count < IP_SEED_MAX_CELLS)
+                memcpy(s->found[s->found_count++], c, sizeof c);
+            if (kind == 2)
                 return 1;
-            }
         }
         double exit_t;
         if (!dda_next(&d, &exit_t))
@@ -130,8 +184,7 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
 }
 
 /* Walks the sub-blocks of brick `b` front to back. */
-static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], double t0, double t1,
-                      uint32_t cell[3])
+static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], double t0, double t1)
 {
     const ip_layout *l = s->layout;
     uint32_t origin[3], extent[3];
@@ -157,7 +210,7 @@ static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], dou
                 last[k] = origin[k] + extent[k] - 1; /* one past the brick's last cell */
                 hi[k] = lo[k] + se < last[k] ? lo[k] + se : last[k];
             }
-            int found = walk_cells(s, r, lo, hi, enter_t, exit_t, cell);
+            int found = walk_cells(s, r, lo, hi, enter_t, exit_t);
             if (found)
                 return found;
         }
@@ -185,10 +238,10 @@ static void node_box(const ip_seeder *s, uint32_t depth, const uint32_t node[3],
 }
 
 static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uint32_t node[3],
-                     double t0, double t1, uint32_t cell[3])
+                     double t0, double t1)
 {
     if (depth == 0)
-        return walk_brick(s, r, node, t0, t1, cell);
+        return walk_brick(s, r, node, t0, t1);
     child_hit hits[8];
     int count = 0;
     uint32_t grid[3];
@@ -212,14 +265,14 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
         hits[at] = (child_hit){{ch[0], ch[1], ch[2]}, a, b};
     }
     for (int i = 0; i < count; i++) {
-        int found = walk_node(s, r, depth - 1, hits[i].node, hits[i].t0, hits[i].t1, cell);
+        int found = walk_node(s, r, depth - 1, hits[i].node, hits[i].t0, hits[i].t1);
         if (found)
             return found;
     }
     return 0;
 }
 
-void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso)
+void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_angle)
 {
     memset(s, 0, sizeof *s);
     s->sampler = sampler;
@@ -227,12 +280,17 @@ void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso)
     s->layout = sampler->layout;
     s->level = sampler->level;
     s->iso = iso;
+    s->margin = IP_SEED_MARGIN_PIXELS * pixel_angle;
     for (int k = 0; k < 3; k++)
         s->scale[k] = s->layout->spacing[k] * (double)(1u << s->level);
 }
 
-int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], uint32_t cell[3])
+int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], uint32_t cells[][3],
+                 unsigned *count)
 {
+    s->found = cells;
+    s->found_count = 0;
+    *count = 0;
     const ip_level_layout *lv = &s->layout->levels[s->level];
     uint32_t root[3] = {0, 0, 0};
     uint32_t depth = lv->octree_depth;
@@ -249,5 +307,7 @@ int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], uint32_
     node_box(s, depth, root, lo, hi);
     if (!clip(&r, lo, hi, &t0, &t1))
         return 0;
-    return walk_node(s, &r, depth, root, t0, t1, cell);
+    int found = walk_node(s, &r, depth, root, t0, t1);
+    *count = s->found_count;
+    return found;
 }

@@ -13,13 +13,28 @@ typedef struct ip_seeder {
     float iso;
     double scale[3];     /* world units per level cell along each axis (uniform part) */
     uint64_t cells_tested; /* active cells whose triangles were tested against a ray */
+    uint32_t (*found)[3];  /* the cells of the current ray (see ip_seed_find) */
+    unsigned found_count;
+    double margin;         /* IP_SEED_MARGIN_PIXELS as an angle, radians */
 } ip_seeder;
 
-void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso);
+/* A ray whose pixel centre lies within this distance of a triangle's projected edge extracts
+ * the cell and goes on to the first triangle it clearly hits: a rasteriser (which snaps
+ * vertices to 1/256 pixel) may decide either way there. Far larger than that rounding, far
+ * smaller than a pixel. */
+#define IP_SEED_MARGIN_PIXELS (1.0 / 64.0)
+#define IP_SEED_MAX_CELLS 64
 
-/* Casts the ray eye + t * dir (world units, dir of unit length, t >= 0) through the octree.
- * @return 1 and the seed cell (level coordinates), 0 when the ray meets no triangle, -1 when
- * a brick could not be read (see the sampler's status). */
-int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], uint32_t cell[3]);
+/* `pixel_angle`: the angle one pixel subtends at the image centre (radians). */
+void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_angle);
+
+/* Casts the ray eye + t * dir (world units, dir of unit length, t >= 0) through the octree,
+ * front to back, to the first cell whose triangles it clearly hits (the seed). Fills
+ * cells[0 .. *count) (room for IP_SEED_MAX_CELLS) with the cells the ray passed within the
+ * margin of on the way, then the seed. @return 1 when the last cell is a seed, 0 when the ray
+ * clearly hits nothing (the cells are near misses only, possibly none), -1 when a brick could
+ * not be read (see the sampler's status). */
+int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], uint32_t cells[][3],
+                 unsigned *count);
 
 #endif

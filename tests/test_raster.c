@@ -382,6 +382,19 @@ static void test_bad_arguments(void)
     c = front_camera(70000, 2);
     CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, NULL, NULL, &err) == IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "larger");
+    const double bad_hi[3] = {20, NAN, 5}, inverted_hi[3] = {-30, 20, 5};
+    c = front_camera(W, H);
+    CHECK(ip_raster_mesh(&m, &c, box_lo, bad_hi, index, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_raster_mesh(&m, &c, box_lo, inverted_hi, index, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK_CONTAINS(err.message, "box");
+    /* a triangle with a non-finite vertex is skipped, the others drawn */
+    const double xy[6] = {2.5, 2.5, 30.5, 2.5, 2.5, 30.5};
+    add_screen_triangle(&m, &c, xy, 10.0);
+    add_screen_triangle(&m, &c, xy, 9.0);
+    m.positions[4] = NAN;
+    CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err) == IP_OK);
+    CHECK(index[5 * W + 5] == 1);
+    ip_mesh_clear(&m);
     /* an empty mesh: only background */
     c = front_camera(W, H);
     CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err) == IP_OK);
@@ -389,6 +402,7 @@ static void test_bad_arguments(void)
     for (int i = 0; i < W * H; i++)
         any += index[i] != UINT32_MAX;
     CHECK(any == 0);
+    ip_mesh_free(&m);
 }
 
 /* Reads a PNG back as RGBA with libpng; returns the pixels (malloc) and whether it had alpha. */

@@ -16,7 +16,8 @@ jobs=$(nproc 2>/dev/null || echo 2)
 
 # Debian packages: compiler and build tools, the libraries, clang for the sanitizer and fuzzer
 # builds, and the lz4/zstd programs the benchmark compares against.
-packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang lz4 zstd"
+packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang lz4 zstd
+          libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri"
 
 install_missing() {
     missing=""

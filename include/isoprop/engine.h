@@ -15,7 +15,14 @@
  * Ray seeding reads only the summaries until it reaches a candidate cell; bricks are pinned
  * through the cache as seeding descends into them and as propagation crosses their faces.
  *
- * Threads: an engine is driven by one thread; ip_engine_cancel() may be called from any other.
+ * Threads: an engine is driven by one thread, which ip_engine_step() joins to its workers:
+ * they share the progressive ray sequence (handed out in small batches, in order), the
+ * visited set (an atomic bit per cell) and the cache, and keep their own triangle buffers,
+ * appended to the mesh at the end of the step. Which thread extracts a cell varies from run to
+ * run, so the triangles' order and, where propagations meet, which cells are extracted may
+ * vary; what every pixel finally shows does not (each pixel's own ray extracts its seed).
+ * With several threads the times are summed over the threads. ip_engine_cancel() may be
+ * called from any thread.
  */
 #ifndef ISOPROP_ENGINE_H
 #define ISOPROP_ENGINE_H
@@ -37,6 +44,7 @@ extern "C" {
 typedef struct ip_engine_options {
     double cutoff_degrees;    /* propagation cut-off angle around the seed's ray */
     double foldback_degrees;  /* fold-back tolerance */
+    unsigned threads;         /* worker threads for seeding and propagation; 0 = every core */
 } ip_engine_options;
 
 /* Counters and times, per step or in total. Times are wall seconds, split as the paper does. */
@@ -53,8 +61,8 @@ typedef struct ip_engine_counts {
 
 typedef struct ip_engine ip_engine;
 
-/*! ip_engine_options_default() : the paper's cut-off (1.81 degrees) and a 0.25 degree
- *  fold-back tolerance. */
+/*! ip_engine_options_default() : the paper's cut-off (1.81 degrees), a 0.25 degree
+ *  fold-back tolerance, and every core. */
 void ip_engine_options_default(ip_engine_options *options);
 
 /*! ip_engine_create() : an engine reading through `cache` (which must outlive it). *out is the
@@ -95,10 +103,15 @@ void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
 
 /*! ip_extract_full() : triangulates every active cell of level `level`, brick by brick, skipping
  *  bricks and sub-blocks whose summary range excludes `iso`; the oracle and the baseline.
- *  Triangles equal those of the progressive engine for the same cells. Appends to `mesh`.
+ *  Triangles equal those of the progressive engine for the same cells. Runs on `threads`
+ *  threads (0 = every core) and appends to `mesh` in brick order, so the result is the same
+ *  for any number of threads. Times are summed over threads.
  *  @return IP_OK or a brick read error. */
-ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, ip_mesh *mesh,
-                          ip_engine_counts *counts, ip_error *err);
+ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,
+                          ip_mesh *mesh, ip_engine_counts *counts, ip_error *err);
+
+/*! ip_thread_count() : `requested`, or the number of online cores when it is 0. */
+unsigned ip_thread_count(unsigned requested);
 
 #ifdef __cplusplus
 }

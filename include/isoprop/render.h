@@ -45,24 +45,32 @@ typedef struct ip_shading {
 /*! ip_shading_default() : the parameters both renderers use. Thread-safe. */
 void ip_shading_default(ip_shading *shading);
 
+/*! ip_render_check_box() : validates the world box [lo, hi] (world units) that both
+ *  renderers take for their near and far planes: finite, lo <= hi on every axis.
+ *  @return IP_OK or IP_ERR_ARGUMENT with a message. Thread-safe. */
+ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_error *err);
+
 /*! ip_raster_mesh() : renders `mesh` in software, the reference for the GPU renderer.
  *  `camera` gives the image size (width x height pixels) and the view; near and far planes
  *  come from ip_camera_depth_range(camera, lo, hi), lo and hi being the world box of the
  *  volume (world units). A pixel is covered by a triangle when its centre (x + 0.5, y + 0.5)
  *  lies inside the triangle's projection, vertices being snapped to 1/256 pixel; a centre
- *  exactly on an edge belongs to the triangle only for a top or a left edge, so triangles
- *  that share an edge cover each pixel once, without gaps. Depth is compared exactly in
- *  double precision (1 / view depth, interpolated); the nearest triangle wins, and on equal
- *  depth the lower triangle index wins (as OpenGL's GL_LESS with triangles drawn in order).
+ *  exactly on an edge belongs to the triangle only for a top edge (horizontal, the triangle
+ *  below it) or a left edge, so triangles that share an edge cover each pixel once, without
+ *  gaps. Triangles are clipped to the near and far planes first. Depth is compared in double
+ *  precision (1 / view depth, interpolated); the nearest triangle wins, and on equal depth
+ *  the lower triangle index wins (as OpenGL's GL_LESS with triangles drawn in order), so
+ *  coverage depends on the set of triangles only, never on their order.
  *  Degenerate triangles (zero projected area) cover nothing.
  *  `triangle_index` (may be NULL): width * height entries, top row first, filled with the
  *  index in `mesh` of the triangle each pixel shows, or UINT32_MAX where it shows none.
  *  `rgba` (may be NULL): width * height * 4 bytes, filled with the shaded image described at
  *  the top of this header. Both buffers are owned by the caller.
  *  Single-threaded; reentrant (no shared state), so calls may run concurrently.
- *  @return IP_OK, IP_ERR_ARGUMENT (bad camera, image over 65536 pixels a side, mesh with
- *  UINT32_MAX triangles or more) or IP_ERR_NOMEM (working buffers: about 12 bytes a pixel,
- *  24 with rgba). */
+ *  Triangles with a non-finite coordinate are skipped.
+ *  @return IP_OK, IP_ERR_ARGUMENT (bad camera or box, image over 65536 pixels a side, mesh
+ *  with UINT32_MAX triangles or more) or IP_ERR_NOMEM (working buffers: about 12 bytes a
+ *  pixel, 24 with rgba). */
 ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
                          const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
                          ip_error *err);
@@ -100,11 +108,15 @@ void ip_gl_context_release(ip_gl_context *context);
 void ip_gl_context_destroy(ip_gl_context *context);
 
 /* The GPU renderer: holds the mesh in GPU buffers and draws it with the shading above.
- * Every call must come from the thread where its OpenGL context is current (a headless
- * renderer makes its own context current on the calling thread at each call); a renderer is
- * not thread-safe. OpenGL state a call changes: the bound framebuffers, vertex array,
- * program and array buffer, the viewport, depth test (on, GL_LESS, writes on), face culling,
- * blending and scissor test (off), and the pack alignment. */
+ * A renderer is not thread-safe. A headless renderer makes its own context current on the
+ * calling thread at each call, so it may move between threads provided the thread that used
+ * it last calls ip_renderer_release() first; a renderer on the caller's context needs that
+ * context current at every call. OpenGL state the calls change, which a caller sharing the
+ * context must set again for its own drawing: the bound framebuffers, renderbuffer, vertex
+ * array, program and buffers (array, copy, pixel pack: 0 afterwards); the viewport; depth
+ * test (on, GL_LESS, writes on); face culling, blending, scissor test, depth clamp and sRGB
+ * conversion (off); polygon mode (fill); colour mask (all on); pack alignment and row layout
+ * (1, tight). */
 typedef struct ip_renderer ip_renderer;
 
 /*! ip_renderer_create_headless() : a renderer with its own headless context and an
@@ -150,8 +162,8 @@ uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
  *  from ip_camera_depth_range(camera, lo, hi) for the volume's world box [lo, hi].
  *  The image is complete when the call returns from the caller's point of view (OpenGL may
  *  still be working: ip_renderer_read_rgba() waits for it).
- *  @return IP_OK, IP_ERR_ARGUMENT (bad camera, size mismatch) or IP_ERR_UNSUPPORTED (an
- *  OpenGL error, named in the message). */
+ *  @return IP_OK, IP_ERR_ARGUMENT (bad camera or box, size mismatch) or IP_ERR_UNSUPPORTED
+ *  (an OpenGL error, named in the message). */
 ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera, const double lo[3],
                            const double hi[3], ip_error *err);
 
@@ -159,6 +171,11 @@ ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera, const
  *  bytes, caller-owned), top row first, waiting for OpenGL to finish.
  *  @return IP_OK or IP_ERR_UNSUPPORTED (an OpenGL error). */
 ip_status ip_renderer_read_rgba(ip_renderer *renderer, uint8_t *rgba, ip_error *err);
+
+/*! ip_renderer_release() : makes a headless renderer's context no longer current on the
+ *  calling thread, so that another thread may use the renderer; a no-op for a renderer on the
+ *  caller's context. */
+void ip_renderer_release(ip_renderer *renderer);
 
 /*! ip_renderer_destroy() : frees the GPU objects and, for a headless renderer, its context
  *  (NULL is a no-op). A renderer on the caller's context needs that context current. */

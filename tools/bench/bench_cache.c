@@ -111,23 +111,29 @@ static double mib(uint64_t bytes)
     return (double)bytes / 1048576.0;
 }
 
-/* ---- a team of threads started together; the caller times from the start to the last join ---- */
+/* ---- a team of threads started together, timed from the first start to the last finish ---- */
 
 typedef struct team_member {
     void *(*work)(void *);
     void *arg;
     pthread_barrier_t *start;
+    double started, finished;
 } team_member;
 
+/* Each thread reads the clock itself: on a busy machine the thread that released the barrier
+ * may only run again after the others have finished. */
 static void *team_entry(void *p)
 {
     team_member *m = p;
     pthread_barrier_wait(m->start);
-    return m->work(m->arg);
+    m->started = now_seconds();
+    m->work(m->arg);
+    m->finished = now_seconds();
+    return NULL;
 }
 
-/* Runs work(args + t * arg_size) on `threads` threads started at once; returns wall seconds
- * from the start to the last finish, or a negative value if a thread could not be created. */
+/* Runs work(args + t * arg_size) on `threads` threads started at once; returns the wall
+ * seconds from the first thread's start to the last one's finish. */
 static double run_team(unsigned threads, void *(*work)(void *), void *args, size_t arg_size)
 {
     pthread_t *ids = calloc(threads, sizeof *ids);
@@ -141,7 +147,7 @@ static double run_team(unsigned threads, void *(*work)(void *), void *args, size
     pthread_barrier_init(&start, NULL, threads + 1);
     unsigned made = 0;
     for (; made < threads; made++) {
-        members[made] = (team_member){work, (char *)args + made * arg_size, &start};
+        members[made] = (team_member){work, (char *)args + made * arg_size, &start, 0, 0};
         if (pthread_create(&ids[made], NULL, team_entry, &members[made]) != 0)
             break;
     }
@@ -150,10 +156,14 @@ static double run_team(unsigned threads, void *(*work)(void *), void *args, size
         exit(1); /* the started threads wait at the barrier forever: nothing to clean up */
     }
     pthread_barrier_wait(&start);
-    double t0 = now_seconds();
-    for (unsigned t = 0; t < threads; t++)
+    double t0 = 0, t1 = 0;
+    for (unsigned t = 0; t < threads; t++) {
         pthread_join(ids[t], NULL);
-    double t1 = now_seconds();
+        if (t == 0 || members[t].started < t0)
+            t0 = members[t].started;
+        if (t == 0 || members[t].finished > t1)
+            t1 = members[t].finished;
+    }
     pthread_barrier_destroy(&start);
     free(ids);
     free(members);
@@ -382,8 +392,8 @@ static int measure_stage(const bench_file *f, const brick_info *list, uint64_t c
     uint64_t passes = 1;
     double t = time_stage(f, list, count, what, threads, passes, jobs);
     while (t < min_seconds) {
-        double want = min_seconds / (t > 1e-6 ? t : 1e-6) * 1.2;
-        passes = (uint64_t)((double)passes * (want < 2.0 ? 2.0 : want)) + 1;
+        double grow = min_seconds / (t > 1e-6 ? t : 1e-6) * 1.2; /* at most 10x a step */
+        passes = (uint64_t)((double)passes * (grow < 2.0 ? 2.0 : grow > 10.0 ? 10.0 : grow));
         t = time_stage(f, list, count, what, threads, passes, jobs);
     }
     double rates[16];

@@ -1,0 +1,52 @@
+# isorender end to end: image, mesh, stats and progress files; bad input.
+. "$(dirname "$0")/lib.sh"
+
+"$bin/isogen" sphere --dims 48x40x36 --type uint8 -o "$work/" --quiet
+"$bin/isobrick" sphere_48x40x36_uint8.raw -o s.ibv --brick-size 8 --quiet
+
+run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o p.png \
+    --mesh p.ply --stats p.json --progress p.csv --software
+check "progressive render succeeds" test "$rc" = 0
+check "the image is a PNG" sh -c 'head -c 8 p.png | od -An -tx1 | grep -q "89 50 4e 47 0d 0a 1a 0a"'
+check "the summary is printed" grep -q "triangles" "$work/.out"
+check "the cache table is printed" grep -q "cache statistics" "$work/.out"
+check "the PLY header" sh -c 'head -c 200 p.ply | grep -q "format binary_little_endian 1.0"'
+json=$(cat p.json)
+for key in cache budget_bytes resident_bytes resident_peak_bytes hits misses evictions \
+           bytes_decompressed decode_seconds bricks_touched bricks_total hit_rate \
+           peak_rss_bytes rays seeds cells triangles intersection_s propagation_s \
+           extraction_s rendering_s; do
+    check "stats has \"$key\"" sh -c 'printf "%s" "$0" | grep -q "\"$1\":"' "$json" "$key"
+done
+check "every pixel had its ray" sh -c 'printf "%s" "$0" | grep -q "\"rays\": 19200, \"rays_total\": 19200, \"done\": true"' "$json"
+check "progress header" test "$(head -1 p.csv)" = "time_s,rays,seeds,cells,triangles,final_pixel_pct"
+check "progress ends with every ray and 100 % final pixels" sh -c 'tail -1 p.csv | grep -q "^[0-9.]*,19200,.*,100.0000$"'
+check "a checkpoint each time the ray count doubles" test "$(grep -c . p.csv)" = 17
+# final_pixel_pct never decreases
+check "final pixels only grow" awk -F, 'NR > 2 && $6 + 0 < prev { exit 1 } { prev = $6 + 0 }' p.csv
+triangles=$(printf '%s' "$json" | sed 's/.*"triangles": \([0-9]*\).*/\1/')
+faces=$(head -c 400 p.ply | sed -n 's/^element face \([0-9]*\).*/\1/p')
+check "the PLY holds every triangle ($faces = $triangles)" test "$faces" = "$triangles"
+
+# the full extraction and the progressive one make the same picture
+run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o f.png --full --software --quiet
+check "full render succeeds" test "$rc" = 0
+check "full and progressive images are identical" cmp -s p.png f.png
+
+# limits: a ray budget
+run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --rays 100 -o r.png --stats r.json --software --quiet --warm
+check "a ray budget stops early" grep -q '"rays": 100, "rays_total": 19200, "done": false' r.json
+check "a warm run says so" grep -q '"warm": true' r.json
+
+# bad input: one line, non-zero, nothing written
+expect_error 2 "--iso" "$bin/isorender" s.ibv -o x.png
+check "no image without --iso" test ! -e x.png
+expect_error 1 "nothere.ibv" "$bin/isorender" nothere.ibv --iso 1 -o x.png
+expect_error 2 "--size" "$bin/isorender" s.ibv --iso 1 --size 12 -o x.png
+expect_error 1 "view" "$bin/isorender" s.ibv --iso 1 --view +w -o x.png
+expect_error 1 "camera" "$bin/isorender" s.ibv --iso 1 --camera 0,0,0,0,0,0,0,0,1,30 -o x.png
+expect_error 1 "exists" "$bin/isorender" s.ibv --iso 100.5 --size 16x12 -o p.png --software
+head -c 1000 s.ibv >cut.ibv
+expect_error 1 "cut.ibv" "$bin/isorender" cut.ibv --iso 1 -o x.png
+check "no image after errors" test ! -e x.png
+finish
