@@ -16,16 +16,22 @@
 #define MAX_THREADS 64
 #define RAY_BATCH 16 /* rays a worker takes at once: small, so the order stays progressive */
 
-/* One worker's private state: its pinned bricks, its queue, its triangles. */
-typedef struct worker {
-    ip_engine *engine;
+/* A worker's tools for one pyramid level: pinned bricks, seeding state, propagation queue. */
+typedef struct level_tools {
+    int ready;
     ip_sampler sampler;
     ip_seeder seeder;
     ip_propagator propagator;
+} level_tools;
+
+/* One worker's private state: its tools per level and its triangles. */
+typedef struct worker {
+    ip_engine *engine;
+    level_tools level[IP_MAX_LEVELS];
     ip_mesh mesh;
     ip_engine_counts counts;
     ip_status status;
-    ip_error error;
+    uint32_t failed_level;
 } worker;
 
 struct ip_engine {
@@ -39,6 +45,8 @@ struct ip_engine {
     ip_camera_basis basis;
     float iso;
     int begun;
+    uint32_t levels_used;       /* levels 0 .. levels_used - 1 have a distance band */
+    double lod_distance[IP_MAX_LEVELS + 1]; /* D[k]; D[levels_used] = infinity */
     pthread_mutex_t order_lock; /* the shared ray sequence */
     ip_ray_order order;
     uint64_t step_rays_left;    /* rays the current step may still hand out */
@@ -60,6 +68,8 @@ void ip_engine_options_default(ip_engine_options *o)
     o->cutoff_degrees = IP_DEFAULT_CUTOFF_DEGREES;
     o->foldback_degrees = IP_DEFAULT_FOLDBACK_DEGREES;
     o->threads = 0;
+    o->lod = 1;
+    o->pixel_error = 1.0;
 }
 
 ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
@@ -70,6 +80,9 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
         return ip_fail(err, IP_ERR_ARGUMENT, "cut-off %g and fold-back %g must be in degrees, "
                        "0 < cut-off <= 180, 0 <= fold-back <= 180",
                        options->cutoff_degrees, options->foldback_degrees);
+    if (options->lod && !(options->pixel_error > 0 && isfinite(options->pixel_error)))
+        return ip_fail(err, IP_ERR_ARGUMENT, "the pixel error %g must be positive",
+                       options->pixel_error);
     ip_engine *e = calloc(1, sizeof *e);
     if (!e)
         return ip_fail(err, IP_ERR_NOMEM, "out of memory");
@@ -85,7 +98,6 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     for (unsigned t = 0; st == IP_OK && t < e->threads; t++) {
         e->workers[t].engine = e;
         ip_mesh_init(&e->workers[t].mesh);
-        st = ip_sampler_init(&e->workers[t].sampler, cache, 0);
     }
     if (st != IP_OK) {
         ip_engine_destroy(e);
@@ -100,8 +112,13 @@ void ip_engine_destroy(ip_engine *e)
     if (!e)
         return;
     for (unsigned t = 0; e->workers && t < e->threads; t++) {
-        ip_propagator_free(&e->workers[t].propagator);
-        ip_sampler_free(&e->workers[t].sampler);
+        for (uint32_t k = 0; k < IP_MAX_LEVELS; k++) {
+            level_tools *lt = &e->workers[t].level[k];
+            if (!lt->ready)
+                continue;
+            ip_propagator_free(&lt->propagator);
+            ip_sampler_free(&lt->sampler);
+        }
         ip_mesh_free(&e->workers[t].mesh);
     }
     free(e->workers);
@@ -109,6 +126,40 @@ void ip_engine_destroy(ip_engine *e)
     ip_mesh_free(&e->mesh);
     pthread_mutex_destroy(&e->order_lock);
     free(e);
+}
+
+/* D[k]: beyond it a level-k cell (2^k level-0 cells across, at the largest spacing)
+ * projects to at most pixel_error pixels. Levels whose D lies beyond the volume's farthest
+ * corner are not used. */
+static void set_lod_distances(ip_engine *e)
+{
+    const ip_layout *l = ip_store_layout(ip_cache_store(e->cache));
+    double spacing = fmax(l->spacing[0], fmax(l->spacing[1], l->spacing[2]));
+    double pixels_per_radian = 0.5 * e->camera.height / e->basis.tan_half_y;
+    double far = 0;
+    for (int k = 0; k < 8; k++) {
+        double d2 = 0;
+        for (int a = 0; a < 3; a++) {
+            double c = (k >> a & 1) ? (l->dims[a] - 1) * l->spacing[a] : 0;
+            d2 += (c - e->camera.eye[a]) * (c - e->camera.eye[a]);
+        }
+        far = fmax(far, sqrt(d2));
+    }
+    e->lod_distance[0] = 0;
+    e->levels_used = 1;
+    for (uint32_t k = 1; e->options.lod && k < l->level_count; k++) {
+        double d = (double)(1u << k) * spacing * pixels_per_radian / e->options.pixel_error;
+        if (d >= far)
+            break;
+        e->lod_distance[k] = d;
+        e->levels_used = k + 1;
+    }
+    e->lod_distance[e->levels_used] = INFINITY;
+}
+
+double ip_engine_lod_distance(const ip_engine *e, uint32_t level)
+{
+    return level < e->levels_used ? e->lod_distance[level] : INFINITY;
 }
 
 ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_error *err)
@@ -125,16 +176,27 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     e->iso = iso;
     memset(&e->totals, 0, sizeof e->totals);
     ip_ray_order_init(&e->order, camera->width, camera->height);
+    set_lod_distances(e);
+    double pixel_angle = 2.0 * e->basis.tan_half_y / camera->height;
     for (unsigned t = 0; t < e->threads; t++) {
         worker *w = &e->workers[t];
-        ip_sampler_release(&w->sampler);
-        w->sampler.status = IP_OK;
         ip_mesh_clear(&w->mesh);
-        ip_seeder_init(&w->seeder, &w->sampler, iso, 2.0 * e->basis.tan_half_y / camera->height);
-        ip_propagator_free(&w->propagator);
-        if (ip_propagator_init(&w->propagator, &w->sampler, &e->visited, &w->mesh, &e->camera,
-                               iso, &e->options) != IP_OK)
-            return ip_fail(err, IP_ERR_NOMEM, "out of memory");
+        for (uint32_t k = 0; k < e->levels_used; k++) {
+            level_tools *lt = &w->level[k];
+            if (!lt->ready) {
+                if (ip_sampler_init(&lt->sampler, e->cache, k) != IP_OK)
+                    return ip_fail(err, IP_ERR_NOMEM, "out of memory");
+                lt->ready = 1;
+            }
+            ip_sampler_release(&lt->sampler);
+            lt->sampler.status = IP_OK;
+            ip_seeder_init(&lt->seeder, &lt->sampler, iso, pixel_angle);
+            ip_propagator_free(&lt->propagator);
+            if (ip_propagator_init(&lt->propagator, &lt->sampler, &e->visited, &w->mesh,
+                                   &e->camera, iso, &e->options, e->lod_distance[k],
+                                   e->lod_distance[k + 1]) != IP_OK)
+                return ip_fail(err, IP_ERR_NOMEM, "out of memory");
+        }
     }
     atomic_store(&e->cancel, 0);
     e->begun = 1;
@@ -163,32 +225,44 @@ static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
     to->rendering_seconds += from->rendering_seconds;
 }
 
-/* Casts the ray of pixel (x, y): extracts its seed, and the cells it nearly hit before it,
- * propagating from each that was not extracted yet. */
+/* Casts the ray of pixel (x, y), one distance band (pyramid level) after the other, front to
+ * back: extracts its seed, and the cells it nearly hit before it, propagating from each that
+ * was not extracted yet. */
 static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
 {
     ip_engine *e = w->engine;
     double dir[3];
     uint32_t cells[IP_SEED_MAX_CELLS][3];
-    unsigned count;
     ip_camera_pixel_ray(&e->basis, &e->camera, x + 0.5, y + 0.5, dir);
-    double t0 = ip_now_seconds();
-    int found = ip_seed_find(&w->seeder, e->camera.eye, dir, cells, &count);
-    w->counts.intersection_seconds += ip_now_seconds() - t0;
     w->counts.rays++;
-    if (found < 0)
-        return w->sampler.status;
-    ip_status st = IP_OK;
-    for (unsigned i = 0; i < count && st == IP_OK; i++) {
-        int was = ip_visited_mark(&e->visited, 0, cells[i]);
-        if (was < 0)
-            return IP_ERR_NOMEM;
-        if (was)
-            continue;
-        w->counts.seeds++;
-        st = ip_propagate(&w->propagator, cells[i], dir, &w->counts);
+    for (uint32_t k = 0; k < e->levels_used; k++) {
+        level_tools *lt = &w->level[k];
+        unsigned count;
+        double t0 = ip_now_seconds();
+        int found = ip_seed_find(&lt->seeder, e->camera.eye, dir, e->lod_distance[k],
+                                 e->lod_distance[k + 1], cells, &count);
+        w->counts.intersection_seconds += ip_now_seconds() - t0;
+        if (found < 0) {
+            w->failed_level = k;
+            return lt->sampler.status;
+        }
+        for (unsigned i = 0; i < count; i++) {
+            int was = ip_visited_mark(&e->visited, k, cells[i]);
+            if (was < 0)
+                return IP_ERR_NOMEM;
+            if (was)
+                continue;
+            w->counts.seeds++;
+            ip_status st = ip_propagate(&lt->propagator, cells[i], dir, &w->counts);
+            if (st != IP_OK) {
+                w->failed_level = k;
+                return st;
+            }
+        }
+        if (found)
+            return IP_OK;
     }
-    return st;
+    return IP_OK;
 }
 
 /* Takes up to RAY_BATCH pixels of the shared order for this step; returns how many. */
@@ -221,7 +295,8 @@ static void *work(void *p)
             w->status = cast_ray(w, xy[i][0], xy[i][1]);
         }
     }
-    ip_sampler_release(&w->sampler); /* let the cache evict freely between steps */
+    for (uint32_t k = 0; k < e->levels_used; k++) /* let the cache evict freely between steps */
+        ip_sampler_release(&w->level[k].sampler);
     return NULL;
 }
 
@@ -267,7 +342,7 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
             else if (st == IP_ERR_NOMEM)
                 ip_fail(err, st, "out of memory");
             else if (err)
-                *err = w->sampler.error;
+                *err = w->level[w->failed_level].sampler.error;
         }
     }
     add_counts(&e->totals, &c);

@@ -11,7 +11,8 @@
 
 ip_status ip_propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
                              ip_mesh *mesh, const ip_camera *camera, float iso,
-                             const ip_engine_options *options)
+                             const ip_engine_options *options, double near_distance,
+                             double far_distance)
 {
     memset(p, 0, sizeof *p);
     p->sampler = sampler;
@@ -23,6 +24,8 @@ ip_status ip_propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *
     p->cutoff = options->cutoff_degrees * DEG;
     p->foldback = options->foldback_degrees * DEG;
     p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
+    p->near_distance = near_distance;
+    p->far_distance = far_distance;
     p->queue_capacity = 4096;
     p->queue = malloc(p->queue_capacity * sizeof *p->queue);
     return p->queue ? IP_OK : IP_ERR_NOMEM;
@@ -161,6 +164,12 @@ ip_status ip_propagate(ip_propagator *p, const uint32_t seed[3], const double di
             double a = angle_to(eye, dir, centre);
             if (a > p->cutoff || a < q.max_angle - p->foldback || !in_frustum(p, centre, diagonal))
                 continue;
+            if (p->near_distance > 0 || p->far_distance < INFINITY) {
+                double v[3] = {centre[0] - eye[0], centre[1] - eye[1], centre[2] - eye[2]};
+                double d = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                if (d < p->near_distance || d >= p->far_distance)
+                    continue; /* another level's band: the resolution boundary */
+            }
             int was = ip_visited_mark(p->visited, p->sampler->level, n3);
             if (was < 0)
                 st = IP_ERR_NOMEM;

@@ -24,13 +24,18 @@ typedef struct ip_propagator {
     double cutoff;      /* radians */
     double foldback;    /* radians */
     double pixel_scale; /* pixels per unit of (size / depth) */
+    double near_distance, far_distance; /* the level's distance band from the eye */
     ip_queued_cell *queue;
     uint64_t queue_capacity;
 } ip_propagator;
 
+/* Propagation within one level: cells whose centre lies outside the distance band
+ * [near_distance, far_distance) from the eye belong to another level and stop it (the paper's
+ * resolution boundary). */
 ip_status ip_propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
                              ip_mesh *mesh, const ip_camera *camera, float iso,
-                             const ip_engine_options *options);
+                             const ip_engine_options *options, double near_distance,
+                             double far_distance);
 void ip_propagator_free(ip_propagator *p);
 
 /* Propagates from `seed` (already marked visited) along the surface, for the ray `dir` (unit,

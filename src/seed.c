@@ -285,8 +285,8 @@ void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_a
         s->scale[k] = s->layout->spacing[k] * (double)(1u << s->level);
 }
 
-int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], uint32_t cells[][3],
-                 unsigned *count)
+int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
+                 double t_max, uint32_t cells[][3], unsigned *count)
 {
     s->found = cells;
     s->found_count = 0;
@@ -303,7 +303,7 @@ int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], uint32_
     }
     r.world_origin = eye;
     r.world_dir = dir;
-    double lo[3], hi[3], t0 = 0.0, t1 = INFINITY;
+    double lo[3], hi[3], t0 = t_min, t1 = t_max;
     node_box(s, depth, root, lo, hi);
     if (!clip(&r, lo, hi, &t0, &t1))
         return 0;

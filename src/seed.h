@@ -28,13 +28,14 @@ typedef struct ip_seeder {
 /* `pixel_angle`: the angle one pixel subtends at the image centre (radians). */
 void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_angle);
 
-/* Casts the ray eye + t * dir (world units, dir of unit length, t >= 0) through the octree,
- * front to back, to the first cell whose triangles it clearly hits (the seed). Fills
+/* Casts the ray eye + t * dir (world units, dir of unit length, t_min <= t <= t_max) through
+ * the octree of the seeder's level, front to back, to the first cell whose triangles it
+ * clearly hits (the seed). Fills
  * cells[0 .. *count) (room for IP_SEED_MAX_CELLS) with the cells the ray passed within the
  * margin of on the way, then the seed. @return 1 when the last cell is a seed, 0 when the ray
  * clearly hits nothing (the cells are near misses only, possibly none), -1 when a brick could
  * not be read (see the sampler's status). */
-int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], uint32_t cells[][3],
-                 unsigned *count);
+int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
+                 double t_max, uint32_t cells[][3], unsigned *count);
 
 #endif

@@ -4,12 +4,21 @@
  * vertices). Also: empty space reads summaries only; cancel and restart leave nothing stale. */
 #include <dirent.h>
 #include <math.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdatomic.h>
 
 #include "check.h"
 #include "isoprop/bricker.h"
 #include "isoprop/engine.h"
 #include "isoprop/generate.h"
 #include "isoprop/render.h"
+
+/* The stated tolerance of adaptive resolution against full resolution, on the long gyroid of
+ * check_lod(): pixels whose coverage changes, in % of covered pixels, and the mean absolute
+ * colour difference over the image, in % of full scale. */
+#define LOD_COVERAGE_TOLERANCE_PCT 2
+#define LOD_COLOUR_TOLERANCE_PCT 1
 
 typedef struct scene {
     ip_store *store;
@@ -122,6 +131,7 @@ static void check_view(scene *s, const char *what, const char *axis, float iso, 
     ip_engine *e;
     ip_engine_options o;
     ip_engine_options_default(&o);
+    o.lod = 0; /* the exact-image guarantee is for full resolution */
     REQUIRE(ip_engine_create(s->cache, &o, &e, &err) == IP_OK);
     ip_engine_counts t;
     run_all_rays(e, &cam, iso, &t);
@@ -170,6 +180,145 @@ static void check_view(scene *s, const char *what, const char *axis, float iso, 
     ip_engine_destroy(e);
 }
 
+/* Adaptive resolution on a long volume seen end-on, whose far half projects to less than a
+ * pixel per cell: the far part comes from coarse levels, so fewer level-0 bricks are decoded,
+ * and the image stays close to the full-resolution one. */
+static void check_lod(const char *dir)
+{
+    char raw[4200], ibv[4200];
+    ip_gen_params p = {IP_FIELD_GYROID, {24, 24, 512}, IP_UINT8, 0.0, 1};
+    ip_error err;
+    snprintf(raw, sizeof raw, "%s/long_24x24x512_uint8.raw", dir);
+    snprintf(ibv, sizeof ibv, "%s/long.ibv", dir);
+    REQUIRE(ip_generate_write(&p, raw, 1, &err) == IP_OK);
+    ip_input_desc d;
+    ip_brick_options bo;
+    REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
+    ip_brick_options_default(&bo);
+    bo.brick_edge = 8;
+    bo.subblock_edge = 4;
+    bo.force = 1;
+    REQUIRE(ip_brick_volume(&d, ibv, &bo, NULL, &err) == IP_OK);
+    scene s;
+    open_scene(ibv, &s);
+    ip_camera cam;
+    REQUIRE(ip_camera_fit_axis(s.lo, s.hi, "-z", 30.0, 64, 64, &cam, &err) == IP_OK);
+    uint32_t *index[2];
+    uint8_t *rgba[2];
+    uint64_t fine_misses[2], coarse_misses[2];
+    for (int lod = 0; lod < 2; lod++) {
+        ip_cache *cache;
+        REQUIRE(ip_cache_create(s.store, 64ull << 20, &cache, &err) == IP_OK);
+        ip_engine *e;
+        ip_engine_options o;
+        ip_engine_options_default(&o);
+        o.lod = lod;
+        REQUIRE(ip_engine_create(cache, &o, &e, &err) == IP_OK);
+        ip_engine_counts t;
+        run_all_rays(e, &cam, 127.5f, &t);
+        if (lod) {
+            double d1 = ip_engine_lod_distance(e, 1);
+            CHECK_MSG(d1 > 0 && d1 < s.hi[2], "D[1] = %g", d1);
+        }
+        ip_cache_stats st;
+        ip_cache_get_stats(cache, &st);
+        fine_misses[lod] = st.level[0].misses;
+        coarse_misses[lod] = st.misses - st.level[0].misses;
+        index[lod] = malloc(64 * 64 * 4);
+        rgba[lod] = malloc(64 * 64 * 4);
+        REQUIRE(ip_raster_mesh(ip_engine_mesh(e), &cam, s.lo, s.hi, index[lod], rgba[lod], &err) ==
+                IP_OK);
+        ip_engine_destroy(e);
+        ip_cache_destroy(cache);
+    }
+    size_t covered = 0, coverage_diff = 0;
+    double colour_diff = 0;
+    for (size_t i = 0; i < 64 * 64; i++) {
+        covered += index[0][i] != UINT32_MAX;
+        coverage_diff += (index[0][i] != UINT32_MAX) != (index[1][i] != UINT32_MAX);
+        for (int c = 0; c < 3; c++)
+            colour_diff += abs((int)rgba[0][4 * i + c] - (int)rgba[1][4 * i + c]);
+    }
+    colour_diff /= 64.0 * 64.0 * 3.0 * 255.0;
+    printf("test_engine: lod: level-0 bricks decoded %llu (off) -> %llu (on), coarse %llu; "
+           "coverage differs on %zu of %zu pixels, mean colour difference %.2f %%\n",
+           (unsigned long long)fine_misses[0], (unsigned long long)fine_misses[1],
+           (unsigned long long)coarse_misses[1], coverage_diff, covered, 100 * colour_diff);
+    CHECK(coarse_misses[0] == 0 && coarse_misses[1] > 0);
+    CHECK_MSG(fine_misses[1] * 10 < fine_misses[0] * 7, "lod decoded %llu of %llu fine bricks",
+              (unsigned long long)fine_misses[1], (unsigned long long)fine_misses[0]);
+    CHECK_MSG(coverage_diff * 100 <= covered * LOD_COVERAGE_TOLERANCE_PCT,
+              "lod changes coverage on %zu of %zu pixels", coverage_diff, covered);
+    CHECK_MSG(colour_diff * 100 <= LOD_COLOUR_TOLERANCE_PCT, "lod colour difference %.2f %%",
+              100 * colour_diff);
+    for (int lod = 0; lod < 2; lod++) {
+        free(index[lod]);
+        free(rgba[lod]);
+    }
+    close_scene(&s);
+}
+
+typedef struct canceller {
+    ip_engine *engine;
+    atomic_int stop;
+} canceller;
+
+static void *cancel_soon(void *p)
+{
+    canceller *c = p;
+    for (int i = 0; i < 200 && !atomic_load(&c->stop); i++)
+        sched_yield();
+    ip_engine_cancel(c->engine);
+    return NULL;
+}
+
+/* Many threads, cancelled from another thread mid-step, then run to the end: the result covers
+ * exactly the pixels one thread covers. Run under ThreadSanitizer by the test suite. */
+static void check_threads(scene *s, float iso)
+{
+    ip_error err;
+    ip_camera cam;
+    REQUIRE(ip_camera_fit_axis(s->lo, s->hi, "+y", 30.0, 90, 70, &cam, &err) == IP_OK);
+    uint32_t *index[2];
+    for (int run = 0; run < 2; run++) {
+        ip_engine *e;
+        ip_engine_options o;
+        ip_engine_options_default(&o);
+        o.lod = 0;
+        o.threads = run == 0 ? 1 : 8;
+        REQUIRE(ip_engine_create(s->cache, &o, &e, &err) == IP_OK);
+        if (run == 1) {
+            for (int round = 0; round < 3; round++) { /* cancel in flight, several times */
+                REQUIRE(ip_engine_begin(e, &cam, iso + 0.05f * (float)round, &err) == IP_OK);
+                canceller c = {e, 0};
+                pthread_t t;
+                REQUIRE(pthread_create(&t, NULL, cancel_soon, &c) == 0);
+                ip_status st = IP_OK;
+                while (st == IP_OK && !ip_engine_done(e))
+                    st = ip_engine_step(e, 500, 0, NULL, &err);
+                atomic_store(&c.stop, 1);
+                pthread_join(t, NULL);
+                CHECK(st == IP_OK || st == IP_ERR_CANCELLED);
+            }
+        }
+        ip_engine_counts t;
+        run_all_rays(e, &cam, iso, &t);
+        index[run] = malloc(90 * 70 * 4);
+        REQUIRE(ip_raster_mesh(ip_engine_mesh(e), &cam, s->lo, s->hi, index[run], NULL, &err) ==
+                IP_OK);
+        ip_engine_destroy(e);
+    }
+    size_t differ = 0, covered = 0;
+    for (size_t i = 0; i < 90 * 70; i++) {
+        covered += index[0][i] != UINT32_MAX;
+        differ += (index[0][i] != UINT32_MAX) != (index[1][i] != UINT32_MAX);
+    }
+    CHECK_MSG(differ == 0 && covered > 0, "8 threads cover %zu pixels differently (of %zu)",
+              differ, covered);
+    free(index[0]);
+    free(index[1]);
+}
+
 /* A ray through empty space reads summaries only: no brick is decoded. */
 static void check_empty_space(scene *s, float iso)
 {
@@ -210,6 +359,7 @@ static void check_cancel_restart(scene *s, float iso_a, float iso_b)
     ip_engine_options o;
     ip_engine_options_default(&o);
     o.threads = 1; /* one thread extracts the same cells in the same order every time */
+    o.lod = 0;
     REQUIRE(ip_engine_create(s->cache, &o, &e, &err) == IP_OK);
     REQUIRE(ip_engine_create(s->cache, &o, &fresh, &err) == IP_OK);
     REQUIRE(ip_engine_begin(e, &cam, iso_a, &err) == IP_OK);
@@ -280,6 +430,7 @@ int main(void)
     check_view(&s, "gyroid", "-x", 0.5f, 128, 96);
     check_view(&s, "gyroid", "+y", 0.6f, 96, 128);
     check_cancel_restart(&s, 0.5f, 0.45f);
+    check_threads(&s, 0.5f);
     close_scene(&s);
 
     make_volume(dir, IP_FIELD_MARSCHNER_LOBB, 41, IP_UINT16, 16, ibv, sizeof ibv);
@@ -288,6 +439,7 @@ int main(void)
     check_view(&s, "marschner-lobb", "-z", 2047.5f, 110, 140);
     close_scene(&s);
 
+    check_lod(dir);
     check_shared_data();
     return test_summary("test_engine");
 }

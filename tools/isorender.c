@@ -23,6 +23,8 @@ static const char usage[] =
     "  --time SECONDS      stop extracting after this long\n"
     "  --cutoff DEGREES    propagation cut-off angle (default 1.81)\n"
     "  --foldback DEGREES  fold-back tolerance (default 0.25)\n"
+    "  --lod on|off        adaptive resolution: far regions from coarser levels (default on)\n"
+    "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n"
     "  --full              triangulate every active cell instead (the baseline)\n"
     "  --warm              extract once untimed first, so the timed run finds a warm cache\n"
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
@@ -37,7 +39,8 @@ static const char usage[] =
 
 typedef struct options {
     const char *file, *out, *mesh, *stats, *progress, *view, *camera;
-    double iso, time_limit, cutoff, foldback;
+    double iso, time_limit, cutoff, foldback, pixel_error;
+    int lod;
     int has_iso, full, software, force, quiet, warm;
     uint64_t rays, cache_bytes;
     unsigned threads;
@@ -87,6 +90,8 @@ static int parse_args(int argc, char **argv, options *o)
     o->height = 1200;
     o->cutoff = IP_DEFAULT_CUTOFF_DEGREES;
     o->foldback = IP_DEFAULT_FOLDBACK_DEGREES;
+    o->lod = 1;
+    o->pixel_error = 1.0;
     o->cache_bytes = ip_cache_default_budget();
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -126,6 +131,14 @@ static int parse_args(int argc, char **argv, options *o)
             if (tool_parse_u64(v, &n) != 0 || n < 1 || n > 64)
                 return tool_usage_error("isorender", "--threads must be 1-64");
             o->threads = (unsigned)n, i++;
+        } else if (!strcmp(a, "--lod") && v) {
+            if (strcmp(v, "on") && strcmp(v, "off"))
+                return tool_usage_error("isorender", "--lod must be on or off");
+            o->lod = !strcmp(v, "on"), i++;
+        } else if (!strcmp(a, "--pixel-error") && v) {
+            if (tool_parse_double(v, &o->pixel_error) != 0 || o->pixel_error <= 0)
+                return tool_usage_error("isorender", "--pixel-error '%s' is not positive", v);
+            i++;
         } else if (!strcmp(a, "--cache-mb") && v) {
             if (tool_parse_cache_mb(v, &o->cache_bytes) != 0)
                 return tool_usage_error("isorender", "bad --cache-mb '%s'", v);
@@ -211,6 +224,8 @@ static int extract_progressive(run *r, ip_error *err)
     eo.cutoff_degrees = r->o.cutoff;
     eo.foldback_degrees = r->o.foldback;
     eo.threads = r->o.threads;
+    eo.lod = r->o.lod;
+    eo.pixel_error = r->o.pixel_error;
     if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
         return -1;
     if (r->o.warm) { /* the same work once, untimed: the bricks it needs stay in the cache */
@@ -374,6 +389,8 @@ static void json_counts(FILE *f, void *user)
             r->camera.eye[0], r->camera.eye[1], r->camera.eye[2], r->camera.target[0],
             r->camera.target[1], r->camera.target[2], r->camera.up[0], r->camera.up[1],
             r->camera.up[2], r->camera.fov_y);
+    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", r->o.lod ? "true" : "false",
+            r->o.pixel_error);
     fprintf(f, ", \"warm\": %s, \"threads\": %u", r->o.warm ? "true" : "false",
             ip_thread_count(r->o.threads));
     fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", r->o.cutoff,

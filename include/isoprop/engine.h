@@ -15,6 +15,14 @@
  * Ray seeding reads only the summaries until it reaches a candidate cell; bricks are pinned
  * through the cache as seeding descends into them and as propagation crosses their faces.
  *
+ * Adaptive resolution (the paper's section 2.3, on by default): with D[k] the distance from
+ * the eye beyond which a cell of pyramid level k (a meta-cell of 2^k level-0 cells) projects
+ * to at most `pixel_error` pixels, the part of a ray between D[k] and D[k+1] is seeded in level
+ * k's octree and bricks, and propagation stays within its level's distance band. Far regions
+ * are extracted from the coarse levels of the brick file and never load fine bricks. Cracks at
+ * the band boundaries are sub-pixel, as in the paper; the exact-image guarantee above holds
+ * with lod off (or wherever every D[k >= 1] lies beyond the volume).
+ *
  * Threads: an engine is driven by one thread, which ip_engine_step() joins to its workers:
  * they share the progressive ray sequence (handed out in small batches, in order), the
  * visited set (an atomic bit per cell) and the cache, and keep their own triangle buffers,
@@ -45,6 +53,9 @@ typedef struct ip_engine_options {
     double cutoff_degrees;    /* propagation cut-off angle around the seed's ray */
     double foldback_degrees;  /* fold-back tolerance */
     unsigned threads;         /* worker threads for seeding and propagation; 0 = every core */
+    int lod;                  /* adaptive resolution: far regions from coarser pyramid levels */
+    double pixel_error;       /* with lod: a meta-cell is used once it projects to at most this
+                                 many pixels (1: the paper's sub-pixel rule) */
 } ip_engine_options;
 
 /* Counters and times, per step or in total. Times are wall seconds, split as the paper does. */
@@ -62,7 +73,7 @@ typedef struct ip_engine_counts {
 typedef struct ip_engine ip_engine;
 
 /*! ip_engine_options_default() : the paper's cut-off (1.81 degrees), a 0.25 degree
- *  fold-back tolerance, and every core. */
+ *  fold-back tolerance, every core, and adaptive resolution with a 1-pixel error. */
 void ip_engine_options_default(ip_engine_options *options);
 
 /*! ip_engine_create() : an engine reading through `cache` (which must outlive it). *out is the
@@ -94,6 +105,10 @@ void ip_engine_cancel(ip_engine *engine);
 /*! ip_engine_mesh() : the triangles extracted since ip_engine_begin(), in extraction order;
  *  owned by the engine, valid until the next begin, step or destroy. */
 const ip_mesh *ip_engine_mesh(const ip_engine *engine);
+
+/*! ip_engine_lod_distance() : D[level] of the current view, world units (0 for level 0;
+ *  infinity for levels that are never used). Valid after ip_engine_begin(). */
+double ip_engine_lod_distance(const ip_engine *engine, uint32_t level);
 
 /*! ip_engine_totals() : counts and times since ip_engine_begin(). */
 void ip_engine_totals(const ip_engine *engine, ip_engine_counts *counts);

@@ -133,16 +133,18 @@ static void *team_entry(void *p)
 }
 
 /* Runs work(args + t * arg_size) on `threads` threads started at once; returns the wall
- * seconds from the first thread's start to the last one's finish. */
-static double run_team(unsigned threads, void *(*work)(void *), void *args, size_t arg_size)
+ * seconds from the first thread's start to the last one's finish, and when `each` is not NULL
+ * fills each[t] with thread t's own seconds. Exits on failure (a benchmark has nothing
+ * sensible to go on with). */
+static double run_team(unsigned threads, void *(*work)(void *), void *args, size_t arg_size,
+                       double *each)
 {
     pthread_t *ids = calloc(threads, sizeof *ids);
     team_member *members = calloc(threads, sizeof *members);
     pthread_barrier_t start;
     if (!ids || !members) {
-        free(ids);
-        free(members);
-        return -1.0;
+        fprintf(stderr, "%s: out of memory for %u threads\n", program, threads);
+        exit(1);
     }
     pthread_barrier_init(&start, NULL, threads + 1);
     unsigned made = 0;
@@ -163,6 +165,8 @@ static double run_team(unsigned threads, void *(*work)(void *), void *args, size
             t0 = members[t].started;
         if (t == 0 || members[t].finished > t1)
             t1 = members[t].finished;
+        if (each)
+            each[t] = members[t].finished - members[t].started;
     }
     pthread_barrier_destroy(&start);
     free(ids);
@@ -372,7 +376,7 @@ static double time_stage(const bench_file *f, const brick_info *list, uint64_t c
         jobs[t].threads = threads;
         jobs[t].passes = passes;
     }
-    return run_team(threads, decode_work, jobs, sizeof *jobs);
+    return run_team(threads, decode_work, jobs, sizeof *jobs, NULL);
 }
 
 typedef struct rate {
@@ -612,17 +616,18 @@ static int bench_hits(const bench_file *f, const options *o)
     const int runs = o->quick ? 3 : 7;
     printf("### Hit path: pin + unpin of a resident brick\n\n");
     printf("Every level-0 brick is resident (budget %.0f MiB). Each thread does %llu pin + "
-           "unpin pairs per run; ns per pair is each thread's wall time / its pairs (the "
-           "latency a caller sees), the median of %d runs (fastest and slowest in brackets); "
-           "pairs per second counts all threads.\n\n",
+           "unpin pairs per run; ns per pair is a thread's own time / its pairs (the latency a "
+           "caller sees), averaged over the threads, the median of %d runs (fastest and slowest "
+           "in brackets); pairs per second counts all threads over the run's wall time (median).\n\n",
            mib(budget), (unsigned long long)iterations, runs);
     printf("| case | threads | ns per pair | million pairs per second, all threads |\n");
     printf("| --- | ---: | ---: | ---: |\n");
     hit_job *jobs = calloc(threads, sizeof *jobs);
     uint64_t *own = calloc(threads, sizeof *own);
+    double *each = calloc(threads, sizeof *each);
     atomic_uint_fast64_t counter;
     atomic_init(&counter, 0);
-    if (!jobs || !own)
+    if (!jobs || !own || !each)
         return 1;
     for (int c = 0; c < case_count; c++) {
         const hit_case *hc = &cases[c];
@@ -632,11 +637,15 @@ static int bench_hits(const bench_file *f, const options *o)
             jobs[t] = (hit_job){cache, hc->cycle_all ? order : &own[t], hc->cycle_all ? n : 1,
                                 iterations, &counter, 0};
         }
-        double ns[16];
+        double ns[16], rates[16];
         for (int r = 0; r < runs; r++) {
-            double secs = run_team(hc->threads, hc->reference ? counter_work : hit_work, jobs,
-                                   sizeof *jobs);
-            ns[r] = secs * 1e9 / (double)iterations;
+            double wall = run_team(hc->threads, hc->reference ? counter_work : hit_work, jobs,
+                                   sizeof *jobs, each);
+            double sum = 0;
+            for (unsigned t = 0; t < hc->threads; t++)
+                sum += each[t];
+            ns[r] = sum / hc->threads * 1e9 / (double)iterations;
+            rates[r] = (double)hc->threads * (double)iterations / wall;
         }
         for (unsigned t = 0; t < hc->threads; t++)
             if (jobs[t].failed) {
@@ -646,7 +655,7 @@ static int bench_hits(const bench_file *f, const options *o)
             }
         double med = median(ns, (size_t)runs);
         printf("| %s | %u | %.1f (%.1f .. %.1f) | %.1f |\n", hc->name, hc->threads, med, ns[0],
-               ns[runs - 1], hc->threads * 1e3 / med);
+               ns[runs - 1], median(rates, (size_t)runs) / 1e6);
     }
     printf("\n");
     ip_cache_stats s;
@@ -658,6 +667,7 @@ static int bench_hits(const bench_file *f, const options *o)
     ip_cache_destroy(cache);
     free(jobs);
     free(own);
+    free(each);
     free(order);
     return 0;
 }
@@ -747,7 +757,7 @@ static int run_budget(const bench_file *f, const char *name, const uint64_t *seq
         return 1;
     for (unsigned t = 0; t < threads; t++)
         jobs[t] = (run_job){cache, sequence, count, t, threads, 0, {IP_OK, {0}}};
-    double secs = run_team(threads, run_work, jobs, sizeof *jobs);
+    double secs = run_team(threads, run_work, jobs, sizeof *jobs, NULL);
     for (unsigned t = 0; t < threads; t++)
         if (jobs[t].failed)
             return tool_fail(program, &jobs[t].err);
