@@ -63,13 +63,19 @@ typedef struct plane_ellipsoid {
     double density;
 } plane_ellipsoid;
 
+/* The phantom is averaged over PARTIAL^3 points spread across each voxel, as a scanner
+ * integrates over its voxels: edges get the intermediate (partial-volume) values of a real
+ * CT, and isosurfaces between two tissues are smooth instead of voxel staircases. */
+#define PARTIAL 3
+
 /* Everything a plane's samples share. */
 typedef struct plane_context {
     const ip_gen_params *params;
     uint32_t z_index;
     double z;
-    plane_ellipsoid ellipsoids[ELLIPSOID_COUNT];
-    size_t ellipsoid_count;
+    double half_voxel[3];  /* half a voxel along each axis, normalised units */
+    plane_ellipsoid ellipsoids[PARTIAL][ELLIPSOID_COUNT]; /* per sub-plane in z */
+    size_t ellipsoid_count[PARTIAL];
     double gyroid_sin_z, gyroid_cos_z;
     double ml_z_term; /* 1 - sin(pi z / 2) */
 } plane_context;
@@ -123,25 +129,34 @@ static double normalised(uint32_t i, uint32_t n)
     return -1.0 + 2.0 * (double)i / (double)(n - 1);
 }
 
+/* Offset of sub-point j (0 .. PARTIAL-1) from a voxel's centre, in half voxels. */
+static double partial_offset(int j)
+{
+    return (2.0 * j + 1.0) / PARTIAL - 1.0;
+}
+
 static void prepare_shepp_logan(plane_context *pc)
 {
-    pc->ellipsoid_count = 0;
-    for (size_t i = 0; i < ELLIPSOID_COUNT; i++) {
-        const ellipsoid *e = &shepp_logan_ellipsoids[i];
-        double dz = (pc->z - e->z0) / e->c;
-        if (dz * dz > 1.0)
-            continue;
-        plane_ellipsoid *p = &pc->ellipsoids[pc->ellipsoid_count++];
-        double angle = e->angle_deg * GEN_PI / 180.0;
-        p->x0 = e->x0;
-        p->y0 = e->y0;
-        p->cos_t = cos(angle);
-        p->sin_t = sin(angle);
-        p->inv_a2 = 1.0 / (e->a * e->a);
-        p->inv_b2 = 1.0 / (e->b * e->b);
-        p->z_term = dz * dz;
-        p->reach = e->a > e->b ? e->a : e->b;
-        p->density = e->density;
+    for (int s = 0; s < PARTIAL; s++) {
+        double z = pc->z + partial_offset(s) * pc->half_voxel[2];
+        pc->ellipsoid_count[s] = 0;
+        for (size_t i = 0; i < ELLIPSOID_COUNT; i++) {
+            const ellipsoid *e = &shepp_logan_ellipsoids[i];
+            double dz = (z - e->z0) / e->c;
+            if (dz * dz > 1.0)
+                continue;
+            plane_ellipsoid *p = &pc->ellipsoids[s][pc->ellipsoid_count[s]++];
+            double angle = e->angle_deg * GEN_PI / 180.0;
+            p->x0 = e->x0;
+            p->y0 = e->y0;
+            p->cos_t = cos(angle);
+            p->sin_t = sin(angle);
+            p->inv_a2 = 1.0 / (e->a * e->a);
+            p->inv_b2 = 1.0 / (e->b * e->b);
+            p->z_term = dz * dz;
+            p->reach = e->a > e->b ? e->a : e->b;
+            p->density = e->density;
+        }
     }
 }
 
@@ -151,6 +166,8 @@ static void prepare_plane(plane_context *pc, const ip_gen_params *params, uint32
     pc->params = params;
     pc->z_index = z;
     pc->z = normalised(z, params->dims[2]);
+    for (int a = 0; a < 3; a++)
+        pc->half_voxel[a] = 1.0 / (double)(params->dims[a] - 1);
     if (params->field == IP_FIELD_SHEPP_LOGAN)
         prepare_shepp_logan(pc);
     double k = GYROID_PERIODS * GEN_PI;
@@ -167,12 +184,12 @@ static void axis_point_at(axis_point *p, const plane_context *pc, uint32_t i, ui
     p->cos_k = pc->params->field == IP_FIELD_GYROID ? cos(k * p->t) : 0.0;
 }
 
-/* Sum of the densities of the ellipsoids that contain (x, y, z); 0 outside the head. */
-static double shepp_logan_value(const plane_context *pc, double x, double y)
+/* Sum of the densities of the ellipsoids of sub-plane `s` that contain (x, y); 0 outside. */
+static double shepp_logan_point(const plane_context *pc, int s, double x, double y)
 {
     double sum = 0.0;
-    for (size_t i = 0; i < pc->ellipsoid_count; i++) {
-        const plane_ellipsoid *e = &pc->ellipsoids[i];
+    for (size_t i = 0; i < pc->ellipsoid_count[s]; i++) {
+        const plane_ellipsoid *e = &pc->ellipsoids[s][i];
         double dx = x - e->x0, dy = y - e->y0;
         if (fabs(dy) > e->reach)
             continue;
@@ -182,6 +199,18 @@ static double shepp_logan_value(const plane_context *pc, double x, double y)
             sum += e->density;
     }
     return sum;
+}
+
+/* The phantom averaged over the voxel around (x, y, z): PARTIAL^3 points. */
+static double shepp_logan_value(const plane_context *pc, double x, double y)
+{
+    double sum = 0.0;
+    for (int s = 0; s < PARTIAL; s++)
+        for (int j = 0; j < PARTIAL; j++)
+            for (int i = 0; i < PARTIAL; i++)
+                sum += shepp_logan_point(pc, s, x + partial_offset(i) * pc->half_voxel[0],
+                                         y + partial_offset(j) * pc->half_voxel[1]);
+    return sum / (PARTIAL * PARTIAL * PARTIAL);
 }
 
 static double sphere_value(const plane_context *pc, double x, double y)

@@ -514,3 +514,17 @@ int ip_header_parse_double_list(const char *text, double *values, int max, int *
         p = end;
     }
 }
+
+int ip_header_overridden(ip_header_owner by, const ip_input_overrides *overrides)
+{
+    if (!overrides)
+        return 0;
+    switch (by) {
+    case BY_NOTHING: return 0;
+    case BY_DIMS: return overrides->has_dims;
+    case BY_TYPE: return overrides->has_type;
+    case BY_ENDIAN: return overrides->has_endian;
+    case BY_SPACING: return overrides->has_spacing;
+    }
+    return 0;
+}

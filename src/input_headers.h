@@ -71,4 +71,17 @@ int ip_header_parse_bool(const char *text, int *out);
 int ip_header_parse_u64_list(const char *text, uint64_t *values, int max, int *count);
 int ip_header_parse_double_list(const char *text, double *values, int max, int *count);
 
+/* Which override, if any, replaces a header field: a field that an override replaces is not
+ * read at all, so the override can stand in for a value the reader cannot use. */
+typedef enum ip_header_owner {
+    BY_NOTHING,
+    BY_DIMS,
+    BY_TYPE,
+    BY_ENDIAN,
+    BY_SPACING
+} ip_header_owner;
+
+/* 1 when `overrides` (may be NULL) replaces fields owned by `by`. */
+int ip_header_overridden(ip_header_owner by, const ip_input_overrides *overrides);
+
 #endif

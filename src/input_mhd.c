@@ -30,14 +30,6 @@ typedef struct mhd_header {
     char data_path[IP_PATH_MAX];
 } mhd_header;
 
-typedef enum mhd_overridden_by {
-    BY_NOTHING,
-    BY_DIMS,
-    BY_TYPE,
-    BY_ENDIAN,
-    BY_SPACING
-} mhd_overridden_by;
-
 typedef ip_status (*mhd_key_parser)(mhd_header *h, char *value, ip_error *err);
 
 static ip_status bad_value(const mhd_header *h, const char *value, const char *why,
@@ -160,7 +152,7 @@ static ip_status parse_data_file(mhd_header *h, char *value, ip_error *err)
 
 static const struct {
     const char *name;
-    mhd_overridden_by by;
+    ip_header_owner by;
     mhd_key_parser parse;
 } mhd_keys[] = {
     {"NDims", BY_DIMS, parse_ndims},
@@ -177,20 +169,6 @@ static const struct {
     {"ElementDataFile", BY_NOTHING, parse_data_file},
 };
 
-static int is_overridden(mhd_overridden_by by, const ip_input_overrides *overrides)
-{
-    if (!overrides)
-        return 0;
-    switch (by) {
-    case BY_NOTHING: return 0;
-    case BY_DIMS: return overrides->has_dims;
-    case BY_TYPE: return overrides->has_type;
-    case BY_ENDIAN: return overrides->has_endian;
-    case BY_SPACING: return overrides->has_spacing;
-    }
-    return 0;
-}
-
 /* One "Key = Value" line; keys the reader does not need (ObjectType, Offset,
  * TransformMatrix, ...) are skipped. */
 static ip_status parse_line(mhd_header *h, char *line, const ip_input_overrides *overrides,
@@ -206,7 +184,7 @@ static ip_status parse_line(mhd_header *h, char *line, const ip_input_overrides 
     for (size_t i = 0; i < sizeof mhd_keys / sizeof mhd_keys[0]; i++) {
         if (strcasecmp(key, mhd_keys[i].name) != 0)
             continue;
-        if (is_overridden(mhd_keys[i].by, overrides))
+        if (ip_header_overridden(mhd_keys[i].by, overrides))
             return IP_OK;
         h->key = mhd_keys[i].name;
         if (value[0] == '\0')

@@ -37,13 +37,6 @@ typedef struct nrrd_header {
 } nrrd_header;
 
 /* Which override makes a field irrelevant. */
-typedef enum nrrd_overridden_by {
-    BY_NOTHING,
-    BY_DIMS,
-    BY_TYPE,
-    BY_ENDIAN,
-    BY_SPACING
-} nrrd_overridden_by;
 
 typedef ip_status (*nrrd_field_parser)(nrrd_header *h, char *value, ip_error *err);
 
@@ -217,7 +210,7 @@ static ip_status parse_data_file(nrrd_header *h, char *value, ip_error *err)
 
 static const struct {
     const char *name;
-    nrrd_overridden_by by;
+    ip_header_owner by;
     nrrd_field_parser parse;
 } nrrd_fields[] = {
     {"type", BY_TYPE, parse_type},
@@ -234,20 +227,6 @@ static const struct {
     {"data file", BY_NOTHING, parse_data_file},
     {"datafile", BY_NOTHING, parse_data_file},
 };
-
-static int is_overridden(nrrd_overridden_by by, const ip_input_overrides *overrides)
-{
-    if (!overrides)
-        return 0;
-    switch (by) {
-    case BY_NOTHING: return 0;
-    case BY_DIMS: return overrides->has_dims;
-    case BY_TYPE: return overrides->has_type;
-    case BY_ENDIAN: return overrides->has_endian;
-    case BY_SPACING: return overrides->has_spacing;
-    }
-    return 0;
-}
 
 /* One "field: value" line. Key/value pairs ("key:=value") and fields that describe anything
  * else (content, kinds, space origin, ...) are not needed to read the samples. */
@@ -270,7 +249,7 @@ static ip_status parse_line(nrrd_header *h, char *line, const ip_input_overrides
     for (size_t i = 0; i < sizeof nrrd_fields / sizeof nrrd_fields[0]; i++) {
         if (strcmp(line, nrrd_fields[i].name) != 0)
             continue;
-        if (is_overridden(nrrd_fields[i].by, overrides))
+        if (ip_header_overridden(nrrd_fields[i].by, overrides))
             return IP_OK;
         if (value[0] == '\0')
             return ip_fail(err, IP_ERR_INPUT, "%s: line %lu: field '%s' has no value", h->path,

@@ -2,7 +2,7 @@
 # isoprop set-up: installs the Debian packages the project needs (only those missing),
 # configures and builds, then runs one job.
 #
-#   tools/setup.sh demo    build, then generate, brick and describe the default volume
+#   tools/setup.sh demo    build, then generate, brick, describe and render the default volume
 #   tools/setup.sh test    build, then run the whole test suite: a -Werror build, a build under
 #                          AddressSanitizer + UndefinedBehaviorSanitizer (with the fuzzers), and
 #                          the threaded tests under ThreadSanitizer
@@ -51,6 +51,9 @@ demo() {
     build/isogen shepp-logan --dims 128x128x128 --type uint16 -o bricks/ --force --quiet
     build/isobrick "$volume" -o bricks/shepp-logan.ibv --force
     build/isoinfo bricks/shepp-logan.ibv
+    build/isorender bricks/shepp-logan.ibv --iso 1000.5 --view -y --size 800x600 \
+        -o bricks/shepp-logan.png --stats bricks/shepp-logan.json --force
+    echo "image: bricks/shepp-logan.png, statistics: bricks/shepp-logan.json"
 }
 
 run_tests() {
