@@ -49,6 +49,8 @@ ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
 ip_status ip_mesh_append(ip_mesh *m, const float *positions, const float *normals,
                          const uint64_t *cells, uint64_t count)
 {
+    if (count == 0)
+        return IP_OK; /* the arrays of an empty mesh may be NULL */
     ip_status st = ip_mesh_reserve(m, m->triangle_count + count);
     if (st != IP_OK)
         return st;
