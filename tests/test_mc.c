@@ -146,7 +146,7 @@ static void gen_edge_corners(int edge, unsigned corners[2])
 /* 1 when both edges lie on one face of the cell (their 4 corners agree on some axis bit). */
 static int edges_share_face(int e1, int e2)
 {
-    unsigned c[4];
+    unsigned c[4] = {0, 0, 0, 0};
     gen_edge_corners(e1, c);
     gen_edge_corners(e2, c + 2);
     for (unsigned axis = 0; axis < 3; axis++) {
