@@ -13,6 +13,8 @@
 
 #define STRIPES 64 /* load coordination locks, by brick index */
 
+struct entry;
+
 /* A decoded brick. Entries are type-stable: once allocated they are recycled, never freed
  * before the cache, so a thread that read a slot's pointer may always look at the entry and
  * find out (pins < 0, or another brick) that it lost a race. */
@@ -32,6 +34,20 @@ typedef struct slot {
     _Atomic(entry *) entry;
 } slot;
 
+/* The LRU order: a min-heap of (tick, entry), updated lazily. A hit only stamps the entry's
+ * tick (no lock); eviction pops the smallest key, and an entry whose tick moved on since its
+ * key was taken is pushed back under its new tick. A popped entry whose key equals its tick is
+ * the least recently used: every other key is at most its entry's tick. */
+typedef struct heap_item {
+    uint64_t key;
+    struct entry *entry;
+} heap_item;
+
+#define HIT_STRIPES 16
+typedef struct padded_counter {
+    _Alignas(64) atomic_uint_fast64_t value;
+} padded_counter;
+
 struct ip_cache {
     const ip_store *store;
     const ip_layout *layout;
@@ -44,6 +60,9 @@ struct ip_cache {
     pthread_mutex_t evict_lock; /* resident set, free list, accounting */
     entry **resident;          /* resident entries, unordered */
     uint64_t resident_count, resident_capacity;
+    heap_item *heap;           /* every resident entry once, keyed by a tick <= its last pin */
+    heap_item *parked;         /* evict_one()'s room for pinned entries it set aside */
+    uint64_t heap_count, heap_capacity;
     entry *free_entries;
     void **spare_work;         /* decode scratch buffers not in use, under evict_lock */
     uint64_t spare_count, spare_capacity;
@@ -52,11 +71,12 @@ struct ip_cache {
     size_t work_size;
     long page_size;
     atomic_uint_fast64_t clock;
-    atomic_uint_fast64_t hits, misses, evictions, waits, bytes_decompressed, bytes_read,
+    padded_counter hits[HIT_STRIPES]; /* striped by brick: hits on different bricks do not
+                                         contend for one cache line */
+    atomic_uint_fast64_t misses, evictions, waits, bytes_decompressed, bytes_read,
         decode_ns, over_budget_pins, errors, touched_count;
     atomic_uint_fast64_t level_touched[32], level_misses[32];
     uint64_t resident_bytes, resident_peak; /* under evict_lock */
-    atomic_uint_fast64_t pinned_bytes;
 };
 
 uint64_t ip_cache_default_budget(void)
@@ -122,6 +142,8 @@ void ip_cache_destroy(ip_cache *c)
     free(c->spare_work);
     free(c->all_entries);
     free(c->resident);
+    free(c->heap);
+    free(c->parked);
     free(c->slots);
     free((void *)c->touched);
     free(c->loading);
@@ -165,47 +187,111 @@ static int try_pin(ip_cache *c, uint64_t g, ip_brick *b)
     /* pinned: it cannot be evicted now, but it may have been recycled for another brick
      * between our load of the slot and the pin */
     if (atomic_load(&e->brick) != g || atomic_load(&c->slots[g].entry) != e) {
-        /* undo; if another pinner unpinned meanwhile, ours was the last pin of a pinned
-         * brick, and the pinned bytes it added are ours to remove */
-        size_t bytes = e->bytes; /* read while pinned: once unpinned it may be recycled */
-        if (atomic_fetch_sub(&e->pins, 1) == 1 && p > 0)
-            atomic_fetch_sub(&c->pinned_bytes, bytes);
+        /* undo */
+        atomic_fetch_sub(&e->pins, 1);
         return 0;
     }
-    if (p == 0)
-        atomic_fetch_add(&c->pinned_bytes, e->bytes);
     atomic_store_explicit(&e->tick, atomic_fetch_add(&c->clock, 1) + 1, memory_order_relaxed);
     fill_brick(e, b);
     return 1;
 }
 
-/* Evicts the least recently pinned unpinned entry and returns it (still holding its samples
- * buffer), or NULL when every resident entry is pinned. evict_lock held. */
+static void heap_sift_up(heap_item *h, uint64_t i)
+{
+    heap_item item = h[i];
+    while (i > 0 && h[(i - 1) / 2].key > item.key) {
+        h[i] = h[(i - 1) / 2];
+        i = (i - 1) / 2;
+    }
+    h[i] = item;
+}
+
+static void heap_sift_down(heap_item *h, uint64_t n, uint64_t i)
+{
+    heap_item item = h[i];
+    for (;;) {
+        uint64_t child = 2 * i + 1;
+        if (child >= n)
+            break;
+        if (child + 1 < n && h[child + 1].key < h[child].key)
+            child++;
+        if (h[child].key >= item.key)
+            break;
+        h[i] = h[child];
+        i = child;
+    }
+    h[i] = item;
+}
+
+/* Adds `e` under its current tick. evict_lock held; the room was made by heap_reserve(). */
+static void heap_push(ip_cache *c, entry *e)
+{
+    c->heap[c->heap_count] = (heap_item){atomic_load_explicit(&e->tick, memory_order_relaxed), e};
+    heap_sift_up(c->heap, c->heap_count++);
+}
+
+static heap_item heap_pop(ip_cache *c)
+{
+    heap_item top = c->heap[0];
+    c->heap[0] = c->heap[--c->heap_count];
+    if (c->heap_count > 0)
+        heap_sift_down(c->heap, c->heap_count, 0);
+    return top;
+}
+
+/* Room for one more resident entry in the heap (and in the parking space of evict_one(),
+ * which may hold every resident entry at once). evict_lock held. */
+static int heap_reserve(ip_cache *c)
+{
+    if (c->heap_count < c->heap_capacity)
+        return 0;
+    uint64_t cap = c->heap_capacity ? 2 * c->heap_capacity : 64;
+    heap_item *grown = realloc(c->heap, cap * sizeof *grown);
+    if (!grown)
+        return -1;
+    c->heap = grown;
+    heap_item *parked = realloc(c->parked, cap * sizeof *parked);
+    if (!parked)
+        return -1;
+    c->parked = parked;
+    c->heap_capacity = cap;
+    return 0;
+}
+
+/* Removes the least recently pinned unpinned entry from the resident set and returns it (still
+ * holding its samples buffer), or NULL when every resident entry is pinned. O(log n) per call,
+ * amortised over the hits since. evict_lock held. */
 static entry *evict_one(ip_cache *c)
 {
-    for (;;) {
-        entry *victim = NULL;
-        uint64_t oldest = UINT64_MAX;
-        for (uint64_t i = 0; i < c->resident_count; i++) {
-            entry *e = c->resident[i];
-            uint64_t t = atomic_load_explicit(&e->tick, memory_order_relaxed);
-            if (atomic_load_explicit(&e->pins, memory_order_relaxed) == 0 && t < oldest) {
-                oldest = t;
-                victim = e;
-            }
+    entry *victim = NULL;
+    uint64_t parked = 0;
+    while (c->heap_count > 0) {
+        heap_item top = heap_pop(c);
+        uint64_t tick = atomic_load_explicit(&top.entry->tick, memory_order_relaxed);
+        if (tick != top.key) { /* pinned since its key was taken: re-key it */
+            c->heap[c->heap_count] = (heap_item){tick, top.entry};
+            heap_sift_up(c->heap, c->heap_count++);
+            continue;
         }
-        if (!victim)
-            return NULL;
         int zero = 0;
-        if (!atomic_compare_exchange_strong(&victim->pins, &zero, -1))
-            continue; /* pinned meanwhile: choose again */
-        atomic_store(&c->slots[atomic_load(&victim->brick)].entry, NULL);
-        c->resident[victim->resident_slot] = c->resident[--c->resident_count];
-        c->resident[victim->resident_slot]->resident_slot = victim->resident_slot;
-        c->resident_bytes -= victim->bytes;
-        atomic_fetch_add(&c->evictions, 1);
-        return victim;
+        if (atomic_compare_exchange_strong(&top.entry->pins, &zero, -1)) {
+            victim = top.entry;
+            break;
+        }
+        c->parked[parked++] = top; /* pinned now: set aside, given back below */
     }
+    for (uint64_t i = 0; i < parked; i++) {
+        c->heap[c->heap_count] = c->parked[i];
+        heap_sift_up(c->heap, c->heap_count++);
+    }
+    if (!victim)
+        return NULL;
+    atomic_store(&c->slots[atomic_load(&victim->brick)].entry, NULL);
+    c->resident[victim->resident_slot] = c->resident[--c->resident_count];
+    c->resident[victim->resident_slot]->resident_slot = victim->resident_slot;
+    c->resident_bytes -= victim->bytes;
+    atomic_fetch_add(&c->evictions, 1);
+    return victim;
 }
 
 /* Returns an entry to the free list. Its samples go back to the allocator: only the entry
@@ -288,15 +374,20 @@ static ip_status add_resident(ip_cache *c, entry *e)
         c->resident = grown;
         c->resident_capacity = cap;
     }
+    if (heap_reserve(c) != 0)
+        return IP_ERR_NOMEM;
     e->resident_slot = (uint32_t)c->resident_count;
     c->resident[c->resident_count++] = e;
+    heap_push(c, e);
     return IP_OK;
 }
 
-/* The kernel maps file pages in aligned windows around a fault ("fault-around", 64 KiB by
- * default), so a decode maps pages of neighbouring payloads too. Releasing whole windows
- * keeps those from piling up in the process. */
-#define FAULT_AROUND_BYTES 65536u
+/* The kernel maps more than the faulting page: aligned windows around it ("fault-around",
+ * 64 KiB by default) and, where the page cache holds large folios, the whole folio (up to
+ * 2 MiB, seen on ext4). So a decode maps pages of neighbouring payloads too. Releasing the
+ * aligned 2 MiB span around a payload keeps them from piling up in the process; a neighbour
+ * needed again is one minor fault away. */
+#define FAULT_AROUND_BYTES (2u << 20)
 
 /* Drops the mapping's pages under (and around) a payload once decoded: they stay in the page
  * cache if needed again, and keeping them mapped would grow the process by the compressed
@@ -389,6 +480,7 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
     memcpy(e->origin, origin, sizeof origin);
     ip_status st = decode_into(c, g, e, err);
     pthread_mutex_lock(&c->evict_lock);
+    atomic_store(&e->tick, atomic_fetch_add(&c->clock, 1) + 1);
     if (st == IP_OK)
         st = add_resident(c, e);
     if (st != IP_OK) {
@@ -399,11 +491,9 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
         return st == IP_ERR_NOMEM ? ip_fail(err, st, "out of memory") : st;
     }
     atomic_store(&e->brick, g);
-    atomic_store(&e->tick, atomic_fetch_add(&c->clock, 1) + 1);
     atomic_store(&e->pins, 1);
     atomic_store_explicit(&c->slots[g].entry, e, memory_order_release);
     pthread_mutex_unlock(&c->evict_lock);
-    atomic_fetch_add(&c->pinned_bytes, bytes);
     atomic_fetch_add(&c->misses, 1);
     atomic_fetch_add(&c->level_misses[level], 1);
     atomic_fetch_add(&c->bytes_decompressed, bytes);
@@ -420,7 +510,7 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
     ip_brick_coords(c->layout, g, &level, brick);
     note_touch(c, g, level);
     if (try_pin(c, g, b)) {
-        atomic_fetch_add_explicit(&c->hits, 1, memory_order_relaxed);
+        atomic_fetch_add_explicit(&c->hits[g % HIT_STRIPES].value, 1, memory_order_relaxed);
         return IP_OK;
     }
     pthread_mutex_t *lock = &c->stripe_lock[g % STRIPES];
@@ -429,7 +519,7 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
     for (;;) {
         if (try_pin(c, g, b)) {
             pthread_mutex_unlock(lock);
-            atomic_fetch_add(&c->hits, 1);
+            atomic_fetch_add(&c->hits[g % HIT_STRIPES].value, 1);
             if (waited)
                 atomic_fetch_add(&c->waits, 1);
             return IP_OK;
@@ -452,11 +542,8 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
 void ip_cache_unpin_brick(ip_cache *c, const ip_brick *b)
 {
     entry *e = atomic_load_explicit(&c->slots[b->index].entry, memory_order_acquire);
-    /* a pinned brick stays in its slot, so the slot still holds its entry; its size is read
-     * before the pin goes, as an unpinned entry may be evicted and recycled at once */
-    size_t bytes = e->bytes;
-    if (atomic_fetch_sub(&e->pins, 1) == 1)
-        atomic_fetch_sub(&c->pinned_bytes, bytes);
+    /* a pinned brick stays in its slot, so the slot still holds its entry */
+    atomic_fetch_sub(&e->pins, 1);
 }
 
 void ip_cache_get_stats(const ip_cache *cc, ip_cache_stats *s)
@@ -468,8 +555,12 @@ void ip_cache_get_stats(const ip_cache *cc, ip_cache_stats *s)
     s->resident_bytes = c->resident_bytes;
     s->resident_peak_bytes = c->resident_peak;
     s->resident_bricks = c->resident_count;
+    for (uint64_t i = 0; i < c->resident_count; i++) /* pinned bytes, counted when asked */
+        if (atomic_load(&c->resident[i]->pins) > 0)
+            s->pinned_bytes += c->resident[i]->bytes;
     pthread_mutex_unlock(&c->evict_lock);
-    s->hits = atomic_load(&c->hits);
+    for (int i = 0; i < HIT_STRIPES; i++)
+        s->hits += atomic_load(&c->hits[i].value);
     s->misses = atomic_load(&c->misses);
     s->evictions = atomic_load(&c->evictions);
     s->waits = atomic_load(&c->waits);
@@ -477,7 +568,6 @@ void ip_cache_get_stats(const ip_cache *cc, ip_cache_stats *s)
     s->bytes_read = atomic_load(&c->bytes_read);
     s->decode_seconds = (double)atomic_load(&c->decode_ns) * 1e-9;
     s->over_budget_pins = atomic_load(&c->over_budget_pins);
-    s->pinned_bytes = atomic_load(&c->pinned_bytes);
     s->errors = atomic_load(&c->errors);
     s->bricks_touched = atomic_load(&c->touched_count);
     s->bricks_total = c->layout->brick_count;
