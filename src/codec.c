@@ -139,36 +139,41 @@ static void shuffle(const unsigned char *src, unsigned char *dst, size_t count, 
             dst[b * count + i] = src[i * size + b];
 }
 
-/* Unshuffles 2- or 4-byte samples into host integers (little-endian hosts), undoing the delta
- * predictor in the same pass when asked: one pass the compiler can vectorise (the plain case)
- * instead of a strided byte loop per plane. */
+/* Unshuffles 2- or 4-byte samples into host integers (little-endian hosts) and, when asked,
+ * undoes the delta predictor: a first pass that the compiler vectorises (byte planes to
+ * integers, zigzag undone), then a running sum, the only serial part. */
 static void unshuffle_fast(const unsigned char *src, void *dst, size_t count, size_t size,
                            int delta)
 {
     if (size == 2) {
-        const unsigned char *b0 = src, *b1 = src + count;
-        uint16_t *d = dst, prev = 0;
-        if (!delta)
+        const unsigned char *restrict b0 = src, *restrict b1 = src + count;
+        uint16_t *restrict d = dst;
+        if (!delta) {
             for (size_t i = 0; i < count; i++)
                 d[i] = (uint16_t)(b0[i] | b1[i] << 8);
-        else
-            for (size_t i = 0; i < count; i++) {
-                uint16_t z = (uint16_t)(b0[i] | b1[i] << 8);
-                d[i] = prev = (uint16_t)(prev + UNZIGZAG(uint16_t, z));
-            }
+            return;
+        }
+        for (size_t i = 0; i < count; i++) {
+            uint16_t z = (uint16_t)(b0[i] | b1[i] << 8);
+            d[i] = UNZIGZAG(uint16_t, z);
+        }
+        uint16_t sum = 0;
+        for (size_t i = 0; i < count; i++)
+            d[i] = sum = (uint16_t)(sum + d[i]);
     } else {
-        const unsigned char *b0 = src, *b1 = src + count, *b2 = b1 + count, *b3 = b2 + count;
-        uint32_t *d = dst, prev = 0;
-        if (!delta)
+        const unsigned char *restrict b0 = src, *restrict b1 = src + count,
+                                      *restrict b2 = b1 + count, *restrict b3 = b2 + count;
+        uint32_t *restrict d = dst;
+        for (size_t i = 0; i < count; i++) {
+            uint32_t z = (uint32_t)b0[i] | (uint32_t)b1[i] << 8 | (uint32_t)b2[i] << 16 |
+                         (uint32_t)b3[i] << 24;
+            d[i] = delta ? UNZIGZAG(uint32_t, z) : z;
+        }
+        if (delta) {
+            uint32_t sum = 0;
             for (size_t i = 0; i < count; i++)
-                d[i] = (uint32_t)b0[i] | (uint32_t)b1[i] << 8 | (uint32_t)b2[i] << 16 |
-                       (uint32_t)b3[i] << 24;
-        else
-            for (size_t i = 0; i < count; i++) {
-                uint32_t z = (uint32_t)b0[i] | (uint32_t)b1[i] << 8 | (uint32_t)b2[i] << 16 |
-                             (uint32_t)b3[i] << 24;
-                d[i] = prev = prev + UNZIGZAG(uint32_t, z);
-            }
+                d[i] = sum = sum + d[i];
+        }
     }
 }
 
