@@ -28,7 +28,10 @@ trap 'rm -rf "$tmp"' EXIT
 echo "# Brick cache benchmark"
 echo
 echo "- machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(awk '/MemTotal/ { printf "%.0f GiB", $2 / 1048576 }' /proc/meminfo) RAM"
-echo "- load before: $(uptime | sed 's/.*load average/load average/')"
+# Other processes share the cores: the load and the kernel's CPU pressure ("some": the share
+# of time runnable tasks waited for a core) say how much, before and after.
+load() { echo "$(uptime | sed 's/.*load average/load average/')$( [ -r /proc/pressure/cpu ] && echo "; CPU pressure: $(head -1 /proc/pressure/cpu)")"; }
+echo "- load before: $(load)"
 
 case $input in
 *.ibv)
@@ -46,9 +49,12 @@ esac
 echo "- command: $build/bench_cache $ibv${*:+ $*}"
 echo
 
+stall() { sed -n 's/^some .*total=\([0-9]*\).*/\1/p' /proc/pressure/cpu 2>/dev/null || true; }
+stall0=$(stall)
 start=$(date +%s.%N)
 "$build/bench_cache" "$ibv" "$@"
 end=$(date +%s.%N)
+stall1=$(stall)
 
 echo "### lz4 -b1 on the whole raw file"
 echo
@@ -66,4 +72,10 @@ else
 fi
 echo
 echo "- bench_cache wall time: $(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.1f s", b - a }')"
-echo "- load after: $(uptime | sed 's/.*load average/load average/')"
+if [ -n "$stall0" ] && [ -n "$stall1" ]; then
+    # "some" CPU pressure: time during which at least one runnable task waited for a core
+    # (ours or another process's); near 0 % means bench_cache had the cores it asked for.
+    echo "- CPU pressure during bench_cache: $(awk -v a="$stall0" -v b="$stall1" -v s="$start" -v e="$end" \
+        'BEGIN { printf "%.1f s of waiting for a core (%.1f %% of the run)", (b - a) / 1e6, (b - a) / 1e4 / (e - s) }')"
+fi
+echo "- load after: $(load)"

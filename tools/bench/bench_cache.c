@@ -35,8 +35,8 @@ static const char usage[] =
     "Measures the brick cache on the level-0 bricks of FILE.ibv; prints Markdown tables.\n"
     "  --threads N      threads of the parallel rows (default: all cores)\n"
     "  --budgets LIST   cache budgets in MiB for the random and sequential runs, comma-separated;\n"
-    "                   'all' is the decoded size of level 0 rounded up, left out when a larger\n"
-    "                   budget is in the list (default 16,64,256,all)\n"
+    "                   'all' is the decoded size of level 0 rounded up, left out when another\n"
+    "                   listed budget holds level 0 already (default 16,64,256,all)\n"
     "  --only PARTS     comma-separated subset of decode,hits,random,sequential (default all)\n"
     "  --quick          fewer and shorter repetitions, a random run of 1 x (not 4 x) the\n"
     "                   level-0 brick count: a smoke run, not figures to quote\n";
@@ -104,6 +104,13 @@ static uint64_t splitmix64(uint64_t *state)
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     return z ^ (z >> 31);
+}
+
+/* Prints "bench_cache: out of memory for WHAT" and returns the exit code 1. */
+static int out_of_memory(const char *what)
+{
+    fprintf(stderr, "%s: out of memory for %s\n", program, what);
+    return 1;
 }
 
 static double mib(uint64_t bytes)
@@ -214,11 +221,8 @@ static int open_file(const char *path, bench_file *f)
     size_t n = lv->brick_count ? (size_t)lv->brick_count : 1;
     f->bricks = calloc(n, sizeof *f->bricks);
     f->payload = calloc(n, sizeof *f->payload);
-    if (!f->bricks || !f->payload) {
-        fprintf(stderr, "%s: out of memory for %llu bricks\n", program,
-                (unsigned long long)lv->brick_count);
-        return 1;
-    }
+    if (!f->bricks || !f->payload)
+        return out_of_memory("the brick lists");
     for (uint64_t i = 0; i < lv->brick_count; i++) {
         uint64_t g = lv->first_brick + i;
         uint64_t bytes = ip_store_brick_samples(f->store, g) * f->type_size;
@@ -436,7 +440,7 @@ static int bench_decode_groups(const bench_file *f, const options *o, decode_job
 {
     brick_info *group = malloc(f->level0_count * sizeof *group);
     if (!group)
-        return 1;
+        return out_of_memory("a brick list");
     printf("By encoding and filters, one thread, all level-0 bricks (constant ones included, "
            "as a cache miss decodes them too): ip_brick_decode against LZ4 alone on the same "
            "bricks; \"filters\" is the share of ip_brick_decode's time spent outside LZ4.\n\n");
@@ -479,14 +483,12 @@ static int bench_decode(const bench_file *f, const options *o)
     unsigned max_threads = o->threads;
     decode_job *jobs = calloc(max_threads, sizeof *jobs);
     if (!jobs)
-        return 1;
+        return out_of_memory("decode jobs");
     for (unsigned t = 0; t < max_threads; t++) {
         jobs[t].dst = malloc(f->largest_brick_bytes);
         jobs[t].work = malloc(f->work_size);
-        if (!jobs[t].dst || !jobs[t].work) {
-            fprintf(stderr, "%s: out of memory for decode buffers\n", program);
-            return 1;
-        }
+        if (!jobs[t].dst || !jobs[t].work)
+            return out_of_memory("decode buffers");
     }
     printf("Each figure is the median of %d timings of at least %.2f s each (the best in "
            "brackets). GB/s per core = bytes / wall second / threads, 1 GB = 10^9 bytes. "
@@ -586,7 +588,7 @@ static int bench_hits(const bench_file *f, const options *o)
     uint64_t n = f->level0_count;
     uint64_t *order = malloc(n * sizeof *order);
     if (!order)
-        return 1;
+        return out_of_memory("a brick list");
     for (uint64_t i = 0; i < n; i++) {
         ip_brick b;
         order[i] = f->layout->levels[0].first_brick + i;
@@ -628,7 +630,7 @@ static int bench_hits(const bench_file *f, const options *o)
     atomic_uint_fast64_t counter;
     atomic_init(&counter, 0);
     if (!jobs || !own || !each)
-        return 1;
+        return out_of_memory("hit jobs");
     for (int c = 0; c < case_count; c++) {
         const hit_case *hc = &cases[c];
         for (unsigned t = 0; t < hc->threads; t++) {
@@ -754,7 +756,7 @@ static int run_budget(const bench_file *f, const char *name, const uint64_t *seq
         return tool_fail(program, &err);
     run_job *jobs = calloc(threads, sizeof *jobs);
     if (!jobs)
-        return 1;
+        return out_of_memory("run jobs");
     for (unsigned t = 0; t < threads; t++)
         jobs[t] = (run_job){cache, sequence, count, t, threads, 0, {IP_OK, {0}}};
     double secs = run_team(threads, run_work, jobs, sizeof *jobs, NULL);
@@ -785,10 +787,8 @@ static int bench_runs(const bench_file *f, const options *o, const budget_list *
     uint64_t random_count = (o->quick ? 1 : 4) * n;
     uint64_t *random = malloc(random_count * sizeof *random);
     uint64_t *sweep = malloc(2 * n * sizeof *sweep);
-    if (!random || !sweep) {
-        fprintf(stderr, "%s: out of memory for the pin sequences\n", program);
-        return 1;
-    }
+    if (!random || !sweep)
+        return out_of_memory("the pin sequences");
     uint64_t seed = 20240601;
     for (uint64_t i = 0; i < random_count; i++)
         random[i] = first + splitmix64(&seed) % n;
@@ -803,8 +803,13 @@ static int bench_runs(const bench_file *f, const options *o, const budget_list *
            "one thread.\n",
            (unsigned long long)(2 * n));
     printf("- Each pin is followed by its unpin; nothing reads the samples. Level 0 decodes to "
-           "%.1f MiB.\n",
+           "%.1f MiB; budgets that hold all of it:",
            mib(f->level0_decoded));
+    int holding = 0;
+    for (int b = 0; b < budgets->count; b++)
+        if ((budgets->mib[b] << 20) >= f->level0_decoded)
+            printf("%s %llu MiB", holding++ ? "," : "", (unsigned long long)budgets->mib[b]);
+    printf("%s.\n", holding ? "" : " none");
     printf("- decode s: time inside checksum + decode summed over threads "
            "(ip_cache_stats.decode_seconds); other us per miss: (wall x threads - decode s) / "
            "misses, i.e. everything else a miss costs (victim scan, allocation, locks, madvise) "
