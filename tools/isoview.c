@@ -1,8 +1,10 @@
 /* isoview: the interactive viewer. The isosurface refines progressively in a window while it
- * stays responsive: each frame casts rays for at most FRAME_BUDGET_SECONDS (ip_engine_step()
- * on the render thread, whose workers use every core), uploads the triangles added since the
- * last frame and draws. Any change of view or isovalue restarts the progressive order at once;
- * as extraction is time-sliced, the work in flight is at most one frame's slice.
+ * stays responsive: each frame casts rays for a time slice (ip_engine_step() on the render
+ * thread, whose workers use every core), uploads the triangles added since the last frame and
+ * draws. The slice is FRAME_BUDGET_SECONDS, or as long as the previous frame took to draw when
+ * that was longer (software OpenGL drawing a large mesh), up to MAX_SLICE_SECONDS, so that
+ * drawing never starves refinement. Any change of view or isovalue restarts the progressive
+ * order at once; as extraction is time-sliced, the work in flight is at most one slice.
  *
  * Scripts (--script FILE) drive the viewer for tests and demos, one command a line; blank lines
  * and lines starting with '#' are ignored. Commands run in order, each at the start of a frame,
@@ -35,15 +37,11 @@
 #include <time.h>
 #include <unistd.h>
 
-/* The font is a single header of static functions written in its own style; its warnings are
- * not ours. */
+/* The font is a header of static functions (some unused here) in its own style: its warnings
+ * are not ours (CMake also adds its folder as a system include folder). */
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wmissing-prototypes"
-#pragma GCC diagnostic ignored "-Wstrict-prototypes"
-#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wmissing-braces"
 #include <stb_easy_font.h>
 #pragma GCC diagnostic pop
 
@@ -54,6 +52,7 @@
 #include "tool_common.h"
 
 #define FRAME_BUDGET_SECONDS 0.012 /* ray casting per frame: keeps 30+ fps while refining */
+#define MAX_SLICE_SECONDS 0.25     /* the longest slice: bounds the delay of input */
 #define ORBIT_DEGREES_PER_PIXEL 0.3
 #define WHEEL_ZOOM 1.1             /* per wheel notch */
 #define FPS_WINDOW_SECONDS 0.5     /* the overlay's fps is averaged over this long */
@@ -66,8 +65,12 @@ static const char usage[] =
     "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
     "                      (default -y; up is +z, or +y for the z views)\n"
     "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n"
+    "  --rays N            each pass (view and isovalue) stops after N rays\n"
+    "  --time SECONDS      each pass stops extracting after this long\n"
     "  --cutoff DEGREES    propagation cut-off angle (default 1.81)\n"
     "  --foldback DEGREES  fold-back tolerance (default 0.25)\n"
+    "  --lod on|off        adaptive resolution: far regions from coarser levels (default on)\n"
+    "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n"
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
     "  --threads N         threads for seeding, propagation and full extraction\n"
     "                      (default: all cores)\n"
@@ -102,9 +105,9 @@ static const char help_text[] =
 
 typedef struct options {
     const char *file, *view, *camera, *stats, *script, *screenshot_path;
-    double iso, cutoff, foldback, screenshot_at, exit_after;
-    int has_iso, force, quiet;
-    uint64_t cache_bytes;
+    double iso, time_limit, cutoff, foldback, pixel_error, screenshot_at, exit_after;
+    int has_iso, lod, force, quiet;
+    uint64_t rays, cache_bytes;
     unsigned threads;
     uint32_t width, height;
 } options;
@@ -161,11 +164,12 @@ typedef struct viewer {
     double lo[3], hi[3];
     float value_min, value_max;
     ip_camera camera;
-    float iso;
+    double iso;              /* the engine takes it as a float */
     int restart;             /* the view or the isovalue changed: begin again */
     uint64_t uploaded;       /* triangles of the engine's mesh on the GPU */
     uint64_t passes;         /* ip_engine_begin() calls */
     double pass_wall, pass_render; /* this pass: seconds stepping, seconds drawing */
+    double draw_seconds;     /* the last frame, from the end of its slice to its swap */
     int paused, want_full, full_shown, overlay_on, help_on;
     ip_mesh full_mesh;
     ip_engine_counts full_counts;
@@ -234,6 +238,8 @@ static int parse_args(int argc, char **argv, options *o)
     o->height = 960;
     o->cutoff = IP_DEFAULT_CUTOFF_DEGREES;
     o->foldback = IP_DEFAULT_FOLDBACK_DEGREES;
+    o->lod = 1;
+    o->pixel_error = 1.0;
     o->cache_bytes = ip_cache_default_budget();
     o->screenshot_at = -1;
     o->exit_after = -1;
@@ -254,6 +260,14 @@ static int parse_args(int argc, char **argv, options *o)
             o->view = v, i++;
         } else if (!strcmp(a, "--camera") && v) {
             o->camera = v, i++;
+        } else if (!strcmp(a, "--rays") && v) {
+            if (tool_parse_u64(v, &o->rays) != 0 || o->rays == 0)
+                return tool_usage_error("isoview", "--rays '%s' is not a positive count", v);
+            i++;
+        } else if (!strcmp(a, "--time") && v) {
+            if (tool_parse_double(v, &o->time_limit) != 0 || o->time_limit <= 0)
+                return tool_usage_error("isoview", "--time '%s' is not positive seconds", v);
+            i++;
         } else if (!strcmp(a, "--cutoff") && v) {
             if (tool_parse_double(v, &o->cutoff) != 0)
                 return tool_usage_error("isoview", "--cutoff '%s' is not a number", v);
@@ -267,6 +281,14 @@ static int parse_args(int argc, char **argv, options *o)
             if (tool_parse_u64(v, &n) != 0 || n < 1 || n > 64)
                 return tool_usage_error("isoview", "--threads must be 1-64");
             o->threads = (unsigned)n, i++;
+        } else if (!strcmp(a, "--lod") && v) {
+            if (strcmp(v, "on") && strcmp(v, "off"))
+                return tool_usage_error("isoview", "--lod must be on or off");
+            o->lod = !strcmp(v, "on"), i++;
+        } else if (!strcmp(a, "--pixel-error") && v) {
+            if (tool_parse_double(v, &o->pixel_error) != 0 || o->pixel_error <= 0)
+                return tool_usage_error("isoview", "--pixel-error '%s' is not positive", v);
+            i++;
         } else if (!strcmp(a, "--cache-mb") && v) {
             if (tool_parse_cache_mb(v, &o->cache_bytes) != 0)
                 return tool_usage_error("isoview", "bad --cache-mb '%s'", v);
@@ -400,7 +422,7 @@ static void change_view(viewer *v)
 
 static void change_iso(viewer *v, double iso)
 {
-    v->iso = (float)iso;
+    v->iso = iso;
     v->restart = 1;
 }
 
@@ -580,9 +602,21 @@ static int load_script(viewer *v, ip_error *err)
     return rc;
 }
 
+/* 1 once this pass has cast its --rays, 2 once it has extracted for its --time, else 0. */
+static int pass_limit_reached(const viewer *v)
+{
+    ip_engine_counts t;
+    ip_engine_totals(v->engine, &t);
+    if (v->o.rays && t.rays >= v->o.rays)
+        return 1;
+    return v->o.time_limit > 0 && v->pass_wall >= v->o.time_limit ? 2 : 0;
+}
+
+/* 1 once nothing more will be extracted until the next change (pausing aside). */
 static int refinement_complete(const viewer *v)
 {
-    return !v->restart && !v->want_full && (v->full_shown || ip_engine_done(v->engine));
+    return !v->restart && !v->want_full &&
+           (v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v));
 }
 
 static void request_screenshot(viewer *v, const char *path)
@@ -660,7 +694,7 @@ static void step_iso(viewer *v, double fraction)
     double range = (double)v->value_max - (double)v->value_min;
     if (!(range > 0))
         range = 1;
-    change_iso(v, (double)v->iso + fraction * range);
+    change_iso(v, v->iso + fraction * range);
 }
 
 static void on_key(GLFWwindow *window, int key, int scancode, int action, int mods)
@@ -901,13 +935,16 @@ static void overlay_draw(overlay *t, char *text, float x, float y, float scale, 
     /* quad 0 is the panel; the text follows */
     int quads = stb_easy_font_print(0, 0, text, NULL, t->quads + QUAD_BYTES,
                                     t->quads_size - QUAD_BYTES);
+    if ((uint32_t)quads + 1 > t->index_quads)
+        quads = (int)t->index_quads - 1;
     float w = (float)stb_easy_font_width(text), h = (float)stb_easy_font_height(text);
     put_rectangle(t->quads, 0, -pad, -pad, w + pad, h + pad);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, (GLsizei)width, (GLsizei)height);
     glDisable(GL_DEPTH_TEST);
     glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    /* colour blends; alpha stays opaque, so that screenshots stay RGB */
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
     glUseProgram(t->program);
     glUniform2f(t->viewport_at, (float)width, (float)height);
     glUniform1f(t->scale_at, scale);
@@ -931,12 +968,12 @@ static void overlay_draw(overlay *t, char *text, float x, float y, float scale, 
 
 static void frame_done(frame_clock *k, double t)
 {
-    if (k->frames == 0) {
-        k->first = k->window_start = k->second_start = t;
-        k->slowest = k->fastest = 0;
-    }
     k->frames++;
     k->last = t;
+    if (k->frames == 1) { /* rates count the frames that end after this one */
+        k->first = k->window_start = k->second_start = t;
+        return;
+    }
     k->window_frames++;
     if (t - k->window_start >= FPS_WINDOW_SECONDS) {
         k->shown = (double)k->window_frames / (t - k->window_start);
@@ -972,7 +1009,7 @@ static int begin_pass(viewer *v)
     v->pass_wall = v->pass_render = 0;
     ip_renderer_clear_mesh(v->renderer);
     v->uploaded = 0;
-    if (ip_engine_begin(v->engine, &v->camera, v->iso, &v->err) != IP_OK)
+    if (ip_engine_begin(v->engine, &v->camera, (float)v->iso, &v->err) != IP_OK)
         return -1;
     return 0;
 }
@@ -980,10 +1017,18 @@ static int begin_pass(viewer *v)
 /* One frame's slice of ray casting, then the new triangles to the GPU. */
 static int refine(viewer *v)
 {
-    if (v->paused || v->full_shown || ip_engine_done(v->engine))
+    if (v->paused || v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v))
         return 0;
+    double slice = v->draw_seconds < FRAME_BUDGET_SECONDS ? FRAME_BUDGET_SECONDS
+                   : v->draw_seconds > MAX_SLICE_SECONDS ? MAX_SLICE_SECONDS
+                   : v->draw_seconds;
+    if (v->o.time_limit > 0 && slice > v->o.time_limit - v->pass_wall)
+        slice = v->o.time_limit - v->pass_wall;
+    ip_engine_counts t;
+    ip_engine_totals(v->engine, &t);
     double start = now();
-    ip_status st = ip_engine_step(v->engine, 0, FRAME_BUDGET_SECONDS, NULL, &v->err);
+    ip_status st = ip_engine_step(v->engine, v->o.rays ? v->o.rays - t.rays : 0, slice, NULL,
+                                  &v->err);
     v->pass_wall += now() - start;
     if (st != IP_OK && st != IP_ERR_CANCELLED)
         return -1;
@@ -1001,7 +1046,7 @@ static int extract_full(viewer *v)
     ip_mesh_clear(&v->full_mesh);
     memset(&v->full_counts, 0, sizeof v->full_counts);
     double start = now();
-    if (ip_extract_full(v->cache, v->iso, 0, v->o.threads, &v->full_mesh, &v->full_counts,
+    if (ip_extract_full(v->cache, (float)v->iso, 0, v->o.threads, &v->full_mesh, &v->full_counts,
                         &v->err) != IP_OK)
         return -1;
     v->full_wall = now() - start;
@@ -1015,6 +1060,8 @@ static int extract_full(viewer *v)
 
 /* ---- drawing ---- */
 
+/* The heads-up text. "final px" is the share of pixels already showing their final colour: it
+ * is known exactly once every ray has been cast (100 %), and shown as "-" before. */
 static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
 {
     ip_engine_counts t;
@@ -1023,28 +1070,31 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
     ip_cache_get_stats(v->cache, &s);
     double pixels = (double)v->camera.width * v->camera.height;
     uint64_t lookups = s.hits + s.misses;
-    char iso[96], state[64] = "", progress[160];
+    char iso[96], state[48] = "", progress[128];
     if (v->typing)
-        snprintf(iso, sizeof iso, "iso> %s_   (Enter applies, Esc cancels)", v->typed);
+        snprintf(iso, sizeof iso, "iso> %s_  (Enter applies, Esc cancels)", v->typed);
     else
-        snprintf(iso, sizeof iso, "iso %.9g   (values %.9g .. %.9g)", (double)v->iso,
+        snprintf(iso, sizeof iso, "iso %.7g  (values %.7g .. %.7g)", v->iso,
                  (double)v->value_min, (double)v->value_max);
     if (working_on_full)
-        snprintf(state, sizeof state, "   [extracting everything...]");
+        snprintf(state, sizeof state, "  [extracting all...]");
     else if (v->full_shown)
-        snprintf(state, sizeof state, "   [full extraction]");
+        snprintf(state, sizeof state, "  [full]");
     else if (v->paused)
-        snprintf(state, sizeof state, "   [paused]");
+        snprintf(state, sizeof state, "  [paused]");
+    else if (!ip_engine_done(v->engine) && pass_limit_reached(v))
+        snprintf(state, sizeof state, "  [%s reached]",
+                 pass_limit_reached(v) == 1 ? "--rays" : "--time");
     if (v->full_shown)
-        snprintf(progress, sizeof progress, "full: %llu cells, %llu triangles in %.2f s   "
-                 "final pixels 100 %%", (unsigned long long)v->full_counts.cells,
-                 (unsigned long long)v->full_counts.triangles, v->full_wall);
+        snprintf(progress, sizeof progress, "full: %llu cells in %.2f s   final px 100 %%\n"
+                 "triangles %llu", (unsigned long long)v->full_counts.cells, v->full_wall,
+                 (unsigned long long)v->full_counts.triangles);
     else
-        snprintf(progress, sizeof progress, "rays %.1f %% of %.0f pixels   triangles %llu   "
-                 "final pixels %s", pixels > 0 ? 100.0 * (double)t.rays / pixels : 0.0, pixels,
-                 (unsigned long long)t.triangles, ip_engine_done(v->engine) ? "100 %" : "-");
-    int n = snprintf(text, size, "%s%s\n%s\nfps %.1f\ncache %.1f / %.1f MiB   hit rate %.1f %%"
-                     "   misses %llu   bricks %llu / %llu",
+        snprintf(progress, sizeof progress, "rays %.1f %% of %.0f   final px %s\n"
+                 "triangles %llu", pixels > 0 ? 100.0 * (double)t.rays / pixels : 0.0, pixels,
+                 ip_engine_done(v->engine) ? "100 %" : "-", (unsigned long long)t.triangles);
+    int n = snprintf(text, size, "%s%s\n%s\nfps %.1f\ncache %.1f / %.1f MiB   hit rate %.1f %%\n"
+                     "misses %llu   bricks %llu / %llu",
                      iso, state, progress, v->clock.shown, (double)s.resident_bytes / 1048576.0,
                      (double)s.budget_bytes / 1048576.0,
                      lookups ? 100.0 * (double)s.hits / (double)lookups : 0.0,
@@ -1173,12 +1223,17 @@ static int frame(viewer *v)
         if (extract_full(v) != 0)
             return -1;
     }
-    if (refine(v) != 0 || draw_frame(v, 0) != 0)
+    if (refine(v) != 0)
+        return -1;
+    double drawn = now();
+    if (draw_frame(v, 0) != 0)
         return -1;
     if (v->screenshot_pending && save_screenshot(v) != 0)
         return -1;
     glfwSwapBuffers(v->window);
-    frame_done(&v->clock, now());
+    double end = now();
+    v->draw_seconds = end - drawn;
+    frame_done(&v->clock, end);
     return 0;
 }
 
@@ -1241,12 +1296,14 @@ static void json_counts(FILE *f, void *user)
     tool_json_string(f, v->o.file);
     fprintf(f, ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
                "\"renderer\": \"opengl\"",
-            (double)v->iso, full ? "full" : "progressive", v->camera.width, v->camera.height);
+            v->iso, full ? "full" : "progressive", v->camera.width, v->camera.height);
     fprintf(f, ", \"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"target\": [%.9g, %.9g, %.9g], "
                "\"up\": [%.9g, %.9g, %.9g], \"fov\": %.9g}",
             v->camera.eye[0], v->camera.eye[1], v->camera.eye[2], v->camera.target[0],
             v->camera.target[1], v->camera.target[2], v->camera.up[0], v->camera.up[1],
             v->camera.up[2], v->camera.fov_y);
+    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", v->o.lod ? "true" : "false",
+            v->o.pixel_error);
     fprintf(f, ", \"warm\": false, \"threads\": %u", ip_thread_count(v->o.threads));
     fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", v->o.cutoff,
             v->o.foldback);
@@ -1280,7 +1337,7 @@ static void print_summary(const viewer *v)
         t = v->full_counts;
     else
         ip_engine_totals(v->engine, &t);
-    printf("%s: iso %g, %s, %ux%u\n", v->o.file, (double)v->iso,
+    printf("%s: iso %g, %s, %ux%u\n", v->o.file, v->iso,
            v->full_shown ? "full extraction" : "progressive", v->camera.width,
            v->camera.height);
     printf("  rays          %llu of %llu\n", (unsigned long long)t.rays,
@@ -1336,6 +1393,8 @@ static int prepare(viewer *v)
     eo.cutoff_degrees = v->o.cutoff;
     eo.foldback_degrees = v->o.foldback;
     eo.threads = v->o.threads;
+    eo.lod = v->o.lod;
+    eo.pixel_error = v->o.pixel_error;
     return ip_engine_create(v->cache, &eo, &v->engine, err) == IP_OK ? 0 : -1;
 }
 
@@ -1353,7 +1412,7 @@ int main(int argc, char **argv)
     }
     ip_error_clear(&v->err);
     ip_mesh_init(&v->full_mesh);
-    v->iso = (float)v->o.iso;
+    v->iso = v->o.iso;
     v->overlay_on = 1;
     v->drag_button = -1;
     v->restart = 1;

@@ -15,9 +15,11 @@ cd "$root"
 jobs=$(nproc 2>/dev/null || echo 2)
 
 # Debian packages: compiler and build tools, the libraries, clang for the sanitizer and fuzzer
-# builds, and the lz4/zstd programs the benchmark compares against.
+# builds, and the lz4/zstd programs the benchmark compares against; GLFW and stb_easy_font for
+# the viewer, and a virtual X server (xvfb-run) for its test.
 packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang lz4 zstd
-          libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri"
+          libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri
+          libglfw3-dev libstb-dev xvfb xauth"
 
 install_missing() {
     missing=""

@@ -1,0 +1,98 @@
+/* png_compare: compares two PNG images pixel by pixel, for the end-to-end tests.
+ *
+ *   png_compare A.png B.png [--level L] [--max-pct P]
+ *
+ * Both images are read as 8-bit RGBA. A pixel differs when one of its channels differs by more
+ * than L (default 0). Prints one line: the size, how many pixels differ and the largest channel
+ * difference. Exit status: 0 when the sizes agree and at most P % of the pixels differ
+ * (default 0), 1 otherwise, 2 for a bad command line or an unreadable image.
+ */
+#include <png.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static unsigned char *read_rgba(const char *path, png_uint_32 *width, png_uint_32 *height)
+{
+    png_image image;
+    memset(&image, 0, sizeof image);
+    image.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&image, path)) {
+        fprintf(stderr, "png_compare: %s: %s\n", path, image.message);
+        return NULL;
+    }
+    image.format = PNG_FORMAT_RGBA;
+    unsigned char *rgba = malloc(PNG_IMAGE_SIZE(image));
+    if (!rgba || !png_image_finish_read(&image, NULL, rgba, 0, NULL)) {
+        fprintf(stderr, "png_compare: %s: %s\n", path, rgba ? image.message : "out of memory");
+        png_image_free(&image);
+        free(rgba);
+        return NULL;
+    }
+    *width = image.width;
+    *height = image.height;
+    return rgba;
+}
+
+static int parse_number(const char *text, double *out)
+{
+    char *end;
+    *out = strtod(text, &end);
+    return end != text && !*end && *out >= 0 ? 0 : -1;
+}
+
+int main(int argc, char **argv)
+{
+    const char *path[2] = {NULL, NULL};
+    double level = 0, max_pct = 0;
+    int files = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--level") && i + 1 < argc) {
+            if (parse_number(argv[++i], &level) != 0)
+                goto usage;
+        } else if (!strcmp(argv[i], "--max-pct") && i + 1 < argc) {
+            if (parse_number(argv[++i], &max_pct) != 0)
+                goto usage;
+        } else if (argv[i][0] != '-' && files < 2) {
+            path[files++] = argv[i];
+        } else {
+            goto usage;
+        }
+    }
+    if (files != 2)
+        goto usage;
+    png_uint_32 w[2] = {0, 0}, h[2] = {0, 0};
+    unsigned char *a = read_rgba(path[0], &w[0], &h[0]);
+    unsigned char *b = a ? read_rgba(path[1], &w[1], &h[1]) : NULL;
+    if (!b) {
+        free(a);
+        return 2;
+    }
+    if (w[0] != w[1] || h[0] != h[1]) {
+        printf("%s %s: sizes differ (%ux%u, %ux%u)\n", path[0], path[1], (unsigned)w[0],
+               (unsigned)h[0], (unsigned)w[1], (unsigned)h[1]);
+        free(a);
+        free(b);
+        return 1;
+    }
+    size_t pixels = (size_t)w[0] * h[0], differ = 0;
+    int largest = 0;
+    for (size_t p = 0; p < pixels; p++) {
+        int worst = 0;
+        for (int c = 0; c < 4; c++) {
+            int d = abs((int)a[4 * p + c] - (int)b[4 * p + c]);
+            worst = d > worst ? d : worst;
+        }
+        largest = worst > largest ? worst : largest;
+        differ += worst > level;
+    }
+    double pct = pixels ? 100.0 * (double)differ / (double)pixels : 0.0;
+    printf("%s %s: %ux%u, %zu pixels (%.3f %%) differ by more than %g, largest difference %d\n",
+           path[0], path[1], (unsigned)w[0], (unsigned)h[0], differ, pct, level, largest);
+    free(a);
+    free(b);
+    return pct <= max_pct ? 0 : 1;
+usage:
+    fprintf(stderr, "usage: png_compare A.png B.png [--level L] [--max-pct P]\n");
+    return 2;
+}
