@@ -225,6 +225,21 @@ static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
     to->rendering_seconds += from->rendering_seconds;
 }
 
+/* Extracts one cell without propagating from it. */
+static ip_status extract_one(worker *w, level_tools *lt, const uint32_t cell[3])
+{
+    unsigned mc;
+    ip_status st = IP_OK;
+    double t0 = ip_now_seconds();
+    int n = ip_extract_cell(&lt->sampler, &w->mesh, cell, w->engine->iso, &mc, &st);
+    w->counts.extraction_seconds += ip_now_seconds() - t0;
+    if (n < 0)
+        return st;
+    w->counts.cells++;
+    w->counts.triangles += (uint64_t)n;
+    return IP_OK;
+}
+
 /* Casts the ray of pixel (x, y), one distance band (pyramid level) after the other, front to
  * back: extracts its seed, and the cells it nearly hit before it, propagating from each that
  * was not extracted yet. */
@@ -238,9 +253,10 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
     for (uint32_t k = 0; k < e->levels_used; k++) {
         level_tools *lt = &w->level[k];
         unsigned count;
+        int seed_index;
         double t0 = ip_now_seconds();
         int found = ip_seed_find(&lt->seeder, e->camera.eye, dir, e->lod_distance[k],
-                                 e->lod_distance[k + 1], cells, &count);
+                                 e->lod_distance[k + 1], cells, &count, &seed_index);
         w->counts.intersection_seconds += ip_now_seconds() - t0;
         if (found < 0) {
             w->failed_level = k;
@@ -252,8 +268,13 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
                 return IP_ERR_NOMEM;
             if (was)
                 continue;
-            w->counts.seeds++;
-            ip_status st = ip_propagate(&lt->propagator, cells[i], dir, &w->counts);
+            ip_status st;
+            if ((int)i == seed_index) { /* the seed: propagate from it */
+                w->counts.seeds++;
+                st = ip_propagate(&lt->propagator, cells[i], dir, &w->counts);
+            } else { /* a rounding case: its own triangles only, for the pixel's sake */
+                st = extract_one(w, lt, cells[i]);
+            }
             if (st != IP_OK) {
                 w->failed_level = k;
                 return st;

@@ -97,8 +97,8 @@ static int active(const float *range, float iso)
 /* Classifies the ray against the cell's triangles as a rasteriser would classify its pixel
  * centre: each triangle is projected centrally around the ray (point-in-triangle is the same
  * for every central projection through the ray) and the ray's distance to its edges is
- * measured as an angle. 2: inside a triangle by at least the margin; 1: within the margin of
- * one; 0: neither. `ro` and `rd` are the ray in the cell's frame (corner 0 at the origin). */
+ * measured as an angle. 3: inside a triangle by at least the margin; 2: inside one, within
+ * the margin of its edge; 1: outside every triangle, within the margin of one; 0: none. `ro` and `rd` are the ray in the cell's frame (corner 0 at the origin). */
 static int classify_cell(const ip_seeder *s, const float values[8], const float size[3],
                          const double ro[3], const double rd[3])
 {
@@ -121,7 +121,7 @@ static int classify_cell(const ip_seeder *s, const float values[8], const float 
     w[1] = rd[2] * u[0] - rd[0] * u[2];
     w[2] = rd[0] * u[1] - rd[1] * u[0];
     int best = 0;
-    for (int t = 0; t < n && best < 2; t++) {
+    for (int t = 0; t < n && best < 3; t++) {
         double p[3][2];
         int behind = 0;
         for (int j = 0; j < 3; j++) {
@@ -144,7 +144,10 @@ static int classify_cell(const ip_seeder *s, const float values[8], const float 
             double dist = len > 0 ? (ex * (0 - a[1]) - ey * (0 - a[0])) / len : 0;
             least = fmin(least, area >= 0 ? dist : -dist);
         }
-        int kind = area != 0 && least >= s->margin ? 2 : least >= -s->margin ? 1 : 0;
+        int kind = area != 0 && least >= s->margin ? 3
+                   : area != 0 && least >= 0      ? 2
+                   : least >= -s->margin          ? 1
+                                                  : 0;
         best = kind > best ? kind : best;
     }
     return best;
@@ -172,9 +175,11 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
                 ro[k] = r->world_origin[k] - (double)origin[k];
             s->cells_tested++;
             int kind = classify_cell(s, values, size, ro, r->world_dir);
+            if (kind >= 2 && s->seed_index < 0)
+                s->seed_index = (int)s->found_count; /* the first cell the ray is inside */
             if (kind && s->found_count < IP_SEED_MAX_CELLS)
                 memcpy(s->found[s->found_count++], c, sizeof c);
-            if (kind == 2)
+            if (kind == 3)
                 return 1;
         }
         double exit_t;
@@ -286,11 +291,13 @@ void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_a
 }
 
 int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
-                 double t_max, uint32_t cells[][3], unsigned *count)
+                 double t_max, uint32_t cells[][3], unsigned *count, int *seed_index)
 {
     s->found = cells;
     s->found_count = 0;
+    s->seed_index = -1;
     *count = 0;
+    *seed_index = -1;
     const ip_level_layout *lv = &s->layout->levels[s->level];
     uint32_t root[3] = {0, 0, 0};
     uint32_t depth = lv->octree_depth;
@@ -309,5 +316,6 @@ int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], double 
         return 0;
     int found = walk_node(s, &r, depth, root, t0, t1);
     *count = s->found_count;
-    return found;
+    *seed_index = s->seed_index;
+    return found || s->seed_index >= 0;
 }

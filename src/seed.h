@@ -15,6 +15,7 @@ typedef struct ip_seeder {
     uint64_t cells_tested; /* active cells whose triangles were tested against a ray */
     uint32_t (*found)[3];  /* the cells of the current ray (see ip_seed_find) */
     unsigned found_count;
+    int seed_index;        /* position in found of the first cell the ray is inside, or -1 */
     double margin;         /* IP_SEED_MARGIN_PIXELS as an angle, radians */
 } ip_seeder;
 
@@ -29,13 +30,14 @@ typedef struct ip_seeder {
 void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_angle);
 
 /* Casts the ray eye + t * dir (world units, dir of unit length, t_min <= t <= t_max) through
- * the octree of the seeder's level, front to back, to the first cell whose triangles it
- * clearly hits (the seed). Fills
- * cells[0 .. *count) (room for IP_SEED_MAX_CELLS) with the cells the ray passed within the
- * margin of on the way, then the seed. @return 1 when the last cell is a seed, 0 when the ray
- * clearly hits nothing (the cells are near misses only, possibly none), -1 when a brick could
- * not be read (see the sampler's status). */
+ * the octree of the seeder's level, front to back. The seed is the first cell with a triangle
+ * the ray passes inside. Fills cells[0 .. *count) (room for IP_SEED_MAX_CELLS) with every cell
+ * the ray passed inside or within the margin of, in order, up to the first it passes inside by
+ * more than the margin (where it stops); *seed_index is the seed's position there, or -1.
+ * The other cells are where a rasteriser may show a triangle at this pixel after rounding.
+ * @return 1 when there is a seed, 0 when not (the cells are near misses only, possibly none),
+ * -1 when a brick could not be read (see the sampler's status). */
 int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
-                 double t_max, uint32_t cells[][3], unsigned *count);
+                 double t_max, uint32_t cells[][3], unsigned *count, int *seed_index);
 
 #endif

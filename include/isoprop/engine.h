@@ -4,7 +4,8 @@
  * the progressive order (centre first, then the centres of quadrants, ...). A ray walks the
  * min/max octree front to back, from the root through bricks and sub-blocks to cells, entering
  * only nodes whose range holds the isovalue, and stops at the first cell whose marching-cubes
- * triangles it really hits: the seed. Unless already extracted, the seed's surface is
+ * triangles it really hits: the seed. (Cells it passes within 1/64 pixel of a triangle edge on
+ * the way, where rounding could decide either way, are extracted too, alone.) Unless already extracted, the seed's surface is
  * propagated breadth-first into face neighbours that share a sign change, while they stay
  * within the cut-off angle of the seed's ray, do not fold back (the angle to the ray must not
  * drop below the largest angle among their predecessors by more than a tolerance) and lie in
