@@ -290,7 +290,6 @@ static entry *evict_one(ip_cache *c)
     c->resident[victim->resident_slot] = c->resident[--c->resident_count];
     c->resident[victim->resident_slot]->resident_slot = victim->resident_slot;
     c->resident_bytes -= victim->bytes;
-    atomic_fetch_add(&c->evictions, 1);
     return victim;
 }
 
@@ -338,6 +337,7 @@ static entry *reserve_entry(ip_cache *c, size_t bytes)
             atomic_fetch_add(&c->over_budget_pins, 1);
             break;
         }
+        atomic_fetch_add(&c->evictions, 1);
         if (spare)
             free_entry(c, spare);
         spare = victim;
@@ -544,6 +544,21 @@ void ip_cache_unpin_brick(ip_cache *c, const ip_brick *b)
     entry *e = atomic_load_explicit(&c->slots[b->index].entry, memory_order_acquire);
     /* a pinned brick stays in its slot, so the slot still holds its entry */
     atomic_fetch_sub(&e->pins, 1);
+}
+
+uint64_t ip_cache_trim(ip_cache *c, uint64_t keep_bytes)
+{
+    uint64_t freed = 0;
+    pthread_mutex_lock(&c->evict_lock);
+    while (c->resident_bytes > keep_bytes) {
+        entry *victim = evict_one(c);
+        if (!victim)
+            break; /* the rest is pinned */
+        freed += victim->bytes;
+        free_entry(c, victim);
+    }
+    pthread_mutex_unlock(&c->evict_lock);
+    return freed;
 }
 
 void ip_cache_get_stats(const ip_cache *cc, ip_cache_stats *s)

@@ -15,6 +15,7 @@
 
 #define MAX_THREADS 64
 #define RAY_BATCH 16 /* rays a worker takes at once: small, so the order stays progressive */
+#define FLUSH_TRIANGLES 16384 /* a worker's buffer moves to the engine's mesh past this size */
 
 /* A worker's tools for one pyramid level: pinned bricks, seeding state, propagation queue. */
 typedef struct level_tools {
@@ -41,6 +42,7 @@ struct ip_engine {
     worker *workers;
     ip_visited visited;
     ip_mesh mesh;
+    pthread_mutex_t mesh_lock;  /* workers append their buffers to `mesh` during a step */
     ip_camera camera;
     ip_camera_basis basis;
     float iso;
@@ -70,6 +72,7 @@ void ip_engine_options_default(ip_engine_options *o)
     o->threads = 0;
     o->lod = 1;
     o->pixel_error = 1.0;
+    o->cell_ids = 0;
 }
 
 ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
@@ -91,13 +94,16 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     e->threads = ip_thread_count(options->threads);
     atomic_init(&e->cancel, 0);
     pthread_mutex_init(&e->order_lock, NULL);
+    pthread_mutex_init(&e->mesh_lock, NULL);
     ip_mesh_init(&e->mesh);
+    e->mesh.with_cells = options->cell_ids != 0;
     e->workers = calloc(e->threads, sizeof *e->workers);
     ip_status st = e->workers ? ip_visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
                               : IP_ERR_NOMEM;
     for (unsigned t = 0; st == IP_OK && t < e->threads; t++) {
         e->workers[t].engine = e;
         ip_mesh_init(&e->workers[t].mesh);
+        e->workers[t].mesh.with_cells = e->mesh.with_cells;
     }
     if (st != IP_OK) {
         ip_engine_destroy(e);
@@ -125,6 +131,7 @@ void ip_engine_destroy(ip_engine *e)
     ip_visited_free(&e->visited);
     ip_mesh_free(&e->mesh);
     pthread_mutex_destroy(&e->order_lock);
+    pthread_mutex_destroy(&e->mesh_lock);
     free(e);
 }
 
@@ -254,10 +261,8 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
         level_tools *lt = &w->level[k];
         unsigned count;
         int seed_index;
-        double t0 = ip_now_seconds();
         int found = ip_seed_find(&lt->seeder, e->camera.eye, dir, e->lod_distance[k],
                                  e->lod_distance[k + 1], cells, &count, &seed_index);
-        w->counts.intersection_seconds += ip_now_seconds() - t0;
         if (found < 0) {
             w->failed_level = k;
             return lt->sampler.status;
@@ -301,6 +306,17 @@ static unsigned take_rays(ip_engine *e, uint32_t xy[][2])
     return n;
 }
 
+/* Moves the worker's triangles to the engine's mesh. */
+static ip_status flush_triangles(worker *w)
+{
+    ip_engine *e = w->engine;
+    pthread_mutex_lock(&e->mesh_lock);
+    ip_status st = ip_mesh_append_mesh(&e->mesh, &w->mesh, 0, w->mesh.triangle_count);
+    pthread_mutex_unlock(&e->mesh_lock);
+    ip_mesh_clear(&w->mesh);
+    return st;
+}
+
 static void *work(void *p)
 {
     worker *w = p;
@@ -308,6 +324,10 @@ static void *work(void *p)
     uint32_t xy[RAY_BATCH][2];
     unsigned n;
     while (w->status == IP_OK && (n = take_rays(e, xy)) > 0) {
+        /* The clock is read once per batch: seeding is the batch's time less what
+         * propagation and extraction measured of it. */
+        double t0 = ip_now_seconds();
+        double inner = w->counts.propagation_seconds + w->counts.extraction_seconds;
         for (unsigned i = 0; i < n && w->status == IP_OK; i++) {
             if (atomic_load_explicit(&e->cancel, memory_order_relaxed)) {
                 w->status = IP_ERR_CANCELLED;
@@ -315,7 +335,15 @@ static void *work(void *p)
             }
             w->status = cast_ray(w, xy[i][0], xy[i][1]);
         }
+        double seeding = ip_now_seconds() - t0 -
+                         (w->counts.propagation_seconds + w->counts.extraction_seconds - inner);
+        w->counts.intersection_seconds += seeding > 0 ? seeding : 0;
+        if (w->mesh.triangle_count >= FLUSH_TRIANGLES && flush_triangles(w) != IP_OK &&
+            w->status == IP_OK)
+            w->status = IP_ERR_NOMEM;
     }
+    if (flush_triangles(w) != IP_OK && w->status == IP_OK)
+        w->status = IP_ERR_NOMEM;
     for (uint32_t k = 0; k < e->levels_used; k++) /* let the cache evict freely between steps */
         ip_sampler_release(&w->level[k].sampler);
     return NULL;
@@ -353,9 +381,6 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
     for (unsigned t = 0; t < threads; t++) {
         worker *w = &e->workers[t];
         add_counts(&c, &w->counts);
-        if (st == IP_OK && ip_mesh_append(&e->mesh, w->mesh.positions, w->mesh.normals,
-                                          w->mesh.cells, w->mesh.triangle_count) != IP_OK)
-            st = ip_fail(err, IP_ERR_NOMEM, "out of memory");
         if (st == IP_OK && w->status != IP_OK) {
             st = w->status;
             if (st == IP_ERR_CANCELLED)

@@ -114,8 +114,7 @@ static ip_status merge_in_brick_order(full_worker *w, unsigned threads, ip_mesh 
         uint64_t first = b->start_of[cursor[best]];
         uint64_t end = cursor[best] + 1 < b->chunks ? b->start_of[cursor[best] + 1]
                                                     : b->mesh.triangle_count;
-        st = ip_mesh_append(mesh, b->mesh.positions + 9 * first, b->mesh.normals + 9 * first,
-                            b->mesh.cells + first, end - first);
+        st = ip_mesh_append_mesh(mesh, &b->mesh, first, end - first);
         cursor[best]++;
     }
     free(cursor);
@@ -138,6 +137,7 @@ ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned t
     for (unsigned t = 0; t < threads; t++) {
         w[t] = (full_worker){.cache = cache, .iso = iso, .level = level, .next = &next};
         ip_mesh_init(&w[t].mesh);
+        w[t].mesh.with_cells = mesh->with_cells;
         if (ip_sampler_init(&w[t].sampler, cache, level) != IP_OK)
             st = IP_ERR_NOMEM;
     }

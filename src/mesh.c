@@ -12,12 +12,20 @@ void ip_mesh_init(ip_mesh *m)
     memset(m, 0, sizeof *m);
 }
 
+void ip_mesh_init_with_cells(ip_mesh *m)
+{
+    ip_mesh_init(m);
+    m->with_cells = 1;
+}
+
 void ip_mesh_free(ip_mesh *m)
 {
+    int with_cells = m->with_cells;
     free(m->positions);
     free(m->normals);
     free(m->cells);
     ip_mesh_init(m);
+    m->with_cells = with_cells;
 }
 
 void ip_mesh_clear(ip_mesh *m)
@@ -29,24 +37,30 @@ ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
 {
     if (triangles <= m->capacity)
         return IP_OK;
+    /* Growth by half (not doubling) keeps the slack small for meshes of millions of triangles;
+     * large blocks are moved by remapping pages, not copied, so the cost stays low. */
     uint64_t cap = m->capacity ? m->capacity : 1024;
     while (cap < triangles)
-        cap *= 2;
+        cap += cap / 2;
     float *p = realloc(m->positions, cap * 9 * sizeof *p);
     if (p)
         m->positions = p;
-    float *n = p ? realloc(m->normals, cap * 9 * sizeof *n) : NULL;
+    int16_t *n = p ? realloc(m->normals, cap * 9 * sizeof *n) : NULL;
     if (n)
         m->normals = n;
-    uint64_t *c = n ? realloc(m->cells, cap * sizeof *c) : NULL;
-    if (!c)
+    if (!n)
         return IP_ERR_NOMEM; /* the arrays that grew keep the old contents */
-    m->cells = c;
+    if (m->with_cells) {
+        uint64_t *c = realloc(m->cells, cap * sizeof *c);
+        if (!c)
+            return IP_ERR_NOMEM;
+        m->cells = c;
+    }
     m->capacity = cap;
     return IP_OK;
 }
 
-ip_status ip_mesh_append(ip_mesh *m, const float *positions, const float *normals,
+ip_status ip_mesh_append(ip_mesh *m, const float *positions, const int16_t *normals,
                          const uint64_t *cells, uint64_t count)
 {
     if (count == 0)
@@ -55,10 +69,39 @@ ip_status ip_mesh_append(ip_mesh *m, const float *positions, const float *normal
     if (st != IP_OK)
         return st;
     memcpy(m->positions + 9 * m->triangle_count, positions, count * 9 * sizeof(float));
-    memcpy(m->normals + 9 * m->triangle_count, normals, count * 9 * sizeof(float));
-    memcpy(m->cells + m->triangle_count, cells, count * sizeof(uint64_t));
+    memcpy(m->normals + 9 * m->triangle_count, normals, count * 9 * sizeof(int16_t));
+    if (m->with_cells)
+        memcpy(m->cells + m->triangle_count, cells, count * sizeof(uint64_t));
     m->triangle_count += count;
     return IP_OK;
+}
+
+ip_status ip_mesh_append_float_normals(ip_mesh *m, const float *positions, const float *normals,
+                                       const uint64_t *cells, uint64_t count)
+{
+    enum { PART = 256 };
+    int16_t packed[9 * PART];
+    for (uint64_t done = 0; done < count; done += PART) {
+        uint64_t n = count - done < PART ? count - done : PART;
+        for (uint64_t i = 0; i < 9 * n; i++)
+            packed[i] = ip_normal_pack(normals[9 * done + i]);
+        ip_status st = ip_mesh_append(m, positions + 9 * done, packed,
+                                      cells ? cells + done : NULL, n);
+        if (st != IP_OK)
+            return st;
+    }
+    return IP_OK;
+}
+
+ip_status ip_mesh_append_mesh(ip_mesh *m, const ip_mesh *from, uint64_t first, uint64_t count)
+{
+    if (first > from->triangle_count || count > from->triangle_count - first ||
+        (m->with_cells && count && !from->with_cells))
+        return IP_ERR_ARGUMENT;
+    if (count == 0)
+        return IP_OK;
+    return ip_mesh_append(m, from->positions + 9 * first, from->normals + 9 * first,
+                          m->with_cells ? from->cells + first : NULL, count);
 }
 
 static void put_f32(unsigned char *p, float v)
@@ -94,7 +137,7 @@ ip_status ip_mesh_write_ply(const ip_mesh *m, const char *path, int force, ip_er
         for (uint64_t i = 0; i < count * 3; i++)
             for (int k = 0; k < 3; k++) {
                 put_f32(buf + 24 * i + 4 * k, m->positions[9 * t + 3 * i + k]);
-                put_f32(buf + 24 * i + 12 + 4 * k, m->normals[9 * t + 3 * i + k]);
+                put_f32(buf + 24 * i + 12 + 4 * k, ip_normal_unpack(m->normals[9 * t + 3 * i + k]));
             }
         st = ip_pwrite_all(out.fd, buf, count * 72, offset, path, err);
         offset += count * 72;

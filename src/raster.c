@@ -91,7 +91,7 @@ static void setup_view(raster_view *v, const ip_camera *c, const double lo[3], c
     v->guard_y = GUARD_PIXELS / side * v->basis.tan_half_y;
 }
 
-static void to_view(const raster_view *v, const float *p, const float *n, view_vertex *out)
+static void to_view(const raster_view *v, const float *p, const int16_t *n, view_vertex *out)
 {
     double d[3] = {p[0] - v->eye[0], p[1] - v->eye[1], p[2] - v->eye[2]};
     const double *r = v->basis.right, *u = v->basis.up, *f = v->basis.forward;
@@ -99,7 +99,7 @@ static void to_view(const raster_view *v, const float *p, const float *n, view_v
     out->p[1] = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
     out->p[2] = d[0] * f[0] + d[1] * f[1] + d[2] * f[2];
     for (int i = 0; i < 3; i++)
-        out->n[i] = n[i];
+        out->n[i] = ip_normal_unpack(n[i]);
 }
 
 /* Signed distance-like value of a vertex to clip plane k; inside when >= 0. */

@@ -8,8 +8,10 @@
 #include "isoprop/render.h"
 
 enum {
-    TRIANGLE_BYTES = 9 * sizeof(float), /* per buffer: positions or normals */
-    MIN_CAPACITY = 4096,                /* triangles; growth is geometric */
+    POSITION_BYTES = 9 * sizeof(float),  /* a triangle's positions */
+    NORMAL_BYTES = 9 * sizeof(int16_t),  /* a triangle's packed normals */
+    MIN_CAPACITY = 4096,                 /* triangles; growth is geometric */
+    STREAM_TRIANGLES = 65536,            /* triangles per draw of ip_renderer_draw_mesh() */
 };
 /* glDrawArrays counts vertices in a GLint */
 #define MAX_TRIANGLES ((uint64_t)INT32_MAX / 3)
@@ -24,8 +26,10 @@ struct ip_renderer {
     GLint view_at, projection_at, eye_at, surface_at, terms_at; /* mesh uniforms */
     GLint top_at, bottom_at, height_at;                         /* background uniforms */
     GLuint mesh_array, background_array; /* vertex arrays; the background has no attributes */
-    GLuint positions, normals;           /* TRIANGLE_BYTES per triangle each */
+    GLuint positions, normals;           /* POSITION_BYTES and NORMAL_BYTES per triangle */
     uint64_t triangle_count, triangle_capacity;
+    GLuint stream_array;                 /* ip_renderer_draw_mesh(): its vertex array, */
+    GLuint stream_positions, stream_normals; /* and buffers of STREAM_TRIANGLES, made on first use */
     ip_shading shading;
 };
 
@@ -181,17 +185,25 @@ static ip_status build_programs(ip_renderer *r, ip_error *err)
     return check_gl("building the shaders", err);
 }
 
+/* Points a vertex array at position and normal buffers: floats, and signed normalised
+ * shorts (OpenGL reads v / 32767, as ip_normal_unpack() does). */
+static void bind_array(GLuint array, GLuint positions, GLuint normals)
+{
+    glBindVertexArray(array);
+    glBindBuffer(GL_ARRAY_BUFFER, positions);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+    glEnableVertexAttribArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, normals);
+    glVertexAttribPointer(1, 3, GL_SHORT, GL_TRUE, 0, NULL);
+    glEnableVertexAttribArray(1);
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
 /* Points the mesh vertex array at the current buffers. */
 static void bind_mesh_array(ip_renderer *r)
 {
-    glBindVertexArray(r->mesh_array);
-    glBindBuffer(GL_ARRAY_BUFFER, r->positions);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, NULL);
-    glEnableVertexAttribArray(0);
-    glBindBuffer(GL_ARRAY_BUFFER, r->normals);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, NULL);
-    glEnableVertexAttribArray(1);
-    glBindVertexArray(0);
+    bind_array(r->mesh_array, r->positions, r->normals);
 }
 
 /* (Re)allocates the headless renderer's colour and depth buffers. */
@@ -333,15 +345,16 @@ static ip_status reserve_triangles(ip_renderer *r, uint64_t needed, ip_error *er
     capacity = capacity < needed ? needed : capacity;
     capacity = capacity > MAX_TRIANGLES ? MAX_TRIANGLES : capacity;
     GLuint grown[2] = {0, 0}, old[2] = {r->positions, r->normals};
+    const uint64_t bytes[2] = {POSITION_BYTES, NORMAL_BYTES};
     glGenBuffers(2, grown);
     for (int i = 0; i < 2; i++) {
         glBindBuffer(GL_COPY_WRITE_BUFFER, grown[i]);
-        glBufferData(GL_COPY_WRITE_BUFFER, (GLsizeiptr)(capacity * TRIANGLE_BYTES), NULL,
+        glBufferData(GL_COPY_WRITE_BUFFER, (GLsizeiptr)(capacity * bytes[i]), NULL,
                      GL_STATIC_DRAW);
         glBindBuffer(GL_COPY_READ_BUFFER, old[i]);
         if (r->triangle_count)
             glCopyBufferSubData(GL_COPY_READ_BUFFER, GL_COPY_WRITE_BUFFER, 0, 0,
-                                (GLsizeiptr)(r->triangle_count * TRIANGLE_BYTES));
+                                (GLsizeiptr)(r->triangle_count * bytes[i]));
     }
     glBindBuffer(GL_COPY_READ_BUFFER, 0);
     glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
@@ -375,12 +388,12 @@ ip_status ip_renderer_upload(ip_renderer *r, const ip_mesh *m, uint64_t first, i
         st = reserve_triangles(r, r->triangle_count + added, err);
     if (st != IP_OK)
         return st;
-    GLintptr offset = (GLintptr)(r->triangle_count * TRIANGLE_BYTES);
-    GLsizeiptr size = (GLsizeiptr)(added * TRIANGLE_BYTES);
     glBindBuffer(GL_ARRAY_BUFFER, r->positions);
-    glBufferSubData(GL_ARRAY_BUFFER, offset, size, m->positions + 9 * first);
+    glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)(r->triangle_count * POSITION_BYTES),
+                    (GLsizeiptr)(added * POSITION_BYTES), m->positions + 9 * first);
     glBindBuffer(GL_ARRAY_BUFFER, r->normals);
-    glBufferSubData(GL_ARRAY_BUFFER, offset, size, m->normals + 9 * first);
+    glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)(r->triangle_count * NORMAL_BYTES),
+                    (GLsizeiptr)(added * NORMAL_BYTES), m->normals + 9 * first);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     st = check_gl("uploading triangles", err);
     if (st == IP_OK)
@@ -426,8 +439,9 @@ static void draw_background(const ip_renderer *r)
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-static void draw_mesh(const ip_renderer *r, const ip_camera *camera, double near_plane,
-                      double far_plane)
+/* Depth test on, the mesh program with the camera's and the shading's uniforms. */
+static void use_mesh_program(const ip_renderer *r, const ip_camera *camera, double near_plane,
+                             double far_plane)
 {
     const ip_shading *s = &r->shading;
     float view[16], projection[16];
@@ -442,14 +456,23 @@ static void draw_mesh(const ip_renderer *r, const ip_camera *camera, double near
     glUniform3fv(r->eye_at, 1, eye);
     glUniform3fv(r->surface_at, 1, s->surface);
     glUniform4fv(r->terms_at, 1, terms);
+}
+
+static void draw_mesh(const ip_renderer *r, const ip_camera *camera, double near_plane,
+                      double far_plane)
+{
+    use_mesh_program(r, camera, near_plane, far_plane);
     glBindVertexArray(r->mesh_array);
     glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * r->triangle_count));
     glBindVertexArray(0);
     glUseProgram(0);
 }
 
-ip_status ip_renderer_draw(ip_renderer *r, const ip_camera *camera, const double lo[3],
-                           const double hi[3], ip_error *err)
+/* Checks the view and makes the context current; then clears the depth and draws the
+ * background. */
+static ip_status begin_image(ip_renderer *r, const ip_camera *camera, const double lo[3],
+                             const double hi[3], double *near_plane, double *far_plane,
+                             ip_error *err)
 {
     ip_status st = ip_camera_check(camera, err);
     if (st == IP_OK)
@@ -462,14 +485,66 @@ ip_status ip_renderer_draw(ip_renderer *r, const ip_camera *camera, const double
     st = make_current(r, err);
     if (st != IP_OK)
         return st;
-    double near_plane, far_plane;
-    ip_camera_depth_range(camera, lo, hi, &near_plane, &far_plane);
+    ip_camera_depth_range(camera, lo, hi, near_plane, far_plane);
     set_draw_state(r);
     glClearDepth(1.0);
     glClear(GL_DEPTH_BUFFER_BIT);
     draw_background(r);
+    return IP_OK;
+}
+
+ip_status ip_renderer_draw(ip_renderer *r, const ip_camera *camera, const double lo[3],
+                           const double hi[3], ip_error *err)
+{
+    double near_plane, far_plane;
+    ip_status st = begin_image(r, camera, lo, hi, &near_plane, &far_plane, err);
+    if (st != IP_OK)
+        return st;
     if (r->triangle_count)
         draw_mesh(r, camera, near_plane, far_plane);
+    return check_gl("drawing", err);
+}
+
+/* The streaming buffers, allocated once at their full size. */
+static ip_status make_stream_buffers(ip_renderer *r, ip_error *err)
+{
+    if (r->stream_array)
+        return IP_OK;
+    glGenVertexArrays(1, &r->stream_array);
+    glGenBuffers(1, &r->stream_positions);
+    glGenBuffers(1, &r->stream_normals);
+    bind_array(r->stream_array, r->stream_positions, r->stream_normals);
+    return check_gl("creating the streaming buffers", err);
+}
+
+ip_status ip_renderer_draw_mesh(ip_renderer *r, const ip_mesh *m, const ip_camera *camera,
+                                const double lo[3], const double hi[3], ip_error *err)
+{
+    double near_plane, far_plane;
+    ip_status st = begin_image(r, camera, lo, hi, &near_plane, &far_plane, err);
+    if (st == IP_OK)
+        st = make_stream_buffers(r, err);
+    if (st != IP_OK || m->triangle_count == 0)
+        return st == IP_OK ? check_gl("drawing", err) : st;
+    use_mesh_program(r, camera, near_plane, far_plane);
+    glBindVertexArray(r->stream_array);
+    /* Each part replaces the buffers' storage (orphaning it), so the driver never waits for
+     * the previous draw and frees each part's copy once drawn. Drawing in parts, in order,
+     * gives the image of one draw: the depth test sees the same triangles in the same order. */
+    for (uint64_t first = 0; first < m->triangle_count; first += STREAM_TRIANGLES) {
+        uint64_t count = m->triangle_count - first;
+        count = count < STREAM_TRIANGLES ? count : STREAM_TRIANGLES;
+        glBindBuffer(GL_ARRAY_BUFFER, r->stream_positions);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(count * POSITION_BYTES),
+                     m->positions + 9 * first, GL_STREAM_DRAW);
+        glBindBuffer(GL_ARRAY_BUFFER, r->stream_normals);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(count * NORMAL_BYTES),
+                     m->normals + 9 * first, GL_STREAM_DRAW);
+        glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * count));
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glBindVertexArray(0);
+    glUseProgram(0);
     return check_gl("drawing", err);
 }
 
@@ -516,10 +591,10 @@ void ip_renderer_destroy(ip_renderer *r)
         return;
     int current = !r->context || ip_gl_context_make_current(r->context, NULL) == IP_OK;
     if (r->has_objects && current) {
-        GLuint buffers[2] = {r->positions, r->normals};
-        GLuint arrays[2] = {r->mesh_array, r->background_array};
-        glDeleteBuffers(2, buffers);
-        glDeleteVertexArrays(2, arrays);
+        GLuint buffers[4] = {r->positions, r->normals, r->stream_positions, r->stream_normals};
+        GLuint arrays[3] = {r->mesh_array, r->background_array, r->stream_array};
+        glDeleteBuffers(4, buffers);
+        glDeleteVertexArrays(3, arrays);
         glDeleteProgram(r->mesh_program);
         glDeleteProgram(r->background_program);
         if (r->context) {

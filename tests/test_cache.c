@@ -112,6 +112,26 @@ static void test_scripted_lru(const ip_store *s)
     pin_unpin(c, 4);
     ip_cache_get_stats(c, &st);
     CHECK(st.hits == 4 && st.misses == 8 && st.evictions == 4);
+    /* trimming: keep one brick's worth (the most recent, 4), then all but the pinned one */
+    CHECK(ip_cache_trim(c, BRICK_BYTES) == 3 * BRICK_BYTES);
+    ip_cache_get_stats(c, &st);
+    CHECK(st.resident_bytes == BRICK_BYTES && st.resident_bricks == 1 && st.evictions == 4);
+    pin_unpin(c, 4);
+    ip_cache_get_stats(c, &st);
+    CHECK(st.hits == 5 && st.misses == 8);
+    ip_brick held;
+    REQUIRE(ip_cache_pin_brick(c, 0, &held, NULL) == IP_OK);
+    CHECK(ip_cache_trim(c, 0) == BRICK_BYTES); /* brick 4 goes, pinned brick 0 stays */
+    ip_cache_get_stats(c, &st);
+    CHECK(st.resident_bytes == BRICK_BYTES && st.pinned_bytes == BRICK_BYTES);
+    CHECK(brick_ok(&held));
+    ip_cache_unpin_brick(c, &held);
+    CHECK(ip_cache_trim(c, 0) == BRICK_BYTES);
+    ip_cache_get_stats(c, &st);
+    CHECK(st.resident_bytes == 0 && st.resident_bricks == 0 && st.evictions == 4);
+    pin_unpin(c, 0); /* loads again */
+    ip_cache_get_stats(c, &st);
+    CHECK(st.misses == 10 && st.resident_bytes == BRICK_BYTES);
     ip_cache_destroy(c);
 
     /* a long pseudo-random sequence against the model, for several budgets */

@@ -66,11 +66,13 @@ static void make_volume(const char *dir, ip_field field, uint32_t n, ip_type typ
     REQUIRE(ip_brick_volume(&d, ibv, &o, NULL, &err) == IP_OK);
 }
 
-/* Two triangles are the same when they come from the same cell and have the same vertices. */
+/* Two triangles are the same when they come from the same cell and have the same vertices
+ * and normals. */
 static int same_triangle(const ip_mesh *a, uint64_t i, const ip_mesh *b, uint64_t j)
 {
     return a->cells[i] == b->cells[j] &&
-           memcmp(&a->positions[9 * i], &b->positions[9 * j], 9 * sizeof(float)) == 0;
+           memcmp(&a->positions[9 * i], &b->positions[9 * j], 9 * sizeof(float)) == 0 &&
+           memcmp(&a->normals[9 * i], &b->normals[9 * j], 9 * sizeof(int16_t)) == 0;
 }
 
 static int compare_cells(const void *x, const void *y)
@@ -132,12 +134,14 @@ static void check_view(scene *s, const char *what, const char *axis, float iso, 
     ip_engine_options o;
     ip_engine_options_default(&o);
     o.lod = 0; /* the exact-image guarantee is for full resolution */
+    o.cell_ids = 1;
     REQUIRE(ip_engine_create(s->cache, &o, &e, &err) == IP_OK);
     ip_engine_counts t;
     run_all_rays(e, &cam, iso, &t);
     const ip_mesh *part = ip_engine_mesh(e);
+    REQUIRE(part->with_cells && (part->cells || part->triangle_count == 0));
     ip_mesh full;
-    ip_mesh_init(&full);
+    ip_mesh_init_with_cells(&full);
     ip_engine_counts fc;
     REQUIRE(ip_extract_full(s->cache, iso, 0, 0, &full, &fc, &err) == IP_OK);
     CHECK(t.rays == (uint64_t)w * h);
@@ -360,6 +364,7 @@ static void check_cancel_restart(scene *s, float iso_a, float iso_b)
     ip_engine_options_default(&o);
     o.threads = 1; /* one thread extracts the same cells in the same order every time */
     o.lod = 0;
+    o.cell_ids = 1;
     REQUIRE(ip_engine_create(s->cache, &o, &e, &err) == IP_OK);
     REQUIRE(ip_engine_create(s->cache, &o, &fresh, &err) == IP_OK);
     REQUIRE(ip_engine_begin(e, &cam, iso_a, &err) == IP_OK);

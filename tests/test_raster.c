@@ -42,7 +42,7 @@ static void add_screen_triangle(ip_mesh *m, const ip_camera *c, const double xy[
         point_at(c, xy[2 * k], xy[2 * k + 1], depth, p + 3 * k);
         n[3 * k] = 0, n[3 * k + 1] = 0, n[3 * k + 2] = 1;
     }
-    REQUIRE(ip_mesh_append(m, p, n, &cell, 1) == IP_OK);
+    REQUIRE(ip_mesh_append_float_normals(m, p, n, &cell, 1) == IP_OK);
 }
 
 /* Coverage of one triangle alone: 1 where covered. */
@@ -216,7 +216,7 @@ static void build_cube(ip_mesh *m, float face[12][3])
                 }
             uint64_t cell = (uint64_t)f;
             memcpy(face[2 * f + half], normals[f], sizeof normals[f]);
-            REQUIRE(ip_mesh_append(m, p, n, &cell, 1) == IP_OK);
+            REQUIRE(ip_mesh_append_float_normals(m, p, n, &cell, 1) == IP_OK);
         }
 }
 
@@ -334,7 +334,7 @@ static void test_clipping(void)
     const uint64_t cells[2] = {0, 1};
     ip_mesh m;
     ip_mesh_init(&m);
-    REQUIRE(ip_mesh_append(&m, p, n, cells, 2) == IP_OK);
+    REQUIRE(ip_mesh_append_float_normals(&m, p, n, cells, 2) == IP_OK);
     uint32_t index[120 * 90];
     REQUIRE(ip_raster_mesh(&m, &c, lo, hi, index, NULL, NULL) == IP_OK);
     ip_camera_basis b;
@@ -361,7 +361,7 @@ static void test_clipping(void)
     /* a triangle wholly behind the eye covers nothing */
     ip_mesh_clear(&m);
     const float behind[9] = {-1, -20, 2, 1, -20, 2, 0, -20, 3};
-    REQUIRE(ip_mesh_append(&m, behind, n, cells, 1) == IP_OK);
+    REQUIRE(ip_mesh_append_float_normals(&m, behind, n, cells, 1) == IP_OK);
     REQUIRE(ip_raster_mesh(&m, &c, lo, hi, index, NULL, NULL) == IP_OK);
     int any = 0;
     for (int i = 0; i < 120 * 90; i++)

@@ -40,7 +40,7 @@ static void add_triangle(ip_mesh *m, const float a[3], const float b[3], const f
     memcpy(p, a, 12), memcpy(p + 3, b, 12), memcpy(p + 6, c, 12);
     memcpy(n, na, 12), memcpy(n + 3, nb, 12), memcpy(n + 6, nc, 12);
     uint64_t cell = m->triangle_count;
-    REQUIRE(ip_mesh_append(m, p, n, &cell, 1) == IP_OK);
+    REQUIRE(ip_mesh_append_float_normals(m, p, n, &cell, 1) == IP_OK);
 }
 
 static void midpoint(const float a[3], const float b[3], float out[3])
@@ -215,8 +215,7 @@ static void test_incremental_upload(ip_renderer *r, const ip_mesh *m)
     const uint64_t cuts[4] = {0, 1000, 4100, m->triangle_count};
     for (int k = 0; k < 3; k++) {
         uint64_t count = cuts[k + 1] - cuts[k];
-        REQUIRE(ip_mesh_append(&partial, m->positions + 9 * cuts[k], m->normals + 9 * cuts[k],
-                               m->cells + cuts[k], count) == IP_OK);
+        REQUIRE(ip_mesh_append_mesh(&partial, m, cuts[k], count) == IP_OK);
         CHECK(ip_renderer_upload(fresh, &partial, cuts[k], NULL) == IP_OK);
         CHECK(ip_renderer_triangle_count(fresh) == cuts[k + 1]);
     }
@@ -246,6 +245,45 @@ static void test_incremental_upload(ip_renderer *r, const ip_mesh *m)
     free(once);
     free(parts);
     free(again);
+}
+
+/* Streaming a mesh in parts (more than one part: 65,536 triangles each) gives the very image
+ * of uploading it whole, and leaves the uploaded triangles alone. */
+static void test_streamed_draw(ip_renderer *r)
+{
+    ip_mesh big;
+    ip_mesh_init(&big);
+    add_sphere(&big, 6); /* 81,920 triangles */
+    const float lo[3] = {0.3f, -1.15f, -0.95f}, hi[3] = {1.2f, -0.4f, -0.15f};
+    add_box(&big, lo, hi);
+    REQUIRE(big.triangle_count > 65536);
+    ip_camera c = scene_camera(320, 240);
+    size_t bytes = 320 * 240 * 4;
+    uint8_t *whole = malloc(bytes), *streamed = malloc(bytes), *empty = malloc(bytes);
+    REQUIRE(whole && streamed && empty);
+    ip_error err;
+    ip_renderer_clear_mesh(r);
+    REQUIRE(ip_renderer_upload(r, &big, 0, NULL) == IP_OK);
+    draw_and_read(r, &c, whole);
+    ip_renderer_clear_mesh(r);
+    CHECK(ip_renderer_draw_mesh(r, &big, &c, scene_lo, scene_hi, &err) == IP_OK);
+    CHECK(ip_renderer_read_rgba(r, streamed, &err) == IP_OK);
+    CHECK_MSG(memcmp(whole, streamed, bytes) == 0, "a streamed draw differs from one draw");
+    CHECK(ip_renderer_triangle_count(r) == 0);
+    /* an empty mesh: the background alone */
+    ip_mesh none;
+    ip_mesh_init(&none);
+    CHECK(ip_renderer_draw_mesh(r, &none, &c, scene_lo, scene_hi, &err) == IP_OK);
+    CHECK(ip_renderer_read_rgba(r, streamed, &err) == IP_OK);
+    draw_and_read(r, &c, empty);
+    CHECK(memcmp(empty, streamed, bytes) == 0);
+    /* a camera of another size is refused */
+    ip_camera small = scene_camera(100, 80);
+    CHECK(ip_renderer_draw_mesh(r, &big, &small, scene_lo, scene_hi, &err) == IP_ERR_ARGUMENT);
+    free(whole);
+    free(streamed);
+    free(empty);
+    ip_mesh_free(&big);
 }
 
 static void test_resize_and_errors(ip_renderer *r, const ip_mesh *m)
@@ -355,6 +393,9 @@ int main(void)
     printf("scene: %llu triangles\n", (unsigned long long)m.triangle_count);
     test_against_raster(r, &m);
     test_incremental_upload(r, &m);
+    test_streamed_draw(r);
+    ip_renderer_clear_mesh(r);
+    REQUIRE(ip_renderer_upload(r, &m, 0, NULL) == IP_OK);
 
     uint8_t *image = malloc(320 * 240 * 4);
     REQUIRE(image);

@@ -4,6 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include "isoprop/cache.h"
 #include "isoprop/engine.h"
@@ -355,9 +358,8 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
         ip_renderer *gl;
         ip_error why;
         if (ip_renderer_create_headless(r->camera.width, r->camera.height, &gl, &why) == IP_OK) {
-            ip_status st = ip_renderer_upload(gl, r->mesh, 0, err);
-            if (st == IP_OK)
-                st = ip_renderer_draw(gl, &r->camera, r->lo, r->hi, err);
+            /* streamed: the driver never holds a second copy of the whole mesh */
+            ip_status st = ip_renderer_draw_mesh(gl, r->mesh, &r->camera, r->lo, r->hi, err);
             if (st == IP_OK)
                 st = ip_renderer_read_rgba(gl, rgba, err);
             ip_renderer_destroy(gl);
@@ -429,8 +431,21 @@ static void print_summary(const run *r)
     printf("  image         %s\n", r->o.out);
 }
 
+/* Frees the decoded bricks once extraction is over: the image needs only the mesh, and
+ * rendering a large one needs memory of its own. The statistics are taken before. */
+static void drop_bricks(run *r)
+{
+    ip_cache_trim(r->cache, 0);
+#ifdef __GLIBC__
+    malloc_trim(0); /* give the freed bricks back to the system now */
+#endif
+}
+
 static int finish(run *r, ip_error *err)
 {
+    ip_cache_stats st;
+    ip_cache_get_stats(r->cache, &st);
+    drop_bricks(r);
     size_t n = (size_t)r->camera.width * r->camera.height;
     uint8_t *rgba = malloc(n * 4);
     if (!rgba) {
@@ -453,8 +468,6 @@ static int finish(run *r, ip_error *err)
         if (write_progress(r) != 0)
             return 1;
     }
-    ip_cache_stats st;
-    ip_cache_get_stats(r->cache, &st);
     uint64_t summary = ip_store_layout(r->store)->summary_size;
     if (!r->o.quiet) {
         print_summary(r);

@@ -49,7 +49,7 @@ typedef struct ip_cache_stats {
     uint64_t resident_bytes;       /* decoded bytes held now */
     uint64_t resident_peak_bytes;  /* most decoded bytes held at once */
     uint64_t resident_bricks;
-    uint64_t hits, misses, evictions;
+    uint64_t hits, misses, evictions; /* evictions: bricks evicted to make room */
     uint64_t waits;                /* misses that waited for another thread's decode */
     uint64_t bytes_decompressed;   /* decoded bytes produced by misses */
     uint64_t bytes_read;           /* compressed payload bytes read by misses */
@@ -82,6 +82,13 @@ ip_status ip_cache_pin_brick(ip_cache *cache, uint64_t g, ip_brick *brick, ip_er
 
 /*! ip_cache_unpin_brick() : releases one pin taken by ip_cache_pin_brick(). */
 void ip_cache_unpin_brick(ip_cache *cache, const ip_brick *brick);
+
+/*! ip_cache_trim() : evicts unpinned bricks, least recently used first, until at most
+ *  `keep_bytes` of decoded bricks stay resident (0: all that are not pinned), and frees their
+ *  memory; for a caller done with them for now (before rendering a large mesh, say). These
+ *  evictions are not counted in `evictions`, which counts those made for room.
+ *  Thread-safe. @return the decoded bytes freed. */
+uint64_t ip_cache_trim(ip_cache *cache, uint64_t keep_bytes);
 
 /*! ip_cache_get_stats() : a snapshot of the counters (consistent per counter, not across them
  *  while other threads work). */

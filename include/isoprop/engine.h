@@ -27,7 +27,7 @@
  * Threads: an engine is driven by one thread, which ip_engine_step() joins to its workers:
  * they share the progressive ray sequence (handed out in small batches, in order), the
  * visited set (an atomic bit per cell) and the cache, and keep their own triangle buffers,
- * appended to the mesh at the end of the step. Which thread extracts a cell varies from run to
+ * moved to the mesh every few thousand triangles and at the end of the step. Which thread extracts a cell varies from run to
  * run, so the triangles' order and, where propagations meet, which cells are extracted may
  * vary; what every pixel finally shows does not (each pixel's own ray extracts its seed).
  * With several threads the times are summed over the threads. ip_engine_cancel() may be
@@ -57,9 +57,14 @@ typedef struct ip_engine_options {
     int lod;                  /* adaptive resolution: far regions from coarser pyramid levels */
     double pixel_error;       /* with lod: a meta-cell is used once it projects to at most this
                                  many pixels (1: the paper's sub-pixel rule) */
+    int cell_ids;             /* keep each triangle's cell id in the mesh (8 bytes a triangle
+                                 more; for comparing extractions) */
 } ip_engine_options;
 
-/* Counters and times, per step or in total. Times are wall seconds, split as the paper does. */
+/* Counters and times, per step or in total. Times are wall seconds, split as the paper does.
+ * To keep clock reads off the hot paths, seeding is timed per batch of rays (less what
+ * propagation measured inside it) and, within a propagation, one extraction in 16 is timed
+ * and counted 16 times: the split between propagation and extraction is an estimate. */
 typedef struct ip_engine_counts {
     uint64_t rays;            /* rays cast */
     uint64_t seeds;           /* rays whose seed cell was new and started a propagation */
@@ -74,7 +79,7 @@ typedef struct ip_engine_counts {
 typedef struct ip_engine ip_engine;
 
 /*! ip_engine_options_default() : the paper's cut-off (1.81 degrees), a 0.25 degree
- *  fold-back tolerance, every core, and adaptive resolution with a 1-pixel error. */
+ *  fold-back tolerance, every core, adaptive resolution with a 1-pixel error, no cell ids. */
 void ip_engine_options_default(ip_engine_options *options);
 
 /*! ip_engine_create() : an engine reading through `cache` (which must outlive it). *out is the
@@ -119,6 +124,7 @@ void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
 
 /*! ip_extract_full() : triangulates every active cell of level `level`, brick by brick, skipping
  *  bricks and sub-blocks whose summary range excludes `iso`; the oracle and the baseline.
+ *  Cell ids are kept when `mesh` keeps them (mesh->with_cells).
  *  Triangles equal those of the progressive engine for the same cells. Runs on `threads`
  *  threads (0 = every core) and appends to `mesh` in brick order, so the result is the same
  *  for any number of threads. Times are summed over threads.

@@ -167,6 +167,16 @@ uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
 ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera, const double lo[3],
                            const double hi[3], ip_error *err);
 
+/*! ip_renderer_draw_mesh() : draws the background and the triangles of `mesh`, in order,
+ *  like ip_renderer_draw() would after uploading exactly `mesh` (the same image), but
+ *  streams them through one GPU buffer of 65,536 triangles, so that neither the GPU nor the
+ *  driver holds a second copy of a large mesh: for one-off images. The uploaded triangles are
+ *  left alone and not drawn. `mesh` is read during the call only.
+ *  @return as ip_renderer_draw(). */
+ip_status ip_renderer_draw_mesh(ip_renderer *renderer, const ip_mesh *mesh,
+                                const ip_camera *camera, const double lo[3],
+                                const double hi[3], ip_error *err);
+
 /*! ip_renderer_read_rgba() : copies the image drawn last into `rgba` (width * height * 4
  *  bytes, caller-owned), top row first, waiting for OpenGL to finish.
  *  @return IP_OK or IP_ERR_UNSUPPORTED (an OpenGL error). */
