@@ -41,13 +41,9 @@ static const char usage[] =
     "  --quiet             print nothing but errors\n";
 
 typedef struct options {
-    const char *file, *out, *mesh, *stats, *progress, *view, *camera;
-    double iso, time_limit, cutoff, foldback, pixel_error;
-    int lod;
-    int has_iso, full, software, force, quiet, warm;
-    uint64_t rays, cache_bytes;
-    unsigned threads;
-    uint32_t width, height;
+    tool_view_options common;
+    const char *file, *out, *mesh, *stats, *progress;
+    int full, software, force, quiet, warm;
 } options;
 
 typedef struct checkpoint {
@@ -72,80 +68,21 @@ typedef struct run {
     const char *renderer_name;
 } run;
 
-static int parse_size(const char *text, uint32_t *w, uint32_t *h)
-{
-    unsigned long a, b;
-    char x, extra;
-    if (sscanf(text, "%lu%c%lu%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') || a < 1 ||
-        b < 1 || a > 16384 || b > 16384)
-        return -1;
-    *w = (uint32_t)a;
-    *h = (uint32_t)b;
-    return 0;
-}
-
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->out = "isorender.png";
-    o->view = "-y";
-    o->width = 1600;
-    o->height = 1200;
-    o->cutoff = IP_DEFAULT_CUTOFF_DEGREES;
-    o->foldback = IP_DEFAULT_FOLDBACK_DEGREES;
-    o->lod = 1;
-    o->pixel_error = 1.0;
-    o->cache_bytes = ip_cache_default_budget();
+    tool_view_options_default(&o->common, 1600, 1200);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int taken = tool_parse_view_option("isorender", argc, argv, &i, &o->common);
+        if (taken == 2)
+            return 2;
+        if (taken)
+            continue;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage, stdout);
             exit(0);
-        } else if (!strcmp(a, "--iso") && v) {
-            if (tool_parse_double(v, &o->iso) != 0)
-                return tool_usage_error("isorender", "--iso '%s' is not a number", v);
-            o->has_iso = 1, i++;
-        } else if (!strcmp(a, "--size") && v) {
-            if (parse_size(v, &o->width, &o->height) != 0)
-                return tool_usage_error("isorender", "--size '%s' is not WxH", v);
-            i++;
-        } else if (!strcmp(a, "--view") && v) {
-            o->view = v, i++;
-        } else if (!strcmp(a, "--camera") && v) {
-            o->camera = v, i++;
-        } else if (!strcmp(a, "--rays") && v) {
-            if (tool_parse_u64(v, &o->rays) != 0 || o->rays == 0)
-                return tool_usage_error("isorender", "--rays '%s' is not a positive count", v);
-            i++;
-        } else if (!strcmp(a, "--time") && v) {
-            if (tool_parse_double(v, &o->time_limit) != 0 || o->time_limit <= 0)
-                return tool_usage_error("isorender", "--time '%s' is not positive seconds", v);
-            i++;
-        } else if (!strcmp(a, "--cutoff") && v) {
-            if (tool_parse_double(v, &o->cutoff) != 0)
-                return tool_usage_error("isorender", "--cutoff '%s' is not a number", v);
-            i++;
-        } else if (!strcmp(a, "--foldback") && v) {
-            if (tool_parse_double(v, &o->foldback) != 0)
-                return tool_usage_error("isorender", "--foldback '%s' is not a number", v);
-            i++;
-        } else if (!strcmp(a, "--threads") && v) {
-            uint64_t n;
-            if (tool_parse_u64(v, &n) != 0 || n < 1 || n > 64)
-                return tool_usage_error("isorender", "--threads must be 1-64");
-            o->threads = (unsigned)n, i++;
-        } else if (!strcmp(a, "--lod") && v) {
-            if (strcmp(v, "on") && strcmp(v, "off"))
-                return tool_usage_error("isorender", "--lod must be on or off");
-            o->lod = !strcmp(v, "on"), i++;
-        } else if (!strcmp(a, "--pixel-error") && v) {
-            if (tool_parse_double(v, &o->pixel_error) != 0 || o->pixel_error <= 0)
-                return tool_usage_error("isorender", "--pixel-error '%s' is not positive", v);
-            i++;
-        } else if (!strcmp(a, "--cache-mb") && v) {
-            if (tool_parse_cache_mb(v, &o->cache_bytes) != 0)
-                return tool_usage_error("isorender", "bad --cache-mb '%s'", v);
-            i++;
         } else if (!strcmp(a, "-o") && v) {
             o->out = v, i++;
         } else if (!strcmp(a, "--mesh") && v) {
@@ -174,9 +111,9 @@ static int parse_args(int argc, char **argv, options *o)
     }
     if (!o->file)
         return tool_usage_error("isorender", "no brick file");
-    if (!o->has_iso)
+    if (!o->common.has_iso)
         return tool_usage_error("isorender", "--iso V is required");
-    if (o->full && (o->rays || o->time_limit > 0))
+    if (o->full && (o->common.rays || o->common.time_limit > 0))
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
     return 0;
 }
@@ -195,14 +132,14 @@ static int setup_camera(run *r, ip_error *err)
         r->lo[a] = 0;
         r->hi[a] = (l->dims[a] - 1) * l->spacing[a];
     }
-    if (r->o.camera) {
-        r->camera.width = r->o.width;
-        r->camera.height = r->o.height;
-        if (ip_camera_parse(r->o.camera, &r->camera, err) != IP_OK)
+    if (r->o.common.camera) {
+        r->camera.width = r->o.common.width;
+        r->camera.height = r->o.common.height;
+        if (ip_camera_parse(r->o.common.camera, &r->camera, err) != IP_OK)
             return -1;
         return ip_camera_check(&r->camera, err) == IP_OK ? 0 : -1;
     }
-    return ip_camera_fit_axis(r->lo, r->hi, r->o.view, 30.0, r->o.width, r->o.height, &r->camera,
+    return ip_camera_fit_axis(r->lo, r->hi, r->o.common.view, 30.0, r->o.common.width, r->o.common.height, &r->camera,
                               err) == IP_OK ? 0 : -1;
 }
 
@@ -223,30 +160,25 @@ static int add_checkpoint(run *r, double start)
 static int extract_progressive(run *r, ip_error *err)
 {
     ip_engine_options eo;
-    ip_engine_options_default(&eo);
-    eo.cutoff_degrees = r->o.cutoff;
-    eo.foldback_degrees = r->o.foldback;
-    eo.threads = r->o.threads;
-    eo.lod = r->o.lod;
-    eo.pixel_error = r->o.pixel_error;
+    tool_engine_options(&r->o.common, &eo);
     if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
         return -1;
     if (r->o.warm) { /* the same work once, untimed: the bricks it needs stay in the cache */
-        if (ip_engine_begin(r->engine, &r->camera, (float)r->o.iso, err) != IP_OK ||
-            ip_engine_step(r->engine, r->o.rays, r->o.time_limit, NULL, err) != IP_OK)
+        if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK ||
+            ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
             return -1;
     }
-    if (ip_engine_begin(r->engine, &r->camera, (float)r->o.iso, err) != IP_OK)
+    if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK)
         return -1;
     double start = now();
-    uint64_t target = 1, limit = r->o.rays ? r->o.rays : UINT64_MAX;
+    uint64_t target = 1, limit = r->o.common.rays ? r->o.common.rays : UINT64_MAX;
     while (!ip_engine_done(r->engine)) {
         ip_engine_counts t;
         ip_engine_totals(r->engine, &t);
         if (t.rays >= limit)
             break;
-        double left = r->o.time_limit > 0 ? r->o.time_limit - (now() - start) : 0;
-        if (r->o.time_limit > 0 && left <= 0)
+        double left = r->o.common.time_limit > 0 ? r->o.common.time_limit - (now() - start) : 0;
+        if (r->o.common.time_limit > 0 && left <= 0)
             break;
         uint64_t batch = (target < limit ? target : limit) - t.rays;
         if (ip_engine_step(r->engine, batch, left, NULL, err) != IP_OK)
@@ -265,12 +197,12 @@ static int extract_full(run *r, ip_error *err)
 {
     ip_mesh_init(&r->full_mesh);
     if (r->o.warm) {
-        if (ip_extract_full(r->cache, (float)r->o.iso, 0, r->o.threads, &r->full_mesh, NULL, err) != IP_OK)
+        if (ip_extract_full(r->cache, (float)r->o.common.iso, 0, r->o.common.threads, &r->full_mesh, NULL, err) != IP_OK)
             return -1;
         ip_mesh_clear(&r->full_mesh);
     }
     double start = now();
-    if (ip_extract_full(r->cache, (float)r->o.iso, 0, r->o.threads, &r->full_mesh, &r->totals, err) != IP_OK)
+    if (ip_extract_full(r->cache, (float)r->o.common.iso, 0, r->o.common.threads, &r->full_mesh, &r->totals, err) != IP_OK)
         return -1;
     r->extraction_wall = now() - start;
     r->mesh = &r->full_mesh;
@@ -384,19 +316,19 @@ static void json_counts(FILE *f, void *user)
     tool_json_string(f, r->o.file);
     fprintf(f, ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
                "\"renderer\": \"%s\"",
-            r->o.iso, r->o.full ? "full" : "progressive", r->camera.width, r->camera.height,
+            r->o.common.iso, r->o.full ? "full" : "progressive", r->camera.width, r->camera.height,
             r->renderer_name ? r->renderer_name : "none");
     fprintf(f, ", \"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"target\": [%.9g, %.9g, %.9g], "
                "\"up\": [%.9g, %.9g, %.9g], \"fov\": %.9g}",
             r->camera.eye[0], r->camera.eye[1], r->camera.eye[2], r->camera.target[0],
             r->camera.target[1], r->camera.target[2], r->camera.up[0], r->camera.up[1],
             r->camera.up[2], r->camera.fov_y);
-    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", r->o.lod ? "true" : "false",
-            r->o.pixel_error);
+    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", r->o.common.lod ? "true" : "false",
+            r->o.common.pixel_error);
     fprintf(f, ", \"warm\": %s, \"threads\": %u", r->o.warm ? "true" : "false",
-            ip_thread_count(r->o.threads));
-    fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", r->o.cutoff,
-            r->o.foldback);
+            ip_thread_count(r->o.common.threads));
+    fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", r->o.common.cutoff,
+            r->o.common.foldback);
     fprintf(f, ", \"rays\": %llu, \"rays_total\": %llu, \"done\": %s, \"seeds\": %llu, "
                "\"cells\": %llu, \"triangles\": %llu",
             (unsigned long long)t->rays,
@@ -417,7 +349,7 @@ static void json_counts(FILE *f, void *user)
 static void print_summary(const run *r)
 {
     const ip_engine_counts *t = &r->totals;
-    printf("%s: iso %g, %s, %ux%u\n", r->o.file, r->o.iso, r->o.full ? "full extraction" : "progressive",
+    printf("%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso, r->o.full ? "full extraction" : "progressive",
            r->camera.width, r->camera.height);
     printf("  rays          %llu of %llu\n", (unsigned long long)t->rays,
            (unsigned long long)r->camera.width * r->camera.height);
@@ -491,7 +423,7 @@ int main(int argc, char **argv)
     if (ip_store_open(r.o.file, &r.store, &err) != IP_OK)
         return tool_fail("isorender", &err);
     rc = 1;
-    if (ip_cache_create(r.store, r.o.cache_bytes, &r.cache, &err) != IP_OK ||
+    if (ip_cache_create(r.store, r.o.common.cache_bytes, &r.cache, &err) != IP_OK ||
         setup_camera(&r, &err) != 0 ||
         (r.o.full ? extract_full(&r, &err) : extract_progressive(&r, &err)) != 0)
         rc = tool_fail("isorender", &err);

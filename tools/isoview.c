@@ -104,12 +104,10 @@ static const char help_text[] =
     "Esc            quit";
 
 typedef struct options {
-    const char *file, *view, *camera, *stats, *script, *screenshot_path;
-    double iso, time_limit, cutoff, foldback, pixel_error, screenshot_at, exit_after;
-    int has_iso, lod, force, quiet;
-    uint64_t rays, cache_bytes;
-    unsigned threads;
-    uint32_t width, height;
+    tool_view_options common;
+    const char *file, *stats, *script, *screenshot_path;
+    double screenshot_at, exit_after;
+    int force, quiet;
 } options;
 
 typedef enum command_kind {
@@ -218,81 +216,22 @@ static void set_error(ip_error *err, ip_status code, const char *fmt, ...)
     va_end(ap);
 }
 
-static int parse_size(const char *text, uint32_t *w, uint32_t *h)
-{
-    unsigned long a, b;
-    char x, extra;
-    if (sscanf(text, "%lu%c%lu%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') || a < 1 ||
-        b < 1 || a > 16384 || b > 16384)
-        return -1;
-    *w = (uint32_t)a;
-    *h = (uint32_t)b;
-    return 0;
-}
-
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
-    o->view = "-y";
-    o->width = 1280;
-    o->height = 960;
-    o->cutoff = IP_DEFAULT_CUTOFF_DEGREES;
-    o->foldback = IP_DEFAULT_FOLDBACK_DEGREES;
-    o->lod = 1;
-    o->pixel_error = 1.0;
-    o->cache_bytes = ip_cache_default_budget();
+    tool_view_options_default(&o->common, 1280, 960);
     o->screenshot_at = -1;
     o->exit_after = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int taken = tool_parse_view_option("isoview", argc, argv, &i, &o->common);
+        if (taken == 2)
+            return 2;
+        if (taken)
+            continue;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage, stdout);
             exit(0);
-        } else if (!strcmp(a, "--iso") && v) {
-            if (tool_parse_double(v, &o->iso) != 0)
-                return tool_usage_error("isoview", "--iso '%s' is not a number", v);
-            o->has_iso = 1, i++;
-        } else if (!strcmp(a, "--size") && v) {
-            if (parse_size(v, &o->width, &o->height) != 0)
-                return tool_usage_error("isoview", "--size '%s' is not WxH", v);
-            i++;
-        } else if (!strcmp(a, "--view") && v) {
-            o->view = v, i++;
-        } else if (!strcmp(a, "--camera") && v) {
-            o->camera = v, i++;
-        } else if (!strcmp(a, "--rays") && v) {
-            if (tool_parse_u64(v, &o->rays) != 0 || o->rays == 0)
-                return tool_usage_error("isoview", "--rays '%s' is not a positive count", v);
-            i++;
-        } else if (!strcmp(a, "--time") && v) {
-            if (tool_parse_double(v, &o->time_limit) != 0 || o->time_limit <= 0)
-                return tool_usage_error("isoview", "--time '%s' is not positive seconds", v);
-            i++;
-        } else if (!strcmp(a, "--cutoff") && v) {
-            if (tool_parse_double(v, &o->cutoff) != 0)
-                return tool_usage_error("isoview", "--cutoff '%s' is not a number", v);
-            i++;
-        } else if (!strcmp(a, "--foldback") && v) {
-            if (tool_parse_double(v, &o->foldback) != 0)
-                return tool_usage_error("isoview", "--foldback '%s' is not a number", v);
-            i++;
-        } else if (!strcmp(a, "--threads") && v) {
-            uint64_t n;
-            if (tool_parse_u64(v, &n) != 0 || n < 1 || n > 64)
-                return tool_usage_error("isoview", "--threads must be 1-64");
-            o->threads = (unsigned)n, i++;
-        } else if (!strcmp(a, "--lod") && v) {
-            if (strcmp(v, "on") && strcmp(v, "off"))
-                return tool_usage_error("isoview", "--lod must be on or off");
-            o->lod = !strcmp(v, "on"), i++;
-        } else if (!strcmp(a, "--pixel-error") && v) {
-            if (tool_parse_double(v, &o->pixel_error) != 0 || o->pixel_error <= 0)
-                return tool_usage_error("isoview", "--pixel-error '%s' is not positive", v);
-            i++;
-        } else if (!strcmp(a, "--cache-mb") && v) {
-            if (tool_parse_cache_mb(v, &o->cache_bytes) != 0)
-                return tool_usage_error("isoview", "bad --cache-mb '%s'", v);
-            i++;
         } else if (!strcmp(a, "--stats") && v) {
             o->stats = v, i++;
         } else if (!strcmp(a, "--script") && v) {
@@ -319,7 +258,7 @@ static int parse_args(int argc, char **argv, options *o)
     }
     if (!o->file)
         return tool_usage_error("isoview", "no brick file");
-    if (!o->has_iso)
+    if (!o->common.has_iso)
         return tool_usage_error("isoview", "--iso V is required");
     return 0;
 }
@@ -429,7 +368,7 @@ static void change_iso(viewer *v, double iso)
 static void reset_view(viewer *v)
 {
     ip_error ignored;
-    if (camera_from(v, v->o.camera, v->o.view, &v->camera, &ignored) == 0)
+    if (camera_from(v, v->o.common.camera, v->o.common.view, &v->camera, &ignored) == 0)
         change_view(v);
 }
 
@@ -607,9 +546,9 @@ static int pass_limit_reached(const viewer *v)
 {
     ip_engine_counts t;
     ip_engine_totals(v->engine, &t);
-    if (v->o.rays && t.rays >= v->o.rays)
+    if (v->o.common.rays && t.rays >= v->o.common.rays)
         return 1;
-    return v->o.time_limit > 0 && v->pass_wall >= v->o.time_limit ? 2 : 0;
+    return v->o.common.time_limit > 0 && v->pass_wall >= v->o.common.time_limit ? 2 : 0;
 }
 
 /* 1 once nothing more will be extracted until the next change (pausing aside). */
@@ -1022,12 +961,12 @@ static int refine(viewer *v)
     double slice = v->draw_seconds < FRAME_BUDGET_SECONDS ? FRAME_BUDGET_SECONDS
                    : v->draw_seconds > MAX_SLICE_SECONDS ? MAX_SLICE_SECONDS
                    : v->draw_seconds;
-    if (v->o.time_limit > 0 && slice > v->o.time_limit - v->pass_wall)
-        slice = v->o.time_limit - v->pass_wall;
+    if (v->o.common.time_limit > 0 && slice > v->o.common.time_limit - v->pass_wall)
+        slice = v->o.common.time_limit - v->pass_wall;
     ip_engine_counts t;
     ip_engine_totals(v->engine, &t);
     double start = now();
-    ip_status st = ip_engine_step(v->engine, v->o.rays ? v->o.rays - t.rays : 0, slice, NULL,
+    ip_status st = ip_engine_step(v->engine, v->o.common.rays ? v->o.common.rays - t.rays : 0, slice, NULL,
                                   &v->err);
     v->pass_wall += now() - start;
     if (st != IP_OK && st != IP_ERR_CANCELLED)
@@ -1046,7 +985,7 @@ static int extract_full(viewer *v)
     ip_mesh_clear(&v->full_mesh);
     memset(&v->full_counts, 0, sizeof v->full_counts);
     double start = now();
-    if (ip_extract_full(v->cache, (float)v->iso, 0, v->o.threads, &v->full_mesh, &v->full_counts,
+    if (ip_extract_full(v->cache, (float)v->iso, 0, v->o.common.threads, &v->full_mesh, &v->full_counts,
                         &v->err) != IP_OK)
         return -1;
     v->full_wall = now() - start;
@@ -1255,7 +1194,7 @@ static int open_window(viewer *v)
     glfwWindowHint(GLFW_SAMPLES, 0); /* the image must match isorender's */
     char title[256];
     snprintf(title, sizeof title, "isoview: %s", v->o.file);
-    v->window = glfwCreateWindow((int)v->o.width, (int)v->o.height, title, NULL, NULL);
+    v->window = glfwCreateWindow((int)v->o.common.width, (int)v->o.common.height, title, NULL, NULL);
     if (!v->window) {
         fprintf(stderr, "isoview: cannot open a window: %s\n",
                 glfw_error[0] ? glfw_error : "no OpenGL 3.3 core context");
@@ -1271,8 +1210,8 @@ static int open_window(viewer *v)
     glfwSetScrollCallback(v->window, on_scroll);
     int width, height;
     glfwGetFramebufferSize(v->window, &width, &height);
-    v->camera.width = width > 0 ? (uint32_t)width : v->o.width;
-    v->camera.height = height > 0 ? (uint32_t)height : v->o.height;
+    v->camera.width = width > 0 ? (uint32_t)width : v->o.common.width;
+    v->camera.height = height > 0 ? (uint32_t)height : v->o.common.height;
     if (ip_renderer_create_current(v->camera.width, v->camera.height, 0, &v->renderer,
                                    &v->err) != IP_OK ||
         overlay_create(&v->text, &v->err) != 0) {
@@ -1302,11 +1241,11 @@ static void json_counts(FILE *f, void *user)
             v->camera.eye[0], v->camera.eye[1], v->camera.eye[2], v->camera.target[0],
             v->camera.target[1], v->camera.target[2], v->camera.up[0], v->camera.up[1],
             v->camera.up[2], v->camera.fov_y);
-    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", v->o.lod ? "true" : "false",
-            v->o.pixel_error);
-    fprintf(f, ", \"warm\": false, \"threads\": %u", ip_thread_count(v->o.threads));
-    fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", v->o.cutoff,
-            v->o.foldback);
+    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", v->o.common.lod ? "true" : "false",
+            v->o.common.pixel_error);
+    fprintf(f, ", \"warm\": false, \"threads\": %u", ip_thread_count(v->o.common.threads));
+    fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", v->o.common.cutoff,
+            v->o.common.foldback);
     fprintf(f, ", \"rays\": %llu, \"rays_total\": %llu, \"done\": %s, \"seeds\": %llu, "
                "\"cells\": %llu, \"triangles\": %llu",
             (unsigned long long)t.rays,
@@ -1368,7 +1307,7 @@ static int prepare(viewer *v)
 {
     ip_error *err = &v->err;
     if (ip_store_open(v->o.file, &v->store, err) != IP_OK ||
-        ip_cache_create(v->store, v->o.cache_bytes, &v->cache, err) != IP_OK)
+        ip_cache_create(v->store, v->o.common.cache_bytes, &v->cache, err) != IP_OK)
         return -1;
     const ip_layout *l = ip_store_layout(v->store);
     for (int a = 0; a < 3; a++) {
@@ -1377,9 +1316,9 @@ static int prepare(viewer *v)
     }
     v->value_min = l->value_min;
     v->value_max = l->value_max;
-    v->camera.width = v->o.width;
-    v->camera.height = v->o.height;
-    if (camera_from(v, v->o.camera, v->o.view, &v->camera, err) != 0)
+    v->camera.width = v->o.common.width;
+    v->camera.height = v->o.common.height;
+    if (camera_from(v, v->o.common.camera, v->o.common.view, &v->camera, err) != 0)
         return -1;
     if (v->o.script && load_script(v, err) != 0)
         return -1;
@@ -1389,12 +1328,7 @@ static int prepare(viewer *v)
         return -1;
     }
     ip_engine_options eo;
-    ip_engine_options_default(&eo);
-    eo.cutoff_degrees = v->o.cutoff;
-    eo.foldback_degrees = v->o.foldback;
-    eo.threads = v->o.threads;
-    eo.lod = v->o.lod;
-    eo.pixel_error = v->o.pixel_error;
+    tool_engine_options(&v->o.common, &eo);
     return ip_engine_create(v->cache, &eo, &v->engine, err) == IP_OK ? 0 : -1;
 }
 
@@ -1412,7 +1346,7 @@ int main(int argc, char **argv)
     }
     ip_error_clear(&v->err);
     ip_mesh_init(&v->full_mesh);
-    v->iso = v->o.iso;
+    v->iso = v->o.common.iso;
     v->overlay_on = 1;
     v->drag_button = -1;
     v->restart = 1;
@@ -1421,8 +1355,8 @@ int main(int argc, char **argv)
         tool_fail("isoview", &v->err);
     } else if (open_window(v) == 0) {
         /* the window may have opened at another size than asked: fit --view to it */
-        if (!v->o.camera)
-            (void)camera_from(v, NULL, v->o.view, &v->camera, &v->err);
+        if (!v->o.common.camera)
+            (void)camera_from(v, NULL, v->o.common.view, &v->camera, &v->err);
         v->start = now();
         while (!v->quit)
             if (frame(v) != 0) {

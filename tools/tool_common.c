@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "isoprop/engine.h"
 #include "tool_common.h"
 
 int tool_fail(const char *program, const ip_error *err)
@@ -208,5 +209,104 @@ int tool_write_stats_file(const char *program, const char *path, const ip_cache_
         unlink(temp);
         return -1;
     }
+    return 0;
+}
+
+void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t height)
+{
+    memset(o, 0, sizeof *o);
+    o->view = "-y";
+    o->width = width;
+    o->height = height;
+    o->cutoff = IP_DEFAULT_CUTOFF_DEGREES;
+    o->foldback = IP_DEFAULT_FOLDBACK_DEGREES;
+    o->lod = 1;
+    o->pixel_error = 1.0;
+    o->cache_bytes = ip_cache_default_budget();
+}
+
+void tool_engine_options(const tool_view_options *o, ip_engine_options *eo)
+{
+    ip_engine_options_default(eo);
+    eo->cutoff_degrees = o->cutoff;
+    eo->foldback_degrees = o->foldback;
+    eo->threads = o->threads;
+    eo->lod = o->lod;
+    eo->pixel_error = o->pixel_error;
+}
+
+static int parse_size(const char *text, uint32_t *w, uint32_t *h)
+{
+    unsigned long a, b;
+    char x, extra;
+    if (sscanf(text, "%lu%c%lu%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') || a < 1 ||
+        b < 1 || a > 16384 || b > 16384)
+        return -1;
+    *w = (uint32_t)a;
+    *h = (uint32_t)b;
+    return 0;
+}
+
+/* The value of one shared option; returns 0, or 2 after a usage error. */
+static int parse_view_value(const char *p, const char *a, const char *v, tool_view_options *o)
+{
+    if (!strcmp(a, "--iso")) {
+        if (tool_parse_double(v, &o->iso) != 0)
+            return tool_usage_error(p, "--iso '%s' is not a number", v);
+        o->has_iso = 1;
+    } else if (!strcmp(a, "--size")) {
+        if (parse_size(v, &o->width, &o->height) != 0)
+            return tool_usage_error(p, "--size '%s' is not WxH", v);
+    } else if (!strcmp(a, "--view")) {
+        o->view = v;
+    } else if (!strcmp(a, "--camera")) {
+        o->camera = v;
+    } else if (!strcmp(a, "--rays")) {
+        if (tool_parse_u64(v, &o->rays) != 0 || o->rays == 0)
+            return tool_usage_error(p, "--rays '%s' is not a positive count", v);
+    } else if (!strcmp(a, "--time")) {
+        if (tool_parse_double(v, &o->time_limit) != 0 || o->time_limit <= 0)
+            return tool_usage_error(p, "--time '%s' is not positive seconds", v);
+    } else if (!strcmp(a, "--cutoff")) {
+        if (tool_parse_double(v, &o->cutoff) != 0)
+            return tool_usage_error(p, "--cutoff '%s' is not a number", v);
+    } else if (!strcmp(a, "--foldback")) {
+        if (tool_parse_double(v, &o->foldback) != 0)
+            return tool_usage_error(p, "--foldback '%s' is not a number", v);
+    } else if (!strcmp(a, "--threads")) {
+        uint64_t n;
+        if (tool_parse_u64(v, &n) != 0 || n < 1 || n > 64)
+            return tool_usage_error(p, "--threads must be 1-64");
+        o->threads = (unsigned)n;
+    } else if (!strcmp(a, "--lod")) {
+        if (strcmp(v, "on") && strcmp(v, "off"))
+            return tool_usage_error(p, "--lod must be on or off");
+        o->lod = !strcmp(v, "on");
+    } else if (!strcmp(a, "--pixel-error")) {
+        if (tool_parse_double(v, &o->pixel_error) != 0 || o->pixel_error <= 0)
+            return tool_usage_error(p, "--pixel-error '%s' is not positive", v);
+    } else { /* --cache-mb */
+        if (tool_parse_cache_mb(v, &o->cache_bytes) != 0)
+            return tool_usage_error(p, "bad --cache-mb '%s'", v);
+    }
+    return 0;
+}
+
+int tool_parse_view_option(const char *program, int argc, char **argv, int *i,
+                           tool_view_options *o)
+{
+    static const char *const names[] = {"--iso", "--size", "--view", "--camera", "--rays",
+                                        "--time", "--cutoff", "--foldback", "--threads",
+                                        "--lod", "--pixel-error", "--cache-mb"};
+    const char *a = argv[*i];
+    if (*i + 1 >= argc)
+        return 0;
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
+        if (!strcmp(a, names[k])) {
+            if (parse_view_value(program, a, argv[*i + 1], o) != 0)
+                return 2;
+            *i += 1;
+            return 1;
+        }
     return 0;
 }
