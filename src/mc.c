@@ -5,13 +5,8 @@
 
 #include "isoprop/mc.h"
 
-unsigned ip_mc_case(const float corner_values[8], float iso)
-{
-    unsigned mc_case = 0;
-    for (unsigned i = 0; i < 8; i++)
-        mc_case |= (unsigned)(corner_values[i] >= iso) << i;
-    return mc_case;
-}
+/* The external definition of the inline one in isoprop/mc.h (C11 6.7.4). */
+extern unsigned ip_mc_case(const float corner_values[8], float iso);
 
 unsigned ip_mc_crossed_faces(unsigned mc_case)
 {

@@ -12,6 +12,8 @@ ip_status ip_sampler_init(ip_sampler *s, ip_cache *cache, uint32_t level)
     s->cache = cache;
     s->layout = ip_store_layout(ip_cache_store(cache));
     s->level = level;
+    while ((1u << s->edge_shift) < s->layout->brick_edge) /* a power of two */
+        s->edge_shift++;
     for (int a = 0; a < 3; a++) {
         s->dims[a] = s->layout->levels[level].dims[a];
         s->world[a] = malloc(s->dims[a] * sizeof(double));
@@ -48,9 +50,11 @@ void ip_sampler_free(ip_sampler *s)
 static const ip_brick *brick_at(ip_sampler *s, const uint32_t brick[3])
 {
     uint64_t g = ip_brick_global_index(s->layout, s->level, brick);
-    for (int i = 0; i < IP_SAMPLER_SLOTS; i++)
-        if (s->used[i] && s->held[i].index == g)
+    for (unsigned i = 0; i < IP_SAMPLER_SLOTS; i++)
+        if (s->used[i] && s->held[i].index == g) {
+            s->last = i;
             return &s->held[i];
+        }
     if (s->status != IP_OK)
         return NULL;
     unsigned v = s->next_victim;
@@ -65,21 +69,24 @@ static const ip_brick *brick_at(ip_sampler *s, const uint32_t brick[3])
         return NULL;
     }
     s->used[v] = 1;
+    s->last = v;
     return &s->held[v];
 }
 
 const ip_brick *ip_sampler_cell_brick(ip_sampler *s, const uint32_t cell[3])
 {
+    /* Cells come in runs within one brick (a sub-block, a propagation front): the brick of
+     * the last lookup is tested first, without the global index and the scan of the slots.
+     * A brick's cells are origin .. origin + B - 1 (the unsigned difference wraps below). */
+    const ip_brick *last = &s->held[s->last];
+    uint32_t edge = s->layout->brick_edge;
+    if (s->used[s->last] && cell[0] - last->origin[0] < edge &&
+        cell[1] - last->origin[1] < edge && cell[2] - last->origin[2] < edge)
+        return last;
     uint32_t b[3];
     for (int a = 0; a < 3; a++)
-        b[a] = cell[a] / s->layout->brick_edge;
+        b[a] = cell[a] >> s->edge_shift;
     return brick_at(s, b);
-}
-
-static float brick_sample(const ip_brick *b, ip_type type, uint32_t x, uint32_t y, uint32_t z)
-{
-    return ip_sample_get(b->samples, type,
-                         x + (size_t)b->extent[0] * (y + (size_t)b->extent[1] * z));
 }
 
 int ip_sampler_cell_values(ip_sampler *s, const uint32_t cell[3], float values[8])
@@ -87,10 +94,9 @@ int ip_sampler_cell_values(ip_sampler *s, const uint32_t cell[3], float values[8
     const ip_brick *b = ip_sampler_cell_brick(s, cell);
     if (!b)
         return 0;
-    uint32_t x = cell[0] - b->origin[0], y = cell[1] - b->origin[1], z = cell[2] - b->origin[2];
-    for (int c = 0; c < 8; c++)
-        values[c] = brick_sample(b, s->layout->type, x + (c & 1), y + ((c >> 1) & 1),
-                                 z + ((c >> 2) & 1));
+    ptrdiff_t corners[8];
+    ip_brick_corner_offsets(b, corners);
+    ip_brick_cell_values(b, s->layout->type, corners, cell, values);
     return 1;
 }
 
@@ -103,86 +109,106 @@ void ip_sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float orig
     }
 }
 
-/* Sample (x, y, z) of the level, clamped to the volume; any brick holding it will do. */
-static float sample_at(ip_sampler *s, int64_t x, int64_t y, int64_t z, int *ok)
+/* Sample p of the level, clamped to the volume; any brick holding it will do (neighbouring
+ * bricks share their face layers): `near`, a pinned brick, when it holds it, else the one
+ * whose cells it starts. Returns 0 after a failure. */
+static int sample_at(ip_sampler *s, const ip_brick *near, const int64_t p[3], float *out)
 {
-    int64_t p[3] = {x, y, z};
     uint32_t q[3], brick[3];
+    int held = 1;
     for (int a = 0; a < 3; a++) {
         q[a] = (uint32_t)(p[a] < 0 ? 0 : p[a] >= s->dims[a] ? s->dims[a] - 1 : p[a]);
+        held &= q[a] - near->origin[a] < near->extent[a];
         uint32_t cells = s->dims[a] - 1;
-        brick[a] = (q[a] < cells ? q[a] : cells - 1) / s->layout->brick_edge;
+        brick[a] = (q[a] < cells ? q[a] : cells - 1) >> s->edge_shift;
     }
-    const ip_brick *b = brick_at(s, brick);
-    if (!b) {
-        *ok = 0;
-        return 0.0f;
-    }
-    return brick_sample(b, s->layout->type, q[0] - b->origin[0], q[1] - b->origin[1],
-                        q[2] - b->origin[2]);
-}
-
-/* The 4x4x4 samples around a cell (cell - 1 .. cell + 2, clamped), x fastest. The fast path
- * reads them from the cell's own brick when they all lie in it. */
-static int neighbourhood(ip_sampler *s, const uint32_t cell[3], float v[64])
-{
-    const ip_brick *b = ip_sampler_cell_brick(s, cell);
+    const ip_brick *b = held ? near : brick_at(s, brick);
     if (!b)
         return 0;
-    int inside = 1;
-    for (int a = 0; a < 3; a++)
-        inside &= cell[a] >= b->origin[a] + 1 && cell[a] + 2 < b->origin[a] + b->extent[a];
-    if (inside) {
-        uint32_t x0 = cell[0] - 1 - b->origin[0], y0 = cell[1] - 1 - b->origin[1],
-                 z0 = cell[2] - 1 - b->origin[2];
-        for (uint32_t k = 0, i = 0; k < 4; k++)
-            for (uint32_t j = 0; j < 4; j++)
-                for (uint32_t h = 0; h < 4; h++, i++)
-                    v[i] = brick_sample(b, s->layout->type, x0 + h, y0 + j, z0 + k);
-        return 1;
-    }
-    int ok = 1;
-    for (int k = 0, i = 0; k < 4; k++)
-        for (int j = 0; j < 4; j++)
-            for (int h = 0; h < 4; h++, i++)
-                v[i] = sample_at(s, (int64_t)cell[0] - 1 + h, (int64_t)cell[1] - 1 + j,
-                                 (int64_t)cell[2] - 1 + k, &ok);
-    return ok;
+    *out = ip_sample_get(b->samples, s->layout->type, ip_brick_sample_index(b, q));
+    return 1;
 }
 
-/* World distance between the samples either side of sample i (clamped) along axis a, and
- * which neighbours those are, for a central (or one-sided) difference. */
-static double span(const ip_sampler *s, int a, int64_t i, int *lo, int *hi)
+/* The sample next to corner c of `cell` outwards along axis a (one below the cell where the
+ * corner is on its low side, one above where it is on its high side), clamped to the volume:
+ * with the corner across the cell it gives the central difference of the corner's gradient.
+ * Gathered as out[3 * c + a]: from the cell's brick when it holds all 24 (one typed read),
+ * else sample by sample from whichever brick holds each. Returns 0 after a failure. */
+static int gradient_neighbours(ip_sampler *s, const uint32_t cell[3], const ip_brick *b,
+                               float out[24])
+{
+    ptrdiff_t stride[3] = {1, (ptrdiff_t)b->extent[0],
+                           (ptrdiff_t)b->extent[0] * (ptrdiff_t)b->extent[1]};
+    ptrdiff_t below[3], above[3];
+    int inside = 1;
+    for (int a = 0; a < 3; a++) {
+        /* clamped at the volume's faces: the corner itself, which the brick holds */
+        int low = cell[a] > 0, high = cell[a] + 2 < s->dims[a];
+        below[a] = low ? -stride[a] : 0;
+        above[a] = high ? stride[a] : 0;
+        inside &= (!low || cell[a] > b->origin[a]) &&
+                  (!high || cell[a] + 2 < b->origin[a] + b->extent[a]);
+    }
+    if (inside) {
+        ptrdiff_t corners[8], offsets[24];
+        ip_brick_corner_offsets(b, corners);
+        for (int c = 0; c < 8; c++)
+            for (int a = 0; a < 3; a++)
+                offsets[3 * c + a] = corners[c] + ((c >> a) & 1 ? above[a] : below[a]);
+        ip_samples_gather(b->samples, s->layout->type, ip_brick_sample_index(b, cell), offsets,
+                          24, out);
+        return 1;
+    }
+    /* A brick read here may take the slot of `b`: the slot then describes the new brick,
+     * which sample_at() checks like any other, so `b` stays safe to pass until a failure. */
+    for (int c = 0; c < 8; c++)
+        for (int a = 0; a < 3; a++) {
+            int64_t p[3] = {(int64_t)cell[0] + (c & 1), (int64_t)cell[1] + ((c >> 1) & 1),
+                            (int64_t)cell[2] + ((c >> 2) & 1)};
+            p[a] += (c >> a) & 1 ? 1 : -1;
+            if (!sample_at(s, b, p, &out[3 * c + a]))
+                return 0;
+        }
+    return 1;
+}
+
+/* World distance between the samples either side of sample i (clamped) along axis a, for a
+ * central (or, at the volume's faces, one-sided) difference. */
+static double span(const ip_sampler *s, int a, int64_t i)
 {
     int64_t last = s->dims[a] - 1;
     int64_t l = i > 0 ? i - 1 : 0, h = i < last ? i + 1 : last;
-    *lo = (int)(l - i);
-    *hi = (int)(h - i);
     return s->world[a][h] - s->world[a][l];
 }
 
 int ip_sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
                            unsigned *mc_case)
 {
-    float v[64], values[8], gradients[8][3], origin[3], size[3];
-    if (!neighbourhood(s, cell, v))
+    float values[8], outer[24], gradients[8][3], origin[3], size[3];
+    /* The case first, from the 8 corners alone: most cells of an active sub-block are not
+     * active, and need neither the gradient neighbours nor the divisions. */
+    const ip_brick *b = ip_sampler_cell_brick(s, cell);
+    if (!b)
         return -1;
-    for (int c = 0; c < 8; c++) {
-        int cx = 1 + (c & 1), cy = 1 + ((c >> 1) & 1), cz = 1 + ((c >> 2) & 1);
-        int at[3] = {cx, cy, cz};
-        values[c] = v[cx + 4 * (cy + 4 * cz)];
-        for (int a = 0; a < 3; a++) {
-            int lo, hi;
-            double d = span(s, a, (int64_t)cell[a] + at[a] - 1, &lo, &hi);
-            int step = a == 0 ? 1 : a == 1 ? 4 : 16;
-            float vh = v[cx + 4 * (cy + 4 * cz) + hi * step];
-            float vl = v[cx + 4 * (cy + 4 * cz) + lo * step];
-            gradients[c][a] = d > 0 ? (float)((vh - vl) / d) : 0.0f;
-        }
-    }
+    ptrdiff_t corners[8];
+    ip_brick_corner_offsets(b, corners);
+    ip_brick_cell_values(b, s->layout->type, corners, cell, values);
     *mc_case = ip_mc_case(values, iso);
     if (*mc_case == 0 || *mc_case == 255)
         return 0;
+    if (!gradient_neighbours(s, cell, b, outer))
+        return -1;
+    double d[2][3]; /* per axis, the span around the cell's low and high corners */
+    for (int a = 0; a < 3; a++)
+        for (int h = 0; h < 2; h++)
+            d[h][a] = span(s, a, (int64_t)cell[a] + h);
+    for (int c = 0; c < 8; c++)
+        for (int a = 0; a < 3; a++) {
+            int h = (c >> a) & 1;
+            float across = values[c ^ (1 << a)];
+            float vh = h ? outer[3 * c + a] : across, vl = h ? across : outer[3 * c + a];
+            gradients[c][a] = d[h][a] > 0 ? (float)((vh - vl) / d[h][a]) : 0.0f;
+        }
     ip_sampler_cell_box(s, cell, origin, size);
     return ip_mc_triangulate_cell(values, (const float(*)[3])gradients, iso, origin, size, out);
 }

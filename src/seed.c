@@ -8,6 +8,8 @@
  * parameter t stays the world distance along the ray. */
 typedef struct index_ray {
     double origin[3], dir[3];
+    double inv_dir[3];  /* 1 / dir (0 where dir is 0, unused there): clip() runs per node */
+    double len;         /* the largest |dir| component, for dda_init()'s nudge */
     const double *world_origin, *world_dir;
 } index_ray;
 
@@ -22,7 +24,7 @@ static int clip(const index_ray *r, const double lo[3], const double hi[3], doub
                 return 0;
             continue;
         }
-        double inv = 1.0 / r->dir[k];
+        double inv = r->inv_dir[k];
         double ta = (lo[k] - r->origin[k]) * inv, tb = (hi[k] - r->origin[k]) * inv;
         if (ta > tb) {
             double t = ta;
@@ -47,8 +49,7 @@ static void dda_init(dda *d, const index_ray *r, const double base[3], double ed
                      const uint32_t n[3], double t0, double t1)
 {
     double mid = t0; /* the entry point: nudge inwards along the ray */
-    double len = fmax(fabs(r->dir[0]), fmax(fabs(r->dir[1]), fabs(r->dir[2])));
-    mid += 1e-9 * edge / (len > 0 ? len : 1);
+    mid += 1e-9 * edge / (r->len > 0 ? r->len : 1);
     if (mid > t1)
         mid = 0.5 * (t0 + t1);
     for (int k = 0; k < 3; k++) {
@@ -159,13 +160,19 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
 {
     double base[3] = {lo[0], lo[1], lo[2]};
     uint32_t n[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    /* A sub-block lies in one brick: look it up once, not per cell. Nothing below reads
+     * through the sampler, so the brick stays pinned in its slot. */
+    const ip_brick *brick = ip_sampler_cell_brick(s->sampler, lo);
+    if (!brick)
+        return -1;
+    ptrdiff_t corners[8];
+    ip_brick_corner_offsets(brick, corners);
     dda d;
     dda_init(&d, r, base, 1.0, n, t0, t1);
     for (;;) {
         uint32_t c[3] = {lo[0] + (uint32_t)d.i[0], lo[1] + (uint32_t)d.i[1], lo[2] + (uint32_t)d.i[2]};
         float values[8];
-        if (!ip_sampler_cell_values(s->sampler, c, values))
-            return -1;
+        ip_brick_cell_values(brick, s->layout->type, corners, c, values);
         unsigned mc = ip_mc_case(values, s->iso);
         if (mc != 0 && mc != 255) {
             float origin[3], size[3];
@@ -194,7 +201,8 @@ static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], dou
     const ip_layout *l = s->layout;
     uint32_t origin[3], extent[3];
     ip_brick_extent(l, s->level, b, origin, extent);
-    uint64_t g = ip_brick_global_index(l, s->level, b);
+    const uint32_t *bricks = s->grid[0];
+    uint64_t g = s->first_brick + b[0] + (uint64_t)bricks[0] * (b[1] + (uint64_t)bricks[1] * b[2]);
     const float *ranges = ip_store_subblock_ranges(s->store, g);
     uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
     uint32_t n[3];
@@ -249,14 +257,15 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
         return walk_brick(s, r, node, t0, t1);
     child_hit hits[8];
     int count = 0;
-    uint32_t grid[3];
-    ip_octree_grid(s->layout, s->level, depth - 1, grid);
+    const uint32_t *grid = s->grid[depth - 1];
+    const float *ranges = s->ranges[depth - 1];
     for (int c = 0; c < 8; c++) {
         uint32_t ch[3] = {2 * node[0] + (c & 1), 2 * node[1] + ((c >> 1) & 1),
                           2 * node[2] + ((c >> 2) & 1)};
         if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
             continue;
-        if (!active(ip_store_node_range(s->store, s->level, depth - 1, ch), s->iso))
+        uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
+        if (!active(&ranges[2 * i], s->iso))
             continue;
         double lo[3], hi[3], a = t0, b = t1;
         node_box(s, depth - 1, ch, lo, hi);
@@ -288,6 +297,17 @@ void ip_seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_a
     s->margin = IP_SEED_MARGIN_PIXELS * pixel_angle;
     for (int k = 0; k < 3; k++)
         s->scale[k] = s->layout->spacing[k] * (double)(1u << s->level);
+    /* The node grid and the first node's range of every depth, so that a child's range is
+     * one multiply-add away: each depth's nodes (depth 0: the level's bricks) are stored
+     * contiguously, x fastest (docs/format.md), and ip_store_node_range() would otherwise
+     * sum the grids of the shallower depths on every lookup. */
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    static const uint32_t origin[3] = {0, 0, 0};
+    for (uint32_t depth = 0; depth <= lv->octree_depth && depth <= IP_SEED_MAX_DEPTH; depth++) {
+        ip_octree_grid(s->layout, s->level, depth, s->grid[depth]);
+        s->ranges[depth] = ip_store_node_range(s->store, s->level, depth, origin);
+    }
+    s->first_brick = lv->first_brick;
 }
 
 int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
@@ -301,13 +321,15 @@ int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], double 
     const ip_level_layout *lv = &s->layout->levels[s->level];
     uint32_t root[3] = {0, 0, 0};
     uint32_t depth = lv->octree_depth;
-    if (!active(ip_store_node_range(s->store, s->level, depth, root), s->iso))
+    if (!active(s->ranges[depth], s->iso))
         return 0;
     index_ray r;
     for (int k = 0; k < 3; k++) {
         r.origin[k] = eye[k] / s->scale[k];
         r.dir[k] = dir[k] / s->scale[k];
+        r.inv_dir[k] = r.dir[k] != 0.0 ? 1.0 / r.dir[k] : 0.0;
     }
+    r.len = fmax(fabs(r.dir[0]), fmax(fabs(r.dir[1]), fabs(r.dir[2])));
     r.world_origin = eye;
     r.world_dir = dir;
     double lo[3], hi[3], t0 = t_min, t1 = t_max;

@@ -5,6 +5,10 @@
 #include "isoprop/store.h"
 #include "sampler.h"
 
+/* Octree depths above the bricks: at most 30, as a level has fewer than 2^31 / 2 bricks along
+ * an axis (ip_layout_init() bounds the dimensions and the brick edge). */
+#define IP_SEED_MAX_DEPTH 31
+
 typedef struct ip_seeder {
     ip_sampler *sampler;
     const ip_store *store;
@@ -17,6 +21,11 @@ typedef struct ip_seeder {
     unsigned found_count;
     int seed_index;        /* position in found of the first cell the ray is inside, or -1 */
     double margin;         /* IP_SEED_MARGIN_PIXELS as an angle, radians */
+    /* Per octree depth of the level (0: the bricks): the node grid and the range of its
+     * node (0, 0, 0), the others following x fastest. */
+    uint32_t grid[IP_SEED_MAX_DEPTH + 1][3];
+    const float *ranges[IP_SEED_MAX_DEPTH + 1];
+    uint64_t first_brick;  /* global index of the level's brick (0, 0, 0) */
 } ip_seeder;
 
 /* A ray whose pixel centre lies within this distance of a triangle's projected edge extracts

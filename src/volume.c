@@ -55,16 +55,9 @@ ip_status ip_type_parse(const char *name, ip_type *out)
     return IP_ERR_ARGUMENT;
 }
 
-float ip_sample_get(const void *samples, ip_type type, size_t index)
-{
-    switch (type) {
-    case IP_UINT8: return (float)((const uint8_t *)samples)[index];
-    case IP_UINT16: return (float)((const uint16_t *)samples)[index];
-    case IP_INT16: return (float)((const int16_t *)samples)[index];
-    case IP_FLOAT32: return ((const float *)samples)[index];
-    }
-    return 0.0f;
-}
+/* The external definition of the inline one in isoprop/volume.h (C11 6.7.4), for callers
+ * that take its address or do not inline it. */
+extern float ip_sample_get(const void *samples, ip_type type, size_t index);
 
 ip_status ip_dims_parse(const char *text, uint32_t dims[3])
 {

@@ -74,8 +74,15 @@ typedef struct ip_mc_vertex {
 } ip_mc_vertex;
 
 /*! ip_mc_case() : the case index (0..255) of a cell: bit i is set when corner_values[i] >= iso.
- *  A NaN value is never >= iso, so it counts as outside. */
-unsigned ip_mc_case(const float corner_values[8], float iso);
+ *  A NaN value is never >= iso, so it counts as outside. An inline definition: seeding and the
+ *  full extraction classify every cell they visit with it; src/mc.c holds the external one. */
+inline unsigned ip_mc_case(const float corner_values[8], float iso)
+{
+    unsigned mc_case = 0;
+    for (unsigned i = 0; i < 8; i++)
+        mc_case |= (unsigned)(corner_values[i] >= iso) << i;
+    return mc_case;
+}
 
 /*! ip_mc_crossed_faces() : a 6-bit mask of the faces of a cell of case `mc_case` that the surface
  *  crosses (bit f set when face f has a crossed edge): the neighbours across those faces are

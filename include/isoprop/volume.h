@@ -41,9 +41,21 @@ const char *ip_type_name(ip_type type);
  *  @return IP_OK and *out set, or IP_ERR_ARGUMENT for an unknown name (*out untouched). */
 ip_status ip_type_parse(const char *name, ip_type *out);
 
-/*! ip_sample_get() : sample `index` of a native-endian array of `type`, as a float.
- *  Exact for every supported type (uint8/uint16/int16 fit a float's 24-bit mantissa). */
-float ip_sample_get(const void *samples, ip_type type, size_t index);
+/*! ip_sample_get() : sample `index` of a native-endian array of `type`, as a float; 0 for an
+ *  unknown type. Exact for every supported type (uint8/uint16/int16 fit a float's 24-bit
+ *  mantissa). An inline definition, so that callers that read sample by sample pay no call;
+ *  src/volume.c holds the external one. (Loops over many samples of one type do better
+ *  still to switch on the type once, outside the loop.) */
+inline float ip_sample_get(const void *samples, ip_type type, size_t index)
+{
+    switch (type) {
+    case IP_UINT8: return (float)((const uint8_t *)samples)[index];
+    case IP_UINT16: return (float)((const uint16_t *)samples)[index];
+    case IP_INT16: return (float)((const int16_t *)samples)[index];
+    case IP_FLOAT32: return ((const float *)samples)[index];
+    }
+    return 0.0f;
+}
 
 /*! ip_dims_parse() : parses "XxYxZ" (e.g. "512x512x234") into dims; each must be in [1, 2^31).
  *  @return IP_OK, or IP_ERR_ARGUMENT when the text is not three positive integers. */
