@@ -164,10 +164,13 @@ static void fill_brick(const entry *e, ip_brick *b)
     b->index = atomic_load_explicit(&e->brick, memory_order_relaxed);
 }
 
+/* Bits of a brick's `touched` byte: pinned at least once; its payload asked for in advance. */
+enum { TOUCHED = 1, PREFETCHED = 2 };
+
 static void note_touch(ip_cache *c, uint64_t g, uint32_t level)
 {
-    if (!atomic_load_explicit(&c->touched[g], memory_order_relaxed) &&
-        !atomic_exchange(&c->touched[g], 1)) {
+    if (!(atomic_load_explicit(&c->touched[g], memory_order_relaxed) & TOUCHED) &&
+        !(atomic_fetch_or(&c->touched[g], TOUCHED) & TOUCHED)) {
         atomic_fetch_add(&c->touched_count, 1);
         atomic_fetch_add(&c->level_touched[level], 1);
     }
@@ -413,6 +416,36 @@ static void release_payload_pages(const ip_cache *c, uint64_t g)
         madvise((void *)start, end - start, MADV_DONTNEED);
 }
 
+/* Asks the kernel to read, in the background, the payloads of the face neighbours of brick g
+ * (level `level`, coordinates b) that were never pinned nor asked for: propagation crosses
+ * brick faces, so on a cold page cache they are the next reads, and their I/O then overlaps
+ * the decoding and extraction of this one instead of stalling a worker on a page fault. Costs
+ * a system call per neighbour, once per brick; no thread of ours waits for the reads. */
+static void prefetch_neighbours(ip_cache *c, uint32_t level, const uint32_t b[3])
+{
+    const unsigned char *base = ip_store_mapping(c->store);
+    const uint32_t *grid = c->layout->levels[level].bricks;
+    uintptr_t page = (uintptr_t)c->page_size;
+    for (int f = 0; f < 6 && base; f++) {
+        uint32_t n[3] = {b[0], b[1], b[2]};
+        int axis = f / 2;
+        if (f % 2 == 0 ? n[axis] == 0 : n[axis] + 1 >= grid[axis])
+            continue;
+        n[axis] += f % 2 == 0 ? (uint32_t)-1 : 1u;
+        uint64_t g = ip_brick_global_index(c->layout, level, n);
+        if (atomic_load_explicit(&c->touched[g], memory_order_relaxed) ||
+            atomic_fetch_or(&c->touched[g], PREFETCHED))
+            continue;
+        ip_brick_entry be;
+        ip_store_brick_entry(c->store, g, &be);
+        if (be.stored_size == 0)
+            continue; /* constant: nothing to read */
+        uintptr_t start = (uintptr_t)(base + be.offset) & ~(page - 1);
+        uintptr_t end = (uintptr_t)(base + be.offset + be.stored_size);
+        madvise((void *)start, end - start, MADV_WILLNEED);
+    }
+}
+
 /* Decode scratch comes from a small pool: one buffer per thread decoding at once. */
 static void *take_work(ip_cache *c)
 {
@@ -478,6 +511,7 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
     e->level = level;
     memcpy(e->extent, extent, sizeof extent);
     memcpy(e->origin, origin, sizeof origin);
+    prefetch_neighbours(c, level, brick);
     ip_status st = decode_into(c, g, e, err);
     pthread_mutex_lock(&c->evict_lock);
     atomic_store(&e->tick, atomic_fetch_add(&c->clock, 1) + 1);
