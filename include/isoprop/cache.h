@@ -14,6 +14,10 @@
  * Memory: resident bytes are the decoded bricks; the compressed pages of the mapping that a
  * decode touched are released right after it (madvise), so the process holds the budget, the
  * summaries and a fixed overhead, whatever the file's size.
+ *
+ * Read-ahead: a miss also asks the kernel to read the compressed payloads of the brick's six
+ * face neighbours in the background (once per brick), the bricks propagation crosses into
+ * next, so that a cold start does not stall on page faults.
  */
 #ifndef ISOPROP_CACHE_H
 #define ISOPROP_CACHE_H
