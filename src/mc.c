@@ -120,6 +120,19 @@ int ip_mc_triangulate_cell(const float values[8], const float gradients[8][3], f
     return count;
 }
 
+unsigned ip_mc_cell_edge_points(const float values[8], float iso, const float origin[3],
+                                const float size[3], float points[12][3])
+{
+    unsigned crossed = ip_mc_edge_table[ip_mc_case(values, iso)];
+    for (unsigned e = 0; e < 12; e++)
+        if (crossed >> e & 1u) {
+            float t = edge_fraction(values[ip_mc_edge_corners[e][0]],
+                                    values[ip_mc_edge_corners[e][1]], iso);
+            edge_position(e, t, origin, size, points[e]);
+        }
+    return crossed;
+}
+
 /* Moller-Trumbore, accepting both sides and the triangle's edges; 1 and *t on a hit at t >= 0.
  * Double precision keeps thin triangles (vertices near a corner) from losing hits. */
 static int ray_hits_triangle(const double o[3], const double d[3], const double a[3],

@@ -11,7 +11,26 @@ typedef struct index_ray {
     double inv_dir[3];  /* 1 / dir (0 where dir is 0, unused there): clip() runs per node */
     double len;         /* the largest |dir| component, for dda_init()'s nudge */
     const double *world_origin, *world_dir;
+    double u[3], w[3];  /* a unit basis across world_dir, for classify_cell() */
 } index_ray;
+
+/* A unit basis (u, w) across the unit direction d. */
+static void across_basis(const double d[3], double u[3], double w[3])
+{
+    int k = fabs(d[0]) < fabs(d[1]) ? (fabs(d[0]) < fabs(d[2]) ? 0 : 2)
+                                    : (fabs(d[1]) < fabs(d[2]) ? 1 : 2);
+    double axis[3] = {0, 0, 0};
+    axis[k] = 1;
+    u[0] = d[1] * axis[2] - d[2] * axis[1];
+    u[1] = d[2] * axis[0] - d[0] * axis[2];
+    u[2] = d[0] * axis[1] - d[1] * axis[0];
+    double un = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int i = 0; i < 3; i++)
+        u[i] /= un;
+    w[0] = d[1] * u[2] - d[2] * u[1];
+    w[1] = d[2] * u[0] - d[0] * u[2];
+    w[2] = d[0] * u[1] - d[1] * u[0];
+}
 
 /* Clips the ray to the index box [lo, hi]; returns 0 when it misses it or only behind t0. */
 static int clip(const index_ray *r, const double lo[3], const double hi[3], double *t0,
@@ -99,47 +118,39 @@ static int active(const float *range, float iso)
  * centre: each triangle is projected centrally around the ray (point-in-triangle is the same
  * for every central projection through the ray) and the ray's distance to its edges is
  * measured as an angle. 3: inside a triangle by at least the margin; 2: inside one, within
- * the margin of its edge; 1: outside every triangle, within the margin of one; 0: none. `ro` and `rd` are the ray in the cell's frame (corner 0 at the origin). */
-static int classify_cell(const ip_seeder *s, const float values[8], const float size[3],
-                         const double ro[3], const double rd[3])
+ * the margin of its edge; 1: outside every triangle, within the margin of one; 0: none.
+ * `mc` is the cell's case; `ro` the ray's origin in the cell's frame (corner 0 at the origin),
+ * its direction and the basis across it are r's. */
+static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc,
+                         const float values[8], const float size[3], const double ro[3])
 {
     static const float zero[3] = {0, 0, 0};
-    ip_mc_vertex v[IP_MC_MAX_VERTICES];
-    int n = ip_mc_triangulate_cell(values, NULL, s->iso, zero, size, v);
-    /* a basis (u, w) across the ray */
-    double u[3], w[3];
-    int k = fabs(rd[0]) < fabs(rd[1]) ? (fabs(rd[0]) < fabs(rd[2]) ? 0 : 2)
-                                      : (fabs(rd[1]) < fabs(rd[2]) ? 1 : 2);
-    double axis[3] = {0, 0, 0};
-    axis[k] = 1;
-    u[0] = rd[1] * axis[2] - rd[2] * axis[1];
-    u[1] = rd[2] * axis[0] - rd[0] * axis[2];
-    u[2] = rd[0] * axis[1] - rd[1] * axis[0];
-    double un = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-    for (int i = 0; i < 3; i++)
-        u[i] /= un;
-    w[0] = rd[1] * u[2] - rd[2] * u[1];
-    w[1] = rd[2] * u[0] - rd[0] * u[2];
-    w[2] = rd[0] * u[1] - rd[1] * u[0];
-    int best = 0;
-    for (int t = 0; t < n && best < 3; t++) {
-        double p[3][2];
-        int behind = 0;
-        for (int j = 0; j < 3; j++) {
-            double d[3] = {v[3 * t + j].position[0] - ro[0], v[3 * t + j].position[1] - ro[1],
-                           v[3 * t + j].position[2] - ro[2]};
-            double depth = d[0] * rd[0] + d[1] * rd[1] + d[2] * rd[2];
-            behind |= !(depth > 0);
-            p[j][0] = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / depth;
-            p[j][1] = (d[0] * w[0] + d[1] * w[1] + d[2] * w[2]) / depth;
-        }
-        if (behind)
+    float points[12][3];
+    unsigned crossed = ip_mc_cell_edge_points(values, s->iso, zero, size, points);
+    /* each crossing point projected once, though up to 4 triangles share it */
+    double p[12][2];
+    unsigned behind = 0;
+    const double *rd = r->world_dir, *u = r->u, *w = r->w;
+    for (unsigned e = 0; e < 12; e++) {
+        if (!(crossed >> e & 1u))
             continue;
-        double area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) -
-                      (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+        double d[3] = {points[e][0] - ro[0], points[e][1] - ro[1], points[e][2] - ro[2]};
+        double depth = d[0] * rd[0] + d[1] * rd[1] + d[2] * rd[2];
+        behind |= (unsigned)!(depth > 0) << e;
+        p[e][0] = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / depth;
+        p[e][1] = (d[0] * w[0] + d[1] * w[1] + d[2] * w[2]) / depth;
+    }
+    const int8_t *row = ip_mc_triangle_table[mc];
+    int n = ip_mc_triangle_count[mc], best = 0;
+    for (int t = 0; t < n && best < 3; t++) {
+        const int8_t *tri = row + 3 * t;
+        if (behind >> tri[0] & 1u || behind >> tri[1] & 1u || behind >> tri[2] & 1u)
+            continue;
+        const double *p0 = p[tri[0]], *p1 = p[tri[1]], *p2 = p[tri[2]];
+        double area = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]);
         double least = INFINITY;
         for (int j = 0; j < 3; j++) {
-            const double *a = p[j], *b = p[(j + 1) % 3];
+            const double *a = p[tri[j]], *b = p[tri[(j + 1) % 3]];
             double ex = b[0] - a[0], ey = b[1] - a[1], len = sqrt(ex * ex + ey * ey);
             /* signed distance of the ray (the origin) to the edge, positive inside */
             double dist = len > 0 ? (ex * (0 - a[1]) - ey * (0 - a[0])) / len : 0;
@@ -181,7 +192,7 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
             for (int k = 0; k < 3; k++) /* the cell's frame keeps precision in large volumes */
                 ro[k] = r->world_origin[k] - (double)origin[k];
             s->cells_tested++;
-            int kind = classify_cell(s, values, size, ro, r->world_dir);
+            int kind = classify_cell(s, r, mc, values, size, ro);
             if (kind >= 2 && s->seed_index < 0)
                 s->seed_index = (int)s->found_count; /* the first cell the ray is inside */
             if (kind && s->found_count < IP_SEED_MAX_CELLS)
@@ -332,6 +343,7 @@ int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], double 
     r.len = fmax(fabs(r.dir[0]), fmax(fabs(r.dir[1]), fabs(r.dir[2])));
     r.world_origin = eye;
     r.world_dir = dir;
+    across_basis(dir, r.u, r.w);
     double lo[3], hi[3], t0 = t_min, t1 = t_max;
     node_box(s, depth, root, lo, hi);
     if (!clip(&r, lo, hi, &t0, &t1))

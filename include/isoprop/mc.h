@@ -109,6 +109,14 @@ unsigned ip_mc_crossed_faces(unsigned mc_case);
 int ip_mc_triangulate_cell(const float values[8], const float gradients[8][3], float iso,
                            const float origin[3], const float size[3], ip_mc_vertex *out);
 
+/*! ip_mc_cell_edge_points() : the points where the surface crosses the cell's edges, exactly
+ *  where ip_mc_triangulate_cell() (same values, iso, origin, size) puts its vertices, without
+ *  the normals: points[e] is set for every edge e whose bit is set in the returned mask
+ *  (ip_mc_edge_table of the cell's case); the others are left alone. A cell's triangles are
+ *  then the rows of ip_mc_triangle_table. No allocation. */
+unsigned ip_mc_cell_edge_points(const float values[8], float iso, const float origin[3],
+                                const float size[3], float points[12][3]);
+
 /*! ip_mc_ray_hits_cell() : whether the ray ray_origin + t * ray_dir, t >= 0, hits a triangle of
  *  the cell's triangulation (either side), as produced by ip_mc_triangulate_cell with the same
  *  values, iso, origin and size. A ray can cross an active cell without touching its triangles;
