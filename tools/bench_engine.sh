@@ -624,7 +624,7 @@ phases() {
             d["classify_cell"] = "seeding: ray against the cell triangles"
             d["ip_propagate"] = "propagation (with extraction)"
             d["ip_extract_cell"] = "marching cubes of one cell, mesh append"
-            d["ip_sampler_triangulate"] = "64 samples, 24 gradients, MC"
+            d["ip_sampler_triangulate"] = "corners, case; 24 neighbours and gradients when active; MC"
             d["ip_now_seconds"] = "clock_gettime for the phase times"
             d["ip_cache_pin_brick"] = "brick cache (decode on a miss)"
             d["render_image"] = "isorender: final OpenGL image"
