@@ -1,0 +1,147 @@
+/* Meshes: packed normals, cell ids on request, appends, and the PLY writer. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "isoprop/mesh.h"
+
+static void test_normal_packing(void)
+{
+    CHECK(ip_normal_pack(1.0f) == 32767 && ip_normal_pack(-1.0f) == -32767);
+    CHECK(ip_normal_pack(0.0f) == 0 && ip_normal_pack(-0.0f) == 0);
+    CHECK(ip_normal_pack(2.0f) == 32767 && ip_normal_pack(-5.0f) == -32767); /* clamped */
+    CHECK(ip_normal_pack(NAN) == 0);
+    CHECK(ip_normal_pack(INFINITY) == 32767 && ip_normal_pack(-INFINITY) == -32767);
+    float worst = 0;
+    for (int i = -1000; i <= 1000; i++) {
+        float v = (float)i / 1000.0f;
+        float back = ip_normal_unpack(ip_normal_pack(v));
+        worst = fabsf(back - v) > worst ? fabsf(back - v) : worst;
+    }
+    /* rounding to nearest: at most half a step of 1/32767 */
+    CHECK_MSG(worst <= 0.5f / 32767.0f + 1e-7f, "round trip error %g", (double)worst);
+}
+
+/* n triangles: triangle t has positions t + k/10 and normals (1, 0, 0) or (0, -1, 0). */
+static void fill(float *p, float *n, uint64_t *cells, uint64_t count, uint64_t first)
+{
+    for (uint64_t t = 0; t < count; t++) {
+        for (int i = 0; i < 9; i++) {
+            p[9 * t + i] = (float)(first + t) + (float)i / 10.0f;
+            n[9 * t + i] = 0;
+        }
+        for (int k = 0; k < 3; k++)
+            n[9 * t + 3 * k + ((first + t) % 2 ? 1 : 0)] = (first + t) % 2 ? -1.0f : 1.0f;
+        cells[t] = 1000 + first + t;
+    }
+}
+
+static void test_appends(void)
+{
+    enum { N = 700 }; /* more than the 256 triangles ip_mesh_append_float_normals packs at once */
+    float *p = malloc(N * 9 * sizeof *p), *n = malloc(N * 9 * sizeof *n);
+    uint64_t *cells = malloc(N * sizeof *cells);
+    REQUIRE(p && n && cells);
+    fill(p, n, cells, N, 0);
+
+    ip_mesh plain, with;
+    ip_mesh_init(&plain);
+    ip_mesh_init_with_cells(&with);
+    CHECK(!plain.with_cells && with.with_cells);
+    CHECK(ip_mesh_append_float_normals(&plain, p, n, NULL, N) == IP_OK);
+    CHECK(ip_mesh_append_float_normals(&with, p, n, cells, N) == IP_OK);
+    CHECK(plain.triangle_count == N && with.triangle_count == N);
+    CHECK(plain.cells == NULL && with.cells != NULL);
+    int same = 1;
+    for (uint64_t t = 0; t < N; t++) {
+        same &= with.cells[t] == 1000 + t;
+        for (int i = 0; i < 9; i++)
+            same &= plain.positions[9 * t + i] == p[9 * t + i] &&
+                    plain.normals[9 * t + i] == ip_normal_pack(n[9 * t + i]) &&
+                    with.normals[9 * t + i] == plain.normals[9 * t + i];
+    }
+    CHECK(same);
+    CHECK(plain.capacity >= N && plain.capacity <= 2 * N + 1024);
+
+    /* a range of one mesh onto another, with and without cell ids */
+    ip_mesh part;
+    ip_mesh_init_with_cells(&part);
+    CHECK(ip_mesh_append_mesh(&part, &with, 100, 50) == IP_OK);
+    CHECK(part.triangle_count == 50 && part.cells[0] == 1100 && part.cells[49] == 1149);
+    CHECK(part.positions[0] == p[900] && part.normals[9 * 49 + 4] == with.normals[9 * 149 + 4]);
+    CHECK(ip_mesh_append_mesh(&part, &plain, 0, 10) == IP_ERR_ARGUMENT); /* no ids to copy */
+    CHECK(ip_mesh_append_mesh(&part, &with, N - 5, 6) == IP_ERR_ARGUMENT); /* past the end */
+    CHECK(ip_mesh_append_mesh(&part, &with, N + 1, 0) == IP_ERR_ARGUMENT);
+    CHECK(ip_mesh_append_mesh(&part, &with, N, 0) == IP_OK);
+    CHECK(part.triangle_count == 50);
+    CHECK(ip_mesh_append_mesh(&plain, &with, 0, 3) == IP_OK); /* ids dropped */
+    CHECK(plain.triangle_count == N + 3 && plain.cells == NULL);
+
+    /* clear keeps the memory; free keeps the choice of cell ids */
+    ip_mesh_clear(&with);
+    CHECK(with.triangle_count == 0 && with.capacity >= N);
+    ip_mesh_free(&with);
+    CHECK(with.positions == NULL && with.capacity == 0 && with.with_cells);
+    CHECK(ip_mesh_append_float_normals(&with, p, n, cells, 1) == IP_OK && with.cells[0] == 1000);
+    ip_mesh_free(&with);
+    ip_mesh_free(&plain);
+    ip_mesh_free(&part);
+    free(p);
+    free(n);
+    free(cells);
+}
+
+static float get_f32(const unsigned char *b)
+{
+    uint32_t u = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+    float f;
+    memcpy(&f, &u, 4);
+    return f;
+}
+
+static void test_ply(void)
+{
+    const char *dir = test_tmp_dir("test_mesh");
+    char path[4200];
+    snprintf(path, sizeof path, "%s/two.ply", dir);
+    remove(path);
+    float p[18], n[18];
+    uint64_t cells[2];
+    fill(p, n, cells, 2, 0);
+    ip_mesh m;
+    ip_mesh_init(&m);
+    REQUIRE(ip_mesh_append_float_normals(&m, p, n, NULL, 2) == IP_OK);
+    ip_error err;
+    REQUIRE(ip_mesh_write_ply(&m, path, 0, &err) == IP_OK);
+    CHECK(ip_mesh_write_ply(&m, path, 0, &err) == IP_ERR_EXISTS);
+    CHECK(ip_mesh_write_ply(&m, path, 1, &err) == IP_OK);
+
+    FILE *f = fopen(path, "rb");
+    REQUIRE(f);
+    static unsigned char buf[4096];
+    size_t size = fread(buf, 1, sizeof buf, f);
+    fclose(f);
+    const char *end = strstr((const char *)buf, "end_header\n");
+    REQUIRE(end);
+    CHECK(strstr((const char *)buf, "element vertex 6\n") != NULL);
+    CHECK(strstr((const char *)buf, "element face 2\n") != NULL);
+    size_t body = (size_t)(end - (const char *)buf) + strlen("end_header\n");
+    CHECK(size == body + 6 * 24 + 2 * 13); /* 6 vertices of 6 floats, 2 faces of 1 + 3 ints */
+    const unsigned char *v = buf + body;
+    /* vertex 4 (triangle 1, vertex 1): position p[12..14], normal (0, -1, 0) */
+    CHECK(get_f32(v + 4 * 24) == p[12] && get_f32(v + 4 * 24 + 8) == p[14]);
+    CHECK(get_f32(v + 4 * 24 + 12) == 0.0f && get_f32(v + 4 * 24 + 16) == -1.0f);
+    const unsigned char *face = v + 6 * 24 + 13;
+    CHECK(face[0] == 3 && face[1] == 3 && face[5] == 4 && face[9] == 5);
+    ip_mesh_free(&m);
+}
+
+int main(void)
+{
+    test_normal_packing();
+    test_appends();
+    test_ply();
+    return test_summary("test_mesh");
+}
