@@ -15,6 +15,7 @@
 
 #define MAX_THREADS 64
 #define RAY_BATCH 16 /* rays a worker takes at once: small, so the order stays progressive */
+#define LOCAL_LEVELS 3 /* ray order: the finest levels cast in Z-order (see begin) */
 #define FLUSH_TRIANGLES 16384 /* a worker's buffer moves to the engine's mesh past this size */
 
 /* A worker's tools for one pyramid level: pinned bricks, seeding state, propagation queue. */
@@ -183,6 +184,12 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     e->iso = iso;
     memset(&e->totals, 0, sizeof e->totals);
     ip_ray_order_init(&e->order, camera->width, camera->height);
+    /* The finest levels (cells of at most 2^LOCAL_LEVELS pixels a side, most of the rays)
+     * are cast in Z-order: consecutive rays then cross the same bricks and sub-blocks while
+     * they are still in the processor's caches. The image is nearly complete by then, so
+     * the coarser levels, which make it, keep their spread-out order. */
+    uint32_t last = ip_ray_order_last_level(&e->order);
+    ip_ray_order_set_local_from(&e->order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
     set_lod_distances(e);
     double pixel_angle = 2.0 * e->basis.tan_half_y / camera->height;
     for (unsigned t = 0; t < e->threads; t++) {

@@ -24,8 +24,19 @@ ip_status ip_ray_order_init(ip_ray_order *order, uint32_t width, uint32_t height
     order->height = height;
     order->x_levels = levels_for(width);
     order->y_levels = levels_for(height);
+    order->local_from = UINT32_MAX;
     ip_ray_order_reset(order);
     return IP_OK;
+}
+
+void ip_ray_order_set_local_from(ip_ray_order *order, uint32_t level)
+{
+    order->local_from = level;
+}
+
+uint32_t ip_ray_order_last_level(const ip_ray_order *order)
+{
+    return order->x_levels > order->y_levels ? order->x_levels : order->y_levels;
 }
 
 uint32_t ip_ray_order_level(const ip_ray_order *order)
@@ -71,10 +82,11 @@ static void next_cell(ip_ray_order *order, uint32_t nx, uint32_t ny)
     static const uint8_t digit_x[4] = {0, 1, 1, 0}, digit_y[4] = {0, 1, 0, 1};
     uint64_t position = ++order->next_cell;
     uint32_t both = min_u32(nx, ny), s = 0;
+    int local = order->level >= order->local_from; /* finest split first: Z-order */
     for (; s < both; s++) {
         uint32_t digit = (uint32_t)(position >> 2 * s) & 3u;
-        set_bit(&order->cell_x, nx - 1 - s, digit_x[digit]);
-        set_bit(&order->cell_y, ny - 1 - s, digit_y[digit]);
+        set_bit(&order->cell_x, local ? s : nx - 1 - s, digit_x[digit]);
+        set_bit(&order->cell_y, local ? s : ny - 1 - s, digit_y[digit]);
         if (digit != 0)
             return;
     }
@@ -82,7 +94,7 @@ static void next_cell(ip_ray_order *order, uint32_t nx, uint32_t ny)
     uint32_t splits = nx > both ? nx : ny;
     for (; s < splits; s++) {
         uint32_t bit = (uint32_t)(position >> (both + s)) & 1u;
-        set_bit(cell, splits - 1 - s, bit);
+        set_bit(cell, local ? s : splits - 1 - s, bit);
         if (bit)
             return;
     }

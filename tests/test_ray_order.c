@@ -372,6 +372,78 @@ static void test_distance_transform(void)
     }
 }
 
+/* Local levels: each level holds the same pixels as in Bayer order, the levels before the
+ * first local one come in the very same sequence, every pixel still comes once, and within a
+ * local level consecutive rays are near each other (a mean chessboard step under 1/16 of
+ * Bayer order's, which jumps across the screen). */
+static void test_local_levels(uint32_t w, uint32_t h, uint32_t local_from)
+{
+    ip_ray_order bayer, local;
+    REQUIRE(ip_ray_order_init(&bayer, w, h) == IP_OK && ip_ray_order_init(&local, w, h) == IP_OK);
+    ip_ray_order_set_local_from(&local, local_from);
+    uint64_t n = (uint64_t)w * h;
+    uint32_t(*a)[3] = malloc(n * sizeof *a), (*b)[3] = malloc(n * sizeof *b);
+    REQUIRE(a && b);
+    for (int pass = 0; pass < 2; pass++) { /* the second pass after a reset: the same again */
+        uint64_t i = 0;
+        uint32_t x, y;
+        while (ip_ray_order_next(&bayer, &x, &y))
+            a[i][0] = ip_ray_order_level(&bayer), a[i][1] = x, a[i++][2] = y;
+        REQUIRE(i == n);
+        i = 0;
+        while (ip_ray_order_next(&local, &x, &y) && i < n)
+            b[i][0] = ip_ray_order_level(&local), b[i][1] = x, b[i++][2] = y;
+        CHECK_MSG(i == n, "%ux%u local from %u: %llu pixels", w, h, local_from,
+                  (unsigned long long)i);
+        ip_ray_order_reset(&bayer);
+        ip_ray_order_reset(&local);
+    }
+    /* level by level: the same pixels (as sets), in the same order before local_from */
+    unsigned char *in_level = calloc(n, 1);
+    REQUIRE(in_level);
+    uint64_t start = 0, differ = 0, order_differs = 0;
+    double steps = 0, bayer_steps = 0;
+    uint64_t step_count = 0;
+    while (start < n) {
+        uint64_t end = start;
+        while (end < n && a[end][0] == a[start][0])
+            end++;
+        for (uint64_t i = start; i < end; i++)
+            in_level[(size_t)a[i][2] * w + a[i][1]] = 1;
+        for (uint64_t i = start; i < end; i++) {
+            differ += b[i][0] != a[start][0] || !in_level[(size_t)b[i][2] * w + b[i][1]];
+            if (a[start][0] < local_from)
+                order_differs += b[i][1] != a[i][1] || b[i][2] != a[i][2];
+            else if (i > start) {
+                uint32_t dx = b[i][1] > b[i - 1][1] ? b[i][1] - b[i - 1][1] : b[i - 1][1] - b[i][1];
+                uint32_t dy = b[i][2] > b[i - 1][2] ? b[i][2] - b[i - 1][2] : b[i - 1][2] - b[i][2];
+                uint32_t ex = a[i][1] > a[i - 1][1] ? a[i][1] - a[i - 1][1] : a[i - 1][1] - a[i][1];
+                uint32_t ey = a[i][2] > a[i - 1][2] ? a[i][2] - a[i - 1][2] : a[i - 1][2] - a[i][2];
+                steps += dx > dy ? dx : dy;
+                bayer_steps += ex > ey ? ex : ey;
+                step_count++;
+            }
+        }
+        for (uint64_t i = start; i < end; i++)
+            in_level[(size_t)a[i][2] * w + a[i][1]] = 0;
+        start = end;
+    }
+    CHECK_MSG(differ == 0, "%ux%u local from %u: %llu rays in another level", w, h, local_from,
+              (unsigned long long)differ);
+    CHECK_MSG(order_differs == 0, "%ux%u local from %u: coarse levels reordered", w, h,
+              local_from);
+    if (step_count > 0) {
+        double mean = steps / (double)step_count, bayer_mean = bayer_steps / (double)step_count;
+        printf("%ux%u local from level %u: mean step %.2f pixels (Bayer order: %.2f)\n", w, h,
+               local_from, mean, bayer_mean);
+        CHECK_MSG(mean * 16 < bayer_mean, "%ux%u: mean step %.2f, Bayer %.2f", w,
+                  h, mean, bayer_mean);
+    }
+    free(in_level);
+    free(a);
+    free(b);
+}
+
 static int bench(uint32_t w, uint32_t h)
 {
     ip_ray_order order;
@@ -405,5 +477,10 @@ int main(int argc, char **argv)
     test_spread(17, 13);
     test_spread(640, 480);
     test_spread(1, 100);
+    test_local_levels(1600, 1200, 8);
+    test_local_levels(640, 480, 0);
+    test_local_levels(255, 257, 5);
+    test_local_levels(1000, 1, 3);
+    test_local_levels(17, 13, 40); /* past the last level: Bayer order throughout */
     return test_summary("test_ray_order");
 }

@@ -1,7 +1,8 @@
 /* isoprop: progressive view-dependent isosurface extraction (Liu, Finkelstein, Li).
  *
  * ip_engine_begin() fixes a view and an isovalue; each ip_engine_step() casts the next rays of
- * the progressive order (centre first, then the centres of quadrants, ...). A ray walks the
+ * the progressive order (centre first, then the centres of quadrants, ...; the three finest
+ * levels, most of the rays, in Z-order, for the caches: see ray_order.h). A ray walks the
  * min/max octree front to back, from the root through bricks and sub-blocks to cells, entering
  * only nodes whose range holds the isovalue, and stops at the first cell whose marching-cubes
  * triangles it really hits: the seed. (Cells it passes within 1/64 pixel of a triangle edge on

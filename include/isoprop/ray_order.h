@@ -22,6 +22,12 @@
  * (low x, high y). Consecutive rays therefore land far apart, and the first quarter of a level
  * is a regular lattice of every other cell, the first half a checkerboard.
  *
+ * Local levels (optional, ip_ray_order_set_local_from()): from a chosen level on, the same
+ * digits choose the finest split first instead of the coarsest, so that a level is walked in
+ * Z-order: consecutive rays land in neighbouring cells, and a ray caster finds the data of the
+ * ray before still in its caches. A level holds the same pixels either way; only their order
+ * within the level changes, and the coarser levels keep their spread.
+ *
  * Spread (asserted by tests/test_ray_order.c): after the first 4^k rays, levels 0..k-1 are
  * complete, so every pixel is within ceil(S / 2^k) pixels of a cast ray along each axis
  * (chessboard distance), S = max(width, height); for a square power-of-two image of side W that
@@ -54,6 +60,7 @@ typedef struct ip_ray_order {
     uint64_t next_cell;          /* the position in the level of the next cell to examine */
     uint32_t cell_x, cell_y;     /* that cell's column and row among the level's cells */
     uint64_t emitted;            /* pixels returned since init or reset */
+    uint32_t local_from;         /* the first level walked in Z-order (UINT32_MAX: none) */
 } ip_ray_order;
 
 /*! ip_ray_order_init() : prepares `order` to walk a width x height image from the beginning.
@@ -77,6 +84,14 @@ uint64_t ip_ray_order_emitted(const ip_ray_order *order);
  *  the centres of the 4^k level-k cells); 0 before the first call. After the last pixel of level
  *  k, every pixel is within half a level-k cell of a cast ray along each axis. */
 uint32_t ip_ray_order_level(const ip_ray_order *order);
+
+/*! ip_ray_order_set_local_from() : walks level `level` and every finer level in Z-order (see
+ *  "Local levels" above); UINT32_MAX, the default after init, walks every level in Bayer
+ *  order. Call it before the first next() or after a reset; reset keeps the choice. */
+void ip_ray_order_set_local_from(ip_ray_order *order, uint32_t level);
+
+/*! ip_ray_order_last_level() : the finest level, whose cells are at most one pixel. */
+uint32_t ip_ray_order_last_level(const ip_ray_order *order);
 
 /*! ip_ray_order_reset() : starts the same order again from its first pixel. */
 void ip_ray_order_reset(ip_ray_order *order);
