@@ -4,12 +4,10 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <unistd.h>
 
 #include "internal.h"
 #include "isoprop/cache.h"
-#include "isoprop/codec.h"
 
 #define STRIPES 64 /* load coordination locks, by brick index */
 
@@ -69,7 +67,6 @@ struct ip_cache {
     entry **all_entries;       /* every entry ever made, for destroy */
     uint64_t all_count, all_capacity;
     size_t work_size;
-    long page_size;
     atomic_uint_fast64_t clock;
     padded_counter hits[HIT_STRIPES]; /* striped by brick: hits on different bricks do not
                                          contend for one cache line */
@@ -100,14 +97,11 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
     c->store = store;
     c->layout = ip_store_layout(store);
     c->budget = budget_bytes;
-    c->page_size = sysconf(_SC_PAGESIZE);
     uint64_t n = c->layout->brick_count;
     c->slots = calloc(n, sizeof *c->slots);
     c->touched = calloc(n, sizeof *c->touched);
     c->loading = calloc(n, 1);
-    size_t most = (size_t)(c->layout->brick_edge + 1) * (c->layout->brick_edge + 1) *
-                  (c->layout->brick_edge + 1);
-    c->work_size = ip_brick_work_size(most, c->layout->type);
+    c->work_size = ip_store_read_work_size(store);
     if (!c->slots || !c->touched || !c->loading) {
         ip_cache_destroy(c);
         return ip_fail(err, IP_ERR_NOMEM, "out of memory for a cache of %llu bricks",
@@ -385,48 +379,15 @@ static ip_status add_resident(ip_cache *c, entry *e)
     return IP_OK;
 }
 
-/* The kernel maps more than the faulting page: aligned windows around it ("fault-around",
- * 64 KiB by default) and, where the page cache holds large folios, the whole folio (up to
- * 2 MiB, seen on ext4). So a decode maps pages of neighbouring payloads too. Releasing the
- * aligned 2 MiB span around a payload keeps them from piling up in the process; a neighbour
- * needed again is one minor fault away. */
-#define FAULT_AROUND_BYTES (2u << 20)
-
-/* Drops the mapping's pages under (and around) a payload once decoded: they stay in the page
- * cache if needed again, and keeping them mapped would grow the process by the compressed
- * file's size. Another thread reading a neighbour in the same window just faults it back. */
-static void release_payload_pages(const ip_cache *c, uint64_t g)
-{
-    ip_brick_entry be;
-    ip_store_brick_entry(c->store, g, &be);
-    const unsigned char *base = ip_store_mapping(c->store);
-    if (be.stored_size == 0 || !base)
-        return;
-    uintptr_t window = FAULT_AROUND_BYTES > (uintptr_t)c->page_size ? FAULT_AROUND_BYTES
-                                                                    : (uintptr_t)c->page_size;
-    uintptr_t first = (uintptr_t)base; /* the header page is touched once at open */
-    uintptr_t summary = ((uintptr_t)(base + c->layout->summary_offset)) & ~(uintptr_t)(c->page_size - 1);
-    uintptr_t start = ((uintptr_t)(base + be.offset)) & ~(window - 1);
-    uintptr_t end = ((uintptr_t)(base + be.offset + be.stored_size) + window - 1) & ~(window - 1);
-    if (start < first)
-        start = first;
-    if (end > summary)
-        end = summary; /* never drop the summary section's pages */
-    if (end > start)
-        madvise((void *)start, end - start, MADV_DONTNEED);
-}
-
 /* Asks the kernel to read, in the background, the payloads of the face neighbours of brick g
  * (level `level`, coordinates b) that were never pinned nor asked for: propagation crosses
  * brick faces, so on a cold page cache they are the next reads, and their I/O then overlaps
- * the decoding and extraction of this one instead of stalling a worker on a page fault. Costs
+ * the decoding and extraction of this one instead of stalling a worker on a read. Costs
  * a system call per neighbour, once per brick; no thread of ours waits for the reads. */
 static void prefetch_neighbours(ip_cache *c, uint32_t level, const uint32_t b[3])
 {
-    const unsigned char *base = ip_store_mapping(c->store);
     const uint32_t *grid = c->layout->levels[level].bricks;
-    uintptr_t page = (uintptr_t)c->page_size;
-    for (int f = 0; f < 6 && base; f++) {
+    for (int f = 0; f < 6; f++) {
         uint32_t n[3] = {b[0], b[1], b[2]};
         int axis = f / 2;
         if (f % 2 == 0 ? n[axis] == 0 : n[axis] + 1 >= grid[axis])
@@ -436,13 +397,7 @@ static void prefetch_neighbours(ip_cache *c, uint32_t level, const uint32_t b[3]
         if (atomic_load_explicit(&c->touched[g], memory_order_relaxed) ||
             atomic_fetch_or(&c->touched[g], PREFETCHED))
             continue;
-        ip_brick_entry be;
-        ip_store_brick_entry(c->store, g, &be);
-        if (be.stored_size == 0)
-            continue; /* constant: nothing to read */
-        uintptr_t start = (uintptr_t)(base + be.offset) & ~(page - 1);
-        uintptr_t end = (uintptr_t)(base + be.offset + be.stored_size);
-        madvise((void *)start, end - start, MADV_WILLNEED);
+        ip_store_prefetch_brick(c->store, g);
     }
 }
 
@@ -490,7 +445,6 @@ static ip_status decode_into(ip_cache *c, uint64_t g, entry *e, ip_error *err)
     ip_brick_entry be;
     ip_store_brick_entry(c->store, g, &be);
     atomic_fetch_add(&c->bytes_read, be.stored_size);
-    release_payload_pages(c, g);
     return st;
 }
 

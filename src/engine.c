@@ -351,6 +351,11 @@ static void *work(void *p)
     }
     if (flush_triangles(w) != IP_OK && w->status == IP_OK)
         w->status = IP_ERR_NOMEM;
+    if (w->status != IP_OK) { /* the step fails: the other workers take no more rays */
+        pthread_mutex_lock(&e->order_lock);
+        e->step_rays_left = 0;
+        pthread_mutex_unlock(&e->order_lock);
+    }
     for (uint32_t k = 0; k < e->levels_used; k++) /* let the cache evict freely between steps */
         ip_sampler_release(&w->level[k].sampler);
     return NULL;

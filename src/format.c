@@ -427,8 +427,10 @@ static ip_status check_level_table(const ip_layout *l, const unsigned char *tabl
     return IP_OK;
 }
 
+/* `reserved`: the entry's reserved bytes or'ed together. */
 static ip_status check_entry(const ip_layout *l, uint64_t g, const ip_brick_entry *e,
-                             float lo, float hi, const char *name, ip_error *err)
+                             unsigned reserved, float lo, float hi, const char *name,
+                             ip_error *err)
 {
     uint32_t level, brick[3], origin[3], extent[3];
     ip_brick_coords(l, g, &level, brick);
@@ -437,6 +439,8 @@ static ip_status check_entry(const ip_layout *l, uint64_t g, const ip_brick_entr
     const char *why = NULL;
     if (!range_ok(lo, hi))
         why = "an invalid value range";
+    else if (reserved)
+        why = "non-zero reserved bytes";
     else if (e->encoding == IP_BRICK_CONSTANT) {
         if (e->stored_size != 0 || e->filters != 0 || e->checksum != 0 || lo != hi)
             why = "an inconsistent constant entry";
@@ -459,33 +463,53 @@ static ip_status check_entry(const ip_layout *l, uint64_t g, const ip_brick_entr
     return IP_OK;
 }
 
-ip_status ip_format_parse(const unsigned char *file, uint64_t size, const char *name,
-                          unsigned flags, ip_layout *layout, ip_error *err)
+ip_status ip_format_parse_header(const unsigned char header[IP_HEADER_SIZE], uint64_t file_size,
+                                 const char *name, unsigned flags, ip_layout *layout,
+                                 ip_error *err)
 {
-    if (size < IP_HEADER_SIZE)
+    if (file_size < IP_HEADER_SIZE)
         return ip_fail(err, IP_ERR_FORMAT, "%s: %llu bytes is too short for a brick file",
-                       name, (unsigned long long)size);
-    ip_status st = parse_header(file, name, flags, layout, err);
-    if (st == IP_OK)
-        st = check_sections(layout, size, name, err);
-    if (st != IP_OK)
-        return st;
-    const unsigned char *summary = file + layout->summary_offset;
+                       name, (unsigned long long)file_size);
+    ip_status st = parse_header(header, name, flags, layout, err);
+    return st == IP_OK ? check_sections(layout, file_size, name, err) : st;
+}
+
+ip_status ip_format_parse_summary(ip_layout *layout, const unsigned char *gap,
+                                  const unsigned char *summary, const char *name,
+                                  unsigned flags, ip_error *err)
+{
+    uint64_t gap_size = layout->summary_offset - (layout->data_offset + layout->data_size);
+    for (uint64_t i = 0; i < gap_size; i++)
+        if (gap[i] != 0)
+            return ip_fail(err, IP_ERR_FORMAT, "%s: byte %llu, in the padding before the "
+                           "summary section, is not zero", name,
+                           (unsigned long long)(layout->data_offset + layout->data_size + i));
     if (!(flags & IP_PARSE_SKIP_CHECKSUMS) &&
         ip_format_checksum(summary, layout->summary_size) != layout->summary_checksum)
         return ip_fail(err, IP_ERR_CHECKSUM, "%s: summary section checksum mismatch", name);
-    st = check_level_table(layout, summary, name, layout, err);
+    ip_status st = check_level_table(layout, summary, name, layout, err);
     if (st != IP_OK)
         return st;
     ip_summary_offsets o;
     ip_summary_offsets_of(layout, &o);
     for (uint64_t g = 0; g < layout->brick_count; g++) {
-        ip_brick_entry e;
-        ip_directory_entry_decode(summary + o.directory + g * IP_DIRECTORY_ENTRY_SIZE, &e);
+        const unsigned char *d = summary + o.directory + g * IP_DIRECTORY_ENTRY_SIZE;
         const unsigned char *r = summary + o.brick_ranges + g * IP_RANGE_SIZE;
-        st = check_entry(layout, g, &e, load_f32(r), load_f32(r + 4), name, err);
+        ip_brick_entry e;
+        ip_directory_entry_decode(d, &e);
+        st = check_entry(layout, g, &e, d[14] | d[15], load_f32(r), load_f32(r + 4), name, err);
         if (st != IP_OK)
             return st;
     }
     return IP_OK;
+}
+
+ip_status ip_format_parse(const unsigned char *file, uint64_t size, const char *name,
+                          unsigned flags, ip_layout *layout, ip_error *err)
+{
+    ip_status st = ip_format_parse_header(file, size, name, flags, layout, err);
+    if (st != IP_OK)
+        return st;
+    return ip_format_parse_summary(layout, file + layout->data_offset + layout->data_size,
+                                   file + layout->summary_offset, name, flags, err);
 }

@@ -349,6 +349,8 @@ int ip_seed_find(ip_seeder *s, const double eye[3], const double dir[3], double 
     if (!clip(&r, lo, hi, &t0, &t1))
         return 0;
     int found = walk_node(s, &r, depth, root, t0, t1);
+    if (found < 0)
+        return -1; /* a brick could not be read: the cells found so far may be wrong */
     *count = s->found_count;
     *seed_index = s->seed_index;
     return found || s->seed_index >= 0;

@@ -100,7 +100,7 @@ static void check_file(const char *ibv, const volume *v)
     const ip_layout *l = ip_store_layout(s);
     size_t most = (size_t)(l->brick_edge + 1) * (l->brick_edge + 1) * (l->brick_edge + 1);
     float *dst = malloc(most * 4);
-    void *work = malloc(ip_brick_work_size(most, l->type));
+    void *work = malloc(ip_store_read_work_size(s));
     float *sub = malloc(sizeof(float) * 2 * ip_layout_subblocks_per_brick(l));
     float *want = malloc(most * sizeof(float));
     REQUIRE(dst && work && sub && want);

@@ -440,7 +440,7 @@ echo "A fresh process after dropping the page cache, casting 1 ray and writing i
     "peak RSS $(awk '{printf "%.0f", $2/1024}' big-first.time) MiB."
 echo "Cold run memory (medians): mesh $(fmt_k "$(h jmed triangles big-cold-?.json)") K triangles," \
     "cache resident peak $(calc "round($(h jmed cache.resident_peak_bytes big-cold-?.json) / 1048576)") MiB," \
-    "summaries $(calc "round($(h get big-cold-1.json cache summary_bytes) / 1048576)") MiB (mapped)."
+    "summaries $(calc "round($(h get big-cold-1.json cache summary_bytes) / 1048576)") MiB (read once at open)."
 # VTK Flying Edges' peak memory on the raw file, when it fits
 bytes=$(stat -c %s "$big_raw" 2>/dev/null || echo 0)
 measuring && awk '/MemAvailable/ { printf "%.0f\n", $2 * 1024 }' /proc/meminfo >avail.txt

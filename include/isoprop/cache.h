@@ -11,13 +11,13 @@
  * that miss on the same brick decode it once (the second waits for the first). Eviction is
  * exact LRU over the last pin time of each unpinned brick.
  *
- * Memory: resident bytes are the decoded bricks; the compressed pages of the mapping that a
- * decode touched are released right after it (madvise), so the process holds the budget, the
- * summaries and a fixed overhead, whatever the file's size.
+ * Memory: resident bytes are the decoded bricks; a miss reads its compressed payload into a
+ * scratch buffer (ip_store_read_brick()), so the process holds the budget, the summaries and a
+ * fixed overhead, whatever the file's size.
  *
  * Read-ahead: a miss also asks the kernel to read the compressed payloads of the brick's six
  * face neighbours in the background (once per brick), the bricks propagation crosses into
- * next, so that a cold start does not stall on page faults.
+ * next, so that a cold start does not stall on their reads.
  */
 #ifndef ISOPROP_CACHE_H
 #define ISOPROP_CACHE_H
@@ -60,7 +60,7 @@ typedef struct ip_cache_stats {
     double decode_seconds;         /* time in checksum + decode, summed over threads */
     uint64_t over_budget_pins;     /* loads that found every resident brick pinned */
     uint64_t pinned_bytes;         /* decoded bytes pinned now */
-    uint64_t errors;               /* loads that failed their checksum or decode */
+    uint64_t errors;               /* loads that failed: read, checksum or decode */
     uint64_t bricks_touched, bricks_total;
     uint32_t levels;
     ip_cache_level_stats level[32];
@@ -79,9 +79,10 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
 void ip_cache_destroy(ip_cache *cache);
 
 /*! ip_cache_pin_brick() : pins global brick `g` and fills *brick. On a miss the brick is read
- *  from the mapping, its checksum verified and decoded; a bad brick is reported (IP_ERR_CHECKSUM
- *  or IP_ERR_CORRUPT naming it) and nothing is pinned, and the caller may go on with other
- *  bricks. @return IP_OK, IP_ERR_CHECKSUM, IP_ERR_CORRUPT, IP_ERR_ARGUMENT or IP_ERR_NOMEM. */
+ *  from the file, its checksum verified and decoded; a bad brick is reported (IP_ERR_CHECKSUM,
+ *  IP_ERR_CORRUPT or IP_ERR_IO naming it) and nothing is pinned, and the caller may go on with
+ *  other bricks. @return IP_OK, IP_ERR_CHECKSUM, IP_ERR_CORRUPT, IP_ERR_IO, IP_ERR_ARGUMENT or
+ *  IP_ERR_NOMEM. */
 ip_status ip_cache_pin_brick(ip_cache *cache, uint64_t g, ip_brick *brick, ip_error *err);
 
 /*! ip_cache_unpin_brick() : releases one pin taken by ip_cache_pin_brick(). */

@@ -153,11 +153,29 @@ enum {
     IP_PARSE_SKIP_CHECKSUMS = 1 /* for fuzzing the structure checks behind the checksums */
 };
 
-/*! ip_format_parse() : parses and validates a whole brick file image (`file`, `size` bytes,
- *  e.g. a read-only mapping): header, checksums of the header and summary section, level
- *  table against the layout derived from the header, every directory entry (offsets inside the
- *  data section, sizes, encodings), and that value ranges are ordered. Touches no payload
- *  byte. `name` is used in messages. Safe on arbitrary bytes.
+/*! ip_format_parse_header() : parses and validates the 256-byte header of a brick file of
+ *  `file_size` bytes: magic, version, header checksum, the layout its dims, B and s imply, and
+ *  the section offsets against the size. Fills *layout (value ranges of the levels come with
+ *  the summary). `name` is used in messages. Safe on arbitrary bytes.
+ *  @return IP_OK, IP_ERR_FORMAT, IP_ERR_CHECKSUM or IP_ERR_UNSUPPORTED. */
+ip_status ip_format_parse_header(const unsigned char header[IP_HEADER_SIZE], uint64_t file_size,
+                                 const char *name, unsigned flags, ip_layout *layout,
+                                 ip_error *err);
+
+/*! ip_format_parse_summary() : validates the rest of the metadata of a file whose header
+ *  ip_format_parse_header() accepted into *layout: `gap` holds the padding between the data
+ *  section and the summary section (summary_offset - data_offset - data_size bytes, which must
+ *  be zero), `summary` the summary section (summary_size bytes): its checksum, the level table
+ *  against the layout, every directory entry (encodings, sizes, offsets inside the data
+ *  section, reserved bytes zero) and every brick range. Sets the levels' value ranges.
+ *  Touches no payload byte. Safe on arbitrary bytes.
+ *  @return IP_OK, IP_ERR_FORMAT or IP_ERR_CHECKSUM. */
+ip_status ip_format_parse_summary(ip_layout *layout, const unsigned char *gap,
+                                  const unsigned char *summary, const char *name,
+                                  unsigned flags, ip_error *err);
+
+/*! ip_format_parse() : ip_format_parse_header() then ip_format_parse_summary() on a whole
+ *  brick file image (`file`, `size` bytes) held in memory.
  *  @return IP_OK and *layout filled, or IP_ERR_FORMAT / IP_ERR_CHECKSUM / IP_ERR_UNSUPPORTED. */
 ip_status ip_format_parse(const unsigned char *file, uint64_t size, const char *name,
                           unsigned flags, ip_layout *layout, ip_error *err);

@@ -1,14 +1,20 @@
 /* isoprop: a brick file opened for reading.
  *
- * ip_store_open() maps the file read-only and validates its header, summary checksum and
- * directory (ip_format_parse()); after that every summary (level table, brick and sub-block
- * ranges, octree nodes) is available without touching any brick payload. Reading a brick
- * verifies its checksum and decodes it. A store is immutable after opening: every function
- * here is safe to call from many threads at once.
+ * ip_store_open() reads the header and the summary section once, into memory the store owns,
+ * and validates them (ip_format_parse_header(), ip_format_parse_summary()): after that every
+ * summary (level table, brick and sub-block ranges, octree nodes) is available without
+ * touching the file again, and stays as verified whatever happens to the file. Reading a brick
+ * reads its payload with pread() into the caller's scratch, verifies its checksum there and
+ * decodes those same bytes. So a file that changes while open (truncated, rewritten in place)
+ * gives a clear error naming the brick (IP_ERR_IO for a short read, IP_ERR_CHECKSUM for other
+ * bytes), never a signal and never unverified samples. Nothing of the file is mapped.
+ * A store is immutable after opening: every function here is safe to call from many threads
+ * at once.
  */
 #ifndef ISOPROP_STORE_H
 #define ISOPROP_STORE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "isoprop/format.h"
@@ -36,10 +42,6 @@ const ip_layout *ip_store_layout(const ip_store *store);
 /*! ip_store_path() : the path the store was opened with. */
 const char *ip_store_path(const ip_store *store);
 
-/*! ip_store_mapping() : the first byte of the read-only mapping of the whole file (e.g. to
- *  madvise pages away after a decode); owned by the store, never written. */
-const unsigned char *ip_store_mapping(const ip_store *store);
-
 /*! ip_store_brick_entry() : directory entry of global brick `g` (< brick_count). */
 void ip_store_brick_entry(const ip_store *store, uint64_t g, ip_brick_entry *entry);
 
@@ -58,14 +60,24 @@ const float *ip_store_node_range(const ip_store *store, uint32_t level, uint32_t
 /*! ip_store_brick_samples() : number of samples of brick `g` (its extent's product). */
 uint64_t ip_store_brick_samples(const ip_store *store, uint64_t g);
 
-/*! ip_store_read_brick() : verifies the checksum of brick `g` and decodes it into `dst`
- *  (ip_store_brick_samples() samples of the file's type, host byte order, x fastest; the
- *  extent is ip_brick_extent()). `work` is scratch of ip_brick_work_size() bytes for the
- *  largest brick. Both buffers are the caller's.
- *  @return IP_OK, IP_ERR_CHECKSUM or IP_ERR_CORRUPT naming the brick, its level and
- *  coordinates. */
+/*! ip_store_read_work_size() : bytes of scratch ip_store_read_brick() needs, for any brick of
+ *  this file (its largest payload plus the codec's scratch for the largest brick). */
+size_t ip_store_read_work_size(const ip_store *store);
+
+/*! ip_store_read_brick() : reads brick `g`'s payload, verifies its checksum and decodes it into
+ *  `dst` (ip_store_brick_samples() samples of the file's type, host byte order, x fastest; the
+ *  extent is ip_brick_extent()). `work` is scratch of ip_store_read_work_size() bytes. Both
+ *  buffers are the caller's. A constant brick reads nothing.
+ *  @return IP_OK; IP_ERR_CHECKSUM or IP_ERR_CORRUPT naming the brick, its level and
+ *  coordinates; IP_ERR_IO when the read fails or the file ends before the payload (it shrank
+ *  since it was opened: the message gives both sizes). */
 ip_status ip_store_read_brick(const ip_store *store, uint64_t g, void *dst, void *work,
                               ip_error *err);
+
+/*! ip_store_prefetch_brick() : asks the kernel to start reading brick `g`'s payload into the
+ *  page cache in the background (posix_fadvise WILLNEED); returns at once, waits for nothing.
+ *  A hint: a later ip_store_read_brick() finds the bytes in memory instead of stalling. */
+void ip_store_prefetch_brick(const ip_store *store, uint64_t g);
 
 /*! ip_store_check_summary() : recomputes the range and sub-block ranges of brick `g` from its
  *  decoded `samples` (as ip_store_read_brick() or the cache give them) and compares them with
@@ -73,7 +85,7 @@ ip_status ip_store_read_brick(const ip_store *store, uint64_t g, void *dst, void
 ip_status ip_store_check_summary(const ip_store *store, uint64_t g, const void *samples,
                                  ip_error *err);
 
-/*! ip_store_verify_brick() : ip_store_read_brick(), then recomputes the brick's range and
+/*! ip_store_verify_brick() : ip_store_read_brick() (same buffers), then recomputes the brick's range and
  *  sub-block ranges from the decoded samples and compares them with the summary section.
  *  @return IP_OK, or IP_ERR_CHECKSUM / IP_ERR_CORRUPT naming the brick. */
 ip_status ip_store_verify_brick(const ip_store *store, uint64_t g, void *dst, void *work,

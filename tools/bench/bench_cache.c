@@ -13,7 +13,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <time.h>
 #include <unistd.h>
 #ifdef __GLIBC__
@@ -194,7 +193,8 @@ typedef struct brick_info {
 typedef struct bench_file {
     ip_store *store;
     const ip_layout *layout;
-    const unsigned char *map;
+    unsigned char *payloads;      /* the file up to its summary section, read once: the bytes
+                                     the stages below other than ip_store_read_brick work on */
     size_t type_size;
     uint64_t level0_count;        /* every level-0 brick */
     uint64_t level0_decoded;      /* their decoded bytes */
@@ -207,6 +207,31 @@ typedef struct bench_file {
     size_t work_size;
 } bench_file;
 
+/* Reads the file's header and data section into f->payloads (the store reads payloads itself,
+ * into its callers' scratch; the stages that time the codec alone need the bytes in memory). */
+static int read_payloads(const char *path, bench_file *f)
+{
+    uint64_t size = f->layout->summary_offset;
+    f->payloads = malloc(size ? size : 1);
+    if (!f->payloads)
+        return out_of_memory("the payloads");
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    uint64_t done = 0;
+    while (fd >= 0 && done < size) {
+        ssize_t n = pread(fd, f->payloads + done, size - done, (off_t)done);
+        if (n <= 0)
+            break;
+        done += (uint64_t)n;
+    }
+    if (fd >= 0)
+        close(fd);
+    if (done != size) {
+        fprintf(stderr, "%s: %s: cannot read the data section\n", program, path);
+        return 1;
+    }
+    return 0;
+}
+
 static int open_file(const char *path, bench_file *f)
 {
     ip_error err;
@@ -214,7 +239,6 @@ static int open_file(const char *path, bench_file *f)
     if (ip_store_open(path, &f->store, &err) != IP_OK)
         return tool_fail(program, &err);
     f->layout = ip_store_layout(f->store);
-    f->map = ip_store_mapping(f->store);
     f->type_size = ip_type_size(f->layout->type);
     const ip_level_layout *lv = &f->layout->levels[0];
     f->level0_count = lv->brick_count;
@@ -247,7 +271,7 @@ static int open_file(const char *path, bench_file *f)
         f->with_shuffle += (b.entry.filters & IP_FILTER_SHUFFLE) != 0;
         f->payload[f->payload_count++] = b;
     }
-    f->work_size = ip_brick_work_size(f->largest_brick_bytes / f->type_size, f->layout->type);
+    f->work_size = ip_store_read_work_size(f->store);
     return 0;
 }
 
@@ -265,16 +289,6 @@ static int warm_page_cache(const char *path)
         ;
     close(fd);
     return 0;
-}
-
-/* Drops this process's mapping of the payload section (the page cache keeps it), as the cache
- * itself does after each decode, so that each run starts from the same resident set. */
-static void drop_payload_pages(const bench_file *f)
-{
-    long page = sysconf(_SC_PAGESIZE);
-    uint64_t end = f->layout->summary_offset & ~(uint64_t)(page - 1);
-    if (end > 0)
-        madvise((void *)(uintptr_t)f->map, end, MADV_DONTNEED);
 }
 
 static void print_file_facts(const bench_file *f, const options *o)
@@ -328,7 +342,7 @@ static void *decode_work(void *p)
     for (uint64_t pass = 0; pass < j->passes; pass++)
         for (uint64_t i = j->thread; i < j->count; i += j->threads) {
             const brick_info *b = &j->list[i];
-            const unsigned char *src = f->map + b->entry.offset;
+            const unsigned char *src = f->payloads + b->entry.offset;
             switch (j->what) {
             case STAGE_READ:
                 j->failed |= ip_store_read_brick(f->store, b->g, j->dst, j->work, &err) != IP_OK;
@@ -745,7 +759,6 @@ static int run_budget(const bench_file *f, const char *name, const uint64_t *seq
 {
     ip_error err;
     ip_cache *cache;
-    drop_payload_pages(f);
 #ifdef __GLIBC__
     malloc_trim(0); /* give the previous run's bricks back, so RSS starts low */
 #endif
@@ -812,13 +825,13 @@ static int bench_runs(const bench_file *f, const options *o, const budget_list *
     printf("%s.\n", holding ? "" : " none");
     printf("- decode s: time inside checksum + decode summed over threads "
            "(ip_cache_stats.decode_seconds); other us per miss: (wall x threads - decode s) / "
-           "misses, i.e. everything else a miss costs (victim scan, allocation, locks, madvise) "
+           "misses, i.e. everything else a miss costs (victim scan, allocation, locks, the payload's read) "
            "plus the hits' share.\n");
     if (peak_resets)
         printf("- peak RSS is the process's high-water mark during the run alone: it is reset "
                "before each run (/proc/self/clear_refs), after the previous cache is freed "
                "and malloc_trim(); RSS before is the process at the start of the run (store "
-               "mapping summaries, sequences, allocator).\n\n");
+               "summaries, sequences, allocator).\n\n");
     else
         printf("- peak RSS is the process's high-water mark since it started (it only grows: "
                "this kernel does not let it be reset), so only its first rise is this run's.\n\n");
@@ -939,8 +952,11 @@ int main(int argc, char **argv)
     if (warm_page_cache(o.path) != 0)
         return 1;
     print_file_facts(&f, &o);
-    if ((o.parts & PART_DECODE) && bench_decode(&f, &o) != 0)
+    if ((o.parts & PART_DECODE) &&
+        (read_payloads(o.path, &f) != 0 || bench_decode(&f, &o) != 0))
         return 1;
+    free(f.payloads); /* the runs below measure memory: only the store's own reads count */
+    f.payloads = NULL;
     if ((o.parts & PART_HITS) && bench_hits(&f, &o) != 0)
         return 1;
     if ((o.parts & (PART_RANDOM | PART_SEQUENTIAL)) && bench_runs(&f, &o, &budgets) != 0)

@@ -1,0 +1,272 @@
+/* The store against a hostile or changing file: what it checks on opening (the padding before
+ * the summary, reserved directory bytes, non-regular files), and what a reader gets when the
+ * file changes after opening (truncated, rewritten in place): a clear error naming the file
+ * and the brick, never a signal and never unverified samples. */
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "isoprop/bricker.h"
+#include "isoprop/generate.h"
+#include "isoprop/store.h"
+
+/* A gyroid bricked with 4-cell bricks: many payloads, several levels. */
+static void make_file(const char *dir, char *ibv, size_t size)
+{
+    ip_gen_params p = {IP_FIELD_GYROID, {21, 18, 19}, IP_UINT16, 0.0, 1};
+    char name[256], raw[4400];
+    ip_error err;
+    REQUIRE(ip_raw_file_name(name, sizeof name, "gyroid", p.dims, p.type) == IP_OK);
+    snprintf(raw, sizeof raw, "%s/%s", dir, name);
+    REQUIRE(ip_generate_write(&p, raw, 1, &err) == IP_OK);
+    snprintf(ibv, size, "%s/gyroid.ibv", dir);
+    ip_input_desc d;
+    ip_brick_options o;
+    REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
+    ip_brick_options_default(&o);
+    o.brick_edge = 4;
+    o.subblock_edge = 2;
+    o.force = 1;
+    REQUIRE(ip_brick_volume(&d, ibv, &o, NULL, &err) == IP_OK);
+}
+
+static unsigned char *read_whole(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    REQUIRE(f && fseek(f, 0, SEEK_END) == 0);
+    *size = (size_t)ftell(f);
+    unsigned char *bytes = malloc(*size);
+    REQUIRE(bytes && fseek(f, 0, SEEK_SET) == 0 && fread(bytes, 1, *size, f) == *size);
+    fclose(f);
+    return bytes;
+}
+
+static void write_whole(const char *path, const unsigned char *bytes, size_t size)
+{
+    FILE *f = fopen(path, "wb");
+    REQUIRE(f && fwrite(bytes, 1, size, f) == size && fclose(f) == 0);
+}
+
+/* Writes bytes at `offset` of an existing file, in place (same inode, same size). */
+static void poke(const char *path, uint64_t offset, const void *bytes, size_t size)
+{
+    int fd = open(path, O_WRONLY);
+    REQUIRE(fd >= 0 && pwrite(fd, bytes, size, (off_t)offset) == (ssize_t)size);
+    close(fd);
+}
+
+/* Opening `bytes` (written to `path`) fails with `code` and a message holding `text`. */
+static void open_fails(const char *path, const unsigned char *bytes, size_t size, ip_status code,
+                       const char *text)
+{
+    write_whole(path, bytes, size);
+    ip_store *s = NULL;
+    ip_error err;
+    ip_status st = ip_store_open(path, &s, &err);
+    CHECK_MSG(st == code, "%s: status %d, wanted %d", text, (int)st, (int)code);
+    if (st != IP_OK) {
+        CHECK_CONTAINS(err.message, path);
+        CHECK_CONTAINS(err.message, text);
+    }
+    ip_store_close(s);
+}
+
+/* The first brick with a payload; fills its entry. */
+static uint64_t first_payload(const ip_store *s, ip_brick_entry *e)
+{
+    for (uint64_t g = 0; g < ip_store_layout(s)->brick_count; g++) {
+        ip_store_brick_entry(s, g, e);
+        if (e->stored_size > 0)
+            return g;
+    }
+    REQUIRE(!"a payload");
+    return 0;
+}
+
+/* docs/format.md: the padding before the summary section and a directory entry's reserved
+ * bytes are zero; a file with anything else there is not one this reader wrote or knows. The
+ * checksums are recomputed, so only the rule itself can reject these. */
+static void test_zero_fields(const char *dir, const char *ibv)
+{
+    size_t size;
+    unsigned char *good = read_whole(ibv, &size);
+    ip_layout l;
+    REQUIRE(ip_format_parse(good, size, "good", 0, &l, NULL) == IP_OK);
+    uint64_t data_end = l.data_offset + l.data_size;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/hostile.ibv", dir);
+    unsigned char *bad = malloc(size);
+    REQUIRE(bad);
+
+    REQUIRE(l.summary_offset > data_end); /* this file has padding */
+    memcpy(bad, good, size);
+    bad[l.summary_offset - 1] = 0x5a;
+    open_fails(path, bad, size, IP_ERR_FORMAT, "padding before the summary section");
+
+    ip_summary_offsets o;
+    ip_summary_offsets_of(&l, &o);
+    for (int byte = 14; byte <= 15; byte++) {
+        memcpy(bad, good, size);
+        unsigned char *entry = bad + l.summary_offset + o.directory + 3 * IP_DIRECTORY_ENTRY_SIZE;
+        entry[byte] = 1;
+        uint64_t sum = ip_format_checksum(bad + l.summary_offset, l.summary_size);
+        for (int i = 0; i < 8; i++) /* header byte 128: the summary checksum */
+            bad[128 + i] = (unsigned char)(sum >> (8 * i));
+        uint64_t head = ip_format_checksum(bad, 248);
+        for (int i = 0; i < 8; i++)
+            bad[248 + i] = (unsigned char)(head >> (8 * i));
+        open_fails(path, bad, size, IP_ERR_FORMAT, "brick 3");
+        open_fails(path, bad, size, IP_ERR_FORMAT, "reserved bytes");
+    }
+
+    /* the untouched bytes still open: the rules above reject only what they name */
+    memcpy(bad, good, size);
+    open_fails(path, bad, size, IP_OK, "");
+    /* a truncated or extended file fails on its size */
+    open_fails(path, good, size - 1, IP_ERR_FORMAT, "truncated or extended");
+    memcpy(bad, good, size);
+    free(bad);
+    bad = calloc(size + 100, 1);
+    REQUIRE(bad);
+    memcpy(bad, good, size);
+    open_fails(path, bad, size + 100, IP_ERR_FORMAT, "truncated or extended");
+    free(bad);
+    free(good);
+}
+
+/* A FIFO (or any non-regular file) is refused at once: opening it for reading would wait for a
+ * writer forever. The test would hang, not fail, without the fix: ctest's timeout catches it. */
+static void test_not_regular(const char *dir)
+{
+    char fifo[4200];
+    snprintf(fifo, sizeof fifo, "%s/fifo.ibv", dir);
+    REQUIRE(mkfifo(fifo, 0600) == 0);
+    ip_store *s = NULL;
+    ip_error err;
+    CHECK(ip_store_open(fifo, &s, &err) == IP_ERR_IO);
+    CHECK_CONTAINS(err.message, fifo);
+    CHECK_CONTAINS(err.message, "not a regular file");
+    CHECK(ip_store_open(dir, &s, &err) == IP_ERR_IO);
+    CHECK_CONTAINS(err.message, "not a regular file");
+    unlink(fifo);
+}
+
+/* The file shrinks after opening: reading a brick past the new end is an I/O error naming the
+ * file, the brick and both sizes; bricks still inside the file read as before. */
+static void test_truncated_while_open(const char *dir, const char *ibv)
+{
+    char path[4200], cmd[9000];
+    snprintf(path, sizeof path, "%s/shrinks.ibv", dir);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", ibv, path);
+    REQUIRE(system(cmd) == 0);
+    ip_store *s;
+    ip_error err;
+    REQUIRE(ip_store_open(path, &s, &err) == IP_OK);
+    const ip_layout *l = ip_store_layout(s);
+    void *dst = malloc(ip_store_brick_samples(s, 0) * 8 + 4096);
+    void *work = malloc(ip_store_read_work_size(s));
+    REQUIRE(dst && work);
+    ip_brick_entry first;
+    uint64_t g0 = first_payload(s, &first);
+    /* cut the file in the middle of the last payload */
+    uint64_t last = g0, cut = 0;
+    for (uint64_t g = 0; g < l->brick_count; g++) {
+        ip_brick_entry e;
+        ip_store_brick_entry(s, g, &e);
+        if (e.stored_size > 1 && e.offset > cut) {
+            cut = e.offset + e.stored_size / 2;
+            last = g;
+        }
+    }
+    REQUIRE(last != g0 && truncate(path, (off_t)cut) == 0);
+    CHECK(ip_store_read_brick(s, g0, dst, work, &err) == IP_OK);
+    CHECK(ip_store_read_brick(s, last, dst, work, &err) == IP_ERR_IO);
+    CHECK_CONTAINS(err.message, path);
+    char brick[64], sizes[96];
+    snprintf(brick, sizeof brick, "brick %llu ", (unsigned long long)last);
+    snprintf(sizes, sizeof sizes, "ends at byte %llu", (unsigned long long)cut);
+    CHECK_CONTAINS(err.message, brick);
+    CHECK_CONTAINS(err.message, sizes);
+    CHECK_CONTAINS(err.message, "truncated or rewritten");
+    /* to nothing at all: every payload is then past the end */
+    REQUIRE(truncate(path, 0) == 0);
+    CHECK(ip_store_read_brick(s, g0, dst, work, &err) == IP_ERR_IO);
+    CHECK_CONTAINS(err.message, "ends at byte 0");
+    ip_store_close(s);
+    free(dst);
+    free(work);
+}
+
+/* Bytes rewritten in place after opening: the payload read is the payload checked, so the
+ * brick fails its checksum; the summaries were read at open and stay as verified. */
+static void test_rewritten_while_open(const char *dir, const char *ibv)
+{
+    char path[4200], cmd[9000];
+    snprintf(path, sizeof path, "%s/rewritten.ibv", dir);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", ibv, path);
+    REQUIRE(system(cmd) == 0);
+    ip_store *s;
+    ip_error err;
+    REQUIRE(ip_store_open(path, &s, &err) == IP_OK);
+    const ip_layout *l = ip_store_layout(s);
+    void *dst = malloc(ip_store_brick_samples(s, 0) * 8 + 4096);
+    void *work = malloc(ip_store_read_work_size(s));
+    REQUIRE(dst && work);
+    ip_brick_entry e;
+    uint64_t g = first_payload(s, &e);
+    float before[2];
+    ip_store_brick_range(s, g, before);
+    static const unsigned char junk[16] = {0xde, 0xad, 0xbe, 0xef, 1, 2, 3, 4,
+                                           5,    6,    7,    8,    9, 10, 11, 12};
+    poke(path, e.offset, junk, e.stored_size < sizeof junk ? e.stored_size : sizeof junk);
+    poke(path, l->summary_offset + 16, junk, sizeof junk); /* the summary too */
+    CHECK(ip_store_read_brick(s, g, dst, work, &err) == IP_ERR_CHECKSUM);
+    CHECK_CONTAINS(err.message, path);
+    float after[2];
+    ip_store_brick_range(s, g, after);
+    CHECK(memcmp(before, after, sizeof before) == 0);
+    ip_store_close(s);
+    /* reopened, the file fails as a whole: its summary no longer matches its checksum */
+    CHECK(ip_store_open(path, &s, &err) == IP_ERR_CHECKSUM);
+    CHECK_CONTAINS(err.message, "summary section checksum");
+    free(dst);
+    free(work);
+}
+
+/* Reading every brick of a good file: each decodes, and its scratch is what the store says. */
+static void test_reads(const char *ibv)
+{
+    ip_store *s;
+    ip_error err;
+    REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
+    const ip_layout *l = ip_store_layout(s);
+    size_t most = 0;
+    for (uint64_t g = 0; g < l->brick_count; g++)
+        if (ip_store_brick_samples(s, g) > most)
+            most = ip_store_brick_samples(s, g);
+    void *dst = malloc(most * ip_type_size(l->type));
+    void *work = malloc(ip_store_read_work_size(s));
+    REQUIRE(dst && work);
+    int bad = 0;
+    for (uint64_t g = 0; g < l->brick_count; g++)
+        bad += ip_store_verify_brick(s, g, dst, work, &err) != IP_OK;
+    CHECK_MSG(bad == 0, "%d bricks failed: %s", bad, err.message);
+    CHECK(ip_store_verify_octree(s, &err) == IP_OK);
+    ip_store_close(s);
+    free(dst);
+    free(work);
+}
+
+int main(void)
+{
+    const char *dir = test_tmp_dir("test_store");
+    char ibv[4200];
+    make_file(dir, ibv, sizeof ibv);
+    test_reads(ibv);
+    test_zero_fields(dir, ibv);
+    test_not_regular(dir);
+    test_truncated_while_open(dir, ibv);
+    test_rewritten_while_open(dir, ibv);
+    return test_summary("test_store");
+}
