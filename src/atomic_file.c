@@ -10,6 +10,7 @@
 
 #include "atomic_file.h"
 #include "internal.h"
+#include "isoprop/output.h"
 
 static void folder_of(const char *path, char *out, size_t size)
 {
@@ -43,22 +44,104 @@ static ip_status open_named_temp(ip_atomic_file *file, const char *folder, ip_er
     return IP_OK;
 }
 
+/* What a file that is not regular is, for messages. */
+static const char *kind_of(mode_t mode)
+{
+    if (S_ISDIR(mode))
+        return "a directory";
+    if (S_ISCHR(mode))
+        return "a character device";
+    if (S_ISBLK(mode))
+        return "a block device";
+    if (S_ISFIFO(mode))
+        return "a FIFO";
+    if (S_ISSOCK(mode))
+        return "a socket";
+    return "not a regular file";
+}
+
+/* The rule shared by ip_output_check() and the commit: only regular files are replaced.
+ * stat() follows a symbolic link, so a link to a device is refused like the device. */
+static ip_status check_replaceable(const char *path, int force, ip_error *err)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        if (errno == ENOENT)
+            return IP_OK;
+        return ip_fail_errno(err, IP_ERR_IO, errno, "%s: cannot examine the output path",
+                             path);
+    }
+    if (!S_ISREG(st.st_mode))
+        return ip_fail(err, IP_ERR_ARGUMENT,
+                       "%s: exists and is %s, not a regular file; refusing to replace it "
+                       "(even with --force)", path, kind_of(st.st_mode));
+    if (!force)
+        return ip_fail(err, IP_ERR_EXISTS, "%s: exists (use --force to overwrite)", path);
+    return IP_OK;
+}
+
+ip_status ip_output_check(const char *path, int force, ip_error *err)
+{
+    if (!path || !path[0])
+        return ip_fail(err, IP_ERR_ARGUMENT, "the output path is empty");
+    return check_replaceable(path, force, err);
+}
+
+/* The real path of the folder of `path` plus its base name; the path itself when the folder
+ * cannot be resolved. */
+static void canonical_path(const char *path, char *out, size_t size)
+{
+    char folder[IP_PATH_MAX], base[IP_PATH_MAX];
+    folder_of(path, folder, sizeof folder);
+    base_of(path, base, sizeof base);
+    char *real = realpath(folder, NULL);
+    if (!real) {
+        snprintf(out, size, "%s", path);
+        return;
+    }
+    snprintf(out, size, "%s/%s", strcmp(real, "/") == 0 ? "" : real, base);
+    free(real);
+}
+
+int ip_path_same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (!a || !b)
+        return 0;
+    int have_a = stat(a, &sa) == 0, have_b = stat(b, &sb) == 0;
+    if (have_a && have_b)
+        return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    if (have_a || have_b)
+        return 0;
+    char ca[2 * IP_PATH_MAX], cb[2 * IP_PATH_MAX];
+    canonical_path(a, ca, sizeof ca);
+    canonical_path(b, cb, sizeof cb);
+    return strcmp(ca, cb) == 0;
+}
+
+ip_status ip_output_not_input(const char *output_path, const char *input_path, ip_error *err)
+{
+    if (!ip_path_same_file(output_path, input_path))
+        return IP_OK;
+    if (strcmp(output_path, input_path) == 0)
+        return ip_fail(err, IP_ERR_ARGUMENT, "%s: is an input of this run; refusing to write "
+                       "over it", output_path);
+    return ip_fail(err, IP_ERR_ARGUMENT, "%s: is the same file as the input %s; refusing to "
+                   "write over it", output_path, input_path);
+}
+
 ip_status ip_atomic_create(ip_atomic_file *file, const char *path, int force, ip_error *err)
 {
     char folder[IP_PATH_MAX];
-    struct stat st;
     memset(file, 0, sizeof *file);
     file->fd = -1;
     file->force = force;
     if (strlen(path) + 32 >= sizeof file->path)
         return ip_fail(err, IP_ERR_ARGUMENT, "%s: path too long", path);
     snprintf(file->path, sizeof file->path, "%s", path);
-    if (stat(path, &st) == 0) {
-        if (!force)
-            return ip_fail(err, IP_ERR_EXISTS, "%s: exists (use --force to overwrite)", path);
-        if (S_ISDIR(st.st_mode))
-            return ip_fail(err, IP_ERR_ARGUMENT, "%s: is a directory", path);
-    }
+    ip_status st = ip_output_check(path, force, err);
+    if (st != IP_OK)
+        return st;
     folder_of(path, folder, sizeof folder);
     file->fd = open(folder, O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
     if (file->fd >= 0)
@@ -139,7 +222,11 @@ ip_status ip_atomic_commit(ip_atomic_file *file, ip_error *err)
         ip_atomic_abort(file);
         return st;
     }
-    st = file->named ? rename_named(file, err) : link_unnamed(file, err);
+    /* Again, as late as possible: something not regular may have appeared since the create
+     * (rename() would replace a device node or a FIFO with this file). */
+    st = check_replaceable(file->path, file->force, err);
+    if (st == IP_OK)
+        st = file->named ? rename_named(file, err) : link_unnamed(file, err);
     if (st != IP_OK) {
         ip_atomic_abort(file);
         return st;
@@ -200,4 +287,20 @@ ip_status ip_pread_all(int fd, void *data, size_t size, uint64_t offset, const c
         offset += (uint64_t)n;
     }
     return IP_OK;
+}
+
+ip_status ip_output_write(const char *path, const void *data, size_t size, int force,
+                          ip_error *err)
+{
+    ip_atomic_file out;
+    if (!path || (!data && size))
+        return ip_fail(err, IP_ERR_ARGUMENT, "ip_output_write: path and data are required");
+    ip_status st = ip_atomic_create(&out, path, force, err);
+    if (st != IP_OK)
+        return st;
+    st = ip_pwrite_all(out.fd, data, size, 0, path, err);
+    if (st == IP_OK)
+        return ip_atomic_commit(&out, err);
+    ip_atomic_abort(&out);
+    return st;
 }

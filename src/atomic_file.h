@@ -5,7 +5,8 @@
  * gives it its final name in one step (link without --force, so an existing file is never
  * clobbered; link then rename with --force), then fsyncs the folder. Until then nothing exists
  * under the final name; a crash, a signal or an error leaves no partial output behind (with
- * O_TMPFILE, not even a temporary file). Internal to the library.
+ * O_TMPFILE, not even a temporary file). The public face of these rules is
+ * isoprop/output.h. Internal to the library.
  */
 #ifndef ISOPROP_ATOMIC_FILE_H
 #define ISOPROP_ATOMIC_FILE_H
@@ -24,7 +25,10 @@ typedef struct ip_atomic_file {
     char temp_path[IP_PATH_MAX];   /* the fallback temporary name, when named */
 } ip_atomic_file;
 
-/* Starts an output at `path`. Without force, an existing path fails at once (IP_ERR_EXISTS). */
+/* Starts an output at `path`. Without force, an existing path fails at once (IP_ERR_EXISTS);
+ * a path that exists and is not a regular file (a directory, device, FIFO or socket, or a link
+ * to one) fails even with force (IP_ERR_ARGUMENT): only regular files are ever replaced. The
+ * commit checks both again, just before the file gets its name. */
 ip_status ip_atomic_create(ip_atomic_file *file, const char *path, int force, ip_error *err);
 
 /* Makes the output durable and visible under its final name; closes it either way. */

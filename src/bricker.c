@@ -15,6 +15,7 @@
 #include "isoprop/bricker.h"
 #include "isoprop/codec.h"
 #include "isoprop/format.h"
+#include "isoprop/output.h"
 #include "summary.h"
 
 /* One pyramid level's slab: up to B+1 consecutive planes of the level. */
@@ -586,16 +587,35 @@ static void count_bricks(bricker *b)
         (uint64_t)b->layout.dims[0] * b->layout.dims[1] * b->layout.dims[2] * b->sample_size;
 }
 
+/* What no option can make right: a spacing nothing downstream renders correctly, and an
+ * output that is the input (or its detached data file), which --force would replace with the
+ * brick file, or which would be read while it is being written. */
+static ip_status check_request(const ip_input_desc *in, const char *out_path, ip_error *err)
+{
+    ip_status st = ip_spacing_check(in->spacing, in->path, err);
+    if (st == IP_OK)
+        st = ip_output_not_input(out_path, in->path, err);
+    if (st == IP_OK && strcmp(in->data_path, in->path) != 0)
+        st = ip_output_not_input(out_path, in->data_path, err);
+    return st;
+}
+
 ip_status ip_brick_volume(const ip_input_desc *input, const char *out_path,
                           const ip_brick_options *options, ip_brick_report *report,
                           ip_error *err)
 {
     double start = ip_now_seconds();
+    if (!input || !out_path || !options)
+        return ip_fail(err, IP_ERR_ARGUMENT, "ip_brick_volume: input, out_path and options "
+                       "are required");
+    ip_status st = check_request(input, out_path, err);
+    if (st != IP_OK)
+        return st;
     bricker b;
     ip_atomic_file out;
     out.fd = -1;
     out.named = 0;
-    ip_status st = bricker_init(&b, input, out_path, options, err);
+    st = bricker_init(&b, input, out_path, options, err);
     if (st == IP_OK)
         st = ip_atomic_create(&out, out_path, options->force, err);
     if (st == IP_OK)

@@ -131,7 +131,9 @@ void ip_camera_depth_range(const ip_camera *c, const double lo[3], const double 
         extent = fmax(extent, hi[i] - lo[i]);
     if (zmax <= 0)
         zmax = extent;
-    *far_plane = zmax * 1.01 + 1e-3;
+    /* the margin scales with the volume: an absolute one (it was 1e-3 world units) dwarfed
+     * volumes a few nanometres across, and the near plane, far / 10^5, then clipped them */
+    *far_plane = zmax * 1.01 + 1e-3 * extent;
     /* keep the depth buffer's precision: near no closer than far / 10^5 */
     *near_plane = fmax(zmin * 0.99, *far_plane * 1e-5);
 }

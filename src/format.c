@@ -357,6 +357,11 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
     if (ip_layout_init(layout, dims, (ip_type)type, spacing, ip_load_u32le(h + 56),
                        ip_load_u32le(h + 60), &why) != IP_OK)
         return ip_fail(err, IP_ERR_FORMAT, "%s: %s", name, why.message);
+    /* a spacing nothing downstream renders correctly (a file from before the bounds, or a
+     * hostile one): refused here, so that no reader of the library reaches the engine with it */
+    ip_status st = ip_spacing_check(spacing, name, err);
+    if (st != IP_OK)
+        return st;
     for (int i = 144; i < 248; i++)
         if (h[i] != 0)
             return ip_fail(err, IP_ERR_FORMAT, "%s: reserved header byte %d is not zero", name, i);
@@ -444,6 +449,8 @@ static ip_status check_entry(const ip_layout *l, uint64_t g, const ip_brick_entr
     else if (e->encoding == IP_BRICK_CONSTANT) {
         if (e->stored_size != 0 || e->filters != 0 || e->checksum != 0 || lo != hi)
             why = "an inconsistent constant entry";
+        else if (!ip_type_holds(l->type, lo))
+            why = "a constant value its sample type cannot hold";
     } else if (e->encoding == IP_BRICK_RAW) {
         if (e->stored_size != raw || e->filters != 0)
             why = "a raw payload of the wrong size";

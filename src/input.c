@@ -189,7 +189,8 @@ static ip_status validate_spacing(const ip_input_desc *desc, ip_error *err)
             return ip_fail(err, IP_ERR_INPUT, "%s: spacing %g along %c is not a positive number",
                            desc->path, s, axis_names[axis]);
     }
-    return IP_OK;
+    /* a positive spacing can still be one that nothing downstream renders correctly */
+    return ip_spacing_check(desc->spacing, desc->path, err);
 }
 
 /* dims x type size in bytes; a product past 63 bits (file offsets are signed) is an error. */
@@ -344,11 +345,28 @@ ip_status ip_input_describe(const char *path, const ip_input_overrides *override
 
 ip_status ip_header_open(ip_header_file *header, const char *path, ip_error *err)
 {
+    struct stat st;
     memset(header, 0, sizeof *header);
     header->path = path;
-    header->file = fopen(path, "rb");
-    if (!header->file)
+    /* O_NONBLOCK: a FIFO must be refused below, not hang the caller waiting for a writer. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
         return ip_fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
+    if (fstat(fd, &st) != 0) {
+        int e = errno;
+        close(fd);
+        return ip_fail_errno(err, IP_ERR_IO, e, "%s: cannot stat", path);
+    }
+    if (!S_ISREG(st.st_mode)) {
+        close(fd);
+        return ip_fail(err, IP_ERR_INPUT, "%s: not a regular file", path);
+    }
+    header->file = fdopen(fd, "rb");
+    if (!header->file) {
+        int e = errno;
+        close(fd);
+        return ip_fail_errno(err, IP_ERR_NOMEM, e, "%s: cannot read", path);
+    }
     return IP_OK;
 }
 

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -100,9 +101,17 @@ ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_err
         ip_input_close(r);
         return status;
     }
-    r->fd = open(desc->data_path, O_RDONLY | O_CLOEXEC);
+    /* O_NONBLOCK and the type check: the file may have been replaced by a FIFO or a device
+     * since ip_input_describe() looked at it; reading one would hang or never end. */
+    r->fd = open(desc->data_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (r->fd < 0) {
         status = ip_fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", r->label);
+        ip_input_close(r);
+        return status;
+    }
+    struct stat st;
+    if (fstat(r->fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        status = ip_fail(err, IP_ERR_INPUT, "%s: not a regular file", r->label);
         ip_input_close(r);
         return status;
     }

@@ -6,6 +6,7 @@
 #include "atomic_file.h"
 #include "internal.h"
 #include "isoprop/generate.h"
+#include "isoprop/output.h"
 
 /* Output planes are gathered into writes of about this many bytes. */
 #define WRITE_GROUP_BYTES ((size_t)16 << 20)
@@ -272,7 +273,13 @@ ip_status ip_upsample_write(const ip_input_desc *input, uint32_t factor, const c
         return ip_fail(err, IP_ERR_ARGUMENT, "%s: upsampling factor must be at least 1", path);
     u.input = input;
     u.factor = factor;
-    ip_status st = upsampler_size(&u, path, err);
+    /* the output replaces nothing it reads (with force it would otherwise replace the input) */
+    ip_status st = ip_output_not_input(path, input->path, err);
+    if (st == IP_OK && strcmp(input->data_path, input->path) != 0)
+        st = ip_output_not_input(path, input->data_path, err);
+    if (st != IP_OK)
+        return st;
+    st = upsampler_size(&u, path, err);
     if (st == IP_OK)
         st = upsampler_alloc(&u, path, err);
     if (st == IP_OK)

@@ -1,4 +1,5 @@
 /* Sample types, dimension parsing and small platform helpers. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,6 +29,17 @@ const char *ip_type_name(ip_type type)
     case IP_FLOAT32: return "float32";
     }
     return "unknown";
+}
+
+int ip_type_holds(ip_type type, float value)
+{
+    switch (type) {
+    case IP_UINT8: return value >= 0.0f && value <= 255.0f && value == floorf(value);
+    case IP_UINT16: return value >= 0.0f && value <= 65535.0f && value == floorf(value);
+    case IP_INT16: return value >= -32768.0f && value <= 32767.0f && value == floorf(value);
+    case IP_FLOAT32: return isfinite(value);
+    }
+    return 0;
 }
 
 ip_status ip_type_parse(const char *name, ip_type *out)
@@ -83,6 +95,39 @@ ip_status ip_dims_parse(const char *text, uint32_t dims[3])
     if (*p != '\0')
         return IP_ERR_ARGUMENT;
     memcpy(dims, parsed, sizeof parsed);
+    return IP_OK;
+}
+
+ip_status ip_spacing_check(const double spacing[3], const char *name, ip_error *err)
+{
+    static const char axes[3] = {'x', 'y', 'z'};
+    const char *who = name && name[0] ? name : "spacing";
+    const char *sep = name && name[0] ? ": spacing" : "";
+    for (int a = 0; a < 3; a++) {
+        double s = spacing[a];
+        if (!(s >= IP_SPACING_MIN && s <= IP_SPACING_MAX))
+            return ip_fail(err, IP_ERR_UNSUPPORTED,
+                           "%s%s %g along %c is outside the range that renders correctly, "
+                           "%g to %g world units (express the spacing in another unit, e.g. "
+                           "%s)",
+                           who, sep, s, axes[a], IP_SPACING_MIN, IP_SPACING_MAX,
+                           s < IP_SPACING_MIN ? "micrometres instead of metres"
+                                              : "kilometres instead of metres");
+    }
+    int lo = 0, hi = 0;
+    for (int a = 1; a < 3; a++) {
+        if (spacing[a] < spacing[lo])
+            lo = a;
+        if (spacing[a] > spacing[hi])
+            hi = a;
+    }
+    if (spacing[hi] > IP_SPACING_RATIO_MAX * spacing[lo])
+        return ip_fail(err, IP_ERR_UNSUPPORTED,
+                       "%s%s %g,%g,%g: %g along %c is %g times %g along %c, more than the "
+                       "%g times that renders correctly (resample the volume to a less "
+                       "anisotropic grid)",
+                       who, sep, spacing[0], spacing[1], spacing[2], spacing[hi], axes[hi],
+                       spacing[hi] / spacing[lo], spacing[lo], axes[lo], IP_SPACING_RATIO_MAX);
     return IP_OK;
 }
 

@@ -43,9 +43,25 @@ static int test_checks_failed;
 #define CHECK_CONTAINS(text, needle) \
     CHECK_MSG(strstr((text), (needle)) != NULL, "\"%s\" lacks \"%s\"", (text), (needle))
 
+/* The scratch folders test_tmp_dir() made, removed by test_summary() when every check
+ * passed and kept, for diagnosis, otherwise (and after a REQUIRE or a crash). */
+#define TEST_TMP_DIRS_MAX 16
+static char test_tmp_dirs[TEST_TMP_DIRS_MAX][4096];
+static int test_tmp_dir_count;
+
 static inline int test_summary(const char *name)
 {
     printf("%s: %d passed, %d failed\n", name, test_checks_passed, test_checks_failed);
+    for (int i = 0; i < test_tmp_dir_count; i++) {
+        char cmd[sizeof test_tmp_dirs[0] + 64];
+        if (test_checks_failed == 0) {
+            int n = snprintf(cmd, sizeof cmd, "rm -rf '%s'", test_tmp_dirs[i]);
+            if (n < 0 || (size_t)n >= sizeof cmd || system(cmd) != 0)
+                fprintf(stderr, "%s: cannot remove %s\n", name, test_tmp_dirs[i]);
+        } else {
+            fprintf(stderr, "%s: scratch files kept in %s\n", name, test_tmp_dirs[i]);
+        }
+    }
     return test_checks_failed == 0 ? 0 : 1;
 }
 
@@ -61,6 +77,11 @@ static inline const char *test_tmp_dir(const char *name)
         fprintf(stderr, "cannot create %s\n", dir);
         exit(1);
     }
+    int known = 0;
+    for (int i = 0; i < test_tmp_dir_count; i++)
+        known |= strcmp(test_tmp_dirs[i], dir) == 0;
+    if (!known && test_tmp_dir_count < TEST_TMP_DIRS_MAX)
+        snprintf(test_tmp_dirs[test_tmp_dir_count++], sizeof test_tmp_dirs[0], "%s", dir);
     return dir;
 }
 

@@ -1,6 +1,5 @@
 /* isobrick: brick a raw, NRRD or MetaImage volume into a brick file (.ibv), once. */
 #include <errno.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,17 +26,10 @@ static const char usage[] =
     "  --hc [LEVEL]        LZ4 high compression (level 1-12, default 9) instead of fast\n"
     "  --threads N         compression threads (default: all cores)\n"
     "  --mem-mb N          cap on working memory in MiB (default: none)\n"
-    "  --force             replace OUT if it exists\n"
-    "  --quiet             no progress bar and no summary\n";
-
-/* Set by SIGINT/SIGTERM; the progress callback turns it into a clean cancel. */
-static volatile sig_atomic_t interrupted;
-
-static void on_signal(int sig)
-{
-    (void)sig;
-    interrupted = 1;
-}
+    "  --force             replace OUT if it exists (a regular file; never the input)\n"
+    "  --quiet             no progress bar and no summary\n"
+    "  --version           print the version and exit\n"
+    "Ctrl-C cancels cleanly: no output is left, and isobrick ends as killed by the signal.\n";
 
 typedef struct progress_state {
     int show;
@@ -63,7 +55,7 @@ static int report_progress(void *user, uint64_t done, uint64_t total)
             p->last = now;
         }
     }
-    return interrupted != 0;
+    return tool_signal_caught() != 0; /* SIGINT/SIGTERM: a clean cancel */
 }
 
 typedef struct options {
@@ -84,11 +76,14 @@ static int parse_args(int argc, char **argv, options *o)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage, stdout);
             exit(0);
+        } else if (!strcmp(a, "--version")) {
+            tool_print_version("isobrick");
+            exit(0);
         } else if (!strcmp(a, "-o") && v) {
             o->output = v, i++;
         } else if (!strcmp(a, "--dims") && v) {
-            if (ip_dims_parse(v, o->overrides.dims) != IP_OK)
-                return tool_usage_error("isobrick", "--dims '%s' is not XxYxZ", v);
+            if (tool_parse_dims("isobrick", "--dims", v, o->overrides.dims) != 0)
+                return 2;
             o->overrides.has_dims = 1, i++;
         } else if (!strcmp(a, "--type") && v) {
             if (ip_type_parse(v, &o->overrides.type) != IP_OK)
@@ -195,11 +190,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "isobrick: cannot create the folder bricks/ for the output\n");
         return 1;
     }
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    /* the input, its detached data file (NRRD, MetaImage) and the output, before any work */
+    const char *inputs[] = {desc.path, desc.data_path}, *outputs[] = {out};
+    if (tool_check_paths("isobrick", inputs, 2, outputs, 1, o.brick.force) != 0)
+        return 1;
+    tool_signals_catch();
     progress_state progress = {!o.quiet && isatty(STDERR_FILENO), 0, 0};
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -210,7 +205,9 @@ int main(int argc, char **argv)
     if (ip_brick_volume(&desc, out, &o.brick, &report, &err) != IP_OK) {
         if (progress.show)
             fputc('\n', stderr);
-        return tool_fail("isobrick", &err);
+        rc = tool_fail("isobrick", &err);
+        tool_signals_reraise(); /* cancelled by a signal: end as killed by it */
+        return rc;
     }
     if (!o.quiet)
         print_summary(&report, out);

@@ -32,8 +32,9 @@ static const char usage_text[] =
     "  --endian E       byte order of a raw INPUT (default little)\n"
     "  -o OUT           output file, or a folder (existing, or ending in '/') to write the\n"
     "                   conventionally named file into (default: that name, here)\n"
-    "  --force          replace an existing output\n"
+    "  --force          replace an existing output (a regular file; never the input)\n"
     "  --quiet          print nothing on success\n"
+    "  --version        print the version and exit\n"
     "\n"
     "Prints the path written on stdout and a one-line summary on stderr.\n"
     "Exit status: 0 success, 1 failure, 2 bad command line.\n";
@@ -81,8 +82,8 @@ static int apply_value(options *o, const char *name, const char *value)
 {
     uint64_t u;
     if (strcmp(name, "--dims") == 0) {
-        if (ip_dims_parse(value, o->dims) != IP_OK)
-            return tool_usage_error(PROGRAM, "--dims: '%s' is not XxYxZ", value);
+        if (tool_parse_dims(PROGRAM, "--dims", value, o->dims) != 0)
+            return 2;
         o->has_dims = 1;
     } else if (strcmp(name, "--type") == 0) {
         if (ip_type_parse(value, &o->type) != IP_OK)
@@ -111,7 +112,8 @@ static int apply_value(options *o, const char *name, const char *value)
     return 0;
 }
 
-/* Handles argv[*i]; returns 0 to go on, 2 after a usage error, -1 after --help. */
+/* Handles argv[*i]; returns 0 to go on, 2 after a usage error, -1 after --help, -2 after
+ * --version. */
 static int parse_argument(options *o, int argc, char **argv, int *i)
 {
     static const char *const valued[] = {"--dims", "--type", "--endian", "--noise",
@@ -119,6 +121,8 @@ static int parse_argument(options *o, int argc, char **argv, int *i)
     const char *arg = argv[*i];
     if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0)
         return -1;
+    if (strcmp(arg, "--version") == 0)
+        return -2;
     if (strcmp(arg, "--force") == 0) {
         o->force = 1;
         return 0;
@@ -257,6 +261,9 @@ static int run_generate(const options *o, ip_field field)
             IP_OK ||
         output_path(o->output, name, path, sizeof path) != 0)
         return 1;
+    const char *outputs[] = {path};
+    if (tool_check_paths(PROGRAM, NULL, 0, outputs, 1, o->force) != 0)
+        return 1;
     double start = now_seconds();
     if (ip_generate_write(&params, path, o->force, &err) != IP_OK)
         return tool_fail(PROGRAM, &err);
@@ -296,6 +303,9 @@ static int run_upsample(const options *o)
     }
     if (output_path(o->output, file, path, sizeof path) != 0)
         return 1;
+    const char *inputs[] = {desc.path, desc.data_path}, *outputs[] = {path};
+    if (tool_check_paths(PROGRAM, inputs, 2, outputs, 1, o->force) != 0)
+        return 1;
     double start = now_seconds();
     if (ip_upsample_write(&desc, o->factor, path, o->force, &err) != IP_OK)
         return tool_fail(PROGRAM, &err);
@@ -310,6 +320,10 @@ int main(int argc, char **argv)
     memset(&o, 0, sizeof o);
     for (int i = 1; i < argc; i++) {
         int rc = parse_argument(&o, argc, argv, &i);
+        if (rc == -2) {
+            tool_print_version(PROGRAM);
+            return 0;
+        }
         if (rc < 0) {
             fputs(usage_text, stdout);
             return 0;

@@ -9,14 +9,19 @@
 #include "tool_common.h"
 
 static const char usage[] =
-    "usage: isoinfo FILE.ibv [--json] [--verify] [--cache-mb N] [--stats FILE.json]\n"
+    "usage: isoinfo FILE.ibv [--json] [--verify] [--cache-mb N] [--stats FILE.json] [--force]\n"
     "Prints the header, levels, brick counts, compression ratio, value range and summary size.\n"
     "  --json     print the same as one JSON object\n"
     "  --verify   check every checksum, decode every brick and compare it with its summaries;\n"
     "             exits 1 and names the first bad brick; reads through the brick cache and\n"
     "             prints its statistics on exit\n"
     "  --cache-mb N     brick cache budget in MiB (default 512, or a quarter of RAM if less)\n"
-    "  --stats FILE     write the cache statistics as JSON (a \"cache\" object)\n";
+    "  --stats FILE     write the cache statistics as JSON (a \"cache\" object), complete or\n"
+    "                   not at all\n"
+    "  --force          replace an existing --stats file (a regular file; never the input)\n"
+    "  --version        print the version and exit\n"
+    "Ctrl-C stops --verify cleanly: no --stats is written, and isoinfo ends as killed by the\n"
+    "signal.\n";
 
 typedef struct file_facts {
     uint64_t constant, compressed, raw, payload_bytes, raw_bytes;
@@ -117,6 +122,11 @@ static int verify(const ip_store *s, ip_cache *cache, int quiet)
     ip_error err;
     ip_error_clear(&err);
     for (uint64_t g = 0; g < l->brick_count; g++) {
+        if (tool_signal_caught()) {
+            fprintf(stderr, "isoinfo: %s: verification cancelled after %llu of %llu bricks\n",
+                    ip_store_path(s), (unsigned long long)g, (unsigned long long)l->brick_count);
+            return 1;
+        }
         ip_brick b;
         if (ip_cache_pin_brick(cache, g, &b, &err) != IP_OK)
             return tool_fail("isoinfo", &err);
@@ -136,12 +146,17 @@ static int verify(const ip_store *s, ip_cache *cache, int quiet)
 int main(int argc, char **argv)
 {
     const char *path = NULL, *stats_path = NULL;
-    int json = 0, check = 0;
+    int json = 0, check = 0, force = 0;
     uint64_t budget = ip_cache_default_budget();
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
             fputs(usage, stdout);
             return 0;
+        } else if (!strcmp(argv[i], "--version")) {
+            tool_print_version("isoinfo");
+            return 0;
+        } else if (!strcmp(argv[i], "--force")) {
+            force = 1;
         } else if (!strcmp(argv[i], "--json")) {
             json = 1;
         } else if (!strcmp(argv[i], "--verify")) {
@@ -161,6 +176,11 @@ int main(int argc, char **argv)
     }
     if (!path)
         return tool_usage_error("isoinfo", "no file");
+    const char *inputs[] = {path}, *outputs[] = {stats_path};
+    if (tool_check_paths("isoinfo", inputs, 1, outputs, 1, force) != 0)
+        return 1;
+    if (check)
+        tool_signals_catch(); /* --verify reads every brick: Ctrl-C stops it cleanly */
     ip_store *store;
     ip_error err;
     ip_error_clear(&err);
@@ -179,8 +199,11 @@ int main(int argc, char **argv)
     uint64_t summary_bytes = ip_store_layout(store)->summary_size;
     if (check && !json)
         tool_print_cache_table(stdout, &stats, summary_bytes);
-    if (stats_path && tool_write_stats_file("isoinfo", stats_path, &stats, summary_bytes, NULL,
-                                            NULL) != 0)
+    if (rc == 0 && tool_signal_caught())
+        rc = 1; /* the last brick was checked, but the run was interrupted: no output */
+    if (stats_path && !tool_signal_caught() &&
+        tool_write_stats_file("isoinfo", stats_path, force, &stats, summary_bytes, NULL,
+                              NULL) != 0)
         rc = 1;
     if (rc == 0) {
         if (json)
@@ -190,5 +213,6 @@ int main(int argc, char **argv)
     }
     ip_cache_destroy(cache);
     ip_store_close(store);
+    tool_signals_reraise();
     return rc;
 }

@@ -34,11 +34,16 @@ static const char usage[] =
     "  --threads N         threads for seeding, propagation and --full (default: all cores)\n"
     "  -o OUT.png          the image (default isorender.png)\n"
     "  --mesh OUT.ply      also write the triangles as binary PLY\n"
-    "  --stats OUT.json    counts, times and the cache statistics as JSON\n"
+    "  --stats OUT.json    counts, times, warnings and the cache statistics as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct at checkpoints\n"
     "  --software          render with the software rasterizer instead of OpenGL\n"
-    "  --force             replace existing outputs\n"
-    "  --quiet             print nothing but errors\n";
+    "  --force             replace existing outputs (regular files only; never an input)\n"
+    "  --quiet             print nothing but errors and warnings\n"
+    "  --version           print the version and exit\n"
+    "Every output appears only when complete. The summary's time line gives the extraction's\n"
+    "wall time, then its parts (intersection, propagation, marching cubes) in CPU seconds\n"
+    "summed over the threads, which can add up to more than the wall time. Ctrl-C cancels:\n"
+    "no output is written, and isorender ends as killed by the signal.\n";
 
 typedef struct options {
     tool_view_options common;
@@ -66,6 +71,8 @@ typedef struct run {
     size_t checkpoint_count;
     double extraction_wall, progress_render_seconds, final_pct;
     const char *renderer_name;
+    char warning[600];    /* the --iso warning, "" when none */
+    int writing;          /* 1 once the outputs are being written */
 } run;
 
 static int parse_args(int argc, char **argv, options *o)
@@ -82,6 +89,9 @@ static int parse_args(int argc, char **argv, options *o)
             continue;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage, stdout);
+            exit(0);
+        } else if (!strcmp(a, "--version")) {
+            tool_print_version("isorender");
             exit(0);
         } else if (!strcmp(a, "-o") && v) {
             o->out = v, i++;
@@ -163,6 +173,7 @@ static int extract_progressive(run *r, ip_error *err)
     tool_engine_options(&r->o.common, &eo);
     if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
         return -1;
+    tool_signals_cancel_engine(r->engine);
     if (r->o.warm) { /* the same work once, untimed: the bricks it needs stay in the cache */
         if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK ||
             ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
@@ -172,7 +183,8 @@ static int extract_progressive(run *r, ip_error *err)
         return -1;
     double start = now();
     uint64_t target = 1, limit = r->o.common.rays ? r->o.common.rays : UINT64_MAX;
-    while (!ip_engine_done(r->engine)) {
+    /* ip_engine_begin() clears a cancel: a signal before it is seen through the flag */
+    while (!ip_engine_done(r->engine) && !tool_signal_caught()) {
         ip_engine_counts t;
         ip_engine_totals(r->engine, &t);
         if (t.rays >= limit)
@@ -257,15 +269,9 @@ static int final_pixels(run *r, ip_error *err)
     return 0;
 }
 
-static int write_progress(const run *r)
+static void progress_csv(FILE *f, void *user)
 {
-    char temp[4200];
-    snprintf(temp, sizeof temp, "%s.tmp", r->o.progress);
-    FILE *f = fopen(temp, "w");
-    if (!f) {
-        fprintf(stderr, "isorender: %s: cannot write\n", r->o.progress);
-        return -1;
-    }
+    const run *r = user;
     fprintf(f, "time_s,rays,seeds,cells,triangles,final_pixel_pct\n");
     for (size_t c = 0; c < r->checkpoint_count; c++) {
         const checkpoint *k = &r->checkpoints[c];
@@ -273,13 +279,6 @@ static int write_progress(const run *r)
                 (unsigned long long)k->seeds, (unsigned long long)k->cells,
                 (unsigned long long)k->triangles, k->final_pct);
     }
-    int bad = ferror(f) | (fclose(f) != 0);
-    if (bad || rename(temp, r->o.progress) != 0) {
-        fprintf(stderr, "isorender: %s: cannot write\n", r->o.progress);
-        remove(temp);
-        return -1;
-    }
-    return 0;
 }
 
 /* Renders with OpenGL through EGL, or in software when asked or when no OpenGL is found. */
@@ -344,6 +343,10 @@ static void json_counts(FILE *f, void *user)
     if (r->checkpoint_count)
         fprintf(f, ", \"final_pixel_pct\": %.4f",
                 r->checkpoints[r->checkpoint_count - 1].final_pct);
+    fprintf(f, ", \"warnings\": [");
+    if (r->warning[0])
+        tool_json_string(f, r->warning);
+    fprintf(f, "]");
 }
 
 static void print_summary(const run *r)
@@ -356,10 +359,11 @@ static void print_summary(const run *r)
     printf("  seeds         %llu\n", (unsigned long long)t->seeds);
     printf("  cells         %llu\n", (unsigned long long)t->cells);
     printf("  triangles     %llu\n", (unsigned long long)t->triangles);
-    printf("  time          %.3f s extraction: intersection %.3f, propagation %.3f, "
-           "marching cubes %.3f; rendering %.3f (%s)\n",
-           r->extraction_wall, t->intersection_seconds, t->propagation_seconds,
-           t->extraction_seconds, t->rendering_seconds, r->renderer_name);
+    printf("  time          %.3f s extraction (wall); CPU s summed over %u threads: "
+           "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
+           r->extraction_wall, ip_thread_count(r->o.common.threads), t->intersection_seconds,
+           t->propagation_seconds, t->extraction_seconds, t->rendering_seconds,
+           r->renderer_name);
     printf("  image         %s\n", r->o.out);
 }
 
@@ -373,6 +377,8 @@ static void drop_bricks(run *r)
 #endif
 }
 
+/* Renders, then writes every output (each all-or-nothing). A signal caught before the
+ * writing starts means no output at all. */
 static int finish(run *r, ip_error *err)
 {
     ip_cache_stats st;
@@ -386,27 +392,31 @@ static int finish(run *r, ip_error *err)
         return 1;
     }
     int rc = render_image(r, rgba, err);
-    if (rc == 0 && ip_png_write(r->o.out, rgba, r->camera.width, r->camera.height, r->o.force,
-                                err) != IP_OK)
+    if (rc == 0 && r->o.progress && !r->o.full && final_pixels(r, err) != 0)
+        rc = -1;
+    if (rc != 0 || tool_signal_caught()) {
+        free(rgba);
+        return rc != 0 ? tool_fail("isorender", err) : 1;
+    }
+    r->writing = 1;
+    if (ip_png_write(r->o.out, rgba, r->camera.width, r->camera.height, r->o.force, err) !=
+        IP_OK)
         rc = -1;
     free(rgba);
     if (rc == 0 && r->o.mesh && ip_mesh_write_ply(r->mesh, r->o.mesh, r->o.force, err) != IP_OK)
         rc = -1;
     if (rc != 0)
         return tool_fail("isorender", err);
-    if (r->o.progress && !r->o.full) {
-        if (final_pixels(r, err) != 0)
-            return tool_fail("isorender", err);
-        if (write_progress(r) != 0)
-            return 1;
-    }
+    if (r->o.progress && !r->o.full &&
+        tool_write_text_file("isorender", r->o.progress, r->o.force, progress_csv, r) != 0)
+        return 1;
     uint64_t summary = ip_store_layout(r->store)->summary_size;
     if (!r->o.quiet) {
         print_summary(r);
         tool_print_cache_table(stdout, &st, summary);
     }
-    if (r->o.stats && tool_write_stats_file("isorender", r->o.stats, &st, summary, json_counts,
-                                            r) != 0)
+    if (r->o.stats && tool_write_stats_file("isorender", r->o.stats, r->o.force, &st, summary,
+                                            json_counts, r) != 0)
         return 1;
     return 0;
 }
@@ -418,21 +428,38 @@ int main(int argc, char **argv)
     int rc = parse_args(argc, argv, &r.o);
     if (rc)
         return rc;
+    const char *inputs[] = {r.o.file};
+    const char *outputs[] = {r.o.out, r.o.mesh, r.o.stats, r.o.full ? NULL : r.o.progress};
+    if (tool_check_paths("isorender", inputs, 1, outputs, 4, r.o.force) != 0)
+        return 1;
+    tool_signals_catch();
     ip_error err;
     ip_error_clear(&err);
-    if (ip_store_open(r.o.file, &r.store, &err) != IP_OK)
-        return tool_fail("isorender", &err);
+    if (ip_store_open(r.o.file, &r.store, &err) != IP_OK) {
+        rc = tool_fail("isorender", &err);
+        tool_signals_reraise();
+        return rc;
+    }
     rc = 1;
     if (ip_cache_create(r.store, r.o.common.cache_bytes, &r.cache, &err) != IP_OK ||
-        setup_camera(&r, &err) != 0 ||
-        (r.o.full ? extract_full(&r, &err) : extract_progressive(&r, &err)) != 0)
+               setup_camera(&r, &err) != 0) {
         rc = tool_fail("isorender", &err);
-    else
-        rc = finish(&r, &err);
+    } else {
+        /* the errors above come first: a bad command line is one line, not a warning too */
+        tool_warn_iso_range("isorender", r.store, r.o.common.iso, r.warning, sizeof r.warning);
+        if ((r.o.full ? extract_full(&r, &err) : extract_progressive(&r, &err)) == 0)
+            rc = finish(&r, &err);
+        else if (!(err.code == IP_ERR_CANCELLED && tool_signal_caught()))
+            rc = tool_fail("isorender", &err); /* a cancel by a signal is reported below */
+    }
+    tool_signals_cancel_engine(NULL);
+    if (tool_signal_caught() && !r.writing)
+        fprintf(stderr, "isorender: %s: cancelled; no output written\n", r.o.file);
     ip_engine_destroy(r.engine);
     ip_mesh_free(&r.full_mesh);
     free(r.checkpoints);
     ip_cache_destroy(r.cache);
     ip_store_close(r.store);
+    tool_signals_reraise();
     return rc;
 }

@@ -29,11 +29,13 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -47,6 +49,7 @@
 
 #include "isoprop/cache.h"
 #include "isoprop/engine.h"
+#include "isoprop/output.h"
 #include "isoprop/render.h"
 #include "isoprop/store.h"
 #include "tool_common.h"
@@ -80,8 +83,12 @@ static const char usage[] =
     "                      save the window's image that long after it opened\n"
     "  --exit-after SECONDS\n"
     "                      close the window that long after it opened (exit status 0)\n"
-    "  --force             replace existing screenshots named by --script or --screenshot-at\n"
-    "  --quiet             print nothing but errors\n"
+    "  --force             replace existing outputs: --stats, screenshots named by --script\n"
+    "                      or --screenshot-at (regular files only; never an input)\n"
+    "  --quiet             print nothing but errors and warnings\n"
+    "  --version           print the version and exit\n"
+    "Ctrl-C (or SIGTERM) closes the window without writing --stats or pending screenshots;\n"
+    "isoview then ends as killed by the signal.\n"
     "Controls: left drag orbits, right drag pans, the wheel zooms; Up/Down change V by 1 %\n"
     "of the value range (with Shift 0.1 %), PageUp/PageDown by 10 %; i types V (Enter\n"
     "applies); r resets the view; p pauses; f extracts everything; s saves a screenshot;\n"
@@ -231,6 +238,9 @@ static int parse_args(int argc, char **argv, options *o)
             continue;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage, stdout);
+            exit(0);
+        } else if (!strcmp(a, "--version")) {
+            tool_print_version("isoview");
             exit(0);
         } else if (!strcmp(a, "--stats") && v) {
             o->stats = v, i++;
@@ -459,10 +469,8 @@ static int parse_command(viewer *v, char *line, command *c, ip_error *err)
     } else if (!strcmp(word, "screenshot")) {
         if (args != 1)
             goto arguments;
-        if (!v->o.force && access(arg1, F_OK) == 0) {
-            set_error(err, IP_ERR_EXISTS, "%s exists (use --force to replace it)", arg1);
+        if (ip_output_check(arg1, v->o.force, err) != IP_OK)
             return -1;
-        }
         c->kind = COMMAND_SCREENSHOT;
     } else if (!strcmp(word, "quit")) {
         if (args != 0)
@@ -491,9 +499,22 @@ arguments:
 /* Reads the whole script up front, so that a bad line fails before a window opens. */
 static int load_script(viewer *v, ip_error *err)
 {
-    FILE *f = fopen(v->o.script, "r");
-    if (!f) {
+    /* O_NONBLOCK and a type check: a FIFO is refused, not waited on */
+    struct stat st;
+    int fd = open(v->o.script, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
         set_error(err, IP_ERR_IO, "%s: cannot open: %s", v->o.script, strerror(errno));
+        return -1;
+    }
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        set_error(err, IP_ERR_IO, "%s: not a regular file", v->o.script);
+        return -1;
+    }
+    FILE *f = fdopen(fd, "r");
+    if (!f) {
+        close(fd);
+        set_error(err, IP_ERR_NOMEM, "%s: cannot read: %s", v->o.script, strerror(errno));
         return -1;
     }
     char line[4096];
@@ -1167,7 +1188,7 @@ static int frame(viewer *v)
     double drawn = now();
     if (draw_frame(v, 0) != 0)
         return -1;
-    if (v->screenshot_pending && save_screenshot(v) != 0)
+    if (v->screenshot_pending && !tool_signal_caught() && save_screenshot(v) != 0)
         return -1;
     glfwSwapBuffers(v->window);
     double end = now();
@@ -1296,18 +1317,49 @@ static int finish(viewer *v)
         print_summary(v);
         tool_print_cache_table(stdout, &s, summary);
     }
-    if (v->o.stats &&
-        tool_write_stats_file("isoview", v->o.stats, &s, summary, json_counts, v) != 0)
+    if (v->o.stats && !tool_signal_caught() &&
+        tool_write_stats_file("isoview", v->o.stats, v->o.force, &s, summary, json_counts, v) !=
+            0)
         return 1;
     return 0;
 }
 
-/* Everything that needs no window, so that bad input fails before one opens. */
+/* The run's inputs and outputs: the brick file, the script, --stats, --screenshot-at and
+ * the script's screenshots, checked together (tool_check_paths()). Returns 0, or 1 after
+ * printing the problem. */
+static int check_paths(const viewer *v)
+{
+    size_t outputs_count = 2;
+    for (size_t i = 0; i < v->command_count; i++)
+        outputs_count += v->commands[i].kind == COMMAND_SCREENSHOT;
+    const char **outputs = calloc(outputs_count, sizeof *outputs);
+    if (!outputs) {
+        fprintf(stderr, "isoview: out of memory\n");
+        return 1;
+    }
+    size_t n = 0;
+    outputs[n++] = v->o.stats;
+    outputs[n++] = v->o.screenshot_path;
+    for (size_t i = 0; i < v->command_count; i++)
+        if (v->commands[i].kind == COMMAND_SCREENSHOT)
+            outputs[n++] = v->commands[i].text;
+    const char *inputs[] = {v->o.file, v->o.script};
+    int rc = tool_check_paths("isoview", inputs, 2, outputs, n, v->o.force);
+    free(outputs);
+    return rc;
+}
+
+/* Everything that needs no window, so that bad input fails before one opens. Returns 0, -1
+ * with the error in v->err, or -2 after the error was printed. */
 static int prepare(viewer *v)
 {
     ip_error *err = &v->err;
-    if (ip_store_open(v->o.file, &v->store, err) != IP_OK ||
-        ip_cache_create(v->store, v->o.common.cache_bytes, &v->cache, err) != IP_OK)
+    const char *inputs[] = {v->o.file, v->o.script};
+    if (tool_check_paths("isoview", inputs, 2, NULL, 0, v->o.force) != 0)
+        return -2;
+    if (ip_store_open(v->o.file, &v->store, err) != IP_OK)
+        return -1;
+    if (ip_cache_create(v->store, v->o.common.cache_bytes, &v->cache, err) != IP_OK)
         return -1;
     const ip_layout *l = ip_store_layout(v->store);
     for (int a = 0; a < 3; a++) {
@@ -1322,14 +1374,15 @@ static int prepare(viewer *v)
         return -1;
     if (v->o.script && load_script(v, err) != 0)
         return -1;
-    if (v->o.screenshot_path && !v->o.force && access(v->o.screenshot_path, F_OK) == 0) {
-        set_error(err, IP_ERR_EXISTS, "%s exists (use --force to replace it)",
-                  v->o.screenshot_path);
-        return -1;
-    }
+    if (check_paths(v) != 0)
+        return -2;
     ip_engine_options eo;
     tool_engine_options(&v->o.common, &eo);
-    return ip_engine_create(v->cache, &eo, &v->engine, err) == IP_OK ? 0 : -1;
+    if (ip_engine_create(v->cache, &eo, &v->engine, err) != IP_OK)
+        return -1;
+    tool_signals_cancel_engine(v->engine);
+    tool_warn_iso_range("isoview", v->store, v->o.common.iso, NULL, 0);
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -1351,14 +1404,16 @@ int main(int argc, char **argv)
     v->drag_button = -1;
     v->restart = 1;
     rc = 1;
-    if (prepare(v) != 0) {
+    tool_signals_catch();
+    int prepared = prepare(v);
+    if (prepared == -1) {
         tool_fail("isoview", &v->err);
-    } else if (open_window(v) == 0) {
+    } else if (prepared == 0 && open_window(v) == 0) {
         /* the window may have opened at another size than asked: fit --view to it */
         if (!v->o.common.camera)
             (void)camera_from(v, NULL, v->o.common.view, &v->camera, &v->err);
         v->start = now();
-        while (!v->quit)
+        while (!v->quit && !tool_signal_caught())
             if (frame(v) != 0) {
                 tool_fail("isoview", &v->err);
                 v->failed = 1;
@@ -1367,6 +1422,10 @@ int main(int argc, char **argv)
         int written = finish(v);
         rc = v->failed || written != 0;
     }
+    tool_signals_cancel_engine(NULL);
+    if (tool_signal_caught())
+        fprintf(stderr, "isoview: %s: interrupted; no --stats or pending screenshot written\n",
+                v->o.file);
     free(v->screenshot_pending);
     overlay_destroy(&v->text);
     ip_renderer_destroy(v->renderer);
@@ -1379,5 +1438,6 @@ int main(int argc, char **argv)
     ip_cache_destroy(v->cache);
     ip_store_close(v->store);
     free(v);
+    tool_signals_reraise();
     return rc;
 }

@@ -5,7 +5,8 @@
 #   tools/setup.sh demo    build, then generate, brick, describe and render the default volume
 #   tools/setup.sh test    build, then run the whole test suite: a -Werror build, a build under
 #                          AddressSanitizer + UndefinedBehaviorSanitizer (with the fuzzers), and
-#                          the threaded tests under ThreadSanitizer
+#                          the threaded tests under ThreadSanitizer; the final summary lists,
+#                          per build, the tests that were skipped (whole or in part) and why
 #   tools/setup.sh build   build only (into build/)
 set -eu
 
@@ -58,20 +59,74 @@ demo() {
     echo "image: bricks/shepp-logan.png, statistics: bricks/shepp-logan.json"
 }
 
+# run_ctest DIR ENV [ctest arguments...]: runs ctest in DIR with the environment assignments
+# ENV (may be empty), showing its output as it comes and keeping it in DIR/ctest.log; returns
+# ctest's status.
+run_ctest() {
+    dir=$1 envs=$2
+    shift 2
+    # shellcheck disable=SC2086 # ENV is a list of assignments
+    { (cd "$dir" && env $envs ctest "$@"); echo $? >"$dir/ctest.status"; } 2>&1 |
+        tee "$dir/ctest.log"
+    return "$(cat "$dir/ctest.status")"
+}
+
+# skip_report DIR: what the last ctest run in DIR skipped, one line each: the tests that did
+# not run (skipped with status 77, or not run at all) with the reason they printed, then the
+# parts of passing tests that they say they skipped (e.g. the volumes of ../shared/data).
+skip_report() {
+    dir=$1
+    log=$dir/Testing/Temporary/LastTest.log
+    [ -f "$dir/ctest.log" ] && [ -f "$log" ] || { echo "    (no ctest log)"; return 0; }
+    whole=$(sed -n 's/^[[:space:]]*[0-9][0-9]* - \(.*\) (\(Skipped\|Not Run\))$/\1|\2/p' \
+        "$dir/ctest.log")
+    awk -v whole="$whole" '
+        BEGIN {
+            n = split(whole, list, "\n")
+            for (i = 1; i <= n; i++) if (split(list[i], f, "|") == 2) how[f[1]] = f[2]
+        }
+        /^[0-9]+\/[0-9]+ Test: / { name = $0; sub(/^[0-9]+\/[0-9]+ Test: /, "", name); next }
+        /^Output:$/ { inside = 1; last = ""; why = ""; getline; next }
+        /^<end of output>$/ {
+            inside = 0
+            if (name in how) {
+                print "    " name ": " (how[name] == "Skipped" ? "skipped" : "not run") ": " \
+                      (why != "" ? why : last != "" ? last : "(no reason printed)")
+                done[name] = 1
+            }
+            next
+        }
+        inside && NF { last = $0; if (tolower($0) ~ /skip/ && why == "") why = $0 }
+        inside && tolower($0) ~ /skip/ && !(name in how) { print "    " name " (passed), in part: " $0 }
+        END {
+            for (t in how) if (!(t in done)) print "    " t ": " tolower(how[t]) " (no output)"
+        }' "$log"
+}
+
 run_tests() {
     status=0
+    skips=$(mktemp)
     echo "== build with -Werror (gcc) and run the suite"
     configure_and_build build -DIP_WERROR=ON
-    (cd build && ctest --output-on-failure -j "$jobs") || status=1
+    run_ctest build "" --output-on-failure -j "$jobs" || status=1
+    { echo "  build (gcc, -Werror):"; skip_report build; } >>"$skips"
     echo "== AddressSanitizer + UndefinedBehaviorSanitizer (clang), fuzzers included"
     CC=clang configure_and_build build-asan -DIP_WERROR=ON -DIP_SANITIZE=address,undefined \
         -DIP_FUZZ=ON
-    (cd build-asan && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j "$jobs") ||
+    run_ctest build-asan "ASAN_OPTIONS=detect_leaks=1" --output-on-failure -j "$jobs" ||
         status=1
+    { echo "  build-asan (clang, ASan + UBSan):"; skip_report build-asan; } >>"$skips"
     echo "== ThreadSanitizer (clang): the threaded tests"
     CC=clang configure_and_build build-tsan -DIP_WERROR=ON -DIP_SANITIZE=thread
-    (cd build-tsan && IP_SKIP_SHARED_DATA=1 ctest --output-on-failure -L threads -j "$jobs") ||
+    run_ctest build-tsan "IP_SKIP_SHARED_DATA=1" --output-on-failure -L threads -j "$jobs" ||
         status=1
+    { echo "  build-tsan (clang, TSan, threaded tests only):"; skip_report build-tsan; } >>"$skips"
+    echo "== skipped tests, per build (whole tests, then parts of passing ones)"
+    awk '
+        /^  [^ ]/ { if (header != "" && !any) print "    none"; print; header = $0; any = 0; next }
+        { any = 1; print }
+        END { if (header != "" && !any) print "    none" }' "$skips"
+    rm -f "$skips"
     if [ "$status" = 0 ]; then echo "setup: all test runs passed"; else echo "setup: FAILED"; fi
     return "$status"
 }

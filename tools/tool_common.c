@@ -1,11 +1,22 @@
 /* Helpers shared by the programs. */
+#include <ctype.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
+#include <pthread.h>
+#include <sched.h>
+#include <signal.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "isoprop/engine.h"
+#include "isoprop/output.h"
+#include "isoprop/version.h"
+#include "isoprop/volume.h"
 #include "tool_common.h"
 
 int tool_fail(const char *program, const ip_error *err)
@@ -66,6 +77,233 @@ int tool_parse_double3(const char *text, double out[3])
         tok = strtok_r(NULL, ",", &save);
     }
     return tok ? -1 : 0;
+}
+
+int tool_parse_dims(const char *program, const char *option, const char *text,
+                    uint32_t dims[3])
+{
+    static const char axes[3] = {'x', 'y', 'z'};
+    unsigned long long value[3];
+    const char *p = text;
+    int count = 0;
+    for (; count < 3; count++) {
+        char *end;
+        if (!isdigit((unsigned char)*p))
+            break;
+        errno = 0;
+        value[count] = strtoull(p, &end, 10);
+        if (errno == ERANGE)
+            value[count] = ULLONG_MAX;
+        p = end;
+        if (count < 2) {
+            if (*p != 'x' && *p != 'X')
+                break;
+            p++;
+        }
+    }
+    if (count < 3 || *p != '\0')
+        return tool_usage_error(program, "%s '%s' is not XxYxZ (three whole numbers, e.g. "
+                                "512x512x234)", option, text);
+    for (int k = 0; k < 3; k++) {
+        if (value[k] < 2)
+            return tool_usage_error(program, "%s '%s': the dimension along %c is %llu; each "
+                                    "must be at least 2", option, text, axes[k], value[k]);
+        if (value[k] >= (1ull << 31))
+            return tool_usage_error(program, "%s '%s': the dimension along %c is too large "
+                                    "(at most %llu)", option, text, axes[k], (1ull << 31) - 1);
+    }
+    if (ip_dims_parse(text, dims) != IP_OK) /* cannot fail after the checks above */
+        return tool_usage_error(program, "%s '%s' is not XxYxZ", option, text);
+    return 0;
+}
+
+void tool_print_version(const char *program)
+{
+    printf("%s %s\n", program, ip_version());
+}
+
+/* An input must be there and be a regular file: a FIFO would block the open or the reads,
+ * a device would never end. stat() does not open, so it never blocks. */
+static int check_input(const char *program, const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        fprintf(stderr, "%s: %s: cannot open: %s\n", program, path, strerror(errno));
+        return 1;
+    }
+    if (S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "%s: %s: is a directory, not a file\n", program, path);
+        return 1;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        fprintf(stderr, "%s: %s: not a regular file (%s)\n", program, path,
+                S_ISFIFO(st.st_mode)   ? "a FIFO"
+                : S_ISCHR(st.st_mode)  ? "a character device"
+                : S_ISBLK(st.st_mode)  ? "a block device"
+                : S_ISSOCK(st.st_mode) ? "a socket"
+                                       : "not a plain file");
+        return 1;
+    }
+    return 0;
+}
+
+/* The folder an output goes into must be there and writable, so that a run with several
+ * outputs does not write the first ones and then fail on a later one. */
+static int check_output_folder(const char *program, const char *path)
+{
+    char folder[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(folder, sizeof folder, ".");
+    else if (slash == path)
+        snprintf(folder, sizeof folder, "/");
+    else
+        snprintf(folder, sizeof folder, "%.*s", (int)(slash - path), path);
+    struct stat st;
+    if (stat(folder, &st) != 0 || !S_ISDIR(st.st_mode) || access(folder, W_OK | X_OK) != 0) {
+        int e = errno;
+        fprintf(stderr, "%s: %s: cannot write in folder %s: %s\n", program, path, folder,
+                stat(folder, &st) == 0 && !S_ISDIR(st.st_mode) ? "not a directory"
+                                                               : strerror(e));
+        return 1;
+    }
+    return 0;
+}
+
+int tool_check_paths(const char *program, const char *const *inputs, size_t input_count,
+                     const char *const *outputs, size_t output_count, int force)
+{
+    ip_error err;
+    for (size_t i = 0; i < input_count; i++)
+        if (inputs[i] && check_input(program, inputs[i]) != 0)
+            return 1;
+    for (size_t o = 0; o < output_count; o++) {
+        if (!outputs[o])
+            continue;
+        for (size_t i = 0; i < input_count; i++)
+            if (inputs[i] && ip_output_not_input(outputs[o], inputs[i], &err) != IP_OK)
+                return tool_fail(program, &err);
+        for (size_t k = 0; k < o; k++)
+            if (outputs[k] && ip_path_same_file(outputs[o], outputs[k])) {
+                if (strcmp(outputs[o], outputs[k]) == 0)
+                    fprintf(stderr, "%s: %s: named for two outputs; each output needs a file "
+                            "of its own\n", program, outputs[o]);
+                else
+                    fprintf(stderr, "%s: %s: is the same file as the output %s; each output "
+                            "needs a file of its own\n", program, outputs[o], outputs[k]);
+                return 1;
+            }
+        if (ip_output_check(outputs[o], force, &err) != IP_OK)
+            return tool_fail(program, &err);
+        if (check_output_folder(program, outputs[o]) != 0)
+            return 1;
+    }
+    return 0;
+}
+
+int tool_write_text_file(const char *program, const char *path, int force,
+                         void (*fill)(FILE *out, void *user), void *user)
+{
+    char *text = NULL;
+    size_t size = 0;
+    FILE *out = open_memstream(&text, &size);
+    if (!out) {
+        fprintf(stderr, "%s: %s: out of memory\n", program, path);
+        return -1;
+    }
+    fill(out, user);
+    int failed = ferror(out);
+    failed |= fclose(out) != 0;
+    if (failed) {
+        fprintf(stderr, "%s: %s: out of memory\n", program, path);
+        free(text);
+        return -1;
+    }
+    ip_error err;
+    ip_status st = ip_output_write(path, text, size, force, &err);
+    free(text);
+    if (st != IP_OK) {
+        tool_fail(program, &err);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- signals ---- */
+
+static volatile sig_atomic_t signal_caught;
+static _Atomic(ip_engine *) signal_engine;
+static atomic_int signal_handlers_running;
+
+static void on_signal(int sig)
+{
+    int saved = errno;
+    atomic_fetch_add(&signal_handlers_running, 1);
+    if (!signal_caught)
+        signal_caught = sig;
+    ip_engine *engine = atomic_load(&signal_engine);
+    if (engine)
+        ip_engine_cancel(engine); /* an atomic store: async-signal-safe */
+    atomic_fetch_sub(&signal_handlers_running, 1);
+    errno = saved;
+}
+
+void tool_signals_catch(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+int tool_signal_caught(void)
+{
+    return signal_caught;
+}
+
+void tool_signals_cancel_engine(ip_engine *engine)
+{
+    atomic_store(&signal_engine, engine);
+    /* a handler running on another thread may have read the old engine: wait it out */
+    while (atomic_load(&signal_handlers_running) != 0)
+        sched_yield();
+}
+
+void tool_signals_reraise(void)
+{
+    int sig = signal_caught;
+    if (!sig)
+        return;
+    tool_signals_cancel_engine(NULL);
+    fflush(stdout);
+    fflush(stderr);
+    signal(sig, SIG_DFL);
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, sig);
+    pthread_sigmask(SIG_UNBLOCK, &set, NULL);
+    raise(sig);
+}
+
+int tool_warn_iso_range(const char *program, const ip_store *store, double iso, char *warning,
+                        size_t warning_size)
+{
+    const ip_layout *l = ip_store_layout(store);
+    if (warning && warning_size)
+        warning[0] = '\0';
+    float v = (float)iso; /* the isovalue as the engine takes it */
+    if (v > l->value_min && v <= l->value_max)
+        return 0;
+    char text[512];
+    snprintf(text, sizeof text, "--iso %g is outside the value range of %s, %g .. %g: there "
+             "is no surface (an isovalue must be above the minimum and at most the maximum)",
+             iso, ip_store_path(store), (double)l->value_min, (double)l->value_max);
+    fprintf(stderr, "%s: warning: %s\n", program, text);
+    if (warning && warning_size)
+        snprintf(warning, warning_size, "%s", text);
+    return 1;
 }
 
 void tool_json_string(FILE *out, const char *text)
@@ -183,33 +421,32 @@ void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_
             (unsigned long long)summary_bytes, (unsigned long long)peak_rss());
 }
 
-int tool_write_stats_file(const char *program, const char *path, const ip_cache_stats *s,
-                          uint64_t summary_bytes, void (*extra)(FILE *out, void *user),
-                          void *user)
+typedef struct stats_json {
+    const ip_cache_stats *stats;
+    uint64_t summary_bytes;
+    void (*extra)(FILE *out, void *user);
+    void *user;
+} stats_json;
+
+static void fill_stats(FILE *out, void *user)
 {
-    char temp[4200];
-    snprintf(temp, sizeof temp, "%s.tmp.%ld", path, (long)getpid());
-    FILE *out = fopen(temp, "w");
-    if (!out) {
-        fprintf(stderr, "%s: %s: cannot write: %s\n", program, path, strerror(errno));
-        return -1;
-    }
+    const stats_json *j = user;
     fprintf(out, "{\"cache\": {");
-    tool_write_cache_json(out, s, summary_bytes);
+    tool_write_cache_json(out, j->stats, j->summary_bytes);
     fprintf(out, "}");
-    if (extra) {
+    if (j->extra) {
         fprintf(out, ", ");
-        extra(out, user);
+        j->extra(out, j->user);
     }
     fprintf(out, "}\n");
-    int failed = ferror(out);
-    failed |= fclose(out) != 0;
-    if (failed || rename(temp, path) != 0) {
-        fprintf(stderr, "%s: %s: cannot write: %s\n", program, path, strerror(errno));
-        unlink(temp);
-        return -1;
-    }
-    return 0;
+}
+
+int tool_write_stats_file(const char *program, const char *path, int force,
+                          const ip_cache_stats *s, uint64_t summary_bytes,
+                          void (*extra)(FILE *out, void *user), void *user)
+{
+    stats_json j = {s, summary_bytes, extra, user};
+    return tool_write_text_file(program, path, force, fill_stats, &j);
 }
 
 void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t height)
@@ -235,15 +472,36 @@ void tool_engine_options(const tool_view_options *o, ip_engine_options *eo)
     eo->pixel_error = o->pixel_error;
 }
 
-static int parse_size(const char *text, uint32_t *w, uint32_t *h)
+#define MAX_IMAGE_SIDE 16384 /* pixels; OpenGL's common maximum renderbuffer size */
+
+/* Parses --size WxH; returns 0, or 2 after a usage error that says what is wrong. */
+static int parse_size(const char *p, const char *text, uint32_t *w, uint32_t *h)
 {
-    unsigned long a, b;
-    char x, extra;
-    if (sscanf(text, "%lu%c%lu%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') || a < 1 ||
-        b < 1 || a > 16384 || b > 16384)
-        return -1;
-    *w = (uint32_t)a;
-    *h = (uint32_t)b;
+    unsigned long long side[2];
+    const char *q = text;
+    for (int k = 0; k < 2; k++) {
+        char *end;
+        if (!isdigit((unsigned char)*q))
+            return tool_usage_error(p, "--size '%s' is not WxH (e.g. 1600x1200)", text);
+        errno = 0;
+        side[k] = strtoull(q, &end, 10);
+        if (errno == ERANGE)
+            side[k] = ULLONG_MAX;
+        q = end;
+        if (k == 0 && *q != 'x' && *q != 'X')
+            return tool_usage_error(p, "--size '%s' is not WxH (e.g. 1600x1200)", text);
+        if (k == 0)
+            q++;
+    }
+    if (*q != '\0')
+        return tool_usage_error(p, "--size '%s' is not WxH (e.g. 1600x1200)", text);
+    for (int k = 0; k < 2; k++)
+        if (side[k] < 1 || side[k] > MAX_IMAGE_SIDE)
+            return tool_usage_error(p, "--size '%s': the %s, %llu pixels, is not within 1 .. "
+                                    "%d", text, k ? "height" : "width", side[k],
+                                    MAX_IMAGE_SIDE);
+    *w = (uint32_t)side[0];
+    *h = (uint32_t)side[1];
     return 0;
 }
 
@@ -255,8 +513,8 @@ static int parse_view_value(const char *p, const char *a, const char *v, tool_vi
             return tool_usage_error(p, "--iso '%s' is not a number", v);
         o->has_iso = 1;
     } else if (!strcmp(a, "--size")) {
-        if (parse_size(v, &o->width, &o->height) != 0)
-            return tool_usage_error(p, "--size '%s' is not WxH", v);
+        if (parse_size(p, v, &o->width, &o->height) != 0)
+            return 2;
     } else if (!strcmp(a, "--view")) {
         o->view = v;
     } else if (!strcmp(a, "--camera")) {

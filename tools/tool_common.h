@@ -2,10 +2,13 @@
 #ifndef ISOPROP_TOOL_COMMON_H
 #define ISOPROP_TOOL_COMMON_H
 
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 
+#include "isoprop/engine.h"
 #include "isoprop/status.h"
+#include "isoprop/store.h"
 
 /* Prints "PROGRAM: message" on stderr and returns exit code 1 (2 for usage errors). */
 int tool_fail(const char *program, const ip_error *err);
@@ -17,6 +20,44 @@ int tool_parse_u64(const char *text, uint64_t *out);
 int tool_parse_double(const char *text, double *out);
 /* Parses "a,b,c" into three finite doubles; returns 0 on success. */
 int tool_parse_double3(const char *text, double out[3]);
+
+/* Parses the value of a dims option ("XxYxZ", each 2 .. 2^31 - 1). Returns 0, or 2 after a
+ * usage error that says what is wrong (not three numbers, a dimension that is zero or under 2,
+ * one too large). */
+int tool_parse_dims(const char *program, const char *option, const char *text,
+                    uint32_t dims[3]);
+
+/* Handles --version: prints "PROGRAM VERSION" (the library's, isoprop/version.h) on stdout. */
+void tool_print_version(const char *program);
+
+/* Checks every file of a run before any work, so that a bad one fails the run at once:
+ * each input (NULL entries are skipped) exists and is a regular file (a FIFO or a device is
+ * refused, never opened); no output is an input (the same file by device and inode, however
+ * spelled); no two outputs are the same file; each output may be written (absent, or a
+ * regular file and `force`; a directory, device or FIFO is refused even with force; see
+ * isoprop/output.h). Returns 0, or 1 after printing one line "PROGRAM: path: problem". */
+int tool_check_paths(const char *program, const char *const *inputs, size_t input_count,
+                     const char *const *outputs, size_t output_count, int force);
+
+/* Writes what fill(out, user) prints as the whole file at `path`, all-or-nothing (nothing is
+ * left at path on failure; an existing file is replaced only with `force`, and only when it
+ * is a regular file). Returns 0, or -1 after printing "PROGRAM: path: reason" on stderr. */
+int tool_write_text_file(const char *program, const char *path, int force,
+                         void (*fill)(FILE *out, void *user), void *user);
+
+/* Ctrl-C and SIGTERM. tool_signals_catch() installs handlers that only record the signal
+ * (and cancel the engine named by tool_signals_cancel_engine(), an atomic store), so that the
+ * program can stop cleanly, write no output and then end as killed by that signal, with
+ * tool_signals_reraise() (shell status 130 for SIGINT, 143 for SIGTERM). */
+void tool_signals_catch(void);
+/* The signal caught so far (SIGINT or SIGTERM), or 0. */
+int tool_signal_caught(void);
+/* The engine a signal cancels from now on (NULL: none). Before an engine is destroyed, call
+ * with NULL: it returns once no handler can still be using the old one. */
+void tool_signals_cancel_engine(ip_engine *engine);
+/* When a signal was caught: flushes stdout and stderr, restores the default action and
+ * raises the signal again (the process ends there). Returns when none was caught. */
+void tool_signals_reraise(void);
 
 /* Writes `text` as a JSON string literal (with quotes and escapes). */
 void tool_json_string(FILE *out, const char *text);
@@ -68,8 +109,16 @@ void tool_print_cache_table(FILE *out, const ip_cache_stats *s, uint64_t summary
 void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_bytes);
 
 /* Writes {"cache": {...}} plus, when extra is not NULL, the members that extra(out, user)
- * prints (each preceded by ", "), to `path` via a temporary file and a rename.
+ * prints (preceded by ", "), to `path` with tool_write_text_file() (all-or-nothing; an
+ * existing file is replaced only with `force`).
  * Returns 0, or -1 after printing "PROGRAM: path: reason" on stderr. */
-int tool_write_stats_file(const char *program, const char *path, const ip_cache_stats *s,
-                          uint64_t summary_bytes, void (*extra)(FILE *out, void *user),
-                          void *user);
+int tool_write_stats_file(const char *program, const char *path, int force,
+                          const ip_cache_stats *s, uint64_t summary_bytes,
+                          void (*extra)(FILE *out, void *user), void *user);
+
+/* Warns (one line on stderr, "PROGRAM: warning: ...") when `iso` cannot cross the file's
+ * value range (a cell is active when min < iso <= max), so that the image is legitimately
+ * empty. `warning` (may be NULL) receives the warning's text, "" when none. Returns 1 when it
+ * warned, else 0. */
+int tool_warn_iso_range(const char *program, const ip_store *store, double iso, char *warning,
+                        size_t warning_size);

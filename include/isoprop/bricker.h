@@ -54,9 +54,14 @@ ip_status ip_brick_memory_needed(const ip_input_desc *input, const ip_brick_opti
 
 /*! ip_brick_volume() : bricks `input` into a new brick file at `out_path`. On any failure,
  *  cancellation included, nothing is left at out_path (an existing file there is untouched).
+ *  Follows the output rules of isoprop/output.h: out_path is never the input file or its
+ *  data file (however spelled), and only a regular file is ever replaced (with force).
  *  `report` (may be NULL) is filled on success.
  *  @return IP_OK, IP_ERR_EXISTS, IP_ERR_LIMIT (memory_limit too small: the message says how
- *  much is needed), IP_ERR_INPUT, IP_ERR_IO, IP_ERR_NOMEM or IP_ERR_CANCELLED. */
+ *  much is needed), IP_ERR_INPUT, IP_ERR_IO, IP_ERR_NOMEM or IP_ERR_CANCELLED;
+ *  IP_ERR_ARGUMENT when out_path is the input (or its data file) or exists as something other
+ *  than a regular file, or an argument is NULL; IP_ERR_UNSUPPORTED for a spacing outside the
+ *  bounds of ip_spacing_check(). */
 ip_status ip_brick_volume(const ip_input_desc *input, const char *out_path,
                           const ip_brick_options *options, ip_brick_report *report,
                           ip_error *err);

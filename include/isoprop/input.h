@@ -58,12 +58,15 @@ typedef struct ip_input_overrides {
  *  MetaImage, anything else headerless raw (little-endian, spacing 1,1,1, dims and type from
  *  a base name NAME_XxYxZ_TYPE.raw or from the overrides). Checks everything that can be
  *  checked before reading samples: a dimension under 2 (or at or above 2^31), an unknown
- *  type, an unreadable or malformed header, a missing data file, a size past 2^63 bytes, and
- *  (raw encoding) a data size that does not equal dims x type size; the length of gzip data
- *  is checked by the reader. Reentrant; *out is untouched on failure.
+ *  type, an unreadable or malformed header, a header or data file that is not a regular file
+ *  (a FIFO or a device is refused at once, never waited on), a missing data file, a size past
+ *  2^63 bytes, (raw encoding) a data size that does not equal dims x type size, and a spacing
+ *  outside the bounds of ip_spacing_check(); the length of gzip data is checked by the
+ *  reader. Reentrant; *out is untouched on failure.
  *  @return IP_OK, or IP_ERR_INPUT / IP_ERR_IO with err->message naming the file and the
- *  problem in one line; IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an
- *  override type that is not an ip_type; IP_ERR_NOMEM when an allocation fails. */
+ *  problem in one line; IP_ERR_UNSUPPORTED for a spacing outside the renderable range;
+ *  IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an override type that is not
+ *  an ip_type; IP_ERR_NOMEM when an allocation fails. */
 ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
                             ip_input_desc *out, ip_error *err);
 
@@ -73,7 +76,8 @@ typedef struct ip_input_reader ip_input_reader;
 /*! ip_input_open() : opens a reader positioned at plane z = 0. *out is owned by the caller
  *  and released with ip_input_close(). Gzip streams use a fixed 256 KiB input buffer and
  *  inflate straight into the caller's planes. @return IP_OK, IP_ERR_IO or IP_ERR_NOMEM;
- *  IP_ERR_ARGUMENT for NULL arguments or a desc without type and dims. */
+ *  IP_ERR_INPUT when the data file is no longer a regular file; IP_ERR_ARGUMENT for NULL
+ *  arguments or a desc without type and dims. */
 ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_error *err);
 
 /*! ip_input_read_planes() : reads the next `count` z-planes into `dst`, which must hold

@@ -89,8 +89,10 @@ ip_status ip_mesh_append_mesh(ip_mesh *mesh, const ip_mesh *from, uint64_t first
                               uint64_t count);
 
 /*! ip_mesh_write_ply() : writes the mesh as binary little-endian PLY (float x,y,z,nx,ny,nz per
- *  vertex, 3 vertices per triangle, faces as uchar-counted int lists), atomically.
- *  @return IP_OK, IP_ERR_EXISTS (force == 0 and the file exists) or IP_ERR_IO. */
+ *  vertex, 3 vertices per triangle, faces as uchar-counted int lists), atomically; only a
+ *  regular file is ever replaced (isoprop/output.h).
+ *  @return IP_OK, IP_ERR_EXISTS (force == 0 and the file exists), IP_ERR_ARGUMENT (the path
+ *  exists and is not a regular file), IP_ERR_NOMEM or IP_ERR_IO. */
 ip_status ip_mesh_write_ply(const ip_mesh *mesh, const char *path, int force, ip_error *err);
 
 #ifdef __cplusplus

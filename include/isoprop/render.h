@@ -77,9 +77,10 @@ ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const dou
 
 /*! ip_png_write() : writes an image given as width * height * 4 bytes (RGBA, top row first)
  *  as an 8-bit PNG: RGB when every alpha is 255, RGBA otherwise. The file appears only once
- *  complete (atomic); an existing `path` is replaced only when `force` is non-zero.
- *  Reentrant. @return IP_OK, IP_ERR_EXISTS, IP_ERR_ARGUMENT (an empty image), IP_ERR_NOMEM
- *  or IP_ERR_IO. */
+ *  complete (atomic); an existing `path` is replaced only when `force` is non-zero, and
+ *  only when it is a regular file (isoprop/output.h).
+ *  Reentrant. @return IP_OK, IP_ERR_EXISTS, IP_ERR_ARGUMENT (an empty image, or a path that
+ *  is not a regular file), IP_ERR_NOMEM or IP_ERR_IO. */
 ip_status ip_png_write(const char *path, const uint8_t *rgba, uint32_t width, uint32_t height,
                        int force, ip_error *err);
 

@@ -33,6 +33,10 @@ typedef enum ip_type {
 /*! ip_type_size() : bytes per sample of `type` (1, 2 or 4); 0 for an unknown type. */
 size_t ip_type_size(ip_type type);
 
+/*! ip_type_holds() : 1 when a sample of `type` can hold `value` exactly (an integer within
+ *  the type's range; any finite value for float32), else 0. */
+int ip_type_holds(ip_type type, float value);
+
 /*! ip_type_name() : the canonical name ("uint8", "uint16", "int16", "float32"), or "unknown". */
 const char *ip_type_name(ip_type type);
 
@@ -60,6 +64,22 @@ inline float ip_sample_get(const void *samples, ip_type type, size_t index)
 /*! ip_dims_parse() : parses "XxYxZ" (e.g. "512x512x234") into dims; each must be in [1, 2^31).
  *  @return IP_OK, or IP_ERR_ARGUMENT when the text is not three positive integers. */
 ip_status ip_dims_parse(const char *text, uint32_t dims[3]);
+
+/* The spacings (world units between samples) the whole pipeline renders correctly: camera
+ * framing, seeding, propagation, level of detail, float32 vertex positions and normals, the
+ * software rasterizer and OpenGL. Measured limits and the safety margins are in
+ * docs/format.md (the header's spacing field). Every component must lie in
+ * [IP_SPACING_MIN, IP_SPACING_MAX], and the largest may be at most IP_SPACING_RATIO_MAX times
+ * the smallest. */
+#define IP_SPACING_MIN 1e-9
+#define IP_SPACING_MAX 1e6
+#define IP_SPACING_RATIO_MAX 1e3
+
+/*! ip_spacing_check() : checks that `spacing` (world units along x, y, z) is within the bounds
+ *  above. `name` (a file name, may be NULL) starts the message. Reentrant.
+ *  @return IP_OK, or IP_ERR_UNSUPPORTED with a one-line message giving the accepted range
+ *  (and suggesting another unit, or resampling for too large a ratio). */
+ip_status ip_spacing_check(const double spacing[3], const char *name, ip_error *err);
 
 #ifdef __cplusplus
 }

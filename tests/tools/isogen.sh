@@ -152,4 +152,6 @@ check "upsample missing input: exit 1" [ "$status" = 1 ]
 check "upsample missing input: one-line error" one_error
 
 echo "isogen: $passed passed, $failed failed"
+# the scratch folder goes when the test passes, stays for diagnosis when it fails
+if [ "$failed" = 0 ]; then rm -rf "$work"; else echo "isogen: scratch files kept in $work" >&2; fi
 [ "$failed" = 0 ]

@@ -1,5 +1,7 @@
 # Helpers for the end-to-end tests of the programs. Source it; call finish at the end.
 # IP_BIN: folder with the programs; IP_TEST_TMP: scratch space; IP_SHARED_DATA: real volumes.
+# The scratch folder $work is removed when the test passes or skips (exit 0 or 77) and kept,
+# for diagnosis, when it fails.
 set -u
 passed=0
 failed=0
@@ -9,6 +11,16 @@ work=${IP_TEST_TMP:-/tmp/isoprop-test}/tool_$test_name
 rm -rf "$work"
 mkdir -p "$work"
 cd "$work" || exit 1
+
+remove_work_on_success() {
+    status=$?
+    if [ "$status" = 0 ] || [ "$status" = 77 ]; then
+        cd / && rm -rf "$work"
+    else
+        echo "$test_name: scratch files kept in $work" >&2
+    fi
+}
+trap remove_work_on_success EXIT
 
 ok() { passed=$((passed + 1)); }
 bad() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
