@@ -1317,7 +1317,8 @@ static int finish(viewer *v)
         print_summary(v);
         tool_print_cache_table(stdout, &s, summary);
     }
-    if (v->o.stats && !tool_signal_caught() &&
+    /* a failed run (a bad brick, a renderer error) writes no statistics, as isorender */
+    if (v->o.stats && !v->failed && !tool_signal_caught() &&
         tool_write_stats_file("isoview", v->o.stats, v->o.force, &s, summary, json_counts, v) !=
             0)
         return 1;

@@ -133,4 +133,20 @@ check "--quiet prints nothing" test -z "$out"
 check "stats show rays" grep -q '"rays": [1-9]' at.json
 check "stats say lod" grep -q '"lod": true' at.json
 expect_error 1 "exists" "$bin/isoview" s.ibv --iso 1 --screenshot-at 1 at.png
+
+# a corrupted brick file (4 KiB pages of payloads zeroed): the window closes with one line
+# naming the file and the brick, exit 1, and neither the screenshot nor the statistics appear
+cp s.ibv z.ibv
+for off in 256 100000 200000 300000 400000 500000 600000 700000 800000 900000 1000000; do
+    "$bin/tests/corrupt" inplace z.ibv "zero:$off:4096" || bad "corrupt inplace z.ibv at $off"
+done
+printf 'wait done\nscreenshot z.png\nquit\n' >z.txt
+view z.ibv --iso 1000.5 --size 320x240 --script z.txt --stats z.json --exit-after 60
+lines=$(printf '%s\n' "$err" | grep -c "^isoview:")
+check "a corrupted brick ends isoview with exit 1 (got $rc)" test "$rc" = 1
+check "with one line naming the file and the brick ($err)" \
+    sh -c 'test "$0" = 1 && printf "%s" "$1" | grep -q "^isoview: z.ibv: brick [0-9]* (level"' \
+    "$lines" "$err"
+check "no screenshot of a wrong image" test ! -e z.png
+check "no statistics" test ! -e z.json
 finish
