@@ -7,7 +7,7 @@
 
 #include "check.h"
 #include "isoprop/bricker.h"
-#include "isoprop/codec.h"
+#include "codec.h"
 #include "isoprop/generate.h"
 #include "isoprop/input.h"
 #include "isoprop/store.h"
@@ -170,22 +170,22 @@ static void check_file(const char *ibv, const volume *v)
 }
 
 static int brick_file_at(const char *raw, const char *ibv, uint32_t b, uint32_t s,
-                         unsigned threads, int level, ip_brick_report *report)
+                         unsigned threads, int level, ip_bricker_report *report)
 {
     ip_input_desc desc;
     ip_error err;
-    ip_brick_options o;
+    ip_bricker_options o;
     if (ip_input_describe(raw, NULL, &desc, &err) != IP_OK) {
         fprintf(stderr, "%s\n", err.message);
         return -1;
     }
-    ip_brick_options_default(&o);
+    ip_bricker_options_default(&o);
     o.brick_edge = b;
     o.subblock_edge = s;
     o.threads = threads;
     o.lz4_level = level;
     o.force = 1;
-    if (ip_brick_volume(&desc, ibv, &o, report, &err) != IP_OK) {
+    if (ip_bricker_run(&desc, ibv, &o, report, &err) != IP_OK) {
         fprintf(stderr, "%s\n", err.message);
         return -1;
     }
@@ -193,7 +193,7 @@ static int brick_file_at(const char *raw, const char *ibv, uint32_t b, uint32_t 
 }
 
 static int brick_file(const char *raw, const char *ibv, uint32_t b, uint32_t s, unsigned threads,
-                      ip_brick_report *report)
+                      ip_bricker_report *report)
 {
     return brick_file_at(raw, ibv, b, s, threads, IP_LZ4_FAST, report);
 }
@@ -230,7 +230,7 @@ static void round_trip(const char *dir, uint32_t x, uint32_t y, uint32_t z, ip_t
     uint32_t dims[3] = {x, y, z};
     volume v = make_volume(dir, dims, type, constant, raw, sizeof raw);
     snprintf(ibv, sizeof ibv, "%s.b%u.ibv", raw, b);
-    ip_brick_report r;
+    ip_bricker_report r;
     CHECK_MSG(brick_file(raw, ibv, b, s, 2, &r) == 0, "%s", raw);
     check_file(ibv, &v);
     if (constant)
@@ -296,27 +296,27 @@ static void test_cancel_and_limits(const char *dir)
     snprintf(out, sizeof out, "%s/out.ibv", sub);
     ip_input_desc desc;
     ip_error err;
-    ip_brick_options o;
+    ip_bricker_options o;
     REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
-    ip_brick_options_default(&o);
+    ip_bricker_options_default(&o);
     o.brick_edge = 8;
     o.progress = cancel_half;
-    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_ERR_CANCELLED);
+    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_ERR_CANCELLED);
     CHECK(access(out, F_OK) != 0);
     CHECK(count_entries(sub) == 1); /* only the input: no temporary or spill file left */
 
     o.progress = NULL;
     o.memory_limit = 1024;
-    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_ERR_LIMIT);
+    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_ERR_LIMIT);
     CHECK_CONTAINS(err.message, "MiB");
     CHECK(access(out, F_OK) != 0);
 
     o.memory_limit = 0;
-    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_OK);
-    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_ERR_EXISTS);
+    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_OK);
+    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_ERR_EXISTS);
     CHECK_CONTAINS(err.message, "out.ibv");
     o.force = 1;
-    CHECK(ip_brick_volume(&desc, out, &o, NULL, &err) == IP_OK);
+    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_OK);
     CHECK(count_entries(sub) == 2);
     free(v.values);
 }

@@ -27,14 +27,14 @@ static void make_file(const char *dir, char *ibv, size_t size)
                 fputc((x * 3 + y * 5 + z * 7) % 251, f);
     REQUIRE(fclose(f) == 0);
     ip_input_desc desc;
-    ip_brick_options o;
+    ip_bricker_options o;
     ip_error err;
     REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
-    ip_brick_options_default(&o);
+    ip_bricker_options_default(&o);
     o.brick_edge = 8;
     o.subblock_edge = 4;
     o.force = 1;
-    REQUIRE(ip_brick_volume(&desc, ibv, &o, NULL, &err) == IP_OK);
+    REQUIRE(ip_bricker_run(&desc, ibv, &o, NULL, &err) == IP_OK);
 }
 
 static int expected_sample(const ip_brick *b, uint32_t x, uint32_t y, uint32_t z)

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "format.h"
 #include "isoprop/bricker.h"
 #include "isoprop/engine.h"
 #include "isoprop/generate.h"
@@ -61,14 +62,14 @@ static void make_volume(const char *dir, ip_field field, const uint32_t dims[3],
     REQUIRE(ip_generate_write(&p, raw, 1, &err) == IP_OK);
     snprintf(ibv, size, "%s/%s.b%u.ibv", dir, ip_field_name(field), edge);
     ip_input_desc d;
-    ip_brick_options o;
+    ip_bricker_options o;
     REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
-    ip_brick_options_default(&o);
+    ip_bricker_options_default(&o);
     o.brick_edge = edge;
     o.subblock_edge = subblock;
     o.force = 1;
     o.threads = 2;
-    REQUIRE(ip_brick_volume(&d, ibv, &o, NULL, &err) == IP_OK);
+    REQUIRE(ip_bricker_run(&d, ibv, &o, NULL, &err) == IP_OK);
     unlink(raw);
 }
 
@@ -218,11 +219,8 @@ static void open_subject(subject *s, const char *name, const char *path, float i
     snprintf(s->path, sizeof s->path, "%s", path);
     s->iso = iso;
     s->bytes = read_file(path, &s->size);
-    REQUIRE(ip_format_parse(s->bytes, s->size, path, 0, &s->layout, &err) == IP_OK);
-    for (int a = 0; a < 3; a++) {
-        s->lo[a] = 0;
-        s->hi[a] = (s->layout.dims[a] - 1) * s->layout.spacing[a];
-    }
+    REQUIRE(ip__format_parse(s->bytes, s->size, path, 0, &s->layout, &err) == IP_OK);
+    ip_layout_world_box(&s->layout, s->lo, s->hi);
     REQUIRE(ip_camera_fit_axis(s->lo, s->hi, axis, 30.0, WIDTH, HEIGHT, &s->camera, &err) ==
             IP_OK);
     for (int k = 0; k < 4; k++) {
@@ -328,12 +326,12 @@ static void report(const char *name, const char *kind, int copies, const tally r
 static void check_payload_flips(const subject *s, const char *dir)
 {
     ip_summary_offsets so;
-    ip_summary_offsets_of(&s->layout, &so);
+    ip__summary_offsets_of(&s->layout, &so);
     uint64_t *bricks = malloc(s->layout.brick_count * sizeof *bricks), count = 0;
     REQUIRE(bricks);
     for (uint64_t g = 0; g < s->layout.brick_count; g++) {
         ip_brick_entry e;
-        ip_directory_entry_decode(s->bytes + s->layout.summary_offset + so.directory +
+        ip__format_entry_decode(s->bytes + s->layout.summary_offset + so.directory +
                                       g * IP_DIRECTORY_ENTRY_SIZE, &e);
         if (e.stored_size > 0)
             bricks[count++] = g;
@@ -349,7 +347,7 @@ static void check_payload_flips(const subject *s, const char *dir)
     for (uint64_t i = 0; i < count; i += step) {
         uint64_t g = bricks[i];
         ip_brick_entry e;
-        ip_directory_entry_decode(s->bytes + s->layout.summary_offset + so.directory +
+        ip__format_entry_decode(s->bytes + s->layout.summary_offset + so.directory +
                                       g * IP_DIRECTORY_ENTRY_SIZE, &e);
         /* a different spot and bit in each brick: first bytes, middle, last */
         uint64_t byte = e.offset + (e.stored_size - 1) * (i % 5) / 4;
@@ -426,13 +424,13 @@ static void overwrite_payloads(const char *path, void *user)
 {
     const subject *s = user;
     ip_summary_offsets so;
-    ip_summary_offsets_of(&s->layout, &so);
+    ip__summary_offsets_of(&s->layout, &so);
     int fd = open(path, O_WRONLY);
     REQUIRE(fd >= 0);
     static const unsigned char zeros[32];
     for (uint64_t g = 0; g < s->layout.brick_count; g++) {
         ip_brick_entry e;
-        ip_directory_entry_decode(s->bytes + s->layout.summary_offset + so.directory +
+        ip__format_entry_decode(s->bytes + s->layout.summary_offset + so.directory +
                                       g * IP_DIRECTORY_ENTRY_SIZE, &e);
         if (e.stored_size == 0)
             continue;

@@ -32,10 +32,7 @@ static void open_scene(const char *ibv, scene *s)
     REQUIRE(ip_store_open(ibv, &s->store, &err) == IP_OK);
     REQUIRE(ip_cache_create(s->store, 256ull << 20, &s->cache, &err) == IP_OK);
     const ip_layout *l = ip_store_layout(s->store);
-    for (int a = 0; a < 3; a++) {
-        s->lo[a] = 0;
-        s->hi[a] = (l->dims[a] - 1) * l->spacing[a];
-    }
+    ip_layout_world_box(l, s->lo, s->hi);
 }
 
 static void close_scene(scene *s)
@@ -56,14 +53,14 @@ static void make_volume(const char *dir, ip_field field, uint32_t n, ip_type typ
     REQUIRE(ip_generate_write(&p, raw, 1, &err) == IP_OK);
     snprintf(ibv, size, "%s/%s.b%u.ibv", dir, ip_field_name(field), edge);
     ip_input_desc d;
-    ip_brick_options o;
+    ip_bricker_options o;
     REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
     d.spacing[2] = 1.25; /* anisotropic: world coordinates must honour spacing */
-    ip_brick_options_default(&o);
+    ip_bricker_options_default(&o);
     o.brick_edge = edge;
     o.subblock_edge = edge / 4 ? edge / 4 : 1;
     o.force = 1;
-    REQUIRE(ip_brick_volume(&d, ibv, &o, NULL, &err) == IP_OK);
+    REQUIRE(ip_bricker_run(&d, ibv, &o, NULL, &err) == IP_OK);
 }
 
 /* Two triangles are the same when they come from the same cell and have the same vertices
@@ -196,13 +193,13 @@ static void check_lod(const char *dir)
     snprintf(ibv, sizeof ibv, "%s/long.ibv", dir);
     REQUIRE(ip_generate_write(&p, raw, 1, &err) == IP_OK);
     ip_input_desc d;
-    ip_brick_options bo;
+    ip_bricker_options bo;
     REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
-    ip_brick_options_default(&bo);
+    ip_bricker_options_default(&bo);
     bo.brick_edge = 8;
     bo.subblock_edge = 4;
     bo.force = 1;
-    REQUIRE(ip_brick_volume(&d, ibv, &bo, NULL, &err) == IP_OK);
+    REQUIRE(ip_bricker_run(&d, ibv, &bo, NULL, &err) == IP_OK);
     scene s;
     open_scene(ibv, &s);
     ip_camera cam;
@@ -404,12 +401,12 @@ static void check_shared_data(void)
         fclose(f);
         snprintf(ibv, sizeof ibv, "%s/%s.ibv", test_tmp_dir("test_engine_shared"), volumes[v].file);
         ip_input_desc d;
-        ip_brick_options o;
+        ip_bricker_options o;
         ip_error err;
         REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
-        ip_brick_options_default(&o);
+        ip_bricker_options_default(&o);
         o.force = 1;
-        REQUIRE(ip_brick_volume(&d, ibv, &o, NULL, &err) == IP_OK);
+        REQUIRE(ip_bricker_run(&d, ibv, &o, NULL, &err) == IP_OK);
         scene s;
         open_scene(ibv, &s);
         check_view(&s, volumes[v].file, "-y", volumes[v].iso, 200, 160);

@@ -191,14 +191,14 @@ static void test_output_is_input(void)
     REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
     struct stat before, after;
     REQUIRE(stat(raw, &before) == 0);
-    ip_brick_options options;
-    ip_brick_options_default(&options);
+    ip_bricker_options options;
+    ip_bricker_options_default(&options);
     options.force = 1;
     options.threads = 1;
-    CHECK(ip_brick_volume(&desc, raw, &options, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_bricker_run(&desc, raw, &options, NULL, &err) == IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "sphere_8x6x5_uint8.raw");
     format_path(spelled, "%s/./sphere_8x6x5_uint8.raw", scratch);
-    CHECK(ip_brick_volume(&desc, spelled, &options, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_bricker_run(&desc, spelled, &options, NULL, &err) == IP_ERR_ARGUMENT);
     CHECK(ip_upsample_write(&desc, 2, raw, 1, &err) == IP_ERR_ARGUMENT);
     CHECK(ip_upsample_write(&desc, 1, spelled, 1, &err) == IP_ERR_ARGUMENT);
     REQUIRE(stat(raw, &after) == 0);
@@ -211,16 +211,16 @@ static void test_output_is_input(void)
              "encoding: raw\ndata file: %s\n", data);
     write_text(header, text);
     REQUIRE(ip_input_describe(header, NULL, &desc, &err) == IP_OK);
-    CHECK(ip_brick_volume(&desc, data, &options, NULL, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_brick_volume(&desc, header, &options, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_bricker_run(&desc, data, &options, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_bricker_run(&desc, header, &options, NULL, &err) == IP_ERR_ARGUMENT);
     CHECK(ip_upsample_write(&desc, 2, data, 1, &err) == IP_ERR_ARGUMENT);
     REQUIRE(stat(raw, &after) == 0);
     CHECK(after.st_ino == before.st_ino && after.st_size == before.st_size);
     /* and a brick file that is not an input is written */
     at(ibv, "good.ibv");
-    CHECK(ip_brick_volume(&desc, ibv, &options, NULL, &err) == IP_OK);
+    CHECK(ip_bricker_run(&desc, ibv, &options, NULL, &err) == IP_OK);
     /* an existing device or FIFO is never replaced by a brick file */
-    CHECK(ip_brick_volume(&desc, "/dev/null", &options, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_bricker_run(&desc, "/dev/null", &options, NULL, &err) == IP_ERR_ARGUMENT);
     CHECK(!temporaries_left());
 }
 

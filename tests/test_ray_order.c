@@ -5,19 +5,19 @@
 
 #include "check.h"
 #include "internal.h"
-#include "isoprop/ray_order.h"
+#include "ray_order.h"
 
 /* Walks the whole order; checks bounds, repeats and the end. Returns the number of pixels. */
 static uint64_t walk_once(uint32_t w, uint32_t h, uint64_t *hash)
 {
     ip_ray_order order;
-    REQUIRE(ip_ray_order_init(&order, w, h) == IP_OK);
+    REQUIRE(ip__ray_order_init(&order, w, h) == IP_OK);
     unsigned char *seen = calloc((size_t)w * h, 1);
     REQUIRE(seen);
     uint64_t n = 0, repeats = 0, outside = 0;
     uint32_t x, y, last_level = 0, level_went_back = 0;
     *hash = 1469598103934665603ull;
-    while (ip_ray_order_next(&order, &x, &y)) {
+    while (ip__ray_order_next(&order, &x, &y)) {
         if (x >= w || y >= h) {
             outside++;
             continue;
@@ -25,18 +25,18 @@ static uint64_t walk_once(uint32_t w, uint32_t h, uint64_t *hash)
         repeats += seen[(size_t)y * w + x]++ != 0;
         if (n == 0)
             CHECK_MSG(x == w / 2 && y == h / 2, "%ux%u: first ray (%u, %u)", w, h, x, y);
-        level_went_back += ip_ray_order_level(&order) < last_level;
-        last_level = ip_ray_order_level(&order);
+        level_went_back += ip__ray_order_level(&order) < last_level;
+        last_level = ip__ray_order_level(&order);
         *hash = (*hash ^ ((uint64_t)x << 32 | y)) * 1099511628211ull;
         n++;
     }
     CHECK_MSG(outside == 0 && repeats == 0, "%ux%u: %llu outside, %llu repeats", w, h,
               (unsigned long long)outside, (unsigned long long)repeats);
     CHECK_MSG(n == (uint64_t)w * h, "%ux%u: %llu pixels", w, h, (unsigned long long)n);
-    CHECK(ip_ray_order_count(&order) == (uint64_t)w * h && ip_ray_order_emitted(&order) == n);
+    CHECK(ip__ray_order_count(&order) == (uint64_t)w * h && ip__ray_order_emitted(&order) == n);
     CHECK(level_went_back == 0);
     x = y = 12345;
-    CHECK(ip_ray_order_next(&order, &x, &y) == 0 && x == 12345 && y == 12345);
+    CHECK(ip__ray_order_next(&order, &x, &y) == 0 && x == 12345 && y == 12345);
     free(seen);
     return n;
 }
@@ -107,13 +107,13 @@ static int same_as_reference(uint32_t w, uint32_t h)
     REQUIRE(expected);
     reference_order(w, h, expected);
     ip_ray_order order;
-    REQUIRE(ip_ray_order_init(&order, w, h) == IP_OK);
+    REQUIRE(ip__ray_order_init(&order, w, h) == IP_OK);
     int same = 1;
     uint32_t x, y;
     for (size_t i = 0; i < (size_t)w * h && same; i++)
-        same = ip_ray_order_next(&order, &x, &y) && x == expected[i][0] && y == expected[i][1];
+        same = ip__ray_order_next(&order, &x, &y) && x == expected[i][0] && y == expected[i][1];
     free(expected);
-    return same && !ip_ray_order_next(&order, &x, &y);
+    return same && !ip__ray_order_next(&order, &x, &y);
 }
 
 static void test_matches_reference(void)
@@ -139,23 +139,23 @@ static void test_first_rays(void)
     static const uint32_t expected[][2] = {{8, 8}, {4, 4}, {12, 12}, {12, 4}, {4, 12},
                                            {2, 2}, {10, 10}, {10, 2}, {2, 10}, {6, 6}};
     ip_ray_order order;
-    REQUIRE(ip_ray_order_init(&order, 16, 16) == IP_OK);
+    REQUIRE(ip__ray_order_init(&order, 16, 16) == IP_OK);
     for (size_t i = 0; i < sizeof expected / sizeof expected[0]; i++) {
         uint32_t x = 0, y = 0;
-        CHECK(ip_ray_order_next(&order, &x, &y) == 1);
+        CHECK(ip__ray_order_next(&order, &x, &y) == 1);
         CHECK_MSG(x == expected[i][0] && y == expected[i][1], "ray %zu is (%u, %u)", i, x, y);
-        CHECK(ip_ray_order_level(&order) == (i == 0 ? 0u : i < 5 ? 1u : 2u));
+        CHECK(ip__ray_order_level(&order) == (i == 0 ? 0u : i < 5 ? 1u : 2u));
     }
     /* Reset replays the same order. */
-    ip_ray_order_reset(&order);
-    CHECK(ip_ray_order_emitted(&order) == 0);
+    ip__ray_order_reset(&order);
+    CHECK(ip__ray_order_emitted(&order) == 0);
     uint32_t x = 0, y = 0;
-    CHECK(ip_ray_order_next(&order, &x, &y) == 1 && x == 8 && y == 8);
+    CHECK(ip__ray_order_next(&order, &x, &y) == 1 && x == 8 && y == 8);
     /* A single row: the centre, then the quarter points. */
-    REQUIRE(ip_ray_order_init(&order, 8, 1) == IP_OK);
+    REQUIRE(ip__ray_order_init(&order, 8, 1) == IP_OK);
     static const uint32_t row[8] = {4, 2, 6, 1, 5, 3, 7, 0};
     for (int i = 0; i < 8; i++) {
-        CHECK(ip_ray_order_next(&order, &x, &y) == 1 && y == 0);
+        CHECK(ip__ray_order_next(&order, &x, &y) == 1 && y == 0);
         CHECK_MSG(x == row[i], "8x1 ray %d is %u", i, x);
     }
 }
@@ -163,14 +163,14 @@ static void test_first_rays(void)
 static void test_bad_arguments(void)
 {
     ip_ray_order order;
-    CHECK(ip_ray_order_init(NULL, 4, 4) == IP_ERR_ARGUMENT);
-    CHECK(ip_ray_order_init(&order, 0, 4) == IP_ERR_ARGUMENT);
-    CHECK(ip_ray_order_init(&order, 4, 0) == IP_ERR_ARGUMENT);
-    CHECK(ip_ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE + 1, 4) == IP_ERR_ARGUMENT);
-    CHECK(ip_ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE, 1) == IP_OK);
+    CHECK(ip__ray_order_init(NULL, 4, 4) == IP_ERR_ARGUMENT);
+    CHECK(ip__ray_order_init(&order, 0, 4) == IP_ERR_ARGUMENT);
+    CHECK(ip__ray_order_init(&order, 4, 0) == IP_ERR_ARGUMENT);
+    CHECK(ip__ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE + 1, 4) == IP_ERR_ARGUMENT);
+    CHECK(ip__ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE, 1) == IP_OK);
     uint32_t x, y;
-    CHECK(ip_ray_order_next(&order, &x, &y) == 1 && x == IP_RAY_ORDER_MAX_SIDE / 2 && y == 0);
-    CHECK(ip_ray_order_count(&order) == IP_RAY_ORDER_MAX_SIDE);
+    CHECK(ip__ray_order_next(&order, &x, &y) == 1 && x == IP_RAY_ORDER_MAX_SIDE / 2 && y == 0);
+    CHECK(ip__ray_order_count(&order) == IP_RAY_ORDER_MAX_SIDE);
 }
 
 /* Exact squared Euclidean distance transform along one line: the lower envelope of the
@@ -319,14 +319,14 @@ static uint32_t cell_size(uint32_t side, uint32_t k)
 static void test_spread(uint32_t w, uint32_t h)
 {
     ip_ray_order order;
-    REQUIRE(ip_ray_order_init(&order, w, h) == IP_OK);
+    REQUIRE(ip__ray_order_init(&order, w, h) == IP_OK);
     unsigned char *cast = calloc((size_t)w * h, 1);
     REQUIRE(cast);
     uint32_t side = w > h ? w : h;
     uint64_t emitted = 0, next_checkpoint = 1;
     uint32_t x, y, k = 0, level = 0;
     printf("%ux%u, after 4^k rays (chessboard/euclidean):", w, h);
-    int more = ip_ray_order_next(&order, &x, &y);
+    int more = ip__ray_order_next(&order, &x, &y);
     while (more) {
         cast[(size_t)y * w + x] = 1;
         emitted++;
@@ -341,14 +341,14 @@ static void test_spread(uint32_t w, uint32_t h)
             next_checkpoint *= 4;
             k++;
         }
-        more = ip_ray_order_next(&order, &x, &y);
-        if (!more || ip_ray_order_level(&order) != level) {
+        more = ip__ray_order_next(&order, &x, &y);
+        if (!more || ip__ray_order_level(&order) != level) {
             uint32_t cw = cell_size(w, level), ch = cell_size(h, level);
             double bound = sqrt((double)(cw / 2) * (cw / 2) + (double)(ch / 2) * (ch / 2));
             double worst = max_distance(cast, w, h);
             CHECK_MSG(worst <= bound + 1e-9, "%ux%u level %u: %.3f > %.3f", w, h, level, worst,
                       bound);
-            level = ip_ray_order_level(&order);
+            level = ip__ray_order_level(&order);
         }
     }
     printf("\n");
@@ -379,24 +379,24 @@ static void test_distance_transform(void)
 static void test_local_levels(uint32_t w, uint32_t h, uint32_t local_from)
 {
     ip_ray_order bayer, local;
-    REQUIRE(ip_ray_order_init(&bayer, w, h) == IP_OK && ip_ray_order_init(&local, w, h) == IP_OK);
-    ip_ray_order_set_local_from(&local, local_from);
+    REQUIRE(ip__ray_order_init(&bayer, w, h) == IP_OK && ip__ray_order_init(&local, w, h) == IP_OK);
+    ip__ray_order_set_local_from(&local, local_from);
     uint64_t n = (uint64_t)w * h;
     uint32_t(*a)[3] = malloc(n * sizeof *a), (*b)[3] = malloc(n * sizeof *b);
     REQUIRE(a && b);
     for (int pass = 0; pass < 2; pass++) { /* the second pass after a reset: the same again */
         uint64_t i = 0;
         uint32_t x, y;
-        while (ip_ray_order_next(&bayer, &x, &y))
-            a[i][0] = ip_ray_order_level(&bayer), a[i][1] = x, a[i++][2] = y;
+        while (ip__ray_order_next(&bayer, &x, &y))
+            a[i][0] = ip__ray_order_level(&bayer), a[i][1] = x, a[i++][2] = y;
         REQUIRE(i == n);
         i = 0;
-        while (ip_ray_order_next(&local, &x, &y) && i < n)
-            b[i][0] = ip_ray_order_level(&local), b[i][1] = x, b[i++][2] = y;
+        while (ip__ray_order_next(&local, &x, &y) && i < n)
+            b[i][0] = ip__ray_order_level(&local), b[i][1] = x, b[i++][2] = y;
         CHECK_MSG(i == n, "%ux%u local from %u: %llu pixels", w, h, local_from,
                   (unsigned long long)i);
-        ip_ray_order_reset(&bayer);
-        ip_ray_order_reset(&local);
+        ip__ray_order_reset(&bayer);
+        ip__ray_order_reset(&local);
     }
     /* level by level: the same pixels (as sets), in the same order before local_from */
     unsigned char *in_level = calloc(n, 1);
@@ -447,12 +447,12 @@ static void test_local_levels(uint32_t w, uint32_t h, uint32_t local_from)
 static int bench(uint32_t w, uint32_t h)
 {
     ip_ray_order order;
-    if (ip_ray_order_init(&order, w, h) != IP_OK)
+    if (ip__ray_order_init(&order, w, h) != IP_OK)
         return 1;
     uint64_t sum = 0, n = 0;
     uint32_t x, y;
     double start = ip_now_seconds();
-    while (ip_ray_order_next(&order, &x, &y)) {
+    while (ip__ray_order_next(&order, &x, &y)) {
         sum += x ^ y;
         n++;
     }

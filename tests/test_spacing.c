@@ -1,6 +1,6 @@
 /* Spacing bounds: ip_spacing_check() accepts exactly [IP_SPACING_MIN, IP_SPACING_MAX] with a
  * largest-to-smallest ratio of at most IP_SPACING_RATIO_MAX; ip_input_describe() and
- * ip_brick_volume() refuse the rest; and the camera's depth range scales with the volume, so
+ * ip_bricker_run() refuse the rest; and the camera's depth range scales with the volume, so
  * that the smallest accepted spacing is framed like any other (docs/format.md gives the
  * measured limits behind the bounds). */
 #include <math.h>
@@ -83,16 +83,16 @@ static void test_refused_by_the_library(const char *dir)
     /* a description made by hand goes through the same check */
     REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
     desc.spacing[1] = 1e-12;
-    ip_brick_options options;
-    ip_brick_options_default(&options);
+    ip_bricker_options options;
+    ip_bricker_options_default(&options);
     options.threads = 1;
-    CHECK(ip_brick_volume(&desc, ibv, &options, NULL, &err) == IP_ERR_UNSUPPORTED);
+    CHECK(ip_bricker_run(&desc, ibv, &options, NULL, &err) == IP_ERR_UNSUPPORTED);
     CHECK_CONTAINS(err.message, "along y");
     struct stat st;
     CHECK(stat(ibv, &st) != 0);
     desc.spacing[1] = IP_SPACING_MIN;
     desc.spacing[0] = desc.spacing[2] = IP_SPACING_MIN;
-    CHECK(ip_brick_volume(&desc, ibv, &options, NULL, &err) == IP_OK);
+    CHECK(ip_bricker_run(&desc, ibv, &options, NULL, &err) == IP_OK);
 }
 
 /* The depth range encloses the box at every accepted scale: the near plane stays in front of

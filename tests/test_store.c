@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "format.h"
 #include "isoprop/bricker.h"
 #include "isoprop/generate.h"
 #include "isoprop/store.h"
@@ -22,13 +23,13 @@ static void make_file(const char *dir, char *ibv, size_t size)
     REQUIRE(ip_generate_write(&p, raw, 1, &err) == IP_OK);
     snprintf(ibv, size, "%s/gyroid.ibv", dir);
     ip_input_desc d;
-    ip_brick_options o;
+    ip_bricker_options o;
     REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
-    ip_brick_options_default(&o);
+    ip_bricker_options_default(&o);
     o.brick_edge = 4;
     o.subblock_edge = 2;
     o.force = 1;
-    REQUIRE(ip_brick_volume(&d, ibv, &o, NULL, &err) == IP_OK);
+    REQUIRE(ip_bricker_run(&d, ibv, &o, NULL, &err) == IP_OK);
 }
 
 static unsigned char *read_whole(const char *path, size_t *size)
@@ -92,7 +93,7 @@ static void test_zero_fields(const char *dir, const char *ibv)
     size_t size;
     unsigned char *good = read_whole(ibv, &size);
     ip_layout l;
-    REQUIRE(ip_format_parse(good, size, "good", 0, &l, NULL) == IP_OK);
+    REQUIRE(ip__format_parse(good, size, "good", 0, &l, NULL) == IP_OK);
     uint64_t data_end = l.data_offset + l.data_size;
     char path[4200];
     snprintf(path, sizeof path, "%s/hostile.ibv", dir);
@@ -105,15 +106,15 @@ static void test_zero_fields(const char *dir, const char *ibv)
     open_fails(path, bad, size, IP_ERR_FORMAT, "padding before the summary section");
 
     ip_summary_offsets o;
-    ip_summary_offsets_of(&l, &o);
+    ip__summary_offsets_of(&l, &o);
     for (int byte = 14; byte <= 15; byte++) {
         memcpy(bad, good, size);
         unsigned char *entry = bad + l.summary_offset + o.directory + 3 * IP_DIRECTORY_ENTRY_SIZE;
         entry[byte] = 1;
-        uint64_t sum = ip_format_checksum(bad + l.summary_offset, l.summary_size);
+        uint64_t sum = ip__format_checksum(bad + l.summary_offset, l.summary_size);
         for (int i = 0; i < 8; i++) /* header byte 128: the summary checksum */
             bad[128 + i] = (unsigned char)(sum >> (8 * i));
-        uint64_t head = ip_format_checksum(bad, 248);
+        uint64_t head = ip__format_checksum(bad, 248);
         for (int i = 0; i < 8; i++)
             bad[248 + i] = (unsigned char)(head >> (8 * i));
         open_fails(path, bad, size, IP_ERR_FORMAT, "brick 3");

@@ -618,13 +618,13 @@ phases() {
         awk '
         BEGIN {
             d["work"] = "worker threads (seeding + propagation)"
-            d["ip_seed_find"] = "ray seeding (octree walk, cell tests)"
+            d["ip__seed_find"] = "ray seeding (octree walk, cell tests)"
             d["walk_cells"] = "seeding: the cells of active sub-blocks"
-            d["ip_sampler_cell_values"] = "seeding: 8 corner samples per cell"
+            d["ip__sampler_cell_values"] = "seeding: 8 corner samples per cell"
             d["classify_cell"] = "seeding: ray against the cell triangles"
-            d["ip_propagate"] = "propagation (with extraction)"
-            d["ip_extract_cell"] = "marching cubes of one cell, mesh append"
-            d["ip_sampler_triangulate"] = "corners, case; 24 neighbours and gradients when active; MC"
+            d["ip__propagate"] = "propagation (with extraction)"
+            d["ip__extract_cell"] = "marching cubes of one cell, mesh append"
+            d["ip__sampler_triangulate"] = "corners, case; 24 neighbours and gradients when active; MC"
             d["ip_now_seconds"] = "clock_gettime for the phase times"
             d["ip_cache_pin_brick"] = "brick cache (decode on a miss)"
             d["render_image"] = "isorender: final OpenGL image"

@@ -8,7 +8,6 @@
 #include <unistd.h>
 
 #include "isoprop/bricker.h"
-#include "isoprop/codec.h"
 #include "isoprop/input.h"
 #include "tool_common.h"
 
@@ -61,14 +60,14 @@ static int report_progress(void *user, uint64_t done, uint64_t total)
 typedef struct options {
     const char *input, *output;
     ip_input_overrides overrides;
-    ip_brick_options brick;
+    ip_bricker_options brick;
     int quiet;
 } options;
 
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
-    ip_brick_options_default(&o->brick);
+    ip_bricker_options_default(&o->brick);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -153,7 +152,7 @@ static int default_output(const char *input, char *out, size_t size)
     return snprintf(out, size, "bricks/%.*s.ibv", len, base) < (int)size ? 0 : -1;
 }
 
-static void print_summary(const ip_brick_report *r, const char *out)
+static void print_summary(const ip_bricker_report *r, const char *out)
 {
     char in_b[32], file_b[32], rss_b[32];
     printf("wrote %s\n", out);
@@ -201,8 +200,8 @@ int main(int argc, char **argv)
     progress.start = (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
     o.brick.progress = report_progress;
     o.brick.progress_user = &progress;
-    ip_brick_report report;
-    if (ip_brick_volume(&desc, out, &o.brick, &report, &err) != IP_OK) {
+    ip_bricker_report report;
+    if (ip_bricker_run(&desc, out, &o.brick, &report, &err) != IP_OK) {
         if (progress.show)
             fputc('\n', stderr);
         rc = tool_fail("isobrick", &err);

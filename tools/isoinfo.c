@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "isoprop/cache.h"
-#include "isoprop/codec.h"
+#include "isoprop/layout.h"
 #include "isoprop/store.h"
 #include "tool_common.h"
 

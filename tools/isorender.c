@@ -128,20 +128,11 @@ static int parse_args(int argc, char **argv, options *o)
     return 0;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
 
 static int setup_camera(run *r, ip_error *err)
 {
     const ip_layout *l = ip_store_layout(r->store);
-    for (int a = 0; a < 3; a++) {
-        r->lo[a] = 0;
-        r->hi[a] = (l->dims[a] - 1) * l->spacing[a];
-    }
+    ip_layout_world_box(l, r->lo, r->hi);
     if (r->o.common.camera) {
         r->camera.width = r->o.common.width;
         r->camera.height = r->o.common.height;
@@ -162,7 +153,7 @@ static int add_checkpoint(run *r, double start)
         return -1;
     r->checkpoints = grown;
     r->checkpoints[r->checkpoint_count++] =
-        (checkpoint){now() - start, t.rays, t.seeds, t.cells, t.triangles, 0};
+        (checkpoint){ip_now_seconds() - start, t.rays, t.seeds, t.cells, t.triangles, 0};
     return 0;
 }
 
@@ -181,7 +172,7 @@ static int extract_progressive(run *r, ip_error *err)
     }
     if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK)
         return -1;
-    double start = now();
+    double start = ip_now_seconds();
     uint64_t target = 1, limit = r->o.common.rays ? r->o.common.rays : UINT64_MAX;
     /* ip_engine_begin() clears a cancel: a signal before it is seen through the flag */
     while (!ip_engine_done(r->engine) && !tool_signal_caught()) {
@@ -189,7 +180,7 @@ static int extract_progressive(run *r, ip_error *err)
         ip_engine_totals(r->engine, &t);
         if (t.rays >= limit)
             break;
-        double left = r->o.common.time_limit > 0 ? r->o.common.time_limit - (now() - start) : 0;
+        double left = r->o.common.time_limit > 0 ? r->o.common.time_limit - (ip_now_seconds() - start) : 0;
         if (r->o.common.time_limit > 0 && left <= 0)
             break;
         uint64_t batch = (target < limit ? target : limit) - t.rays;
@@ -199,7 +190,7 @@ static int extract_progressive(run *r, ip_error *err)
             return -1;
         target *= 2;
     }
-    r->extraction_wall = now() - start;
+    r->extraction_wall = ip_now_seconds() - start;
     ip_engine_totals(r->engine, &r->totals);
     r->mesh = ip_engine_mesh(r->engine);
     return 0;
@@ -213,10 +204,10 @@ static int extract_full(run *r, ip_error *err)
             return -1;
         ip_mesh_clear(&r->full_mesh);
     }
-    double start = now();
+    double start = ip_now_seconds();
     if (ip_extract_full(r->cache, (float)r->o.common.iso, 0, r->o.common.threads, &r->full_mesh, &r->totals, err) != IP_OK)
         return -1;
-    r->extraction_wall = now() - start;
+    r->extraction_wall = ip_now_seconds() - start;
     r->mesh = &r->full_mesh;
     return 0;
 }
@@ -226,7 +217,7 @@ static int extract_full(run *r, ip_error *err)
  * only grows by appending, and the nearest triangle wins). */
 static int final_pixels(run *r, ip_error *err)
 {
-    double start = now();
+    double start = ip_now_seconds();
     size_t n = (size_t)r->camera.width * r->camera.height;
     uint32_t *index = malloc(n * sizeof *index);
     if (!index)
@@ -265,7 +256,7 @@ static int final_pixels(run *r, ip_error *err)
     }
     free(shown);
     free(index);
-    r->progress_render_seconds = now() - start;
+    r->progress_render_seconds = ip_now_seconds() - start;
     return 0;
 }
 
@@ -284,7 +275,7 @@ static void progress_csv(FILE *f, void *user)
 /* Renders with OpenGL through EGL, or in software when asked or when no OpenGL is found. */
 static int render_image(run *r, uint8_t *rgba, ip_error *err)
 {
-    double start = now();
+    double start = ip_now_seconds();
     if (!r->o.software) {
         ip_renderer *gl;
         ip_error why;
@@ -294,7 +285,7 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
             if (st == IP_OK)
                 st = ip_renderer_read_rgba(gl, rgba, err);
             ip_renderer_destroy(gl);
-            r->totals.rendering_seconds += now() - start;
+            r->totals.rendering_seconds += ip_now_seconds() - start;
             r->renderer_name = "opengl";
             return st == IP_OK ? 0 : -1;
         }
@@ -303,7 +294,7 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
     }
     r->renderer_name = "software";
     int rc = ip_raster_mesh(r->mesh, &r->camera, r->lo, r->hi, NULL, rgba, err) == IP_OK ? 0 : -1;
-    r->totals.rendering_seconds += now() - start;
+    r->totals.rendering_seconds += ip_now_seconds() - start;
     return rc;
 }
 

@@ -207,12 +207,6 @@ static void on_glfw_error(int code, const char *description)
         snprintf(glfw_error, sizeof glfw_error, "%s", description);
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
 
 static void set_error(ip_error *err, ip_status code, const char *fmt, ...)
 {
@@ -388,7 +382,7 @@ static void show_message(viewer *v, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(v->message, sizeof v->message, fmt, ap);
     va_end(ap);
-    v->message_until = now() + 4.0;
+    v->message_until = ip_now_seconds() + 4.0;
 }
 
 /* ---- script ---- */
@@ -986,10 +980,10 @@ static int refine(viewer *v)
         slice = v->o.common.time_limit - v->pass_wall;
     ip_engine_counts t;
     ip_engine_totals(v->engine, &t);
-    double start = now();
+    double start = ip_now_seconds();
     ip_status st = ip_engine_step(v->engine, v->o.common.rays ? v->o.common.rays - t.rays : 0, slice, NULL,
                                   &v->err);
-    v->pass_wall += now() - start;
+    v->pass_wall += ip_now_seconds() - start;
     if (st != IP_OK && st != IP_ERR_CANCELLED)
         return -1;
     const ip_mesh *mesh = ip_engine_mesh(v->engine);
@@ -1005,11 +999,11 @@ static int extract_full(viewer *v)
     v->want_full = 0;
     ip_mesh_clear(&v->full_mesh);
     memset(&v->full_counts, 0, sizeof v->full_counts);
-    double start = now();
+    double start = ip_now_seconds();
     if (ip_extract_full(v->cache, (float)v->iso, 0, v->o.common.threads, &v->full_mesh, &v->full_counts,
                         &v->err) != IP_OK)
         return -1;
-    v->full_wall = now() - start;
+    v->full_wall = ip_now_seconds() - start;
     v->pass_render = 0;
     ip_renderer_clear_mesh(v->renderer);
     if (ip_renderer_upload(v->renderer, &v->full_mesh, 0, &v->err) != IP_OK)
@@ -1060,7 +1054,7 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
                      lookups ? 100.0 * (double)s.hits / (double)lookups : 0.0,
                      (unsigned long long)s.misses, (unsigned long long)s.bricks_touched,
                      (unsigned long long)s.bricks_total);
-    if (n > 0 && (size_t)n < size && v->message[0] && now() < v->message_until)
+    if (n > 0 && (size_t)n < size && v->message[0] && ip_now_seconds() < v->message_until)
         snprintf(text + n, size - (size_t)n, "\n%s", v->message);
     else if (n > 0 && (size_t)n < size && !v->help_on)
         snprintf(text + n, size - (size_t)n, "\nh: help");
@@ -1068,7 +1062,7 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
 
 static int draw_frame(viewer *v, int working_on_full)
 {
-    double start = now();
+    double start = ip_now_seconds();
     if (ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) != IP_OK)
         return -1;
     uint32_t width = v->camera.width, height = v->camera.height;
@@ -1086,7 +1080,7 @@ static int draw_frame(viewer *v, int working_on_full)
         float x = ((float)width - w) / 2, y = ((float)height - h) / 2;
         overlay_draw(&v->text, text, x > 0 ? x : 0, y > 0 ? y : 0, scale, width, height);
     }
-    double seconds = now() - start;
+    double seconds = ip_now_seconds() - start;
     v->pass_render += seconds;
     if (!v->full_shown)
         ip_engine_add_rendering_time(v->engine, seconds);
@@ -1153,7 +1147,7 @@ static int follow_size(viewer *v)
 static int frame(viewer *v)
 {
     glfwPollEvents();
-    double t = now() - v->start;
+    double t = ip_now_seconds() - v->start;
     if (glfwWindowShouldClose(v->window) || (v->o.exit_after >= 0 && t >= v->o.exit_after)) {
         v->quit = 1;
         return 0;
@@ -1185,13 +1179,13 @@ static int frame(viewer *v)
     }
     if (refine(v) != 0)
         return -1;
-    double drawn = now();
+    double drawn = ip_now_seconds();
     if (draw_frame(v, 0) != 0)
         return -1;
     if (v->screenshot_pending && !tool_signal_caught() && save_screenshot(v) != 0)
         return -1;
     glfwSwapBuffers(v->window);
-    double end = now();
+    double end = ip_now_seconds();
     v->draw_seconds = end - drawn;
     frame_done(&v->clock, end);
     return 0;
@@ -1363,10 +1357,7 @@ static int prepare(viewer *v)
     if (ip_cache_create(v->store, v->o.common.cache_bytes, &v->cache, err) != IP_OK)
         return -1;
     const ip_layout *l = ip_store_layout(v->store);
-    for (int a = 0; a < 3; a++) {
-        v->lo[a] = 0;
-        v->hi[a] = (l->dims[a] - 1) * l->spacing[a];
-    }
+    ip_layout_world_box(l, v->lo, v->hi);
     v->value_min = l->value_min;
     v->value_max = l->value_max;
     v->camera.width = v->o.common.width;
@@ -1413,7 +1404,7 @@ int main(int argc, char **argv)
         /* the window may have opened at another size than asked: fit --view to it */
         if (!v->o.common.camera)
             (void)camera_from(v, NULL, v->o.common.view, &v->camera, &v->err);
-        v->start = now();
+        v->start = ip_now_seconds();
         while (!v->quit && !tool_signal_caught())
             if (frame(v) != 0) {
                 tool_fail("isoview", &v->err);

@@ -97,7 +97,10 @@ skip_report() {
             next
         }
         inside && NF { last = $0; if (tolower($0) ~ /skip/ && why == "") why = $0 }
-        inside && tolower($0) ~ /skip/ && !(name in how) { print "    " name " (passed), in part: " $0 }
+        # (the status lines of libFuzzer, such as "#74238 REDUCE ... byteskip", are no reasons)
+        inside && tolower($0) ~ /skip/ && $0 !~ /^#[0-9]|# Uses:/ && !(name in how) {
+            print "    " name " (passed), in part: " $0
+        }
         END {
             for (t in how) if (!(t in done)) print "    " t ": " tolower(how[t]) " (no output)"
         }' "$log"

@@ -334,19 +334,6 @@ const char *tool_format_bytes(char *buf, size_t size, double bytes)
 
 #include <unistd.h>
 
-/* Peak resident set of this process (VmHWM), in bytes; 0 when unknown. */
-static uint64_t peak_rss(void)
-{
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    uint64_t kib = 0;
-    while (f && fgets(line, sizeof line, f))
-        if (strncmp(line, "VmHWM:", 6) == 0)
-            kib = strtoull(line + 6, NULL, 10);
-    if (f)
-        fclose(f);
-    return kib * 1024u;
-}
 
 int tool_parse_cache_mb(const char *text, uint64_t *bytes)
 {
@@ -390,7 +377,7 @@ void tool_print_cache_table(FILE *out, const ip_cache_stats *s, uint64_t summary
                      "%llu bad bricks\n",
                 (unsigned long long)s->over_budget_pins, (unsigned long long)s->errors);
     fprintf(out, "  summaries       %s\n", tool_format_bytes(a, sizeof a, (double)summary_bytes));
-    fprintf(out, "  peak RSS        %s\n", tool_format_bytes(b, sizeof b, (double)peak_rss()));
+    fprintf(out, "  peak RSS        %s\n", tool_format_bytes(b, sizeof b, (double)ip_peak_rss_bytes()));
 }
 
 void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_bytes)
@@ -418,7 +405,7 @@ void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_
                 (unsigned long long)s->level[k].bricks_total,
                 (unsigned long long)s->level[k].misses);
     fprintf(out, "], \"summary_bytes\": %llu, \"peak_rss_bytes\": %llu",
-            (unsigned long long)summary_bytes, (unsigned long long)peak_rss());
+            (unsigned long long)summary_bytes, (unsigned long long)ip_peak_rss_bytes());
 }
 
 typedef struct stats_json {

@@ -9,6 +9,7 @@
 #include "isoprop/engine.h"
 #include "isoprop/status.h"
 #include "isoprop/store.h"
+#include "isoprop/system.h"
 
 /* Prints "PROGRAM: message" on stderr and returns exit code 1 (2 for usage errors). */
 int tool_fail(const char *program, const ip_error *err);

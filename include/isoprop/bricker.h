@@ -4,7 +4,7 @@
  * when a slab is full its layer of bricks is summarised and compressed on all threads and
  * appended to an unnamed spill file. At the end the payloads are copied into the output in
  * Morton order, followed by the summary section and the header. The output appears under its
- * name only when complete (see docs/format.md and src/atomic_file.h).
+ * name only when complete (see docs/format.md and src/common/atomic_file.h).
  */
 #ifndef ISOPROP_BRICKER_H
 #define ISOPROP_BRICKER_H
@@ -21,7 +21,11 @@ extern "C" {
 /* Returns nonzero to cancel the run (e.g. after Ctrl-C). Called from the calling thread. */
 typedef int (*ip_progress_fn)(void *user, uint64_t done_bytes, uint64_t total_bytes);
 
-typedef struct ip_brick_options {
+/* Compression effort: IP_LZ4_FAST is LZ4's default; 1..12 are LZ4HC levels. */
+#define IP_LZ4_FAST 0
+#define IP_LZ4_HC_DEFAULT 9
+
+typedef struct ip_bricker_options {
     uint32_t brick_edge;      /* B, cells per brick edge; default IP_DEFAULT_BRICK_EDGE */
     uint32_t subblock_edge;   /* s, cells per sub-block edge; default IP_DEFAULT_SUBBLOCK_EDGE */
     int lz4_level;            /* IP_LZ4_FAST (default) or an LZ4HC level 1..12 */
@@ -30,9 +34,9 @@ typedef struct ip_brick_options {
     int force;                /* replace an existing output */
     ip_progress_fn progress;  /* may be NULL */
     void *progress_user;
-} ip_brick_options;
+} ip_bricker_options;
 
-typedef struct ip_brick_report {
+typedef struct ip_bricker_report {
     uint64_t input_bytes;     /* dims x type size */
     uint64_t file_bytes;      /* size of the brick file written */
     uint64_t bricks;          /* all levels */
@@ -42,17 +46,17 @@ typedef struct ip_brick_report {
     double seconds;           /* wall time of the whole run */
     uint64_t memory_planned;  /* working memory the run reserved for itself, bytes */
     uint64_t peak_rss;        /* the process's peak resident set at the end (VmHWM), bytes */
-} ip_brick_report;
+} ip_bricker_report;
 
-/*! ip_brick_options_default() : fills `options` with the defaults above. */
-void ip_brick_options_default(ip_brick_options *options);
+/*! ip_bricker_options_default() : fills `options` with the defaults above. */
+IP_API void ip_bricker_options_default(ip_bricker_options *options);
 
-/*! ip_brick_memory_needed() : working memory (bytes) a run with `options` needs for `input`.
+/*! ip_bricker_memory_needed() : working memory (bytes) a run with `options` needs for `input`.
  *  @return IP_OK, or an error for options the layout rejects. */
-ip_status ip_brick_memory_needed(const ip_input_desc *input, const ip_brick_options *options,
+IP_API ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_bricker_options *options,
                                  uint64_t *bytes, ip_error *err);
 
-/*! ip_brick_volume() : bricks `input` into a new brick file at `out_path`. On any failure,
+/*! ip_bricker_run() : bricks `input` into a new brick file at `out_path`. On any failure,
  *  cancellation included, nothing is left at out_path (an existing file there is untouched).
  *  Follows the output rules of isoprop/output.h: out_path is never the input file or its
  *  data file (however spelled), and only a regular file is ever replaced (with force).
@@ -62,8 +66,8 @@ ip_status ip_brick_memory_needed(const ip_input_desc *input, const ip_brick_opti
  *  IP_ERR_ARGUMENT when out_path is the input (or its data file) or exists as something other
  *  than a regular file, or an argument is NULL; IP_ERR_UNSUPPORTED for a spacing outside the
  *  bounds of ip_spacing_check(). */
-ip_status ip_brick_volume(const ip_input_desc *input, const char *out_path,
-                          const ip_brick_options *options, ip_brick_report *report,
+IP_API ip_status ip_bricker_run(const ip_input_desc *input, const char *out_path,
+                          const ip_bricker_options *options, ip_bricker_report *report,
                           ip_error *err);
 
 #ifdef __cplusplus

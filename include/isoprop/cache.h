@@ -67,40 +67,40 @@ typedef struct ip_cache_stats {
 } ip_cache_stats;
 
 /*! ip_cache_default_budget() : 512 MiB, or a quarter of the machine's RAM if smaller; bytes. */
-uint64_t ip_cache_default_budget(void);
+IP_API uint64_t ip_cache_default_budget(void);
 
 /*! ip_cache_create() : a cache over `store` (which must outlive it) holding up to
  *  `budget_bytes` of decoded bricks. *out is owned by the caller, released with
  *  ip_cache_destroy(). @return IP_OK, IP_ERR_ARGUMENT (budget 0) or IP_ERR_NOMEM. */
-ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache **out,
+IP_API ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache **out,
                           ip_error *err);
 
 /*! ip_cache_destroy() : frees every brick; no brick may still be pinned. NULL is allowed. */
-void ip_cache_destroy(ip_cache *cache);
+IP_API void ip_cache_destroy(ip_cache *cache);
 
 /*! ip_cache_pin_brick() : pins global brick `g` and fills *brick. On a miss the brick is read
  *  from the file, its checksum verified and decoded; a bad brick is reported (IP_ERR_CHECKSUM,
  *  IP_ERR_CORRUPT or IP_ERR_IO naming it) and nothing is pinned, and the caller may go on with
  *  other bricks. @return IP_OK, IP_ERR_CHECKSUM, IP_ERR_CORRUPT, IP_ERR_IO, IP_ERR_ARGUMENT or
  *  IP_ERR_NOMEM. */
-ip_status ip_cache_pin_brick(ip_cache *cache, uint64_t g, ip_brick *brick, ip_error *err);
+IP_API ip_status ip_cache_pin_brick(ip_cache *cache, uint64_t g, ip_brick *brick, ip_error *err);
 
 /*! ip_cache_unpin_brick() : releases one pin taken by ip_cache_pin_brick(). */
-void ip_cache_unpin_brick(ip_cache *cache, const ip_brick *brick);
+IP_API void ip_cache_unpin_brick(ip_cache *cache, const ip_brick *brick);
 
 /*! ip_cache_trim() : evicts unpinned bricks, least recently used first, until at most
  *  `keep_bytes` of decoded bricks stay resident (0: all that are not pinned), and frees their
  *  memory; for a caller done with them for now (before rendering a large mesh, say). These
  *  evictions are not counted in `evictions`, which counts those made for room.
  *  Thread-safe. @return the decoded bytes freed. */
-uint64_t ip_cache_trim(ip_cache *cache, uint64_t keep_bytes);
+IP_API uint64_t ip_cache_trim(ip_cache *cache, uint64_t keep_bytes);
 
 /*! ip_cache_get_stats() : a snapshot of the counters (consistent per counter, not across them
  *  while other threads work). */
-void ip_cache_get_stats(const ip_cache *cache, ip_cache_stats *stats);
+IP_API void ip_cache_get_stats(const ip_cache *cache, ip_cache_stats *stats);
 
 /*! ip_cache_store() : the store the cache reads from. */
-const ip_store *ip_cache_store(const ip_cache *cache);
+IP_API const ip_store *ip_cache_store(const ip_cache *cache);
 
 #ifdef __cplusplus
 }

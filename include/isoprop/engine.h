@@ -43,6 +43,7 @@
 #include "isoprop/camera.h"
 #include "isoprop/mesh.h"
 #include "isoprop/status.h"
+#include "isoprop/system.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -81,47 +82,47 @@ typedef struct ip_engine ip_engine;
 
 /*! ip_engine_options_default() : the paper's cut-off (1.81 degrees), a 0.25 degree
  *  fold-back tolerance, every core, adaptive resolution with a 1-pixel error, no cell ids. */
-void ip_engine_options_default(ip_engine_options *options);
+IP_API void ip_engine_options_default(ip_engine_options *options);
 
 /*! ip_engine_create() : an engine reading through `cache` (which must outlive it). *out is the
  *  caller's, released with ip_engine_destroy(). @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM. */
-ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
+IP_API ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
                            ip_error *err);
 
 /*! ip_engine_destroy() : frees the engine and its mesh; NULL is allowed. */
-void ip_engine_destroy(ip_engine *engine);
+IP_API void ip_engine_destroy(ip_engine *engine);
 
 /*! ip_engine_begin() : starts over with a new view and isovalue: drops the mesh, the visited
  *  cells and the ray order, and clears a pending cancel. @return IP_OK or IP_ERR_ARGUMENT. */
-ip_status ip_engine_begin(ip_engine *engine, const ip_camera *camera, float iso, ip_error *err);
+IP_API ip_status ip_engine_begin(ip_engine *engine, const ip_camera *camera, float iso, ip_error *err);
 
 /*! ip_engine_step() : casts up to `max_rays` more rays (0: no limit) for at most `max_seconds`
  *  (0: no limit; checked between rays), appending new triangles to the mesh. `counts` (may be
  *  NULL) receives what this step did. @return IP_OK, IP_ERR_CANCELLED after ip_engine_cancel(),
  *  or the error of a brick that could not be read (IP_ERR_CHECKSUM, IP_ERR_CORRUPT, naming it);
  *  the mesh keeps what was extracted before. */
-ip_status ip_engine_step(ip_engine *engine, uint64_t max_rays, double max_seconds,
+IP_API ip_status ip_engine_step(ip_engine *engine, uint64_t max_rays, double max_seconds,
                          ip_engine_counts *counts, ip_error *err);
 
 /*! ip_engine_done() : 1 once every pixel has had its ray. */
-int ip_engine_done(const ip_engine *engine);
+IP_API int ip_engine_done(const ip_engine *engine);
 
 /*! ip_engine_cancel() : asks a running or later step to stop at the next ray (any thread). */
-void ip_engine_cancel(ip_engine *engine);
+IP_API void ip_engine_cancel(ip_engine *engine);
 
 /*! ip_engine_mesh() : the triangles extracted since ip_engine_begin(), in extraction order;
  *  owned by the engine, valid until the next begin, step or destroy. */
-const ip_mesh *ip_engine_mesh(const ip_engine *engine);
+IP_API const ip_mesh *ip_engine_mesh(const ip_engine *engine);
 
 /*! ip_engine_lod_distance() : D[level] of the current view, world units (0 for level 0;
  *  infinity for levels that are never used). Valid after ip_engine_begin(). */
-double ip_engine_lod_distance(const ip_engine *engine, uint32_t level);
+IP_API double ip_engine_lod_distance(const ip_engine *engine, uint32_t level);
 
 /*! ip_engine_totals() : counts and times since ip_engine_begin(). */
-void ip_engine_totals(const ip_engine *engine, ip_engine_counts *counts);
+IP_API void ip_engine_totals(const ip_engine *engine, ip_engine_counts *counts);
 
 /*! ip_engine_add_rendering_time() : adds the caller's rendering time to the totals. */
-void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
+IP_API void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
 
 /*! ip_extract_full() : triangulates every active cell of level `level`, brick by brick, skipping
  *  bricks and sub-blocks whose summary range excludes `iso`; the oracle and the baseline.
@@ -130,11 +131,9 @@ void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
  *  threads (0 = every core) and appends to `mesh` in brick order, so the result is the same
  *  for any number of threads. Times are summed over threads.
  *  @return IP_OK or a brick read error. */
-ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,
+IP_API ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,
                           ip_mesh *mesh, ip_engine_counts *counts, ip_error *err);
 
-/*! ip_thread_count() : `requested`, or the number of online cores when it is 0. */
-unsigned ip_thread_count(unsigned requested);
 
 #ifdef __cplusplus
 }

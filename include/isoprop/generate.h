@@ -43,14 +43,14 @@ typedef struct ip_gen_params {
 } ip_gen_params;
 
 /*! ip_field_name() : "shepp-logan", "sphere", "gyroid" or "marschner-lobb". */
-const char *ip_field_name(ip_field field);
+IP_API const char *ip_field_name(ip_field field);
 
 /*! ip_field_parse() : parses a field name. @return IP_OK or IP_ERR_ARGUMENT. */
-ip_status ip_field_parse(const char *name, ip_field *out);
+IP_API ip_status ip_field_parse(const char *name, ip_field *out);
 
 /*! ip_generate_plane() : writes z-plane `z` (dims[0]*dims[1] samples of params->type, host
  *  byte order) into `dst`, which the caller owns. Thread-safe. @return IP_OK or IP_ERR_ARGUMENT. */
-ip_status ip_generate_plane(const ip_gen_params *params, uint32_t z, void *dst, ip_error *err);
+IP_API ip_status ip_generate_plane(const ip_gen_params *params, uint32_t z, void *dst, ip_error *err);
 
 /*! ip_generate_write() : writes the whole volume as a little-endian raw file at `path`,
  *  atomically (a temporary file in the same folder, fsync, rename); memory is one group of
@@ -59,7 +59,7 @@ ip_status ip_generate_plane(const ip_gen_params *params, uint32_t z, void *dst, 
  *  existing path that is not a regular file is refused even with force (isoprop/output.h).
  *  @return IP_OK, IP_ERR_ARGUMENT, IP_ERR_EXISTS, IP_ERR_IO or IP_ERR_NOMEM, with
  *  err->message naming `path`; on error no file is left at `path` (or the old one is kept). */
-ip_status ip_generate_write(const ip_gen_params *params, const char *path, int force,
+IP_API ip_status ip_generate_write(const ip_gen_params *params, const char *path, int force,
                             ip_error *err);
 
 /*! ip_upsample_write() : writes `input` enlarged `factor` times along each axis (dims * factor
@@ -70,12 +70,12 @@ ip_status ip_generate_write(const ip_gen_params *params, const char *path, int f
  *  ip_input_open(); single-threaded. `path` may not be the input or its data file
  *  (IP_ERR_ARGUMENT, whatever force says). @return as ip_generate_write(), plus the reader's
  *  IP_ERR_INPUT. */
-ip_status ip_upsample_write(const ip_input_desc *input, uint32_t factor, const char *path,
+IP_API ip_status ip_upsample_write(const ip_input_desc *input, uint32_t factor, const char *path,
                             int force, ip_error *err);
 
 /*! ip_raw_file_name() : writes the conventional name "NAME_XxYxZ_TYPE.raw" for `name`, `dims`
  *  and `type` into buf (size bytes). @return IP_OK, or IP_ERR_ARGUMENT if it does not fit. */
-ip_status ip_raw_file_name(char *buf, size_t size, const char *name, const uint32_t dims[3],
+IP_API ip_status ip_raw_file_name(char *buf, size_t size, const char *name, const uint32_t dims[3],
                            ip_type type);
 
 #ifdef __cplusplus

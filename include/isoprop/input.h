@@ -17,8 +17,6 @@
 extern "C" {
 #endif
 
-#define IP_PATH_MAX 4096
-
 typedef enum ip_encoding {
     IP_ENCODING_RAW = 0,
     IP_ENCODING_GZIP = 1
@@ -67,7 +65,7 @@ typedef struct ip_input_overrides {
  *  problem in one line; IP_ERR_UNSUPPORTED for a spacing outside the renderable range;
  *  IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an override type that is not
  *  an ip_type; IP_ERR_NOMEM when an allocation fails. */
-ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
+IP_API ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
                             ip_input_desc *out, ip_error *err);
 
 /* A sequential plane reader. Not thread-safe; one owner at a time. */
@@ -78,7 +76,7 @@ typedef struct ip_input_reader ip_input_reader;
  *  inflate straight into the caller's planes. @return IP_OK, IP_ERR_IO or IP_ERR_NOMEM;
  *  IP_ERR_INPUT when the data file is no longer a regular file; IP_ERR_ARGUMENT for NULL
  *  arguments or a desc without type and dims. */
-ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_error *err);
+IP_API ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_error *err);
 
 /*! ip_input_read_planes() : reads the next `count` z-planes into `dst`, which must hold
  *  count * dims[0] * dims[1] samples; samples arrive in the host's byte order.
@@ -89,11 +87,11 @@ ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_err
  *  @return IP_OK, IP_ERR_IO or IP_ERR_INPUT; IP_ERR_NOMEM when zlib runs out of memory;
  *  IP_ERR_ARGUMENT for reading past the last plane
  *  or a NULL reader or dst. */
-ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count,
+IP_API ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count,
                                ip_error *err);
 
 /*! ip_input_close() : releases the reader (NULL is allowed). */
-void ip_input_close(ip_input_reader *reader);
+IP_API void ip_input_close(ip_input_reader *reader);
 
 #ifdef __cplusplus
 }

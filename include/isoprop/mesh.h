@@ -53,31 +53,31 @@ static inline uint64_t ip_cell_id(uint32_t level, uint64_t linear)
 }
 
 /*! ip_mesh_init() : an empty mesh that keeps no cell ids (no allocation). */
-void ip_mesh_init(ip_mesh *mesh);
+IP_API void ip_mesh_init(ip_mesh *mesh);
 
 /*! ip_mesh_init_with_cells() : an empty mesh that keeps each triangle's cell id. */
-void ip_mesh_init_with_cells(ip_mesh *mesh);
+IP_API void ip_mesh_init_with_cells(ip_mesh *mesh);
 
 /*! ip_mesh_free() : releases the arrays; the mesh is empty afterwards (and keeps its
  *  with_cells choice). */
-void ip_mesh_free(ip_mesh *mesh);
+IP_API void ip_mesh_free(ip_mesh *mesh);
 
 /*! ip_mesh_clear() : drops every triangle, keeping the memory. */
-void ip_mesh_clear(ip_mesh *mesh);
+IP_API void ip_mesh_clear(ip_mesh *mesh);
 
 /*! ip_mesh_reserve() : makes room for `triangles` in all (grows by half again, at least).
  *  @return IP_OK or IP_ERR_NOMEM (the mesh is unchanged). */
-ip_status ip_mesh_reserve(ip_mesh *mesh, uint64_t triangles);
+IP_API ip_status ip_mesh_reserve(ip_mesh *mesh, uint64_t triangles);
 
 /*! ip_mesh_append() : appends `count` triangles from arrays laid out like the mesh's;
  *  `cells` is read only when the mesh keeps cell ids (and may be NULL otherwise).
  *  @return IP_OK or IP_ERR_NOMEM. */
-ip_status ip_mesh_append(ip_mesh *mesh, const float *positions, const int16_t *normals,
+IP_API ip_status ip_mesh_append(ip_mesh *mesh, const float *positions, const int16_t *normals,
                          const uint64_t *cells, uint64_t count);
 
 /*! ip_mesh_append_float_normals() : ip_mesh_append() with normals given as 9 floats per
  *  triangle, packed with ip_normal_pack(). @return IP_OK or IP_ERR_NOMEM. */
-ip_status ip_mesh_append_float_normals(ip_mesh *mesh, const float *positions,
+IP_API ip_status ip_mesh_append_float_normals(ip_mesh *mesh, const float *positions,
                                        const float *normals, const uint64_t *cells,
                                        uint64_t count);
 
@@ -85,7 +85,7 @@ ip_status ip_mesh_append_float_normals(ip_mesh *mesh, const float *positions,
  *  hold them), with their cell ids when `mesh` keeps them, in which case `from` must too.
  *  @return IP_OK, IP_ERR_ARGUMENT (a range past `from`, or no cell ids to copy) or
  *  IP_ERR_NOMEM. */
-ip_status ip_mesh_append_mesh(ip_mesh *mesh, const ip_mesh *from, uint64_t first,
+IP_API ip_status ip_mesh_append_mesh(ip_mesh *mesh, const ip_mesh *from, uint64_t first,
                               uint64_t count);
 
 /*! ip_mesh_write_ply() : writes the mesh as binary little-endian PLY (float x,y,z,nx,ny,nz per
@@ -93,7 +93,7 @@ ip_status ip_mesh_append_mesh(ip_mesh *mesh, const ip_mesh *from, uint64_t first
  *  regular file is ever replaced (isoprop/output.h).
  *  @return IP_OK, IP_ERR_EXISTS (force == 0 and the file exists), IP_ERR_ARGUMENT (the path
  *  exists and is not a regular file), IP_ERR_NOMEM or IP_ERR_IO. */
-ip_status ip_mesh_write_ply(const ip_mesh *mesh, const char *path, int force, ip_error *err);
+IP_API ip_status ip_mesh_write_ply(const ip_mesh *mesh, const char *path, int force, ip_error *err);
 
 #ifdef __cplusplus
 }

@@ -3,7 +3,7 @@
  * Every file the library writes (brick files, raw volumes, PNG images, PLY meshes, and the
  * buffers given to ip_output_write()) appears under its name only when complete: the bytes go
  * to an unnamed or hidden temporary file in the destination's folder, which is then linked or
- * renamed into place (see src/atomic_file.h). Three rules hold for all of them:
+ * renamed into place (see src/common/atomic_file.h). Three rules hold for all of them:
  *
  *   - without `force`, an existing file is never replaced (IP_ERR_EXISTS);
  *   - only regular files are ever replaced: an existing directory, device, FIFO or socket at
@@ -31,25 +31,25 @@ extern "C" {
  *  @return IP_OK; IP_ERR_EXISTS when a file exists and force is 0; IP_ERR_ARGUMENT when the
  *  path exists and is not a regular file (directory, device, FIFO, socket), force or not;
  *  IP_ERR_IO when it cannot be examined. err->message names the path. */
-ip_status ip_output_check(const char *path, int force, ip_error *err);
+IP_API ip_status ip_output_check(const char *path, int force, ip_error *err);
 
 /*! ip_path_same_file() : 1 when paths `a` and `b` name the same file: the same device and
  *  inode when both exist, else the same canonical spelling (the real path of the folder plus
  *  the base name, so "x.png", "./x.png" and "dir/../x.png" agree before x.png exists); 0
  *  otherwise. Touches nothing. Reentrant. */
-int ip_path_same_file(const char *a, const char *b);
+IP_API int ip_path_same_file(const char *a, const char *b);
 
 /*! ip_output_not_input() : refuses an output that is an input.
  *  @return IP_OK when `output_path` and `input_path` are different files (ip_path_same_file()),
  *  else IP_ERR_ARGUMENT with a message naming both. */
-ip_status ip_output_not_input(const char *output_path, const char *input_path, ip_error *err);
+IP_API ip_status ip_output_not_input(const char *output_path, const char *input_path, ip_error *err);
 
 /*! ip_output_write() : writes `size` bytes from `data` as the whole file at `path`,
  *  all-or-nothing (durable and visible only when complete; nothing is left on failure),
  *  following the rules above. The caller keeps `data`. Reentrant.
  *  @return IP_OK, IP_ERR_EXISTS, IP_ERR_ARGUMENT (not a regular file, path too long) or
  *  IP_ERR_IO, with err->message naming the path. */
-ip_status ip_output_write(const char *path, const void *data, size_t size, int force,
+IP_API ip_status ip_output_write(const char *path, const void *data, size_t size, int force,
                           ip_error *err);
 
 #ifdef __cplusplus

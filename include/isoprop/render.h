@@ -43,12 +43,12 @@ typedef struct ip_shading {
 } ip_shading;
 
 /*! ip_shading_default() : the parameters both renderers use. Thread-safe. */
-void ip_shading_default(ip_shading *shading);
+IP_API void ip_shading_default(ip_shading *shading);
 
 /*! ip_render_check_box() : validates the world box [lo, hi] (world units) that both
  *  renderers take for their near and far planes: finite, lo <= hi on every axis.
  *  @return IP_OK or IP_ERR_ARGUMENT with a message. Thread-safe. */
-ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_error *err);
+IP_API ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_error *err);
 
 /*! ip_raster_mesh() : renders `mesh` in software, the reference for the GPU renderer.
  *  `camera` gives the image size (width x height pixels) and the view; near and far planes
@@ -71,7 +71,7 @@ ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_error *
  *  @return IP_OK, IP_ERR_ARGUMENT (bad camera or box, image over 65536 pixels a side, mesh
  *  with UINT32_MAX triangles or more) or IP_ERR_NOMEM (working buffers: about 12 bytes a
  *  pixel, 24 with rgba). */
-ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
+IP_API ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
                          const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
                          ip_error *err);
 
@@ -81,7 +81,7 @@ ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const dou
  *  only when it is a regular file (isoprop/output.h).
  *  Reentrant. @return IP_OK, IP_ERR_EXISTS, IP_ERR_ARGUMENT (an empty image, or a path that
  *  is not a regular file), IP_ERR_NOMEM or IP_ERR_IO. */
-ip_status ip_png_write(const char *path, const uint8_t *rgba, uint32_t width, uint32_t height,
+IP_API ip_status ip_png_write(const char *path, const uint8_t *rgba, uint32_t width, uint32_t height,
                        int force, ip_error *err);
 
 /* A headless OpenGL 3.3 core context: EGL on Mesa's surfaceless platform (no window, no
@@ -93,20 +93,20 @@ typedef struct ip_gl_context ip_gl_context;
 /*! ip_gl_context_create_headless() : creates the context and makes it current on the calling
  *  thread. @return IP_OK, IP_ERR_UNSUPPORTED (no EGL, no surfaceless platform, no OpenGL 3.3
  *  core: the message says which) or IP_ERR_NOMEM; *out is NULL on failure. */
-ip_status ip_gl_context_create_headless(ip_gl_context **out, ip_error *err);
+IP_API ip_status ip_gl_context_create_headless(ip_gl_context **out, ip_error *err);
 
 /*! ip_gl_context_make_current() : makes the context current on the calling thread (a no-op
  *  when it already is). A context is current on one thread at most: release it on the other
  *  thread first (ip_gl_context_release()). @return IP_OK or IP_ERR_UNSUPPORTED. */
-ip_status ip_gl_context_make_current(ip_gl_context *context, ip_error *err);
+IP_API ip_status ip_gl_context_make_current(ip_gl_context *context, ip_error *err);
 
 /*! ip_gl_context_release() : makes no context current on the calling thread if `context`
  *  is the current one there. */
-void ip_gl_context_release(ip_gl_context *context);
+IP_API void ip_gl_context_release(ip_gl_context *context);
 
 /*! ip_gl_context_destroy() : destroys the context (NULL is a no-op); call it from the thread
  *  where the context is current, or from any thread if it is current nowhere. */
-void ip_gl_context_destroy(ip_gl_context *context);
+IP_API void ip_gl_context_destroy(ip_gl_context *context);
 
 /* The GPU renderer: holds the mesh in GPU buffers and draws it with the shading above.
  * A renderer is not thread-safe. A headless renderer makes its own context current on the
@@ -124,7 +124,7 @@ typedef struct ip_renderer ip_renderer;
  *  off-screen framebuffer of width x height pixels (RGBA8 colour, 24-bit depth).
  *  @return IP_OK, IP_ERR_ARGUMENT (a size of 0 or over the GL limit), IP_ERR_UNSUPPORTED
  *  (no headless OpenGL 3.3 core here) or IP_ERR_NOMEM; *out is NULL on failure. */
-ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip_renderer **out,
+IP_API ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip_renderer **out,
                                       ip_error *err);
 
 /*! ip_renderer_create_current() : a renderer on the OpenGL 3.3 core (or later) context that
@@ -133,13 +133,13 @@ ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip_render
  *  for every later call, destroy included, and owns the framebuffer.
  *  @return IP_OK, IP_ERR_ARGUMENT, IP_ERR_UNSUPPORTED (no current context, or older than 3.3
  *  core) or IP_ERR_NOMEM. */
-ip_status ip_renderer_create_current(uint32_t width, uint32_t height, uint32_t framebuffer,
+IP_API ip_status ip_renderer_create_current(uint32_t width, uint32_t height, uint32_t framebuffer,
                                      ip_renderer **out, ip_error *err);
 
 /*! ip_renderer_resize() : changes the image size (pixels). A headless renderer reallocates
  *  its off-screen framebuffer; otherwise the caller has resized its framebuffer already.
  *  @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM (the old size remains). */
-ip_status ip_renderer_resize(ip_renderer *renderer, uint32_t width, uint32_t height,
+IP_API ip_status ip_renderer_resize(ip_renderer *renderer, uint32_t width, uint32_t height,
                              ip_error *err);
 
 /*! ip_renderer_upload() : appends the triangles [first_triangle, mesh->triangle_count) of
@@ -149,14 +149,14 @@ ip_status ip_renderer_resize(ip_renderer *renderer, uint32_t width, uint32_t hei
  *  so far appends exactly the triangles added since.
  *  @return IP_OK, IP_ERR_ARGUMENT (first_triangle > mesh->triangle_count) or IP_ERR_NOMEM
  *  (GPU memory; nothing of this call is kept). */
-ip_status ip_renderer_upload(ip_renderer *renderer, const ip_mesh *mesh,
+IP_API ip_status ip_renderer_upload(ip_renderer *renderer, const ip_mesh *mesh,
                              uint64_t first_triangle, ip_error *err);
 
 /*! ip_renderer_clear_mesh() : forgets every uploaded triangle, keeping the GPU buffers. */
-void ip_renderer_clear_mesh(ip_renderer *renderer);
+IP_API void ip_renderer_clear_mesh(ip_renderer *renderer);
 
 /*! ip_renderer_triangle_count() : the number of triangles uploaded and not cleared. */
-uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
+IP_API uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
 
 /*! ip_renderer_draw() : draws the background and the uploaded triangles in upload order,
  *  seen by `camera` (whose width and height must be the renderer's), with near and far planes
@@ -165,7 +165,7 @@ uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
  *  still be working: ip_renderer_read_rgba() waits for it).
  *  @return IP_OK, IP_ERR_ARGUMENT (bad camera or box, size mismatch) or IP_ERR_UNSUPPORTED
  *  (an OpenGL error, named in the message). */
-ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera, const double lo[3],
+IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera, const double lo[3],
                            const double hi[3], ip_error *err);
 
 /*! ip_renderer_draw_mesh() : draws the background and the triangles of `mesh`, in order,
@@ -174,23 +174,23 @@ ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera, const
  *  driver holds a second copy of a large mesh: for one-off images. The uploaded triangles are
  *  left alone and not drawn. `mesh` is read during the call only.
  *  @return as ip_renderer_draw(). */
-ip_status ip_renderer_draw_mesh(ip_renderer *renderer, const ip_mesh *mesh,
+IP_API ip_status ip_renderer_draw_mesh(ip_renderer *renderer, const ip_mesh *mesh,
                                 const ip_camera *camera, const double lo[3],
                                 const double hi[3], ip_error *err);
 
 /*! ip_renderer_read_rgba() : copies the image drawn last into `rgba` (width * height * 4
  *  bytes, caller-owned), top row first, waiting for OpenGL to finish.
  *  @return IP_OK or IP_ERR_UNSUPPORTED (an OpenGL error). */
-ip_status ip_renderer_read_rgba(ip_renderer *renderer, uint8_t *rgba, ip_error *err);
+IP_API ip_status ip_renderer_read_rgba(ip_renderer *renderer, uint8_t *rgba, ip_error *err);
 
 /*! ip_renderer_release() : makes a headless renderer's context no longer current on the
  *  calling thread, so that another thread may use the renderer; a no-op for a renderer on the
  *  caller's context. */
-void ip_renderer_release(ip_renderer *renderer);
+IP_API void ip_renderer_release(ip_renderer *renderer);
 
 /*! ip_renderer_destroy() : frees the GPU objects and, for a headless renderer, its context
  *  (NULL is a no-op). A renderer on the caller's context needs that context current. */
-void ip_renderer_destroy(ip_renderer *renderer);
+IP_API void ip_renderer_destroy(ip_renderer *renderer);
 
 #ifdef __cplusplus
 }

@@ -8,6 +8,14 @@
 #ifndef ISOPROP_STATUS_H
 #define ISOPROP_STATUS_H
 
+/* IP_API marks the library's public functions: the only symbols libisoprop.so exports (the
+ * library is compiled with -fvisibility=hidden). */
+#if defined(__GNUC__)
+#define IP_API __attribute__((visibility("default")))
+#else
+#define IP_API
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -28,7 +36,7 @@ typedef enum ip_status {
 } ip_status;
 
 /*! ip_status_message() : a short constant English description of `code` (never NULL). */
-const char *ip_status_message(int code);
+IP_API const char *ip_status_message(int code);
 
 /* Detailed error report, owned by the caller (usually on its stack). */
 typedef struct ip_error {
@@ -37,7 +45,7 @@ typedef struct ip_error {
 } ip_error;
 
 /*! ip_error_clear() : resets `err` (may be NULL) to IP_OK and an empty message. */
-void ip_error_clear(ip_error *err);
+IP_API void ip_error_clear(ip_error *err);
 
 #ifdef __cplusplus
 }

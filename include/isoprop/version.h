@@ -6,6 +6,8 @@
 #ifndef ISOPROP_VERSION_H
 #define ISOPROP_VERSION_H
 
+#include "isoprop/status.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -16,7 +18,7 @@ extern "C" {
 
 /*! ip_version() : the version of the library linked in, as "MAJOR.MINOR.PATCH" (e.g. "0.1.0");
  *  a constant string, never NULL; thread-safe. */
-const char *ip_version(void);
+IP_API const char *ip_version(void);
 
 #ifdef __cplusplus
 }

@@ -26,31 +26,29 @@ typedef enum ip_type {
 #define IP_TYPE_COUNT 4
 
 /* Longest path the library stores, in bytes (including the terminating NUL). */
-#ifndef IP_PATH_MAX
 #define IP_PATH_MAX 4096
-#endif
 
 /*! ip_type_size() : bytes per sample of `type` (1, 2 or 4); 0 for an unknown type. */
-size_t ip_type_size(ip_type type);
+IP_API size_t ip_type_size(ip_type type);
 
 /*! ip_type_holds() : 1 when a sample of `type` can hold `value` exactly (an integer within
  *  the type's range; any finite value for float32), else 0. */
-int ip_type_holds(ip_type type, float value);
+IP_API int ip_type_holds(ip_type type, float value);
 
 /*! ip_type_name() : the canonical name ("uint8", "uint16", "int16", "float32"), or "unknown". */
-const char *ip_type_name(ip_type type);
+IP_API const char *ip_type_name(ip_type type);
 
 /*! ip_type_parse() : parses a type name; accepts the canonical names and the common aliases
  *  (uchar, ushort, short, float, MET_UCHAR, ...).
  *  @return IP_OK and *out set, or IP_ERR_ARGUMENT for an unknown name (*out untouched). */
-ip_status ip_type_parse(const char *name, ip_type *out);
+IP_API ip_status ip_type_parse(const char *name, ip_type *out);
 
 /*! ip_sample_get() : sample `index` of a native-endian array of `type`, as a float; 0 for an
  *  unknown type. Exact for every supported type (uint8/uint16/int16 fit a float's 24-bit
  *  mantissa). An inline definition, so that callers that read sample by sample pay no call;
- *  src/volume.c holds the external one. (Loops over many samples of one type do better
+ *  src/common/volume.c holds the external one. (Loops over many samples of one type do better
  *  still to switch on the type once, outside the loop.) */
-inline float ip_sample_get(const void *samples, ip_type type, size_t index)
+IP_API inline float ip_sample_get(const void *samples, ip_type type, size_t index)
 {
     switch (type) {
     case IP_UINT8: return (float)((const uint8_t *)samples)[index];
@@ -63,7 +61,7 @@ inline float ip_sample_get(const void *samples, ip_type type, size_t index)
 
 /*! ip_dims_parse() : parses "XxYxZ" (e.g. "512x512x234") into dims; each must be in [1, 2^31).
  *  @return IP_OK, or IP_ERR_ARGUMENT when the text is not three positive integers. */
-ip_status ip_dims_parse(const char *text, uint32_t dims[3]);
+IP_API ip_status ip_dims_parse(const char *text, uint32_t dims[3]);
 
 /* The spacings (world units between samples) the whole pipeline renders correctly: camera
  * framing, seeding, propagation, level of detail, float32 vertex positions and normals, the
@@ -79,7 +77,7 @@ ip_status ip_dims_parse(const char *text, uint32_t dims[3]);
  *  above. `name` (a file name, may be NULL) starts the message. Reentrant.
  *  @return IP_OK, or IP_ERR_UNSUPPORTED with a one-line message giving the accepted range
  *  (and suggesting another unit, or resampling for too large a ratio). */
-ip_status ip_spacing_check(const double spacing[3], const char *name, ip_error *err);
+IP_API ip_status ip_spacing_check(const double spacing[3], const char *name, ip_error *err);
 
 #ifdef __cplusplus
 }

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "isoprop/codec.h"
+#include "codec.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -14,17 +14,17 @@ static int round_trip(const uint8_t *data, size_t size, ip_type type, const uint
     size_t count = (size_t)e[0] * e[1] * e[2], bytes = count * ip_type_size(type);
     if (size < bytes)
         return 0;
-    unsigned char *samples = malloc(bytes), *out = malloc(ip_brick_encode_bound(count, type));
-    unsigned char *work = malloc(ip_brick_work_size(count, type)), *back = malloc(bytes);
+    unsigned char *samples = malloc(bytes), *out = malloc(ip__codec_bound(count, type));
+    unsigned char *work = malloc(ip__codec_work_size(count, type)), *back = malloc(bytes);
     memcpy(samples, data, bytes);
     if (type == IP_FLOAT32) /* bricking only sees finite floats: clear exponent all-ones */
         for (size_t i = 0; i < count; i++)
             samples[4 * i + 3] &= 0x3f;
     ip_brick_entry entry;
-    if (ip_brick_encode(samples, e, type, 0, out, work, &entry) != IP_OK)
+    if (ip__codec_encode(samples, e, type, 0, out, work, &entry) != IP_OK)
         abort();
     float constant = ip_sample_get(samples, type, 0);
-    if (ip_brick_decode(&entry, out, e, type, constant, back, work) != IP_OK ||
+    if (ip__codec_decode(&entry, out, e, type, constant, back, work) != IP_OK ||
         memcmp(samples, back, bytes) != 0)
         abort();
     free(samples);
@@ -43,10 +43,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ip_brick_entry entry = {0, (uint32_t)(size - 6), (uint8_t)(data[4] % 4), data[5], 0};
     size_t count = (size_t)e[0] * e[1] * e[2];
     size_t bytes = count * ip_type_size(type);
-    unsigned char *dst = malloc(bytes), *work = malloc(ip_brick_work_size(count, type));
+    unsigned char *dst = malloc(bytes), *work = malloc(ip__codec_work_size(count, type));
     unsigned char *payload = malloc(size - 6 + 1);
     memcpy(payload, data + 6, size - 6); /* an exact-size buffer: overreads are caught */
-    (void)ip_brick_decode(&entry, payload, e, type, 1.0f, dst, work);
+    (void)ip__codec_decode(&entry, payload, e, type, 1.0f, dst, work);
     free(payload);
     free(dst);
     free(work);

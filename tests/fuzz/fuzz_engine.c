@@ -33,7 +33,7 @@
 #include <unistd.h>
 
 #include "isoprop/engine.h"
-#include "isoprop/format.h"
+#include "format.h"
 #include "isoprop/render.h"
 #include "isoprop/store.h"
 
@@ -80,11 +80,11 @@ static void recompute_checksums(unsigned char *file, size_t size)
             uint64_t offset = load_u64(entry);
             uint32_t stored = load_u32(entry + 8);
             if (stored > 0 && offset <= size && stored <= size - offset)
-                store_u64(entry + 16, ip_format_checksum(file + offset, stored));
+                store_u64(entry + 16, ip__format_checksum(file + offset, stored));
         }
-        store_u64(file + 128, ip_format_checksum(file + summary_offset, summary_size));
+        store_u64(file + 128, ip__format_checksum(file + summary_offset, summary_size));
     }
-    store_u64(file + 248, ip_format_checksum(file, 248));
+    store_u64(file + 248, ip__format_checksum(file, 248));
 }
 
 /* Every error must say something, on one line. */

@@ -5,7 +5,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 
-#include "isoprop/format.h"
+#include "format.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -20,9 +20,9 @@ static void check_accepted(const ip_layout *l)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     ip_layout layout;
-    if (ip_format_parse(data, size, "fuzz", 0, &layout, NULL) == IP_OK)
+    if (ip__format_parse(data, size, "fuzz", 0, &layout, NULL) == IP_OK)
         check_accepted(&layout);
-    if (ip_format_parse(data, size, "fuzz", IP_PARSE_SKIP_CHECKSUMS, &layout, NULL) == IP_OK)
+    if (ip__format_parse(data, size, "fuzz", IP_PARSE_SKIP_CHECKSUMS, &layout, NULL) == IP_OK)
         check_accepted(&layout);
     return 0;
 }

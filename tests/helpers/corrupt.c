@@ -36,7 +36,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "isoprop/format.h"
+#include "format.h"
 
 #define NOOP 3
 
@@ -104,7 +104,7 @@ static int write_whole(const char *path, const unsigned char *bytes, uint64_t si
 static int parse(const char *path, const unsigned char *bytes, uint64_t size, ip_layout *l)
 {
     ip_error err;
-    if (ip_format_parse(bytes, size, path, 0, l, &err) != IP_OK) {
+    if (ip__format_parse(bytes, size, path, 0, l, &err) != IP_OK) {
         fprintf(stderr, "corrupt: %s\n", err.message);
         return 1;
     }
@@ -119,14 +119,14 @@ typedef struct payload {
 static payload *payloads_of(const unsigned char *bytes, const ip_layout *l, uint64_t *count)
 {
     ip_summary_offsets so;
-    ip_summary_offsets_of(l, &so);
+    ip__summary_offsets_of(l, &so);
     payload *p = malloc((l->brick_count + 1) * sizeof *p);
     if (!p)
         return NULL;
     *count = 0;
     for (uint64_t g = 0; g < l->brick_count; g++) {
         ip_brick_entry e;
-        ip_directory_entry_decode(bytes + l->summary_offset + so.directory +
+        ip__format_entry_decode(bytes + l->summary_offset + so.directory +
                                       g * IP_DIRECTORY_ENTRY_SIZE, &e);
         if (e.stored_size > 0)
             p[(*count)++] = (payload){g, e.offset, e.stored_size};
@@ -201,7 +201,7 @@ static int cmd_plan(const char *path, int quick, uint64_t seed)
     uint64_t rng = seed;
     uint64_t data_end = l.data_offset + l.data_size;
     ip_summary_offsets so;
-    ip_summary_offsets_of(&l, &so);
+    ip__summary_offsets_of(&l, &so);
 
     /* truncations: the edges of every section, then lengths spread over the data and the
      * summary */
@@ -442,11 +442,11 @@ static void rehash(unsigned char *file, uint64_t size)
             uint64_t offset = load_u64(e);
             uint32_t stored = (uint32_t)load_u64(e + 8);
             if (stored > 0 && offset <= size && stored <= size - offset)
-                store_u64(e + 16, ip_format_checksum(file + offset, stored));
+                store_u64(e + 16, ip__format_checksum(file + offset, stored));
         }
-        store_u64(file + 128, ip_format_checksum(file + summary_offset, summary_size));
+        store_u64(file + 128, ip__format_checksum(file + summary_offset, summary_size));
     }
-    store_u64(file + 248, ip_format_checksum(file, 248));
+    store_u64(file + 248, ip__format_checksum(file, 248));
 }
 
 static int cmd_apply(const char *in, const char *out, const char *spec, int recompute)

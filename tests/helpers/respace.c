@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "isoprop/format.h"
+#include "format.h"
 
 int main(int argc, char **argv)
 {
@@ -36,13 +36,13 @@ int main(int argc, char **argv)
     fclose(in);
     ip_layout layout;
     ip_error err;
-    if (ip_format_parse(file, (uint64_t)size, argv[1], 0, &layout, &err) != IP_OK) {
+    if (ip__format_parse(file, (uint64_t)size, argv[1], 0, &layout, &err) != IP_OK) {
         fprintf(stderr, "respace: %s\n", err.message);
         free(file);
         return 1;
     }
     memcpy(layout.spacing, spacing, sizeof spacing);
-    ip_header_encode(&layout, file);
+    ip__format_header_encode(&layout, file);
     FILE *out = fopen(argv[2], "wb");
     int bad = !out || fwrite(file, 1, (size_t)size, out) != (size_t)size;
     if (out)

@@ -23,8 +23,9 @@
 #include <xxhash.h>
 
 #include "isoprop/cache.h"
-#include "isoprop/codec.h"
+#include "codec.h"
 #include "isoprop/store.h"
+#include "isoprop/system.h"
 #include "tool_common.h"
 
 static const char program[] = "bench_cache";
@@ -52,27 +53,7 @@ typedef struct options {
 
 /* ---- small helpers: time, memory, statistics ---- */
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
-/* A field of /proc/self/status in bytes ("VmRSS:", "VmHWM:"), 0 when unknown. */
-static uint64_t status_bytes(const char *field)
-{
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    uint64_t kib = 0;
-    size_t n = strlen(field);
-    while (f && fgets(line, sizeof line, f))
-        if (strncmp(line, field, n) == 0)
-            kib = strtoull(line + n, NULL, 10);
-    if (f)
-        fclose(f);
-    return kib * 1024u;
-}
 
 /* Resets the process's peak RSS to its current RSS (Linux >= 4.0); 0 on success. */
 static int reset_peak_rss(void)
@@ -132,9 +113,9 @@ static void *team_entry(void *p)
 {
     team_member *m = p;
     pthread_barrier_wait(m->start);
-    m->started = now_seconds();
+    m->started = ip_now_seconds();
     m->work(m->arg);
-    m->finished = now_seconds();
+    m->finished = ip_now_seconds();
     return NULL;
 }
 
@@ -313,13 +294,13 @@ static void print_file_facts(const bench_file *f, const options *o)
 
 typedef enum stage {
     STAGE_READ,   /* ip_store_read_brick: XXH64 + LZ4 + filters */
-    STAGE_DECODE, /* ip_brick_decode: LZ4 + filters */
+    STAGE_DECODE, /* ip__codec_decode: LZ4 + filters */
     STAGE_LZ4,    /* LZ4_decompress_safe alone */
     STAGE_XXH64   /* XXH64 alone */
 } stage;
 
 static const char *const stage_names[] = {
-    "ip_store_read_brick (XXH64 + LZ4 + filters)", "ip_brick_decode (LZ4 + filters)",
+    "ip_store_read_brick (XXH64 + LZ4 + filters)", "ip__codec_decode (LZ4 + filters)",
     "LZ4_decompress_safe alone", "XXH64 alone"};
 
 typedef struct decode_job {
@@ -348,7 +329,7 @@ static void *decode_work(void *p)
                 j->failed |= ip_store_read_brick(f->store, b->g, j->dst, j->work, &err) != IP_OK;
                 break;
             case STAGE_DECODE:
-                j->failed |= ip_brick_decode(&b->entry, src, b->extent, f->layout->type,
+                j->failed |= ip__codec_decode(&b->entry, src, b->extent, f->layout->type,
                                              b->constant_value, j->dst, j->work) != IP_OK;
                 break;
             case STAGE_LZ4:
@@ -456,9 +437,9 @@ static int bench_decode_groups(const bench_file *f, const options *o, decode_job
     if (!group)
         return out_of_memory("a brick list");
     printf("By encoding and filters, one thread, all level-0 bricks (constant ones included, "
-           "as a cache miss decodes them too): ip_brick_decode against LZ4 alone on the same "
-           "bricks; \"filters\" is the share of ip_brick_decode's time spent outside LZ4.\n\n");
-    printf("| bricks | count | decoded MiB | ip_brick_decode GB/s | LZ4 alone GB/s | "
+           "as a cache miss decodes them too): ip__codec_decode against LZ4 alone on the same "
+           "bricks; \"filters\" is the share of ip__codec_decode's time spent outside LZ4.\n\n");
+    printf("| bricks | count | decoded MiB | ip__codec_decode GB/s | LZ4 alone GB/s | "
            "us per brick | filters |\n");
     printf("| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for (unsigned key = 0; key < 0x400; key++) {
@@ -764,7 +745,7 @@ static int run_budget(const bench_file *f, const char *name, const uint64_t *seq
 #endif
     if (peak_resets)
         reset_peak_rss();
-    uint64_t rss_before = status_bytes("VmRSS:");
+    uint64_t rss_before = ip_rss_bytes();
     if (ip_cache_create(f->store, budget_mib << 20, &cache, &err) != IP_OK)
         return tool_fail(program, &err);
     run_job *jobs = calloc(threads, sizeof *jobs);
@@ -778,7 +759,7 @@ static int run_budget(const bench_file *f, const char *name, const uint64_t *seq
             return tool_fail(program, &jobs[t].err);
     ip_cache_stats s;
     ip_cache_get_stats(cache, &s);
-    uint64_t peak = status_bytes("VmHWM:");
+    uint64_t peak = ip_peak_rss_bytes();
     double all = (double)(s.hits + s.misses);
     double other_us = s.misses ? (secs * threads - s.decode_seconds) / (double)s.misses * 1e6 : 0;
     printf("| %s | %llu | %u | %llu | %llu | %llu | %llu | %.1f %% | %.2f | %.2f | %.2f | %.1f | "

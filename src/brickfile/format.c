@@ -1,0 +1,530 @@
+/* The brick file layout: derived geometry, header and summary encoding, validation. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <xxhash.h>
+
+#include "internal.h"
+#include "format.h"
+
+uint64_t ip__format_checksum(const void *data, size_t size)
+{
+    return (uint64_t)XXH64(data, size, 0);
+}
+
+static int is_power_of_two(uint32_t v)
+{
+    return v != 0 && (v & (v - 1)) == 0;
+}
+
+static uint32_t ceil_div(uint64_t a, uint64_t b)
+{
+    return (uint32_t)((a + b - 1) / b);
+}
+
+static uint32_t ceil_log2(uint32_t v)
+{
+    uint32_t r = 0;
+    while ((1ull << r) < v)
+        r++;
+    return r;
+}
+
+uint32_t ip_level_sample_index(uint32_t dim, uint32_t level, uint32_t i)
+{
+    uint64_t s = (uint64_t)i << level;
+    return s < dim - 1 ? (uint32_t)s : dim - 1;
+}
+
+static void level_shape(const ip_layout *layout, uint32_t k, ip_level_layout *lv)
+{
+    uint32_t deepest = 0;
+    for (int a = 0; a < 3; a++) {
+        uint64_t cells = layout->dims[a] - 1u;
+        uint32_t level_cells = (uint32_t)((cells + (1ull << k) - 1) >> k);
+        lv->dims[a] = level_cells + 1;
+        lv->bricks[a] = ceil_div(level_cells, layout->brick_edge);
+        uint32_t depth = ceil_log2(lv->bricks[a]);
+        if (depth > deepest)
+            deepest = depth;
+    }
+    lv->brick_count = (uint64_t)lv->bricks[0] * lv->bricks[1] * lv->bricks[2];
+    lv->octree_depth = deepest;
+    lv->node_count = 0;
+    for (uint32_t j = 1; j <= deepest; j++) {
+        uint64_t n = 1;
+        for (int a = 0; a < 3; a++)
+            n *= ceil_div(lv->bricks[a], 1ull << j);
+        lv->node_count += n;
+    }
+}
+
+ip_status ip__layout_init(ip_layout *layout, const uint32_t dims[3], ip_type type,
+                         const double spacing[3], uint32_t brick_edge, uint32_t subblock_edge,
+                         ip_error *err)
+{
+    memset(layout, 0, sizeof *layout);
+    for (int a = 0; a < 3; a++) {
+        if (dims[a] < 2 || dims[a] >= (1u << 31))
+            return ip__fail(err, IP_ERR_ARGUMENT, "dimension %u along %c is outside [2, 2^31)",
+                           dims[a], "xyz"[a]);
+        if (!(spacing[a] > 0.0) || !isfinite(spacing[a]))
+            return ip__fail(err, IP_ERR_ARGUMENT, "spacing %g along %c is not positive",
+                           spacing[a], "xyz"[a]);
+    }
+    if (ip_type_size(type) == 0)
+        return ip__fail(err, IP_ERR_ARGUMENT, "unknown sample type %d", (int)type);
+    if (!is_power_of_two(brick_edge) || brick_edge < 2 || brick_edge > IP_MAX_BRICK_EDGE)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                       "brick edge %u is not a power of two in [2, %u]", brick_edge,
+                       IP_MAX_BRICK_EDGE);
+    if (!is_power_of_two(subblock_edge) || subblock_edge > brick_edge)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                       "sub-block edge %u is not a power of two no larger than the brick edge %u",
+                       subblock_edge, brick_edge);
+    memcpy(layout->dims, dims, sizeof layout->dims);
+    memcpy(layout->spacing, spacing, sizeof layout->spacing);
+    layout->type = type;
+    layout->brick_edge = brick_edge;
+    layout->subblock_edge = subblock_edge;
+    for (uint32_t k = 0;; k++) {
+        if (k >= IP_MAX_LEVELS)
+            return ip__fail(err, IP_ERR_ARGUMENT, "too many levels");
+        ip_level_layout *lv = &layout->levels[k];
+        level_shape(layout, k, lv);
+        lv->first_brick = layout->brick_count;
+        lv->first_node = layout->node_count;
+        layout->brick_count += lv->brick_count;
+        layout->node_count += lv->node_count;
+        layout->level_count = k + 1;
+        if (lv->brick_count == 1)
+            break;
+    }
+    layout->data_offset = IP_HEADER_SIZE;
+    layout->summary_size = ip__layout_summary_size(layout);
+    return IP_OK;
+}
+
+uint32_t ip_layout_subblocks_per_brick(const ip_layout *layout)
+{
+    uint32_t n = layout->brick_edge / layout->subblock_edge;
+    return n * n * n;
+}
+
+void ip_layout_world_box(const ip_layout *layout, double lo[3], double hi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        lo[a] = 0;
+        hi[a] = (layout->dims[a] - 1) * layout->spacing[a];
+    }
+}
+
+void ip__summary_offsets_of(const ip_layout *layout, ip_summary_offsets *out)
+{
+    out->level_table = 0;
+    out->directory = (uint64_t)layout->level_count * IP_LEVEL_ENTRY_SIZE;
+    out->brick_ranges = out->directory + layout->brick_count * IP_DIRECTORY_ENTRY_SIZE;
+    out->subblock_ranges = out->brick_ranges + layout->brick_count * IP_RANGE_SIZE;
+    out->nodes = out->subblock_ranges +
+                 layout->brick_count * ip_layout_subblocks_per_brick(layout) * IP_RANGE_SIZE;
+    out->end = out->nodes + layout->node_count * IP_RANGE_SIZE;
+}
+
+uint64_t ip__layout_summary_size(const ip_layout *layout)
+{
+    ip_summary_offsets o;
+    ip__summary_offsets_of(layout, &o);
+    return o.end;
+}
+
+void ip_brick_extent(const ip_layout *layout, uint32_t level, const uint32_t brick[3],
+                     uint32_t origin[3], uint32_t extent[3])
+{
+    const ip_level_layout *lv = &layout->levels[level];
+    for (int a = 0; a < 3; a++) {
+        uint32_t first = brick[a] * layout->brick_edge;
+        uint32_t cells = lv->dims[a] - 1 - first;
+        if (cells > layout->brick_edge)
+            cells = layout->brick_edge;
+        origin[a] = first;
+        extent[a] = cells + 1;
+    }
+}
+
+uint64_t ip_brick_global_index(const ip_layout *layout, uint32_t level, const uint32_t brick[3])
+{
+    const ip_level_layout *lv = &layout->levels[level];
+    return lv->first_brick + brick[0] +
+           (uint64_t)lv->bricks[0] * (brick[1] + (uint64_t)lv->bricks[1] * brick[2]);
+}
+
+void ip_brick_coords(const ip_layout *layout, uint64_t global, uint32_t *level,
+                     uint32_t brick[3])
+{
+    uint32_t k = 0;
+    while (k + 1 < layout->level_count && global >= layout->levels[k + 1].first_brick)
+        k++;
+    const ip_level_layout *lv = &layout->levels[k];
+    uint64_t local = global - lv->first_brick;
+    *level = k;
+    brick[0] = (uint32_t)(local % lv->bricks[0]);
+    local /= lv->bricks[0];
+    brick[1] = (uint32_t)(local % lv->bricks[1]);
+    brick[2] = (uint32_t)(local / lv->bricks[1]);
+}
+
+void ip__octree_grid(const ip_layout *layout, uint32_t level, uint32_t depth, uint32_t grid[3])
+{
+    for (int a = 0; a < 3; a++)
+        grid[a] = ceil_div(layout->levels[level].bricks[a], 1ull << depth);
+}
+
+uint64_t ip__octree_node_index(const ip_layout *layout, uint32_t level, uint32_t depth,
+                              const uint32_t node[3])
+{
+    uint64_t index = layout->levels[level].first_node;
+    uint32_t grid[3];
+    for (uint32_t j = 1; j < depth; j++) {
+        ip__octree_grid(layout, level, j, grid);
+        index += (uint64_t)grid[0] * grid[1] * grid[2];
+    }
+    ip__octree_grid(layout, level, depth, grid);
+    return index + node[0] + (uint64_t)grid[0] * (node[1] + (uint64_t)grid[1] * node[2]);
+}
+
+static uint64_t spread_bits(uint32_t v)
+{
+    uint64_t x = v & 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffull;
+    x = (x | x << 16) & 0x1f0000ff0000ffull;
+    x = (x | x << 8) & 0x100f00f00f00f00full;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+    x = (x | x << 2) & 0x1249249249249249ull;
+    return x;
+}
+
+typedef struct morton_key {
+    uint64_t code;
+    uint64_t index;
+} morton_key;
+
+static int compare_morton(const void *a, const void *b)
+{
+    const morton_key *x = a, *y = b;
+    return (x->code > y->code) - (x->code < y->code);
+}
+
+ip_status ip__morton_order(const ip_layout *layout, uint32_t level, uint64_t *order)
+{
+    const ip_level_layout *lv = &layout->levels[level];
+    morton_key *keys = malloc(lv->brick_count * sizeof *keys);
+    if (!keys)
+        return IP_ERR_NOMEM;
+    uint64_t i = 0;
+    for (uint32_t z = 0; z < lv->bricks[2]; z++)
+        for (uint32_t y = 0; y < lv->bricks[1]; y++)
+            for (uint32_t x = 0; x < lv->bricks[0]; x++, i++) {
+                keys[i].code = spread_bits(x) | spread_bits(y) << 1 | spread_bits(z) << 2;
+                keys[i].index = i;
+            }
+    qsort(keys, lv->brick_count, sizeof *keys, compare_morton);
+    for (i = 0; i < lv->brick_count; i++)
+        order[i] = keys[i].index;
+    free(keys);
+    return IP_OK;
+}
+
+/* ---- encoding ---- */
+
+static void store_f32(unsigned char *p, float v)
+{
+    uint32_t bits;
+    memcpy(&bits, &v, 4);
+    ip__store_u32le(p, bits);
+}
+
+static float load_f32(const unsigned char *p)
+{
+    uint32_t bits = ip__load_u32le(p);
+    float v;
+    memcpy(&v, &bits, 4);
+    return v;
+}
+
+static void store_f64(unsigned char *p, double v)
+{
+    uint64_t bits;
+    memcpy(&bits, &v, 8);
+    ip__store_u64le(p, bits);
+}
+
+static double load_f64(const unsigned char *p)
+{
+    uint64_t bits = ip__load_u64le(p);
+    double v;
+    memcpy(&v, &bits, 8);
+    return v;
+}
+
+void ip__format_header_encode(const ip_layout *layout, unsigned char out[IP_HEADER_SIZE])
+{
+    memset(out, 0, IP_HEADER_SIZE);
+    memcpy(out, IP_MAGIC, 8);
+    ip__store_u32le(out + 8, IP_FORMAT_VERSION);
+    ip__store_u32le(out + 12, IP_HEADER_SIZE);
+    for (int a = 0; a < 3; a++) {
+        ip__store_u32le(out + 16 + 4 * a, layout->dims[a]);
+        store_f64(out + 32 + 8 * a, layout->spacing[a]);
+    }
+    ip__store_u32le(out + 28, (uint32_t)layout->type);
+    ip__store_u32le(out + 56, layout->brick_edge);
+    ip__store_u32le(out + 60, layout->subblock_edge);
+    ip__store_u32le(out + 64, layout->level_count);
+    ip__store_u32le(out + 68, 0); /* flags */
+    store_f32(out + 72, layout->value_min);
+    store_f32(out + 76, layout->value_max);
+    ip__store_u64le(out + 80, layout->brick_count);
+    ip__store_u64le(out + 88, layout->node_count);
+    ip__store_u64le(out + 96, layout->data_offset);
+    ip__store_u64le(out + 104, layout->data_size);
+    ip__store_u64le(out + 112, layout->summary_offset);
+    ip__store_u64le(out + 120, layout->summary_size);
+    ip__store_u64le(out + 128, layout->summary_checksum);
+    ip__store_u64le(out + 136, layout->file_size);
+    ip__store_u64le(out + 248, ip__format_checksum(out, 248));
+}
+
+void ip__format_level_table_encode(const ip_layout *layout, unsigned char *out)
+{
+    for (uint32_t k = 0; k < layout->level_count; k++) {
+        const ip_level_layout *lv = &layout->levels[k];
+        unsigned char *e = out + (size_t)k * IP_LEVEL_ENTRY_SIZE;
+        memset(e, 0, IP_LEVEL_ENTRY_SIZE);
+        for (int a = 0; a < 3; a++) {
+            ip__store_u32le(e + 4 * a, lv->dims[a]);
+            ip__store_u32le(e + 12 + 4 * a, lv->bricks[a]);
+        }
+        ip__store_u64le(e + 24, lv->first_brick);
+        ip__store_u32le(e + 32, lv->octree_depth);
+        ip__store_u64le(e + 40, lv->first_node);
+        store_f32(e + 48, lv->value_min);
+        store_f32(e + 52, lv->value_max);
+    }
+}
+
+void ip__format_entry_encode(const ip_brick_entry *entry, unsigned char out[24])
+{
+    ip__store_u64le(out, entry->offset);
+    ip__store_u32le(out + 8, entry->stored_size);
+    out[12] = entry->encoding;
+    out[13] = entry->filters;
+    out[14] = 0;
+    out[15] = 0;
+    ip__store_u64le(out + 16, entry->checksum);
+}
+
+void ip__format_entry_decode(const unsigned char in[24], ip_brick_entry *entry)
+{
+    entry->offset = ip__load_u64le(in);
+    entry->stored_size = ip__load_u32le(in + 8);
+    entry->encoding = in[12];
+    entry->filters = in[13];
+    entry->checksum = ip__load_u64le(in + 16);
+}
+
+/* ---- parsing ---- */
+
+static ip_status parse_header(const unsigned char *h, const char *name, unsigned flags,
+                              ip_layout *layout, ip_error *err)
+{
+    if (memcmp(h, IP_MAGIC, 8) != 0)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: not a brick file (bad magic)", name);
+    uint32_t version = ip__load_u32le(h + 8);
+    if (version != IP_FORMAT_VERSION)
+        return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: format version %u is not supported (this "
+                       "build reads version %u)", name, version, IP_FORMAT_VERSION);
+    if (ip__load_u32le(h + 12) != IP_HEADER_SIZE)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: header size %u is not %u", name,
+                       ip__load_u32le(h + 12), IP_HEADER_SIZE);
+    if (!(flags & IP_PARSE_SKIP_CHECKSUMS) &&
+        ip__load_u64le(h + 248) != ip__format_checksum(h, 248))
+        return ip__fail(err, IP_ERR_CHECKSUM, "%s: header checksum mismatch", name);
+    uint32_t dims[3];
+    double spacing[3];
+    for (int a = 0; a < 3; a++) {
+        dims[a] = ip__load_u32le(h + 16 + 4 * a);
+        spacing[a] = load_f64(h + 32 + 8 * a);
+    }
+    uint32_t type = ip__load_u32le(h + 28);
+    if (type >= IP_TYPE_COUNT)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: unknown sample type %u", name, type);
+    if (ip__load_u32le(h + 68) != 0)
+        return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: unknown header flags 0x%x", name,
+                       ip__load_u32le(h + 68));
+    ip_error why;
+    if (ip__layout_init(layout, dims, (ip_type)type, spacing, ip__load_u32le(h + 56),
+                       ip__load_u32le(h + 60), &why) != IP_OK)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: %s", name, why.message);
+    /* a spacing nothing downstream renders correctly (a file from before the bounds, or a
+     * hostile one): refused here, so that no reader of the library reaches the engine with it */
+    ip_status st = ip_spacing_check(spacing, name, err);
+    if (st != IP_OK)
+        return st;
+    for (int i = 144; i < 248; i++)
+        if (h[i] != 0)
+            return ip__fail(err, IP_ERR_FORMAT, "%s: reserved header byte %d is not zero", name, i);
+    if (ip__load_u32le(h + 64) != layout->level_count ||
+        ip__load_u64le(h + 80) != layout->brick_count ||
+        ip__load_u64le(h + 88) != layout->node_count)
+        return ip__fail(err, IP_ERR_FORMAT,
+                       "%s: level, brick or node counts disagree with the dimensions", name);
+    layout->value_min = load_f32(h + 72);
+    layout->value_max = load_f32(h + 76);
+    layout->data_offset = ip__load_u64le(h + 96);
+    layout->data_size = ip__load_u64le(h + 104);
+    layout->summary_offset = ip__load_u64le(h + 112);
+    layout->summary_checksum = ip__load_u64le(h + 128);
+    layout->file_size = ip__load_u64le(h + 136);
+    if (ip__load_u64le(h + 120) != layout->summary_size)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: summary size %llu is not the expected %llu",
+                       name, (unsigned long long)ip__load_u64le(h + 120),
+                       (unsigned long long)layout->summary_size);
+    return IP_OK;
+}
+
+static ip_status check_sections(const ip_layout *l, uint64_t size, const char *name,
+                                ip_error *err)
+{
+    if (l->file_size != size)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: file is %llu bytes but its header says %llu "
+                       "(truncated or extended)", name, (unsigned long long)size,
+                       (unsigned long long)l->file_size);
+    if (l->data_offset != IP_HEADER_SIZE || l->data_size > size ||
+        l->summary_offset % IP_SUMMARY_ALIGN != 0 ||
+        l->summary_offset < l->data_offset + l->data_size ||
+        l->summary_offset - (l->data_offset + l->data_size) >= IP_SUMMARY_ALIGN ||
+        l->summary_offset > size || size - l->summary_offset != l->summary_size)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: section offsets are inconsistent", name);
+    return IP_OK;
+}
+
+static int range_ok(float lo, float hi)
+{
+    return isfinite(lo) && isfinite(hi) && lo <= hi;
+}
+
+static ip_status check_level_table(const ip_layout *l, const unsigned char *table,
+                                   const char *name, ip_layout *out, ip_error *err)
+{
+    for (uint32_t k = 0; k < l->level_count; k++) {
+        const unsigned char *e = table + (size_t)k * IP_LEVEL_ENTRY_SIZE;
+        const ip_level_layout *lv = &l->levels[k];
+        int same = ip__load_u64le(e + 24) == lv->first_brick &&
+                   ip__load_u32le(e + 32) == lv->octree_depth &&
+                   ip__load_u64le(e + 40) == lv->first_node && ip__load_u32le(e + 36) == 0 &&
+                   ip__load_u64le(e + 56) == 0;
+        for (int a = 0; a < 3; a++)
+            same = same && ip__load_u32le(e + 4 * a) == lv->dims[a] &&
+                   ip__load_u32le(e + 12 + 4 * a) == lv->bricks[a];
+        if (!same)
+            return ip__fail(err, IP_ERR_FORMAT, "%s: level %u of the level table disagrees with "
+                           "the header", name, k);
+        out->levels[k].value_min = load_f32(e + 48);
+        out->levels[k].value_max = load_f32(e + 52);
+        if (!range_ok(out->levels[k].value_min, out->levels[k].value_max))
+            return ip__fail(err, IP_ERR_FORMAT, "%s: level %u has an invalid value range", name, k);
+    }
+    if (!range_ok(l->value_min, l->value_max) || l->value_min != out->levels[0].value_min ||
+        l->value_max != out->levels[0].value_max)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: the value range is invalid", name);
+    return IP_OK;
+}
+
+/* `reserved`: the entry's reserved bytes or'ed together. */
+static ip_status check_entry(const ip_layout *l, uint64_t g, const ip_brick_entry *e,
+                             unsigned reserved, float lo, float hi, const char *name,
+                             ip_error *err)
+{
+    uint32_t level, brick[3], origin[3], extent[3];
+    ip_brick_coords(l, g, &level, brick);
+    ip_brick_extent(l, level, brick, origin, extent);
+    uint64_t raw = (uint64_t)extent[0] * extent[1] * extent[2] * ip_type_size(l->type);
+    const char *why = NULL;
+    if (!range_ok(lo, hi))
+        why = "an invalid value range";
+    else if (reserved)
+        why = "non-zero reserved bytes";
+    else if (e->encoding == IP_BRICK_CONSTANT) {
+        if (e->stored_size != 0 || e->filters != 0 || e->checksum != 0 || lo != hi)
+            why = "an inconsistent constant entry";
+        else if (!ip_type_holds(l->type, lo))
+            why = "a constant value its sample type cannot hold";
+    } else if (e->encoding == IP_BRICK_RAW) {
+        if (e->stored_size != raw || e->filters != 0)
+            why = "a raw payload of the wrong size";
+    } else if (e->encoding == IP_BRICK_LZ4) {
+        if (e->stored_size == 0 || e->stored_size > raw + raw / 255 + 16 || (e->filters & ~7u) ||
+                 (e->filters & 5u) == 5u)
+            why = "an LZ4 payload of impossible size or unknown filters";
+    } else
+        why = "an unknown encoding";
+    if (!why && e->stored_size != 0 &&
+        (e->offset < l->data_offset || e->offset > l->data_offset + l->data_size ||
+         e->stored_size > l->data_offset + l->data_size - e->offset))
+        why = "a payload outside the data section";
+    if (why)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: brick %llu (level %u, %u,%u,%u) has %s", name,
+                       (unsigned long long)g, level, brick[0], brick[1], brick[2], why);
+    return IP_OK;
+}
+
+ip_status ip__format_parse_header(const unsigned char header[IP_HEADER_SIZE], uint64_t file_size,
+                                 const char *name, unsigned flags, ip_layout *layout,
+                                 ip_error *err)
+{
+    if (file_size < IP_HEADER_SIZE)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: %llu bytes is too short for a brick file",
+                       name, (unsigned long long)file_size);
+    ip_status st = parse_header(header, name, flags, layout, err);
+    return st == IP_OK ? check_sections(layout, file_size, name, err) : st;
+}
+
+ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
+                                  const unsigned char *summary, const char *name,
+                                  unsigned flags, ip_error *err)
+{
+    uint64_t gap_size = layout->summary_offset - (layout->data_offset + layout->data_size);
+    for (uint64_t i = 0; i < gap_size; i++)
+        if (gap[i] != 0)
+            return ip__fail(err, IP_ERR_FORMAT, "%s: byte %llu, in the padding before the "
+                           "summary section, is not zero", name,
+                           (unsigned long long)(layout->data_offset + layout->data_size + i));
+    if (!(flags & IP_PARSE_SKIP_CHECKSUMS) &&
+        ip__format_checksum(summary, layout->summary_size) != layout->summary_checksum)
+        return ip__fail(err, IP_ERR_CHECKSUM, "%s: summary section checksum mismatch", name);
+    ip_status st = check_level_table(layout, summary, name, layout, err);
+    if (st != IP_OK)
+        return st;
+    ip_summary_offsets o;
+    ip__summary_offsets_of(layout, &o);
+    for (uint64_t g = 0; g < layout->brick_count; g++) {
+        const unsigned char *d = summary + o.directory + g * IP_DIRECTORY_ENTRY_SIZE;
+        const unsigned char *r = summary + o.brick_ranges + g * IP_RANGE_SIZE;
+        ip_brick_entry e;
+        ip__format_entry_decode(d, &e);
+        st = check_entry(layout, g, &e, d[14] | d[15], load_f32(r), load_f32(r + 4), name, err);
+        if (st != IP_OK)
+            return st;
+    }
+    return IP_OK;
+}
+
+ip_status ip__format_parse(const unsigned char *file, uint64_t size, const char *name,
+                          unsigned flags, ip_layout *layout, ip_error *err)
+{
+    ip_status st = ip__format_parse_header(file, size, name, flags, layout, err);
+    if (st != IP_OK)
+        return st;
+    return ip__format_parse_summary(layout, file + layout->data_offset + layout->data_size,
+                                   file + layout->summary_offset, name, flags, err);
+}

@@ -1,0 +1,70 @@
+/* Min/max summaries of bricks and sub-blocks. */
+#include <math.h>
+
+#include "summary.h"
+
+#define BOX_RANGE(T)                                                               \
+    do {                                                                           \
+        const T *s = samples;                                                      \
+        T lo_v = s[lo[0] + (size_t)extent[0] * (lo[1] + (size_t)extent[1] * lo[2])]; \
+        T hi_v = lo_v;                                                             \
+        for (uint32_t z = lo[2]; z <= hi[2]; z++)                                  \
+            for (uint32_t y = lo[1]; y <= hi[1]; y++) {                            \
+                const T *row = s + (size_t)extent[0] * (y + (size_t)extent[1] * z); \
+                for (uint32_t x = lo[0]; x <= hi[0]; x++) {                        \
+                    T v = row[x];                                                  \
+                    lo_v = v < lo_v ? v : lo_v;                                    \
+                    hi_v = v > hi_v ? v : hi_v;                                    \
+                }                                                                  \
+            }                                                                      \
+        *min = (float)lo_v;                                                        \
+        *max = (float)hi_v;                                                        \
+    } while (0)
+
+void ip__box_range(const void *samples, ip_type type, const uint32_t extent[3],
+                  const uint32_t lo[3], const uint32_t hi[3], float *min, float *max)
+{
+    switch (type) {
+    case IP_UINT8: BOX_RANGE(uint8_t); break;
+    case IP_UINT16: BOX_RANGE(uint16_t); break;
+    case IP_INT16: BOX_RANGE(int16_t); break;
+    case IP_FLOAT32: BOX_RANGE(float); break;
+    }
+}
+
+void ip__summarise_brick(const void *samples, ip_type type, const uint32_t extent[3],
+                        uint32_t brick_edge, uint32_t subblock_edge, float brick_range[2],
+                        float *ranges)
+{
+    uint32_t per_axis = brick_edge / subblock_edge;
+    uint32_t last[3] = {extent[0] - 1, extent[1] - 1, extent[2] - 1};
+    size_t i = 0;
+    for (uint32_t bz = 0; bz < per_axis; bz++)
+        for (uint32_t by = 0; by < per_axis; by++)
+            for (uint32_t bx = 0; bx < per_axis; bx++, i++) {
+                uint32_t c[3] = {bx, by, bz}, lo[3], hi[3];
+                int empty = 0;
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = c[a] * subblock_edge;
+                    hi[a] = lo[a] + subblock_edge;
+                    if (lo[a] >= last[a])
+                        empty = 1;
+                    if (hi[a] > last[a])
+                        hi[a] = last[a];
+                }
+                if (empty) {
+                    ranges[2 * i] = INFINITY;
+                    ranges[2 * i + 1] = -INFINITY;
+                } else {
+                    ip__box_range(samples, type, extent, lo, hi, &ranges[2 * i],
+                                 &ranges[2 * i + 1]);
+                }
+            }
+    /* The non-empty sub-blocks cover every sample of the brick, so their union is its range. */
+    brick_range[0] = INFINITY;
+    brick_range[1] = -INFINITY;
+    for (size_t j = 0; j < i; j++) {
+        brick_range[0] = fminf(brick_range[0], ranges[2 * j]);
+        brick_range[1] = fmaxf(brick_range[1], ranges[2 * j + 1]);
+    }
+}

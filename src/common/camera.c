@@ -1,0 +1,198 @@
+/* The pinhole camera: basis, pixel rays, projection, OpenGL matrices, framing presets. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "isoprop/camera.h"
+
+#define DEG (3.14159265358979323846 / 180.0)
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double a[3], const double b[3], double out[3])
+{
+    double r[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    memcpy(out, r, sizeof r);
+}
+
+static double normalize3(double v[3])
+{
+    double n = sqrt(dot3(v, v));
+    if (n > 0)
+        for (int i = 0; i < 3; i++)
+            v[i] /= n;
+    return n;
+}
+
+ip_status ip_camera_check(const ip_camera *c, ip_error *err)
+{
+    for (int i = 0; i < 3; i++)
+        if (!isfinite(c->eye[i]) || !isfinite(c->target[i]) || !isfinite(c->up[i]))
+            return ip__fail(err, IP_ERR_ARGUMENT, "camera: coordinates must be finite");
+    if (!(c->fov_y > 0.0 && c->fov_y < 180.0))
+        return ip__fail(err, IP_ERR_ARGUMENT, "camera: field of view %g is not in (0, 180) degrees",
+                       c->fov_y);
+    if (c->width < 1 || c->height < 1)
+        return ip__fail(err, IP_ERR_ARGUMENT, "camera: image size must be at least 1x1");
+    double f[3] = {c->target[0] - c->eye[0], c->target[1] - c->eye[1], c->target[2] - c->eye[2]};
+    double u[3] = {c->up[0], c->up[1], c->up[2]}, r[3];
+    if (normalize3(f) == 0.0)
+        return ip__fail(err, IP_ERR_ARGUMENT, "camera: eye and target coincide");
+    if (normalize3(u) == 0.0)
+        return ip__fail(err, IP_ERR_ARGUMENT, "camera: up is zero");
+    cross3(f, u, r);
+    if (sqrt(dot3(r, r)) < 1e-6)
+        return ip__fail(err, IP_ERR_ARGUMENT, "camera: up is parallel to the view direction");
+    return IP_OK;
+}
+
+void ip_camera_basis_of(const ip_camera *c, ip_camera_basis *b)
+{
+    for (int i = 0; i < 3; i++) {
+        b->forward[i] = c->target[i] - c->eye[i];
+        b->up[i] = c->up[i];
+    }
+    normalize3(b->forward);
+    cross3(b->forward, b->up, b->right);
+    normalize3(b->right);
+    cross3(b->right, b->forward, b->up);
+    b->tan_half_y = tan(c->fov_y * DEG / 2);
+    b->tan_half_x = b->tan_half_y * (double)c->width / (double)c->height;
+}
+
+void ip_camera_pixel_ray(const ip_camera_basis *b, const ip_camera *c, double px, double py,
+                         double dir[3])
+{
+    double nx = (2.0 * px / c->width - 1.0) * b->tan_half_x;
+    double ny = (1.0 - 2.0 * py / c->height) * b->tan_half_y;
+    for (int i = 0; i < 3; i++)
+        dir[i] = b->forward[i] + nx * b->right[i] + ny * b->up[i];
+    normalize3(dir);
+}
+
+int ip_camera_project(const ip_camera_basis *b, const ip_camera *c, const double p[3],
+                      double *px, double *py, double *depth)
+{
+    double v[3] = {p[0] - c->eye[0], p[1] - c->eye[1], p[2] - c->eye[2]};
+    double z = dot3(v, b->forward);
+    if (!(z > 0.0))
+        return 0;
+    double nx = dot3(v, b->right) / (z * b->tan_half_x);
+    double ny = dot3(v, b->up) / (z * b->tan_half_y);
+    *px = (nx + 1.0) * 0.5 * c->width;
+    *py = (1.0 - ny) * 0.5 * c->height;
+    *depth = z;
+    return 1;
+}
+
+void ip_camera_view_matrix(const ip_camera *c, float m[16])
+{
+    ip_camera_basis b;
+    ip_camera_basis_of(c, &b);
+    const double *r = b.right, *u = b.up, *f = b.forward;
+    float v[16] = {(float)r[0], (float)u[0], (float)-f[0], 0,
+                   (float)r[1], (float)u[1], (float)-f[1], 0,
+                   (float)r[2], (float)u[2], (float)-f[2], 0,
+                   (float)-dot3(r, c->eye), (float)-dot3(u, c->eye), (float)dot3(f, c->eye), 1};
+    memcpy(m, v, sizeof v);
+}
+
+void ip_camera_projection_matrix(const ip_camera *c, double n, double f, float m[16])
+{
+    double t = tan(c->fov_y * DEG / 2), aspect = (double)c->width / (double)c->height;
+    memset(m, 0, 16 * sizeof *m);
+    m[0] = (float)(1.0 / (t * aspect));
+    m[5] = (float)(1.0 / t);
+    m[10] = (float)(-(f + n) / (f - n));
+    m[11] = -1.0f;
+    m[14] = (float)(-2.0 * f * n / (f - n));
+}
+
+void ip_camera_depth_range(const ip_camera *c, const double lo[3], const double hi[3],
+                           double *near_plane, double *far_plane)
+{
+    ip_camera_basis b;
+    ip_camera_basis_of(c, &b);
+    double zmin = INFINITY, zmax = -INFINITY;
+    for (int k = 0; k < 8; k++) {
+        double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
+        double v[3] = {p[0] - c->eye[0], p[1] - c->eye[1], p[2] - c->eye[2]};
+        double z = dot3(v, b.forward);
+        zmin = fmin(zmin, z);
+        zmax = fmax(zmax, z);
+    }
+    double extent = 0;
+    for (int i = 0; i < 3; i++)
+        extent = fmax(extent, hi[i] - lo[i]);
+    if (zmax <= 0)
+        zmax = extent;
+    /* the margin scales with the volume: an absolute one (it was 1e-3 world units) dwarfed
+     * volumes a few nanometres across, and the near plane, far / 10^5, then clipped them */
+    *far_plane = zmax * 1.01 + 1e-3 * extent;
+    /* keep the depth buffer's precision: near no closer than far / 10^5 */
+    *near_plane = fmax(zmin * 0.99, *far_plane * 1e-5);
+}
+
+ip_status ip_camera_fit_axis(const double lo[3], const double hi[3], const char *axis,
+                             double fov_y, uint32_t width, uint32_t height, ip_camera *out,
+                             ip_error *err)
+{
+    if (!axis || strlen(axis) != 2 || (axis[0] != '+' && axis[0] != '-') || axis[1] < 'x' ||
+        axis[1] > 'z')
+        return ip__fail(err, IP_ERR_ARGUMENT, "view '%s' is not one of +x -x +y -y +z -z",
+                       axis ? axis : "");
+    int a = axis[1] - 'x';
+    double sign = axis[0] == '+' ? 1.0 : -1.0, centre[3];
+    for (int i = 0; i < 3; i++)
+        centre[i] = 0.5 * (lo[i] + hi[i]);
+    memset(out, 0, sizeof *out);
+    out->fov_y = fov_y;
+    out->width = width;
+    out->height = height;
+    out->up[a == 2 ? 1 : 2] = 1.0;
+    /* the image's horizontal axis is the remaining one, the vertical one is up */
+    int v = a == 2 ? 1 : 2, u = 3 - a - v;
+    double tan_y = tan(fov_y * DEG / 2), tan_x = tan_y * (double)width / (double)height;
+    /* the nearest eye distance from the centre at which all 8 corners project inside the
+     * frame: a corner offset (du, dv) across and dw towards the eye needs
+     * distance >= dw + |du| / tan_x and >= dw + |dv| / tan_y */
+    double distance = 0;
+    for (int k = 0; k < 8; k++) {
+        double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
+        double du = fabs(p[u] - centre[u]), dv = fabs(p[v] - centre[v]);
+        double dw = sign * (p[a] - centre[a]);
+        distance = fmax(distance, dw + du / tan_x);
+        distance = fmax(distance, dw + dv / tan_y);
+    }
+    distance *= 1.04; /* a small margin around the volume */
+    memcpy(out->target, centre, sizeof centre);
+    memcpy(out->eye, centre, sizeof centre);
+    out->eye[a] += sign * distance;
+    return ip_camera_check(out, err);
+}
+
+ip_status ip_camera_parse(const char *text, ip_camera *c, ip_error *err)
+{
+    double v[10];
+    const char *p = text;
+    for (int i = 0; i < 10; i++) {
+        char *end;
+        v[i] = strtod(p, &end);
+        if (end == p || !isfinite(v[i]) || (i < 9 ? *end != ',' : *end != '\0'))
+            return ip__fail(err, IP_ERR_ARGUMENT,
+                           "--camera '%s' is not ex,ey,ez,tx,ty,tz,ux,uy,uz,fov", text);
+        p = end + 1;
+    }
+    for (int i = 0; i < 3; i++) {
+        c->eye[i] = v[i];
+        c->target[i] = v[3 + i];
+        c->up[i] = v[6 + i];
+    }
+    c->fov_y = v[9];
+    return IP_OK;
+}

@@ -1,0 +1,57 @@
+/* Internal helpers shared by the library's source files; not part of the public API. */
+#ifndef ISOPROP_INTERNAL_H
+#define ISOPROP_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "isoprop/status.h"
+#include "isoprop/system.h"
+
+#if defined(__GNUC__)
+#define IP_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define IP_PRINTF(a, b)
+#endif
+
+/* Fills err (may be NULL) with code and a formatted one-line message; returns code. */
+ip_status ip__fail(ip_error *err, ip_status code, const char *fmt, ...) IP_PRINTF(3, 4);
+
+/* Like ip__fail, appending ": strerror(errnum)". */
+ip_status ip__fail_errno(ip_error *err, ip_status code, int errnum, const char *fmt, ...)
+    IP_PRINTF(4, 5);
+
+/* Little-endian loads and stores, independent of the host's byte order. */
+static inline uint32_t ip__load_u32le(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+static inline uint64_t ip__load_u64le(const unsigned char *p)
+{
+    return (uint64_t)ip__load_u32le(p) | (uint64_t)ip__load_u32le(p + 4) << 32;
+}
+static inline void ip__store_u32le(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)v;
+    p[1] = (unsigned char)(v >> 8);
+    p[2] = (unsigned char)(v >> 16);
+    p[3] = (unsigned char)(v >> 24);
+}
+static inline void ip__store_u64le(unsigned char *p, uint64_t v)
+{
+    ip__store_u32le(p, (uint32_t)v);
+    ip__store_u32le(p + 4, (uint32_t)(v >> 32));
+}
+
+/* 1 on a little-endian host. */
+static inline int ip__host_little_endian(void)
+{
+    const uint16_t one = 1;
+    return *(const unsigned char *)&one == 1;
+}
+
+/* Reverses the bytes of each of `count` elements of `size` bytes (2 or 4) in place. */
+void ip__swap_bytes(void *data, size_t count, size_t size);
+
+
+#endif

@@ -1,0 +1,160 @@
+/* Triangle soups: growth, append, binary PLY output. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "atomic_file.h"
+#include "internal.h"
+#include "isoprop/mesh.h"
+
+void ip_mesh_init(ip_mesh *m)
+{
+    memset(m, 0, sizeof *m);
+}
+
+void ip_mesh_init_with_cells(ip_mesh *m)
+{
+    ip_mesh_init(m);
+    m->with_cells = 1;
+}
+
+void ip_mesh_free(ip_mesh *m)
+{
+    int with_cells = m->with_cells;
+    free(m->positions);
+    free(m->normals);
+    free(m->cells);
+    ip_mesh_init(m);
+    m->with_cells = with_cells;
+}
+
+void ip_mesh_clear(ip_mesh *m)
+{
+    m->triangle_count = 0;
+}
+
+ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
+{
+    if (triangles <= m->capacity)
+        return IP_OK;
+    /* Growth by half (not doubling) keeps the slack small for meshes of millions of triangles;
+     * large blocks are moved by remapping pages, not copied, so the cost stays low. */
+    uint64_t cap = m->capacity ? m->capacity : 1024;
+    while (cap < triangles)
+        cap += cap / 2;
+    float *p = realloc(m->positions, cap * 9 * sizeof *p);
+    if (p)
+        m->positions = p;
+    int16_t *n = p ? realloc(m->normals, cap * 9 * sizeof *n) : NULL;
+    if (n)
+        m->normals = n;
+    if (!n)
+        return IP_ERR_NOMEM; /* the arrays that grew keep the old contents */
+    if (m->with_cells) {
+        uint64_t *c = realloc(m->cells, cap * sizeof *c);
+        if (!c)
+            return IP_ERR_NOMEM;
+        m->cells = c;
+    }
+    m->capacity = cap;
+    return IP_OK;
+}
+
+ip_status ip_mesh_append(ip_mesh *m, const float *positions, const int16_t *normals,
+                         const uint64_t *cells, uint64_t count)
+{
+    if (count == 0)
+        return IP_OK; /* the arrays of an empty mesh may be NULL */
+    ip_status st = ip_mesh_reserve(m, m->triangle_count + count);
+    if (st != IP_OK)
+        return st;
+    memcpy(m->positions + 9 * m->triangle_count, positions, count * 9 * sizeof(float));
+    memcpy(m->normals + 9 * m->triangle_count, normals, count * 9 * sizeof(int16_t));
+    if (m->with_cells)
+        memcpy(m->cells + m->triangle_count, cells, count * sizeof(uint64_t));
+    m->triangle_count += count;
+    return IP_OK;
+}
+
+ip_status ip_mesh_append_float_normals(ip_mesh *m, const float *positions, const float *normals,
+                                       const uint64_t *cells, uint64_t count)
+{
+    enum { PART = 256 };
+    int16_t packed[9 * PART];
+    for (uint64_t done = 0; done < count; done += PART) {
+        uint64_t n = count - done < PART ? count - done : PART;
+        for (uint64_t i = 0; i < 9 * n; i++)
+            packed[i] = ip_normal_pack(normals[9 * done + i]);
+        ip_status st = ip_mesh_append(m, positions + 9 * done, packed,
+                                      cells ? cells + done : NULL, n);
+        if (st != IP_OK)
+            return st;
+    }
+    return IP_OK;
+}
+
+ip_status ip_mesh_append_mesh(ip_mesh *m, const ip_mesh *from, uint64_t first, uint64_t count)
+{
+    if (first > from->triangle_count || count > from->triangle_count - first ||
+        (m->with_cells && count && !from->with_cells))
+        return IP_ERR_ARGUMENT;
+    if (count == 0)
+        return IP_OK;
+    return ip_mesh_append(m, from->positions + 9 * first, from->normals + 9 * first,
+                          m->with_cells ? from->cells + first : NULL, count);
+}
+
+static void put_f32(unsigned char *p, float v)
+{
+    uint32_t bits;
+    memcpy(&bits, &v, 4);
+    ip__store_u32le(p, bits);
+}
+
+ip_status ip_mesh_write_ply(const ip_mesh *m, const char *path, int force, ip_error *err)
+{
+    ip_atomic_file out;
+    ip_status st = ip__atomic_create(&out, path, force, err);
+    if (st != IP_OK)
+        return st;
+    char header[512];
+    int n = snprintf(header, sizeof header,
+                     "ply\nformat binary_little_endian 1.0\ncomment isoprop isosurface\n"
+                     "element vertex %llu\nproperty float x\nproperty float y\nproperty float z\n"
+                     "property float nx\nproperty float ny\nproperty float nz\n"
+                     "element face %llu\nproperty list uchar int vertex_indices\nend_header\n",
+                     (unsigned long long)(3 * m->triangle_count),
+                     (unsigned long long)m->triangle_count);
+    uint64_t offset = 0;
+    st = ip__pwrite_all(out.fd, header, (size_t)n, 0, path, err);
+    offset += (uint64_t)n;
+    enum { CHUNK = 4096 };
+    unsigned char *buf = malloc((size_t)CHUNK * 3 * 24);
+    if (!buf && st == IP_OK)
+        st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path);
+    for (uint64_t t = 0; st == IP_OK && t < m->triangle_count; t += CHUNK) {
+        uint64_t count = m->triangle_count - t < CHUNK ? m->triangle_count - t : CHUNK;
+        for (uint64_t i = 0; i < count * 3; i++)
+            for (int k = 0; k < 3; k++) {
+                put_f32(buf + 24 * i + 4 * k, m->positions[9 * t + 3 * i + k]);
+                put_f32(buf + 24 * i + 12 + 4 * k, ip_normal_unpack(m->normals[9 * t + 3 * i + k]));
+            }
+        st = ip__pwrite_all(out.fd, buf, count * 72, offset, path, err);
+        offset += count * 72;
+    }
+    for (uint64_t t = 0; st == IP_OK && t < m->triangle_count; t += CHUNK) {
+        uint64_t count = m->triangle_count - t < CHUNK ? m->triangle_count - t : CHUNK;
+        for (uint64_t i = 0; i < count; i++) {
+            buf[13 * i] = 3;
+            for (int k = 0; k < 3; k++)
+                ip__store_u32le(buf + 13 * i + 1 + 4 * k, (uint32_t)(3 * (t + i) + (uint64_t)k));
+        }
+        st = ip__pwrite_all(out.fd, buf, count * 13, offset, path, err);
+        offset += count * 13;
+    }
+    free(buf);
+    if (st == IP_OK)
+        return ip__atomic_commit(&out, err);
+    ip__atomic_abort(&out);
+    return st;
+}

@@ -1,0 +1,53 @@
+/* Process-level facts: a monotonic clock, the peak resident set, the number of cores. */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "isoprop/system.h"
+
+/* A field of /proc/self/status given in KiB ("VmRSS:", "VmHWM:"), in bytes; 0 when unknown. */
+static uint64_t status_bytes(const char *field)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    uint64_t kib = 0;
+    size_t n = strlen(field);
+    if (!f)
+        return 0;
+    while (fgets(line, sizeof line, f)) {
+        if (strncmp(line, field, n) == 0) {
+            kib = strtoull(line + n, NULL, 10);
+            break;
+        }
+    }
+    fclose(f);
+    return kib * 1024u;
+}
+
+uint64_t ip_peak_rss_bytes(void)
+{
+    return status_bytes("VmHWM:");
+}
+
+uint64_t ip_rss_bytes(void)
+{
+    return status_bytes("VmRSS:");
+}
+
+double ip_now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+unsigned ip_thread_count(unsigned requested)
+{
+    if (requested > 0)
+        return requested > IP_MAX_THREADS ? IP_MAX_THREADS : requested;
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1u : n > IP_MAX_THREADS ? IP_MAX_THREADS : (unsigned)n;
+}

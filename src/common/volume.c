@@ -1,0 +1,152 @@
+/* Sample types, dimension parsing and small platform helpers. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+
+#include "internal.h"
+#include "isoprop/volume.h"
+
+size_t ip_type_size(ip_type type)
+{
+    switch (type) {
+    case IP_UINT8: return 1;
+    case IP_UINT16:
+    case IP_INT16: return 2;
+    case IP_FLOAT32: return 4;
+    }
+    return 0;
+}
+
+const char *ip_type_name(ip_type type)
+{
+    switch (type) {
+    case IP_UINT8: return "uint8";
+    case IP_UINT16: return "uint16";
+    case IP_INT16: return "int16";
+    case IP_FLOAT32: return "float32";
+    }
+    return "unknown";
+}
+
+int ip_type_holds(ip_type type, float value)
+{
+    switch (type) {
+    case IP_UINT8: return value >= 0.0f && value <= 255.0f && value == floorf(value);
+    case IP_UINT16: return value >= 0.0f && value <= 65535.0f && value == floorf(value);
+    case IP_INT16: return value >= -32768.0f && value <= 32767.0f && value == floorf(value);
+    case IP_FLOAT32: return isfinite(value);
+    }
+    return 0;
+}
+
+ip_status ip_type_parse(const char *name, ip_type *out)
+{
+    static const struct { const char *name; ip_type type; } names[] = {
+        {"uint8", IP_UINT8},     {"uchar", IP_UINT8},       {"unsigned char", IP_UINT8},
+        {"uint8_t", IP_UINT8},   {"MET_UCHAR", IP_UINT8},   {"u8", IP_UINT8},
+        {"uint16", IP_UINT16},   {"ushort", IP_UINT16},     {"unsigned short", IP_UINT16},
+        {"uint16_t", IP_UINT16}, {"MET_USHORT", IP_UINT16}, {"u16", IP_UINT16},
+        {"unsigned short int", IP_UINT16},
+        {"int16", IP_INT16},     {"short", IP_INT16},       {"signed short", IP_INT16},
+        {"int16_t", IP_INT16},   {"MET_SHORT", IP_INT16},   {"i16", IP_INT16},
+        {"short int", IP_INT16}, {"signed short int", IP_INT16},
+        {"float32", IP_FLOAT32}, {"float", IP_FLOAT32},     {"MET_FLOAT", IP_FLOAT32},
+        {"f32", IP_FLOAT32},
+    };
+    if (!name)
+        return IP_ERR_ARGUMENT;
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        if (strcasecmp(name, names[i].name) == 0) {
+            *out = names[i].type;
+            return IP_OK;
+        }
+    }
+    return IP_ERR_ARGUMENT;
+}
+
+/* The external definition of the inline one in isoprop/volume.h (C11 6.7.4), for callers
+ * that take its address or do not inline it. */
+extern float ip_sample_get(const void *samples, ip_type type, size_t index);
+
+ip_status ip_dims_parse(const char *text, uint32_t dims[3])
+{
+    const char *p = text;
+    uint32_t parsed[3];
+    if (!text)
+        return IP_ERR_ARGUMENT;
+    for (int axis = 0; axis < 3; axis++) {
+        if (*p < '0' || *p > '9')
+            return IP_ERR_ARGUMENT;
+        char *end;
+        unsigned long long v = strtoull(p, &end, 10);
+        if (v < 1 || v >= (1ull << 31))
+            return IP_ERR_ARGUMENT;
+        parsed[axis] = (uint32_t)v;
+        p = end;
+        if (axis < 2) {
+            if (*p != 'x' && *p != 'X')
+                return IP_ERR_ARGUMENT;
+            p++;
+        }
+    }
+    if (*p != '\0')
+        return IP_ERR_ARGUMENT;
+    memcpy(dims, parsed, sizeof parsed);
+    return IP_OK;
+}
+
+ip_status ip_spacing_check(const double spacing[3], const char *name, ip_error *err)
+{
+    static const char axes[3] = {'x', 'y', 'z'};
+    const char *who = name && name[0] ? name : "spacing";
+    const char *sep = name && name[0] ? ": spacing" : "";
+    for (int a = 0; a < 3; a++) {
+        double s = spacing[a];
+        if (!(s >= IP_SPACING_MIN && s <= IP_SPACING_MAX))
+            return ip__fail(err, IP_ERR_UNSUPPORTED,
+                           "%s%s %g along %c is outside the range that renders correctly, "
+                           "%g to %g world units (express the spacing in another unit, e.g. "
+                           "%s)",
+                           who, sep, s, axes[a], IP_SPACING_MIN, IP_SPACING_MAX,
+                           s < IP_SPACING_MIN ? "micrometres instead of metres"
+                                              : "kilometres instead of metres");
+    }
+    int lo = 0, hi = 0;
+    for (int a = 1; a < 3; a++) {
+        if (spacing[a] < spacing[lo])
+            lo = a;
+        if (spacing[a] > spacing[hi])
+            hi = a;
+    }
+    if (spacing[hi] > IP_SPACING_RATIO_MAX * spacing[lo])
+        return ip__fail(err, IP_ERR_UNSUPPORTED,
+                       "%s%s %g,%g,%g: %g along %c is %g times %g along %c, more than the "
+                       "%g times that renders correctly (resample the volume to a less "
+                       "anisotropic grid)",
+                       who, sep, spacing[0], spacing[1], spacing[2], spacing[hi], axes[hi],
+                       spacing[hi] / spacing[lo], spacing[lo], axes[lo], IP_SPACING_RATIO_MAX);
+    return IP_OK;
+}
+
+void ip__swap_bytes(void *data, size_t count, size_t size)
+{
+    unsigned char *p = data;
+    if (size == 2) {
+        for (size_t i = 0; i < count; i++, p += 2) {
+            unsigned char t = p[0];
+            p[0] = p[1];
+            p[1] = t;
+        }
+    } else if (size == 4) {
+        for (size_t i = 0; i < count; i++, p += 4) {
+            unsigned char t0 = p[0], t1 = p[1];
+            p[0] = p[3];
+            p[1] = p[2];
+            p[2] = t1;
+            p[3] = t0;
+        }
+    }
+}

@@ -1,0 +1,417 @@
+/* The progressive engine: ray order, seeding, propagation on worker threads, step budgets,
+ * cancellation. */
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "internal.h"
+#include "isoprop/engine.h"
+#include "ray_order.h"
+#include "propagate.h"
+#include "seed.h"
+
+#define MAX_THREADS IP_MAX_THREADS
+#define RAY_BATCH 16 /* rays a worker takes at once: small, so the order stays progressive */
+#define LOCAL_LEVELS 3 /* ray order: the finest levels cast in Z-order (see begin) */
+#define FLUSH_TRIANGLES 16384 /* a worker's buffer moves to the engine's mesh past this size */
+
+/* A worker's tools for one pyramid level: pinned bricks, seeding state, propagation queue. */
+typedef struct level_tools {
+    int ready;
+    ip_sampler sampler;
+    ip_seeder seeder;
+    ip_propagator propagator;
+} level_tools;
+
+/* One worker's private state: its tools per level and its triangles. */
+typedef struct worker {
+    ip_engine *engine;
+    level_tools level[IP_MAX_LEVELS];
+    ip_mesh mesh;
+    ip_engine_counts counts;
+    ip_status status;
+    uint32_t failed_level;
+} worker;
+
+struct ip_engine {
+    ip_cache *cache;
+    ip_engine_options options;
+    unsigned threads;
+    worker *workers;
+    ip_visited visited;
+    ip_mesh mesh;
+    pthread_mutex_t mesh_lock;  /* workers append their buffers to `mesh` during a step */
+    ip_camera camera;
+    ip_camera_basis basis;
+    float iso;
+    int begun;
+    uint32_t levels_used;       /* levels 0 .. levels_used - 1 have a distance band */
+    double lod_distance[IP_MAX_LEVELS + 1]; /* D[k]; D[levels_used] = infinity */
+    pthread_mutex_t order_lock; /* the shared ray sequence */
+    ip_ray_order order;
+    uint64_t step_rays_left;    /* rays the current step may still hand out */
+    double step_deadline;       /* 0: none */
+    ip_engine_counts totals;
+    atomic_int cancel;
+};
+
+void ip_engine_options_default(ip_engine_options *o)
+{
+    o->cutoff_degrees = IP_DEFAULT_CUTOFF_DEGREES;
+    o->foldback_degrees = IP_DEFAULT_FOLDBACK_DEGREES;
+    o->threads = 0;
+    o->lod = 1;
+    o->pixel_error = 1.0;
+    o->cell_ids = 0;
+}
+
+ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
+                           ip_error *err)
+{
+    if (!(options->cutoff_degrees > 0 && options->cutoff_degrees <= 180) ||
+        !(options->foldback_degrees >= 0 && options->foldback_degrees <= 180))
+        return ip__fail(err, IP_ERR_ARGUMENT, "cut-off %g and fold-back %g must be in degrees, "
+                       "0 < cut-off <= 180, 0 <= fold-back <= 180",
+                       options->cutoff_degrees, options->foldback_degrees);
+    if (options->lod && !(options->pixel_error > 0 && isfinite(options->pixel_error)))
+        return ip__fail(err, IP_ERR_ARGUMENT, "the pixel error %g must be positive",
+                       options->pixel_error);
+    ip_engine *e = calloc(1, sizeof *e);
+    if (!e)
+        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+    e->cache = cache;
+    e->options = *options;
+    e->threads = ip_thread_count(options->threads);
+    atomic_init(&e->cancel, 0);
+    pthread_mutex_init(&e->order_lock, NULL);
+    pthread_mutex_init(&e->mesh_lock, NULL);
+    ip_mesh_init(&e->mesh);
+    e->mesh.with_cells = options->cell_ids != 0;
+    e->workers = calloc(e->threads, sizeof *e->workers);
+    ip_status st = e->workers ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
+                              : IP_ERR_NOMEM;
+    for (unsigned t = 0; st == IP_OK && t < e->threads; t++) {
+        e->workers[t].engine = e;
+        ip_mesh_init(&e->workers[t].mesh);
+        e->workers[t].mesh.with_cells = e->mesh.with_cells;
+    }
+    if (st != IP_OK) {
+        ip_engine_destroy(e);
+        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+    }
+    *out = e;
+    return IP_OK;
+}
+
+void ip_engine_destroy(ip_engine *e)
+{
+    if (!e)
+        return;
+    for (unsigned t = 0; e->workers && t < e->threads; t++) {
+        for (uint32_t k = 0; k < IP_MAX_LEVELS; k++) {
+            level_tools *lt = &e->workers[t].level[k];
+            if (!lt->ready)
+                continue;
+            ip__propagator_free(&lt->propagator);
+            ip__sampler_free(&lt->sampler);
+        }
+        ip_mesh_free(&e->workers[t].mesh);
+    }
+    free(e->workers);
+    ip__visited_free(&e->visited);
+    ip_mesh_free(&e->mesh);
+    pthread_mutex_destroy(&e->order_lock);
+    pthread_mutex_destroy(&e->mesh_lock);
+    free(e);
+}
+
+/* D[k]: beyond it a level-k cell (2^k level-0 cells across, at the largest spacing)
+ * projects to at most pixel_error pixels. Levels whose D lies beyond the volume's farthest
+ * corner are not used. */
+static void set_lod_distances(ip_engine *e)
+{
+    const ip_layout *l = ip_store_layout(ip_cache_store(e->cache));
+    double spacing = fmax(l->spacing[0], fmax(l->spacing[1], l->spacing[2]));
+    double pixels_per_radian = 0.5 * e->camera.height / e->basis.tan_half_y;
+    double far = 0;
+    for (int k = 0; k < 8; k++) {
+        double d2 = 0;
+        for (int a = 0; a < 3; a++) {
+            double c = (k >> a & 1) ? (l->dims[a] - 1) * l->spacing[a] : 0;
+            d2 += (c - e->camera.eye[a]) * (c - e->camera.eye[a]);
+        }
+        far = fmax(far, sqrt(d2));
+    }
+    e->lod_distance[0] = 0;
+    e->levels_used = 1;
+    for (uint32_t k = 1; e->options.lod && k < l->level_count; k++) {
+        double d = (double)(1u << k) * spacing * pixels_per_radian / e->options.pixel_error;
+        if (d >= far)
+            break;
+        e->lod_distance[k] = d;
+        e->levels_used = k + 1;
+    }
+    e->lod_distance[e->levels_used] = INFINITY;
+}
+
+double ip_engine_lod_distance(const ip_engine *e, uint32_t level)
+{
+    return level < e->levels_used ? e->lod_distance[level] : INFINITY;
+}
+
+ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_error *err)
+{
+    ip_status st = ip_camera_check(camera, err);
+    if (st != IP_OK)
+        return st;
+    if (!isfinite(iso))
+        return ip__fail(err, IP_ERR_ARGUMENT, "the isovalue must be finite");
+    ip__visited_clear(&e->visited);
+    ip_mesh_clear(&e->mesh);
+    e->camera = *camera;
+    ip_camera_basis_of(&e->camera, &e->basis);
+    e->iso = iso;
+    memset(&e->totals, 0, sizeof e->totals);
+    ip__ray_order_init(&e->order, camera->width, camera->height);
+    /* The finest levels (cells of at most 2^LOCAL_LEVELS pixels a side, most of the rays)
+     * are cast in Z-order: consecutive rays then cross the same bricks and sub-blocks while
+     * they are still in the processor's caches. The image is nearly complete by then, so
+     * the coarser levels, which make it, keep their spread-out order. */
+    uint32_t last = ip__ray_order_last_level(&e->order);
+    ip__ray_order_set_local_from(&e->order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
+    set_lod_distances(e);
+    double pixel_angle = 2.0 * e->basis.tan_half_y / camera->height;
+    for (unsigned t = 0; t < e->threads; t++) {
+        worker *w = &e->workers[t];
+        ip_mesh_clear(&w->mesh);
+        for (uint32_t k = 0; k < e->levels_used; k++) {
+            level_tools *lt = &w->level[k];
+            if (!lt->ready) {
+                if (ip__sampler_init(&lt->sampler, e->cache, k) != IP_OK)
+                    return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+                lt->ready = 1;
+            }
+            ip__sampler_release(&lt->sampler);
+            lt->sampler.status = IP_OK;
+            ip__seeder_init(&lt->seeder, &lt->sampler, iso, pixel_angle);
+            ip__propagator_free(&lt->propagator);
+            if (ip__propagator_init(&lt->propagator, &lt->sampler, &e->visited, &w->mesh,
+                                   &e->camera, iso, &e->options, e->lod_distance[k],
+                                   e->lod_distance[k + 1]) != IP_OK)
+                return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+        }
+    }
+    atomic_store(&e->cancel, 0);
+    e->begun = 1;
+    return IP_OK;
+}
+
+void ip_engine_cancel(ip_engine *e)
+{
+    atomic_store(&e->cancel, 1);
+}
+
+int ip_engine_done(const ip_engine *e)
+{
+    return e->begun && ip__ray_order_emitted(&e->order) == ip__ray_order_count(&e->order);
+}
+
+static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
+{
+    to->rays += from->rays;
+    to->seeds += from->seeds;
+    to->cells += from->cells;
+    to->triangles += from->triangles;
+    to->intersection_seconds += from->intersection_seconds;
+    to->propagation_seconds += from->propagation_seconds;
+    to->extraction_seconds += from->extraction_seconds;
+    to->rendering_seconds += from->rendering_seconds;
+}
+
+/* Extracts one cell without propagating from it. */
+static ip_status extract_one(worker *w, level_tools *lt, const uint32_t cell[3])
+{
+    unsigned mc;
+    ip_status st = IP_OK;
+    double t0 = ip_now_seconds();
+    int n = ip__extract_cell(&lt->sampler, &w->mesh, cell, w->engine->iso, &mc, &st);
+    w->counts.extraction_seconds += ip_now_seconds() - t0;
+    if (n < 0)
+        return st;
+    w->counts.cells++;
+    w->counts.triangles += (uint64_t)n;
+    return IP_OK;
+}
+
+/* Casts the ray of pixel (x, y), one distance band (pyramid level) after the other, front to
+ * back: extracts its seed, and the cells it nearly hit before it, propagating from each that
+ * was not extracted yet. */
+static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
+{
+    ip_engine *e = w->engine;
+    double dir[3];
+    uint32_t cells[IP_SEED_MAX_CELLS][3];
+    ip_camera_pixel_ray(&e->basis, &e->camera, x + 0.5, y + 0.5, dir);
+    w->counts.rays++;
+    for (uint32_t k = 0; k < e->levels_used; k++) {
+        level_tools *lt = &w->level[k];
+        unsigned count;
+        int seed_index;
+        int found = ip__seed_find(&lt->seeder, e->camera.eye, dir, e->lod_distance[k],
+                                 e->lod_distance[k + 1], cells, &count, &seed_index);
+        if (found < 0) {
+            w->failed_level = k;
+            return lt->sampler.status;
+        }
+        for (unsigned i = 0; i < count; i++) {
+            int was = ip__visited_mark(&e->visited, k, cells[i]);
+            if (was < 0)
+                return IP_ERR_NOMEM;
+            if (was)
+                continue;
+            ip_status st;
+            if ((int)i == seed_index) { /* the seed: propagate from it */
+                w->counts.seeds++;
+                st = ip__propagate(&lt->propagator, cells[i], dir, &w->counts);
+            } else { /* a rounding case: its own triangles only, for the pixel's sake */
+                st = extract_one(w, lt, cells[i]);
+            }
+            if (st != IP_OK) {
+                w->failed_level = k;
+                return st;
+            }
+        }
+        if (found)
+            return IP_OK;
+    }
+    return IP_OK;
+}
+
+/* Takes up to RAY_BATCH pixels of the shared order for this step; returns how many. */
+static unsigned take_rays(ip_engine *e, uint32_t xy[][2])
+{
+    unsigned n = 0;
+    pthread_mutex_lock(&e->order_lock);
+    int late = e->step_deadline > 0 && ip_now_seconds() >= e->step_deadline;
+    while (!late && n < RAY_BATCH && e->step_rays_left > 0 &&
+           ip__ray_order_next(&e->order, &xy[n][0], &xy[n][1])) {
+        n++;
+        e->step_rays_left--;
+    }
+    pthread_mutex_unlock(&e->order_lock);
+    return n;
+}
+
+/* Moves the worker's triangles to the engine's mesh. */
+static ip_status flush_triangles(worker *w)
+{
+    ip_engine *e = w->engine;
+    pthread_mutex_lock(&e->mesh_lock);
+    ip_status st = ip_mesh_append_mesh(&e->mesh, &w->mesh, 0, w->mesh.triangle_count);
+    pthread_mutex_unlock(&e->mesh_lock);
+    ip_mesh_clear(&w->mesh);
+    return st;
+}
+
+static void *work(void *p)
+{
+    worker *w = p;
+    ip_engine *e = w->engine;
+    uint32_t xy[RAY_BATCH][2];
+    unsigned n;
+    while (w->status == IP_OK && (n = take_rays(e, xy)) > 0) {
+        /* The clock is read once per batch: seeding is the batch's time less what
+         * propagation and extraction measured of it. */
+        double t0 = ip_now_seconds();
+        double inner = w->counts.propagation_seconds + w->counts.extraction_seconds;
+        for (unsigned i = 0; i < n && w->status == IP_OK; i++) {
+            if (atomic_load_explicit(&e->cancel, memory_order_relaxed)) {
+                w->status = IP_ERR_CANCELLED;
+                break;
+            }
+            w->status = cast_ray(w, xy[i][0], xy[i][1]);
+        }
+        double seeding = ip_now_seconds() - t0 -
+                         (w->counts.propagation_seconds + w->counts.extraction_seconds - inner);
+        w->counts.intersection_seconds += seeding > 0 ? seeding : 0;
+        if (w->mesh.triangle_count >= FLUSH_TRIANGLES && flush_triangles(w) != IP_OK &&
+            w->status == IP_OK)
+            w->status = IP_ERR_NOMEM;
+    }
+    if (flush_triangles(w) != IP_OK && w->status == IP_OK)
+        w->status = IP_ERR_NOMEM;
+    if (w->status != IP_OK) { /* the step fails: the other workers take no more rays */
+        pthread_mutex_lock(&e->order_lock);
+        e->step_rays_left = 0;
+        pthread_mutex_unlock(&e->order_lock);
+    }
+    for (uint32_t k = 0; k < e->levels_used; k++) /* let the cache evict freely between steps */
+        ip__sampler_release(&w->level[k].sampler);
+    return NULL;
+}
+
+ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
+                         ip_engine_counts *counts, ip_error *err)
+{
+    if (!e->begun)
+        return ip__fail(err, IP_ERR_ARGUMENT, "ip_engine_step() before ip_engine_begin()");
+    if (atomic_load(&e->cancel))
+        return ip__fail(err, IP_ERR_CANCELLED, "extraction cancelled");
+    e->step_rays_left = max_rays ? max_rays : UINT64_MAX;
+    e->step_deadline = max_seconds > 0 ? ip_now_seconds() + max_seconds : 0;
+    unsigned threads = e->threads;
+    if (max_rays && max_rays < (uint64_t)threads * RAY_BATCH)
+        threads = (unsigned)((max_rays + RAY_BATCH - 1) / RAY_BATCH); /* few rays: few threads */
+    pthread_t tids[MAX_THREADS];
+    unsigned started = 0;
+    for (unsigned t = 0; t < threads; t++) {
+        worker *w = &e->workers[t];
+        memset(&w->counts, 0, sizeof w->counts);
+        w->status = IP_OK;
+        w->mesh.triangle_count = 0;
+    }
+    for (unsigned t = 1; t < threads; t++)
+        if (pthread_create(&tids[started], NULL, work, &e->workers[t]) == 0)
+            started++;
+    work(&e->workers[0]);
+    for (unsigned t = 0; t < started; t++)
+        pthread_join(tids[t], NULL);
+    ip_engine_counts c;
+    memset(&c, 0, sizeof c);
+    ip_status st = IP_OK;
+    for (unsigned t = 0; t < threads; t++) {
+        worker *w = &e->workers[t];
+        add_counts(&c, &w->counts);
+        if (st == IP_OK && w->status != IP_OK) {
+            st = w->status;
+            if (st == IP_ERR_CANCELLED)
+                ip__fail(err, st, "extraction cancelled");
+            else if (st == IP_ERR_NOMEM)
+                ip__fail(err, st, "out of memory");
+            else if (err)
+                *err = w->level[w->failed_level].sampler.error;
+        }
+    }
+    add_counts(&e->totals, &c);
+    if (counts)
+        *counts = c;
+    return st;
+}
+
+const ip_mesh *ip_engine_mesh(const ip_engine *e)
+{
+    return &e->mesh;
+}
+
+void ip_engine_totals(const ip_engine *e, ip_engine_counts *counts)
+{
+    *counts = e->totals;
+}
+
+void ip_engine_add_rendering_time(ip_engine *e, double seconds)
+{
+    e->totals.rendering_seconds += seconds;
+}

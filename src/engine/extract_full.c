@@ -1,0 +1,179 @@
+/* Full extraction: every active cell of a level, brick by brick, skipping by summaries. */
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "isoprop/engine.h"
+#include "propagate.h"
+
+/* Triangulates the active cells of one brick, sub-block by sub-block. */
+static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, uint64_t g,
+                               ip_engine_counts *c)
+{
+    const ip_layout *l = s->layout;
+    const float *ranges = ip_store_subblock_ranges(ip_cache_store(s->cache), g);
+    uint32_t level, brick[3], origin[3], extent[3];
+    ip_brick_coords(l, g, &level, brick);
+    ip_brick_extent(l, level, brick, origin, extent);
+    uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
+    ip_status st = IP_OK;
+    for (uint32_t i = 0; i < per * per * per && st == IP_OK; i++) {
+        if (!ip__range_active(ranges[2 * i], ranges[2 * i + 1], iso))
+            continue;
+        uint32_t sb[3] = {i % per, (i / per) % per, i / (per * per)}, lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = origin[a] + se * sb[a];
+            hi[a] = lo[a] + se < origin[a] + extent[a] - 1 ? lo[a] + se : origin[a] + extent[a] - 1;
+        }
+        for (uint32_t z = lo[2]; z < hi[2] && st == IP_OK; z++)
+            for (uint32_t y = lo[1]; y < hi[1] && st == IP_OK; y++)
+                for (uint32_t x = lo[0]; x < hi[0]; x++) {
+                    uint32_t cell[3] = {x, y, z};
+                    unsigned mc;
+                    int n = ip__extract_cell(s, mesh, cell, iso, &mc, &st);
+                    if (n < 0)
+                        break;
+                    if (mc != 0 && mc != 255)
+                        c->cells++;
+                    c->triangles += (uint64_t)n;
+                }
+    }
+    return st;
+}
+
+/* A worker of the full extraction: it takes bricks in order from a shared counter and
+ * remembers where each brick's triangles start in its own mesh. */
+typedef struct full_worker {
+    ip_cache *cache;
+    float iso;
+    uint32_t level;
+    atomic_uint_fast64_t *next;   /* next level-local brick to take */
+    ip_sampler sampler;
+    ip_mesh mesh;
+    uint64_t *brick_of;           /* per chunk of this worker: the brick */
+    uint64_t *start_of;           /* per chunk: its first triangle in mesh */
+    uint64_t chunks, capacity;
+    ip_engine_counts counts;
+    ip_status status;
+} full_worker;
+
+static void *full_work(void *p)
+{
+    full_worker *w = p;
+    const ip_store *store = ip_cache_store(w->cache);
+    const ip_level_layout *lv = &ip_store_layout(store)->levels[w->level];
+    double start = ip_now_seconds();
+    for (;;) {
+        uint64_t i = atomic_fetch_add(w->next, 1);
+        if (i >= lv->brick_count || w->status != IP_OK)
+            break;
+        float range[2];
+        ip_store_brick_range(store, lv->first_brick + i, range);
+        if (!ip__range_active(range[0], range[1], w->iso))
+            continue;
+        if (w->chunks == w->capacity) {
+            uint64_t cap = w->capacity ? 2 * w->capacity : 256;
+            uint64_t *b = realloc(w->brick_of, cap * sizeof *b);
+            if (b)
+                w->brick_of = b;
+            uint64_t *s = b ? realloc(w->start_of, cap * sizeof *s) : NULL;
+            if (!s) {
+                w->status = IP_ERR_NOMEM;
+                break;
+            }
+            w->start_of = s;
+            w->capacity = cap;
+        }
+        w->brick_of[w->chunks] = i;
+        w->start_of[w->chunks++] = w->mesh.triangle_count;
+        w->status = extract_brick(&w->sampler, &w->mesh, w->iso, lv->first_brick + i, &w->counts);
+        ip__sampler_release(&w->sampler); /* a brick at a time */
+    }
+    w->counts.extraction_seconds = ip_now_seconds() - start;
+    return NULL;
+}
+
+/* Appends every worker's triangles to `mesh` in brick order. */
+static ip_status merge_in_brick_order(full_worker *w, unsigned threads, ip_mesh *mesh)
+{
+    uint64_t *cursor = calloc(threads, sizeof *cursor);
+    if (!cursor)
+        return IP_ERR_NOMEM;
+    ip_status st = IP_OK;
+    for (;;) {
+        unsigned best = threads;
+        for (unsigned t = 0; t < threads; t++)
+            if (cursor[t] < w[t].chunks &&
+                (best == threads || w[t].brick_of[cursor[t]] < w[best].brick_of[cursor[best]]))
+                best = t;
+        if (best == threads || st != IP_OK)
+            break;
+        full_worker *b = &w[best];
+        uint64_t first = b->start_of[cursor[best]];
+        uint64_t end = cursor[best] + 1 < b->chunks ? b->start_of[cursor[best] + 1]
+                                                    : b->mesh.triangle_count;
+        st = ip_mesh_append_mesh(mesh, &b->mesh, first, end - first);
+        cursor[best]++;
+    }
+    free(cursor);
+    return st;
+}
+
+ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,
+                          ip_mesh *mesh, ip_engine_counts *counts, ip_error *err)
+{
+    const ip_layout *l = ip_store_layout(ip_cache_store(cache));
+    if (level >= l->level_count)
+        return ip__fail(err, IP_ERR_ARGUMENT, "level %u does not exist", level);
+    threads = ip_thread_count(threads);
+    full_worker *w = calloc(threads, sizeof *w);
+    if (!w)
+        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+    atomic_uint_fast64_t next;
+    atomic_init(&next, 0);
+    ip_status st = IP_OK;
+    for (unsigned t = 0; t < threads; t++) {
+        w[t] = (full_worker){.cache = cache, .iso = iso, .level = level, .next = &next};
+        ip_mesh_init(&w[t].mesh);
+        w[t].mesh.with_cells = mesh->with_cells;
+        if (ip__sampler_init(&w[t].sampler, cache, level) != IP_OK)
+            st = IP_ERR_NOMEM;
+    }
+    pthread_t tids[64];
+    unsigned started = 0;
+    for (unsigned t = 1; st == IP_OK && t < threads && t <= 64; t++)
+        if (pthread_create(&tids[started], NULL, full_work, &w[t]) == 0)
+            started++;
+    if (st == IP_OK)
+        full_work(&w[0]);
+    for (unsigned t = 0; t < started; t++)
+        pthread_join(tids[t], NULL);
+    ip_engine_counts c;
+    memset(&c, 0, sizeof c);
+    for (unsigned t = 0; t < threads; t++) {
+        c.cells += w[t].counts.cells;
+        c.triangles += w[t].counts.triangles;
+        c.extraction_seconds += w[t].counts.extraction_seconds;
+        if (st == IP_OK && w[t].status != IP_OK) {
+            st = w[t].status;
+            if (st == IP_ERR_NOMEM)
+                ip__fail(err, st, "out of memory");
+            else if (err)
+                *err = w[t].sampler.error;
+        }
+    }
+    if (st == IP_OK && merge_in_brick_order(w, threads, mesh) != IP_OK)
+        st = ip__fail(err, IP_ERR_NOMEM, "out of memory");
+    for (unsigned t = 0; t < threads; t++) {
+        ip__sampler_free(&w[t].sampler);
+        ip_mesh_free(&w[t].mesh);
+        free(w[t].brick_of);
+        free(w[t].start_of);
+    }
+    free(w);
+    if (counts)
+        *counts = c;
+    return st;
+}

@@ -1,0 +1,193 @@
+/* Breadth-first propagation of the isosurface from a seed, within the cut-off angle, stopped
+ * where the surface folds back and outside the view frustum. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "propagate.h"
+
+#define DEG (3.14159265358979323846 / 180.0)
+#define TIMING_STRIDE 16 /* extractions per timed extraction */
+
+ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
+                             ip_mesh *mesh, const ip_camera *camera, float iso,
+                             const ip_engine_options *options, double near_distance,
+                             double far_distance)
+{
+    memset(p, 0, sizeof *p);
+    p->sampler = sampler;
+    p->visited = visited;
+    p->mesh = mesh;
+    p->camera = camera;
+    ip_camera_basis_of(camera, &p->basis);
+    p->iso = iso;
+    p->cutoff = options->cutoff_degrees * DEG;
+    p->foldback = options->foldback_degrees * DEG;
+    p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
+    p->near_distance = near_distance;
+    p->far_distance = far_distance;
+    p->queue_capacity = 4096;
+    p->queue = malloc(p->queue_capacity * sizeof *p->queue);
+    return p->queue ? IP_OK : IP_ERR_NOMEM;
+}
+
+void ip__propagator_free(ip_propagator *p)
+{
+    free(p->queue);
+    p->queue = NULL;
+}
+
+int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float iso,
+                    unsigned *mc_case, ip_status *st)
+{
+    ip_mc_vertex v[IP_MC_MAX_VERTICES];
+    int n = ip__sampler_triangulate(s, cell, iso, v, mc_case);
+    if (n < 0) {
+        *st = s->status;
+        return -1;
+    }
+    if (n == 0)
+        return 0;
+    float pos[9 * IP_MC_MAX_TRIANGLES];
+    int16_t nor[9 * IP_MC_MAX_TRIANGLES];
+    uint64_t ids[IP_MC_MAX_TRIANGLES];
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    uint64_t linear = cell[0] + (uint64_t)(lv->dims[0] - 1) *
+                                    (cell[1] + (uint64_t)(lv->dims[1] - 1) * cell[2]);
+    for (int t = 0; t < n; t++) {
+        ids[t] = ip_cell_id(s->level, linear);
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++) {
+                pos[9 * t + 3 * k + a] = v[3 * t + k].position[a];
+                nor[9 * t + 3 * k + a] = ip_normal_pack(v[3 * t + k].normal[a]);
+            }
+    }
+    if (ip_mesh_append(mesh, pos, nor, ids, (uint64_t)n) != IP_OK) {
+        *st = IP_ERR_NOMEM;
+        return -1;
+    }
+    return n;
+}
+
+/* Angle between the unit ray `dir` and the direction from the eye to `p` (radians). */
+static double angle_to(const double eye[3], const double dir[3], const double p[3])
+{
+    double v[3] = {p[0] - eye[0], p[1] - eye[1], p[2] - eye[2]};
+    double c[3] = {dir[1] * v[2] - dir[2] * v[1], dir[2] * v[0] - dir[0] * v[2],
+                   dir[0] * v[1] - dir[1] * v[0]};
+    double along = dir[0] * v[0] + dir[1] * v[1] + dir[2] * v[2];
+    return atan2(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), along);
+}
+
+static void cell_centre(const ip_sampler *s, const uint32_t cell[3], double centre[3],
+                        double *diagonal)
+{
+    double d2 = 0;
+    for (int a = 0; a < 3; a++) {
+        double lo = s->world[a][cell[a]], hi = s->world[a][cell[a] + 1];
+        centre[a] = 0.5 * (lo + hi);
+        d2 += (hi - lo) * (hi - lo);
+    }
+    *diagonal = sqrt(d2);
+}
+
+/* Whether any part of the cell may project into the image (a conservative test on its centre,
+ * widened by the cell's projected size and a 2-pixel margin). */
+static int in_frustum(const ip_propagator *p, const double centre[3], double diagonal)
+{
+    double x, y, depth;
+    if (!ip_camera_project(&p->basis, p->camera, centre, &x, &y, &depth))
+        return 0;
+    double margin = 2.0 + diagonal / depth * p->pixel_scale;
+    return x >= -margin && x <= p->camera->width + margin && y >= -margin &&
+           y <= p->camera->height + margin;
+}
+
+static ip_status grow_queue(ip_propagator *p, uint64_t head, uint64_t tail)
+{
+    /* keep the live part [head, tail) and move it to the front */
+    memmove(p->queue, p->queue + head, (tail - head) * sizeof *p->queue);
+    if (tail - head + 6 > p->queue_capacity / 2) {
+        uint64_t cap = p->queue_capacity * 2;
+        ip_queued_cell *q = realloc(p->queue, cap * sizeof *q);
+        if (!q)
+            return IP_ERR_NOMEM;
+        p->queue = q;
+        p->queue_capacity = cap;
+    }
+    return IP_OK;
+}
+
+ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
+                       ip_engine_counts *counts)
+{
+    static const int offsets[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0},
+                                      {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
+    const uint32_t *dims = p->sampler->dims;
+    const double *eye = p->camera->eye;
+    double start = ip_now_seconds(), extracting = 0;
+    uint64_t extracted = 0;
+    double centre[3], diagonal;
+    cell_centre(p->sampler, seed, centre, &diagonal);
+    uint64_t head = 0, tail = 0;
+    p->queue[tail++] = (ip_queued_cell){{seed[0], seed[1], seed[2]},
+                                        (float)angle_to(eye, dir, centre)};
+    ip_status st = IP_OK;
+    while (head < tail && st == IP_OK) {
+        ip_queued_cell q = p->queue[head++];
+        unsigned mc;
+        /* The clock is read around one extraction in TIMING_STRIDE (a clock read costs about
+         * what a third of a cell's marching cubes does); the split is an estimate. */
+        int timed = extracted++ % TIMING_STRIDE == 0;
+        double t0 = timed ? ip_now_seconds() : 0;
+        int n = ip__extract_cell(p->sampler, p->mesh, q.cell, p->iso, &mc, &st);
+        if (timed)
+            extracting += TIMING_STRIDE * (ip_now_seconds() - t0);
+        if (n < 0)
+            break;
+        counts->cells++;
+        counts->triangles += (uint64_t)n;
+        unsigned faces = ip__mc_crossed_faces(mc);
+        if (tail + 6 > p->queue_capacity && (st = grow_queue(p, head, tail)) == IP_OK) {
+            tail -= head;
+            head = 0;
+        }
+        for (int f = 0; f < 6 && st == IP_OK; f++) {
+            if (!(faces & (1u << f)))
+                continue;
+            int64_t c[3];
+            int inside = 1;
+            for (int a = 0; a < 3; a++) {
+                c[a] = (int64_t)q.cell[a] + offsets[f][a];
+                inside &= c[a] >= 0 && c[a] < (int64_t)dims[a] - 1;
+            }
+            if (!inside)
+                continue;
+            uint32_t n3[3] = {(uint32_t)c[0], (uint32_t)c[1], (uint32_t)c[2]};
+            if (ip__visited_test(p->visited, p->sampler->level, n3))
+                continue;
+            cell_centre(p->sampler, n3, centre, &diagonal);
+            double a = angle_to(eye, dir, centre);
+            if (a > p->cutoff || a < q.max_angle - p->foldback || !in_frustum(p, centre, diagonal))
+                continue;
+            if (p->near_distance > 0 || p->far_distance < INFINITY) {
+                double v[3] = {centre[0] - eye[0], centre[1] - eye[1], centre[2] - eye[2]};
+                double d = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                if (d < p->near_distance || d >= p->far_distance)
+                    continue; /* another level's band: the resolution boundary */
+            }
+            int was = ip__visited_mark(p->visited, p->sampler->level, n3);
+            if (was < 0)
+                st = IP_ERR_NOMEM;
+            else if (!was)
+                p->queue[tail++] = (ip_queued_cell){{n3[0], n3[1], n3[2]},
+                                                    (float)fmax(q.max_angle, a)};
+        }
+    }
+    double total = ip_now_seconds() - start;
+    extracting = extracting < total ? extracting : total;
+    counts->extraction_seconds += extracting;
+    counts->propagation_seconds += total - extracting;
+    return st;
+}

@@ -1,0 +1,52 @@
+/* Surface propagation from a seed cell, and the triangle output shared with full extraction.
+ * Internal. */
+#ifndef ISOPROP_PROPAGATE_H
+#define ISOPROP_PROPAGATE_H
+
+#include "isoprop/camera.h"
+#include "isoprop/engine.h"
+#include "isoprop/mesh.h"
+#include "sampler.h"
+#include "visited.h"
+
+typedef struct ip_queued_cell {
+    uint32_t cell[3];
+    float max_angle; /* the largest angle to the seed's ray among the cell's predecessors */
+} ip_queued_cell;
+
+typedef struct ip_propagator {
+    ip_sampler *sampler;
+    ip_visited *visited;
+    ip_mesh *mesh;
+    const ip_camera *camera;
+    ip_camera_basis basis;
+    float iso;
+    double cutoff;      /* radians */
+    double foldback;    /* radians */
+    double pixel_scale; /* pixels per unit of (size / depth) */
+    double near_distance, far_distance; /* the level's distance band from the eye */
+    ip_queued_cell *queue;
+    uint64_t queue_capacity;
+} ip_propagator;
+
+/* Propagation within one level: cells whose centre lies outside the distance band
+ * [near_distance, far_distance) from the eye belong to another level and stop it (the paper's
+ * resolution boundary). */
+ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
+                             ip_mesh *mesh, const ip_camera *camera, float iso,
+                             const ip_engine_options *options, double near_distance,
+                             double far_distance);
+void ip__propagator_free(ip_propagator *p);
+
+/* Propagates from `seed` (already marked visited) along the surface, for the ray `dir` (unit,
+ * world) from the camera's eye. Adds to counts' cells, triangles and times.
+ * @return IP_OK, IP_ERR_NOMEM or the sampler's error. */
+ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
+                       ip_engine_counts *counts);
+
+/* Triangulates `cell` and appends its triangles to `mesh`. Sets *mc_case. Returns the number of
+ * triangles, or -1 on a read failure / out of memory (status in *st). */
+int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float iso,
+                    unsigned *mc_case, ip_status *st);
+
+#endif

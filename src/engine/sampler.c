@@ -1,0 +1,214 @@
+/* Samples, cells and their triangulation for one level, read through the brick cache. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "sampler.h"
+
+ip_status ip__sampler_init(ip_sampler *s, ip_cache *cache, uint32_t level)
+{
+    memset(s, 0, sizeof *s);
+    s->cache = cache;
+    s->layout = ip_store_layout(ip_cache_store(cache));
+    s->level = level;
+    while ((1u << s->edge_shift) < s->layout->brick_edge) /* a power of two */
+        s->edge_shift++;
+    for (int a = 0; a < 3; a++) {
+        s->dims[a] = s->layout->levels[level].dims[a];
+        s->world[a] = malloc(s->dims[a] * sizeof(double));
+        if (!s->world[a]) {
+            ip__sampler_free(s);
+            return IP_ERR_NOMEM;
+        }
+        for (uint32_t i = 0; i < s->dims[a]; i++)
+            s->world[a][i] =
+                ip_level_sample_index(s->layout->dims[a], level, i) * s->layout->spacing[a];
+    }
+    return IP_OK;
+}
+
+void ip__sampler_release(ip_sampler *s)
+{
+    for (int i = 0; i < IP_SAMPLER_SLOTS; i++)
+        if (s->used[i]) {
+            ip_cache_unpin_brick(s->cache, &s->held[i]);
+            s->used[i] = 0;
+        }
+}
+
+void ip__sampler_free(ip_sampler *s)
+{
+    if (s->cache)
+        ip__sampler_release(s);
+    for (int a = 0; a < 3; a++) {
+        free(s->world[a]);
+        s->world[a] = NULL;
+    }
+}
+
+static const ip_brick *brick_at(ip_sampler *s, const uint32_t brick[3])
+{
+    uint64_t g = ip_brick_global_index(s->layout, s->level, brick);
+    for (unsigned i = 0; i < IP_SAMPLER_SLOTS; i++)
+        if (s->used[i] && s->held[i].index == g) {
+            s->last = i;
+            return &s->held[i];
+        }
+    if (s->status != IP_OK)
+        return NULL;
+    unsigned v = s->next_victim;
+    s->next_victim = (v + 1) % IP_SAMPLER_SLOTS;
+    if (s->used[v]) {
+        ip_cache_unpin_brick(s->cache, &s->held[v]);
+        s->used[v] = 0;
+    }
+    ip_status st = ip_cache_pin_brick(s->cache, g, &s->held[v], &s->error);
+    if (st != IP_OK) {
+        s->status = st;
+        return NULL;
+    }
+    s->used[v] = 1;
+    s->last = v;
+    return &s->held[v];
+}
+
+const ip_brick *ip__sampler_cell_brick(ip_sampler *s, const uint32_t cell[3])
+{
+    /* Cells come in runs within one brick (a sub-block, a propagation front): the brick of
+     * the last lookup is tested first, without the global index and the scan of the slots.
+     * A brick's cells are origin .. origin + B - 1 (the unsigned difference wraps below). */
+    const ip_brick *last = &s->held[s->last];
+    uint32_t edge = s->layout->brick_edge;
+    if (s->used[s->last] && cell[0] - last->origin[0] < edge &&
+        cell[1] - last->origin[1] < edge && cell[2] - last->origin[2] < edge)
+        return last;
+    uint32_t b[3];
+    for (int a = 0; a < 3; a++)
+        b[a] = cell[a] >> s->edge_shift;
+    return brick_at(s, b);
+}
+
+int ip__sampler_cell_values(ip_sampler *s, const uint32_t cell[3], float values[8])
+{
+    const ip_brick *b = ip__sampler_cell_brick(s, cell);
+    if (!b)
+        return 0;
+    ptrdiff_t corners[8];
+    ip__corner_offsets(b, corners);
+    ip__cell_values(b, s->layout->type, corners, cell, values);
+    return 1;
+}
+
+void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float origin[3],
+                         float size[3])
+{
+    for (int a = 0; a < 3; a++) {
+        origin[a] = (float)s->world[a][cell[a]];
+        size[a] = (float)(s->world[a][cell[a] + 1] - s->world[a][cell[a]]);
+    }
+}
+
+/* Sample p of the level, clamped to the volume; any brick holding it will do (neighbouring
+ * bricks share their face layers): `near`, a pinned brick, when it holds it, else the one
+ * whose cells it starts. Returns 0 after a failure. */
+static int sample_at(ip_sampler *s, const ip_brick *near, const int64_t p[3], float *out)
+{
+    uint32_t q[3], brick[3];
+    int held = 1;
+    for (int a = 0; a < 3; a++) {
+        q[a] = (uint32_t)(p[a] < 0 ? 0 : p[a] >= s->dims[a] ? s->dims[a] - 1 : p[a]);
+        held &= q[a] - near->origin[a] < near->extent[a];
+        uint32_t cells = s->dims[a] - 1;
+        brick[a] = (q[a] < cells ? q[a] : cells - 1) >> s->edge_shift;
+    }
+    const ip_brick *b = held ? near : brick_at(s, brick);
+    if (!b)
+        return 0;
+    *out = ip_sample_get(b->samples, s->layout->type, ip__sample_index(b, q));
+    return 1;
+}
+
+/* The sample next to corner c of `cell` outwards along axis a (one below the cell where the
+ * corner is on its low side, one above where it is on its high side), clamped to the volume:
+ * with the corner across the cell it gives the central difference of the corner's gradient.
+ * Gathered as out[3 * c + a]: from the cell's brick when it holds all 24 (one typed read),
+ * else sample by sample from whichever brick holds each. Returns 0 after a failure. */
+static int gradient_neighbours(ip_sampler *s, const uint32_t cell[3], const ip_brick *b,
+                               float out[24])
+{
+    ptrdiff_t stride[3] = {1, (ptrdiff_t)b->extent[0],
+                           (ptrdiff_t)b->extent[0] * (ptrdiff_t)b->extent[1]};
+    ptrdiff_t below[3], above[3];
+    int inside = 1;
+    for (int a = 0; a < 3; a++) {
+        /* clamped at the volume's faces: the corner itself, which the brick holds */
+        int low = cell[a] > 0, high = cell[a] + 2 < s->dims[a];
+        below[a] = low ? -stride[a] : 0;
+        above[a] = high ? stride[a] : 0;
+        inside &= (!low || cell[a] > b->origin[a]) &&
+                  (!high || cell[a] + 2 < b->origin[a] + b->extent[a]);
+    }
+    if (inside) {
+        ptrdiff_t corners[8], offsets[24];
+        ip__corner_offsets(b, corners);
+        for (int c = 0; c < 8; c++)
+            for (int a = 0; a < 3; a++)
+                offsets[3 * c + a] = corners[c] + ((c >> a) & 1 ? above[a] : below[a]);
+        ip__samples_gather(b->samples, s->layout->type, ip__sample_index(b, cell), offsets,
+                          24, out);
+        return 1;
+    }
+    /* A brick read here may take the slot of `b`: the slot then describes the new brick,
+     * which sample_at() checks like any other, so `b` stays safe to pass until a failure. */
+    for (int c = 0; c < 8; c++)
+        for (int a = 0; a < 3; a++) {
+            int64_t p[3] = {(int64_t)cell[0] + (c & 1), (int64_t)cell[1] + ((c >> 1) & 1),
+                            (int64_t)cell[2] + ((c >> 2) & 1)};
+            p[a] += (c >> a) & 1 ? 1 : -1;
+            if (!sample_at(s, b, p, &out[3 * c + a]))
+                return 0;
+        }
+    return 1;
+}
+
+/* World distance between the samples either side of sample i (clamped) along axis a, for a
+ * central (or, at the volume's faces, one-sided) difference. */
+static double span(const ip_sampler *s, int a, int64_t i)
+{
+    int64_t last = s->dims[a] - 1;
+    int64_t l = i > 0 ? i - 1 : 0, h = i < last ? i + 1 : last;
+    return s->world[a][h] - s->world[a][l];
+}
+
+int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
+                           unsigned *mc_case)
+{
+    float values[8], outer[24], gradients[8][3], origin[3], size[3];
+    /* The case first, from the 8 corners alone: most cells of an active sub-block are not
+     * active, and need neither the gradient neighbours nor the divisions. */
+    const ip_brick *b = ip__sampler_cell_brick(s, cell);
+    if (!b)
+        return -1;
+    ptrdiff_t corners[8];
+    ip__corner_offsets(b, corners);
+    ip__cell_values(b, s->layout->type, corners, cell, values);
+    *mc_case = ip__mc_case(values, iso);
+    if (*mc_case == 0 || *mc_case == 255)
+        return 0;
+    if (!gradient_neighbours(s, cell, b, outer))
+        return -1;
+    double d[2][3]; /* per axis, the span around the cell's low and high corners */
+    for (int a = 0; a < 3; a++)
+        for (int h = 0; h < 2; h++)
+            d[h][a] = span(s, a, (int64_t)cell[a] + h);
+    for (int c = 0; c < 8; c++)
+        for (int a = 0; a < 3; a++) {
+            int h = (c >> a) & 1;
+            float across = values[c ^ (1 << a)];
+            float vh = h ? outer[3 * c + a] : across, vl = h ? across : outer[3 * c + a];
+            gradients[c][a] = d[h][a] > 0 ? (float)((vh - vl) / d[h][a]) : 0.0f;
+        }
+    ip__sampler_cell_box(s, cell, origin, size);
+    return ip__mc_triangulate_cell(values, (const float(*)[3])gradients, iso, origin, size, out);
+}

@@ -1,0 +1,358 @@
+/* Ray seeding through the min/max octree: root -> bricks -> sub-blocks -> cells, front to back. */
+#include <math.h>
+#include <string.h>
+
+#include "format.h"
+#include "seed.h"
+
+/* The ray in the level's index space, where cell (i, j, k) is the box [i, i+1] x ... . The
+ * parameter t stays the world distance along the ray. */
+typedef struct index_ray {
+    double origin[3], dir[3];
+    double inv_dir[3];  /* 1 / dir (0 where dir is 0, unused there): clip() runs per node */
+    double len;         /* the largest |dir| component, for dda_init()'s nudge */
+    const double *world_origin, *world_dir;
+    double u[3], w[3];  /* a unit basis across world_dir, for classify_cell() */
+} index_ray;
+
+/* A unit basis (u, w) across the unit direction d. */
+static void across_basis(const double d[3], double u[3], double w[3])
+{
+    int k = fabs(d[0]) < fabs(d[1]) ? (fabs(d[0]) < fabs(d[2]) ? 0 : 2)
+                                    : (fabs(d[1]) < fabs(d[2]) ? 1 : 2);
+    double axis[3] = {0, 0, 0};
+    axis[k] = 1;
+    u[0] = d[1] * axis[2] - d[2] * axis[1];
+    u[1] = d[2] * axis[0] - d[0] * axis[2];
+    u[2] = d[0] * axis[1] - d[1] * axis[0];
+    double un = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int i = 0; i < 3; i++)
+        u[i] /= un;
+    w[0] = d[1] * u[2] - d[2] * u[1];
+    w[1] = d[2] * u[0] - d[0] * u[2];
+    w[2] = d[0] * u[1] - d[1] * u[0];
+}
+
+/* Clips the ray to the index box [lo, hi]; returns 0 when it misses it or only behind t0. */
+static int clip(const index_ray *r, const double lo[3], const double hi[3], double *t0,
+                double *t1)
+{
+    double a = *t0, b = *t1;
+    for (int k = 0; k < 3; k++) {
+        if (r->dir[k] == 0.0) {
+            if (r->origin[k] < lo[k] || r->origin[k] > hi[k])
+                return 0;
+            continue;
+        }
+        double inv = r->inv_dir[k];
+        double ta = (lo[k] - r->origin[k]) * inv, tb = (hi[k] - r->origin[k]) * inv;
+        if (ta > tb) {
+            double t = ta;
+            ta = tb;
+            tb = t;
+        }
+        a = ta > a ? ta : a;
+        b = tb < b ? tb : b;
+    }
+    *t0 = a;
+    *t1 = b;
+    return a <= b;
+}
+
+/* A 3D DDA over a grid of `n` cells of edge `edge` (index units) starting at `base`. */
+typedef struct dda {
+    int32_t i[3], n[3], step[3];
+    double t_max[3], t_delta[3], t, t_end;
+} dda;
+
+static void dda_init(dda *d, const index_ray *r, const double base[3], double edge,
+                     const uint32_t n[3], double t0, double t1)
+{
+    double mid = t0; /* the entry point: nudge inwards along the ray */
+    mid += 1e-9 * edge / (r->len > 0 ? r->len : 1);
+    if (mid > t1)
+        mid = 0.5 * (t0 + t1);
+    for (int k = 0; k < 3; k++) {
+        double p = r->origin[k] + mid * r->dir[k];
+        int32_t c = (int32_t)floor((p - base[k]) / edge);
+        c = c < 0 ? 0 : c >= (int32_t)n[k] ? (int32_t)n[k] - 1 : c;
+        d->i[k] = c;
+        d->n[k] = (int32_t)n[k];
+        if (r->dir[k] > 0) {
+            d->step[k] = 1;
+            d->t_max[k] = (base[k] + (c + 1) * edge - r->origin[k]) / r->dir[k];
+            d->t_delta[k] = edge / r->dir[k];
+        } else if (r->dir[k] < 0) {
+            d->step[k] = -1;
+            d->t_max[k] = (base[k] + c * edge - r->origin[k]) / r->dir[k];
+            d->t_delta[k] = -edge / r->dir[k];
+        } else {
+            d->step[k] = 0;
+            d->t_max[k] = INFINITY;
+            d->t_delta[k] = INFINITY;
+        }
+    }
+    d->t = t0;
+    d->t_end = t1;
+}
+
+/* The current cell's exit parameter; advances to the next cell. Returns 0 when past the end. */
+static int dda_next(dda *d, double *exit_t)
+{
+    int k = d->t_max[0] < d->t_max[1] ? (d->t_max[0] < d->t_max[2] ? 0 : 2)
+                                      : (d->t_max[1] < d->t_max[2] ? 1 : 2);
+    *exit_t = d->t_max[k] < d->t_end ? d->t_max[k] : d->t_end;
+    if (d->t_max[k] > d->t_end || d->step[k] == 0)
+        return 0;
+    d->t = d->t_max[k];
+    d->i[k] += d->step[k];
+    d->t_max[k] += d->t_delta[k];
+    return d->i[k] >= 0 && d->i[k] < d->n[k];
+}
+
+static int active(const float *range, float iso)
+{
+    return ip__range_active(range[0], range[1], iso);
+}
+
+/* Classifies the ray against the cell's triangles as a rasteriser would classify its pixel
+ * centre: each triangle is projected centrally around the ray (point-in-triangle is the same
+ * for every central projection through the ray) and the ray's distance to its edges is
+ * measured as an angle. 3: inside a triangle by at least the margin; 2: inside one, within
+ * the margin of its edge; 1: outside every triangle, within the margin of one; 0: none.
+ * `mc` is the cell's case; `ro` the ray's origin in the cell's frame (corner 0 at the origin),
+ * its direction and the basis across it are r's. */
+static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc,
+                         const float values[8], const float size[3], const double ro[3])
+{
+    static const float zero[3] = {0, 0, 0};
+    float points[12][3];
+    unsigned crossed = ip__mc_cell_edge_points(values, s->iso, zero, size, points);
+    /* each crossing point projected once, though up to 4 triangles share it */
+    double p[12][2];
+    unsigned behind = 0;
+    const double *rd = r->world_dir, *u = r->u, *w = r->w;
+    for (unsigned e = 0; e < 12; e++) {
+        if (!(crossed >> e & 1u))
+            continue;
+        double d[3] = {points[e][0] - ro[0], points[e][1] - ro[1], points[e][2] - ro[2]};
+        double depth = d[0] * rd[0] + d[1] * rd[1] + d[2] * rd[2];
+        behind |= (unsigned)!(depth > 0) << e;
+        p[e][0] = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / depth;
+        p[e][1] = (d[0] * w[0] + d[1] * w[1] + d[2] * w[2]) / depth;
+    }
+    const int8_t *row = ip__mc_triangle_table[mc];
+    int n = ip__mc_triangle_count[mc], best = 0;
+    for (int t = 0; t < n && best < 3; t++) {
+        const int8_t *tri = row + 3 * t;
+        if (behind >> tri[0] & 1u || behind >> tri[1] & 1u || behind >> tri[2] & 1u)
+            continue;
+        const double *p0 = p[tri[0]], *p1 = p[tri[1]], *p2 = p[tri[2]];
+        double area = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]);
+        double least = INFINITY;
+        for (int j = 0; j < 3; j++) {
+            const double *a = p[tri[j]], *b = p[tri[(j + 1) % 3]];
+            double ex = b[0] - a[0], ey = b[1] - a[1], len = sqrt(ex * ex + ey * ey);
+            /* signed distance of the ray (the origin) to the edge, positive inside */
+            double dist = len > 0 ? (ex * (0 - a[1]) - ey * (0 - a[0])) / len : 0;
+            least = fmin(least, area >= 0 ? dist : -dist);
+        }
+        int kind = area != 0 && least >= s->margin ? 3
+                   : area != 0 && least >= 0      ? 2
+                   : least >= -s->margin          ? 1
+                                                  : 0;
+        best = kind > best ? kind : best;
+    }
+    return best;
+}
+
+/* Tests the cells of one sub-block (cells [lo, hi) in level coordinates) along the ray. */
+static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], const uint32_t hi[3],
+                      double t0, double t1)
+{
+    double base[3] = {lo[0], lo[1], lo[2]};
+    uint32_t n[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    /* A sub-block lies in one brick: look it up once, not per cell. Nothing below reads
+     * through the sampler, so the brick stays pinned in its slot. */
+    const ip_brick *brick = ip__sampler_cell_brick(s->sampler, lo);
+    if (!brick)
+        return -1;
+    ptrdiff_t corners[8];
+    ip__corner_offsets(brick, corners);
+    dda d;
+    dda_init(&d, r, base, 1.0, n, t0, t1);
+    for (;;) {
+        uint32_t c[3] = {lo[0] + (uint32_t)d.i[0], lo[1] + (uint32_t)d.i[1], lo[2] + (uint32_t)d.i[2]};
+        float values[8];
+        ip__cell_values(brick, s->layout->type, corners, c, values);
+        unsigned mc = ip__mc_case(values, s->iso);
+        if (mc != 0 && mc != 255) {
+            float origin[3], size[3];
+            double ro[3];
+            ip__sampler_cell_box(s->sampler, c, origin, size);
+            for (int k = 0; k < 3; k++) /* the cell's frame keeps precision in large volumes */
+                ro[k] = r->world_origin[k] - (double)origin[k];
+            s->cells_tested++;
+            int kind = classify_cell(s, r, mc, values, size, ro);
+            if (kind >= 2 && s->seed_index < 0)
+                s->seed_index = (int)s->found_count; /* the first cell the ray is inside */
+            if (kind && s->found_count < IP_SEED_MAX_CELLS)
+                memcpy(s->found[s->found_count++], c, sizeof c);
+            if (kind == 3)
+                return 1;
+        }
+        double exit_t;
+        if (!dda_next(&d, &exit_t))
+            return 0;
+    }
+}
+
+/* Walks the sub-blocks of brick `b` front to back. */
+static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], double t0, double t1)
+{
+    const ip_layout *l = s->layout;
+    uint32_t origin[3], extent[3];
+    ip_brick_extent(l, s->level, b, origin, extent);
+    const uint32_t *bricks = s->grid[0];
+    uint64_t g = s->first_brick + b[0] + (uint64_t)bricks[0] * (b[1] + (uint64_t)bricks[1] * b[2]);
+    const float *ranges = ip_store_subblock_ranges(s->store, g);
+    uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
+    uint32_t n[3];
+    for (int k = 0; k < 3; k++)
+        n[k] = (extent[k] - 1 + se - 1) / se; /* sub-blocks that hold cells */
+    double base[3] = {origin[0], origin[1], origin[2]};
+    dda d;
+    dda_init(&d, r, base, se, n, t0, t1);
+    for (;;) {
+        int32_t at[3] = {d.i[0], d.i[1], d.i[2]};
+        double enter_t = d.t, exit_t;
+        int more = dda_next(&d, &exit_t);
+        uint32_t sb = (uint32_t)at[0] + per * ((uint32_t)at[1] + per * (uint32_t)at[2]);
+        if (active(&ranges[2 * sb], s->iso)) {
+            uint32_t lo[3], hi[3], last[3];
+            for (int k = 0; k < 3; k++) {
+                lo[k] = origin[k] + se * (uint32_t)at[k];
+                last[k] = origin[k] + extent[k] - 1; /* one past the brick's last cell */
+                hi[k] = lo[k] + se < last[k] ? lo[k] + se : last[k];
+            }
+            int found = walk_cells(s, r, lo, hi, enter_t, exit_t);
+            if (found)
+                return found;
+        }
+        if (!more)
+            return 0;
+    }
+}
+
+typedef struct child_hit {
+    uint32_t node[3];
+    double t0, t1;
+} child_hit;
+
+/* Index box of octree node `node` at `depth` (depth 0: a brick). */
+static void node_box(const ip_seeder *s, uint32_t depth, const uint32_t node[3], double lo[3],
+                     double hi[3])
+{
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    for (int k = 0; k < 3; k++) {
+        uint64_t span = (uint64_t)s->layout->brick_edge << depth;
+        uint64_t a = node[k] * span, b = a + span, cells = lv->dims[k] - 1;
+        lo[k] = (double)a;
+        hi[k] = (double)(b < cells ? b : cells);
+    }
+}
+
+static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uint32_t node[3],
+                     double t0, double t1)
+{
+    if (depth == 0)
+        return walk_brick(s, r, node, t0, t1);
+    child_hit hits[8];
+    int count = 0;
+    const uint32_t *grid = s->grid[depth - 1];
+    const float *ranges = s->ranges[depth - 1];
+    for (int c = 0; c < 8; c++) {
+        uint32_t ch[3] = {2 * node[0] + (c & 1), 2 * node[1] + ((c >> 1) & 1),
+                          2 * node[2] + ((c >> 2) & 1)};
+        if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
+            continue;
+        uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
+        if (!active(&ranges[2 * i], s->iso))
+            continue;
+        double lo[3], hi[3], a = t0, b = t1;
+        node_box(s, depth - 1, ch, lo, hi);
+        if (!clip(r, lo, hi, &a, &b))
+            continue;
+        int at = count++;
+        while (at > 0 && hits[at - 1].t0 > a) { /* insertion sort: front to back */
+            hits[at] = hits[at - 1];
+            at--;
+        }
+        hits[at] = (child_hit){{ch[0], ch[1], ch[2]}, a, b};
+    }
+    for (int i = 0; i < count; i++) {
+        int found = walk_node(s, r, depth - 1, hits[i].node, hits[i].t0, hits[i].t1);
+        if (found)
+            return found;
+    }
+    return 0;
+}
+
+void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_angle)
+{
+    memset(s, 0, sizeof *s);
+    s->sampler = sampler;
+    s->store = ip_cache_store(sampler->cache);
+    s->layout = sampler->layout;
+    s->level = sampler->level;
+    s->iso = iso;
+    s->margin = IP_SEED_MARGIN_PIXELS * pixel_angle;
+    for (int k = 0; k < 3; k++)
+        s->scale[k] = s->layout->spacing[k] * (double)(1u << s->level);
+    /* The node grid and the first node's range of every depth, so that a child's range is
+     * one multiply-add away: each depth's nodes (depth 0: the level's bricks) are stored
+     * contiguously, x fastest (docs/format.md), and ip_store_node_range() would otherwise
+     * sum the grids of the shallower depths on every lookup. */
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    static const uint32_t origin[3] = {0, 0, 0};
+    for (uint32_t depth = 0; depth <= lv->octree_depth && depth <= IP_SEED_MAX_DEPTH; depth++) {
+        ip__octree_grid(s->layout, s->level, depth, s->grid[depth]);
+        s->ranges[depth] = ip_store_node_range(s->store, s->level, depth, origin);
+    }
+    s->first_brick = lv->first_brick;
+}
+
+int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
+                 double t_max, uint32_t cells[][3], unsigned *count, int *seed_index)
+{
+    s->found = cells;
+    s->found_count = 0;
+    s->seed_index = -1;
+    *count = 0;
+    *seed_index = -1;
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    uint32_t root[3] = {0, 0, 0};
+    uint32_t depth = lv->octree_depth;
+    if (!active(s->ranges[depth], s->iso))
+        return 0;
+    index_ray r;
+    for (int k = 0; k < 3; k++) {
+        r.origin[k] = eye[k] / s->scale[k];
+        r.dir[k] = dir[k] / s->scale[k];
+        r.inv_dir[k] = r.dir[k] != 0.0 ? 1.0 / r.dir[k] : 0.0;
+    }
+    r.len = fmax(fabs(r.dir[0]), fmax(fabs(r.dir[1]), fabs(r.dir[2])));
+    r.world_origin = eye;
+    r.world_dir = dir;
+    across_basis(dir, r.u, r.w);
+    double lo[3], hi[3], t0 = t_min, t1 = t_max;
+    node_box(s, depth, root, lo, hi);
+    if (!clip(&r, lo, hi, &t0, &t1))
+        return 0;
+    int found = walk_node(s, &r, depth, root, t0, t1);
+    if (found < 0)
+        return -1; /* a brick could not be read: the cells found so far may be wrong */
+    *count = s->found_count;
+    *seed_index = s->seed_index;
+    return found || s->seed_index >= 0;
+}

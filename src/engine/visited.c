@@ -1,0 +1,77 @@
+/* A sparse, concurrent bit set over the cells of every level. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "visited.h"
+
+ip_status ip__visited_init(ip_visited *v, const ip_layout *layout)
+{
+    memset(v, 0, sizeof *v);
+    v->layout = layout;
+    uint64_t b = layout->brick_edge;
+    v->words_per_brick = (b * b * b + 63) / 64;
+    v->bitmaps = calloc(layout->brick_count, sizeof *v->bitmaps);
+    atomic_init(&v->bytes, 0);
+    return v->bitmaps ? IP_OK : IP_ERR_NOMEM;
+}
+
+void ip__visited_clear(ip_visited *v)
+{
+    for (uint64_t g = 0; v->bitmaps && g < v->layout->brick_count; g++) {
+        atomic_uint_fast64_t *m = atomic_load(&v->bitmaps[g]);
+        if (m) {
+            free(m);
+            atomic_store(&v->bitmaps[g], NULL);
+        }
+    }
+    atomic_store(&v->bytes, 0);
+}
+
+void ip__visited_free(ip_visited *v)
+{
+    ip__visited_clear(v);
+    free(v->bitmaps);
+    v->bitmaps = NULL;
+}
+
+/* The brick of a cell and the cell's bit inside it. */
+static uint64_t locate(const ip_visited *v, uint32_t level, const uint32_t cell[3], uint64_t *bit)
+{
+    uint32_t b = v->layout->brick_edge, brick[3], local[3];
+    for (int a = 0; a < 3; a++) {
+        brick[a] = cell[a] / b;
+        local[a] = cell[a] - brick[a] * b;
+    }
+    *bit = local[0] + (uint64_t)b * (local[1] + (uint64_t)b * local[2]);
+    return ip_brick_global_index(v->layout, level, brick);
+}
+
+int ip__visited_mark(ip_visited *v, uint32_t level, const uint32_t cell[3])
+{
+    uint64_t bit, g = locate(v, level, cell, &bit);
+    atomic_uint_fast64_t *m = atomic_load_explicit(&v->bitmaps[g], memory_order_acquire);
+    if (!m) {
+        atomic_uint_fast64_t *fresh = calloc(v->words_per_brick, sizeof *fresh);
+        if (!fresh)
+            return -1;
+        atomic_uint_fast64_t *expected = NULL;
+        if (atomic_compare_exchange_strong(&v->bitmaps[g], &expected, fresh)) {
+            m = fresh;
+            atomic_fetch_add(&v->bytes, v->words_per_brick * sizeof *fresh);
+        } else {
+            free(fresh); /* another thread published first */
+            m = expected;
+        }
+    }
+    uint_fast64_t mask = (uint_fast64_t)1 << (bit & 63);
+    return (atomic_fetch_or(&m[bit >> 6], mask) & mask) != 0;
+}
+
+int ip__visited_test(const ip_visited *v, uint32_t level, const uint32_t cell[3])
+{
+    uint64_t bit, g = locate(v, level, cell, &bit);
+    atomic_uint_fast64_t *m = atomic_load_explicit(&v->bitmaps[g], memory_order_acquire);
+    if (!m)
+        return 0;
+    return (atomic_load_explicit(&m[bit >> 6], memory_order_relaxed) >> (bit & 63)) & 1;
+}

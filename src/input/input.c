@@ -1,0 +1,548 @@
+/* Describing an input volume: format dispatch, the NAME_XxYxZ_TYPE.raw convention, overrides,
+ * the checks made before any sample is read, and the helpers the header parsers share. */
+#include <ctype.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "input_headers.h"
+#include "internal.h"
+#include "isoprop/input.h"
+
+/* Dims at or above this are refused, as ip_dims_parse() refuses them, so that every volume
+ * a header or a name describes could also be described on the command line. */
+#define IP_INPUT_DIM_LIMIT (UINT64_C(1) << 31)
+
+typedef enum input_kind {
+    INPUT_RAW,
+    INPUT_NRRD,
+    INPUT_MHD
+} input_kind;
+
+static const char axis_names[3] = {'x', 'y', 'z'};
+
+static int has_suffix(const char *text, const char *suffix)
+{
+    size_t n = strlen(text), m = strlen(suffix);
+    return n >= m && strcasecmp(text + n - m, suffix) == 0;
+}
+
+static const char *base_name(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    return slash ? slash + 1 : path;
+}
+
+/* The extension decides the format: a raw file's bytes cannot be told from anything else. */
+static input_kind kind_of(const char *path)
+{
+    if (has_suffix(path, ".nrrd") || has_suffix(path, ".nhdr"))
+        return INPUT_NRRD;
+    if (has_suffix(path, ".mhd") || has_suffix(path, ".mha"))
+        return INPUT_MHD;
+    return INPUT_RAW;
+}
+
+/* ---- the raw naming convention ---- */
+
+/* 1 when text[0..len) is exactly DIGITS x DIGITS x DIGITS. */
+static int looks_like_dims(const char *text, size_t len)
+{
+    int digits = 0, separators = 0;
+    for (size_t i = 0; i < len; i++) {
+        if (isdigit((unsigned char)text[i])) {
+            digits++;
+        } else if ((text[i] == 'x' || text[i] == 'X') && digits > 0 && separators < 2) {
+            separators++;
+            digits = 0;
+        } else {
+            return 0;
+        }
+    }
+    return separators == 2 && digits > 0;
+}
+
+/* Parses a field that looks_like_dims() accepted; values too large for 64 bits saturate so
+ * that the range check in validate_dims() reports them. */
+static void parse_dims_field(const char *text, uint64_t dims[3])
+{
+    const char *p = text;
+    for (int axis = 0; axis < 3; axis++) {
+        uint64_t v = 0;
+        for (; isdigit((unsigned char)*p); p++)
+            v = v > UINT64_MAX / 16 ? UINT64_MAX : v * 10 + (uint64_t)(*p - '0');
+        dims[axis] = v;
+        p++; /* the 'x' */
+    }
+}
+
+/* Takes dims and type from a base name NAME_XxYxZ_TYPE.raw (NAME may hold underscores; the
+ * last two fields count). A name that does not follow the convention gives nothing; one that
+ * does but names an unknown type is an error unless the type is overridden. */
+static ip_status describe_from_name(const char *path, const ip_input_overrides *overrides,
+                                    ip_input_desc *desc, ip_text_found *found, ip_error *err)
+{
+    const char *base = base_name(path);
+    size_t len = strlen(base);
+    if (!has_suffix(base, ".raw"))
+        return IP_OK;
+    len -= 4;
+    const char *type_sep = memrchr(base, '_', len);
+    if (!type_sep)
+        return IP_OK;
+    size_t dims_end = (size_t)(type_sep - base);
+    const char *dims_sep = memrchr(base, '_', dims_end);
+    size_t dims_start = dims_sep ? (size_t)(dims_sep - base) + 1 : 0;
+    if (!looks_like_dims(base + dims_start, dims_end - dims_start))
+        return IP_OK;
+
+    if (!(overrides && overrides->has_dims)) {
+        parse_dims_field(base + dims_start, found->dims);
+        found->has_dims = 1;
+    }
+    if (!(overrides && overrides->has_type)) {
+        char type_text[64];
+        size_t type_len = len - dims_end - 1;
+        if (type_len >= sizeof type_text)
+            return ip__fail(err, IP_ERR_INPUT,
+                           "%s: unknown type '%.*s' in the file name (use uint8, uint16, int16 "
+                           "or float32)", path, (int)type_len, type_sep + 1);
+        memcpy(type_text, type_sep + 1, type_len);
+        type_text[type_len] = '\0';
+        if (ip_type_parse(type_text, &desc->type) != IP_OK)
+            return ip__fail(err, IP_ERR_INPUT,
+                           "%s: unknown type '%s' in the file name (use uint8, uint16, int16 "
+                           "or float32)", path, type_text);
+        found->has_type = 1;
+    }
+    return IP_OK;
+}
+
+/* ---- overrides and checks ---- */
+
+static void set_defaults(ip_input_desc *desc, const char *path)
+{
+    memset(desc, 0, sizeof *desc);
+    snprintf(desc->path, sizeof desc->path, "%s", path);
+    snprintf(desc->data_path, sizeof desc->data_path, "%s", path);
+    desc->type = IP_UINT8;
+    desc->encoding = IP_ENCODING_RAW;
+    for (int axis = 0; axis < 3; axis++)
+        desc->spacing[axis] = 1.0;
+}
+
+static ip_status apply_overrides(const ip_input_overrides *overrides, ip_input_desc *desc,
+                                 ip_text_found *found, ip_error *err)
+{
+    if (!overrides)
+        return IP_OK;
+    if (overrides->has_dims) {
+        for (int axis = 0; axis < 3; axis++)
+            found->dims[axis] = overrides->dims[axis];
+        found->has_dims = 1;
+    }
+    if (overrides->has_type) {
+        if (ip_type_size(overrides->type) == 0)
+            return ip__fail(err, IP_ERR_ARGUMENT, "%s: unknown type %d in the overrides",
+                           desc->path, (int)overrides->type);
+        desc->type = overrides->type;
+        found->has_type = 1;
+    }
+    if (overrides->has_endian)
+        desc->big_endian = overrides->big_endian ? 1 : 0;
+    if (overrides->has_spacing) {
+        for (int axis = 0; axis < 3; axis++)
+            desc->spacing[axis] = overrides->spacing[axis];
+    }
+    return IP_OK;
+}
+
+static ip_status validate_dims(ip_input_desc *desc, const ip_text_found *found,
+                               ip_error *err)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        uint64_t n = found->dims[axis];
+        if (n < 2)
+            return ip__fail(err, IP_ERR_INPUT, "%s: dimension %llu along %c is under 2",
+                           desc->path, (unsigned long long)n, axis_names[axis]);
+        if (n >= IP_INPUT_DIM_LIMIT)
+            return ip__fail(err, IP_ERR_INPUT,
+                           "%s: dimension %llu along %c is too large (the limit is %llu)",
+                           desc->path, (unsigned long long)n, axis_names[axis],
+                           (unsigned long long)(IP_INPUT_DIM_LIMIT - 1));
+        desc->dims[axis] = (uint32_t)n;
+    }
+    return IP_OK;
+}
+
+static ip_status validate_spacing(const ip_input_desc *desc, ip_error *err)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        double s = desc->spacing[axis];
+        if (!isfinite(s) || s <= 0.0)
+            return ip__fail(err, IP_ERR_INPUT, "%s: spacing %g along %c is not a positive number",
+                           desc->path, s, axis_names[axis]);
+    }
+    /* a positive spacing can still be one that nothing downstream renders correctly */
+    return ip_spacing_check(desc->spacing, desc->path, err);
+}
+
+/* dims x type size in bytes; a product past 63 bits (file offsets are signed) is an error. */
+static ip_status data_bytes(const ip_input_desc *desc, uint64_t *out, ip_error *err)
+{
+    const uint64_t limit = (uint64_t)INT64_MAX;
+    uint64_t bytes = ip_type_size(desc->type);
+    for (int axis = 0; axis < 3; axis++) {
+        if (bytes > limit / desc->dims[axis])
+            return ip__fail(err, IP_ERR_INPUT,
+                           "%s: %ux%ux%u samples of %s are more than 2^63 bytes", desc->path,
+                           desc->dims[0], desc->dims[1], desc->dims[2],
+                           ip_type_name(desc->type));
+        bytes *= desc->dims[axis];
+    }
+    *out = bytes;
+    return IP_OK;
+}
+
+/* Names the data file in messages: the path alone, or the header and then its data file. */
+static void data_label(const ip_input_desc *desc, char *out, size_t size)
+{
+    if (strcmp(desc->path, desc->data_path) == 0)
+        snprintf(out, size, "%s", desc->path);
+    else
+        snprintf(out, size, "%s: data file %s", desc->path, desc->data_path);
+}
+
+static ip_status size_mismatch(const ip_input_desc *desc, const char *label, uint64_t file_size,
+                               uint64_t bytes, ip_error *err)
+{
+    size_t sample = ip_type_size(desc->type);
+    const char *unit = sample == 1 ? "byte" : "bytes";
+    if (desc->data_offset == 0)
+        return ip__fail(err, IP_ERR_INPUT,
+                       "%s: file size %llu bytes does not equal %ux%ux%u x %zu %s = %llu bytes",
+                       label, (unsigned long long)file_size, desc->dims[0], desc->dims[1],
+                       desc->dims[2], sample, unit, (unsigned long long)bytes);
+    return ip__fail(err, IP_ERR_INPUT,
+                   "%s: data size %llu bytes (file size %llu - offset %llu) does not equal "
+                   "%ux%ux%u x %zu %s = %llu bytes",
+                   label, (unsigned long long)(file_size - desc->data_offset),
+                   (unsigned long long)file_size, (unsigned long long)desc->data_offset,
+                   desc->dims[0], desc->dims[1], desc->dims[2], sample, unit,
+                   (unsigned long long)bytes);
+}
+
+/* Opens the data file (so that a missing or unreadable one is caught now), places data that
+ * sit at the end of the file, and checks the size of raw data exactly. Gzip data cannot be
+ * measured without inflating them; the reader checks their length. */
+static ip_status check_data_file(ip_input_desc *desc, int data_at_end, uint64_t bytes,
+                                 ip_error *err)
+{
+    char label[2 * IP_PATH_MAX + 16];
+    struct stat st;
+    data_label(desc, label, sizeof label);
+    /* O_NONBLOCK: naming a FIFO must fail below, not hang waiting for a writer. */
+    int fd = open(desc->data_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", label);
+    int stat_failed = fstat(fd, &st) != 0;
+    int stat_errno = errno;
+    close(fd);
+    if (stat_failed)
+        return ip__fail_errno(err, IP_ERR_IO, stat_errno, "%s: cannot stat", label);
+    if (!S_ISREG(st.st_mode))
+        return ip__fail(err, IP_ERR_INPUT, "%s: not a regular file", label);
+    uint64_t file_size = (uint64_t)st.st_size;
+
+    if (data_at_end) {
+        if (file_size < bytes)
+            return ip__fail(err, IP_ERR_INPUT,
+                           "%s: file size %llu bytes is under the %ux%ux%u x %zu = %llu bytes "
+                           "of data", label, (unsigned long long)file_size, desc->dims[0],
+                           desc->dims[1], desc->dims[2], ip_type_size(desc->type),
+                           (unsigned long long)bytes);
+        desc->data_offset = file_size - bytes;
+        return IP_OK;
+    }
+    if (desc->encoding == IP_ENCODING_GZIP) {
+        if (desc->data_offset >= file_size)
+            return ip__fail(err, IP_ERR_INPUT,
+                           "%s: no gzip data: the data offset %llu is at or past the end of "
+                           "the file (%llu bytes)", label,
+                           (unsigned long long)desc->data_offset,
+                           (unsigned long long)file_size);
+        return IP_OK;
+    }
+    if (desc->data_offset > file_size)
+        return ip__fail(err, IP_ERR_INPUT,
+                       "%s: the data offset %llu is past the end of the file (%llu bytes)",
+                       label, (unsigned long long)desc->data_offset,
+                       (unsigned long long)file_size);
+    if (file_size - desc->data_offset != bytes)
+        return size_mismatch(desc, label, file_size, bytes, err);
+    return IP_OK;
+}
+
+/* Only a raw file gets here without dims or type: the header parsers report their missing
+ * fields themselves. */
+static ip_status require_layout(const ip_input_desc *desc, const ip_text_found *found,
+                                ip_error *err)
+{
+    if (found->has_dims && found->has_type)
+        return IP_OK;
+    return ip__fail(err, IP_ERR_INPUT,
+                   "%s: cannot tell dims and type: name it NAME_XxYxZ_TYPE.raw or pass --dims "
+                   "and --type", desc->path);
+}
+
+static ip_status read_layout(const char *path, const ip_input_overrides *overrides,
+                             ip_input_desc *desc, ip_text_found *found, ip_error *err)
+{
+    struct stat st;
+    switch (kind_of(path)) {
+    case INPUT_NRRD: return ip__nrrd_read_header(path, overrides, desc, found, err);
+    case INPUT_MHD: return ip__mhd_read_header(path, overrides, desc, found, err);
+    case INPUT_RAW: break;
+    }
+    /* A mistyped path should say so, not complain about the name. */
+    if (stat(path, &st) != 0)
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
+    return describe_from_name(path, overrides, desc, found, err);
+}
+
+ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
+                            ip_input_desc *out, ip_error *err)
+{
+    ip_text_found found;
+    ip_input_desc desc;
+    ip_status status;
+    uint64_t bytes = 0;
+    if (!path || !out)
+        return ip__fail(err, IP_ERR_ARGUMENT, "ip_input_describe: path and out are required");
+    if (path[0] == '\0' || strlen(path) >= IP_PATH_MAX)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%.64s: path is empty or too long", path);
+    memset(&found, 0, sizeof found);
+    set_defaults(&desc, path);
+    if ((status = read_layout(path, overrides, &desc, &found, err)) != IP_OK ||
+        (status = apply_overrides(overrides, &desc, &found, err)) != IP_OK ||
+        (status = require_layout(&desc, &found, err)) != IP_OK ||
+        (status = validate_dims(&desc, &found, err)) != IP_OK ||
+        (status = validate_spacing(&desc, err)) != IP_OK ||
+        (status = data_bytes(&desc, &bytes, err)) != IP_OK ||
+        (status = check_data_file(&desc, found.data_at_end, bytes, err)) != IP_OK)
+        return status;
+    *out = desc;
+    return IP_OK;
+}
+
+/* ---- helpers shared by the header parsers ---- */
+
+ip_status ip__text_open(ip_text_file *header, const char *path, ip_error *err)
+{
+    struct stat st;
+    memset(header, 0, sizeof *header);
+    header->path = path;
+    /* O_NONBLOCK: a FIFO must be refused below, not hang the caller waiting for a writer. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
+    if (fstat(fd, &st) != 0) {
+        int e = errno;
+        close(fd);
+        return ip__fail_errno(err, IP_ERR_IO, e, "%s: cannot stat", path);
+    }
+    if (!S_ISREG(st.st_mode)) {
+        close(fd);
+        return ip__fail(err, IP_ERR_INPUT, "%s: not a regular file", path);
+    }
+    header->file = fdopen(fd, "rb");
+    if (!header->file) {
+        int e = errno;
+        close(fd);
+        return ip__fail_errno(err, IP_ERR_NOMEM, e, "%s: cannot read", path);
+    }
+    return IP_OK;
+}
+
+static ip_status grow_line(ip_text_file *header, ip_error *err)
+{
+    if (header->capacity > IP_TEXT_LINE_MAX)
+        return ip__fail(err, IP_ERR_INPUT, "%s: header line %lu is longer than %d bytes",
+                       header->path, header->line_number + 1, IP_TEXT_LINE_MAX);
+    size_t capacity = header->capacity ? header->capacity * 2 : 256;
+    if (capacity > IP_TEXT_LINE_MAX + 1)
+        capacity = IP_TEXT_LINE_MAX + 1;
+    char *line = realloc(header->line, capacity);
+    if (!line)
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading the header", header->path);
+    header->line = line;
+    header->capacity = capacity;
+    return IP_OK;
+}
+
+ip_status ip__text_next_line(ip_text_file *header, int *got, ip_error *err)
+{
+    size_t len = 0;
+    int c = EOF;
+    ip_status status;
+    *got = 0;
+    if (!header->line && (status = grow_line(header, err)) != IP_OK)
+        return status;
+    while ((c = getc(header->file)) != EOF) {
+        header->offset++;
+        if (c == '\n')
+            break;
+        if (c == '\0')
+            return ip__fail(err, IP_ERR_INPUT, "%s: header line %lu holds a NUL byte",
+                           header->path, header->line_number + 1);
+        if (len + 1 >= header->capacity && (status = grow_line(header, err)) != IP_OK)
+            return status;
+        header->line[len++] = (char)c;
+    }
+    if (c == EOF && ferror(header->file))
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot read the header", header->path);
+    if (c == EOF && len == 0)
+        return IP_OK;
+    if (len > 0 && header->line[len - 1] == '\r')
+        len--;
+    header->line[len] = '\0';
+    header->line_number++;
+    *got = 1;
+    return IP_OK;
+}
+
+void ip__text_close(ip_text_file *header)
+{
+    if (header->file)
+        fclose(header->file);
+    free(header->line);
+    memset(header, 0, sizeof *header);
+}
+
+char *ip__text_trim(char *text)
+{
+    while (isspace((unsigned char)*text))
+        text++;
+    size_t len = strlen(text);
+    while (len > 0 && isspace((unsigned char)text[len - 1]))
+        text[--len] = '\0';
+    return text;
+}
+
+ip_status ip__text_data_path(const char *header_path, const char *name, char out[IP_PATH_MAX],
+                              ip_error *err)
+{
+    int n;
+    if (name[0] == '\0')
+        return ip__fail(err, IP_ERR_INPUT, "%s: the data file name is empty", header_path);
+    if (name[0] == '/') {
+        n = snprintf(out, IP_PATH_MAX, "%s", name);
+    } else {
+        const char *slash = strrchr(header_path, '/');
+        int folder_len = slash ? (int)(slash - header_path) + 1 : 0;
+        n = snprintf(out, IP_PATH_MAX, "%.*s%s", folder_len, header_path, name);
+    }
+    if (n < 0 || n >= IP_PATH_MAX)
+        return ip__fail(err, IP_ERR_INPUT, "%s: the data file path is too long", header_path);
+    return IP_OK;
+}
+
+int ip__text_parse_i64(const char *text, int64_t *out)
+{
+    char *end;
+    while (isspace((unsigned char)*text))
+        text++;
+    if (!isdigit((unsigned char)*text) && !(*text == '-' && isdigit((unsigned char)text[1])))
+        return -1;
+    errno = 0;
+    long long v = strtoll(text, &end, 10);
+    if (errno != 0)
+        return -1;
+    while (isspace((unsigned char)*end))
+        end++;
+    if (*end != '\0')
+        return -1;
+    *out = (int64_t)v;
+    return 0;
+}
+
+int ip__text_parse_bool(const char *text, int *out)
+{
+    char buf[8];
+    int n = snprintf(buf, sizeof buf, "%s", text);
+    if (n < 0 || (size_t)n >= sizeof buf)
+        return -1;
+    char *word = ip__text_trim(buf);
+    if (strcasecmp(word, "true") == 0 || strcmp(word, "1") == 0) {
+        *out = 1;
+        return 0;
+    }
+    if (strcasecmp(word, "false") == 0 || strcmp(word, "0") == 0) {
+        *out = 0;
+        return 0;
+    }
+    return -1;
+}
+
+int ip__text_parse_u64_list(const char *text, uint64_t *values, int max, int *count)
+{
+    const char *p = text;
+    *count = 0;
+    for (;;) {
+        while (isspace((unsigned char)*p))
+            p++;
+        if (*p == '\0')
+            return 0;
+        if (!isdigit((unsigned char)*p))
+            return -1;
+        char *end;
+        errno = 0;
+        unsigned long long v = strtoull(p, &end, 10);
+        if (errno != 0 || (*end != '\0' && !isspace((unsigned char)*end)))
+            return -1;
+        if (*count < max)
+            values[*count] = (uint64_t)v;
+        (*count)++;
+        p = end;
+    }
+}
+
+int ip__text_parse_double_list(const char *text, double *values, int max, int *count)
+{
+    const char *p = text;
+    *count = 0;
+    for (;;) {
+        while (isspace((unsigned char)*p))
+            p++;
+        if (*p == '\0')
+            return 0;
+        char *end;
+        double v = strtod(p, &end);
+        if (end == p || (*end != '\0' && !isspace((unsigned char)*end)))
+            return -1;
+        if (*count < max)
+            values[*count] = v;
+        (*count)++;
+        p = end;
+    }
+}
+
+int ip__text_overridden(ip_text_owner by, const ip_input_overrides *overrides)
+{
+    if (!overrides)
+        return 0;
+    switch (by) {
+    case BY_NOTHING: return 0;
+    case BY_DIMS: return overrides->has_dims;
+    case BY_TYPE: return overrides->has_type;
+    case BY_ENDIAN: return overrides->has_endian;
+    case BY_SPACING: return overrides->has_spacing;
+    }
+    return 0;
+}

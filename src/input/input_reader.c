@@ -1,0 +1,343 @@
+/* Streaming z-planes out of an input volume: positioned reads for raw data, zlib's inflate for
+ * gzip (and zlib) streams, then conversion to the host's byte order and a float32 check. */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include "atomic_file.h"
+#include "internal.h"
+#include "isoprop/input.h"
+
+/* Compressed bytes read per refill: small next to a plane, large enough for few system calls. */
+#define GZIP_INPUT_CHUNK ((size_t)256 * 1024)
+/* zlib counts output space in uInt; larger reads are inflated in pieces of this size. */
+#define GZIP_OUTPUT_STEP ((size_t)1 << 30)
+/* 15-bit window, +32: inflate recognises both the gzip and the zlib wrapper. */
+#define GZIP_WINDOW_BITS (15 + 32)
+
+struct ip_input_reader {
+    ip_input_desc desc;
+    char label[2 * IP_PATH_MAX + 16]; /* how messages name the data */
+    int fd;
+    uint32_t next_z;
+    size_t sample_size;
+    uint64_t plane_bytes;
+    uint64_t total_bytes;
+    ip_status failed; /* sticky: after an error the position in the data is unknown */
+    /* gzip only */
+    z_stream zs;
+    int zs_live;
+    int stream_ended;
+    int file_eof;
+    unsigned char *in_buf;
+    uint64_t file_pos;
+    uint64_t produced;
+};
+
+static void set_label(ip_input_reader *r)
+{
+    const ip_input_desc *d = &r->desc;
+    if (strcmp(d->path, d->data_path) == 0)
+        snprintf(r->label, sizeof r->label, "%s", d->path);
+    else
+        snprintf(r->label, sizeof r->label, "%s: data file %s", d->path, d->data_path);
+}
+
+/* Sizes are checked against 64 bits here as well as in ip_input_describe(), since a caller
+ * may fill a desc by hand. */
+static ip_status measure(ip_input_reader *r, ip_error *err)
+{
+    const ip_input_desc *d = &r->desc;
+    r->sample_size = ip_type_size(d->type);
+    if (r->sample_size == 0 || d->dims[0] < 1 || d->dims[1] < 1 || d->dims[2] < 1)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: the description has no type or dims",
+                       d->path);
+    uint64_t plane = (uint64_t)d->dims[0] * d->dims[1];
+    if (plane > UINT64_MAX / r->sample_size / d->dims[2])
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: %ux%ux%u samples overflow 64 bits", d->path,
+                       d->dims[0], d->dims[1], d->dims[2]);
+    r->plane_bytes = plane * r->sample_size;
+    r->total_bytes = r->plane_bytes * d->dims[2];
+    if (r->plane_bytes > SIZE_MAX)
+        return ip__fail(err, IP_ERR_NOMEM, "%s: a plane of %llu bytes does not fit in memory",
+                       d->path, (unsigned long long)r->plane_bytes);
+    return IP_OK;
+}
+
+static ip_status start_gzip(ip_input_reader *r, ip_error *err)
+{
+    r->in_buf = malloc(GZIP_INPUT_CHUNK);
+    if (!r->in_buf)
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the gzip input", r->label);
+    int ret = inflateInit2(&r->zs, GZIP_WINDOW_BITS);
+    if (ret == Z_MEM_ERROR)
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the gzip decoder", r->label);
+    if (ret != Z_OK)
+        return ip__fail(err, IP_ERR_IO, "%s: cannot start the gzip decoder (zlib error %d)",
+                       r->label, ret);
+    r->zs_live = 1;
+    r->file_pos = r->desc.data_offset;
+    return IP_OK;
+}
+
+ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_error *err)
+{
+    ip_status status;
+    if (!desc || !out)
+        return ip__fail(err, IP_ERR_ARGUMENT, "ip_input_open: desc and out are required");
+    *out = NULL;
+    ip_input_reader *r = calloc(1, sizeof *r);
+    if (!r)
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the reader", desc->path);
+    r->desc = *desc;
+    r->fd = -1;
+    set_label(r);
+    if ((status = measure(r, err)) != IP_OK) {
+        ip_input_close(r);
+        return status;
+    }
+    /* O_NONBLOCK and the type check: the file may have been replaced by a FIFO or a device
+     * since ip_input_describe() looked at it; reading one would hang or never end. */
+    r->fd = open(desc->data_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (r->fd < 0) {
+        status = ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", r->label);
+        ip_input_close(r);
+        return status;
+    }
+    struct stat st;
+    if (fstat(r->fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        status = ip__fail(err, IP_ERR_INPUT, "%s: not a regular file", r->label);
+        ip_input_close(r);
+        return status;
+    }
+    /* Planes are read once, front to back: a hint for read-ahead, harmless if ignored. */
+    (void)posix_fadvise(r->fd, 0, 0, POSIX_FADV_SEQUENTIAL);
+    if (desc->encoding == IP_ENCODING_GZIP && (status = start_gzip(r, err)) != IP_OK) {
+        ip_input_close(r);
+        return status;
+    }
+    *out = r;
+    return IP_OK;
+}
+
+void ip_input_close(ip_input_reader *reader)
+{
+    if (!reader)
+        return;
+    if (reader->zs_live)
+        inflateEnd(&reader->zs);
+    if (reader->fd >= 0)
+        close(reader->fd);
+    free(reader->in_buf);
+    free(reader);
+}
+
+/* ---- gzip ---- */
+
+/* Moves unread input to the front of the buffer and tops it up from the file. */
+static ip_status gzip_refill(ip_input_reader *r, ip_error *err)
+{
+    size_t kept = r->zs.avail_in;
+    if (kept > 0 && r->zs.next_in != r->in_buf)
+        memmove(r->in_buf, r->zs.next_in, kept);
+    r->zs.next_in = r->in_buf;
+    if (r->file_eof || kept == GZIP_INPUT_CHUNK)
+        return IP_OK;
+    ssize_t n;
+    do {
+        n = pread(r->fd, r->in_buf + kept, GZIP_INPUT_CHUNK - kept, (off_t)r->file_pos);
+    } while (n < 0 && errno == EINTR);
+    if (n < 0)
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: read failed", r->label);
+    if (n == 0)
+        r->file_eof = 1;
+    r->zs.avail_in = (uInt)(kept + (size_t)n);
+    r->file_pos += (uint64_t)n;
+    return IP_OK;
+}
+
+/* After one member another may follow (concatenated gzip files are valid gzip); anything else
+ * after the compressed data means the file is not what its header says. */
+static ip_status gzip_member_end(ip_input_reader *r, ip_error *err)
+{
+    ip_status status;
+    if (r->zs.avail_in < 2 && (status = gzip_refill(r, err)) != IP_OK)
+        return status;
+    if (r->zs.avail_in == 0) {
+        r->stream_ended = 1;
+        return IP_OK;
+    }
+    if (r->zs.avail_in >= 2 && r->zs.next_in[0] == 0x1f && r->zs.next_in[1] == 0x8b) {
+        inflateReset(&r->zs);
+        return IP_OK;
+    }
+    return ip__fail(err, IP_ERR_INPUT, "%s: unexpected bytes after the end of the gzip data",
+                   r->label);
+}
+
+/* Inflates once into out[0..avail). *made counts the bytes produced; *starved is set when the
+ * file ends inside the compressed stream. */
+static ip_status gzip_step(ip_input_reader *r, unsigned char *out, size_t avail, size_t *made,
+                           int *starved, ip_error *err)
+{
+    ip_status status;
+    *made = 0;
+    *starved = 0;
+    if (r->zs.avail_in == 0) {
+        if ((status = gzip_refill(r, err)) != IP_OK)
+            return status;
+        if (r->zs.avail_in == 0) {
+            *starved = 1;
+            return IP_OK;
+        }
+    }
+    uInt space = (uInt)(avail < GZIP_OUTPUT_STEP ? avail : GZIP_OUTPUT_STEP);
+    r->zs.next_out = out;
+    r->zs.avail_out = space;
+    int ret = inflate(&r->zs, Z_NO_FLUSH);
+    *made = space - r->zs.avail_out;
+    r->produced += *made;
+    switch (ret) {
+    case Z_OK: return IP_OK;
+    case Z_STREAM_END: return gzip_member_end(r, err);
+    case Z_BUF_ERROR:
+        /* No progress with input and output space left cannot happen; refuse to spin. */
+        if (r->zs.avail_in == 0 || *made > 0)
+            return IP_OK;
+        break;
+    case Z_MEM_ERROR:
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory inflating gzip data", r->label);
+    default: break;
+    }
+    return ip__fail(err, IP_ERR_INPUT, "%s: gzip data are corrupt after %llu bytes: %s", r->label,
+                   (unsigned long long)r->produced, r->zs.msg ? r->zs.msg : "invalid data");
+}
+
+static ip_status gzip_ends_early(const ip_input_reader *r, ip_error *err)
+{
+    return ip__fail(err, IP_ERR_INPUT, "%s: gzip data ends after %llu of %llu bytes", r->label,
+                   (unsigned long long)r->produced, (unsigned long long)r->total_bytes);
+}
+
+static ip_status gzip_read(ip_input_reader *r, unsigned char *dst, size_t size, ip_error *err)
+{
+    size_t done = 0;
+    while (done < size) {
+        size_t made;
+        int starved;
+        if (r->stream_ended)
+            return gzip_ends_early(r, err);
+        ip_status status = gzip_step(r, dst + done, size - done, &made, &starved, err);
+        if (status != IP_OK)
+            return status;
+        done += made;
+        if (starved)
+            return gzip_ends_early(r, err);
+    }
+    return IP_OK;
+}
+
+/* After the last plane the stream must end: one more byte means the dims are wrong. */
+static ip_status gzip_finish(ip_input_reader *r, ip_error *err)
+{
+    unsigned char scratch[4096];
+    while (!r->stream_ended) {
+        size_t made;
+        int starved;
+        ip_status status = gzip_step(r, scratch, sizeof scratch, &made, &starved, err);
+        if (status != IP_OK)
+            return status;
+        if (made > 0)
+            return ip__fail(err, IP_ERR_INPUT,
+                           "%s: gzip data are longer than the %ux%ux%u x %zu = %llu bytes of the "
+                           "dims", r->label, r->desc.dims[0], r->desc.dims[1], r->desc.dims[2],
+                           r->sample_size, (unsigned long long)r->total_bytes);
+        if (starved)
+            return ip__fail(err, IP_ERR_INPUT,
+                           "%s: gzip data end without their end marker after all %llu bytes",
+                           r->label, (unsigned long long)r->total_bytes);
+    }
+    return IP_OK;
+}
+
+/* ---- samples ---- */
+
+static void to_host_order(const ip_input_reader *r, void *samples, size_t count)
+{
+    int host_big = !ip__host_little_endian();
+    if (r->sample_size > 1 && (r->desc.big_endian != 0) != host_big)
+        ip__swap_bytes(samples, count, r->sample_size);
+}
+
+/* NaN and infinity have no place in an isosurface's scalar field; name the first one. */
+static ip_status check_finite(const ip_input_reader *r, const void *samples, size_t count,
+                              ip_error *err)
+{
+    const unsigned char *p = samples;
+    const uint32_t exponent = 0x7f800000u;
+    for (size_t i = 0; i < count; i++) {
+        uint32_t bits;
+        memcpy(&bits, p + 4 * i, sizeof bits);
+        if ((bits & exponent) != exponent)
+            continue;
+        uint64_t plane = (uint64_t)r->desc.dims[0] * r->desc.dims[1];
+        unsigned x = (unsigned)(i % r->desc.dims[0]);
+        unsigned y = (unsigned)((i / r->desc.dims[0]) % r->desc.dims[1]);
+        unsigned long long z = r->next_z + i / plane;
+        return ip__fail(err, IP_ERR_INPUT, "%s: float32 sample at (x,y,z) = (%u,%u,%llu) is %s",
+                       r->label, x, y, z, (bits & 0x007fffffu) ? "NaN" : "infinite");
+    }
+    return IP_OK;
+}
+
+static ip_status read_samples(ip_input_reader *r, void *dst, uint32_t count, ip_error *err)
+{
+    uint64_t bytes = (uint64_t)count * r->plane_bytes;
+    ip_status status;
+    if (bytes > SIZE_MAX)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: %u planes are too many to read at once",
+                       r->label, count);
+    if (r->desc.encoding == IP_ENCODING_GZIP) {
+        status = gzip_read(r, dst, (size_t)bytes, err);
+        if (status == IP_OK && r->next_z + count == r->desc.dims[2])
+            status = gzip_finish(r, err);
+    } else {
+        uint64_t offset = r->desc.data_offset + (uint64_t)r->next_z * r->plane_bytes;
+        status = ip__pread_all(r->fd, dst, (size_t)bytes, offset, r->desc.data_path, err);
+    }
+    if (status != IP_OK)
+        return status;
+    size_t samples = (size_t)(bytes / r->sample_size);
+    to_host_order(r, dst, samples);
+    if (r->desc.type == IP_FLOAT32)
+        return check_finite(r, dst, samples, err);
+    return IP_OK;
+}
+
+ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count,
+                               ip_error *err)
+{
+    if (!reader || (!dst && count > 0))
+        return ip__fail(err, IP_ERR_ARGUMENT, "ip_input_read_planes: reader and dst are required");
+    if (reader->failed != IP_OK)
+        return ip__fail(err, reader->failed, "%s: the reader stopped at an earlier error",
+                       reader->label);
+    if (count > reader->desc.dims[2] - reader->next_z)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                       "%s: cannot read %u planes from z = %u: the volume has %u planes",
+                       reader->label, count, reader->next_z, reader->desc.dims[2]);
+    if (count == 0)
+        return IP_OK;
+    ip_status status = read_samples(reader, dst, count, err);
+    if (status != IP_OK) {
+        reader->failed = status;
+        return status;
+    }
+    reader->next_z += count;
+    return IP_OK;
+}

@@ -1,0 +1,411 @@
+/* The software reference rasterizer: exact coverage, depth and shading of a mesh, no GPU. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "isoprop/render.h"
+
+/* Vertices snap to 1/256 pixel, as GPUs do; edge functions are then exact 64-bit integers, so
+ * two triangles sharing an edge agree on every pixel centre. Clipping to a guard band keeps
+ * snapped coordinates within 2^20 pixels of the image, so products of coordinate differences
+ * stay below 2^60. */
+enum { SUBPIXEL_BITS = 8, MAX_SIDE = 65536, MAX_POLYGON = 9, PLANE_COUNT = 6 };
+#define SUBPIXEL ((int64_t)1 << SUBPIXEL_BITS)
+#define GUARD_PIXELS 1048576.0
+
+void ip_shading_default(ip_shading *s)
+{
+    static const ip_shading defaults = {
+        .surface = {0.93f, 0.89f, 0.79f},
+        .ambient = 0.12f,
+        .diffuse = 0.80f,
+        .specular = 0.12f,
+        .shininess = 32.0f,
+        .background_top = {0.24f, 0.27f, 0.34f},
+        .background_bottom = {0.08f, 0.09f, 0.13f},
+    };
+    *s = defaults;
+}
+
+static uint8_t to_unorm8(double v)
+{
+    v = v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v;
+    return (uint8_t)floor(v * 255.0 + 0.5);
+}
+
+static void shade_background(const ip_shading *s, uint32_t row, uint32_t height, uint8_t out[4])
+{
+    double t = (row + 0.5) / height;
+    for (int i = 0; i < 3; i++)
+        out[i] = to_unorm8(s->background_top[i] + t * (s->background_bottom[i] -
+                                                         (double)s->background_top[i]));
+    out[3] = 255;
+}
+
+/* n: the interpolated normal (any length); v: the unit vector toward the eye. */
+static void shade_surface(const ip_shading *s, const float n[3], const double v[3],
+                          uint8_t out[4])
+{
+    double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+    double c = 1.0;
+    if (len > 1e-12)
+        c = fmin(1.0, fabs(n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / len);
+    double light = s->ambient + s->diffuse * c, highlight = s->specular * pow(c, s->shininess);
+    for (int i = 0; i < 3; i++)
+        out[i] = to_unorm8(s->surface[i] * light + highlight);
+    out[3] = 255;
+}
+
+/* A vertex in view space: x right, y up, z the depth along the view direction (world units);
+ * the normal stays in world space. */
+typedef struct view_vertex {
+    double p[3];
+    double n[3];
+} view_vertex;
+
+typedef struct raster_view {
+    ip_camera_basis basis;
+    double eye[3];
+    double near_plane, far_plane;
+    double guard_x, guard_y; /* the guard band as bounds on x / z and y / z */
+    double width, height;
+} raster_view;
+
+typedef struct raster_target {
+    uint32_t width, height;
+    double *inverse_depth; /* 1 / view depth of the nearest surface; 0 where empty */
+    uint32_t *index;
+    float *normal;         /* 3 per pixel, or NULL when no image is wanted */
+} raster_target;
+
+static void setup_view(raster_view *v, const ip_camera *c, const double lo[3], const double hi[3])
+{
+    ip_camera_basis_of(c, &v->basis);
+    memcpy(v->eye, c->eye, sizeof v->eye);
+    ip_camera_depth_range(c, lo, hi, &v->near_plane, &v->far_plane);
+    v->width = c->width;
+    v->height = c->height;
+    double side = c->width > c->height ? c->width : c->height;
+    v->guard_x = GUARD_PIXELS / side * v->basis.tan_half_x;
+    v->guard_y = GUARD_PIXELS / side * v->basis.tan_half_y;
+}
+
+static void to_view(const raster_view *v, const float *p, const int16_t *n, view_vertex *out)
+{
+    double d[3] = {p[0] - v->eye[0], p[1] - v->eye[1], p[2] - v->eye[2]};
+    const double *r = v->basis.right, *u = v->basis.up, *f = v->basis.forward;
+    out->p[0] = d[0] * r[0] + d[1] * r[1] + d[2] * r[2];
+    out->p[1] = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
+    out->p[2] = d[0] * f[0] + d[1] * f[1] + d[2] * f[2];
+    for (int i = 0; i < 3; i++)
+        out->n[i] = ip_normal_unpack(n[i]);
+}
+
+/* Signed distance-like value of a vertex to clip plane k; inside when >= 0. */
+static double plane_value(const raster_view *v, int k, const view_vertex *a)
+{
+    const double *p = a->p;
+    switch (k) {
+    case 0: return p[2] - v->near_plane;
+    case 1: return v->far_plane - p[2];
+    case 2: return p[0] + v->guard_x * p[2];
+    case 3: return v->guard_x * p[2] - p[0];
+    case 4: return p[1] + v->guard_y * p[2];
+    default: return v->guard_y * p[2] - p[1];
+    }
+}
+
+/* The point where edge (a, b) crosses plane k. Computed from the inside end toward the
+ * outside one, so both triangles sharing the edge get the same point. */
+static view_vertex crossing(const view_vertex *a, double da, const view_vertex *b, double db)
+{
+    if (da < 0) {
+        const view_vertex *t = a;
+        double dt = da;
+        a = b, da = db, b = t, db = dt;
+    }
+    double t = da / (da - db);
+    view_vertex out;
+    for (int i = 0; i < 3; i++) {
+        out.p[i] = a->p[i] + t * (b->p[i] - a->p[i]);
+        out.n[i] = a->n[i] + t * (b->n[i] - a->n[i]);
+    }
+    return out;
+}
+
+/* Sutherland-Hodgman against one plane; returns the new vertex count. */
+static int clip_polygon(const raster_view *v, int k, const view_vertex *in, int count,
+                        view_vertex *out)
+{
+    int n = 0;
+    for (int i = 0; i < count; i++) {
+        const view_vertex *a = &in[i], *b = &in[(i + 1) % count];
+        double da = plane_value(v, k, a), db = plane_value(v, k, b);
+        if (da >= 0)
+            out[n++] = *a;
+        if ((da >= 0) != (db >= 0))
+            out[n++] = crossing(a, da, b, db);
+    }
+    return n;
+}
+
+typedef struct screen_vertex {
+    int64_t x, y;         /* pixels * SUBPIXEL, top-left origin */
+    double inverse_depth; /* 1 / view depth */
+    const double *n;
+} screen_vertex;
+
+static void to_screen(const raster_view *v, const view_vertex *a, screen_vertex *s)
+{
+    double iz = 1.0 / a->p[2];
+    double px = (a->p[0] * iz / v->basis.tan_half_x + 1.0) * 0.5 * v->width;
+    double py = (1.0 - a->p[1] * iz / v->basis.tan_half_y) * 0.5 * v->height;
+    s->x = (int64_t)floor(px * SUBPIXEL + 0.5);
+    s->y = (int64_t)floor(py * SUBPIXEL + 0.5);
+    s->inverse_depth = iz;
+    s->n = a->n;
+}
+
+static int64_t floor_div(int64_t a, int64_t b)
+{
+    int64_t q = a / b;
+    return q * b > a ? q - 1 : q;
+}
+
+/* One edge function E(P) = (b - a) x (P - a), positive inside, stepped per pixel. */
+typedef struct edge {
+    int64_t value;   /* at the current pixel centre, minus the fill-rule bias */
+    int64_t step_x;  /* change per pixel to the right */
+    int64_t step_y;  /* change per pixel down */
+    int64_t bias;    /* 0 on a top or left edge, 1 otherwise */
+} edge;
+
+static edge make_edge(const screen_vertex *a, const screen_vertex *b, int64_t px, int64_t py)
+{
+    int64_t dx = b->x - a->x, dy = b->y - a->y;
+    edge e;
+    /* with the winding made clockwise on screen (y down), a top edge runs left to right and
+     * a left edge runs upward */
+    e.bias = (dy == 0 && dx > 0) || dy < 0 ? 0 : 1;
+    e.value = dx * (py - a->y) - dy * (px - a->x) - e.bias;
+    e.step_x = -dy * SUBPIXEL;
+    e.step_y = dx * SUBPIXEL;
+    return e;
+}
+
+static void write_fragment(raster_target *t, size_t pixel, const screen_vertex v[3],
+                           const int64_t w[3], double inverse_area, uint32_t index)
+{
+    double q[3], inverse_depth = 0;
+    for (int i = 0; i < 3; i++) {
+        q[i] = (double)w[i] * inverse_area * v[i].inverse_depth;
+        inverse_depth += q[i];
+    }
+    if (!(inverse_depth > t->inverse_depth[pixel]))
+        return;
+    t->inverse_depth[pixel] = inverse_depth;
+    t->index[pixel] = index;
+    if (!t->normal)
+        return;
+    for (int k = 0; k < 3; k++)
+        t->normal[3 * pixel + k] =
+            (float)((q[0] * v[0].n[k] + q[1] * v[1].n[k] + q[2] * v[2].n[k]) / inverse_depth);
+}
+
+static void scan_triangle(raster_target *t, const screen_vertex v[3], int64_t area,
+                          uint32_t index)
+{
+    int64_t min_x = v[0].x, max_x = v[0].x, min_y = v[0].y, max_y = v[0].y;
+    for (int i = 1; i < 3; i++) {
+        min_x = v[i].x < min_x ? v[i].x : min_x;
+        max_x = v[i].x > max_x ? v[i].x : max_x;
+        min_y = v[i].y < min_y ? v[i].y : min_y;
+        max_y = v[i].y > max_y ? v[i].y : max_y;
+    }
+    const int64_t half = SUBPIXEL / 2;
+    /* the pixels whose centre x * SUBPIXEL + half lies within the bounding box */
+    int64_t x0 = floor_div(min_x - half + SUBPIXEL - 1, SUBPIXEL);
+    int64_t x1 = floor_div(max_x - half, SUBPIXEL);
+    int64_t y0 = floor_div(min_y - half + SUBPIXEL - 1, SUBPIXEL);
+    int64_t y1 = floor_div(max_y - half, SUBPIXEL);
+    x0 = x0 < 0 ? 0 : x0;
+    y0 = y0 < 0 ? 0 : y0;
+    x1 = x1 >= (int64_t)t->width ? (int64_t)t->width - 1 : x1;
+    y1 = y1 >= (int64_t)t->height ? (int64_t)t->height - 1 : y1;
+    if (x0 > x1 || y0 > y1)
+        return;
+    int64_t px = x0 * SUBPIXEL + half, py = y0 * SUBPIXEL + half;
+    double inverse_area = 1.0 / (double)area;
+    /* edge i is opposite vertex i, so its value is vertex i's barycentric weight * area */
+    edge e[3] = {make_edge(&v[1], &v[2], px, py), make_edge(&v[2], &v[0], px, py),
+                 make_edge(&v[0], &v[1], px, py)};
+    for (int64_t y = y0; y <= y1; y++) {
+        int64_t r[3] = {e[0].value, e[1].value, e[2].value};
+        for (int64_t x = x0; x <= x1; x++) {
+            if ((r[0] | r[1] | r[2]) >= 0) {
+                int64_t w[3] = {r[0] + e[0].bias, r[1] + e[1].bias, r[2] + e[2].bias};
+                write_fragment(t, (size_t)y * t->width + (size_t)x, v, w, inverse_area, index);
+            }
+            for (int i = 0; i < 3; i++)
+                r[i] += e[i].step_x;
+        }
+        for (int i = 0; i < 3; i++)
+            e[i].value += e[i].step_y;
+    }
+}
+
+static void raster_triangle(raster_target *t, const raster_view *view, const view_vertex *a,
+                            const view_vertex *b, const view_vertex *c, uint32_t index)
+{
+    screen_vertex v[3];
+    to_screen(view, a, &v[0]);
+    to_screen(view, b, &v[1]);
+    to_screen(view, c, &v[2]);
+    int64_t area =
+        (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[1].y - v[0].y) * (v[2].x - v[0].x);
+    if (area == 0)
+        return;
+    if (area < 0) {
+        screen_vertex s = v[1];
+        v[1] = v[2];
+        v[2] = s;
+        area = -area;
+    }
+    scan_triangle(t, v, area, index);
+}
+
+/* Clips the triangle where it leaves the view volume or the guard band, then rasterizes the
+ * pieces. Returns without work when the triangle lies outside one plane entirely. */
+static void clip_and_raster(raster_target *t, const raster_view *view, const view_vertex tri[3],
+                            uint32_t index)
+{
+    unsigned outside_all = (1u << PLANE_COUNT) - 1, outside_any = 0;
+    for (int i = 0; i < 3; i++) {
+        if (!isfinite(tri[i].p[0]) || !isfinite(tri[i].p[1]) || !isfinite(tri[i].p[2]))
+            return;
+        unsigned mask = 0;
+        for (int k = 0; k < PLANE_COUNT; k++)
+            mask |= (plane_value(view, k, &tri[i]) < 0 ? 1u : 0u) << k;
+        outside_all &= mask;
+        outside_any |= mask;
+    }
+    if (outside_all)
+        return;
+    if (!outside_any) {
+        raster_triangle(t, view, &tri[0], &tri[1], &tri[2], index);
+        return;
+    }
+    view_vertex poly[2][MAX_POLYGON];
+    int count = 3, cur = 0;
+    memcpy(poly[0], tri, 3 * sizeof *tri);
+    for (int k = 0; k < PLANE_COUNT && count >= 3; k++) {
+        if (!(outside_any & (1u << k)))
+            continue;
+        count = clip_polygon(view, k, poly[cur], count, poly[1 - cur]);
+        cur = 1 - cur;
+    }
+    for (int i = 1; i + 1 < count; i++)
+        raster_triangle(t, view, &poly[cur][0], &poly[cur][i], &poly[cur][i + 1], index);
+}
+
+static void shade_image(const raster_target *t, const ip_camera *camera, uint8_t *rgba)
+{
+    ip_shading s;
+    ip_shading_default(&s);
+    ip_camera_basis basis;
+    ip_camera_basis_of(camera, &basis);
+    for (uint32_t y = 0; y < t->height; y++) {
+        uint8_t background[4];
+        shade_background(&s, y, t->height, background);
+        for (uint32_t x = 0; x < t->width; x++) {
+            size_t pixel = (size_t)y * t->width + x;
+            uint8_t *out = rgba + 4 * pixel;
+            if (t->index[pixel] == UINT32_MAX) {
+                memcpy(out, background, 4);
+                continue;
+            }
+            double ray[3];
+            ip_camera_pixel_ray(&basis, camera, x + 0.5, y + 0.5, ray);
+            shade_surface(&s, t->normal + 3 * pixel, ray, out); /* |n . -ray| = |n . ray| */
+        }
+    }
+}
+
+ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_error *err)
+{
+    for (int i = 0; i < 3; i++)
+        if (!isfinite(lo[i]) || !isfinite(hi[i]) || lo[i] > hi[i])
+            return ip__fail(err, IP_ERR_ARGUMENT, "render: box [%g,%g,%g]-[%g,%g,%g] is not a "
+                           "finite box with lo <= hi", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+    return IP_OK;
+}
+
+static ip_status check_arguments(const ip_mesh *mesh, const ip_camera *camera,
+                                 const double lo[3], const double hi[3], ip_error *err)
+{
+    ip_status st = ip_camera_check(camera, err);
+    if (st == IP_OK)
+        st = ip_render_check_box(lo, hi, err);
+    if (st != IP_OK)
+        return st;
+    if (camera->width > MAX_SIDE || camera->height > MAX_SIDE)
+        return ip__fail(err, IP_ERR_ARGUMENT, "raster: image %ux%u is larger than %dx%d",
+                       camera->width, camera->height, MAX_SIDE, MAX_SIDE);
+    if (mesh->triangle_count >= UINT32_MAX)
+        return ip__fail(err, IP_ERR_ARGUMENT, "raster: %llu triangles are too many",
+                       (unsigned long long)mesh->triangle_count);
+    return IP_OK;
+}
+
+static ip_status allocate_target(raster_target *t, const ip_camera *camera,
+                                 uint32_t *triangle_index, int with_normals, ip_error *err)
+{
+    size_t pixels = (size_t)camera->width * camera->height;
+    memset(t, 0, sizeof *t);
+    t->width = camera->width;
+    t->height = camera->height;
+    t->inverse_depth = calloc(pixels, sizeof *t->inverse_depth);
+    t->index = triangle_index ? triangle_index : malloc(pixels * sizeof *t->index);
+    t->normal = with_normals ? malloc(pixels * 3 * sizeof *t->normal) : NULL;
+    if (!t->inverse_depth || !t->index || (with_normals && !t->normal))
+        return ip__fail(err, IP_ERR_NOMEM, "raster: out of memory for a %ux%u image",
+                       camera->width, camera->height);
+    for (size_t i = 0; i < pixels; i++)
+        t->index[i] = UINT32_MAX;
+    return IP_OK;
+}
+
+static void free_target(raster_target *t, const uint32_t *triangle_index)
+{
+    free(t->inverse_depth);
+    if (t->index != triangle_index)
+        free(t->index);
+    free(t->normal);
+}
+
+ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
+                         const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
+                         ip_error *err)
+{
+    ip_status st = check_arguments(mesh, camera, lo, hi, err);
+    if (st != IP_OK)
+        return st;
+    raster_target target;
+    st = allocate_target(&target, camera, triangle_index, rgba != NULL, err);
+    if (st == IP_OK) {
+        raster_view view;
+        setup_view(&view, camera, lo, hi);
+        for (uint64_t i = 0; i < mesh->triangle_count; i++) {
+            view_vertex tri[3];
+            for (int k = 0; k < 3; k++)
+                to_view(&view, mesh->positions + 9 * i + 3 * k, mesh->normals + 9 * i + 3 * k,
+                        &tri[k]);
+            clip_and_raster(&target, &view, tri, (uint32_t)i);
+        }
+        if (rgba)
+            shade_image(&target, camera, rgba);
+    }
+    free_target(&target, triangle_index);
+    return st;
+}

@@ -1,0 +1,583 @@
+/* The brick cache: lock-free hits, one decode per miss, exact LRU under a byte budget. */
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "internal.h"
+#include "isoprop/cache.h"
+
+#define STRIPES 64 /* load coordination locks, by brick index */
+
+struct entry;
+
+/* A decoded brick. Entries are type-stable: once allocated they are recycled, never freed
+ * before the cache, so a thread that read a slot's pointer may always look at the entry and
+ * find out (pins < 0, or another brick) that it lost a race. */
+typedef struct entry {
+    atomic_int pins;           /* >= 0: pins; -1: free or being evicted */
+    atomic_uint_fast64_t tick; /* last pin time, for LRU */
+    atomic_uint_fast64_t brick;
+    void *samples;
+    size_t bytes;
+    size_t capacity;           /* of samples */
+    uint32_t extent[3], origin[3], level;
+    struct entry *next_free;
+    uint32_t resident_slot;    /* position in the resident array */
+} entry;
+
+typedef struct slot {
+    _Atomic(entry *) entry;
+} slot;
+
+/* The LRU order: a min-heap of (tick, entry), updated lazily. A hit only stamps the entry's
+ * tick (no lock); eviction pops the smallest key, and an entry whose tick moved on since its
+ * key was taken is pushed back under its new tick. A popped entry whose key equals its tick is
+ * the least recently used: every other key is at most its entry's tick. */
+typedef struct heap_item {
+    uint64_t key;
+    struct entry *entry;
+} heap_item;
+
+#define HIT_STRIPES 16
+typedef struct padded_counter {
+    _Alignas(64) atomic_uint_fast64_t value;
+} padded_counter;
+
+struct ip_cache {
+    const ip_store *store;
+    const ip_layout *layout;
+    uint64_t budget;
+    slot *slots;               /* one per brick of every level */
+    atomic_uchar *touched;     /* one flag per brick */
+    unsigned char *loading;    /* one flag per brick, under its stripe lock */
+    pthread_mutex_t stripe_lock[STRIPES];
+    pthread_cond_t stripe_done[STRIPES];
+    pthread_mutex_t evict_lock; /* resident set, free list, accounting */
+    entry **resident;          /* resident entries, unordered */
+    uint64_t resident_count, resident_capacity;
+    heap_item *heap;           /* every resident entry once, keyed by a tick <= its last pin */
+    heap_item *parked;         /* evict_one()'s room for pinned entries it set aside */
+    uint64_t heap_count, heap_capacity;
+    entry *free_entries;
+    void **spare_work;         /* decode scratch buffers not in use, under evict_lock */
+    uint64_t spare_count, spare_capacity;
+    entry **all_entries;       /* every entry ever made, for destroy */
+    uint64_t all_count, all_capacity;
+    size_t work_size;
+    atomic_uint_fast64_t clock;
+    padded_counter hits[HIT_STRIPES]; /* striped by brick: hits on different bricks do not
+                                         contend for one cache line */
+    atomic_uint_fast64_t misses, evictions, waits, bytes_decompressed, bytes_read,
+        decode_ns, over_budget_pins, errors, touched_count;
+    atomic_uint_fast64_t level_touched[32], level_misses[32];
+    uint64_t resident_bytes, resident_peak; /* under evict_lock */
+};
+
+uint64_t ip_cache_default_budget(void)
+{
+    uint64_t budget = 512ull << 20;
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && page > 0 && (uint64_t)pages * (uint64_t)page / 4 < budget)
+        budget = (uint64_t)pages * (uint64_t)page / 4;
+    return budget;
+}
+
+ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache **out,
+                          ip_error *err)
+{
+    if (budget_bytes == 0)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: the cache budget must be positive",
+                       ip_store_path(store));
+    ip_cache *c = calloc(1, sizeof *c);
+    if (!c)
+        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+    c->store = store;
+    c->layout = ip_store_layout(store);
+    c->budget = budget_bytes;
+    uint64_t n = c->layout->brick_count;
+    c->slots = calloc(n, sizeof *c->slots);
+    c->touched = calloc(n, sizeof *c->touched);
+    c->loading = calloc(n, 1);
+    c->work_size = ip_store_read_work_size(store);
+    if (!c->slots || !c->touched || !c->loading) {
+        ip_cache_destroy(c);
+        return ip__fail(err, IP_ERR_NOMEM, "out of memory for a cache of %llu bricks",
+                       (unsigned long long)n);
+    }
+    for (int i = 0; i < STRIPES; i++) {
+        pthread_mutex_init(&c->stripe_lock[i], NULL);
+        pthread_cond_init(&c->stripe_done[i], NULL);
+    }
+    pthread_mutex_init(&c->evict_lock, NULL);
+    *out = c;
+    return IP_OK;
+}
+
+void ip_cache_destroy(ip_cache *c)
+{
+    if (!c)
+        return;
+    for (uint64_t i = 0; i < c->all_count; i++) {
+        free(c->all_entries[i]->samples);
+        free(c->all_entries[i]);
+    }
+    if (c->slots) {
+        for (int i = 0; i < STRIPES; i++) {
+            pthread_mutex_destroy(&c->stripe_lock[i]);
+            pthread_cond_destroy(&c->stripe_done[i]);
+        }
+        pthread_mutex_destroy(&c->evict_lock);
+    }
+    for (uint64_t i = 0; i < c->spare_count; i++)
+        free(c->spare_work[i]);
+    free(c->spare_work);
+    free(c->all_entries);
+    free(c->resident);
+    free(c->heap);
+    free(c->parked);
+    free(c->slots);
+    free((void *)c->touched);
+    free(c->loading);
+    free(c);
+}
+
+const ip_store *ip_cache_store(const ip_cache *c)
+{
+    return c->store;
+}
+
+static void fill_brick(const entry *e, ip_brick *b)
+{
+    b->samples = e->samples;
+    memcpy(b->extent, e->extent, sizeof b->extent);
+    memcpy(b->origin, e->origin, sizeof b->origin);
+    b->level = e->level;
+    b->index = atomic_load_explicit(&e->brick, memory_order_relaxed);
+}
+
+/* Bits of a brick's `touched` byte: pinned at least once; its payload asked for in advance. */
+enum { TOUCHED = 1, PREFETCHED = 2 };
+
+static void note_touch(ip_cache *c, uint64_t g, uint32_t level)
+{
+    if (!(atomic_load_explicit(&c->touched[g], memory_order_relaxed) & TOUCHED) &&
+        !(atomic_fetch_or(&c->touched[g], TOUCHED) & TOUCHED)) {
+        atomic_fetch_add(&c->touched_count, 1);
+        atomic_fetch_add(&c->level_touched[level], 1);
+    }
+}
+
+/* The hit path: pin the slot's entry if it holds brick g. No lock. */
+static int try_pin(ip_cache *c, uint64_t g, ip_brick *b)
+{
+    entry *e = atomic_load_explicit(&c->slots[g].entry, memory_order_acquire);
+    if (!e)
+        return 0;
+    int p = atomic_load(&e->pins);
+    do {
+        if (p < 0)
+            return 0; /* being evicted */
+    } while (!atomic_compare_exchange_weak(&e->pins, &p, p + 1));
+    /* pinned: it cannot be evicted now, but it may have been recycled for another brick
+     * between our load of the slot and the pin */
+    if (atomic_load(&e->brick) != g || atomic_load(&c->slots[g].entry) != e) {
+        /* undo */
+        atomic_fetch_sub(&e->pins, 1);
+        return 0;
+    }
+    atomic_store_explicit(&e->tick, atomic_fetch_add(&c->clock, 1) + 1, memory_order_relaxed);
+    fill_brick(e, b);
+    return 1;
+}
+
+static void heap_sift_up(heap_item *h, uint64_t i)
+{
+    heap_item item = h[i];
+    while (i > 0 && h[(i - 1) / 2].key > item.key) {
+        h[i] = h[(i - 1) / 2];
+        i = (i - 1) / 2;
+    }
+    h[i] = item;
+}
+
+static void heap_sift_down(heap_item *h, uint64_t n, uint64_t i)
+{
+    heap_item item = h[i];
+    for (;;) {
+        uint64_t child = 2 * i + 1;
+        if (child >= n)
+            break;
+        if (child + 1 < n && h[child + 1].key < h[child].key)
+            child++;
+        if (h[child].key >= item.key)
+            break;
+        h[i] = h[child];
+        i = child;
+    }
+    h[i] = item;
+}
+
+/* Adds `e` under its current tick. evict_lock held; the room was made by heap_reserve(). */
+static void heap_push(ip_cache *c, entry *e)
+{
+    c->heap[c->heap_count] = (heap_item){atomic_load_explicit(&e->tick, memory_order_relaxed), e};
+    heap_sift_up(c->heap, c->heap_count++);
+}
+
+static heap_item heap_pop(ip_cache *c)
+{
+    heap_item top = c->heap[0];
+    c->heap[0] = c->heap[--c->heap_count];
+    if (c->heap_count > 0)
+        heap_sift_down(c->heap, c->heap_count, 0);
+    return top;
+}
+
+/* Room for one more resident entry in the heap (and in the parking space of evict_one(),
+ * which may hold every resident entry at once). evict_lock held. */
+static int heap_reserve(ip_cache *c)
+{
+    if (c->heap_count < c->heap_capacity)
+        return 0;
+    uint64_t cap = c->heap_capacity ? 2 * c->heap_capacity : 64;
+    heap_item *grown = realloc(c->heap, cap * sizeof *grown);
+    if (!grown)
+        return -1;
+    c->heap = grown;
+    heap_item *parked = realloc(c->parked, cap * sizeof *parked);
+    if (!parked)
+        return -1;
+    c->parked = parked;
+    c->heap_capacity = cap;
+    return 0;
+}
+
+/* Removes the least recently pinned unpinned entry from the resident set and returns it (still
+ * holding its samples buffer), or NULL when every resident entry is pinned. O(log n) per call,
+ * amortised over the hits since. evict_lock held. */
+static entry *evict_one(ip_cache *c)
+{
+    entry *victim = NULL;
+    uint64_t parked = 0;
+    while (c->heap_count > 0) {
+        heap_item top = heap_pop(c);
+        uint64_t tick = atomic_load_explicit(&top.entry->tick, memory_order_relaxed);
+        if (tick != top.key) { /* pinned since its key was taken: re-key it */
+            c->heap[c->heap_count] = (heap_item){tick, top.entry};
+            heap_sift_up(c->heap, c->heap_count++);
+            continue;
+        }
+        int zero = 0;
+        if (atomic_compare_exchange_strong(&top.entry->pins, &zero, -1)) {
+            victim = top.entry;
+            break;
+        }
+        c->parked[parked++] = top; /* pinned now: set aside, given back below */
+    }
+    for (uint64_t i = 0; i < parked; i++) {
+        c->heap[c->heap_count] = c->parked[i];
+        heap_sift_up(c->heap, c->heap_count++);
+    }
+    if (!victim)
+        return NULL;
+    atomic_store(&c->slots[atomic_load(&victim->brick)].entry, NULL);
+    c->resident[victim->resident_slot] = c->resident[--c->resident_count];
+    c->resident[victim->resident_slot]->resident_slot = victim->resident_slot;
+    c->resident_bytes -= victim->bytes;
+    return victim;
+}
+
+/* Returns an entry to the free list. Its samples go back to the allocator: only the entry
+ * itself must stay allocated (see struct entry), and holding buffers of every size ever seen
+ * would let memory outgrow the budget when brick sizes vary. evict_lock held. */
+static void free_entry(ip_cache *c, entry *e)
+{
+    free(e->samples);
+    e->samples = NULL;
+    e->capacity = 0;
+    e->next_free = c->free_entries;
+    c->free_entries = e;
+}
+
+static entry *new_entry(ip_cache *c)
+{
+    if (c->all_count == c->all_capacity) {
+        uint64_t cap = c->all_capacity ? 2 * c->all_capacity : 64;
+        entry **grown = realloc(c->all_entries, cap * sizeof *grown);
+        if (!grown)
+            return NULL;
+        c->all_entries = grown;
+        c->all_capacity = cap;
+    }
+    entry *e = calloc(1, sizeof *e);
+    if (!e)
+        return NULL;
+    atomic_init(&e->pins, -1);
+    atomic_init(&e->brick, UINT64_MAX);
+    c->all_entries[c->all_count++] = e;
+    return e;
+}
+
+/* Makes room for `bytes`, counts them as resident (a load in flight holds its memory too, so
+ * parallel misses cannot overshoot the budget), and returns a free entry whose buffer holds
+ * exactly `bytes`. The last victim's buffer is reused when it has the right size, which is
+ * the common case of equal bricks. evict_lock held. */
+static entry *reserve_entry(ip_cache *c, size_t bytes)
+{
+    entry *spare = NULL;
+    while (c->resident_bytes + bytes > c->budget && c->resident_count > 0) {
+        entry *victim = evict_one(c);
+        if (!victim) {
+            atomic_fetch_add(&c->over_budget_pins, 1);
+            break;
+        }
+        atomic_fetch_add(&c->evictions, 1);
+        if (spare)
+            free_entry(c, spare);
+        spare = victim;
+    }
+    entry *e = spare;
+    if (!e && c->free_entries) {
+        e = c->free_entries;
+        c->free_entries = e->next_free;
+    }
+    if (!e && !(e = new_entry(c)))
+        return NULL;
+    if (e->capacity != bytes) {
+        free(e->samples);
+        e->samples = malloc(bytes);
+        e->capacity = e->samples ? bytes : 0;
+        if (!e->samples) {
+            free_entry(c, e);
+            return NULL;
+        }
+    }
+    c->resident_bytes += bytes;
+    if (c->resident_bytes > c->resident_peak)
+        c->resident_peak = c->resident_bytes;
+    return e;
+}
+
+static ip_status add_resident(ip_cache *c, entry *e)
+{
+    if (c->resident_count == c->resident_capacity) {
+        uint64_t cap = c->resident_capacity ? 2 * c->resident_capacity : 64;
+        entry **grown = realloc(c->resident, cap * sizeof *grown);
+        if (!grown)
+            return IP_ERR_NOMEM;
+        c->resident = grown;
+        c->resident_capacity = cap;
+    }
+    if (heap_reserve(c) != 0)
+        return IP_ERR_NOMEM;
+    e->resident_slot = (uint32_t)c->resident_count;
+    c->resident[c->resident_count++] = e;
+    heap_push(c, e);
+    return IP_OK;
+}
+
+/* Asks the kernel to read, in the background, the payloads of the face neighbours of brick g
+ * (level `level`, coordinates b) that were never pinned nor asked for: propagation crosses
+ * brick faces, so on a cold page cache they are the next reads, and their I/O then overlaps
+ * the decoding and extraction of this one instead of stalling a worker on a read. Costs
+ * a system call per neighbour, once per brick; no thread of ours waits for the reads. */
+static void prefetch_neighbours(ip_cache *c, uint32_t level, const uint32_t b[3])
+{
+    const uint32_t *grid = c->layout->levels[level].bricks;
+    for (int f = 0; f < 6; f++) {
+        uint32_t n[3] = {b[0], b[1], b[2]};
+        int axis = f / 2;
+        if (f % 2 == 0 ? n[axis] == 0 : n[axis] + 1 >= grid[axis])
+            continue;
+        n[axis] += f % 2 == 0 ? (uint32_t)-1 : 1u;
+        uint64_t g = ip_brick_global_index(c->layout, level, n);
+        if (atomic_load_explicit(&c->touched[g], memory_order_relaxed) ||
+            atomic_fetch_or(&c->touched[g], PREFETCHED))
+            continue;
+        ip_store_prefetch_brick(c->store, g);
+    }
+}
+
+/* Decode scratch comes from a small pool: one buffer per thread decoding at once. */
+static void *take_work(ip_cache *c)
+{
+    void *w = NULL;
+    pthread_mutex_lock(&c->evict_lock);
+    if (c->spare_count > 0)
+        w = c->spare_work[--c->spare_count];
+    pthread_mutex_unlock(&c->evict_lock);
+    return w ? w : malloc(c->work_size);
+}
+
+static void give_work(ip_cache *c, void *w)
+{
+    pthread_mutex_lock(&c->evict_lock);
+    if (c->spare_count == c->spare_capacity) {
+        uint64_t cap = c->spare_capacity ? 2 * c->spare_capacity : 8;
+        void **grown = realloc(c->spare_work, cap * sizeof *grown);
+        if (grown) {
+            c->spare_work = grown;
+            c->spare_capacity = cap;
+        }
+    }
+    if (c->spare_count < c->spare_capacity) {
+        c->spare_work[c->spare_count++] = w;
+        w = NULL;
+    }
+    pthread_mutex_unlock(&c->evict_lock);
+    free(w);
+}
+
+/* Decodes brick g into e (not yet published). */
+static ip_status decode_into(ip_cache *c, uint64_t g, entry *e, ip_error *err)
+{
+    void *work = take_work(c);
+    if (!work)
+        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+    double t0 = ip_now_seconds();
+    ip_status st = ip_store_read_brick(c->store, g, e->samples, work, err);
+    double t1 = ip_now_seconds();
+    give_work(c, work);
+    atomic_fetch_add(&c->decode_ns, (uint64_t)((t1 - t0) * 1e9));
+    ip_brick_entry be;
+    ip_store_brick_entry(c->store, g, &be);
+    atomic_fetch_add(&c->bytes_read, be.stored_size);
+    return st;
+}
+
+/* The miss path for brick g, which this thread has marked as loading. */
+static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
+{
+    uint32_t level, brick[3], origin[3], extent[3];
+    ip_brick_coords(c->layout, g, &level, brick);
+    ip_brick_extent(c->layout, level, brick, origin, extent);
+    size_t bytes = (size_t)extent[0] * extent[1] * extent[2] * ip_type_size(c->layout->type);
+    pthread_mutex_lock(&c->evict_lock);
+    entry *e = reserve_entry(c, bytes);
+    pthread_mutex_unlock(&c->evict_lock);
+    if (!e)
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for brick %llu",
+                       ip_store_path(c->store), (unsigned long long)g);
+    e->bytes = bytes;
+    e->level = level;
+    memcpy(e->extent, extent, sizeof extent);
+    memcpy(e->origin, origin, sizeof origin);
+    prefetch_neighbours(c, level, brick);
+    ip_status st = decode_into(c, g, e, err);
+    pthread_mutex_lock(&c->evict_lock);
+    atomic_store(&e->tick, atomic_fetch_add(&c->clock, 1) + 1);
+    if (st == IP_OK)
+        st = add_resident(c, e);
+    if (st != IP_OK) {
+        c->resident_bytes -= bytes;
+        free_entry(c, e);
+        pthread_mutex_unlock(&c->evict_lock);
+        atomic_fetch_add(&c->errors, 1);
+        return st == IP_ERR_NOMEM ? ip__fail(err, st, "out of memory") : st;
+    }
+    atomic_store(&e->brick, g);
+    atomic_store(&e->pins, 1);
+    atomic_store_explicit(&c->slots[g].entry, e, memory_order_release);
+    pthread_mutex_unlock(&c->evict_lock);
+    atomic_fetch_add(&c->misses, 1);
+    atomic_fetch_add(&c->level_misses[level], 1);
+    atomic_fetch_add(&c->bytes_decompressed, bytes);
+    fill_brick(e, b);
+    return IP_OK;
+}
+
+ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
+{
+    if (g >= c->layout->brick_count)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: brick %llu does not exist",
+                       ip_store_path(c->store), (unsigned long long)g);
+    uint32_t level, brick[3];
+    ip_brick_coords(c->layout, g, &level, brick);
+    note_touch(c, g, level);
+    if (try_pin(c, g, b)) {
+        atomic_fetch_add_explicit(&c->hits[g % HIT_STRIPES].value, 1, memory_order_relaxed);
+        return IP_OK;
+    }
+    pthread_mutex_t *lock = &c->stripe_lock[g % STRIPES];
+    pthread_mutex_lock(lock);
+    int waited = 0;
+    for (;;) {
+        if (try_pin(c, g, b)) {
+            pthread_mutex_unlock(lock);
+            atomic_fetch_add(&c->hits[g % HIT_STRIPES].value, 1);
+            if (waited)
+                atomic_fetch_add(&c->waits, 1);
+            return IP_OK;
+        }
+        if (!c->loading[g])
+            break;
+        waited = 1;
+        pthread_cond_wait(&c->stripe_done[g % STRIPES], lock);
+    }
+    c->loading[g] = 1;
+    pthread_mutex_unlock(lock);
+    ip_status st = load_brick(c, g, b, err);
+    pthread_mutex_lock(lock);
+    c->loading[g] = 0;
+    pthread_cond_broadcast(&c->stripe_done[g % STRIPES]);
+    pthread_mutex_unlock(lock);
+    return st;
+}
+
+void ip_cache_unpin_brick(ip_cache *c, const ip_brick *b)
+{
+    entry *e = atomic_load_explicit(&c->slots[b->index].entry, memory_order_acquire);
+    /* a pinned brick stays in its slot, so the slot still holds its entry */
+    atomic_fetch_sub(&e->pins, 1);
+}
+
+uint64_t ip_cache_trim(ip_cache *c, uint64_t keep_bytes)
+{
+    uint64_t freed = 0;
+    pthread_mutex_lock(&c->evict_lock);
+    while (c->resident_bytes > keep_bytes) {
+        entry *victim = evict_one(c);
+        if (!victim)
+            break; /* the rest is pinned */
+        freed += victim->bytes;
+        free_entry(c, victim);
+    }
+    pthread_mutex_unlock(&c->evict_lock);
+    return freed;
+}
+
+void ip_cache_get_stats(const ip_cache *cc, ip_cache_stats *s)
+{
+    ip_cache *c = (ip_cache *)cc; /* the lock is taken for a consistent resident snapshot */
+    memset(s, 0, sizeof *s);
+    s->budget_bytes = c->budget;
+    pthread_mutex_lock(&c->evict_lock);
+    s->resident_bytes = c->resident_bytes;
+    s->resident_peak_bytes = c->resident_peak;
+    s->resident_bricks = c->resident_count;
+    for (uint64_t i = 0; i < c->resident_count; i++) /* pinned bytes, counted when asked */
+        if (atomic_load(&c->resident[i]->pins) > 0)
+            s->pinned_bytes += c->resident[i]->bytes;
+    pthread_mutex_unlock(&c->evict_lock);
+    for (int i = 0; i < HIT_STRIPES; i++)
+        s->hits += atomic_load(&c->hits[i].value);
+    s->misses = atomic_load(&c->misses);
+    s->evictions = atomic_load(&c->evictions);
+    s->waits = atomic_load(&c->waits);
+    s->bytes_decompressed = atomic_load(&c->bytes_decompressed);
+    s->bytes_read = atomic_load(&c->bytes_read);
+    s->decode_seconds = (double)atomic_load(&c->decode_ns) * 1e-9;
+    s->over_budget_pins = atomic_load(&c->over_budget_pins);
+    s->errors = atomic_load(&c->errors);
+    s->bricks_touched = atomic_load(&c->touched_count);
+    s->bricks_total = c->layout->brick_count;
+    s->levels = c->layout->level_count;
+    for (uint32_t k = 0; k < c->layout->level_count && k < 32; k++) {
+        s->level[k].bricks_total = c->layout->levels[k].brick_count;
+        s->level[k].bricks_touched = atomic_load(&c->level_touched[k]);
+        s->level[k].misses = atomic_load(&c->level_misses[k]);
+    }
+}

@@ -1,0 +1,25 @@
+#!/bin/bash
+# The shared library exports exactly the public API: every function declared with IP_API in
+# include/isoprop/*.h, and nothing else (no internal ip__ symbol, nothing without the ip_ prefix).
+#   exports.sh LIBISOPROP.so INCLUDE_DIR
+set -u
+lib=$1
+include=$2
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+nm -D --defined-only "$lib" | awk 'NF == 3 { print $3 }' | sort -u >"$dir/exported"
+# the name of each IP_API declaration: the identifier before the first '('
+grep -h '^IP_API ' "$include"/isoprop/*.h | sed 's/(.*//; s/.*[ *]//' | sort -u >"$dir/declared"
+failed=0
+while read -r s; do
+    echo "exports: $lib exports $s, which no public header declares with IP_API"
+    failed=1
+done < <(comm -23 "$dir/exported" "$dir/declared")
+while read -r s; do
+    echo "exports: $s is declared with IP_API but $lib does not export it"
+    failed=1
+done < <(comm -13 "$dir/exported" "$dir/declared")
+if [ "$failed" = 0 ]; then
+    echo "exports: $(wc -l <"$dir/exported") public functions exported, no internal symbol"
+fi
+exit "$failed"
