@@ -1,5 +1,6 @@
 /* isobrick: brick a raw, NRRD or MetaImage volume into a brick file (.ibv), once. */
 #include <errno.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -64,77 +65,116 @@ typedef struct options {
     int quiet;
 } options;
 
+/* The values of isobrick's options (tool_option_parse: base is the options). */
+static int parse_dims(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (tool_parse_dims(p, "--dims", v[0], o->overrides.dims) != 0)
+        return 2;
+    o->overrides.has_dims = 1;
+    return 0;
+}
+
+static int parse_type(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (ip_type_parse(v[0], &o->overrides.type) != IP_OK)
+        return tool_usage_error(p, "unknown type '%s'", v[0]);
+    o->overrides.has_type = 1;
+    return 0;
+}
+
+static int parse_endian(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (strcmp(v[0], "big") && strcmp(v[0], "little"))
+        return tool_usage_error(p, "--endian must be big or little");
+    o->overrides.big_endian = !strcmp(v[0], "big");
+    o->overrides.has_endian = 1;
+    return 0;
+}
+
+static int parse_spacing(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    double *s = o->overrides.spacing;
+    if (tool_parse_double3(v[0], s) != 0 || !(s[0] > 0 && s[1] > 0 && s[2] > 0))
+        return tool_usage_error(p, "--spacing '%s' is not three positive numbers", v[0]);
+    o->overrides.has_spacing = 1;
+    return 0;
+}
+
+/* --brick-size and --subblock-size, into the uint32_t at the option's offset: at most 256
+ * here; the bricker checks the rest */
+static int parse_edge(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    uint64_t n;
+    if (tool_parse_u64(v[0], &n) != 0 || n > 256)
+        return tool_usage_error(p, "bad %s '%s'", opt->name, v[0]);
+    *(uint32_t *)(void *)((char *)base + opt->offset) = (uint32_t)n;
+    return 0;
+}
+
+/* --hc [LEVEL]: the next argument is the level when it is a whole number */
+static int parse_hc(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    uint64_t n;
+    o->brick.lz4_level = IP_LZ4_HC_DEFAULT;
+    if (v[0] && tool_parse_u64(v[0], &n) == 0) {
+        if (n < 1 || n > 12)
+            return tool_usage_error(p, "--hc level must be 1-12");
+        o->brick.lz4_level = (int)n;
+    }
+    return 0;
+}
+
+static int parse_threads(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    (void)opt;
+    return tool_parse_threads(p, v[0], 256, &((options *)base)->brick.threads);
+}
+
+static int parse_mem_mb(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    (void)opt;
+    uint64_t n;
+    if (tool_parse_u64(v[0], &n) != 0 || n < 1 || n > (1ull << 40))
+        return tool_usage_error(p, "bad --mem-mb '%s'", v[0]);
+    ((options *)base)->brick.memory_limit = n << 20;
+    return 0;
+}
+
+static const tool_option isobrick_options[] = {
+    {"-o", NULL, 1, offsetof(options, output), NULL, NULL, NULL},
+    {"--dims", NULL, 1, 0, parse_dims, NULL, NULL},
+    {"--type", NULL, 1, 0, parse_type, NULL, NULL},
+    {"--endian", NULL, 1, 0, parse_endian, NULL, NULL},
+    {"--spacing", NULL, 1, 0, parse_spacing, NULL, NULL},
+    {"--brick-size", NULL, 1, offsetof(options, brick.brick_edge), parse_edge, NULL, NULL},
+    {"--subblock-size", NULL, 1, offsetof(options, brick.subblock_edge), parse_edge, NULL, NULL},
+    {"--hc", NULL, TOOL_OPTIONAL_VALUE, 0, parse_hc, NULL, tool_is_u64},
+    {"--threads", NULL, 1, 0, parse_threads, NULL, NULL},
+    {"--mem-mb", NULL, 1, 0, parse_mem_mb, NULL, NULL},
+    {"--force", NULL, 0, offsetof(options, brick.force), NULL, NULL, NULL},
+    {"--quiet", "-q", 0, offsetof(options, quiet), NULL, NULL, NULL},
+};
+
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     ip_bricker_options_default(&o->brick);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        uint64_t n;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            fputs(usage, stdout);
-            exit(0);
-        } else if (!strcmp(a, "--version")) {
-            tool_print_version("isobrick");
-            exit(0);
-        } else if (!strcmp(a, "-o") && v) {
-            o->output = v, i++;
-        } else if (!strcmp(a, "--dims") && v) {
-            if (tool_parse_dims("isobrick", "--dims", v, o->overrides.dims) != 0)
-                return 2;
-            o->overrides.has_dims = 1, i++;
-        } else if (!strcmp(a, "--type") && v) {
-            if (ip_type_parse(v, &o->overrides.type) != IP_OK)
-                return tool_usage_error("isobrick", "unknown type '%s'", v);
-            o->overrides.has_type = 1, i++;
-        } else if (!strcmp(a, "--endian") && v) {
-            if (strcmp(v, "big") && strcmp(v, "little"))
-                return tool_usage_error("isobrick", "--endian must be big or little");
-            o->overrides.big_endian = !strcmp(v, "big");
-            o->overrides.has_endian = 1, i++;
-        } else if (!strcmp(a, "--spacing") && v) {
-            if (tool_parse_double3(v, o->overrides.spacing) != 0 ||
-                !(o->overrides.spacing[0] > 0 && o->overrides.spacing[1] > 0 &&
-                  o->overrides.spacing[2] > 0))
-                return tool_usage_error("isobrick", "--spacing '%s' is not three positive "
-                                        "numbers", v);
-            o->overrides.has_spacing = 1, i++;
-        } else if (!strcmp(a, "--brick-size") && v) {
-            if (tool_parse_u64(v, &n) != 0 || n > 256)
-                return tool_usage_error("isobrick", "bad --brick-size '%s'", v);
-            o->brick.brick_edge = (uint32_t)n, i++;
-        } else if (!strcmp(a, "--subblock-size") && v) {
-            if (tool_parse_u64(v, &n) != 0 || n > 256)
-                return tool_usage_error("isobrick", "bad --subblock-size '%s'", v);
-            o->brick.subblock_edge = (uint32_t)n, i++;
-        } else if (!strcmp(a, "--hc")) {
-            o->brick.lz4_level = IP_LZ4_HC_DEFAULT;
-            if (v && tool_parse_u64(v, &n) == 0) {
-                if (n < 1 || n > 12)
-                    return tool_usage_error("isobrick", "--hc level must be 1-12");
-                o->brick.lz4_level = (int)n, i++;
-            }
-        } else if (!strcmp(a, "--threads") && v) {
-            if (tool_parse_u64(v, &n) != 0 || n < 1 || n > 256)
-                return tool_usage_error("isobrick", "--threads must be 1-256");
-            o->brick.threads = (unsigned)n, i++;
-        } else if (!strcmp(a, "--mem-mb") && v) {
-            if (tool_parse_u64(v, &n) != 0 || n < 1 || n > (1ull << 40))
-                return tool_usage_error("isobrick", "bad --mem-mb '%s'", v);
-            o->brick.memory_limit = n << 20, i++;
-        } else if (!strcmp(a, "--force")) {
-            o->brick.force = 1;
-        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
-            o->quiet = 1;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return tool_usage_error("isobrick", "unknown or incomplete option '%s'", a);
-        } else if (!o->input) {
-            o->input = a;
-        } else {
-            return tool_usage_error("isobrick", "more than one input ('%s')", a);
-        }
-    }
+    const tool_option_table table = {
+        isobrick_options, sizeof isobrick_options / sizeof isobrick_options[0], o};
+    const tool_command_line line = {"isobrick", usage, &table, 1, &o->input, "input"};
+    int rc = tool_parse_command_line(&line, argc, argv);
+    if (rc)
+        return rc;
     if (!o->input)
         return tool_usage_error("isobrick", "no input file");
     return 0;

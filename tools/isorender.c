@@ -1,5 +1,6 @@
 /* isorender: extract an isosurface progressively (or fully) and render it to PNG, headless. */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,8 +48,8 @@ static const char usage[] =
 
 typedef struct options {
     tool_view_options common;
-    const char *file, *out, *mesh, *stats, *progress;
-    int full, software, force, quiet, warm;
+    const char *file, *out, *mesh, *progress;
+    int full, software, warm; /* --stats, --force and --quiet are in common */
 } options;
 
 typedef struct checkpoint {
@@ -75,54 +76,25 @@ typedef struct run {
     int writing;          /* 1 once the outputs are being written */
 } run;
 
+static const tool_option isorender_options[] = {
+    {"-o", NULL, 1, offsetof(options, out), NULL, NULL, NULL},
+    {"--mesh", NULL, 1, offsetof(options, mesh), NULL, NULL, NULL},
+    {"--progress", NULL, 1, offsetof(options, progress), NULL, NULL, NULL},
+    {"--full", NULL, 0, offsetof(options, full), NULL, NULL, NULL},
+    {"--warm", NULL, 0, offsetof(options, warm), NULL, NULL, NULL},
+    {"--software", NULL, 0, offsetof(options, software), NULL, NULL, NULL},
+};
+
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->out = "isorender.png";
     tool_view_options_default(&o->common, 1600, 1200);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        int taken = tool_parse_view_option("isorender", argc, argv, &i, &o->common);
-        if (taken == 2)
-            return 2;
-        if (taken)
-            continue;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            fputs(usage, stdout);
-            exit(0);
-        } else if (!strcmp(a, "--version")) {
-            tool_print_version("isorender");
-            exit(0);
-        } else if (!strcmp(a, "-o") && v) {
-            o->out = v, i++;
-        } else if (!strcmp(a, "--mesh") && v) {
-            o->mesh = v, i++;
-        } else if (!strcmp(a, "--stats") && v) {
-            o->stats = v, i++;
-        } else if (!strcmp(a, "--progress") && v) {
-            o->progress = v, i++;
-        } else if (!strcmp(a, "--full")) {
-            o->full = 1;
-        } else if (!strcmp(a, "--warm")) {
-            o->warm = 1;
-        } else if (!strcmp(a, "--software")) {
-            o->software = 1;
-        } else if (!strcmp(a, "--force")) {
-            o->force = 1;
-        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
-            o->quiet = 1;
-        } else if (a[0] == '-' && a[1]) {
-            return tool_usage_error("isorender", "unknown or incomplete option '%s'", a);
-        } else if (!o->file) {
-            o->file = a;
-        } else {
-            return tool_usage_error("isorender", "more than one file ('%s')", a);
-        }
-    }
-    if (!o->file)
-        return tool_usage_error("isorender", "no brick file");
-    if (!o->common.has_iso)
-        return tool_usage_error("isorender", "--iso V is required");
+    int rc = tool_parse_view_command_line(
+        "isorender", usage, &o->common, isorender_options,
+        sizeof isorender_options / sizeof isorender_options[0], o, &o->file, argc, argv);
+    if (rc)
+        return rc;
     if (o->full && (o->common.rays || o->common.time_limit > 0))
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
     return 0;
@@ -301,36 +273,12 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
 static void json_counts(FILE *f, void *user)
 {
     const run *r = user;
-    const ip_engine_counts *t = &r->totals;
-    fprintf(f, "\"file\": ");
-    tool_json_string(f, r->o.file);
-    fprintf(f, ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
-               "\"renderer\": \"%s\"",
-            r->o.common.iso, r->o.full ? "full" : "progressive", r->camera.width, r->camera.height,
-            r->renderer_name ? r->renderer_name : "none");
-    fprintf(f, ", \"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"target\": [%.9g, %.9g, %.9g], "
-               "\"up\": [%.9g, %.9g, %.9g], \"fov\": %.9g}",
-            r->camera.eye[0], r->camera.eye[1], r->camera.eye[2], r->camera.target[0],
-            r->camera.target[1], r->camera.target[2], r->camera.up[0], r->camera.up[1],
-            r->camera.up[2], r->camera.fov_y);
-    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", r->o.common.lod ? "true" : "false",
-            r->o.common.pixel_error);
-    fprintf(f, ", \"warm\": %s, \"threads\": %u", r->o.warm ? "true" : "false",
-            ip_thread_count(r->o.common.threads));
-    fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", r->o.common.cutoff,
-            r->o.common.foldback);
-    fprintf(f, ", \"rays\": %llu, \"rays_total\": %llu, \"done\": %s, \"seeds\": %llu, "
-               "\"cells\": %llu, \"triangles\": %llu",
-            (unsigned long long)t->rays,
-            (unsigned long long)r->camera.width * r->camera.height,
-            r->o.full || (r->engine && ip_engine_done(r->engine)) ? "true" : "false",
-            (unsigned long long)t->seeds, (unsigned long long)t->cells,
-            (unsigned long long)t->triangles);
-    fprintf(f, ", \"time\": {\"intersection_s\": %.6f, \"propagation_s\": %.6f, "
-               "\"extraction_s\": %.6f, \"rendering_s\": %.6f, \"extraction_wall_s\": %.6f, "
-               "\"progress_render_s\": %.6f}",
-            t->intersection_seconds, t->propagation_seconds, t->extraction_seconds,
-            t->rendering_seconds, r->extraction_wall, r->progress_render_seconds);
+    const tool_run_json j = {r->o.file, r->o.common.iso, r->o.full, &r->camera,
+                             r->renderer_name ? r->renderer_name : "none", &r->o.common,
+                             r->o.warm, r->o.full || (r->engine && ip_engine_done(r->engine)),
+                             &r->totals, r->totals.rendering_seconds, r->extraction_wall,
+                             r->progress_render_seconds};
+    tool_write_run_json(f, &j);
     if (r->checkpoint_count)
         fprintf(f, ", \"final_pixel_pct\": %.4f",
                 r->checkpoints[r->checkpoint_count - 1].final_pct);
@@ -390,24 +338,26 @@ static int finish(run *r, ip_error *err)
         return rc != 0 ? tool_fail("isorender", err) : 1;
     }
     r->writing = 1;
-    if (ip_png_write(r->o.out, rgba, r->camera.width, r->camera.height, r->o.force, err) !=
-        IP_OK)
+    if (ip_png_write(r->o.out, rgba, r->camera.width, r->camera.height, r->o.common.force,
+                     err) != IP_OK)
         rc = -1;
     free(rgba);
-    if (rc == 0 && r->o.mesh && ip_mesh_write_ply(r->mesh, r->o.mesh, r->o.force, err) != IP_OK)
+    if (rc == 0 && r->o.mesh &&
+        ip_mesh_write_ply(r->mesh, r->o.mesh, r->o.common.force, err) != IP_OK)
         rc = -1;
     if (rc != 0)
         return tool_fail("isorender", err);
     if (r->o.progress && !r->o.full &&
-        tool_write_text_file("isorender", r->o.progress, r->o.force, progress_csv, r) != 0)
+        tool_write_text_file("isorender", r->o.progress, r->o.common.force, progress_csv, r) != 0)
         return 1;
     uint64_t summary = ip_store_layout(r->store)->summary_size;
-    if (!r->o.quiet) {
+    if (!r->o.common.quiet) {
         print_summary(r);
         tool_print_cache_table(stdout, &st, summary);
     }
-    if (r->o.stats && tool_write_stats_file("isorender", r->o.stats, r->o.force, &st, summary,
-                                            json_counts, r) != 0)
+    if (r->o.common.stats && tool_write_stats_file("isorender", r->o.common.stats,
+                                                   r->o.common.force, &st, summary,
+                                                   json_counts, r) != 0)
         return 1;
     return 0;
 }
@@ -420,8 +370,8 @@ int main(int argc, char **argv)
     if (rc)
         return rc;
     const char *inputs[] = {r.o.file};
-    const char *outputs[] = {r.o.out, r.o.mesh, r.o.stats, r.o.full ? NULL : r.o.progress};
-    if (tool_check_paths("isorender", inputs, 1, outputs, 4, r.o.force) != 0)
+    const char *outputs[] = {r.o.out, r.o.mesh, r.o.common.stats, r.o.full ? NULL : r.o.progress};
+    if (tool_check_paths("isorender", inputs, 1, outputs, 4, r.o.common.force) != 0)
         return 1;
     tool_signals_catch();
     ip_error err;

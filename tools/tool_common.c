@@ -6,6 +6,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <signal.h>
+#include <stddef.h>
 #include <stdarg.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -332,9 +333,6 @@ const char *tool_format_bytes(char *buf, size_t size, double bytes)
     return buf;
 }
 
-#include <unistd.h>
-
-
 int tool_parse_cache_mb(const char *text, uint64_t *bytes)
 {
     uint64_t mb;
@@ -492,66 +490,236 @@ static int parse_size(const char *p, const char *text, uint32_t *w, uint32_t *h)
     return 0;
 }
 
-/* The value of one shared option; returns 0, or 2 after a usage error. */
-static int parse_view_value(const char *p, const char *a, const char *v, tool_view_options *o)
+/* ---- option parsers ---- */
+
+static int parse_double_option(const char *p, const tool_option *opt, const char *value,
+                               void *base, int positive)
 {
-    if (!strcmp(a, "--iso")) {
-        if (tool_parse_double(v, &o->iso) != 0)
-            return tool_usage_error(p, "--iso '%s' is not a number", v);
-        o->has_iso = 1;
-    } else if (!strcmp(a, "--size")) {
-        if (parse_size(p, v, &o->width, &o->height) != 0)
+    double *out = (double *)(void *)((char *)base + opt->offset);
+    if (tool_parse_double(value, out) != 0 || (positive && *out <= 0))
+        return tool_usage_error(p, "%s '%s' %s", opt->name, value, opt->problem);
+    return 0;
+}
+
+int tool_option_number(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    return parse_double_option(p, opt, v[0], base, 0);
+}
+
+int tool_option_positive(const char *p, const tool_option *opt, const char *const *v,
+                         void *base)
+{
+    return parse_double_option(p, opt, v[0], base, 1);
+}
+
+int tool_parse_threads(const char *program, const char *text, unsigned max, unsigned *threads)
+{
+    uint64_t n;
+    if (tool_parse_u64(text, &n) != 0 || n < 1 || n > max)
+        return tool_usage_error(program, "--threads must be 1-%u", max);
+    *threads = (unsigned)n;
+    return 0;
+}
+
+/* ---- the shared options (base: the tool_view_options) ---- */
+
+static int parse_iso(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    if (tool_option_number(p, opt, v, base) != 0)
+        return 2;
+    ((tool_view_options *)base)->has_iso = 1;
+    return 0;
+}
+
+static int parse_size_option(const char *p, const tool_option *opt, const char *const *v,
+                             void *base)
+{
+    tool_view_options *o = base;
+    (void)opt;
+    return parse_size(p, v[0], &o->width, &o->height) != 0 ? 2 : 0;
+}
+
+static int parse_rays(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    tool_view_options *o = base;
+    (void)opt;
+    if (tool_parse_u64(v[0], &o->rays) != 0 || o->rays == 0)
+        return tool_usage_error(p, "--rays '%s' is not a positive count", v[0]);
+    return 0;
+}
+
+static int parse_view_threads(const char *p, const tool_option *opt, const char *const *v,
+                              void *base)
+{
+    (void)opt;
+    return tool_parse_threads(p, v[0], 64, &((tool_view_options *)base)->threads);
+}
+
+static int parse_lod(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    (void)opt;
+    if (strcmp(v[0], "on") && strcmp(v[0], "off"))
+        return tool_usage_error(p, "--lod must be on or off");
+    ((tool_view_options *)base)->lod = !strcmp(v[0], "on");
+    return 0;
+}
+
+static int parse_cache_budget(const char *p, const tool_option *opt, const char *const *v,
+                              void *base)
+{
+    (void)opt;
+    if (tool_parse_cache_mb(v[0], &((tool_view_options *)base)->cache_bytes) != 0)
+        return tool_usage_error(p, "bad --cache-mb '%s'", v[0]);
+    return 0;
+}
+
+#define VIEW_FIELD(member) offsetof(tool_view_options, member)
+
+static const tool_option view_options[] = {
+    {"--iso", NULL, 1, VIEW_FIELD(iso), parse_iso, "is not a number", NULL},
+    {"--size", NULL, 1, 0, parse_size_option, NULL, NULL},
+    {"--view", NULL, 1, VIEW_FIELD(view), NULL, NULL, NULL},
+    {"--camera", NULL, 1, VIEW_FIELD(camera), NULL, NULL, NULL},
+    {"--rays", NULL, 1, 0, parse_rays, NULL, NULL},
+    {"--time", NULL, 1, VIEW_FIELD(time_limit), tool_option_positive, "is not positive seconds",
+     NULL},
+    {"--cutoff", NULL, 1, VIEW_FIELD(cutoff), tool_option_number, "is not a number", NULL},
+    {"--foldback", NULL, 1, VIEW_FIELD(foldback), tool_option_number, "is not a number", NULL},
+    {"--threads", NULL, 1, 0, parse_view_threads, NULL, NULL},
+    {"--lod", NULL, 1, 0, parse_lod, NULL, NULL},
+    {"--pixel-error", NULL, 1, VIEW_FIELD(pixel_error), tool_option_positive, "is not positive",
+     NULL},
+    {"--cache-mb", NULL, 1, 0, parse_cache_budget, NULL, NULL},
+    {"--stats", NULL, 1, VIEW_FIELD(stats), NULL, NULL, NULL},
+    {"--force", NULL, 0, VIEW_FIELD(force), NULL, NULL, NULL},
+    {"--quiet", "-q", 0, VIEW_FIELD(quiet), NULL, NULL, NULL},
+};
+
+tool_option_table tool_view_option_table(tool_view_options *o)
+{
+    return (tool_option_table){view_options, sizeof view_options / sizeof view_options[0], o};
+}
+
+int tool_is_u64(const char *text)
+{
+    uint64_t ignored;
+    return tool_parse_u64(text, &ignored) == 0;
+}
+
+/* ---- the command-line engine ---- */
+
+static const tool_option *find_option(const tool_command_line *c, const char *name,
+                                      void **base)
+{
+    for (size_t t = 0; t < c->table_count; t++)
+        for (size_t k = 0; k < c->tables[t].count; k++) {
+            const tool_option *opt = &c->tables[t].options[k];
+            if (!strcmp(name, opt->name) || (opt->alias && !strcmp(name, opt->alias))) {
+                *base = c->tables[t].base;
+                return opt;
+            }
+        }
+    return NULL;
+}
+
+/* Takes the option at argv[*i] and its values, advancing *i past them. Returns 0, 1 when
+ * its values are missing, or 2 after a usage error. */
+static int take_option(const tool_command_line *c, const tool_option *opt, void *base,
+                       int argc, char **argv, int *i)
+{
+    int available = argc - 1 - *i;
+    int count = opt->values;
+    if (count == TOOL_OPTIONAL_VALUE)
+        count = available > 0 && opt->accepts(argv[*i + 1]) ? 1 : 0;
+    else if (available < count)
+        return 1;
+    const char *values[2] = {NULL, NULL};
+    for (int k = 0; k < count && k < 2; k++)
+        values[k] = argv[*i + 1 + k];
+    *i += count;
+    char *field = (char *)base + opt->offset;
+    if (opt->parse)
+        return opt->parse(c->program, opt, values, base);
+    if (opt->values == 0)
+        *(int *)(void *)field = 1;
+    else
+        *(const char **)(void *)field = values[0];
+    return 0;
+}
+
+int tool_parse_command_line(const tool_command_line *c, int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        void *base = NULL;
+        const tool_option *opt = find_option(c, a, &base);
+        int rc = opt ? take_option(c, opt, base, argc, argv, &i) : 1;
+        if (rc == 2)
             return 2;
-    } else if (!strcmp(a, "--view")) {
-        o->view = v;
-    } else if (!strcmp(a, "--camera")) {
-        o->camera = v;
-    } else if (!strcmp(a, "--rays")) {
-        if (tool_parse_u64(v, &o->rays) != 0 || o->rays == 0)
-            return tool_usage_error(p, "--rays '%s' is not a positive count", v);
-    } else if (!strcmp(a, "--time")) {
-        if (tool_parse_double(v, &o->time_limit) != 0 || o->time_limit <= 0)
-            return tool_usage_error(p, "--time '%s' is not positive seconds", v);
-    } else if (!strcmp(a, "--cutoff")) {
-        if (tool_parse_double(v, &o->cutoff) != 0)
-            return tool_usage_error(p, "--cutoff '%s' is not a number", v);
-    } else if (!strcmp(a, "--foldback")) {
-        if (tool_parse_double(v, &o->foldback) != 0)
-            return tool_usage_error(p, "--foldback '%s' is not a number", v);
-    } else if (!strcmp(a, "--threads")) {
-        uint64_t n;
-        if (tool_parse_u64(v, &n) != 0 || n < 1 || n > 64)
-            return tool_usage_error(p, "--threads must be 1-64");
-        o->threads = (unsigned)n;
-    } else if (!strcmp(a, "--lod")) {
-        if (strcmp(v, "on") && strcmp(v, "off"))
-            return tool_usage_error(p, "--lod must be on or off");
-        o->lod = !strcmp(v, "on");
-    } else if (!strcmp(a, "--pixel-error")) {
-        if (tool_parse_double(v, &o->pixel_error) != 0 || o->pixel_error <= 0)
-            return tool_usage_error(p, "--pixel-error '%s' is not positive", v);
-    } else { /* --cache-mb */
-        if (tool_parse_cache_mb(v, &o->cache_bytes) != 0)
-            return tool_usage_error(p, "bad --cache-mb '%s'", v);
+        if (rc == 0)
+            continue;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(c->usage, stdout);
+            exit(0);
+        } else if (!strcmp(a, "--version")) {
+            tool_print_version(c->program);
+            exit(0);
+        } else if (a[0] == '-' && a[1]) {
+            return tool_usage_error(c->program, "unknown or incomplete option '%s'", a);
+        } else if (c->positional && !*c->positional) {
+            *c->positional = a;
+        } else {
+            return tool_usage_error(c->program, "more than one %s ('%s')", c->positional_name,
+                                    a);
+        }
     }
     return 0;
 }
 
-int tool_parse_view_option(const char *program, int argc, char **argv, int *i,
-                           tool_view_options *o)
+int tool_parse_view_command_line(const char *program, const char *usage, tool_view_options *o,
+                                 const tool_option *own, size_t own_count, void *own_base,
+                                 const char **file, int argc, char **argv)
 {
-    static const char *const names[] = {"--iso", "--size", "--view", "--camera", "--rays",
-                                        "--time", "--cutoff", "--foldback", "--threads",
-                                        "--lod", "--pixel-error", "--cache-mb"};
-    const char *a = argv[*i];
-    if (*i + 1 >= argc)
-        return 0;
-    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
-        if (!strcmp(a, names[k])) {
-            if (parse_view_value(program, a, argv[*i + 1], o) != 0)
-                return 2;
-            *i += 1;
-            return 1;
-        }
+    const tool_option_table tables[] = {tool_view_option_table(o), {own, own_count, own_base}};
+    const tool_command_line line = {program, usage, tables, 2, file, "file"};
+    int rc = tool_parse_command_line(&line, argc, argv);
+    if (rc)
+        return rc;
+    if (!*file)
+        return tool_usage_error(program, "no brick file");
+    if (!o->has_iso)
+        return tool_usage_error(program, "--iso V is required");
     return 0;
+}
+
+void tool_write_run_json(FILE *f, const tool_run_json *j)
+{
+    const ip_camera *c = j->camera;
+    const tool_view_options *o = j->options;
+    const ip_engine_counts *t = j->counts;
+    fprintf(f, "\"file\": ");
+    tool_json_string(f, j->file);
+    fprintf(f, ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
+               "\"renderer\": \"%s\"",
+            j->iso, j->full ? "full" : "progressive", c->width, c->height, j->renderer);
+    fprintf(f, ", \"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"target\": [%.9g, %.9g, %.9g], "
+               "\"up\": [%.9g, %.9g, %.9g], \"fov\": %.9g}",
+            c->eye[0], c->eye[1], c->eye[2], c->target[0], c->target[1], c->target[2],
+            c->up[0], c->up[1], c->up[2], c->fov_y);
+    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", o->lod ? "true" : "false",
+            o->pixel_error);
+    fprintf(f, ", \"warm\": %s, \"threads\": %u", j->warm ? "true" : "false",
+            ip_thread_count(o->threads));
+    fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", o->cutoff,
+            o->foldback);
+    fprintf(f, ", \"rays\": %llu, \"rays_total\": %llu, \"done\": %s, \"seeds\": %llu, "
+               "\"cells\": %llu, \"triangles\": %llu",
+            (unsigned long long)t->rays, (unsigned long long)c->width * c->height,
+            j->done ? "true" : "false", (unsigned long long)t->seeds,
+            (unsigned long long)t->cells, (unsigned long long)t->triangles);
+    fprintf(f, ", \"time\": {\"intersection_s\": %.6f, \"propagation_s\": %.6f, "
+               "\"extraction_s\": %.6f, \"rendering_s\": %.6f, \"extraction_wall_s\": %.6f, "
+               "\"progress_render_s\": %.6f}",
+            t->intersection_seconds, t->propagation_seconds, t->extraction_seconds,
+            j->rendering_seconds, j->extraction_wall_seconds, j->progress_render_seconds);
 }

@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "isoprop/cache.h"
 #include "isoprop/engine.h"
 #include "isoprop/status.h"
 #include "isoprop/store.h"
@@ -66,15 +67,11 @@ void tool_json_string(FILE *out, const char *text);
 /* Formats a byte count as "12.3 MiB" into buf. */
 const char *tool_format_bytes(char *buf, size_t size, double bytes);
 
-#endif
-
-#include "isoprop/cache.h"
-#include "isoprop/engine.h"
-
 /* Parses --cache-mb's value into bytes; returns 0 on success. */
 int tool_parse_cache_mb(const char *text, uint64_t *bytes);
 
-/* The options isorender and isoview share: what to extract, from where, and how. */
+/* The options isorender and isoview share: what to extract, from where, and how, and the
+ * statistics file, --force and --quiet. */
 typedef struct tool_view_options {
     double iso;
     int has_iso;
@@ -87,6 +84,8 @@ typedef struct tool_view_options {
     int lod;
     double pixel_error;
     uint64_t cache_bytes;
+    const char *stats;          /* --stats OUT.json (NULL: none) */
+    int force, quiet;
 } tool_view_options;
 
 /* The defaults: view -y, the paper's angles, lod on with a 1-pixel error, every core, the
@@ -96,11 +95,81 @@ void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t he
 /* The engine options the shared options ask for. */
 void tool_engine_options(const tool_view_options *o, ip_engine_options *eo);
 
-/* Takes argv[*i] (with its value, argv[*i + 1]) when it is one of the shared options,
- * advancing *i past what it took. Returns 1 when taken, 0 when it is not a shared option
- * (or its value is missing), or 2 after printing a usage error for a bad value. */
-int tool_parse_view_option(const char *program, int argc, char **argv, int *i,
-                           tool_view_options *o);
+/* ---- the command line, parsed from tables ----
+ *
+ * A program describes its options in tables of tool_option (one of them may be the shared
+ * view options, tool_view_option_table()), and tool_parse_command_line() walks argv once,
+ * left to right: -h and --help print the program's usage on stdout and exit 0, --version its
+ * version (exit 0); an option of a table takes its values; anything else starting with '-'
+ * (but "-" alone) is "unknown or incomplete option '...'", as is an option without all its
+ * values; the rest is the one positional argument. */
+
+/* tool_option.values for an option whose value is optional: the next argument is its value
+ * when `accepts` says so (isobrick --hc [LEVEL]). */
+#define TOOL_OPTIONAL_VALUE (-1)
+
+typedef struct tool_option tool_option;
+
+/* Parses an option's values (values[0] .. ; values[0] is NULL for an absent optional value)
+ * into the struct at `base` that the table describes (the field at base + option->offset,
+ * or several). Returns 0, or 2 after a usage error (tool_usage_error()). */
+typedef int tool_option_parse(const char *program, const tool_option *option,
+                              const char *const *values, void *base);
+
+struct tool_option {
+    const char *name;           /* "--size" */
+    const char *alias;          /* a second name ("-q"), or NULL */
+    int values;                 /* the values after the name: 0, 1, 2 or TOOL_OPTIONAL_VALUE */
+    /* without parse: a flag (values 0) sets the int at base + offset to 1, a text (values 1)
+     * stores the value as the const char * at base + offset */
+    size_t offset;
+    tool_option_parse *parse;   /* NULL: a flag or a text, as above */
+    const char *problem;        /* for parsers that use it: "is not a number" */
+    int (*accepts)(const char *value); /* TOOL_OPTIONAL_VALUE: whether it is the value */
+};
+
+/* Parsers for tables: a finite number, and a number > 0, into the double at base + offset;
+ * a bad value is "NAME 'VALUE' PROBLEM" (option->problem). */
+tool_option_parse tool_option_number, tool_option_positive;
+
+/* Parses --threads N: 1 .. max, else "--threads must be 1-MAX". Returns 0, or 2 after the
+ * usage error. */
+int tool_parse_threads(const char *program, const char *text, unsigned max, unsigned *threads);
+
+/* A table and the struct its options fill. */
+typedef struct tool_option_table {
+    const tool_option *options;
+    size_t count;
+    void *base;
+} tool_option_table;
+
+typedef struct tool_command_line {
+    const char *program;        /* for messages: "isorender" */
+    const char *usage;          /* --help's text */
+    const tool_option_table *tables;
+    size_t table_count;
+    const char **positional;    /* receives the positional argument (NULL when none) */
+    const char *positional_name; /* for "more than one NAME ('...')": "file", "input" */
+} tool_command_line;
+
+/* Parses argv[1 ..] as described above. Returns 0, or 2 after printing a usage error; exits
+ * with status 0 after --help or --version. */
+int tool_parse_command_line(const tool_command_line *c, int argc, char **argv);
+
+/* The shared options of tool_view_options as a table over `o`: --iso, --size, --view,
+ * --camera, --rays, --time, --cutoff, --foldback, --threads, --lod, --pixel-error,
+ * --cache-mb, --stats, --force and --quiet (-q). */
+tool_option_table tool_view_option_table(tool_view_options *o);
+
+/* The command line of isorender and isoview: the shared view options and the program's
+ * own table (over own_base), one brick file (*file). The file and --iso are required ("no
+ * brick file", "--iso V is required"). Returns 0, or 2 after a usage error. */
+int tool_parse_view_command_line(const char *program, const char *usage, tool_view_options *o,
+                                 const tool_option *own, size_t own_count, void *own_base,
+                                 const char **file, int argc, char **argv);
+
+/* Whether `text` is a non-negative integer (tool_parse_u64() succeeds): for `accepts`. */
+int tool_is_u64(const char *text);
 
 /* Prints the cache statistics as a short human-readable table (on exit of every tool that
  * reads bricks). `summary_bytes` is the size of the file's summary section. */
@@ -108,6 +177,22 @@ void tool_print_cache_table(FILE *out, const ip_cache_stats *s, uint64_t summary
 
 /* Writes the "cache" object's members (without braces) as JSON. */
 void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_bytes);
+
+/* What isorender and isoview write about a run in --stats (members after "cache"). */
+typedef struct tool_run_json {
+    const char *file;
+    double iso;
+    int full;                       /* full extraction, else progressive */
+    const ip_camera *camera;
+    const char *renderer;           /* "opengl", "software", "none" */
+    const tool_view_options *options;
+    int warm, done;
+    const ip_engine_counts *counts;
+    double rendering_seconds, extraction_wall_seconds, progress_render_seconds;
+} tool_run_json;
+
+/* Writes the run's members ("file" .. "time"; without braces) as JSON. */
+void tool_write_run_json(FILE *out, const tool_run_json *j);
 
 /* Writes {"cache": {...}} plus, when extra is not NULL, the members that extra(out, user)
  * prints (preceded by ", "), to `path` with tool_write_text_file() (all-or-nothing; an
@@ -123,3 +208,5 @@ int tool_write_stats_file(const char *program, const char *path, int force,
  * warned, else 0. */
 int tool_warn_iso_range(const char *program, const ip_store *store, double iso, char *warning,
                         size_t warning_size);
+
+#endif

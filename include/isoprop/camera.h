@@ -73,6 +73,38 @@ IP_API ip_status ip_camera_fit_axis(const double lo[3], const double hi[3], cons
  *  @return IP_OK or IP_ERR_ARGUMENT. */
 IP_API ip_status ip_camera_parse(const char *text, ip_camera *camera, ip_error *err);
 
+/* Camera motions, as a viewer's mouse makes them. Each changes eye, target and up only (the
+ * field of view and the image size stay); the camera must pass ip_camera_check() before, and
+ * still does after. */
+
+/*! ip_camera_orbit() : turns the eye around the target, keeping its distance: first
+ *  `right_degrees` about the camera's up axis (positive: the eye moves to the left, so that the
+ *  scene turns to the right, as a drag to the right turns it), then `down_degrees` about the
+ *  camera's right axis after that turn (positive: the eye moves up, the scene turns down). Up
+ *  turns along and leaves orthonormal to the view, so that no path of orbits makes the camera
+ *  degenerate; orbiting by 360 degrees returns to the start (within rounding). */
+IP_API void ip_camera_orbit(ip_camera *camera, double right_degrees, double down_degrees);
+
+/*! ip_camera_pan() : moves eye and target together by `right` world units along the camera's
+ *  right axis and `up` world units along its up axis (both of ip_camera_basis_of()), so the
+ *  view direction and the distance stay. */
+IP_API void ip_camera_pan(ip_camera *camera, double right, double up);
+
+/*! ip_camera_pixel_size() : the world units one pixel spans at the target's distance, in an
+ *  image `height` pixels tall (> 0) with the camera's vertical field of view: what a pan by
+ *  one pixel moves for the point at the target to follow the cursor. */
+IP_API double ip_camera_pixel_size(const ip_camera *camera, double height);
+
+/*! ip_camera_distance() : the distance from the eye to the target, world units. */
+IP_API double ip_camera_distance(const ip_camera *camera);
+
+/*! ip_camera_dolly() : moves the eye along the view direction toward the target (the target
+ *  stays): the distance is divided by `factor` (> 0; 2 halves it, 0.5 doubles it), then kept
+ *  within [min_distance, max_distance] (world units, 0 < min_distance <= max_distance; pass
+ *  0 and INFINITY for no limit). The view direction and up stay. */
+IP_API void ip_camera_dolly(ip_camera *camera, double factor, double min_distance,
+                            double max_distance);
+
 #ifdef __cplusplus
 }
 #endif

@@ -108,6 +108,14 @@ IP_API void ip_gl_context_release(ip_gl_context *context);
  *  where the context is current, or from any thread if it is current nowhere. */
 IP_API void ip_gl_context_destroy(ip_gl_context *context);
 
+/*! ip_gl_program() : compiles `vertex_source` and `fragment_source` (GLSL, NUL-terminated)
+ *  and links them into a program on the OpenGL context current on the calling thread (one
+ *  must be, 3.3 core or later), for a caller drawing beside the renderer (a viewer's text).
+ *  *program receives the program's name (the caller deletes it with glDeleteProgram), 0 on
+ *  failure. @return IP_OK, or IP_ERR_UNSUPPORTED with the compiler's or linker's log. */
+IP_API ip_status ip_gl_program(const char *vertex_source, const char *fragment_source,
+                               unsigned *program, ip_error *err);
+
 /* The GPU renderer: holds the mesh in GPU buffers and draws it with the shading above.
  * A renderer is not thread-safe. A headless renderer makes its own context current on the
  * calling thread at each call, so it may move between threads provided the thread that used

@@ -1,4 +1,4 @@
-/* The pinhole camera: basis, pixel rays, projection, OpenGL matrices, framing presets. */
+/* The pinhole camera: basis, pixel rays, projection, OpenGL matrices, framing presets, motions. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -195,4 +195,68 @@ ip_status ip_camera_parse(const char *text, ip_camera *c, ip_error *err)
     }
     c->fov_y = v[9];
     return IP_OK;
+}
+
+/* Turns v by `degrees` about the unit `axis` (Rodrigues' formula). */
+static void rotate3(double v[3], const double axis[3], double degrees)
+{
+    double a = degrees * 3.14159265358979323846 / 180.0, c = cos(a), s = sin(a);
+    double d = dot3(axis, v);
+    double x[3];
+    cross3(axis, v, x);
+    for (int i = 0; i < 3; i++)
+        v[i] = v[i] * c + x[i] * s + axis[i] * d * (1 - c);
+}
+
+void ip_camera_orbit(ip_camera *c, double right_degrees, double down_degrees)
+{
+    ip_camera_basis b;
+    ip_camera_basis_of(c, &b);
+    double offset[3], up[3], axis[3];
+    for (int i = 0; i < 3; i++) {
+        offset[i] = c->eye[i] - c->target[i];
+        up[i] = b.up[i];
+        axis[i] = b.right[i];
+    }
+    rotate3(offset, b.up, -right_degrees);
+    rotate3(axis, b.up, -right_degrees); /* the right axis after the first turn */
+    rotate3(offset, axis, -down_degrees);
+    rotate3(up, axis, -down_degrees);
+    for (int i = 0; i < 3; i++) {
+        c->eye[i] = c->target[i] + offset[i];
+        c->up[i] = up[i];
+    }
+}
+
+void ip_camera_pan(ip_camera *c, double right, double up)
+{
+    ip_camera_basis b;
+    ip_camera_basis_of(c, &b);
+    for (int i = 0; i < 3; i++) {
+        double move = right * b.right[i] + up * b.up[i];
+        c->eye[i] += move;
+        c->target[i] += move;
+    }
+}
+
+double ip_camera_distance(const ip_camera *c)
+{
+    double d[3] = {c->eye[0] - c->target[0], c->eye[1] - c->target[1], c->eye[2] - c->target[2]};
+    return sqrt(dot3(d, d));
+}
+
+double ip_camera_pixel_size(const ip_camera *c, double height)
+{
+    return 2.0 * ip_camera_distance(c) * tan(c->fov_y * DEG / 2) / height;
+}
+
+void ip_camera_dolly(ip_camera *c, double factor, double min_distance, double max_distance)
+{
+    double d = ip_camera_distance(c), wanted = d / factor;
+    if (wanted < min_distance)
+        wanted = min_distance;
+    if (wanted > max_distance)
+        wanted = max_distance;
+    for (int i = 0; i < 3; i++)
+        c->eye[i] = c->target[i] + (c->eye[i] - c->target[i]) * wanted / d;
 }

@@ -120,30 +120,49 @@ static ip_status make_current(ip_renderer *r, ip_error *err)
     return st;
 }
 
-static ip_status compile_shader(GLenum kind, const char *source, GLuint *out, ip_error *err)
+/* IP_OK when the shader or program `object` compiled or linked; otherwise deletes it and
+ * fails with "WHAT: PROBLEM: its info log". */
+static ip_status check_built(GLuint object, int is_program, const char *what,
+                             const char *problem, ip_error *err)
+{
+    GLint ok = GL_FALSE;
+    char log[512] = "";
+    if (is_program)
+        glGetProgramiv(object, GL_LINK_STATUS, &ok);
+    else
+        glGetShaderiv(object, GL_COMPILE_STATUS, &ok);
+    if (ok)
+        return IP_OK;
+    if (is_program) {
+        glGetProgramInfoLog(object, sizeof log, NULL, log);
+        glDeleteProgram(object);
+    } else {
+        glGetShaderInfoLog(object, sizeof log, NULL, log);
+        glDeleteShader(object);
+    }
+    return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: %s: %s", what, problem, log);
+}
+
+static ip_status compile_shader(GLenum kind, const char *source, const char *what, GLuint *out,
+                                ip_error *err)
 {
     GLuint shader = glCreateShader(kind);
     glShaderSource(shader, 1, &source, NULL);
     glCompileShader(shader);
-    GLint ok = GL_FALSE;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[512] = "";
-        glGetShaderInfoLog(shader, sizeof log, NULL, log);
-        glDeleteShader(shader);
-        return ip__fail(err, IP_ERR_UNSUPPORTED, "renderer: shader does not compile: %s", log);
-    }
-    *out = shader;
-    return IP_OK;
+    ip_status st = check_built(shader, 0, what, "shader does not compile", err);
+    if (st == IP_OK)
+        *out = shader;
+    return st;
 }
 
-static ip_status link_program(const char *vertex, const char *fragment, GLuint *out,
-                              ip_error *err)
+/* The program of the two shaders; `what` names the caller in messages. */
+static ip_status link_program(const char *vertex, const char *fragment, const char *what,
+                              GLuint *out, ip_error *err)
 {
     GLuint vs = 0, fs = 0;
-    ip_status st = compile_shader(GL_VERTEX_SHADER, vertex, &vs, err);
+    ip_status st = compile_shader(GL_VERTEX_SHADER, vertex, what, &vs, err);
     if (st == IP_OK)
-        st = compile_shader(GL_FRAGMENT_SHADER, fragment, &fs, err);
+        st = compile_shader(GL_FRAGMENT_SHADER, fragment, what, &fs, err);
     if (st != IP_OK) {
         glDeleteShader(vs);
         return st;
@@ -154,23 +173,27 @@ static ip_status link_program(const char *vertex, const char *fragment, GLuint *
     glLinkProgram(program);
     glDeleteShader(vs); /* flagged: freed with the program */
     glDeleteShader(fs);
-    GLint ok = GL_FALSE;
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[512] = "";
-        glGetProgramInfoLog(program, sizeof log, NULL, log);
-        glDeleteProgram(program);
-        return ip__fail(err, IP_ERR_UNSUPPORTED, "renderer: shaders do not link: %s", log);
-    }
-    *out = program;
-    return IP_OK;
+    st = check_built(program, 1, what, "shaders do not link", err);
+    if (st == IP_OK)
+        *out = program;
+    return st;
+}
+
+ip_status ip_gl_program(const char *vertex_source, const char *fragment_source,
+                        unsigned *program, ip_error *err)
+{
+    GLuint built = 0;
+    ip_status st = link_program(vertex_source, fragment_source, "OpenGL", &built, err);
+    *program = st == IP_OK ? built : 0;
+    return st;
 }
 
 static ip_status build_programs(ip_renderer *r, ip_error *err)
 {
-    ip_status st = link_program(mesh_vertex_source, mesh_fragment_source, &r->mesh_program, err);
+    ip_status st = link_program(mesh_vertex_source, mesh_fragment_source, "renderer",
+                                &r->mesh_program, err);
     if (st == IP_OK)
-        st = link_program(background_vertex_source, background_fragment_source,
+        st = link_program(background_vertex_source, background_fragment_source, "renderer",
                           &r->background_program, err);
     if (st != IP_OK)
         return st;

@@ -1,0 +1,156 @@
+/* isoview's parts (not part of the library): the viewer's state and what each file gives the
+ * others. main.c runs the frames (extraction slices, drawing, screenshots, statistics),
+ * options.c reads the command line, script.c the --script commands, controls.c the mouse and
+ * keyboard and the view changes they make, overlay.c the heads-up text. */
+#ifndef ISOVIEW_H
+#define ISOVIEW_H
+
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "isoprop/cache.h"
+#include "isoprop/engine.h"
+#include "isoprop/render.h"
+#include "isoprop/store.h"
+#include "tool_common.h"
+
+typedef struct options {
+    tool_view_options common;   /* with --stats, --force and --quiet */
+    const char *file, *script, *screenshot_path;
+    double screenshot_at, exit_after;
+} options;
+
+typedef enum command_kind {
+    COMMAND_CAMERA,
+    COMMAND_VIEW,
+    COMMAND_ISO,
+    COMMAND_ORBIT,
+    COMMAND_ZOOM,
+    COMMAND_WAIT,
+    COMMAND_WAIT_DONE,
+    COMMAND_FULL,
+    COMMAND_OVERLAY,
+    COMMAND_SCREENSHOT,
+    COMMAND_QUIT
+} command_kind;
+
+typedef struct command {
+    command_kind kind;
+    double a, b;
+    char *text; /* camera, view, screenshot: owned */
+} command;
+
+/* The text overlay: stb_easy_font's quads drawn as indexed triangles in pixel coordinates. */
+typedef struct overlay {
+    GLuint program, array, vertices, indices;
+    GLint viewport_at, scale_at, offset_at, colour_at;
+    uint32_t index_quads; /* quads the index buffer covers */
+    char *quads;          /* stb_easy_font's vertex output */
+    int quads_size;       /* bytes */
+} overlay;
+
+/* Frames per second, for the overlay (a short window) and the stats (whole seconds). */
+typedef struct frame_clock {
+    double first, last;                /* times of the first and last frame, seconds */
+    uint64_t frames;
+    double window_start;
+    uint64_t window_frames;
+    double shown;                      /* the overlay's figure */
+    double second_start;
+    uint64_t second_frames, seconds;   /* whole-second windows completed */
+    double slowest, fastest;           /* frames in the slowest and fastest whole second */
+} frame_clock;
+
+typedef struct viewer {
+    options o;
+    ip_store *store;
+    ip_cache *cache;
+    ip_engine *engine;
+    GLFWwindow *window;
+    ip_renderer *renderer;
+    overlay text;
+    double lo[3], hi[3];
+    float value_min, value_max;
+    ip_camera camera;
+    double iso;              /* the engine takes it as a float */
+    int restart;             /* the view or the isovalue changed: begin again */
+    uint64_t uploaded;       /* triangles of the engine's mesh on the GPU */
+    uint64_t passes;         /* ip_engine_begin() calls */
+    double pass_wall, pass_render; /* this pass: seconds stepping, seconds drawing */
+    double draw_seconds;     /* the last frame, from the end of its slice to its swap */
+    int paused, want_full, full_shown, overlay_on, help_on;
+    ip_mesh full_mesh;
+    ip_engine_counts full_counts;
+    double full_wall;
+    int typing;
+    char typed[48];
+    char message[160];
+    double message_until;
+    int drag_button;         /* GLFW_MOUSE_BUTTON_LEFT or _RIGHT while dragging, else -1 */
+    double drag_x, drag_y;
+    command *commands;
+    size_t command_count, next_command;
+    double wait_until;
+    int waiting_done;
+    char *screenshot_pending; /* a path, or "" for the next free isoview-NNN.png */
+    int screenshot_at_taken;
+    uint32_t screenshot_number;
+    double start;
+    frame_clock clock;
+    int quit, failed;
+    ip_error err;
+} viewer;
+
+/* main.c */
+/* Fills *err with code and the formatted message. */
+void set_error(ip_error *err, ip_status code, const char *fmt, ...);
+/* 1 once this pass has cast its --rays, 2 once it has extracted for its --time, else 0. */
+int pass_limit_reached(const viewer *v);
+/* 1 once nothing more will be extracted until the next change (pausing aside). */
+int refinement_complete(const viewer *v);
+/* Saves the next frame to `path` ("" for the next free isoview-NNN.png). */
+void request_screenshot(viewer *v, const char *path);
+
+/* options.c */
+/* Parses the command line into *o; returns 0, or 2 after a usage error (exits 0 after --help
+ * and --version). */
+int parse_args(int argc, char **argv, options *o);
+
+/* script.c */
+/* A malloc'd copy of text, or NULL. */
+char *copy_text(const char *text);
+/* Reads the whole --script up front, so that a bad line fails before a window opens. Returns
+ * 0, or -1 with the error ("FILE:LINE: problem") in *err. */
+int load_script(viewer *v, ip_error *err);
+/* Runs script commands until a wait, a screenshot (taken at the end of this frame) or the
+ * end of the script; t is seconds since the window opened. */
+void run_script(viewer *v, double t);
+void free_commands(viewer *v);
+
+/* controls.c */
+/* The camera of `axis` (fitted to the volume) or of the camera text, at the current size.
+ * Returns 0, or -1 with the error in *err. */
+int camera_from(viewer *v, const char *camera_text, const char *axis, ip_camera *out,
+                ip_error *err);
+void change_view(viewer *v);
+void change_iso(viewer *v, double iso);
+/* Moves the eye toward the target: the distance is divided by `factor`. */
+void zoom_view(viewer *v, double factor);
+/* Shows a line in the overlay for a few seconds. */
+void show_message(viewer *v, const char *fmt, ...);
+/* Routes the window's keyboard and mouse to the viewer (the window's user pointer). */
+void controls_install(GLFWwindow *window);
+
+/* overlay.c */
+/* Builds the overlay's program and buffers (the window's context current). Returns 0, or -1
+ * with the error in *err. */
+int overlay_create(overlay *t, ip_error *err);
+void overlay_destroy(overlay *t);
+/* Draws the heads-up text (when on, or while a full extraction blocks) and the help over the
+ * frame just rendered. */
+void overlay_draw_frame(viewer *v, int working_on_full);
+
+#endif

@@ -1,0 +1,495 @@
+/* isoview: the interactive viewer. The isosurface refines progressively in a window while it
+ * stays responsive: each frame casts rays for a time slice (ip_engine_step() on the render
+ * thread, whose workers use every core), uploads the triangles added since the last frame and
+ * draws. The slice is FRAME_BUDGET_SECONDS, or as long as the previous frame took to draw when
+ * that was longer (software OpenGL drawing a large mesh), up to MAX_SLICE_SECONDS, so that
+ * drawing never starves refinement. Any change of view or isovalue restarts the progressive
+ * order at once; as extraction is time-sliced, the work in flight is at most one slice.
+ *
+ * The other parts: options.c (the command line), script.c (--script), controls.c (mouse and
+ * keyboard), overlay.c (the heads-up text). docs/isoview.md documents the controls, the
+ * options and the script format.
+ */
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "isoprop/output.h"
+#include "isoview.h"
+
+#define FRAME_BUDGET_SECONDS 0.012 /* ray casting per frame: keeps 30+ fps while refining */
+#define MAX_SLICE_SECONDS 0.25     /* the longest slice: bounds the delay of input */
+#define FPS_WINDOW_SECONDS 0.5     /* the overlay's fps is averaged over this long */
+
+static char glfw_error[512];
+
+static void on_glfw_error(int code, const char *description)
+{
+    (void)code;
+    if (!glfw_error[0])
+        snprintf(glfw_error, sizeof glfw_error, "%s", description);
+}
+
+void set_error(ip_error *err, ip_status code, const char *fmt, ...)
+{
+    va_list ap;
+    err->code = code;
+    va_start(ap, fmt);
+    vsnprintf(err->message, sizeof err->message, fmt, ap);
+    va_end(ap);
+}
+
+int pass_limit_reached(const viewer *v)
+{
+    ip_engine_counts t;
+    ip_engine_totals(v->engine, &t);
+    if (v->o.common.rays && t.rays >= v->o.common.rays)
+        return 1;
+    return v->o.common.time_limit > 0 && v->pass_wall >= v->o.common.time_limit ? 2 : 0;
+}
+
+int refinement_complete(const viewer *v)
+{
+    return !v->restart && !v->want_full &&
+           (v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v));
+}
+
+void request_screenshot(viewer *v, const char *path)
+{
+    free(v->screenshot_pending);
+    v->screenshot_pending = copy_text(path);
+    if (!v->screenshot_pending) {
+        fprintf(stderr, "isoview: out of memory\n");
+        v->failed = v->quit = 1;
+    }
+}
+
+/* ---- frames ---- */
+
+static void frame_done(frame_clock *k, double t)
+{
+    k->frames++;
+    k->last = t;
+    if (k->frames == 1) { /* rates count the frames that end after this one */
+        k->first = k->window_start = k->second_start = t;
+        return;
+    }
+    k->window_frames++;
+    if (t - k->window_start >= FPS_WINDOW_SECONDS) {
+        k->shown = (double)k->window_frames / (t - k->window_start);
+        k->window_start = t;
+        k->window_frames = 0;
+    }
+    k->second_frames++;
+    if (t - k->second_start >= 1.0) {
+        double fps = (double)k->second_frames / (t - k->second_start);
+        if (k->seconds == 0 || fps < k->slowest)
+            k->slowest = fps;
+        if (k->seconds == 0 || fps > k->fastest)
+            k->fastest = fps;
+        k->seconds++;
+        k->second_start = t;
+        k->second_frames = 0;
+    }
+}
+
+static double frames_per_second(const frame_clock *k)
+{
+    return k->frames > 1 && k->last > k->first ? (double)(k->frames - 1) / (k->last - k->first)
+                                                : 0.0;
+}
+
+/* ---- the progressive engine and the mesh on the GPU ---- */
+
+static int begin_pass(viewer *v)
+{
+    v->restart = 0;
+    v->full_shown = 0;
+    v->passes++;
+    v->pass_wall = v->pass_render = 0;
+    ip_renderer_clear_mesh(v->renderer);
+    v->uploaded = 0;
+    if (ip_engine_begin(v->engine, &v->camera, (float)v->iso, &v->err) != IP_OK)
+        return -1;
+    return 0;
+}
+
+/* One frame's slice of ray casting, then the new triangles to the GPU. */
+static int refine(viewer *v)
+{
+    if (v->paused || v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v))
+        return 0;
+    double slice = v->draw_seconds < FRAME_BUDGET_SECONDS ? FRAME_BUDGET_SECONDS
+                   : v->draw_seconds > MAX_SLICE_SECONDS ? MAX_SLICE_SECONDS
+                   : v->draw_seconds;
+    if (v->o.common.time_limit > 0 && slice > v->o.common.time_limit - v->pass_wall)
+        slice = v->o.common.time_limit - v->pass_wall;
+    ip_engine_counts t;
+    ip_engine_totals(v->engine, &t);
+    double start = ip_now_seconds();
+    ip_status st = ip_engine_step(v->engine, v->o.common.rays ? v->o.common.rays - t.rays : 0, slice, NULL,
+                                  &v->err);
+    v->pass_wall += ip_now_seconds() - start;
+    if (st != IP_OK && st != IP_ERR_CANCELLED)
+        return -1;
+    const ip_mesh *mesh = ip_engine_mesh(v->engine);
+    if (ip_renderer_upload(v->renderer, mesh, v->uploaded, &v->err) != IP_OK)
+        return -1;
+    v->uploaded = mesh->triangle_count;
+    return 0;
+}
+
+/* Extracts every active cell (blocking: the frame before shows that it is working). */
+static int extract_full(viewer *v)
+{
+    v->want_full = 0;
+    ip_mesh_clear(&v->full_mesh);
+    memset(&v->full_counts, 0, sizeof v->full_counts);
+    double start = ip_now_seconds();
+    if (ip_extract_full(v->cache, (float)v->iso, 0, v->o.common.threads, &v->full_mesh, &v->full_counts,
+                        &v->err) != IP_OK)
+        return -1;
+    v->full_wall = ip_now_seconds() - start;
+    v->pass_render = 0;
+    ip_renderer_clear_mesh(v->renderer);
+    if (ip_renderer_upload(v->renderer, &v->full_mesh, 0, &v->err) != IP_OK)
+        return -1;
+    v->full_shown = 1;
+    return 0;
+}
+
+static int draw_frame(viewer *v, int working_on_full)
+{
+    double start = ip_now_seconds();
+    if (ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) != IP_OK)
+        return -1;
+    overlay_draw_frame(v, working_on_full);
+    double seconds = ip_now_seconds() - start;
+    v->pass_render += seconds;
+    if (!v->full_shown)
+        ip_engine_add_rendering_time(v->engine, seconds);
+    return 0;
+}
+
+/* Reads the frame just drawn back and writes it; "" picks the next free isoview-NNN.png. */
+static int save_screenshot(viewer *v)
+{
+    char name[64];
+    const char *path = v->screenshot_pending;
+    int automatic = !path[0];
+    if (automatic) {
+        do
+            snprintf(name, sizeof name, "isoview-%03u.png", ++v->screenshot_number);
+        while (access(name, F_OK) == 0 && v->screenshot_number < 100000);
+        path = name;
+    }
+    size_t bytes = (size_t)v->camera.width * v->camera.height * 4;
+    uint8_t *rgba = malloc(bytes);
+    ip_error err;
+    ip_error_clear(&err);
+    int rc = -1;
+    if (!rgba)
+        set_error(&err, IP_ERR_NOMEM, "out of memory for a screenshot");
+    else if (ip_renderer_read_rgba(v->renderer, rgba, &err) == IP_OK &&
+             ip_png_write(path, rgba, v->camera.width, v->camera.height,
+                          automatic ? 0 : v->o.common.force, &err) == IP_OK)
+        rc = 0;
+    free(rgba);
+    if (rc == 0) {
+        show_message(v, "saved %s", path);
+    } else if (automatic) {
+        show_message(v, "screenshot: %s", err.message);
+        fprintf(stderr, "isoview: %s\n", err.message);
+        rc = 0; /* a key press that failed is reported, not fatal */
+    } else {
+        v->err = err;
+    }
+    free(v->screenshot_pending);
+    v->screenshot_pending = NULL;
+    return rc;
+}
+
+/* Follows the framebuffer's size (resizes, HiDPI); returns 0 when there is nothing to draw. */
+static int follow_size(viewer *v)
+{
+    int width, height;
+    glfwGetFramebufferSize(v->window, &width, &height);
+    if (width <= 0 || height <= 0)
+        return 0;
+    if ((uint32_t)width != v->camera.width || (uint32_t)height != v->camera.height) {
+        if (ip_renderer_resize(v->renderer, (uint32_t)width, (uint32_t)height, &v->err) != IP_OK)
+            return -1;
+        v->camera.width = (uint32_t)width;
+        v->camera.height = (uint32_t)height;
+        change_view(v);
+    }
+    return 1;
+}
+
+/* One frame: input, script, timers, extraction slice, drawing, screenshot, swap.
+ * Returns 0, or -1 after an error in v->err. */
+static int frame(viewer *v)
+{
+    glfwPollEvents();
+    double t = ip_now_seconds() - v->start;
+    if (glfwWindowShouldClose(v->window) || (v->o.exit_after >= 0 && t >= v->o.exit_after)) {
+        v->quit = 1;
+        return 0;
+    }
+    run_script(v, t);
+    if (v->quit)
+        return 0;
+    if (v->o.screenshot_path && !v->screenshot_at_taken && t >= v->o.screenshot_at &&
+        !v->screenshot_pending) {
+        v->screenshot_at_taken = 1;
+        request_screenshot(v, v->o.screenshot_path);
+    }
+    int visible = follow_size(v);
+    if (visible < 0)
+        return -1;
+    if (!visible) {
+        glfwWaitEventsTimeout(0.1);
+        return 0;
+    }
+    if (v->restart && begin_pass(v) != 0)
+        return -1;
+    if (v->want_full) {
+        /* show that it is working, then block */
+        if (draw_frame(v, 1) != 0)
+            return -1;
+        glfwSwapBuffers(v->window);
+        if (extract_full(v) != 0)
+            return -1;
+    }
+    if (refine(v) != 0)
+        return -1;
+    double drawn = ip_now_seconds();
+    if (draw_frame(v, 0) != 0)
+        return -1;
+    if (v->screenshot_pending && !tool_signal_caught() && save_screenshot(v) != 0)
+        return -1;
+    glfwSwapBuffers(v->window);
+    double end = ip_now_seconds();
+    v->draw_seconds = end - drawn;
+    frame_done(&v->clock, end);
+    return 0;
+}
+
+/* ---- set-up, exit ---- */
+
+static int open_window(viewer *v)
+{
+    glfwSetErrorCallback(on_glfw_error);
+    if (!glfwInit()) {
+        fprintf(stderr, "isoview: cannot open a window: %s\n",
+                glfw_error[0] ? glfw_error : "GLFW cannot start");
+        return -1;
+    }
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_DEPTH_BITS, 24);
+    glfwWindowHint(GLFW_SAMPLES, 0); /* the image must match isorender's */
+    char title[256];
+    snprintf(title, sizeof title, "isoview: %s", v->o.file);
+    v->window = glfwCreateWindow((int)v->o.common.width, (int)v->o.common.height, title, NULL, NULL);
+    if (!v->window) {
+        fprintf(stderr, "isoview: cannot open a window: %s\n",
+                glfw_error[0] ? glfw_error : "no OpenGL 3.3 core context");
+        return -1;
+    }
+    glfwMakeContextCurrent(v->window);
+    glfwSwapInterval(1);
+    glfwSetWindowUserPointer(v->window, v);
+    controls_install(v->window);
+    int width, height;
+    glfwGetFramebufferSize(v->window, &width, &height);
+    v->camera.width = width > 0 ? (uint32_t)width : v->o.common.width;
+    v->camera.height = height > 0 ? (uint32_t)height : v->o.common.height;
+    if (ip_renderer_create_current(v->camera.width, v->camera.height, 0, &v->renderer,
+                                   &v->err) != IP_OK ||
+        overlay_create(&v->text, &v->err) != 0) {
+        fprintf(stderr, "isoview: %s\n", v->err.message);
+        return -1;
+    }
+    return 0;
+}
+
+static void json_counts(FILE *f, void *user)
+{
+    const viewer *v = user;
+    ip_engine_counts t;
+    int full = v->full_shown;
+    if (full)
+        t = v->full_counts;
+    else
+        ip_engine_totals(v->engine, &t);
+    int done = full || ip_engine_done(v->engine);
+    const tool_run_json j = {v->o.file, v->iso, full, &v->camera, "opengl", &v->o.common, 0,
+                             done, &t, full ? v->pass_render : t.rendering_seconds,
+                             full ? v->full_wall : v->pass_wall, 0.0};
+    tool_write_run_json(f, &j);
+    if (done)
+        fprintf(f, ", \"final_pixel_pct\": %.4f", 100.0);
+    const frame_clock *k = &v->clock;
+    double mean = frames_per_second(k);
+    fprintf(f, ", \"passes\": %llu, \"fps\": {\"frames\": %llu, \"seconds\": %.6f, "
+               "\"mean\": %.3f, \"min\": %.3f, \"max\": %.3f}",
+            (unsigned long long)v->passes, (unsigned long long)k->frames,
+            k->frames ? k->last - k->first : 0.0, mean, k->seconds ? k->slowest : mean,
+            k->seconds ? k->fastest : mean);
+}
+
+static void print_summary(const viewer *v)
+{
+    ip_engine_counts t;
+    if (v->full_shown)
+        t = v->full_counts;
+    else
+        ip_engine_totals(v->engine, &t);
+    printf("%s: iso %g, %s, %ux%u\n", v->o.file, v->iso,
+           v->full_shown ? "full extraction" : "progressive", v->camera.width,
+           v->camera.height);
+    printf("  rays          %llu of %llu\n", (unsigned long long)t.rays,
+           (unsigned long long)v->camera.width * v->camera.height);
+    printf("  triangles     %llu\n", (unsigned long long)t.triangles);
+    printf("  frames        %llu, %.1f fps (passes: %llu)\n",
+           (unsigned long long)v->clock.frames, frames_per_second(&v->clock),
+           (unsigned long long)v->passes);
+}
+
+static int finish(viewer *v)
+{
+    ip_cache_stats s;
+    ip_cache_get_stats(v->cache, &s);
+    uint64_t summary = ip_store_layout(v->store)->summary_size;
+    if (!v->o.common.quiet) {
+        print_summary(v);
+        tool_print_cache_table(stdout, &s, summary);
+    }
+    /* a failed run (a bad brick, a renderer error) writes no statistics, as isorender */
+    if (v->o.common.stats && !v->failed && !tool_signal_caught() &&
+        tool_write_stats_file("isoview", v->o.common.stats, v->o.common.force, &s, summary, json_counts, v) !=
+            0)
+        return 1;
+    return 0;
+}
+
+/* The run's inputs and outputs: the brick file, the script, --stats, --screenshot-at and
+ * the script's screenshots, checked together (tool_check_paths()). Returns 0, or 1 after
+ * printing the problem. */
+static int check_paths(const viewer *v)
+{
+    size_t outputs_count = 2;
+    for (size_t i = 0; i < v->command_count; i++)
+        outputs_count += v->commands[i].kind == COMMAND_SCREENSHOT;
+    const char **outputs = calloc(outputs_count, sizeof *outputs);
+    if (!outputs) {
+        fprintf(stderr, "isoview: out of memory\n");
+        return 1;
+    }
+    size_t n = 0;
+    outputs[n++] = v->o.common.stats;
+    outputs[n++] = v->o.screenshot_path;
+    for (size_t i = 0; i < v->command_count; i++)
+        if (v->commands[i].kind == COMMAND_SCREENSHOT)
+            outputs[n++] = v->commands[i].text;
+    const char *inputs[] = {v->o.file, v->o.script};
+    int rc = tool_check_paths("isoview", inputs, 2, outputs, n, v->o.common.force);
+    free(outputs);
+    return rc;
+}
+
+/* Everything that needs no window, so that bad input fails before one opens. Returns 0, -1
+ * with the error in v->err, or -2 after the error was printed. */
+static int prepare(viewer *v)
+{
+    ip_error *err = &v->err;
+    const char *inputs[] = {v->o.file, v->o.script};
+    if (tool_check_paths("isoview", inputs, 2, NULL, 0, v->o.common.force) != 0)
+        return -2;
+    if (ip_store_open(v->o.file, &v->store, err) != IP_OK)
+        return -1;
+    if (ip_cache_create(v->store, v->o.common.cache_bytes, &v->cache, err) != IP_OK)
+        return -1;
+    const ip_layout *l = ip_store_layout(v->store);
+    ip_layout_world_box(l, v->lo, v->hi);
+    v->value_min = l->value_min;
+    v->value_max = l->value_max;
+    v->camera.width = v->o.common.width;
+    v->camera.height = v->o.common.height;
+    if (camera_from(v, v->o.common.camera, v->o.common.view, &v->camera, err) != 0)
+        return -1;
+    if (v->o.script && load_script(v, err) != 0)
+        return -1;
+    if (check_paths(v) != 0)
+        return -2;
+    ip_engine_options eo;
+    tool_engine_options(&v->o.common, &eo);
+    if (ip_engine_create(v->cache, &eo, &v->engine, err) != IP_OK)
+        return -1;
+    tool_signals_cancel_engine(v->engine);
+    tool_warn_iso_range("isoview", v->store, v->o.common.iso, NULL, 0);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    viewer *v = calloc(1, sizeof *v);
+    if (!v) {
+        fprintf(stderr, "isoview: out of memory\n");
+        return 1;
+    }
+    int rc = parse_args(argc, argv, &v->o);
+    if (rc) {
+        free(v);
+        return rc;
+    }
+    ip_error_clear(&v->err);
+    ip_mesh_init(&v->full_mesh);
+    v->iso = v->o.common.iso;
+    v->overlay_on = 1;
+    v->drag_button = -1;
+    v->restart = 1;
+    rc = 1;
+    tool_signals_catch();
+    int prepared = prepare(v);
+    if (prepared == -1) {
+        tool_fail("isoview", &v->err);
+    } else if (prepared == 0 && open_window(v) == 0) {
+        /* the window may have opened at another size than asked: fit --view to it */
+        if (!v->o.common.camera)
+            (void)camera_from(v, NULL, v->o.common.view, &v->camera, &v->err);
+        v->start = ip_now_seconds();
+        while (!v->quit && !tool_signal_caught())
+            if (frame(v) != 0) {
+                tool_fail("isoview", &v->err);
+                v->failed = 1;
+                break;
+            }
+        int written = finish(v);
+        rc = v->failed || written != 0;
+    }
+    tool_signals_cancel_engine(NULL);
+    if (tool_signal_caught())
+        fprintf(stderr, "isoview: %s: interrupted; no --stats or pending screenshot written\n",
+                v->o.file);
+    free(v->screenshot_pending);
+    overlay_destroy(&v->text);
+    ip_renderer_destroy(v->renderer);
+    if (v->window)
+        glfwDestroyWindow(v->window);
+    glfwTerminate();
+    ip_engine_destroy(v->engine);
+    ip_mesh_free(&v->full_mesh);
+    free_commands(v);
+    ip_cache_destroy(v->cache);
+    ip_store_close(v->store);
+    free(v);
+    tool_signals_reraise();
+    return rc;
+}
+

@@ -1,0 +1,78 @@
+/* isoview's command line: the shared view options (tool_common) and isoview's own. */
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "isoview.h"
+
+static const char usage[] =
+    "usage: isoview FILE.ibv --iso V [options]\n"
+    "Shows the isosurface V in a window (OpenGL 3.3 core through GLFW), refining it\n"
+    "progressively (rays in the paper's order) while you orbit, pan, zoom and change V.\n"
+    "  --size WxH          window size (default 1280x960)\n"
+    "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
+    "                      (default -y; up is +z, or +y for the z views)\n"
+    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n"
+    "  --rays N            each pass (view and isovalue) stops after N rays\n"
+    "  --time SECONDS      each pass stops extracting after this long\n"
+    "  --cutoff DEGREES    propagation cut-off angle (default 1.81)\n"
+    "  --foldback DEGREES  fold-back tolerance (default 0.25)\n"
+    "  --lod on|off        adaptive resolution: far regions from coarser levels (default on)\n"
+    "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n"
+    "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
+    "  --threads N         threads for seeding, propagation and full extraction\n"
+    "                      (default: all cores)\n"
+    "  --stats OUT.json    on exit: counts, times, fps and the cache statistics as JSON\n"
+    "  --script FILE       run the commands of FILE (see docs/isoview.md)\n"
+    "  --screenshot-at SECONDS OUT.png\n"
+    "                      save the window's image that long after it opened\n"
+    "  --exit-after SECONDS\n"
+    "                      close the window that long after it opened (exit status 0)\n"
+    "  --force             replace existing outputs: --stats, screenshots named by --script\n"
+    "                      or --screenshot-at (regular files only; never an input)\n"
+    "  --quiet             print nothing but errors and warnings\n"
+    "  --version           print the version and exit\n"
+    "Ctrl-C (or SIGTERM) closes the window without writing --stats or pending screenshots;\n"
+    "isoview then ends as killed by the signal.\n"
+    "Controls: left drag orbits, right drag pans, the wheel zooms; Up/Down change V by 1 %\n"
+    "of the value range (with Shift 0.1 %), PageUp/PageDown by 10 %; i types V (Enter\n"
+    "applies); r resets the view; p pauses; f extracts everything; s saves a screenshot;\n"
+    "o hides the overlay; h shows help; Esc quits.\n";
+
+/* --screenshot-at SECONDS OUT.png */
+static int parse_screenshot_at(const char *p, const tool_option *opt, const char *const *v,
+                               void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (tool_parse_double(v[0], &o->screenshot_at) != 0 || o->screenshot_at < 0)
+        return tool_usage_error(p, "--screenshot-at '%s' is not seconds", v[0]);
+    o->screenshot_path = v[1];
+    return 0;
+}
+
+static int parse_exit_after(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (tool_parse_double(v[0], &o->exit_after) != 0 || o->exit_after < 0)
+        return tool_usage_error(p, "--exit-after '%s' is not seconds", v[0]);
+    return 0;
+}
+
+static const tool_option isoview_options[] = {
+    {"--script", NULL, 1, offsetof(options, script), NULL, NULL, NULL},
+    {"--screenshot-at", NULL, 2, 0, parse_screenshot_at, NULL, NULL},
+    {"--exit-after", NULL, 1, 0, parse_exit_after, NULL, NULL},
+};
+
+int parse_args(int argc, char **argv, options *o)
+{
+    memset(o, 0, sizeof *o);
+    tool_view_options_default(&o->common, 1280, 960);
+    o->screenshot_at = -1;
+    o->exit_after = -1;
+    return tool_parse_view_command_line(
+        "isoview", usage, &o->common, isoview_options,
+        sizeof isoview_options / sizeof isoview_options[0], o, &o->file, argc, argv);
+}

@@ -1,0 +1,223 @@
+/* isoview's overlay: the heads-up text and the help, stb_easy_font's quads drawn as indexed
+ * triangles in pixel coordinates over the rendered frame. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The font is a header of static functions (some unused here) in its own style: its warnings
+ * are not ours (CMake also adds its folder as a system include folder). */
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wmissing-braces"
+#include <stb_easy_font.h>
+#pragma GCC diagnostic pop
+
+#include "isoview.h"
+
+static const char help_text[] =
+    "left drag      orbit around the target\n"
+    "right drag     pan\n"
+    "wheel          zoom\n"
+    "Up / Down      isovalue +/- 1 % of the value range\n"
+    "Shift+Up/Down  isovalue +/- 0.1 %\n"
+    "PgUp / PgDn    isovalue +/- 10 %\n"
+    "i              type an isovalue (Enter applies, Esc cancels)\n"
+    "r              reset the view\n"
+    "p              pause / resume refinement\n"
+    "f              full extraction (until the next change)\n"
+    "s              save a screenshot (isoview-NNN.png)\n"
+    "o              overlay on / off\n"
+    "h              this help\n"
+    "Esc            quit";
+
+static const char *const overlay_vertex_source =
+    "#version 330 core\n"
+    "layout(location = 0) in vec2 position; /* pixels, top-left origin */\n"
+    "uniform vec2 viewport;\n"
+    "uniform float scale;\n"
+    "uniform vec2 offset;\n"
+    "void main() {\n"
+    "    vec2 p = (offset + position * scale) / viewport * 2.0 - 1.0;\n"
+    "    gl_Position = vec4(p.x, -p.y, 0.0, 1.0);\n"
+    "}\n";
+
+static const char *const overlay_fragment_source =
+    "#version 330 core\n"
+    "uniform vec4 colour;\n"
+    "out vec4 result;\n"
+    "void main() {\n"
+    "    result = colour;\n"
+    "}\n";
+
+enum { FONT_VERTEX_BYTES = 16, QUAD_BYTES = 4 * FONT_VERTEX_BYTES };
+
+int overlay_create(overlay *t, ip_error *err)
+{
+    memset(t, 0, sizeof t[0]);
+    t->quads_size = 4096 * QUAD_BYTES;
+    t->quads = malloc((size_t)t->quads_size);
+    if (!t->quads) {
+        set_error(err, IP_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    if (ip_gl_program(overlay_vertex_source, overlay_fragment_source, &t->program, err) != IP_OK)
+        return -1;
+    t->viewport_at = glGetUniformLocation(t->program, "viewport");
+    t->scale_at = glGetUniformLocation(t->program, "scale");
+    t->offset_at = glGetUniformLocation(t->program, "offset");
+    t->colour_at = glGetUniformLocation(t->program, "colour");
+    glGenVertexArrays(1, &t->array);
+    glGenBuffers(1, &t->vertices);
+    glGenBuffers(1, &t->indices);
+    glBindVertexArray(t->array);
+    glBindBuffer(GL_ARRAY_BUFFER, t->vertices);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, FONT_VERTEX_BYTES, NULL);
+    glEnableVertexAttribArray(0);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, t->indices); /* kept by the vertex array */
+    uint32_t quads = (uint32_t)(t->quads_size / QUAD_BYTES) + 1;
+    uint32_t *index = malloc((size_t)quads * 6 * sizeof *index);
+    if (!index) {
+        glBindVertexArray(0);
+        set_error(err, IP_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    for (uint32_t q = 0; q < quads; q++) {
+        const uint32_t corner[6] = {0, 1, 2, 0, 2, 3};
+        for (int k = 0; k < 6; k++)
+            index[6 * q + k] = 4 * q + corner[k];
+    }
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)quads * 6 * sizeof *index), index,
+                 GL_STATIC_DRAW);
+    free(index);
+    t->index_quads = quads;
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    if (glGetError() != GL_NO_ERROR) {
+        set_error(err, IP_ERR_UNSUPPORTED, "overlay: an OpenGL error while setting up");
+        return -1;
+    }
+    return 0;
+}
+
+void overlay_destroy(overlay *t)
+{
+    if (t->program) {
+        glDeleteProgram(t->program);
+        glDeleteVertexArrays(1, &t->array);
+        glDeleteBuffers(1, &t->vertices);
+        glDeleteBuffers(1, &t->indices);
+    }
+    free(t->quads);
+    memset(t, 0, sizeof t[0]);
+}
+
+/* Fills quad q of the buffer with the rectangle [x0, x1] x [y0, y1]. */
+static void put_rectangle(char *quads, int q, float x0, float y0, float x1, float y1)
+{
+    const float corners[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+    for (int k = 0; k < 4; k++)
+        memcpy(quads + q * QUAD_BYTES + k * FONT_VERTEX_BYTES, corners[k], 2 * sizeof(float));
+}
+
+/* Draws `text` on a translucent panel whose top-left corner is at (x, y) framebuffer pixels
+ * (top-left origin), scaled `scale` times. */
+static void overlay_draw(overlay *t, char *text, float x, float y, float scale, uint32_t width,
+                         uint32_t height)
+{
+    const float pad = 4;
+    /* quad 0 is the panel; the text follows */
+    int quads = stb_easy_font_print(0, 0, text, NULL, t->quads + QUAD_BYTES,
+                                    t->quads_size - QUAD_BYTES);
+    if ((uint32_t)quads + 1 > t->index_quads)
+        quads = (int)t->index_quads - 1;
+    float w = (float)stb_easy_font_width(text), h = (float)stb_easy_font_height(text);
+    put_rectangle(t->quads, 0, -pad, -pad, w + pad, h + pad);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, (GLsizei)width, (GLsizei)height);
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    /* colour blends; alpha stays opaque, so that screenshots stay RGB */
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    glUseProgram(t->program);
+    glUniform2f(t->viewport_at, (float)width, (float)height);
+    glUniform1f(t->scale_at, scale);
+    glUniform2f(t->offset_at, x + pad * scale, y + pad * scale);
+    glBindVertexArray(t->array);
+    glBindBuffer(GL_ARRAY_BUFFER, t->vertices);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(quads + 1) * QUAD_BYTES, t->quads,
+                 GL_STREAM_DRAW);
+    glUniform4f(t->colour_at, 0.0f, 0.0f, 0.0f, 0.6f);
+    glDrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, NULL);
+    glUniform4f(t->colour_at, 1.0f, 1.0f, 0.85f, 1.0f);
+    glDrawElements(GL_TRIANGLES, 6 * quads, GL_UNSIGNED_INT,
+                   (const void *)(6 * sizeof(uint32_t)));
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glDisable(GL_BLEND);
+}
+
+/* The heads-up text. "final px" is the share of pixels already showing their final colour: it
+ * is known exactly once every ray has been cast (100 %), and shown as "-" before. */
+static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
+{
+    ip_engine_counts t;
+    ip_cache_stats s;
+    ip_engine_totals(v->engine, &t);
+    ip_cache_get_stats(v->cache, &s);
+    double pixels = (double)v->camera.width * v->camera.height;
+    uint64_t lookups = s.hits + s.misses;
+    char iso[96], state[48] = "", progress[128];
+    if (v->typing)
+        snprintf(iso, sizeof iso, "iso> %s_  (Enter applies, Esc cancels)", v->typed);
+    else
+        snprintf(iso, sizeof iso, "iso %.7g  (values %.7g .. %.7g)", v->iso,
+                 (double)v->value_min, (double)v->value_max);
+    if (working_on_full)
+        snprintf(state, sizeof state, "  [extracting all...]");
+    else if (v->full_shown)
+        snprintf(state, sizeof state, "  [full]");
+    else if (v->paused)
+        snprintf(state, sizeof state, "  [paused]");
+    else if (!ip_engine_done(v->engine) && pass_limit_reached(v))
+        snprintf(state, sizeof state, "  [%s reached]",
+                 pass_limit_reached(v) == 1 ? "--rays" : "--time");
+    if (v->full_shown)
+        snprintf(progress, sizeof progress, "full: %llu cells in %.2f s   final px 100 %%\n"
+                 "triangles %llu", (unsigned long long)v->full_counts.cells, v->full_wall,
+                 (unsigned long long)v->full_counts.triangles);
+    else
+        snprintf(progress, sizeof progress, "rays %.1f %% of %.0f   final px %s\n"
+                 "triangles %llu", pixels > 0 ? 100.0 * (double)t.rays / pixels : 0.0, pixels,
+                 ip_engine_done(v->engine) ? "100 %" : "-", (unsigned long long)t.triangles);
+    int n = snprintf(text, size, "%s%s\n%s\nfps %.1f\ncache %.1f / %.1f MiB   hit rate %.1f %%\n"
+                     "misses %llu   bricks %llu / %llu",
+                     iso, state, progress, v->clock.shown, (double)s.resident_bytes / 1048576.0,
+                     (double)s.budget_bytes / 1048576.0,
+                     lookups ? 100.0 * (double)s.hits / (double)lookups : 0.0,
+                     (unsigned long long)s.misses, (unsigned long long)s.bricks_touched,
+                     (unsigned long long)s.bricks_total);
+    if (n > 0 && (size_t)n < size && v->message[0] && ip_now_seconds() < v->message_until)
+        snprintf(text + n, size - (size_t)n, "\n%s", v->message);
+    else if (n > 0 && (size_t)n < size && !v->help_on)
+        snprintf(text + n, size - (size_t)n, "\nh: help");
+}
+
+void overlay_draw_frame(viewer *v, int working_on_full)
+{
+    uint32_t width = v->camera.width, height = v->camera.height;
+    float scale = height >= 720 ? 2.0f : 1.0f;
+    if (v->overlay_on || working_on_full) {
+        char text[1024];
+        hud_text(v, text, sizeof text, working_on_full);
+        overlay_draw(&v->text, text, 8 * scale, 8 * scale, scale, width, height);
+    }
+    if (v->help_on) {
+        char text[sizeof help_text];
+        memcpy(text, help_text, sizeof help_text);
+        float w = (float)stb_easy_font_width(text) * scale;
+        float h = (float)stb_easy_font_height(text) * scale;
+        float x = ((float)width - w) / 2, y = ((float)height - h) / 2;
+        overlay_draw(&v->text, text, x > 0 ? x : 0, y > 0 ? y : 0, scale, width, height);
+    }
+}
