@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "array.h"
 #include "internal.h"
 #include "propagate.h"
 
@@ -108,14 +109,9 @@ static ip_status grow_queue(ip_propagator *p, uint64_t head, uint64_t tail)
 {
     /* keep the live part [head, tail) and move it to the front */
     memmove(p->queue, p->queue + head, (tail - head) * sizeof *p->queue);
-    if (tail - head + 6 > p->queue_capacity / 2) {
-        uint64_t cap = p->queue_capacity * 2;
-        ip_queued_cell *q = realloc(p->queue, cap * sizeof *q);
-        if (!q)
-            return IP_ERR_NOMEM;
-        p->queue = q;
-        p->queue_capacity = cap;
-    }
+    if (tail - head + 6 > p->queue_capacity / 2) /* doubles it */
+        return ip__array_reserve(&p->queue, &p->queue_capacity, p->queue_capacity + 1,
+                                 sizeof *p->queue, 4096);
     return IP_OK;
 }
 

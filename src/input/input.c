@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "array.h"
 #include "input_headers.h"
 #include "internal.h"
 #include "isoprop/input.h"
@@ -375,14 +376,13 @@ static ip_status grow_line(ip_text_file *header, ip_error *err)
     if (header->capacity > IP_TEXT_LINE_MAX)
         return ip__fail(err, IP_ERR_INPUT, "%s: header line %lu is longer than %d bytes",
                        header->path, header->line_number + 1, IP_TEXT_LINE_MAX);
-    size_t capacity = header->capacity ? header->capacity * 2 : 256;
+    uint64_t capacity =
+        ip__array_capacity(header->capacity, header->capacity + 1, 256, 1, IP_ARRAY_DOUBLE);
     if (capacity > IP_TEXT_LINE_MAX + 1)
         capacity = IP_TEXT_LINE_MAX + 1;
-    char *line = realloc(header->line, capacity);
-    if (!line)
+    if (ip__array_resize(&header->line, capacity, 1) != IP_OK)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading the header", header->path);
-    header->line = line;
-    header->capacity = capacity;
+    header->capacity = (size_t)capacity;
     return IP_OK;
 }
 
