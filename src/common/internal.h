@@ -68,4 +68,9 @@ enum {
  *  @return : IP_OK and *out set, or IP_ERR_ARGUMENT (NULL or unknown name; *out untouched). */
 ip_status ip__type_from_name(const char *name, unsigned spellings, ip_type *out);
 
+/* Writes to `out` (`size` bytes, cut short if need be, always terminated) the first name in
+ * `spellings` of each type, in the order of ip_type, separated by ", ": "uint8, uint16, int16,
+ * float" for IP_TYPE_SPELLING_NRRD. */
+void ip__type_names(unsigned spellings, char *out, size_t size);
+
 #endif

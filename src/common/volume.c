@@ -92,6 +92,24 @@ int ip_type_holds(ip_type type, float value)
     return 0;
 }
 
+void ip__type_names(unsigned spellings, char *out, size_t size)
+{
+    size_t used = 0;
+    out[0] = '\0';
+    for (int type = IP_UINT8; type <= IP_FLOAT32; type++) {
+        for (size_t i = 0; i < sizeof type_names / sizeof type_names[0]; i++) {
+            if ((int)type_names[i].type != type || !(type_names[i].spellings & spellings))
+                continue;
+            int n = snprintf(out + used, size - used, "%s%s", used ? ", " : "",
+                             type_names[i].name);
+            if (n < 0 || (size_t)n >= size - used)
+                return; /* cut short, terminated */
+            used += (size_t)n;
+            break;
+        }
+    }
+}
+
 ip_status ip_type_parse(const char *name, ip_type *out)
 {
     return ip__type_from_name(name, IP_TYPE_SPELLING_ALL, out);

@@ -305,11 +305,14 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
                              ip_input_desc *desc, ip_text_found *found, ip_error *err)
 {
     struct stat st;
+    const ip_text_format *format = NULL;
     switch (kind_of(path)) {
-    case INPUT_NRRD: return ip__nrrd_read_header(path, overrides, desc, found, err);
-    case INPUT_MHD: return ip__mhd_read_header(path, overrides, desc, found, err);
+    case INPUT_NRRD: format = &ip__nrrd_format; break;
+    case INPUT_MHD: format = &ip__mhd_format; break;
     case INPUT_RAW: break;
     }
+    if (format)
+        return ip__text_read_header(format, path, overrides, desc, found, err);
     /* A mistyped path should say so, not complain about the name. */
     if (stat(path, &st) != 0)
         return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);

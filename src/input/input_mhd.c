@@ -30,31 +30,6 @@ typedef struct mhd_header {
     char data_path[IP_PATH_MAX];
 } mhd_header;
 
-static ip_status parse_ndims(void *header, const ip_text_key *key, char *value, ip_error *err)
-{
-    mhd_header *h = header;
-    if (ip__text_parse_i64(value, &h->ndims) != 0 || h->ndims < 1)
-        return ip__text_bad_value(h, key->name, value, "not a positive whole number", err);
-    if (h->ndims != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: NDims %lld is not supported (need 3)", h->at.path,
-                       (long long)h->ndims);
-    return IP_OK;
-}
-
-static ip_status parse_element_type(void *header, const ip_text_key *key, char *value,
-                                    ip_error *err)
-{
-    mhd_header *h = header;
-    (void)key;
-    if (ip__type_from_name(value, IP_TYPE_SPELLING_METAIMAGE, &h->type) == IP_OK) {
-        h->has_type = 1;
-        return IP_OK;
-    }
-    return ip__fail(err, IP_ERR_INPUT,
-                   "%s: unsupported MetaImage ElementType '%.80s' (supported: MET_UCHAR, "
-                   "MET_USHORT, MET_SHORT, MET_FLOAT)", h->at.path, value);
-}
-
 static ip_status parse_msb(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
     mhd_header *h = header;
@@ -122,24 +97,30 @@ static ip_status parse_data_file(void *header, const ip_text_key *key, char *val
     return ip__text_data_path(h->at.path, value, h->data_path, err);
 }
 
-#define LIST(field) offsetof(mhd_header, field), offsetof(mhd_header, field##_count)
+/* MetaImage keys are words: KEY(ElementType, ...) names the key "ElementType". */
+#define KEY(name, by, parse) {#name, by, parse, 0, 0}
+#define VALUE(name, by, parse, field, seen) {#name, by, parse, offsetof(mhd_header, field), seen}
+#define LIST(name, by, parse, field) \
+    VALUE(name, by, parse, field, offsetof(mhd_header, field##_count))
 static const ip_text_key mhd_key_list[] = {
-    {"NDims", BY_DIMS, parse_ndims, 0, 0},
-    {"DimSize", BY_DIMS, ip__text_key_u64s, LIST(dims)},
-    {"ElementType", BY_TYPE, parse_element_type, 0, 0},
-    {"ElementSpacing", BY_SPACING, ip__text_key_doubles, LIST(spacing)},
-    {"ElementSize", BY_SPACING, ip__text_key_doubles, LIST(size)},
-    {"BinaryDataByteOrderMSB", BY_ENDIAN, parse_msb, 0, 0},
-    {"ElementByteOrderMSB", BY_ENDIAN, parse_msb, 0, 0},
-    {"CompressedData", BY_NOTHING, parse_compressed, 0, 0},
-    {"HeaderSize", BY_NOTHING, parse_header_size, 0, 0},
-    {"ElementNumberOfChannels", BY_NOTHING, parse_channels, 0, 0},
-    {"BinaryData", BY_NOTHING, parse_binary, 0, 0},
-    {"ElementDataFile", BY_NOTHING, parse_data_file, 0, 0},
+    VALUE(NDims, BY_DIMS, ip__text_key_dimensions, ndims, 0),
+    LIST(DimSize, BY_DIMS, ip__text_key_u64s, dims),
+    VALUE(ElementType, BY_TYPE, ip__text_key_type, type, offsetof(mhd_header, has_type)),
+    LIST(ElementSpacing, BY_SPACING, ip__text_key_doubles, spacing),
+    LIST(ElementSize, BY_SPACING, ip__text_key_doubles, size),
+    KEY(BinaryDataByteOrderMSB, BY_ENDIAN, parse_msb),
+    KEY(ElementByteOrderMSB, BY_ENDIAN, parse_msb),
+    KEY(CompressedData, BY_NOTHING, parse_compressed),
+    KEY(HeaderSize, BY_NOTHING, parse_header_size),
+    KEY(ElementNumberOfChannels, BY_NOTHING, parse_channels),
+    KEY(BinaryData, BY_NOTHING, parse_binary),
+    KEY(ElementDataFile, BY_NOTHING, parse_data_file),
 };
+#undef KEY
+#undef VALUE
 #undef LIST
 static const ip_text_keys mhd_keys = {mhd_key_list, sizeof mhd_key_list / sizeof mhd_key_list[0],
-                                      1, NULL};
+                                      1, NULL, "MetaImage", IP_TYPE_SPELLING_METAIMAGE};
 
 /* One "Key = Value" line; keys the reader does not need (ObjectType, Offset,
  * TransformMatrix, ...) are skipped. */
@@ -156,9 +137,10 @@ static ip_status parse_line(mhd_header *h, char *line, const ip_input_overrides 
 }
 
 /* Reads keys up to ElementDataFile, which the format puts last. */
-static ip_status read_keys(ip_text_file *file, mhd_header *h,
+static ip_status read_keys(ip_text_file *file, void *header,
                            const ip_input_overrides *overrides, ip_error *err)
 {
+    mhd_header *h = header;
     int got;
     ip_status status = IP_OK;
     while (!h->has_data_file && (status = ip__text_next_line(file, &got, err)) == IP_OK && got) {
@@ -178,24 +160,15 @@ static ip_status read_keys(ip_text_file *file, mhd_header *h,
     return ip__fail(err, IP_ERR_INPUT, "%s: missing key 'ElementDataFile'", h->at.path);
 }
 
-static ip_status missing(const mhd_header *h, const char *key, ip_error *err)
-{
-    return ip__fail(err, IP_ERR_INPUT, "%s: missing key '%s'", h->at.path, key);
-}
-
 static ip_status check_keys(const mhd_header *h, const ip_input_overrides *overrides,
                             ip_error *err)
 {
-    int dims_given = overrides && overrides->has_dims;
-    if (!dims_given && h->ndims == 0)
-        return missing(h, "NDims", err);
-    if (!dims_given && h->dims_count < 0)
-        return missing(h, "DimSize", err);
-    if (!dims_given && h->dims_count != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: DimSize has %d values, NDims is 3", h->at.path,
-                       h->dims_count);
+    ip_status st = ip__text_check_dims(h, h->ndims, "NDims", h->dims_count, "DimSize", overrides,
+                                       err);
+    if (st != IP_OK)
+        return st;
     if (!(overrides && overrides->has_type) && !h->has_type)
-        return missing(h, "ElementType", err);
+        return ip__text_missing(h, "ElementType", err);
     if (h->spacing_count >= 0 && h->spacing_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: ElementSpacing has %d values, NDims is 3",
                        h->at.path, h->spacing_count);
@@ -213,14 +186,7 @@ static ip_status check_keys(const mhd_header *h, const ip_input_overrides *overr
 static void fill_desc(const mhd_header *h, uint64_t header_end, ip_input_desc *desc,
                       ip_text_found *found)
 {
-    if (h->has_type) {
-        desc->type = h->type;
-        found->has_type = 1;
-    }
-    if (h->dims_count == 3) {
-        memcpy(found->dims, h->dims, sizeof found->dims);
-        found->has_dims = 1;
-    }
+    ip__text_found_layout(h->has_type, h->type, h->dims_count, h->dims, desc, found);
     desc->big_endian = h->has_msb ? h->msb : 0;
     desc->encoding = h->compressed ? IP_ENCODING_GZIP : IP_ENCODING_RAW;
     for (int axis = 0; axis < 3; axis++) {
@@ -238,27 +204,19 @@ static void fill_desc(const mhd_header *h, uint64_t header_end, ip_input_desc *d
         desc->data_offset = base + (uint64_t)h->header_size;
 }
 
-ip_status ip__mhd_read_header(const char *path, const ip_input_overrides *overrides,
-                             ip_input_desc *desc, ip_text_found *found, ip_error *err)
+static void init(void *header)
 {
-    ip_text_file file;
-    mhd_header *h = calloc(1, sizeof *h);
-    if (!h)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading the header", path);
-    h->at.path = path;
-    h->dims_count = -1;
-    h->spacing_count = -1;
-    h->size_count = -1;
-    ip_status status = ip__text_open(&file, path, err);
-    if (status == IP_OK) {
-        status = read_keys(&file, h, overrides, err);
-        uint64_t header_end = file.offset;
-        ip__text_close(&file);
-        if (status == IP_OK)
-            status = check_keys(h, overrides, err);
-        if (status == IP_OK)
-            fill_desc(h, header_end, desc, found);
-    }
-    free(h);
+    mhd_header *h = header;
+    h->dims_count = h->spacing_count = h->size_count = -1; /* not seen yet */
+}
+
+static ip_status finish(void *header, uint64_t header_end, const ip_input_overrides *overrides,
+                        ip_input_desc *desc, ip_text_found *found, ip_error *err)
+{
+    ip_status status = check_keys(header, overrides, err);
+    if (status == IP_OK)
+        fill_desc(header, header_end, desc, found);
     return status;
 }
+
+const ip_text_format ip__mhd_format = {&mhd_keys, sizeof(mhd_header), init, read_keys, finish};

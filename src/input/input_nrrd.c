@@ -35,31 +35,8 @@ typedef struct nrrd_header {
     int64_t line_skip;
     int has_data_file;
     char data_path[IP_PATH_MAX];
+    int blank_line;      /* a blank line ended the header: attached data follow it */
 } nrrd_header;
-
-static ip_status parse_type(void *header, const ip_text_key *key, char *value, ip_error *err)
-{
-    nrrd_header *h = header;
-    (void)key;
-    if (ip__type_from_name(value, IP_TYPE_SPELLING_NRRD, &h->type) == IP_OK) {
-        h->has_type = 1;
-        return IP_OK;
-    }
-    return ip__fail(err, IP_ERR_INPUT,
-                   "%s: unsupported NRRD type '%.80s' (supported: uint8, uint16, int16, float)",
-                   h->at.path, value);
-}
-
-static ip_status parse_dimension(void *header, const ip_text_key *key, char *value, ip_error *err)
-{
-    nrrd_header *h = header;
-    if (ip__text_parse_i64(value, &h->dimension) != 0 || h->dimension < 1)
-        return ip__text_bad_value(h, key->name, value, "not a positive whole number", err);
-    if (h->dimension != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: NRRD dimension %lld is not supported (need 3)",
-                       h->at.path, (long long)h->dimension);
-    return IP_OK;
-}
 
 static ip_status parse_endian(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
@@ -190,8 +167,9 @@ static ip_status parse_data_file(void *header, const ip_text_key *key, char *val
 }
 
 static const ip_text_key nrrd_field_list[] = {
-    {"type", BY_TYPE, parse_type, 0, 0},
-    {"dimension", BY_DIMS, parse_dimension, 0, 0},
+    {"type", BY_TYPE, ip__text_key_type, offsetof(nrrd_header, type),
+     offsetof(nrrd_header, has_type)},
+    {"dimension", BY_DIMS, ip__text_key_dimensions, offsetof(nrrd_header, dimension), 0},
     {"sizes", BY_DIMS, ip__text_key_u64s, offsetof(nrrd_header, sizes),
      offsetof(nrrd_header, sizes_count)},
     {"endian", BY_ENDIAN, parse_endian, 0, 0},
@@ -207,7 +185,8 @@ static const ip_text_key nrrd_field_list[] = {
     {"datafile", BY_NOTHING, parse_data_file, 0, 0},
 };
 static const ip_text_keys nrrd_fields = {
-    nrrd_field_list, sizeof nrrd_field_list / sizeof nrrd_field_list[0], 0, "field"};
+    nrrd_field_list, sizeof nrrd_field_list / sizeof nrrd_field_list[0], 0, "field", "NRRD",
+    IP_TYPE_SPELLING_NRRD};
 
 /* One "field: value" line. Key/value pairs ("key:=value") and fields that describe anything
  * else (content, kinds, space origin, ...) are not needed to read the samples. */
@@ -229,12 +208,12 @@ static ip_status parse_line(nrrd_header *h, char *line, const ip_input_overrides
     return ip__text_dispatch(&nrrd_fields, h, line, ip__text_trim(colon + 1), overrides, err);
 }
 
-/* Reads the magic and the fields; *blank_line tells whether a blank line ended the header
+/* Reads the magic and the fields; h->blank_line tells whether a blank line ended the header
  * (attached data follow it) or the end of the file did. */
-static ip_status read_fields(ip_text_file *file, nrrd_header *h,
-                             const ip_input_overrides *overrides, int *blank_line,
-                             ip_error *err)
+static ip_status read_fields(ip_text_file *file, void *header,
+                             const ip_input_overrides *overrides, ip_error *err)
 {
+    nrrd_header *h = header;
     int got;
     ip_status status = ip__text_next_line(file, &got, err);
     if (status != IP_OK)
@@ -243,10 +222,10 @@ static ip_status read_fields(ip_text_file *file, nrrd_header *h,
         return ip__fail(err, IP_ERR_INPUT,
                        "%s: not a NRRD file (the first line does not start with NRRD000)",
                        h->at.path);
-    *blank_line = 0;
+    h->blank_line = 0;
     while ((status = ip__text_next_line(file, &got, err)) == IP_OK && got) {
         if (file->line[0] == '\0') {
-            *blank_line = 1;
+            h->blank_line = 1;
             break;
         }
         if (file->line[0] == '#')
@@ -256,11 +235,6 @@ static ip_status read_fields(ip_text_file *file, nrrd_header *h,
             return status;
     }
     return status;
-}
-
-static ip_status missing(const nrrd_header *h, const char *field, ip_error *err)
-{
-    return ip__fail(err, IP_ERR_INPUT, "%s: missing field '%s'", h->at.path, field);
 }
 
 /* Moves *offset past `lines` line endings of the data file. */
@@ -310,19 +284,14 @@ static ip_status skip_lines(const nrrd_header *h, const char *data_path, int64_t
 static ip_status check_layout_fields(const nrrd_header *h, const ip_input_overrides *overrides,
                                      ip_error *err)
 {
-    int dims_given = overrides && overrides->has_dims;
-    int type_given = overrides && overrides->has_type;
-    if (!type_given && !h->has_type)
-        return missing(h, "type", err);
-    if (!dims_given && h->dimension == 0)
-        return missing(h, "dimension", err);
-    if (!dims_given && h->sizes_count < 0)
-        return missing(h, "sizes", err);
-    if (!dims_given && h->sizes_count != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: sizes has %d values, dimension is 3", h->at.path,
-                       h->sizes_count);
+    ip_status st = IP_OK;
+    if (!(overrides && overrides->has_type) && !h->has_type)
+        return ip__text_missing(h, "type", err);
+    st = ip__text_check_dims(h, h->dimension, "dimension", h->sizes_count, "sizes", overrides, err);
+    if (st != IP_OK)
+        return st;
     if (!h->has_encoding)
-        return missing(h, "encoding", err);
+        return ip__text_missing(h, "encoding", err);
     if (h->spacings_count >= 0 && h->spacings_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: spacings has %d values, dimension is 3",
                        h->at.path, h->spacings_count);
@@ -354,14 +323,7 @@ static ip_status check_endian(const nrrd_header *h, const ip_input_overrides *ov
 
 static void fill_desc(const nrrd_header *h, ip_input_desc *desc, ip_text_found *found)
 {
-    if (h->has_type) {
-        desc->type = h->type;
-        found->has_type = 1;
-    }
-    if (h->sizes_count == 3) {
-        memcpy(found->dims, h->sizes, sizeof found->dims);
-        found->has_dims = 1;
-    }
+    ip__text_found_layout(h->has_type, h->type, h->sizes_count, h->sizes, desc, found);
     desc->big_endian = h->big_endian;
     desc->encoding = h->encoding;
     for (int axis = 0; axis < 3; axis++) {
@@ -374,13 +336,13 @@ static void fill_desc(const nrrd_header *h, ip_input_desc *desc, ip_text_found *
 
 /* Works out where the samples start: after the header (attached) or at the start of the data
  * file (detached), then past `line skip` lines and `byte skip` bytes. */
-static ip_status place_data(const nrrd_header *h, uint64_t header_end, int blank_line,
-                            ip_input_desc *desc, ip_text_found *found, ip_error *err)
+static ip_status place_data(const nrrd_header *h, uint64_t header_end, ip_input_desc *desc,
+                            ip_text_found *found, ip_error *err)
 {
     uint64_t offset = 0;
     if (h->has_data_file) {
         snprintf(desc->data_path, sizeof desc->data_path, "%s", h->data_path);
-    } else if (blank_line) {
+    } else if (h->blank_line) {
         offset = header_end;
     } else {
         return ip__fail(err, IP_ERR_INPUT,
@@ -400,32 +362,25 @@ static ip_status place_data(const nrrd_header *h, uint64_t header_end, int blank
     return IP_OK;
 }
 
-ip_status ip__nrrd_read_header(const char *path, const ip_input_overrides *overrides,
-                              ip_input_desc *desc, ip_text_found *found, ip_error *err)
+static void init(void *header)
 {
-    ip_text_file file;
-    int blank_line = 0;
-    nrrd_header *h = calloc(1, sizeof *h);
-    if (!h)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading the header", path);
-    h->at.path = path;
-    h->sizes_count = -1;
-    h->spacings_count = -1;
-    h->directions_count = -1;
-    ip_status status = ip__text_open(&file, path, err);
-    if (status == IP_OK) {
-        status = read_fields(&file, h, overrides, &blank_line, err);
-        uint64_t header_end = file.offset;
-        ip__text_close(&file);
-        if (status == IP_OK)
-            status = check_layout_fields(h, overrides, err);
-        if (status == IP_OK)
-            status = check_endian(h, overrides, err);
-        if (status == IP_OK) {
-            fill_desc(h, desc, found);
-            status = place_data(h, header_end, blank_line, desc, found, err);
-        }
-    }
-    free(h);
-    return status;
+    nrrd_header *h = header;
+    h->sizes_count = h->spacings_count = h->directions_count = -1; /* not seen yet */
 }
+
+/* Checks the fields, then fills `desc` and `found`. */
+static ip_status finish(void *header, uint64_t header_end, const ip_input_overrides *overrides,
+                        ip_input_desc *desc, ip_text_found *found, ip_error *err)
+{
+    nrrd_header *h = header;
+    ip_status status = check_layout_fields(h, overrides, err);
+    if (status == IP_OK)
+        status = check_endian(h, overrides, err);
+    if (status != IP_OK)
+        return status;
+    fill_desc(h, desc, found);
+    return place_data(h, header_end, desc, found, err);
+}
+
+const ip_text_format ip__nrrd_format = {&nrrd_fields, sizeof(nrrd_header), init, read_fields,
+                                        finish};

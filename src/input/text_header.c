@@ -219,28 +219,120 @@ ip_status ip__text_bad_value(const void *header, const char *key, const char *va
                    at->line_number, key, value, why);
 }
 
-ip_status ip__text_key_u64s(void *header, const ip_text_key *key, char *value, ip_error *err)
+static ip_status key_list(void *header, const ip_text_key *key, char *value, int whole,
+                          ip_error *err)
 {
     char *base = header;
-    if (ip__text_parse_u64_list(value, (uint64_t *)(base + key->values), 3,
-                                (int *)(base + key->count)) != 0)
-        return ip__text_bad_value(header, key->name, value, "not whole numbers", err);
+    if (parse_list(value, whole, base + key->field, 3, (int *)(base + key->seen)) != 0)
+        return ip__text_bad_value(header, key->name, value,
+                                  whole ? "not whole numbers" : "not numbers", err);
     return IP_OK;
+}
+
+ip_status ip__text_key_u64s(void *header, const ip_text_key *key, char *value, ip_error *err)
+{
+    return key_list(header, key, value, 1, err);
 }
 
 ip_status ip__text_key_doubles(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    return key_list(header, key, value, 0, err);
+}
+
+ip_status ip__text_key_type(void *header, const ip_text_key *key, char *value, ip_error *err)
+{
+    const ip_text_place *at = header;
     char *base = header;
-    if (ip__text_parse_double_list(value, (double *)(base + key->values), 3,
-                                   (int *)(base + key->count)) != 0)
-        return ip__text_bad_value(header, key->name, value, "not numbers", err);
+    if (ip__type_from_name(value, at->keys->type_spellings, (ip_type *)(base + key->field)) ==
+        IP_OK) {
+        *(int *)(base + key->seen) = 1;
+        return IP_OK;
+    }
+    char names[64];
+    ip__type_names(at->keys->type_spellings, names, sizeof names);
+    return ip__fail(err, IP_ERR_INPUT, "%s: unsupported %s %s '%.80s' (supported: %s)", at->path,
+                   at->keys->format, key->name, value, names);
+}
+
+ip_status ip__text_key_dimensions(void *header, const ip_text_key *key, char *value,
+                                  ip_error *err)
+{
+    const ip_text_place *at = header;
+    int64_t *dimensions = (int64_t *)((char *)header + key->field);
+    if (ip__text_parse_i64(value, dimensions) != 0 || *dimensions < 1)
+        return ip__text_bad_value(header, key->name, value, "not a positive whole number", err);
+    if (*dimensions != 3)
+        return ip__fail(err, IP_ERR_INPUT, "%s: %s%s%s %lld is not supported (need 3)", at->path,
+                       at->keys->key_word ? at->keys->format : "",
+                       at->keys->key_word ? " " : "", key->name, (long long)*dimensions);
     return IP_OK;
+}
+
+ip_status ip__text_missing(const void *header, const char *key, ip_error *err)
+{
+    const ip_text_place *at = header;
+    return ip__fail(err, IP_ERR_INPUT, "%s: missing %s '%s'", at->path,
+                   at->keys->key_word ? at->keys->key_word : "key", key);
+}
+
+ip_status ip__text_check_dims(const void *header, int64_t dimensions, const char *dimensions_key,
+                              int sizes_count, const char *sizes_key,
+                              const ip_input_overrides *overrides, ip_error *err)
+{
+    const ip_text_place *at = header;
+    if (overrides && overrides->has_dims)
+        return IP_OK;
+    if (dimensions == 0)
+        return ip__text_missing(header, dimensions_key, err);
+    if (sizes_count < 0)
+        return ip__text_missing(header, sizes_key, err);
+    if (sizes_count != 3)
+        return ip__fail(err, IP_ERR_INPUT, "%s: %s has %d values, %s is 3", at->path, sizes_key,
+                       sizes_count, dimensions_key);
+    return IP_OK;
+}
+
+void ip__text_found_layout(int has_type, ip_type type, int sizes_count, const uint64_t sizes[3],
+                           ip_input_desc *desc, ip_text_found *found)
+{
+    if (has_type) {
+        desc->type = type;
+        found->has_type = 1;
+    }
+    if (sizes_count == 3) {
+        memcpy(found->dims, sizes, sizeof found->dims);
+        found->has_dims = 1;
+    }
+}
+
+ip_status ip__text_read_header(const ip_text_format *format, const char *path,
+                               const ip_input_overrides *overrides, ip_input_desc *desc,
+                               ip_text_found *found, ip_error *err)
+{
+    ip_text_file file;
+    void *header = calloc(1, format->header_size);
+    if (!header)
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading the header", path);
+    ((ip_text_place *)header)->path = path;
+    ((ip_text_place *)header)->keys = format->keys;
+    format->init(header);
+    ip_status status = ip__text_open(&file, path, err);
+    if (status == IP_OK) {
+        status = format->read(&file, header, overrides, err);
+        uint64_t header_end = file.offset;
+        ip__text_close(&file);
+        if (status == IP_OK)
+            status = format->finish(header, header_end, overrides, desc, found, err);
+    }
+    free(header);
+    return status;
 }
 
 ip_status ip__text_dispatch(const ip_text_keys *table, void *header, const char *key,
                             char *value, const ip_input_overrides *overrides, ip_error *err)
 {
-    const ip_text_place *at = header;
+    ip_text_place *at = header;
+    at->keys = table;
     for (size_t i = 0; i < table->count; i++) {
         const ip_text_key *k = &table->keys[i];
         if ((table->ignore_case ? strcasecmp(key, k->name) : strcmp(key, k->name)) != 0)
