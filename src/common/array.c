@@ -14,8 +14,8 @@ uint64_t ip__array_capacity(uint64_t capacity, uint64_t needed, uint64_t first, 
         return 0;
     uint64_t cap = capacity ? capacity : first ? first : 1;
     while (cap < needed) {
-        uint64_t step = cap / (uint64_t)growth;
-        cap = step && cap <= limit - step ? cap + step : limit;
+        uint64_t step = cap / (uint64_t)growth ? cap / (uint64_t)growth : 1;
+        cap = cap <= limit - step ? cap + step : limit;
     }
     return cap;
 }
