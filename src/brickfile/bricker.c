@@ -421,36 +421,13 @@ static ip_status stream_input(bricker *b, const ip_input_desc *in, ip_error *err
 
 /* ---- finishing ---- */
 
-static void build_octree(const ip_layout *l, const float *brick_ranges, float *nodes)
+/* ip__octree_walk() visitor: stores each node's range, read back for the next depth. */
+static int store_node(void *nodes, uint32_t level, uint32_t depth, const uint32_t node[3],
+                      uint64_t node_index, const float range[2])
 {
-    for (uint32_t k = 0; k < l->level_count; k++) {
-        const ip_level_layout *lv = &l->levels[k];
-        for (uint32_t depth = 1; depth <= lv->octree_depth; depth++) {
-            uint32_t grid[3], child_grid[3];
-            ip__octree_grid(l, k, depth, grid);
-            ip__octree_grid(l, k, depth - 1, child_grid);
-            for (uint32_t z = 0; z < grid[2]; z++)
-                for (uint32_t y = 0; y < grid[1]; y++)
-                    for (uint32_t x = 0; x < grid[0]; x++) {
-                        uint32_t node[3] = {x, y, z};
-                        float *out = &nodes[2 * ip__octree_node_index(l, k, depth, node)];
-                        out[0] = INFINITY;
-                        out[1] = -INFINITY;
-                        for (int c = 0; c < 8; c++) {
-                            uint32_t ch[3] = {2 * x + (c & 1), 2 * y + ((c >> 1) & 1),
-                                              2 * z + ((c >> 2) & 1)};
-                            if (ch[0] >= child_grid[0] || ch[1] >= child_grid[1] ||
-                                ch[2] >= child_grid[2])
-                                continue;
-                            const float *r =
-                                depth == 1 ? &brick_ranges[2 * ip_brick_global_index(l, k, ch)]
-                                           : &nodes[2 * ip__octree_node_index(l, k, depth - 1, ch)];
-                            out[0] = fminf(out[0], r[0]);
-                            out[1] = fmaxf(out[1], r[1]);
-                        }
-                    }
-        }
-    }
+    (void)level, (void)depth, (void)node;
+    memcpy((float *)nodes + 2 * node_index, range, 2 * sizeof(float));
+    return 0;
 }
 
 static ip_status copy_range(bricker *b, int out_fd, uint64_t from, uint64_t to, uint32_t size,
@@ -546,7 +523,7 @@ static ip_status write_summary(bricker *b, int out_fd, ip_error *err)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the summary", b->out_path);
     }
     level_ranges(b);
-    build_octree(l, b->brick_ranges, nodes);
+    ip__octree_walk(l, b->brick_ranges, nodes, store_node, nodes);
     ip__format_level_table_encode(l, s + o.level_table);
     for (uint64_t g = 0; g < l->brick_count; g++)
         ip__format_entry_encode(&b->entries[g], s + o.directory + g * IP_DIRECTORY_ENTRY_SIZE);

@@ -1,6 +1,7 @@
 /* Min/max summaries of bricks and sub-blocks. */
 #include <math.h>
 
+#include "format.h"
 #include "summary.h"
 
 #define BOX_RANGE(T)                                                               \
@@ -67,4 +68,49 @@ void ip__summarise_brick(const void *samples, ip_type type, const uint32_t exten
         brick_range[0] = fminf(brick_range[0], ranges[2 * j]);
         brick_range[1] = fmaxf(brick_range[1], ranges[2 * j + 1]);
     }
+}
+
+/* The union of the ranges of the children of `node` at `depth` of `level`. */
+static void node_range(const ip_layout *l, uint32_t level, uint32_t depth, const uint32_t node[3],
+                       const uint32_t child_grid[3], const float *brick_ranges,
+                       const float *node_ranges, float range[2])
+{
+    range[0] = INFINITY;
+    range[1] = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        uint32_t ch[3] = {2 * node[0] + (c & 1), 2 * node[1] + ((c >> 1) & 1),
+                          2 * node[2] + ((c >> 2) & 1)};
+        if (ch[0] >= child_grid[0] || ch[1] >= child_grid[1] || ch[2] >= child_grid[2])
+            continue;
+        const float *r = depth == 1
+                             ? &brick_ranges[2 * ip_brick_global_index(l, level, ch)]
+                             : &node_ranges[2 * ip__octree_node_index(l, level, depth - 1, ch)];
+        range[0] = fminf(range[0], r[0]);
+        range[1] = fmaxf(range[1], r[1]);
+    }
+}
+
+int ip__octree_walk(const ip_layout *l, const float *brick_ranges, const float *node_ranges,
+                    ip_octree_node_fn visit, void *user)
+{
+    for (uint32_t k = 0; k < l->level_count; k++) {
+        for (uint32_t depth = 1; depth <= l->levels[k].octree_depth; depth++) {
+            uint32_t grid[3], child_grid[3];
+            ip__octree_grid(l, k, depth, grid);
+            ip__octree_grid(l, k, depth - 1, child_grid);
+            for (uint32_t z = 0; z < grid[2]; z++)
+                for (uint32_t y = 0; y < grid[1]; y++)
+                    for (uint32_t x = 0; x < grid[0]; x++) {
+                        uint32_t node[3] = {x, y, z};
+                        float range[2];
+                        node_range(l, k, depth, node, child_grid, brick_ranges, node_ranges,
+                                   range);
+                        int stop = visit(user, k, depth, node,
+                                         ip__octree_node_index(l, k, depth, node), range);
+                        if (stop)
+                            return stop;
+                    }
+        }
+    }
+    return 0;
 }

@@ -4,6 +4,7 @@
 
 #include <stdint.h>
 
+#include "isoprop/layout.h"
 #include "isoprop/volume.h"
 
 /* Range of the samples in the inclusive box [lo, hi] of a brick of `extent` samples. */
@@ -17,5 +18,22 @@ void ip__box_range(const void *samples, ip_type type, const uint32_t extent[3],
 void ip__summarise_brick(const void *samples, ip_type type, const uint32_t extent[3],
                         uint32_t brick_edge, uint32_t subblock_edge, float brick_range[2],
                         float *ranges);
+
+/* Called by ip__octree_walk() once per node with the union of its children's ranges, as
+ * read at that moment; a nonzero return stops the walk and is returned by it. */
+typedef int (*ip_octree_node_fn)(void *user, uint32_t level, uint32_t depth,
+                                 const uint32_t node[3], uint64_t node_index,
+                                 const float range[2]);
+
+/*! ip__octree_walk() : visits every node of the min/max octree (docs/format.md) level by level,
+ *  depth 1 first, z slowest and x fastest within a depth, and passes `visit` the union of the
+ *  ranges of the node's up-to-8 children: bricks at depth 1 (`brick_ranges`, 2 floats per
+ *  global brick index), nodes of depth - 1 deeper (`node_ranges`, 2 floats per
+ *  ip__octree_node_index()). `node_ranges` is read only after the visits of the depth below, so
+ *  a visitor that writes each range there builds the octree (the bricker), and one that
+ *  compares checks a stored one (the store). Empty nodes get [+inf, -inf].
+ *  @return : 0, or the first nonzero value `visit` returned. */
+int ip__octree_walk(const ip_layout *l, const float *brick_ranges, const float *node_ranges,
+                    ip_octree_node_fn visit, void *user);
 
 #endif

@@ -6,28 +6,9 @@
 
 #include "internal.h"
 #include "isoprop/camera.h"
+#include "vec3.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
-
-static double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double out[3])
-{
-    double r[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-    memcpy(out, r, sizeof r);
-}
-
-static double normalize3(double v[3])
-{
-    double n = sqrt(dot3(v, v));
-    if (n > 0)
-        for (int i = 0; i < 3; i++)
-            v[i] /= n;
-    return n;
-}
 
 ip_status ip_camera_check(const ip_camera *c, ip_error *err)
 {
@@ -39,28 +20,26 @@ ip_status ip_camera_check(const ip_camera *c, ip_error *err)
                        c->fov_y);
     if (c->width < 1 || c->height < 1)
         return ip__fail(err, IP_ERR_ARGUMENT, "camera: image size must be at least 1x1");
-    double f[3] = {c->target[0] - c->eye[0], c->target[1] - c->eye[1], c->target[2] - c->eye[2]};
-    double u[3] = {c->up[0], c->up[1], c->up[2]}, r[3];
-    if (normalize3(f) == 0.0)
+    double f[3], u[3] = {c->up[0], c->up[1], c->up[2]}, r[3];
+    ip__vec3_sub(c->target, c->eye, f);
+    if (ip__vec3_normalize(f) == 0.0)
         return ip__fail(err, IP_ERR_ARGUMENT, "camera: eye and target coincide");
-    if (normalize3(u) == 0.0)
+    if (ip__vec3_normalize(u) == 0.0)
         return ip__fail(err, IP_ERR_ARGUMENT, "camera: up is zero");
-    cross3(f, u, r);
-    if (sqrt(dot3(r, r)) < 1e-6)
+    ip__vec3_cross(f, u, r);
+    if (ip__vec3_length(r) < 1e-6)
         return ip__fail(err, IP_ERR_ARGUMENT, "camera: up is parallel to the view direction");
     return IP_OK;
 }
 
 void ip_camera_basis_of(const ip_camera *c, ip_camera_basis *b)
 {
-    for (int i = 0; i < 3; i++) {
-        b->forward[i] = c->target[i] - c->eye[i];
-        b->up[i] = c->up[i];
-    }
-    normalize3(b->forward);
-    cross3(b->forward, b->up, b->right);
-    normalize3(b->right);
-    cross3(b->right, b->forward, b->up);
+    ip__vec3_sub(c->target, c->eye, b->forward);
+    memcpy(b->up, c->up, sizeof b->up);
+    ip__vec3_normalize(b->forward);
+    ip__vec3_cross(b->forward, b->up, b->right);
+    ip__vec3_normalize(b->right);
+    ip__vec3_cross(b->right, b->forward, b->up);
     b->tan_half_y = tan(c->fov_y * DEG / 2);
     b->tan_half_x = b->tan_half_y * (double)c->width / (double)c->height;
 }
@@ -72,18 +51,19 @@ void ip_camera_pixel_ray(const ip_camera_basis *b, const ip_camera *c, double px
     double ny = (1.0 - 2.0 * py / c->height) * b->tan_half_y;
     for (int i = 0; i < 3; i++)
         dir[i] = b->forward[i] + nx * b->right[i] + ny * b->up[i];
-    normalize3(dir);
+    ip__vec3_normalize(dir);
 }
 
 int ip_camera_project(const ip_camera_basis *b, const ip_camera *c, const double p[3],
                       double *px, double *py, double *depth)
 {
-    double v[3] = {p[0] - c->eye[0], p[1] - c->eye[1], p[2] - c->eye[2]};
-    double z = dot3(v, b->forward);
+    double v[3];
+    ip__vec3_sub(p, c->eye, v);
+    double z = ip__vec3_dot(v, b->forward);
     if (!(z > 0.0))
         return 0;
-    double nx = dot3(v, b->right) / (z * b->tan_half_x);
-    double ny = dot3(v, b->up) / (z * b->tan_half_y);
+    double nx = ip__vec3_dot(v, b->right) / (z * b->tan_half_x);
+    double ny = ip__vec3_dot(v, b->up) / (z * b->tan_half_y);
     *px = (nx + 1.0) * 0.5 * c->width;
     *py = (1.0 - ny) * 0.5 * c->height;
     *depth = z;
@@ -98,7 +78,7 @@ void ip_camera_view_matrix(const ip_camera *c, float m[16])
     float v[16] = {(float)r[0], (float)u[0], (float)-f[0], 0,
                    (float)r[1], (float)u[1], (float)-f[1], 0,
                    (float)r[2], (float)u[2], (float)-f[2], 0,
-                   (float)-dot3(r, c->eye), (float)-dot3(u, c->eye), (float)dot3(f, c->eye), 1};
+                   (float)-ip__vec3_dot(r, c->eye), (float)-ip__vec3_dot(u, c->eye), (float)ip__vec3_dot(f, c->eye), 1};
     memcpy(m, v, sizeof v);
 }
 
@@ -121,8 +101,9 @@ void ip_camera_depth_range(const ip_camera *c, const double lo[3], const double 
     double zmin = INFINITY, zmax = -INFINITY;
     for (int k = 0; k < 8; k++) {
         double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
-        double v[3] = {p[0] - c->eye[0], p[1] - c->eye[1], p[2] - c->eye[2]};
-        double z = dot3(v, b.forward);
+        double v[3];
+        ip__vec3_sub(p, c->eye, v);
+        double z = ip__vec3_dot(v, b.forward);
         zmin = fmin(zmin, z);
         zmax = fmax(zmax, z);
     }

@@ -7,6 +7,7 @@
 
 #include "isoprop/status.h"
 #include "isoprop/system.h"
+#include "isoprop/volume.h"
 
 #if defined(__GNUC__)
 #define IP_PRINTF(a, b) __attribute__((format(printf, a, b)))
@@ -53,5 +54,23 @@ static inline int ip__host_little_endian(void)
 /* Reverses the bytes of each of `count` elements of `size` bytes (2 or 4) in place. */
 void ip__swap_bytes(void *data, size_t count, size_t size);
 
+/* Who spells a sample type how (a bit set): the canonical names ("uint8", "float32"), the NRRD
+ * format's, MetaImage's ("MET_UCHAR"), and short aliases ("u8", "f32"). */
+enum {
+    IP_TYPE_SPELLING_CANONICAL = 1,
+    IP_TYPE_SPELLING_NRRD = 2,
+    IP_TYPE_SPELLING_METAIMAGE = 4,
+    IP_TYPE_SPELLING_OTHER = 8,
+    IP_TYPE_SPELLING_ALL = 15
+};
+
+/*! ip__type_from_name() : the type named `name` (case-insensitive) in one of `spellings`.
+ *  @return : IP_OK and *out set, or IP_ERR_ARGUMENT (NULL or unknown name; *out untouched). */
+ip_status ip__type_from_name(const char *name, unsigned spellings, ip_type *out);
+
+/* Writes to `out` (`size` bytes, cut short if need be, always terminated) the first name in
+ * `spellings` of each type, in the order of ip_type, separated by ", ": "uint8, uint16, int16,
+ * float" for IP_TYPE_SPELLING_NRRD. */
+void ip__type_names(unsigned spellings, char *out, size_t size);
 
 #endif

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "array.h"
 #include "atomic_file.h"
 #include "internal.h"
 #include "isoprop/mesh.h"
@@ -39,25 +40,17 @@ ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
         return IP_OK;
     /* Growth by half (not doubling) keeps the slack small for meshes of millions of triangles;
      * large blocks are moved by remapping pages, not copied, so the cost stays low. */
-    uint64_t cap = m->capacity ? m->capacity : 1024;
-    while (cap < triangles)
-        cap += cap / 2;
-    float *p = realloc(m->positions, cap * 9 * sizeof *p);
-    if (p)
-        m->positions = p;
-    int16_t *n = p ? realloc(m->normals, cap * 9 * sizeof *n) : NULL;
-    if (n)
-        m->normals = n;
-    if (!n)
-        return IP_ERR_NOMEM; /* the arrays that grew keep the old contents */
-    if (m->with_cells) {
-        uint64_t *c = realloc(m->cells, cap * sizeof *c);
-        if (!c)
-            return IP_ERR_NOMEM;
-        m->cells = c;
-    }
-    m->capacity = cap;
-    return IP_OK;
+    uint64_t cap = ip__array_capacity(m->capacity, triangles, 1024, 9 * sizeof(float),
+                                      IP_ARRAY_HALF);
+    /* the arrays that grew keep the old contents when a later one cannot */
+    ip_status st = cap ? ip__array_resize(&m->positions, cap, 9 * sizeof(float)) : IP_ERR_NOMEM;
+    if (st == IP_OK)
+        st = ip__array_resize(&m->normals, cap, 9 * sizeof(int16_t));
+    if (st == IP_OK && m->with_cells)
+        st = ip__array_resize(&m->cells, cap, sizeof(uint64_t));
+    if (st == IP_OK)
+        m->capacity = cap;
+    return st;
 }
 
 ip_status ip_mesh_append(ip_mesh *m, const float *positions, const int16_t *normals,

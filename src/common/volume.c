@@ -20,15 +20,65 @@ size_t ip_type_size(ip_type type)
     return 0;
 }
 
+/* Every name of every type, and who uses it: ip_type_parse() accepts them all, a header
+ * reader only its format's spellings. The first name of a type is its canonical one. */
+enum {
+    CANONICAL = IP_TYPE_SPELLING_CANONICAL,
+    NRRD = IP_TYPE_SPELLING_NRRD,
+    META = IP_TYPE_SPELLING_METAIMAGE,
+    OTHER = IP_TYPE_SPELLING_OTHER
+};
+static const struct {
+    const char *name;
+    ip_type type;
+    unsigned spellings;
+} type_names[] = {
+    {"uint8", IP_UINT8, CANONICAL | NRRD},
+    {"uint16", IP_UINT16, CANONICAL | NRRD},
+    {"int16", IP_INT16, CANONICAL | NRRD},
+    {"float32", IP_FLOAT32, CANONICAL},
+    {"uchar", IP_UINT8, NRRD},
+    {"unsigned char", IP_UINT8, NRRD},
+    {"uint8_t", IP_UINT8, NRRD},
+    {"MET_UCHAR", IP_UINT8, META},
+    {"u8", IP_UINT8, OTHER},
+    {"ushort", IP_UINT16, NRRD},
+    {"unsigned short", IP_UINT16, NRRD},
+    {"unsigned short int", IP_UINT16, NRRD},
+    {"uint16_t", IP_UINT16, NRRD},
+    {"MET_USHORT", IP_UINT16, META},
+    {"u16", IP_UINT16, OTHER},
+    {"short", IP_INT16, NRRD},
+    {"short int", IP_INT16, NRRD},
+    {"signed short", IP_INT16, NRRD},
+    {"signed short int", IP_INT16, NRRD},
+    {"int16_t", IP_INT16, NRRD},
+    {"MET_SHORT", IP_INT16, META},
+    {"i16", IP_INT16, OTHER},
+    {"float", IP_FLOAT32, NRRD},
+    {"MET_FLOAT", IP_FLOAT32, META},
+    {"f32", IP_FLOAT32, OTHER},
+};
+
 const char *ip_type_name(ip_type type)
 {
-    switch (type) {
-    case IP_UINT8: return "uint8";
-    case IP_UINT16: return "uint16";
-    case IP_INT16: return "int16";
-    case IP_FLOAT32: return "float32";
-    }
+    for (size_t i = 0; i < sizeof type_names / sizeof type_names[0]; i++)
+        if (type_names[i].type == type && (type_names[i].spellings & CANONICAL))
+            return type_names[i].name;
     return "unknown";
+}
+
+ip_status ip__type_from_name(const char *name, unsigned spellings, ip_type *out)
+{
+    if (!name)
+        return IP_ERR_ARGUMENT;
+    for (size_t i = 0; i < sizeof type_names / sizeof type_names[0]; i++) {
+        if ((type_names[i].spellings & spellings) && strcasecmp(name, type_names[i].name) == 0) {
+            *out = type_names[i].type;
+            return IP_OK;
+        }
+    }
+    return IP_ERR_ARGUMENT;
 }
 
 int ip_type_holds(ip_type type, float value)
@@ -42,29 +92,27 @@ int ip_type_holds(ip_type type, float value)
     return 0;
 }
 
-ip_status ip_type_parse(const char *name, ip_type *out)
+void ip__type_names(unsigned spellings, char *out, size_t size)
 {
-    static const struct { const char *name; ip_type type; } names[] = {
-        {"uint8", IP_UINT8},     {"uchar", IP_UINT8},       {"unsigned char", IP_UINT8},
-        {"uint8_t", IP_UINT8},   {"MET_UCHAR", IP_UINT8},   {"u8", IP_UINT8},
-        {"uint16", IP_UINT16},   {"ushort", IP_UINT16},     {"unsigned short", IP_UINT16},
-        {"uint16_t", IP_UINT16}, {"MET_USHORT", IP_UINT16}, {"u16", IP_UINT16},
-        {"unsigned short int", IP_UINT16},
-        {"int16", IP_INT16},     {"short", IP_INT16},       {"signed short", IP_INT16},
-        {"int16_t", IP_INT16},   {"MET_SHORT", IP_INT16},   {"i16", IP_INT16},
-        {"short int", IP_INT16}, {"signed short int", IP_INT16},
-        {"float32", IP_FLOAT32}, {"float", IP_FLOAT32},     {"MET_FLOAT", IP_FLOAT32},
-        {"f32", IP_FLOAT32},
-    };
-    if (!name)
-        return IP_ERR_ARGUMENT;
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
-        if (strcasecmp(name, names[i].name) == 0) {
-            *out = names[i].type;
-            return IP_OK;
+    size_t used = 0;
+    out[0] = '\0';
+    for (int type = IP_UINT8; type <= IP_FLOAT32; type++) {
+        for (size_t i = 0; i < sizeof type_names / sizeof type_names[0]; i++) {
+            if ((int)type_names[i].type != type || !(type_names[i].spellings & spellings))
+                continue;
+            int n = snprintf(out + used, size - used, "%s%s", used ? ", " : "",
+                             type_names[i].name);
+            if (n < 0 || (size_t)n >= size - used)
+                return; /* cut short, terminated */
+            used += (size_t)n;
+            break;
         }
     }
-    return IP_ERR_ARGUMENT;
+}
+
+ip_status ip_type_parse(const char *name, ip_type *out)
+{
+    return ip__type_from_name(name, IP_TYPE_SPELLING_ALL, out);
 }
 
 /* The external definition of the inline one in isoprop/volume.h (C11 6.7.4), for callers

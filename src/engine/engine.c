@@ -12,6 +12,7 @@
 #include "ray_order.h"
 #include "propagate.h"
 #include "seed.h"
+#include "vec3.h"
 
 #define MAX_THREADS IP_MAX_THREADS
 #define RAY_BATCH 16 /* rays a worker takes at once: small, so the order stays progressive */
@@ -138,12 +139,11 @@ static void set_lod_distances(ip_engine *e)
     double pixels_per_radian = 0.5 * e->camera.height / e->basis.tan_half_y;
     double far = 0;
     for (int k = 0; k < 8; k++) {
-        double d2 = 0;
-        for (int a = 0; a < 3; a++) {
-            double c = (k >> a & 1) ? (l->dims[a] - 1) * l->spacing[a] : 0;
-            d2 += (c - e->camera.eye[a]) * (c - e->camera.eye[a]);
-        }
-        far = fmax(far, sqrt(d2));
+        double corner[3], v[3];
+        for (int a = 0; a < 3; a++)
+            corner[a] = (k >> a & 1) ? (l->dims[a] - 1) * l->spacing[a] : 0;
+        ip__vec3_sub(corner, e->camera.eye, v);
+        far = fmax(far, ip__vec3_length(v));
     }
     e->lod_distance[0] = 0;
     e->levels_used = 1;

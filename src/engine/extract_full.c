@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "array.h"
 #include "internal.h"
 #include "isoprop/engine.h"
 #include "propagate.h"
@@ -74,16 +75,13 @@ static void *full_work(void *p)
         if (!ip__range_active(range[0], range[1], w->iso))
             continue;
         if (w->chunks == w->capacity) {
-            uint64_t cap = w->capacity ? 2 * w->capacity : 256;
-            uint64_t *b = realloc(w->brick_of, cap * sizeof *b);
-            if (b)
-                w->brick_of = b;
-            uint64_t *s = b ? realloc(w->start_of, cap * sizeof *s) : NULL;
-            if (!s) {
+            uint64_t cap = ip__array_capacity(w->capacity, w->chunks + 1, 256, sizeof(uint64_t),
+                                              IP_ARRAY_DOUBLE);
+            if (!cap || ip__array_resize(&w->brick_of, cap, sizeof(uint64_t)) != IP_OK ||
+                ip__array_resize(&w->start_of, cap, sizeof(uint64_t)) != IP_OK) {
                 w->status = IP_ERR_NOMEM;
                 break;
             }
-            w->start_of = s;
             w->capacity = cap;
         }
         w->brick_of[w->chunks] = i;

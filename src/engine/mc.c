@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "mc.h"
+#include "vec3.h"
 
 /* The external definition of the inline one in isoprop/mc.h (C11 6.7.4). */
 extern unsigned ip__mc_case(const float corner_values[8], float iso);
@@ -138,24 +139,23 @@ unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float o
 static int ray_hits_triangle(const double o[3], const double d[3], const double a[3],
                              const double b[3], const double c[3], double *t)
 {
-    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    double p[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2],
-                   d[0] * e2[1] - d[1] * e2[0]};
-    double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    double e1[3], e2[3], p[3], s[3], q[3];
+    ip__vec3_sub(b, a, e1);
+    ip__vec3_sub(c, a, e2);
+    ip__vec3_cross(d, e2, p);
+    double det = ip__vec3_dot(e1, p);
     if (det == 0.0) /* the ray runs in the triangle's plane, or the triangle has no area */
         return 0;
     double inv = 1.0 / det;
-    double s[3] = {o[0] - a[0], o[1] - a[1], o[2] - a[2]};
-    double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) * inv;
+    ip__vec3_sub(o, a, s);
+    double u = ip__vec3_dot(s, p) * inv;
     if (u < 0.0 || u > 1.0)
         return 0;
-    double q[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2],
-                   s[0] * e1[1] - s[1] * e1[0]};
-    double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) * inv;
+    ip__vec3_cross(s, e1, q);
+    double v = ip__vec3_dot(d, q) * inv;
     if (v < 0.0 || u + v > 1.0)
         return 0;
-    double hit = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) * inv;
+    double hit = ip__vec3_dot(e2, q) * inv;
     if (!(hit >= 0.0))
         return 0;
     *t = hit;

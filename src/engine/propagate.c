@@ -4,8 +4,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "array.h"
 #include "internal.h"
 #include "propagate.h"
+#include "vec3.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 #define TIMING_STRIDE 16 /* extractions per timed extraction */
@@ -73,11 +75,10 @@ int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float
 /* Angle between the unit ray `dir` and the direction from the eye to `p` (radians). */
 static double angle_to(const double eye[3], const double dir[3], const double p[3])
 {
-    double v[3] = {p[0] - eye[0], p[1] - eye[1], p[2] - eye[2]};
-    double c[3] = {dir[1] * v[2] - dir[2] * v[1], dir[2] * v[0] - dir[0] * v[2],
-                   dir[0] * v[1] - dir[1] * v[0]};
-    double along = dir[0] * v[0] + dir[1] * v[1] + dir[2] * v[2];
-    return atan2(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), along);
+    double v[3], c[3];
+    ip__vec3_sub(p, eye, v);
+    ip__vec3_cross(dir, v, c);
+    return atan2(ip__vec3_length(c), ip__vec3_dot(dir, v));
 }
 
 static void cell_centre(const ip_sampler *s, const uint32_t cell[3], double centre[3],
@@ -108,14 +109,9 @@ static ip_status grow_queue(ip_propagator *p, uint64_t head, uint64_t tail)
 {
     /* keep the live part [head, tail) and move it to the front */
     memmove(p->queue, p->queue + head, (tail - head) * sizeof *p->queue);
-    if (tail - head + 6 > p->queue_capacity / 2) {
-        uint64_t cap = p->queue_capacity * 2;
-        ip_queued_cell *q = realloc(p->queue, cap * sizeof *q);
-        if (!q)
-            return IP_ERR_NOMEM;
-        p->queue = q;
-        p->queue_capacity = cap;
-    }
+    if (tail - head + 6 > p->queue_capacity / 2) /* doubles it */
+        return ip__array_reserve(&p->queue, &p->queue_capacity, p->queue_capacity + 1,
+                                 sizeof *p->queue, 4096);
     return IP_OK;
 }
 
@@ -172,8 +168,9 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
             if (a > p->cutoff || a < q.max_angle - p->foldback || !in_frustum(p, centre, diagonal))
                 continue;
             if (p->near_distance > 0 || p->far_distance < INFINITY) {
-                double v[3] = {centre[0] - eye[0], centre[1] - eye[1], centre[2] - eye[2]};
-                double d = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                double v[3];
+                ip__vec3_sub(centre, eye, v);
+                double d = ip__vec3_length(v);
                 if (d < p->near_distance || d >= p->far_distance)
                     continue; /* another level's band: the resolution boundary */
             }

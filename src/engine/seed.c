@@ -4,6 +4,7 @@
 
 #include "format.h"
 #include "seed.h"
+#include "vec3.h"
 
 /* The ray in the level's index space, where cell (i, j, k) is the box [i, i+1] x ... . The
  * parameter t stays the world distance along the ray. */
@@ -22,15 +23,11 @@ static void across_basis(const double d[3], double u[3], double w[3])
                                     : (fabs(d[1]) < fabs(d[2]) ? 1 : 2);
     double axis[3] = {0, 0, 0};
     axis[k] = 1;
-    u[0] = d[1] * axis[2] - d[2] * axis[1];
-    u[1] = d[2] * axis[0] - d[0] * axis[2];
-    u[2] = d[0] * axis[1] - d[1] * axis[0];
-    double un = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    ip__vec3_cross(d, axis, u);
+    double un = ip__vec3_length(u); /* > 0: the axis is the one least along d */
     for (int i = 0; i < 3; i++)
         u[i] /= un;
-    w[0] = d[1] * u[2] - d[2] * u[1];
-    w[1] = d[2] * u[0] - d[0] * u[2];
-    w[2] = d[0] * u[1] - d[1] * u[0];
+    ip__vec3_cross(d, u, w);
 }
 
 /* Clips the ray to the index box [lo, hi]; returns 0 when it misses it or only behind t0. */
@@ -136,10 +133,10 @@ static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc,
         if (!(crossed >> e & 1u))
             continue;
         double d[3] = {points[e][0] - ro[0], points[e][1] - ro[1], points[e][2] - ro[2]};
-        double depth = d[0] * rd[0] + d[1] * rd[1] + d[2] * rd[2];
+        double depth = ip__vec3_dot(d, rd);
         behind |= (unsigned)!(depth > 0) << e;
-        p[e][0] = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / depth;
-        p[e][1] = (d[0] * w[0] + d[1] * w[1] + d[2] * w[2]) / depth;
+        p[e][0] = ip__vec3_dot(d, u) / depth;
+        p[e][1] = ip__vec3_dot(d, w) / depth;
     }
     const int8_t *row = ip__mc_triangle_table[mc];
     int n = ip__mc_triangle_count[mc], best = 0;

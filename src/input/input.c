@@ -1,5 +1,5 @@
 /* Describing an input volume: format dispatch, the NAME_XxYxZ_TYPE.raw convention, overrides,
- * the checks made before any sample is read, and the helpers the header parsers share. */
+ * the checks made before any sample is read. */
 #include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -305,11 +305,14 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
                              ip_input_desc *desc, ip_text_found *found, ip_error *err)
 {
     struct stat st;
+    const ip_text_format *format = NULL;
     switch (kind_of(path)) {
-    case INPUT_NRRD: return ip__nrrd_read_header(path, overrides, desc, found, err);
-    case INPUT_MHD: return ip__mhd_read_header(path, overrides, desc, found, err);
+    case INPUT_NRRD: format = &ip__nrrd_format; break;
+    case INPUT_MHD: format = &ip__mhd_format; break;
     case INPUT_RAW: break;
     }
+    if (format)
+        return ip__text_read_header(format, path, overrides, desc, found, err);
     /* A mistyped path should say so, not complain about the name. */
     if (stat(path, &st) != 0)
         return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
@@ -339,210 +342,4 @@ ip_status ip_input_describe(const char *path, const ip_input_overrides *override
         return status;
     *out = desc;
     return IP_OK;
-}
-
-/* ---- helpers shared by the header parsers ---- */
-
-ip_status ip__text_open(ip_text_file *header, const char *path, ip_error *err)
-{
-    struct stat st;
-    memset(header, 0, sizeof *header);
-    header->path = path;
-    /* O_NONBLOCK: a FIFO must be refused below, not hang the caller waiting for a writer. */
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0)
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
-    if (fstat(fd, &st) != 0) {
-        int e = errno;
-        close(fd);
-        return ip__fail_errno(err, IP_ERR_IO, e, "%s: cannot stat", path);
-    }
-    if (!S_ISREG(st.st_mode)) {
-        close(fd);
-        return ip__fail(err, IP_ERR_INPUT, "%s: not a regular file", path);
-    }
-    header->file = fdopen(fd, "rb");
-    if (!header->file) {
-        int e = errno;
-        close(fd);
-        return ip__fail_errno(err, IP_ERR_NOMEM, e, "%s: cannot read", path);
-    }
-    return IP_OK;
-}
-
-static ip_status grow_line(ip_text_file *header, ip_error *err)
-{
-    if (header->capacity > IP_TEXT_LINE_MAX)
-        return ip__fail(err, IP_ERR_INPUT, "%s: header line %lu is longer than %d bytes",
-                       header->path, header->line_number + 1, IP_TEXT_LINE_MAX);
-    size_t capacity = header->capacity ? header->capacity * 2 : 256;
-    if (capacity > IP_TEXT_LINE_MAX + 1)
-        capacity = IP_TEXT_LINE_MAX + 1;
-    char *line = realloc(header->line, capacity);
-    if (!line)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading the header", header->path);
-    header->line = line;
-    header->capacity = capacity;
-    return IP_OK;
-}
-
-ip_status ip__text_next_line(ip_text_file *header, int *got, ip_error *err)
-{
-    size_t len = 0;
-    int c = EOF;
-    ip_status status;
-    *got = 0;
-    if (!header->line && (status = grow_line(header, err)) != IP_OK)
-        return status;
-    while ((c = getc(header->file)) != EOF) {
-        header->offset++;
-        if (c == '\n')
-            break;
-        if (c == '\0')
-            return ip__fail(err, IP_ERR_INPUT, "%s: header line %lu holds a NUL byte",
-                           header->path, header->line_number + 1);
-        if (len + 1 >= header->capacity && (status = grow_line(header, err)) != IP_OK)
-            return status;
-        header->line[len++] = (char)c;
-    }
-    if (c == EOF && ferror(header->file))
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot read the header", header->path);
-    if (c == EOF && len == 0)
-        return IP_OK;
-    if (len > 0 && header->line[len - 1] == '\r')
-        len--;
-    header->line[len] = '\0';
-    header->line_number++;
-    *got = 1;
-    return IP_OK;
-}
-
-void ip__text_close(ip_text_file *header)
-{
-    if (header->file)
-        fclose(header->file);
-    free(header->line);
-    memset(header, 0, sizeof *header);
-}
-
-char *ip__text_trim(char *text)
-{
-    while (isspace((unsigned char)*text))
-        text++;
-    size_t len = strlen(text);
-    while (len > 0 && isspace((unsigned char)text[len - 1]))
-        text[--len] = '\0';
-    return text;
-}
-
-ip_status ip__text_data_path(const char *header_path, const char *name, char out[IP_PATH_MAX],
-                              ip_error *err)
-{
-    int n;
-    if (name[0] == '\0')
-        return ip__fail(err, IP_ERR_INPUT, "%s: the data file name is empty", header_path);
-    if (name[0] == '/') {
-        n = snprintf(out, IP_PATH_MAX, "%s", name);
-    } else {
-        const char *slash = strrchr(header_path, '/');
-        int folder_len = slash ? (int)(slash - header_path) + 1 : 0;
-        n = snprintf(out, IP_PATH_MAX, "%.*s%s", folder_len, header_path, name);
-    }
-    if (n < 0 || n >= IP_PATH_MAX)
-        return ip__fail(err, IP_ERR_INPUT, "%s: the data file path is too long", header_path);
-    return IP_OK;
-}
-
-int ip__text_parse_i64(const char *text, int64_t *out)
-{
-    char *end;
-    while (isspace((unsigned char)*text))
-        text++;
-    if (!isdigit((unsigned char)*text) && !(*text == '-' && isdigit((unsigned char)text[1])))
-        return -1;
-    errno = 0;
-    long long v = strtoll(text, &end, 10);
-    if (errno != 0)
-        return -1;
-    while (isspace((unsigned char)*end))
-        end++;
-    if (*end != '\0')
-        return -1;
-    *out = (int64_t)v;
-    return 0;
-}
-
-int ip__text_parse_bool(const char *text, int *out)
-{
-    char buf[8];
-    int n = snprintf(buf, sizeof buf, "%s", text);
-    if (n < 0 || (size_t)n >= sizeof buf)
-        return -1;
-    char *word = ip__text_trim(buf);
-    if (strcasecmp(word, "true") == 0 || strcmp(word, "1") == 0) {
-        *out = 1;
-        return 0;
-    }
-    if (strcasecmp(word, "false") == 0 || strcmp(word, "0") == 0) {
-        *out = 0;
-        return 0;
-    }
-    return -1;
-}
-
-int ip__text_parse_u64_list(const char *text, uint64_t *values, int max, int *count)
-{
-    const char *p = text;
-    *count = 0;
-    for (;;) {
-        while (isspace((unsigned char)*p))
-            p++;
-        if (*p == '\0')
-            return 0;
-        if (!isdigit((unsigned char)*p))
-            return -1;
-        char *end;
-        errno = 0;
-        unsigned long long v = strtoull(p, &end, 10);
-        if (errno != 0 || (*end != '\0' && !isspace((unsigned char)*end)))
-            return -1;
-        if (*count < max)
-            values[*count] = (uint64_t)v;
-        (*count)++;
-        p = end;
-    }
-}
-
-int ip__text_parse_double_list(const char *text, double *values, int max, int *count)
-{
-    const char *p = text;
-    *count = 0;
-    for (;;) {
-        while (isspace((unsigned char)*p))
-            p++;
-        if (*p == '\0')
-            return 0;
-        char *end;
-        double v = strtod(p, &end);
-        if (end == p || (*end != '\0' && !isspace((unsigned char)*end)))
-            return -1;
-        if (*count < max)
-            values[*count] = v;
-        (*count)++;
-        p = end;
-    }
-}
-
-int ip__text_overridden(ip_text_owner by, const ip_input_overrides *overrides)
-{
-    if (!overrides)
-        return 0;
-    switch (by) {
-    case BY_NOTHING: return 0;
-    case BY_DIMS: return overrides->has_dims;
-    case BY_TYPE: return overrides->has_type;
-    case BY_ENDIAN: return overrides->has_endian;
-    case BY_SPACING: return overrides->has_spacing;
-    }
-    return 0;
 }

@@ -1,5 +1,6 @@
 /* MetaImage headers (.mhd with a separate data file, .mha or ElementDataFile = LOCAL with the
  * data right after the header): "Key = Value" lines ending with ElementDataFile. */
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,11 +8,10 @@
 
 #include "input_headers.h"
 #include "internal.h"
+#include "text_header.h"
 
 typedef struct mhd_header {
-    const char *path;
-    unsigned long line_number;
-    const char *key;        /* the key being parsed, for messages */
+    ip_text_place at;       /* first: see ip_text_place */
     int64_t ndims;          /* 0 until the key is seen */
     int dims_count;         /* -1 until the key is seen */
     uint64_t dims[3];
@@ -30,113 +30,60 @@ typedef struct mhd_header {
     char data_path[IP_PATH_MAX];
 } mhd_header;
 
-typedef ip_status (*mhd_key_parser)(mhd_header *h, char *value, ip_error *err);
-
-static ip_status bad_value(const mhd_header *h, const char *value, const char *why,
-                           ip_error *err)
+static ip_status parse_msb(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
-    return ip__fail(err, IP_ERR_INPUT, "%s: line %lu: bad %s '%.80s': %s", h->path,
-                   h->line_number, h->key, value, why);
-}
-
-static ip_status parse_ndims(mhd_header *h, char *value, ip_error *err)
-{
-    if (ip__text_parse_i64(value, &h->ndims) != 0 || h->ndims < 1)
-        return bad_value(h, value, "not a positive whole number", err);
-    if (h->ndims != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: NDims %lld is not supported (need 3)", h->path,
-                       (long long)h->ndims);
-    return IP_OK;
-}
-
-static ip_status parse_dim_size(mhd_header *h, char *value, ip_error *err)
-{
-    if (ip__text_parse_u64_list(value, h->dims, 3, &h->dims_count) != 0)
-        return bad_value(h, value, "not whole numbers", err);
-    return IP_OK;
-}
-
-static ip_status parse_element_type(mhd_header *h, char *value, ip_error *err)
-{
-    static const struct { const char *name; ip_type type; } names[] = {
-        {"MET_UCHAR", IP_UINT8},
-        {"MET_USHORT", IP_UINT16},
-        {"MET_SHORT", IP_INT16},
-        {"MET_FLOAT", IP_FLOAT32},
-    };
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
-        if (strcasecmp(value, names[i].name) == 0) {
-            h->type = names[i].type;
-            h->has_type = 1;
-            return IP_OK;
-        }
-    }
-    return ip__fail(err, IP_ERR_INPUT,
-                   "%s: unsupported MetaImage ElementType '%.80s' (supported: MET_UCHAR, "
-                   "MET_USHORT, MET_SHORT, MET_FLOAT)", h->path, value);
-}
-
-static ip_status parse_spacing(mhd_header *h, char *value, ip_error *err)
-{
-    if (ip__text_parse_double_list(value, h->spacing, 3, &h->spacing_count) != 0)
-        return bad_value(h, value, "not numbers", err);
-    return IP_OK;
-}
-
-static ip_status parse_size(mhd_header *h, char *value, ip_error *err)
-{
-    if (ip__text_parse_double_list(value, h->size, 3, &h->size_count) != 0)
-        return bad_value(h, value, "not numbers", err);
-    return IP_OK;
-}
-
-static ip_status parse_msb(mhd_header *h, char *value, ip_error *err)
-{
+    mhd_header *h = header;
     if (ip__text_parse_bool(value, &h->msb) != 0)
-        return bad_value(h, value, "not True or False", err);
+        return ip__text_bad_value(h, key->name, value, "not True or False", err);
     h->has_msb = 1;
     return IP_OK;
 }
 
-static ip_status parse_compressed(mhd_header *h, char *value, ip_error *err)
+static ip_status parse_compressed(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    mhd_header *h = header;
     if (ip__text_parse_bool(value, &h->compressed) != 0)
-        return bad_value(h, value, "not True or False", err);
+        return ip__text_bad_value(h, key->name, value, "not True or False", err);
     return IP_OK;
 }
 
-static ip_status parse_header_size(mhd_header *h, char *value, ip_error *err)
+static ip_status parse_header_size(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    mhd_header *h = header;
     if (ip__text_parse_i64(value, &h->header_size) != 0 || h->header_size < -1)
-        return bad_value(h, value, "not -1 or a byte count", err);
+        return ip__text_bad_value(h, key->name, value, "not -1 or a byte count", err);
     return IP_OK;
 }
 
-static ip_status parse_channels(mhd_header *h, char *value, ip_error *err)
+static ip_status parse_channels(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    mhd_header *h = header;
     int64_t channels;
     if (ip__text_parse_i64(value, &channels) != 0 || channels < 1)
-        return bad_value(h, value, "not a positive whole number", err);
+        return ip__text_bad_value(h, key->name, value, "not a positive whole number", err);
     if (channels != 1)
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: ElementNumberOfChannels %lld is not supported (need 1)", h->path,
+                       "%s: ElementNumberOfChannels %lld is not supported (need 1)", h->at.path,
                        (long long)channels);
     return IP_OK;
 }
 
-static ip_status parse_binary(mhd_header *h, char *value, ip_error *err)
+static ip_status parse_binary(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    mhd_header *h = header;
     int binary;
     if (ip__text_parse_bool(value, &binary) != 0)
-        return bad_value(h, value, "not True or False", err);
+        return ip__text_bad_value(h, key->name, value, "not True or False", err);
     if (!binary)
         return ip__fail(err, IP_ERR_INPUT, "%s: text data (BinaryData = False) are not supported",
-                       h->path);
+                       h->at.path);
     return IP_OK;
 }
 
-static ip_status parse_data_file(mhd_header *h, char *value, ip_error *err)
+static ip_status parse_data_file(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    mhd_header *h = header;
+    (void)key;
     h->has_data_file = 1;
     if (strcmp(value, "LOCAL") == 0) {
         h->local = 1;
@@ -146,28 +93,34 @@ static ip_status parse_data_file(mhd_header *h, char *value, ip_error *err)
     if (strncmp(value, "LIST", 4) == 0 || strchr(value, '%'))
         return ip__fail(err, IP_ERR_INPUT,
                        "%s: data split over several files ('ElementDataFile = %.80s') is not "
-                       "supported", h->path, value);
-    return ip__text_data_path(h->path, value, h->data_path, err);
+                       "supported", h->at.path, value);
+    return ip__text_data_path(h->at.path, value, h->data_path, err);
 }
 
-static const struct {
-    const char *name;
-    ip_text_owner by;
-    mhd_key_parser parse;
-} mhd_keys[] = {
-    {"NDims", BY_DIMS, parse_ndims},
-    {"DimSize", BY_DIMS, parse_dim_size},
-    {"ElementType", BY_TYPE, parse_element_type},
-    {"ElementSpacing", BY_SPACING, parse_spacing},
-    {"ElementSize", BY_SPACING, parse_size},
-    {"BinaryDataByteOrderMSB", BY_ENDIAN, parse_msb},
-    {"ElementByteOrderMSB", BY_ENDIAN, parse_msb},
-    {"CompressedData", BY_NOTHING, parse_compressed},
-    {"HeaderSize", BY_NOTHING, parse_header_size},
-    {"ElementNumberOfChannels", BY_NOTHING, parse_channels},
-    {"BinaryData", BY_NOTHING, parse_binary},
-    {"ElementDataFile", BY_NOTHING, parse_data_file},
+/* MetaImage keys are words: KEY(ElementType, ...) names the key "ElementType". */
+#define KEY(name, by, parse) {#name, by, parse, 0, 0}
+#define VALUE(name, by, parse, field, seen) {#name, by, parse, offsetof(mhd_header, field), seen}
+#define LIST(name, by, parse, field) \
+    VALUE(name, by, parse, field, offsetof(mhd_header, field##_count))
+static const ip_text_key mhd_key_list[] = {
+    VALUE(NDims, BY_DIMS, ip__text_key_dimensions, ndims, 0),
+    LIST(DimSize, BY_DIMS, ip__text_key_u64s, dims),
+    VALUE(ElementType, BY_TYPE, ip__text_key_type, type, offsetof(mhd_header, has_type)),
+    LIST(ElementSpacing, BY_SPACING, ip__text_key_doubles, spacing),
+    LIST(ElementSize, BY_SPACING, ip__text_key_doubles, size),
+    KEY(BinaryDataByteOrderMSB, BY_ENDIAN, parse_msb),
+    KEY(ElementByteOrderMSB, BY_ENDIAN, parse_msb),
+    KEY(CompressedData, BY_NOTHING, parse_compressed),
+    KEY(HeaderSize, BY_NOTHING, parse_header_size),
+    KEY(ElementNumberOfChannels, BY_NOTHING, parse_channels),
+    KEY(BinaryData, BY_NOTHING, parse_binary),
+    KEY(ElementDataFile, BY_NOTHING, parse_data_file),
 };
+#undef KEY
+#undef VALUE
+#undef LIST
+static const ip_text_keys mhd_keys = {mhd_key_list, sizeof mhd_key_list / sizeof mhd_key_list[0],
+                                      1, NULL, "MetaImage", IP_TYPE_SPELLING_METAIMAGE};
 
 /* One "Key = Value" line; keys the reader does not need (ObjectType, Offset,
  * TransformMatrix, ...) are skipped. */
@@ -176,36 +129,25 @@ static ip_status parse_line(mhd_header *h, char *line, const ip_input_overrides 
 {
     char *equals = strchr(line, '=');
     if (!equals)
-        return ip__fail(err, IP_ERR_INPUT, "%s: line %lu is not 'Key = Value': '%.80s'", h->path,
-                       h->line_number, line);
+        return ip__fail(err, IP_ERR_INPUT, "%s: line %lu is not 'Key = Value': '%.80s'", h->at.path,
+                       h->at.line_number, line);
     *equals = '\0';
-    char *key = ip__text_trim(line);
-    char *value = ip__text_trim(equals + 1);
-    for (size_t i = 0; i < sizeof mhd_keys / sizeof mhd_keys[0]; i++) {
-        if (strcasecmp(key, mhd_keys[i].name) != 0)
-            continue;
-        if (ip__text_overridden(mhd_keys[i].by, overrides))
-            return IP_OK;
-        h->key = mhd_keys[i].name;
-        if (value[0] == '\0')
-            return ip__fail(err, IP_ERR_INPUT, "%s: line %lu: %s has no value", h->path,
-                           h->line_number, mhd_keys[i].name);
-        return mhd_keys[i].parse(h, value, err);
-    }
-    return IP_OK;
+    return ip__text_dispatch(&mhd_keys, h, ip__text_trim(line), ip__text_trim(equals + 1),
+                             overrides, err);
 }
 
 /* Reads keys up to ElementDataFile, which the format puts last. */
-static ip_status read_keys(ip_text_file *file, mhd_header *h,
+static ip_status read_keys(ip_text_file *file, void *header,
                            const ip_input_overrides *overrides, ip_error *err)
 {
+    mhd_header *h = header;
     int got;
     ip_status status = IP_OK;
     while (!h->has_data_file && (status = ip__text_next_line(file, &got, err)) == IP_OK && got) {
         char *line = ip__text_trim(file->line);
         if (line[0] == '\0' || line[0] == '#')
             continue;
-        h->line_number = file->line_number;
+        h->at.line_number = file->line_number;
         if ((status = parse_line(h, line, overrides, err)) != IP_OK)
             return status;
     }
@@ -213,38 +155,29 @@ static ip_status read_keys(ip_text_file *file, mhd_header *h,
         return IP_OK;
     if (status != IP_OK)
         return status;
-    if (h->line_number == 0)
-        return ip__fail(err, IP_ERR_INPUT, "%s: empty MetaImage header", h->path);
-    return ip__fail(err, IP_ERR_INPUT, "%s: missing key 'ElementDataFile'", h->path);
-}
-
-static ip_status missing(const mhd_header *h, const char *key, ip_error *err)
-{
-    return ip__fail(err, IP_ERR_INPUT, "%s: missing key '%s'", h->path, key);
+    if (h->at.line_number == 0)
+        return ip__fail(err, IP_ERR_INPUT, "%s: empty MetaImage header", h->at.path);
+    return ip__fail(err, IP_ERR_INPUT, "%s: missing key 'ElementDataFile'", h->at.path);
 }
 
 static ip_status check_keys(const mhd_header *h, const ip_input_overrides *overrides,
                             ip_error *err)
 {
-    int dims_given = overrides && overrides->has_dims;
-    if (!dims_given && h->ndims == 0)
-        return missing(h, "NDims", err);
-    if (!dims_given && h->dims_count < 0)
-        return missing(h, "DimSize", err);
-    if (!dims_given && h->dims_count != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: DimSize has %d values, NDims is 3", h->path,
-                       h->dims_count);
+    ip_status st = ip__text_check_dims(h, h->ndims, "NDims", h->dims_count, "DimSize", overrides,
+                                       err);
+    if (st != IP_OK)
+        return st;
     if (!(overrides && overrides->has_type) && !h->has_type)
-        return missing(h, "ElementType", err);
+        return ip__text_missing(h, "ElementType", err);
     if (h->spacing_count >= 0 && h->spacing_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: ElementSpacing has %d values, NDims is 3",
-                       h->path, h->spacing_count);
+                       h->at.path, h->spacing_count);
     if (h->spacing_count < 0 && h->size_count >= 0 && h->size_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: ElementSize has %d values, NDims is 3",
-                       h->path, h->size_count);
+                       h->at.path, h->size_count);
     if (h->compressed && h->header_size == -1)
         return ip__fail(err, IP_ERR_INPUT, "%s: HeaderSize -1 needs uncompressed data",
-                       h->path);
+                       h->at.path);
     return IP_OK;
 }
 
@@ -253,14 +186,7 @@ static ip_status check_keys(const mhd_header *h, const ip_input_overrides *overr
 static void fill_desc(const mhd_header *h, uint64_t header_end, ip_input_desc *desc,
                       ip_text_found *found)
 {
-    if (h->has_type) {
-        desc->type = h->type;
-        found->has_type = 1;
-    }
-    if (h->dims_count == 3) {
-        memcpy(found->dims, h->dims, sizeof found->dims);
-        found->has_dims = 1;
-    }
+    ip__text_found_layout(h->has_type, h->type, h->dims_count, h->dims, desc, found);
     desc->big_endian = h->has_msb ? h->msb : 0;
     desc->encoding = h->compressed ? IP_ENCODING_GZIP : IP_ENCODING_RAW;
     for (int axis = 0; axis < 3; axis++) {
@@ -278,27 +204,19 @@ static void fill_desc(const mhd_header *h, uint64_t header_end, ip_input_desc *d
         desc->data_offset = base + (uint64_t)h->header_size;
 }
 
-ip_status ip__mhd_read_header(const char *path, const ip_input_overrides *overrides,
-                             ip_input_desc *desc, ip_text_found *found, ip_error *err)
+static void init(void *header)
 {
-    ip_text_file file;
-    mhd_header *h = calloc(1, sizeof *h);
-    if (!h)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading the header", path);
-    h->path = path;
-    h->dims_count = -1;
-    h->spacing_count = -1;
-    h->size_count = -1;
-    ip_status status = ip__text_open(&file, path, err);
-    if (status == IP_OK) {
-        status = read_keys(&file, h, overrides, err);
-        uint64_t header_end = file.offset;
-        ip__text_close(&file);
-        if (status == IP_OK)
-            status = check_keys(h, overrides, err);
-        if (status == IP_OK)
-            fill_desc(h, header_end, desc, found);
-    }
-    free(h);
+    mhd_header *h = header;
+    h->dims_count = h->spacing_count = h->size_count = -1; /* not seen yet */
+}
+
+static ip_status finish(void *header, uint64_t header_end, const ip_input_overrides *overrides,
+                        ip_input_desc *desc, ip_text_found *found, ip_error *err)
+{
+    ip_status status = check_keys(header, overrides, err);
+    if (status == IP_OK)
+        fill_desc(header, header_end, desc, found);
     return status;
 }
+
+const ip_text_format ip__mhd_format = {&mhd_keys, sizeof(mhd_header), init, read_keys, finish};

@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,10 +14,10 @@
 
 #include "input_headers.h"
 #include "internal.h"
+#include "text_header.h"
 
 typedef struct nrrd_header {
-    const char *path;
-    unsigned long line_number;
+    ip_text_place at;    /* first: see ip_text_place */
     int has_type;
     ip_type type;
     int64_t dimension;   /* 0 until the field is seen */
@@ -34,83 +35,33 @@ typedef struct nrrd_header {
     int64_t line_skip;
     int has_data_file;
     char data_path[IP_PATH_MAX];
+    int blank_line;      /* a blank line ended the header: attached data follow it */
 } nrrd_header;
 
-/* Which override makes a field irrelevant. */
-
-typedef ip_status (*nrrd_field_parser)(nrrd_header *h, char *value, ip_error *err);
-
-static ip_status bad_value(const nrrd_header *h, const char *field, const char *value,
-                           const char *why, ip_error *err)
+static ip_status parse_endian(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
-    return ip__fail(err, IP_ERR_INPUT, "%s: line %lu: bad %s '%.80s': %s", h->path,
-                   h->line_number, field, value, why);
-}
-
-static ip_status parse_type(nrrd_header *h, char *value, ip_error *err)
-{
-    /* Every spelling the format allows for the four types the engine handles. */
-    static const struct { const char *name; ip_type type; } names[] = {
-        {"uchar", IP_UINT8},           {"unsigned char", IP_UINT8},
-        {"uint8", IP_UINT8},           {"uint8_t", IP_UINT8},
-        {"ushort", IP_UINT16},         {"unsigned short", IP_UINT16},
-        {"unsigned short int", IP_UINT16},
-        {"uint16", IP_UINT16},         {"uint16_t", IP_UINT16},
-        {"short", IP_INT16},           {"short int", IP_INT16},
-        {"signed short", IP_INT16},    {"signed short int", IP_INT16},
-        {"int16", IP_INT16},           {"int16_t", IP_INT16},
-        {"float", IP_FLOAT32},
-    };
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
-        if (strcasecmp(value, names[i].name) == 0) {
-            h->type = names[i].type;
-            h->has_type = 1;
-            return IP_OK;
-        }
-    }
-    return ip__fail(err, IP_ERR_INPUT,
-                   "%s: unsupported NRRD type '%.80s' (supported: uint8, uint16, int16, float)",
-                   h->path, value);
-}
-
-static ip_status parse_dimension(nrrd_header *h, char *value, ip_error *err)
-{
-    if (ip__text_parse_i64(value, &h->dimension) != 0 || h->dimension < 1)
-        return bad_value(h, "dimension", value, "not a positive whole number", err);
-    if (h->dimension != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: NRRD dimension %lld is not supported (need 3)",
-                       h->path, (long long)h->dimension);
-    return IP_OK;
-}
-
-static ip_status parse_sizes(nrrd_header *h, char *value, ip_error *err)
-{
-    if (ip__text_parse_u64_list(value, h->sizes, 3, &h->sizes_count) != 0)
-        return bad_value(h, "sizes", value, "not whole numbers", err);
-    return IP_OK;
-}
-
-static ip_status parse_endian(nrrd_header *h, char *value, ip_error *err)
-{
+    nrrd_header *h = header;
     if (strcasecmp(value, "little") == 0)
         h->big_endian = 0;
     else if (strcasecmp(value, "big") == 0)
         h->big_endian = 1;
     else
-        return bad_value(h, "endian", value, "not 'little' or 'big'", err);
+        return ip__text_bad_value(h, key->name, value, "not 'little' or 'big'", err);
     h->has_endian = 1;
     return IP_OK;
 }
 
-static ip_status parse_encoding(nrrd_header *h, char *value, ip_error *err)
+static ip_status parse_encoding(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    nrrd_header *h = header;
+    (void)key;
     if (strcasecmp(value, "raw") == 0)
         h->encoding = IP_ENCODING_RAW;
     else if (strcasecmp(value, "gzip") == 0 || strcasecmp(value, "gz") == 0)
         h->encoding = IP_ENCODING_GZIP;
     else
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: unsupported NRRD encoding '%.80s' (supported: raw, gzip)", h->path,
+                       "%s: unsupported NRRD encoding '%.80s' (supported: raw, gzip)", h->at.path,
                        value);
     h->has_encoding = 1;
     return IP_OK;
@@ -122,13 +73,13 @@ static double spacing_of(double value)
     return isnan(value) ? 1.0 : fabs(value);
 }
 
-static ip_status parse_spacings(nrrd_header *h, char *value, ip_error *err)
+static ip_status parse_spacings(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
-    if (ip__text_parse_double_list(value, h->spacings, 3, &h->spacings_count) != 0)
-        return bad_value(h, "spacings", value, "not numbers", err);
-    for (int axis = 0; axis < h->spacings_count && axis < 3; axis++)
+    nrrd_header *h = header;
+    ip_status st = ip__text_key_doubles(header, key, value, err);
+    for (int axis = 0; st == IP_OK && axis < h->spacings_count && axis < 3; axis++)
         h->spacings[axis] = spacing_of(h->spacings[axis]);
-    return IP_OK;
+    return st;
 }
 
 /* Parses one "(a,b,...)" vector at *p into its length. */
@@ -159,8 +110,9 @@ static int parse_vector_norm(const char **p, double *norm)
 
 /* Each axis's spacing is the length of its direction vector; "none" marks an axis outside
  * world space, which gets the default spacing. */
-static ip_status parse_directions(nrrd_header *h, char *value, ip_error *err)
+static ip_status parse_directions(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    nrrd_header *h = header;
     const char *p = value;
     h->directions_count = 0;
     for (;;) {
@@ -172,61 +124,69 @@ static ip_status parse_directions(nrrd_header *h, char *value, ip_error *err)
         if (strncmp(p, "none", 4) == 0)
             p += 4;
         else if (parse_vector_norm(&p, &norm) != 0)
-            return bad_value(h, "space directions", value, "not '(x,y,z)' vectors or 'none'",
-                             err);
+            return ip__text_bad_value(h, key->name, value, "not '(x,y,z)' vectors or 'none'",
+                                      err);
         if (*p != '\0' && *p != ' ' && *p != '\t')
-            return bad_value(h, "space directions", value, "not '(x,y,z)' vectors or 'none'",
-                             err);
+            return ip__text_bad_value(h, key->name, value, "not '(x,y,z)' vectors or 'none'",
+                                      err);
         if (h->directions_count < 3)
             h->directions[h->directions_count] = spacing_of(norm);
         h->directions_count++;
     }
 }
 
-static ip_status parse_byte_skip(nrrd_header *h, char *value, ip_error *err)
+static ip_status parse_byte_skip(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    nrrd_header *h = header;
+    (void)key;
     if (ip__text_parse_i64(value, &h->byte_skip) != 0 || h->byte_skip < -1)
-        return bad_value(h, "byte skip", value, "not -1 or a byte count", err);
+        return ip__text_bad_value(h, "byte skip", value, "not -1 or a byte count", err);
     return IP_OK;
 }
 
-static ip_status parse_line_skip(nrrd_header *h, char *value, ip_error *err)
+static ip_status parse_line_skip(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    nrrd_header *h = header;
+    (void)key;
     if (ip__text_parse_i64(value, &h->line_skip) != 0 || h->line_skip < 0)
-        return bad_value(h, "line skip", value, "not a line count", err);
+        return ip__text_bad_value(h, "line skip", value, "not a line count", err);
     return IP_OK;
 }
 
-static ip_status parse_data_file(nrrd_header *h, char *value, ip_error *err)
+static ip_status parse_data_file(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
+    nrrd_header *h = header;
+    (void)key;
     /* "LIST" and "printf-pattern min max step" spread the data over several files. */
     if (strncmp(value, "LIST", 4) == 0 || strchr(value, '%'))
         return ip__fail(err, IP_ERR_INPUT,
                        "%s: data split over several files ('data file: %.80s') is not supported",
-                       h->path, value);
+                       h->at.path, value);
     h->has_data_file = 1;
-    return ip__text_data_path(h->path, value, h->data_path, err);
+    return ip__text_data_path(h->at.path, value, h->data_path, err);
 }
 
-static const struct {
-    const char *name;
-    ip_text_owner by;
-    nrrd_field_parser parse;
-} nrrd_fields[] = {
-    {"type", BY_TYPE, parse_type},
-    {"dimension", BY_DIMS, parse_dimension},
-    {"sizes", BY_DIMS, parse_sizes},
-    {"endian", BY_ENDIAN, parse_endian},
-    {"encoding", BY_NOTHING, parse_encoding},
-    {"spacings", BY_SPACING, parse_spacings},
-    {"space directions", BY_SPACING, parse_directions},
-    {"byte skip", BY_NOTHING, parse_byte_skip},
-    {"byteskip", BY_NOTHING, parse_byte_skip},
-    {"line skip", BY_NOTHING, parse_line_skip},
-    {"lineskip", BY_NOTHING, parse_line_skip},
-    {"data file", BY_NOTHING, parse_data_file},
-    {"datafile", BY_NOTHING, parse_data_file},
+static const ip_text_key nrrd_field_list[] = {
+    {"type", BY_TYPE, ip__text_key_type, offsetof(nrrd_header, type),
+     offsetof(nrrd_header, has_type)},
+    {"dimension", BY_DIMS, ip__text_key_dimensions, offsetof(nrrd_header, dimension), 0},
+    {"sizes", BY_DIMS, ip__text_key_u64s, offsetof(nrrd_header, sizes),
+     offsetof(nrrd_header, sizes_count)},
+    {"endian", BY_ENDIAN, parse_endian, 0, 0},
+    {"encoding", BY_NOTHING, parse_encoding, 0, 0},
+    {"spacings", BY_SPACING, parse_spacings, offsetof(nrrd_header, spacings),
+     offsetof(nrrd_header, spacings_count)},
+    {"space directions", BY_SPACING, parse_directions, 0, 0},
+    {"byte skip", BY_NOTHING, parse_byte_skip, 0, 0},
+    {"byteskip", BY_NOTHING, parse_byte_skip, 0, 0},
+    {"line skip", BY_NOTHING, parse_line_skip, 0, 0},
+    {"lineskip", BY_NOTHING, parse_line_skip, 0, 0},
+    {"data file", BY_NOTHING, parse_data_file, 0, 0},
+    {"datafile", BY_NOTHING, parse_data_file, 0, 0},
 };
+static const ip_text_keys nrrd_fields = {
+    nrrd_field_list, sizeof nrrd_field_list / sizeof nrrd_field_list[0], 0, "field", "NRRD",
+    IP_TYPE_SPELLING_NRRD};
 
 /* One "field: value" line. Key/value pairs ("key:=value") and fields that describe anything
  * else (content, kinds, space origin, ...) are not needed to read the samples. */
@@ -241,30 +201,19 @@ static ip_status parse_line(nrrd_header *h, char *line, const ip_input_overrides
         size_t len = strlen(line);
         if (len == 0 || line[len - 1] != ':')
             return ip__fail(err, IP_ERR_INPUT, "%s: line %lu is not 'field: value': '%.80s'",
-                           h->path, h->line_number, line);
+                           h->at.path, h->at.line_number, line);
         colon = line + len - 1;
     }
     *colon = '\0';
-    char *value = ip__text_trim(colon + 1);
-    for (size_t i = 0; i < sizeof nrrd_fields / sizeof nrrd_fields[0]; i++) {
-        if (strcmp(line, nrrd_fields[i].name) != 0)
-            continue;
-        if (ip__text_overridden(nrrd_fields[i].by, overrides))
-            return IP_OK;
-        if (value[0] == '\0')
-            return ip__fail(err, IP_ERR_INPUT, "%s: line %lu: field '%s' has no value", h->path,
-                           h->line_number, line);
-        return nrrd_fields[i].parse(h, value, err);
-    }
-    return IP_OK;
+    return ip__text_dispatch(&nrrd_fields, h, line, ip__text_trim(colon + 1), overrides, err);
 }
 
-/* Reads the magic and the fields; *blank_line tells whether a blank line ended the header
+/* Reads the magic and the fields; h->blank_line tells whether a blank line ended the header
  * (attached data follow it) or the end of the file did. */
-static ip_status read_fields(ip_text_file *file, nrrd_header *h,
-                             const ip_input_overrides *overrides, int *blank_line,
-                             ip_error *err)
+static ip_status read_fields(ip_text_file *file, void *header,
+                             const ip_input_overrides *overrides, ip_error *err)
 {
+    nrrd_header *h = header;
     int got;
     ip_status status = ip__text_next_line(file, &got, err);
     if (status != IP_OK)
@@ -272,25 +221,20 @@ static ip_status read_fields(ip_text_file *file, nrrd_header *h,
     if (!got || strncmp(file->line, "NRRD000", 7) != 0)
         return ip__fail(err, IP_ERR_INPUT,
                        "%s: not a NRRD file (the first line does not start with NRRD000)",
-                       h->path);
-    *blank_line = 0;
+                       h->at.path);
+    h->blank_line = 0;
     while ((status = ip__text_next_line(file, &got, err)) == IP_OK && got) {
         if (file->line[0] == '\0') {
-            *blank_line = 1;
+            h->blank_line = 1;
             break;
         }
         if (file->line[0] == '#')
             continue;
-        h->line_number = file->line_number;
+        h->at.line_number = file->line_number;
         if ((status = parse_line(h, file->line, overrides, err)) != IP_OK)
             return status;
     }
     return status;
-}
-
-static ip_status missing(const nrrd_header *h, const char *field, ip_error *err)
-{
-    return ip__fail(err, IP_ERR_INPUT, "%s: missing field '%s'", h->path, field);
 }
 
 /* Moves *offset past `lines` line endings of the data file. */
@@ -301,24 +245,24 @@ static ip_status skip_lines(const nrrd_header *h, const char *data_path, int64_t
     /* O_NONBLOCK: a header naming a FIFO must not hang the caller waiting for a writer. */
     int fd = open(data_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0)
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: data file %s: cannot open", h->path,
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: data file %s: cannot open", h->at.path,
                              data_path);
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         close(fd);
-        return ip__fail(err, IP_ERR_INPUT, "%s: data file %s: not a regular file", h->path,
+        return ip__fail(err, IP_ERR_INPUT, "%s: data file %s: not a regular file", h->at.path,
                        data_path);
     }
     FILE *f = fdopen(fd, "rb");
     if (!f) {
         int e = errno;
         close(fd);
-        return ip__fail_errno(err, IP_ERR_NOMEM, e, "%s: data file %s: cannot read", h->path,
+        return ip__fail_errno(err, IP_ERR_NOMEM, e, "%s: data file %s: cannot read", h->at.path,
                              data_path);
     }
     if (fseeko(f, (off_t)*offset, SEEK_SET) != 0) {
         int e = errno;
         fclose(f);
-        return ip__fail_errno(err, IP_ERR_IO, e, "%s: cannot seek in %s", h->path, data_path);
+        return ip__fail_errno(err, IP_ERR_IO, e, "%s: cannot seek in %s", h->at.path, data_path);
     }
     int64_t seen = 0;
     int c = 0;
@@ -330,9 +274,9 @@ static ip_status skip_lines(const nrrd_header *h, const char *data_path, int64_t
     int failed = ferror(f);
     fclose(f);
     if (failed)
-        return ip__fail(err, IP_ERR_IO, "%s: cannot read %s", h->path, data_path);
+        return ip__fail(err, IP_ERR_IO, "%s: cannot read %s", h->at.path, data_path);
     if (seen < lines)
-        return ip__fail(err, IP_ERR_INPUT, "%s: line skip %lld passes the end of %s", h->path,
+        return ip__fail(err, IP_ERR_INPUT, "%s: line skip %lld passes the end of %s", h->at.path,
                        (long long)lines, data_path);
     return IP_OK;
 }
@@ -340,32 +284,27 @@ static ip_status skip_lines(const nrrd_header *h, const char *data_path, int64_t
 static ip_status check_layout_fields(const nrrd_header *h, const ip_input_overrides *overrides,
                                      ip_error *err)
 {
-    int dims_given = overrides && overrides->has_dims;
-    int type_given = overrides && overrides->has_type;
-    if (!type_given && !h->has_type)
-        return missing(h, "type", err);
-    if (!dims_given && h->dimension == 0)
-        return missing(h, "dimension", err);
-    if (!dims_given && h->sizes_count < 0)
-        return missing(h, "sizes", err);
-    if (!dims_given && h->sizes_count != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: sizes has %d values, dimension is 3", h->path,
-                       h->sizes_count);
+    ip_status st = IP_OK;
+    if (!(overrides && overrides->has_type) && !h->has_type)
+        return ip__text_missing(h, "type", err);
+    st = ip__text_check_dims(h, h->dimension, "dimension", h->sizes_count, "sizes", overrides, err);
+    if (st != IP_OK)
+        return st;
     if (!h->has_encoding)
-        return missing(h, "encoding", err);
+        return ip__text_missing(h, "encoding", err);
     if (h->spacings_count >= 0 && h->spacings_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: spacings has %d values, dimension is 3",
-                       h->path, h->spacings_count);
+                       h->at.path, h->spacings_count);
     if (h->directions_count >= 0 && h->directions_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: space directions has %d vectors, dimension is 3",
-                       h->path, h->directions_count);
+                       h->at.path, h->directions_count);
     if (h->encoding == IP_ENCODING_GZIP && h->byte_skip == -1)
         return ip__fail(err, IP_ERR_INPUT, "%s: byte skip -1 needs raw encoding, not gzip",
-                       h->path);
+                       h->at.path);
     /* For compressed data the format applies the byte skip after inflating. */
     if (h->encoding == IP_ENCODING_GZIP && h->byte_skip > 0)
         return ip__fail(err, IP_ERR_INPUT, "%s: byte skip with gzip encoding is not supported",
-                       h->path);
+                       h->at.path);
     return IP_OK;
 }
 
@@ -379,19 +318,12 @@ static ip_status check_endian(const nrrd_header *h, const ip_input_overrides *ov
     if (ip_type_size(type) <= 1)
         return IP_OK;
     return ip__fail(err, IP_ERR_INPUT, "%s: missing field 'endian' (needed for %s samples)",
-                   h->path, ip_type_name(type));
+                   h->at.path, ip_type_name(type));
 }
 
 static void fill_desc(const nrrd_header *h, ip_input_desc *desc, ip_text_found *found)
 {
-    if (h->has_type) {
-        desc->type = h->type;
-        found->has_type = 1;
-    }
-    if (h->sizes_count == 3) {
-        memcpy(found->dims, h->sizes, sizeof found->dims);
-        found->has_dims = 1;
-    }
+    ip__text_found_layout(h->has_type, h->type, h->sizes_count, h->sizes, desc, found);
     desc->big_endian = h->big_endian;
     desc->encoding = h->encoding;
     for (int axis = 0; axis < 3; axis++) {
@@ -404,18 +336,18 @@ static void fill_desc(const nrrd_header *h, ip_input_desc *desc, ip_text_found *
 
 /* Works out where the samples start: after the header (attached) or at the start of the data
  * file (detached), then past `line skip` lines and `byte skip` bytes. */
-static ip_status place_data(const nrrd_header *h, uint64_t header_end, int blank_line,
-                            ip_input_desc *desc, ip_text_found *found, ip_error *err)
+static ip_status place_data(const nrrd_header *h, uint64_t header_end, ip_input_desc *desc,
+                            ip_text_found *found, ip_error *err)
 {
     uint64_t offset = 0;
     if (h->has_data_file) {
         snprintf(desc->data_path, sizeof desc->data_path, "%s", h->data_path);
-    } else if (blank_line) {
+    } else if (h->blank_line) {
         offset = header_end;
     } else {
         return ip__fail(err, IP_ERR_INPUT,
                        "%s: no blank line ends the header and no 'data file' field names the "
-                       "data", h->path);
+                       "data", h->at.path);
     }
     if (h->line_skip > 0) {
         ip_status status = skip_lines(h, desc->data_path, h->line_skip, &offset, err);
@@ -430,32 +362,25 @@ static ip_status place_data(const nrrd_header *h, uint64_t header_end, int blank
     return IP_OK;
 }
 
-ip_status ip__nrrd_read_header(const char *path, const ip_input_overrides *overrides,
-                              ip_input_desc *desc, ip_text_found *found, ip_error *err)
+static void init(void *header)
 {
-    ip_text_file file;
-    int blank_line = 0;
-    nrrd_header *h = calloc(1, sizeof *h);
-    if (!h)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading the header", path);
-    h->path = path;
-    h->sizes_count = -1;
-    h->spacings_count = -1;
-    h->directions_count = -1;
-    ip_status status = ip__text_open(&file, path, err);
-    if (status == IP_OK) {
-        status = read_fields(&file, h, overrides, &blank_line, err);
-        uint64_t header_end = file.offset;
-        ip__text_close(&file);
-        if (status == IP_OK)
-            status = check_layout_fields(h, overrides, err);
-        if (status == IP_OK)
-            status = check_endian(h, overrides, err);
-        if (status == IP_OK) {
-            fill_desc(h, desc, found);
-            status = place_data(h, header_end, blank_line, desc, found, err);
-        }
-    }
-    free(h);
-    return status;
+    nrrd_header *h = header;
+    h->sizes_count = h->spacings_count = h->directions_count = -1; /* not seen yet */
 }
+
+/* Checks the fields, then fills `desc` and `found`. */
+static ip_status finish(void *header, uint64_t header_end, const ip_input_overrides *overrides,
+                        ip_input_desc *desc, ip_text_found *found, ip_error *err)
+{
+    nrrd_header *h = header;
+    ip_status status = check_layout_fields(h, overrides, err);
+    if (status == IP_OK)
+        status = check_endian(h, overrides, err);
+    if (status != IP_OK)
+        return status;
+    fill_desc(h, desc, found);
+    return place_data(h, header_end, desc, found, err);
+}
+
+const ip_text_format ip__nrrd_format = {&nrrd_fields, sizeof(nrrd_header), init, read_fields,
+                                        finish};

@@ -5,6 +5,7 @@
 
 #include "internal.h"
 #include "isoprop/render.h"
+#include "vec3.h"
 
 /* Vertices snap to 1/256 pixel, as GPUs do; edge functions are then exact 64-bit integers, so
  * two triangles sharing an edge agree on every pixel centre. Clipping to a guard band keeps
@@ -47,10 +48,11 @@ static void shade_background(const ip_shading *s, uint32_t row, uint32_t height,
 static void shade_surface(const ip_shading *s, const float n[3], const double v[3],
                           uint8_t out[4])
 {
-    double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+    const double normal[3] = {n[0], n[1], n[2]};
+    double len = ip__vec3_length(normal);
     double c = 1.0;
     if (len > 1e-12)
-        c = fmin(1.0, fabs(n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / len);
+        c = fmin(1.0, fabs(ip__vec3_dot(normal, v)) / len);
     double light = s->ambient + s->diffuse * c, highlight = s->specular * pow(c, s->shininess);
     for (int i = 0; i < 3; i++)
         out[i] = to_unorm8(s->surface[i] * light + highlight);
@@ -95,9 +97,9 @@ static void to_view(const raster_view *v, const float *p, const int16_t *n, view
 {
     double d[3] = {p[0] - v->eye[0], p[1] - v->eye[1], p[2] - v->eye[2]};
     const double *r = v->basis.right, *u = v->basis.up, *f = v->basis.forward;
-    out->p[0] = d[0] * r[0] + d[1] * r[1] + d[2] * r[2];
-    out->p[1] = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
-    out->p[2] = d[0] * f[0] + d[1] * f[1] + d[2] * f[2];
+    out->p[0] = ip__vec3_dot(d, r);
+    out->p[1] = ip__vec3_dot(d, u);
+    out->p[2] = ip__vec3_dot(d, f);
     for (int i = 0; i < 3; i++)
         out->n[i] = ip_normal_unpack(n[i]);
 }

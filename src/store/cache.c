@@ -6,7 +6,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "array.h"
 #include "internal.h"
+#include "lru_heap.h"
 #include "isoprop/cache.h"
 
 #define STRIPES 64 /* load coordination locks, by brick index */
@@ -32,14 +34,10 @@ typedef struct slot {
     _Atomic(entry *) entry;
 } slot;
 
-/* The LRU order: a min-heap of (tick, entry), updated lazily. A hit only stamps the entry's
- * tick (no lock); eviction pops the smallest key, and an entry whose tick moved on since its
- * key was taken is pushed back under its new tick. A popped entry whose key equals its tick is
- * the least recently used: every other key is at most its entry's tick. */
-typedef struct heap_item {
-    uint64_t key;
-    struct entry *entry;
-} heap_item;
+/* The LRU order: a min-heap (lru_heap.h) of (tick, entry), updated lazily. A hit only stamps
+ * the entry's tick (no lock); eviction pops the smallest key, and an entry whose tick moved on
+ * since its key was taken is pushed back under its new tick. A popped entry whose key equals
+ * its tick is the least recently used: every other key is at most its entry's tick. */
 
 #define HIT_STRIPES 16
 typedef struct padded_counter {
@@ -58,9 +56,8 @@ struct ip_cache {
     pthread_mutex_t evict_lock; /* resident set, free list, accounting */
     entry **resident;          /* resident entries, unordered */
     uint64_t resident_count, resident_capacity;
-    heap_item *heap;           /* every resident entry once, keyed by a tick <= its last pin */
-    heap_item *parked;         /* evict_one()'s room for pinned entries it set aside */
-    uint64_t heap_count, heap_capacity;
+    ip_lru_heap heap;          /* every resident entry once, keyed by a tick <= its last pin;
+                                  its parking room holds the pinned ones evict_one() sets aside */
     entry *free_entries;
     void **spare_work;         /* decode scratch buffers not in use, under evict_lock */
     uint64_t spare_count, spare_capacity;
@@ -136,8 +133,7 @@ void ip_cache_destroy(ip_cache *c)
     free(c->spare_work);
     free(c->all_entries);
     free(c->resident);
-    free(c->heap);
-    free(c->parked);
+    ip__lru_heap_free(&c->heap);
     free(c->slots);
     free((void *)c->touched);
     free(c->loading);
@@ -193,66 +189,11 @@ static int try_pin(ip_cache *c, uint64_t g, ip_brick *b)
     return 1;
 }
 
-static void heap_sift_up(heap_item *h, uint64_t i)
-{
-    heap_item item = h[i];
-    while (i > 0 && h[(i - 1) / 2].key > item.key) {
-        h[i] = h[(i - 1) / 2];
-        i = (i - 1) / 2;
-    }
-    h[i] = item;
-}
-
-static void heap_sift_down(heap_item *h, uint64_t n, uint64_t i)
-{
-    heap_item item = h[i];
-    for (;;) {
-        uint64_t child = 2 * i + 1;
-        if (child >= n)
-            break;
-        if (child + 1 < n && h[child + 1].key < h[child].key)
-            child++;
-        if (h[child].key >= item.key)
-            break;
-        h[i] = h[child];
-        i = child;
-    }
-    h[i] = item;
-}
-
-/* Adds `e` under its current tick. evict_lock held; the room was made by heap_reserve(). */
+/* Adds `e` under its current tick. evict_lock held; the room was made by
+ * ip__lru_heap_reserve(). */
 static void heap_push(ip_cache *c, entry *e)
 {
-    c->heap[c->heap_count] = (heap_item){atomic_load_explicit(&e->tick, memory_order_relaxed), e};
-    heap_sift_up(c->heap, c->heap_count++);
-}
-
-static heap_item heap_pop(ip_cache *c)
-{
-    heap_item top = c->heap[0];
-    c->heap[0] = c->heap[--c->heap_count];
-    if (c->heap_count > 0)
-        heap_sift_down(c->heap, c->heap_count, 0);
-    return top;
-}
-
-/* Room for one more resident entry in the heap (and in the parking space of evict_one(),
- * which may hold every resident entry at once). evict_lock held. */
-static int heap_reserve(ip_cache *c)
-{
-    if (c->heap_count < c->heap_capacity)
-        return 0;
-    uint64_t cap = c->heap_capacity ? 2 * c->heap_capacity : 64;
-    heap_item *grown = realloc(c->heap, cap * sizeof *grown);
-    if (!grown)
-        return -1;
-    c->heap = grown;
-    heap_item *parked = realloc(c->parked, cap * sizeof *parked);
-    if (!parked)
-        return -1;
-    c->parked = parked;
-    c->heap_capacity = cap;
-    return 0;
+    ip__lru_heap_push(&c->heap, atomic_load_explicit(&e->tick, memory_order_relaxed), e);
 }
 
 /* Removes the least recently pinned unpinned entry from the resident set and returns it (still
@@ -261,26 +202,22 @@ static int heap_reserve(ip_cache *c)
 static entry *evict_one(ip_cache *c)
 {
     entry *victim = NULL;
-    uint64_t parked = 0;
-    while (c->heap_count > 0) {
-        heap_item top = heap_pop(c);
-        uint64_t tick = atomic_load_explicit(&top.entry->tick, memory_order_relaxed);
+    while (c->heap.count > 0) {
+        ip_lru_item top = ip__lru_heap_pop(&c->heap);
+        entry *e = top.value;
+        uint64_t tick = atomic_load_explicit(&e->tick, memory_order_relaxed);
         if (tick != top.key) { /* pinned since its key was taken: re-key it */
-            c->heap[c->heap_count] = (heap_item){tick, top.entry};
-            heap_sift_up(c->heap, c->heap_count++);
+            ip__lru_heap_push(&c->heap, tick, e);
             continue;
         }
         int zero = 0;
-        if (atomic_compare_exchange_strong(&top.entry->pins, &zero, -1)) {
-            victim = top.entry;
+        if (atomic_compare_exchange_strong(&e->pins, &zero, -1)) {
+            victim = e;
             break;
         }
-        c->parked[parked++] = top; /* pinned now: set aside, given back below */
+        ip__lru_heap_park(&c->heap, top); /* pinned now: set aside, given back below */
     }
-    for (uint64_t i = 0; i < parked; i++) {
-        c->heap[c->heap_count] = c->parked[i];
-        heap_sift_up(c->heap, c->heap_count++);
-    }
+    ip__lru_heap_unpark(&c->heap);
     if (!victim)
         return NULL;
     atomic_store(&c->slots[atomic_load(&victim->brick)].entry, NULL);
@@ -304,14 +241,9 @@ static void free_entry(ip_cache *c, entry *e)
 
 static entry *new_entry(ip_cache *c)
 {
-    if (c->all_count == c->all_capacity) {
-        uint64_t cap = c->all_capacity ? 2 * c->all_capacity : 64;
-        entry **grown = realloc(c->all_entries, cap * sizeof *grown);
-        if (!grown)
-            return NULL;
-        c->all_entries = grown;
-        c->all_capacity = cap;
-    }
+    if (ip__array_reserve(&c->all_entries, &c->all_capacity, c->all_count + 1,
+                          sizeof *c->all_entries, 64) != IP_OK)
+        return NULL;
     entry *e = calloc(1, sizeof *e);
     if (!e)
         return NULL;
@@ -363,15 +295,11 @@ static entry *reserve_entry(ip_cache *c, size_t bytes)
 
 static ip_status add_resident(ip_cache *c, entry *e)
 {
-    if (c->resident_count == c->resident_capacity) {
-        uint64_t cap = c->resident_capacity ? 2 * c->resident_capacity : 64;
-        entry **grown = realloc(c->resident, cap * sizeof *grown);
-        if (!grown)
-            return IP_ERR_NOMEM;
-        c->resident = grown;
-        c->resident_capacity = cap;
-    }
-    if (heap_reserve(c) != 0)
+    if (ip__array_reserve(&c->resident, &c->resident_capacity, c->resident_count + 1,
+                          sizeof *c->resident, 64) != IP_OK)
+        return IP_ERR_NOMEM;
+    /* the parking room of evict_one() may hold every resident entry at once */
+    if (ip__lru_heap_reserve(&c->heap, c->heap.count + 1) != IP_OK)
         return IP_ERR_NOMEM;
     e->resident_slot = (uint32_t)c->resident_count;
     c->resident[c->resident_count++] = e;
@@ -415,15 +343,9 @@ static void *take_work(ip_cache *c)
 static void give_work(ip_cache *c, void *w)
 {
     pthread_mutex_lock(&c->evict_lock);
-    if (c->spare_count == c->spare_capacity) {
-        uint64_t cap = c->spare_capacity ? 2 * c->spare_capacity : 8;
-        void **grown = realloc(c->spare_work, cap * sizeof *grown);
-        if (grown) {
-            c->spare_work = grown;
-            c->spare_capacity = cap;
-        }
-    }
-    if (c->spare_count < c->spare_capacity) {
+    /* when the pool cannot grow, the buffer is freed instead */
+    if (ip__array_reserve(&c->spare_work, &c->spare_capacity, c->spare_count + 1,
+                          sizeof *c->spare_work, 8) == IP_OK) {
         c->spare_work[c->spare_count++] = w;
         w = NULL;
     }

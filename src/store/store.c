@@ -194,13 +194,18 @@ const float *ip_store_subblock_ranges(const ip_store *s, uint64_t g)
     return s->ranges + 2 * s->layout.brick_count + 2 * g * s->subblocks;
 }
 
+/* The octree's node ranges: after the brick and sub-block ranges. */
+static const float *stored_nodes(const ip_store *s)
+{
+    return s->ranges + 2 * s->layout.brick_count * (1 + (uint64_t)s->subblocks);
+}
+
 const float *ip_store_node_range(const ip_store *s, uint32_t level, uint32_t depth,
                                  const uint32_t node[3])
 {
     if (depth == 0)
         return s->ranges + 2 * ip_brick_global_index(&s->layout, level, node);
-    uint64_t first_node = 2 * s->layout.brick_count * (1 + (uint64_t)s->subblocks);
-    return s->ranges + first_node + 2 * ip__octree_node_index(&s->layout, level, depth, node);
+    return stored_nodes(s) + 2 * ip__octree_node_index(&s->layout, level, depth, node);
 }
 
 uint64_t ip_store_brick_samples(const ip_store *s, uint64_t g)
@@ -302,35 +307,28 @@ ip_status ip_store_verify_brick(const ip_store *s, uint64_t g, void *dst, void *
     return st == IP_OK ? ip_store_check_summary(s, g, dst, err) : st;
 }
 
+/* ip__octree_walk() visitor: the first node whose stored range differs from its children's. */
+typedef struct octree_check {
+    const float *stored; /* the node ranges */
+    uint32_t level, depth, node[3];
+} octree_check;
+
+static int check_node(void *user, uint32_t level, uint32_t depth, const uint32_t node[3],
+                      uint64_t node_index, const float range[2])
+{
+    octree_check *c = user;
+    if (same_range(range, &c->stored[2 * node_index]))
+        return 0;
+    *c = (octree_check){c->stored, level, depth, {node[0], node[1], node[2]}};
+    return 1;
+}
+
 ip_status ip_store_verify_octree(const ip_store *s, ip_error *err)
 {
-    const ip_layout *l = &s->layout;
-    for (uint32_t k = 0; k < l->level_count; k++) {
-        for (uint32_t depth = 1; depth <= l->levels[k].octree_depth; depth++) {
-            uint32_t grid[3], child[3];
-            ip__octree_grid(l, k, depth, grid);
-            ip__octree_grid(l, k, depth - 1, child);
-            for (uint32_t z = 0; z < grid[2]; z++)
-                for (uint32_t y = 0; y < grid[1]; y++)
-                    for (uint32_t x = 0; x < grid[0]; x++) {
-                        uint32_t node[3] = {x, y, z};
-                        float want[2] = {INFINITY, -INFINITY};
-                        for (int c = 0; c < 8; c++) {
-                            uint32_t ch[3] = {2 * x + (c & 1), 2 * y + ((c >> 1) & 1),
-                                              2 * z + ((c >> 2) & 1)};
-                            if (ch[0] >= child[0] || ch[1] >= child[1] || ch[2] >= child[2])
-                                continue;
-                            const float *r = ip_store_node_range(s, k, depth - 1, ch);
-                            want[0] = fminf(want[0], r[0]);
-                            want[1] = fmaxf(want[1], r[1]);
-                        }
-                        if (!same_range(want, ip_store_node_range(s, k, depth, node)))
-                            return ip__fail(err, IP_ERR_CORRUPT,
-                                           "%s: octree node %u,%u,%u at depth %u of level %u "
-                                           "disagrees with its children", s->path, x, y, z,
-                                           depth, k);
-                    }
-        }
-    }
-    return IP_OK;
+    octree_check c = {stored_nodes(s), 0, 0, {0, 0, 0}};
+    if (ip__octree_walk(&s->layout, s->ranges, c.stored, check_node, &c) == 0)
+        return IP_OK;
+    return ip__fail(err, IP_ERR_CORRUPT,
+                   "%s: octree node %u,%u,%u at depth %u of level %u disagrees with its children",
+                   s->path, c.node[0], c.node[1], c.node[2], c.depth, c.level);
 }
