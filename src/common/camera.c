@@ -182,9 +182,9 @@ ip_status ip_camera_parse(const char *text, ip_camera *c, ip_error *err)
 static void rotate3(double v[3], const double axis[3], double degrees)
 {
     double a = degrees * 3.14159265358979323846 / 180.0, c = cos(a), s = sin(a);
-    double d = dot3(axis, v);
+    double d = ip__vec3_dot(axis, v);
     double x[3];
-    cross3(axis, v, x);
+    ip__vec3_cross(axis, v, x);
     for (int i = 0; i < 3; i++)
         v[i] = v[i] * c + x[i] * s + axis[i] * d * (1 - c);
 }
@@ -223,7 +223,7 @@ void ip_camera_pan(ip_camera *c, double right, double up)
 double ip_camera_distance(const ip_camera *c)
 {
     double d[3] = {c->eye[0] - c->target[0], c->eye[1] - c->target[1], c->eye[2] - c->target[2]};
-    return sqrt(dot3(d, d));
+    return ip__vec3_length(d);
 }
 
 double ip_camera_pixel_size(const ip_camera *c, double height)
