@@ -1,7 +1,8 @@
 /* isoprop: bricking a raw volume into a brick file, streaming, with bounded memory.
  *
  * The input is read once, plane by plane. Each pyramid level keeps one slab of B+1 planes;
- * when a slab is full its layer of bricks is summarised and compressed on all threads and
+ * when a slab is full its layer of bricks is summarised and compressed on all threads (the
+ * calling one and helpers started once per run, joined before ip_bricker_run() returns) and
  * appended to an unnamed spill file. At the end the payloads are copied into the output in
  * Morton order, followed by the summary section and the header. The output appears under its
  * name only when complete (see docs/format.md and src/common/atomic_file.h).

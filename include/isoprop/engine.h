@@ -25,8 +25,10 @@
  * the band boundaries are sub-pixel, as in the paper; the exact-image guarantee above holds
  * with lod off (or wherever every D[k >= 1] lies beyond the volume).
  *
- * Threads: an engine is driven by one thread, which ip_engine_step() joins to its workers:
- * they share the progressive ray sequence (handed out in small batches, in order), the
+ * Threads: an engine is driven by one thread. ip_engine_create() starts its worker threads
+ * (ip_thread_count(options.threads) in all, the driving thread counted), which sleep between
+ * steps; ip_engine_step() wakes them, works as one of them and returns when all have stopped.
+ * They share the progressive ray sequence (handed out in small batches, in order), the
  * visited set (an atomic bit per cell) and the cache, and keep their own triangle buffers,
  * moved to the mesh every few thousand triangles and at the end of the step. Which thread extracts a cell varies from run to
  * run, so the triangles' order and, where propagations meet, which cells are extracted may
@@ -84,12 +86,15 @@ typedef struct ip_engine ip_engine;
  *  fold-back tolerance, every core, adaptive resolution with a 1-pixel error, no cell ids. */
 IP_API void ip_engine_options_default(ip_engine_options *options);
 
-/*! ip_engine_create() : an engine reading through `cache` (which must outlive it). *out is the
- *  caller's, released with ip_engine_destroy(). @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM. */
+/*! ip_engine_create() : an engine reading through `cache` (which must outlive it), with its
+ *  worker threads started: ip_thread_count(options.threads) - 1 of them, idle until a step
+ *  (see Threads above). *out is the caller's, released with ip_engine_destroy().
+ *  @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM. */
 IP_API ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
                            ip_error *err);
 
-/*! ip_engine_destroy() : frees the engine and its mesh; NULL is allowed. */
+/*! ip_engine_destroy() : stops and joins the engine's worker threads and frees the engine and
+ *  its mesh; not during a step. NULL is allowed. */
 IP_API void ip_engine_destroy(ip_engine *engine);
 
 /*! ip_engine_begin() : starts over with a new view and isovalue: drops the mesh, the visited
@@ -128,7 +133,8 @@ IP_API void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
  *  bricks and sub-blocks whose summary range excludes `iso`; the oracle and the baseline.
  *  Cell ids are kept when `mesh` keeps them (mesh->with_cells).
  *  Triangles equal those of the progressive engine for the same cells. Runs on `threads`
- *  threads (0 = every core) and appends to `mesh` in brick order, so the result is the same
+ *  threads (0 = every core; the calling thread and threads started for the call and joined
+ *  before it returns) and appends to `mesh` in brick order, so the result is the same
  *  for any number of threads. Times are summed over threads.
  *  @return IP_OK or a brick read error. */
 IP_API ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,

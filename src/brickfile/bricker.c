@@ -2,7 +2,6 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,6 +15,7 @@
 #include "codec.h"
 #include "format.h"
 #include "isoprop/output.h"
+#include "pool.h"
 #include "summary.h"
 
 /* One pyramid level's slab: up to B+1 consecutive planes of the level. */
@@ -53,8 +53,9 @@ struct bricker {
     const char *out_path;
     size_t sample_size;
     unsigned threads;
+    ip__pool *pool;             /* compresses every layer; started at init */
     level_slab slabs[IP_MAX_LEVELS];
-    brick_scratch *scratch;     /* one per thread */
+    brick_scratch *scratch;     /* one per job of a layer (per thread) */
     ip_brick_entry *entries;    /* offsets point into the spill file until the end */
     float *brick_ranges;        /* 2 per brick */
     float *subblock_ranges;     /* 2 per sub-block */
@@ -162,22 +163,19 @@ static int process_brick(layer_job *job, uint64_t i, brick_scratch *s)
     return 0;
 }
 
-typedef struct worker_arg {
-    layer_job *job;
-    brick_scratch *scratch;
-} worker_arg;
-
-static void *layer_worker(void *p)
+/* One job of a layer (on the pool): takes bricks from the shared counter until none is left,
+ * with scratch buffers of its own. */
+static void layer_worker(void *user, unsigned index)
 {
-    worker_arg *a = p;
+    layer_job *job = user;
+    brick_scratch *scratch = &job->b->scratch[index];
     for (;;) {
-        uint64_t i = atomic_fetch_add(&a->job->next, 1);
-        if (i >= a->job->brick_total || atomic_load(&a->job->failed))
+        uint64_t i = atomic_fetch_add(&job->next, 1);
+        if (i >= job->brick_total || atomic_load(&job->failed))
             break;
-        if (process_brick(a->job, i, a->scratch) != 0)
-            atomic_store(&a->job->failed, 1);
+        if (process_brick(job, i, scratch) != 0)
+            atomic_store(&job->failed, 1);
     }
-    return NULL;
 }
 
 /* ---- one layer ---- */
@@ -205,20 +203,10 @@ static ip_status emit_layer(bricker *b, uint32_t level, ip_error *err)
     job.payloads = calloc(job.brick_total, sizeof *job.payloads);
     if (!job.payloads)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", b->out_path);
-    unsigned helpers = b->threads - 1;
-    if (helpers > job.brick_total)
-        helpers = (unsigned)(job.brick_total > 0 ? job.brick_total - 1 : 0);
-    pthread_t tids[256];
-    worker_arg args[257];
-    unsigned started = 0;
-    for (unsigned t = 0; t <= helpers && t < 257; t++)
-        args[t] = (worker_arg){&job, &b->scratch[t]};
-    for (unsigned t = 1; t <= helpers && t <= 256; t++)
-        if (pthread_create(&tids[started], NULL, layer_worker, &args[t]) == 0)
-            started++;
-    layer_worker(&args[0]);
-    for (unsigned t = 0; t < started; t++)
-        pthread_join(tids[t], NULL);
+    unsigned jobs = b->threads;
+    if (jobs > job.brick_total)
+        jobs = (unsigned)(job.brick_total > 0 ? job.brick_total : 1);
+    ip__pool_run(b->pool, jobs, layer_worker, &job);
     ip_status st = atomic_load(&job.failed)
                        ? ip__fail(err, IP_ERR_NOMEM, "%s: out of memory while compressing",
                                  b->out_path)
@@ -345,8 +333,6 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
         return ip__fail(err, st, "%s: %s", in->path, why.message);
     b->sample_size = ip_type_size(in->type);
     b->threads = thread_count(o);
-    if (b->threads > 256)
-        b->threads = 256;
     uint64_t need = memory_for(&b->layout, b->threads);
     b->report.memory_planned = need;
     if (o->memory_limit && need > o->memory_limit)
@@ -373,11 +359,14 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
     for (uint32_t k = 0; k < b->layout.level_count; k++)
         if ((st = alloc_level(b, k, err)) != IP_OK)
             return st;
+    if (ip__pool_create(b->threads, &b->pool, NULL) != IP_OK)
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", out_path);
     return open_spill(b, err);
 }
 
 static void bricker_free(bricker *b)
 {
+    ip__pool_destroy(b->pool);
     for (uint32_t k = 0; k < IP_MAX_LEVELS; k++) {
         free(b->slabs[k].planes);
         free(b->slabs[k].x_index);

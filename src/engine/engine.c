@@ -9,12 +9,12 @@
 
 #include "internal.h"
 #include "isoprop/engine.h"
+#include "pool.h"
 #include "ray_order.h"
 #include "propagate.h"
 #include "seed.h"
 #include "vec3.h"
 
-#define MAX_THREADS IP_MAX_THREADS
 #define RAY_BATCH 16 /* rays a worker takes at once: small, so the order stays progressive */
 #define LOCAL_LEVELS 3 /* ray order: the finest levels cast in Z-order (see begin) */
 #define FLUSH_TRIANGLES 16384 /* a worker's buffer moves to the engine's mesh past this size */
@@ -42,6 +42,7 @@ struct ip_engine {
     ip_engine_options options;
     unsigned threads;
     worker *workers;
+    ip__pool *pool;             /* runs the workers of every step; started at create */
     ip_visited visited;
     ip_mesh mesh;
     pthread_mutex_t mesh_lock;  /* workers append their buffers to `mesh` during a step */
@@ -94,6 +95,8 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     e->workers = calloc(e->threads, sizeof *e->workers);
     ip_status st = e->workers ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
                               : IP_ERR_NOMEM;
+    if (st == IP_OK)
+        st = ip__pool_create(e->threads, &e->pool, NULL);
     for (unsigned t = 0; st == IP_OK && t < e->threads; t++) {
         e->workers[t].engine = e;
         ip_mesh_init(&e->workers[t].mesh);
@@ -111,6 +114,7 @@ void ip_engine_destroy(ip_engine *e)
 {
     if (!e)
         return;
+    ip__pool_destroy(e->pool);
     for (unsigned t = 0; e->workers && t < e->threads; t++) {
         for (uint32_t k = 0; k < IP_MAX_LEVELS; k++) {
             level_tools *lt = &e->workers[t].level[k];
@@ -316,10 +320,12 @@ static ip_status flush_triangles(worker *w)
     return st;
 }
 
-static void *work(void *p)
+/* One worker's share of a step (a job of the engine's pool): batches of rays until the step's
+ * budget, the order or the time runs out, or a worker fails. */
+static void work(void *user, unsigned index)
 {
-    worker *w = p;
-    ip_engine *e = w->engine;
+    ip_engine *e = user;
+    worker *w = &e->workers[index];
     uint32_t xy[RAY_BATCH][2];
     unsigned n;
     while (w->status == IP_OK && (n = take_rays(e, xy)) > 0) {
@@ -350,7 +356,6 @@ static void *work(void *p)
     }
     for (uint32_t k = 0; k < e->levels_used; k++) /* let the cache evict freely between steps */
         ip__sampler_release(&w->level[k].sampler);
-    return NULL;
 }
 
 ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
@@ -365,20 +370,13 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
     unsigned threads = e->threads;
     if (max_rays && max_rays < (uint64_t)threads * RAY_BATCH)
         threads = (unsigned)((max_rays + RAY_BATCH - 1) / RAY_BATCH); /* few rays: few threads */
-    pthread_t tids[MAX_THREADS];
-    unsigned started = 0;
     for (unsigned t = 0; t < threads; t++) {
         worker *w = &e->workers[t];
         memset(&w->counts, 0, sizeof w->counts);
         w->status = IP_OK;
         w->mesh.triangle_count = 0;
     }
-    for (unsigned t = 1; t < threads; t++)
-        if (pthread_create(&tids[started], NULL, work, &e->workers[t]) == 0)
-            started++;
-    work(&e->workers[0]);
-    for (unsigned t = 0; t < started; t++)
-        pthread_join(tids[t], NULL);
+    ip__pool_run(e->pool, threads, work, e);
     ip_engine_counts c;
     memset(&c, 0, sizeof c);
     ip_status st = IP_OK;

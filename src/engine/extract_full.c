@@ -1,5 +1,4 @@
 /* Full extraction: every active cell of a level, brick by brick, skipping by summaries. */
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,6 +6,7 @@
 #include "array.h"
 #include "internal.h"
 #include "isoprop/engine.h"
+#include "pool.h"
 #include "propagate.h"
 
 /* Triangulates the active cells of one brick, sub-block by sub-block. */
@@ -60,9 +60,9 @@ typedef struct full_worker {
     ip_status status;
 } full_worker;
 
-static void *full_work(void *p)
+static void full_work(void *user, unsigned index)
 {
-    full_worker *w = p;
+    full_worker *w = (full_worker *)user + index;
     const ip_store *store = ip_cache_store(w->cache);
     const ip_level_layout *lv = &ip_store_layout(store)->levels[w->level];
     double start = ip_now_seconds();
@@ -90,7 +90,6 @@ static void *full_work(void *p)
         ip__sampler_release(&w->sampler); /* a brick at a time */
     }
     w->counts.extraction_seconds = ip_now_seconds() - start;
-    return NULL;
 }
 
 /* Appends every worker's triangles to `mesh` in brick order. */
@@ -139,15 +138,14 @@ ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned t
         if (ip__sampler_init(&w[t].sampler, cache, level) != IP_OK)
             st = IP_ERR_NOMEM;
     }
-    pthread_t tids[64];
-    unsigned started = 0;
-    for (unsigned t = 1; st == IP_OK && t < threads && t <= 64; t++)
-        if (pthread_create(&tids[started], NULL, full_work, &w[t]) == 0)
-            started++;
+    ip__pool *pool = NULL;
     if (st == IP_OK)
-        full_work(&w[0]);
-    for (unsigned t = 0; t < started; t++)
-        pthread_join(tids[t], NULL);
+        st = ip__pool_create(threads, &pool, NULL);
+    if (st == IP_OK)
+        ip__pool_run(pool, threads, full_work, w);
+    else
+        ip__fail(err, st, "out of memory");
+    ip__pool_destroy(pool);
     ip_engine_counts c;
     memset(&c, 0, sizeof c);
     for (unsigned t = 0; t < threads; t++) {

@@ -1,0 +1,129 @@
+/* The library's thread pool: helpers started once, woken for each run by a generation
+ * counter, taking job indices under one mutex. Jobs are coarse (a worker's share of a step,
+ * a layer or a group of planes), so one lock per job costs nothing. */
+#include <pthread.h>
+#include <signal.h>
+#include <stdlib.h>
+
+#include "internal.h"
+#include "pool.h"
+
+struct ip__pool {
+    pthread_mutex_t lock;
+    pthread_cond_t work_ready;  /* helpers: a new run (generation changed) or stop */
+    pthread_cond_t work_done;   /* the caller: done reached jobs */
+    unsigned helpers;           /* helper threads started */
+    pthread_t *tids;
+    /* The current run, guarded by lock. */
+    unsigned long generation;   /* runs started so far */
+    ip__pool_job fn;
+    void *user;
+    unsigned jobs, next, done;
+    int stop;
+};
+
+/* Runs jobs of the current run until none is left to take; called and returns with the lock
+ * held. */
+static void take_jobs(ip__pool *p)
+{
+    while (p->next < p->jobs) {
+        unsigned i = p->next++;
+        ip__pool_job fn = p->fn;
+        void *user = p->user;
+        pthread_mutex_unlock(&p->lock);
+        fn(user, i);
+        pthread_mutex_lock(&p->lock);
+        if (++p->done == p->jobs)
+            pthread_cond_signal(&p->work_done);
+    }
+}
+
+static void *helper(void *arg)
+{
+    ip__pool *p = arg;
+    unsigned long seen = 0; /* not p->generation: a run may start before this thread does */
+    pthread_mutex_lock(&p->lock);
+    for (;;) {
+        while (!p->stop && p->generation == seen)
+            pthread_cond_wait(&p->work_ready, &p->lock);
+        if (p->stop)
+            break;
+        seen = p->generation;
+        take_jobs(p);
+    }
+    pthread_mutex_unlock(&p->lock);
+    return NULL;
+}
+
+ip_status ip__pool_create(unsigned threads, ip__pool **out, ip_error *err)
+{
+    if (threads < 1)
+        threads = 1;
+    if (threads > IP_MAX_THREADS)
+        threads = IP_MAX_THREADS;
+    ip__pool *p = calloc(1, sizeof *p);
+    if (!p || (threads > 1 && !(p->tids = calloc(threads - 1, sizeof *p->tids)))) {
+        free(p);
+        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+    }
+    pthread_mutex_init(&p->lock, NULL);
+    pthread_cond_init(&p->work_ready, NULL);
+    pthread_cond_init(&p->work_done, NULL);
+    /* Helpers start with every signal blocked, so that a signal for the process (Ctrl-C)
+     * goes to the program's own threads, which may be waiting for it, and never to a helper
+     * that lives as long as the pool. */
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_SETMASK, &all, &old);
+    for (unsigned t = 0; t + 1 < threads; t++)
+        if (pthread_create(&p->tids[p->helpers], NULL, helper, p) == 0)
+            p->helpers++;
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    *out = p;
+    return IP_OK;
+}
+
+void ip__pool_destroy(ip__pool *p)
+{
+    if (!p)
+        return;
+    pthread_mutex_lock(&p->lock);
+    p->stop = 1;
+    pthread_cond_broadcast(&p->work_ready);
+    pthread_mutex_unlock(&p->lock);
+    for (unsigned t = 0; t < p->helpers; t++)
+        pthread_join(p->tids[t], NULL);
+    pthread_cond_destroy(&p->work_done);
+    pthread_cond_destroy(&p->work_ready);
+    pthread_mutex_destroy(&p->lock);
+    free(p->tids);
+    free(p);
+}
+
+unsigned ip__pool_threads(const ip__pool *p)
+{
+    return 1 + p->helpers;
+}
+
+void ip__pool_run(ip__pool *p, unsigned jobs, ip__pool_job fn, void *user)
+{
+    if (p->helpers == 0 || jobs == 1) { /* nobody to share with: no locks, no wake-ups */
+        for (unsigned i = 0; i < jobs; i++)
+            fn(user, i);
+        return;
+    }
+    if (jobs == 0)
+        return;
+    pthread_mutex_lock(&p->lock);
+    p->fn = fn;
+    p->user = user;
+    p->jobs = jobs;
+    p->next = 0;
+    p->done = 0;
+    p->generation++;
+    pthread_cond_broadcast(&p->work_ready);
+    take_jobs(p);
+    while (p->done < p->jobs)
+        pthread_cond_wait(&p->work_done, &p->lock);
+    pthread_mutex_unlock(&p->lock);
+}

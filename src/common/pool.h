@@ -1,0 +1,35 @@
+/* A small persistent thread pool: started once, it runs numbered jobs on its threads and on
+ * the caller's, and waits for them all. Internal to the library. */
+#ifndef ISOPROP_POOL_H
+#define ISOPROP_POOL_H
+
+#include "isoprop/status.h"
+
+typedef struct ip__pool ip__pool;
+
+/* The work of one ip__pool_run(): called once for each index 0 .. jobs - 1, on any of the
+ * pool's threads or the caller's, several at once. */
+typedef void (*ip__pool_job)(void *user, unsigned index);
+
+/* Starts a pool of `threads` threads counting the caller's (clamped to 1 .. IP_MAX_THREADS;
+ * pass ip_thread_count()'s answer), that is threads - 1 helper threads, which wait for work
+ * until ip__pool_destroy(), with every signal blocked. A pool of 1 starts none and runs every
+ * job on the caller. Where a helper cannot be started the pool keeps those that did (the jobs
+ * still all run, on fewer threads). *out is the caller's, released with ip__pool_destroy().
+ * @return IP_OK or IP_ERR_NOMEM. */
+ip_status ip__pool_create(unsigned threads, ip__pool **out, ip_error *err);
+
+/* Stops and joins the helper threads and frees the pool; NULL is a no-op. Not during a run. */
+void ip__pool_destroy(ip__pool *pool);
+
+/* The threads that run jobs, the caller's included: 1 + the helpers that started. */
+unsigned ip__pool_threads(const ip__pool *pool);
+
+/* Runs fn(user, i) exactly once for each i in 0 .. jobs - 1, on the helpers and the calling
+ * thread, and returns when every call has returned; what the calls wrote is then visible to
+ * the caller. Indices are taken in increasing order, each by the first free thread, so a job
+ * never runs on two threads at once but its thread varies. One run at a time per pool, never
+ * from inside a job. jobs == 0 does nothing. */
+void ip__pool_run(ip__pool *pool, unsigned jobs, ip__pool_job fn, void *user);
+
+#endif
