@@ -93,7 +93,7 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
                        ip_store_path(store));
     ip_cache *c = calloc(1, sizeof *c);
     if (!c)
-        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for a cache", ip_store_path(store));
     c->store = store;
     c->layout = ip_store_layout(store);
     c->budget = budget_bytes;
@@ -104,8 +104,8 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
     c->work_size = ip_store_read_work_size(store);
     if (!c->slots || !c->touched || !c->loading) {
         ip_cache_destroy(c);
-        return ip__fail(err, IP_ERR_NOMEM, "out of memory for a cache of %llu bricks",
-                       (unsigned long long)n);
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for a cache of %llu bricks",
+                       ip_store_path(store), (unsigned long long)n);
     }
     for (int i = 0; i < STRIPES; i++) {
         pthread_mutex_init(&c->stripe_lock[i], NULL);
