@@ -43,7 +43,14 @@ static int guard_intact(const unsigned char *p, size_t size)
     return 1;
 }
 
-enum pattern { SMOOTH, PLANE, NOISE, CONSTANT, STEPS, PATTERN_COUNT };
+enum pattern {
+    SMOOTH,
+    PLANE,
+    NOISE,
+    CONSTANT,
+    STEPS,
+    PATTERN_COUNT
+};
 static const char *const pattern_names[] = {"smooth", "plane", "noise", "constant", "steps"};
 
 /* Fills `count` samples of `type` laid out over extent e. */
@@ -62,13 +69,14 @@ static void fill(void *dst, ip_type type, const uint32_t e[3], enum pattern p)
                 default: v = ((x / 3 + y / 2 + z) % 4) * 60.0; break;
                 }
                 switch (type) {
-                case IP_UINT8: ((uint8_t *)dst)[i] = (uint8_t)v; break;
+                case IP_UINT8: ((uint8_t *)dst)[i] = (uint8_t)(unsigned)v; break; /* mod 256 */
                 case IP_UINT16:
-                    ((uint16_t *)dst)[i] = (uint16_t)(p == NOISE ? next_random() : v * 200);
+                    ((uint16_t *)dst)[i] =
+                        (uint16_t)(p == NOISE ? next_random() : (unsigned)(v * 200));
                     break;
                 case IP_INT16:
-                    ((int16_t *)dst)[i] = (int16_t)(p == NOISE ? (int16_t)next_random()
-                                                               : (int16_t)(v * 100 - 9000));
+                    ((int16_t *)dst)[i] =
+                        (int16_t)(p == NOISE ? (int16_t)next_random() : (int16_t)(v * 100 - 9000));
                     break;
                 case IP_FLOAT32:
                     if (p == NOISE) {
@@ -87,8 +95,8 @@ static const uint32_t extents[][3] = {{2, 2, 2}, {3, 5, 7}, {9, 9, 9}, {33, 17, 
 
 /* Encodes and decodes one brick; checks the entry and that the samples come back bit for
  * bit. Returns the entry. */
-static ip_brick_entry round_trip(const void *samples, const uint32_t e[3], ip_type type,
-                                 int level, const char *what)
+static ip_brick_entry round_trip(const void *samples, const uint32_t e[3], ip_type type, int level,
+                                 const char *what)
 {
     size_t count = (size_t)e[0] * e[1] * e[2], raw = count * ip_type_size(type);
     size_t bound = ip__codec_bound(count, type), work_size = ip__codec_work_size(count, type);
@@ -158,8 +166,7 @@ static void test_round_trips(void)
                     if (p == CONSTANT)
                         CHECK_MSG(entry.encoding == IP_BRICK_CONSTANT, "%s", what);
                     if (p == NOISE && t == IP_UINT8 && count >= 27)
-                        CHECK_MSG(entry.encoding == IP_BRICK_RAW, "%s: noise is stored raw",
-                                  what);
+                        CHECK_MSG(entry.encoding == IP_BRICK_RAW, "%s: noise is stored raw", what);
                     if ((p == SMOOTH || p == PLANE) && count >= 1000)
                         CHECK_MSG(entry.encoding == IP_BRICK_LZ4, "%s: compressible", what);
                     free(samples);
@@ -212,8 +219,8 @@ static uint64_t sample_bits(const void *s, size_t w, size_t i)
 
 /* Encodes samples of w bytes with `filters` per the specification; returns the LZ4 block's
  * size in `payload` (capacity `cap`). */
-static int reference_encode(const void *samples, const uint32_t e[3], size_t w,
-                            unsigned filters, unsigned char *payload, int cap)
+static int reference_encode(const void *samples, const uint32_t e[3], size_t w, unsigned filters,
+                            unsigned char *payload, int cap)
 {
     size_t n = (size_t)e[0] * e[1] * e[2];
     uint64_t mask = w == 8 ? ~0ull : (1ull << (8 * w)) - 1;
@@ -262,8 +269,11 @@ static int reference_encode(const void *samples, const uint32_t e[3], size_t w,
 /* The decoder against the specification: every valid filter combination, every type. */
 static void test_decoder_against_spec(void)
 {
-    static const unsigned combos[] = {0, IP_FILTER_DELTA, IP_FILTER_SHUFFLE,
-                                      IP_FILTER_DELTA | IP_FILTER_SHUFFLE, IP_FILTER_MED,
+    static const unsigned combos[] = {0,
+                                      IP_FILTER_DELTA,
+                                      IP_FILTER_SHUFFLE,
+                                      IP_FILTER_DELTA | IP_FILTER_SHUFFLE,
+                                      IP_FILTER_MED,
                                       IP_FILTER_MED | IP_FILTER_SHUFFLE};
     for (int t = 0; t < IP_TYPE_COUNT; t++)
         for (size_t x = 0; x < EXTENT_COUNT; x++)
@@ -280,13 +290,11 @@ static void test_decoder_against_spec(void)
                     fill(samples, (ip_type)t, e, (enum pattern)p);
                     int size = reference_encode(samples, e, w, combos[c], payload, cap);
                     REQUIRE(size > 0);
-                    ip_brick_entry entry = {0, (uint32_t)size, IP_BRICK_LZ4,
-                                            (uint8_t)combos[c], 0};
-                    ip_status st =
-                        ip__codec_decode(&entry, payload, e, (ip_type)t, 0, dst, work);
+                    ip_brick_entry entry = {0, (uint32_t)size, IP_BRICK_LZ4, (uint8_t)combos[c], 0};
+                    ip_status st = ip__codec_decode(&entry, payload, e, (ip_type)t, 0, dst, work);
                     CHECK_MSG(st == IP_OK && memcmp(dst, samples, raw) == 0,
-                              "type %d, %ux%ux%u, %s, filters %u: status %d", t, e[0], e[1],
-                              e[2], pattern_names[p], combos[c], (int)st);
+                              "type %d, %ux%ux%u, %s, filters %u: status %d", t, e[0], e[1], e[2],
+                              pattern_names[p], combos[c], (int)st);
                     CHECK(guard_intact(dst, raw) && guard_intact(work, work_size));
                     free(samples);
                     free(payload);
@@ -308,8 +316,7 @@ static void decode_fails(const ip_brick_entry *entry, const unsigned char *paylo
     memcpy(exact, payload, entry->stored_size);
     ip_status st = ip__codec_decode(entry, exact, e, type, 0, dst, work);
     CHECK_MSG(st == IP_ERR_CORRUPT, "%s: status %d", what, (int)st);
-    CHECK_MSG(guard_intact(dst, raw) && guard_intact(work, work_size), "%s: out of bounds",
-              what);
+    CHECK_MSG(guard_intact(dst, raw) && guard_intact(work, work_size), "%s: out of bounds", what);
     free(exact);
     free(dst);
     free(work);

@@ -37,8 +37,8 @@ static void check_layout_against_spec(const uint32_t dims[3], uint32_t B, uint32
         for (int a = 0; a < 3; a++) {
             uint32_t n = ceil_div_u64(dims[a] - 1, 1ull << k) + 1;
             uint32_t nb = ceil_div_u64(n - 1, B);
-            CHECK_MSG(l.levels[k].dims[a] == n, "%s: level %u dims[%d] %u, wanted %u", what, k,
-                      a, l.levels[k].dims[a], n);
+            CHECK_MSG(l.levels[k].dims[a] == n, "%s: level %u dims[%d] %u, wanted %u", what, k, a,
+                      l.levels[k].dims[a], n);
             CHECK_MSG(l.levels[k].bricks[a] == nb, "%s: level %u bricks[%d]", what, k, a);
             bricks *= nb;
             uint32_t d = 0;
@@ -68,8 +68,8 @@ static void check_layout_against_spec(const uint32_t dims[3], uint32_t B, uint32
     CHECK(l.brick_count == bricks_total && l.node_count == nodes_total);
     CHECK(l.data_offset == IP_HEADER_SIZE);
     uint64_t P = B / s;
-    CHECK_MSG(l.summary_size == l.level_count * 64ull + bricks_total * (24 + 8 + 8 * P * P * P) +
-                                    nodes_total * 8,
+    CHECK_MSG(l.summary_size ==
+                  l.level_count * 64ull + bricks_total * (24 + 8 + 8 * P * P * P) + nodes_total * 8,
               "%s: summary size", what);
     CHECK(ip_layout_subblocks_per_brick(&l) == P * P * P);
 
@@ -109,8 +109,7 @@ static void check_layout_against_spec(const uint32_t dims[3], uint32_t B, uint32
             if (j == L->octree_depth)
                 CHECK(grid[0] == 1 && grid[1] == 1 && grid[2] == 1);
         }
-        CHECK_MSG(expect == L->first_node + L->node_count, "%s: level %u node numbering", what,
-                  lv);
+        CHECK_MSG(expect == L->first_node + L->node_count, "%s: level %u node numbering", what, lv);
         /* Morton order: a permutation, by increasing interleaved code */
         uint64_t *order = malloc(L->brick_count * sizeof *order);
         char *seen = calloc(L->brick_count, 1);
@@ -141,8 +140,8 @@ static void check_layout_against_spec(const uint32_t dims[3], uint32_t B, uint32
 
 static void test_layouts(void)
 {
-    static const uint32_t shapes[][3] = {{2, 2, 2},    {3, 2, 2},  {21, 18, 19}, {33, 33, 33},
-                                         {100, 7, 2},  {65, 2, 9}, {257, 3, 130}, {5, 300, 17}};
+    static const uint32_t shapes[][3] = {{2, 2, 2},   {3, 2, 2},  {21, 18, 19},  {33, 33, 33},
+                                         {100, 7, 2}, {65, 2, 9}, {257, 3, 130}, {5, 300, 17}};
     static const uint32_t edges[][2] = {{2, 1}, {2, 2}, {4, 2}, {8, 8}, {16, 4}, {32, 8}};
     for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++)
         for (size_t j = 0; j < sizeof edges / sizeof edges[0]; j++)
@@ -244,8 +243,8 @@ static void make_image(image *m)
     ip_brick_extent(l, 0, b0, origin, extent);
     uint32_t raw = extent[0] * extent[1] * extent[2] * 2;
     l->data_size = raw;
-    l->summary_offset = (IP_HEADER_SIZE + raw + IP_SUMMARY_ALIGN - 1) / IP_SUMMARY_ALIGN *
-                        IP_SUMMARY_ALIGN;
+    l->summary_offset =
+        (IP_HEADER_SIZE + raw + IP_SUMMARY_ALIGN - 1) / IP_SUMMARY_ALIGN * IP_SUMMARY_ALIGN;
     l->file_size = l->summary_offset + l->summary_size;
     l->value_min = 5;
     l->value_max = 9;
@@ -336,8 +335,8 @@ static void test_header_round_trip(void)
           parsed.node_count == l->node_count);
     CHECK(parsed.value_min == 5 && parsed.value_max == 9);
     CHECK(parsed.data_offset == 256 && parsed.data_size == l->data_size);
-    CHECK(parsed.summary_offset == l->summary_offset &&
-          parsed.summary_size == l->summary_size && parsed.file_size == m.size);
+    CHECK(parsed.summary_offset == l->summary_offset && parsed.summary_size == l->summary_size &&
+          parsed.file_size == m.size);
     CHECK(parsed.summary_checksum == ip__load_u64le(h + IP_HDR_SUMMARY_CHECKSUM));
     for (uint32_t k = 0; k < l->level_count; k++) {
         CHECK(memcmp(parsed.levels[k].dims, l->levels[k].dims, sizeof l->levels[k].dims) == 0);
@@ -353,8 +352,7 @@ static void test_header_round_trip(void)
 
 static void test_entry_round_trip(void)
 {
-    ip_brick_entry e = {0x0102030405060708ull, 0xA0B0C0D0u, IP_BRICK_LZ4, 6,
-                        0x1122334455667788ull},
+    ip_brick_entry e = {0x0102030405060708ull, 0xA0B0C0D0u, IP_BRICK_LZ4, 6, 0x1122334455667788ull},
                    back;
     unsigned char d[IP_DIRECTORY_ENTRY_SIZE];
     memset(d, 0xFF, sizeof d);
@@ -366,8 +364,7 @@ static void test_entry_round_trip(void)
     CHECK(ip__load_u64le(d + IP_DIR_CHECKSUM) == e.checksum);
     ip__format_entry_decode(d, &back);
     CHECK(back.offset == e.offset && back.stored_size == e.stored_size &&
-          back.encoding == e.encoding && back.filters == e.filters &&
-          back.checksum == e.checksum);
+          back.encoding == e.encoding && back.filters == e.filters && back.checksum == e.checksum);
 }
 
 /* Parsing the image after `change` (then resealed unless `keep_checksums`) fails with `code`
@@ -387,8 +384,8 @@ static void refused(image *m, change_fn change, uint64_t arg, int reseal_after, 
     ip_layout l;
     ip_error err;
     ip_status st = ip__format_parse(m->bytes, m->size, NAME, 0, &l, &err);
-    CHECK_MSG(st == code, "%s (%llu): status %d, wanted %d (%s)", text,
-              (unsigned long long)arg, (int)st, (int)code, st != IP_OK ? err.message : "");
+    CHECK_MSG(st == code, "%s (%llu): status %d, wanted %d (%s)", text, (unsigned long long)arg,
+              (int)st, (int)code, st != IP_OK ? err.message : "");
     if (st != IP_OK) {
         CHECK_CONTAINS(err.message, NAME);
         CHECK_CONTAINS(err.message, text);
@@ -506,8 +503,7 @@ static void test_header_refusals(void)
     refused(&m, set_spacing_y, double_bits(1e-3), 1, IP_ERR_UNSUPPORTED, "times");
     for (uint64_t i = IP_HDR_RESERVED; i < IP_HDR_CHECKSUM; i++) {
         char text[64];
-        snprintf(text, sizeof text, "reserved header byte %llu is not zero",
-                 (unsigned long long)i);
+        snprintf(text, sizeof text, "reserved header byte %llu is not zero", (unsigned long long)i);
         refused(&m, flip_byte, i, 1, IP_ERR_FORMAT, text);
     }
     refused(&m, set_u32, at(IP_HDR_LEVEL_COUNT, m.layout.level_count + 1), 1, IP_ERR_FORMAT,
@@ -647,8 +643,7 @@ static void test_summary_refusals(void)
     refused(&m, set_entry_filters, last << 8 | 1, 1, IP_ERR_FORMAT, "inconsistent constant");
     refused(&m, poke_entry_byte, last << 8 | IP_DIR_CHECKSUM, 1, IP_ERR_FORMAT,
             "inconsistent constant");
-    refused(&m, set_brick_max, last << 32 | f32_bits(6), 1, IP_ERR_FORMAT,
-            "inconsistent constant");
+    refused(&m, set_brick_max, last << 32 | f32_bits(6), 1, IP_ERR_FORMAT, "inconsistent constant");
     refused(&m, set_brick_max, last << 32 | f32_bits(5.5f), 0, IP_ERR_CHECKSUM,
             "summary section checksum mismatch");
     /* a raw brick: exact size, no filters */
@@ -680,8 +675,8 @@ static void test_summary_refusals(void)
     REQUIRE(gap > 0);
     refused(&m, gap_byte, 0, 1, IP_ERR_FORMAT, "in the padding before the summary section");
     refused(&m, gap_byte, gap - 1, 1, IP_ERR_FORMAT, "is not zero");
-    const uint64_t arrays[] = {m.o.level_table, m.o.directory, m.o.brick_ranges,
-                               m.o.subblock_ranges, m.o.nodes, m.o.end - 1};
+    const uint64_t arrays[] = {m.o.level_table,     m.o.directory, m.o.brick_ranges,
+                               m.o.subblock_ranges, m.o.nodes,     m.o.end - 1};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         refused(&m, summary_byte, arrays[i], 0, IP_ERR_CHECKSUM,
                 "summary section checksum mismatch");

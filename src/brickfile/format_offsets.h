@@ -15,7 +15,7 @@
 /* Header (IP_HEADER_SIZE = 256 bytes) */
 enum {
     IP_HDR_MAGIC = 0,              /* 8 bytes, IP_MAGIC */
-    IP_HDR_MAGIC_SIZE = 8,
+    IP_HDR_MAGIC_SIZE = 8,         /* bytes of the magic */
     IP_HDR_VERSION = 8,            /* u32 */
     IP_HDR_HEADER_SIZE = 12,       /* u32 */
     IP_HDR_DIMS = 16,              /* u32 x 3 */
@@ -41,26 +41,26 @@ enum {
 
 /* Level table entry (IP_LEVEL_ENTRY_SIZE = 64 bytes) */
 enum {
-    IP_LVL_DIMS = 0,         /* u32 x 3 */
-    IP_LVL_BRICKS = 12,      /* u32 x 3 */
-    IP_LVL_FIRST_BRICK = 24, /* u64 */
+    IP_LVL_DIMS = 0,          /* u32 x 3 */
+    IP_LVL_BRICKS = 12,       /* u32 x 3 */
+    IP_LVL_FIRST_BRICK = 24,  /* u64 */
     IP_LVL_OCTREE_DEPTH = 32, /* u32 */
-    IP_LVL_RESERVED_A = 36,  /* u32, 0 */
-    IP_LVL_FIRST_NODE = 40,  /* u64 */
-    IP_LVL_VALUE_MIN = 48,   /* f32 */
-    IP_LVL_VALUE_MAX = 52,   /* f32 */
-    IP_LVL_RESERVED_B = 56   /* u64, 0 */
+    IP_LVL_RESERVED_A = 36,   /* u32, 0 */
+    IP_LVL_FIRST_NODE = 40,   /* u64 */
+    IP_LVL_VALUE_MIN = 48,    /* f32 */
+    IP_LVL_VALUE_MAX = 52,    /* f32 */
+    IP_LVL_RESERVED_B = 56    /* u64, 0 */
 };
 
 /* Directory entry (IP_DIRECTORY_ENTRY_SIZE = 24 bytes) */
 enum {
-    IP_DIR_OFFSET = 0,       /* u64 */
-    IP_DIR_STORED_SIZE = 8,  /* u32 */
-    IP_DIR_ENCODING = 12,    /* u8 */
-    IP_DIR_FILTERS = 13,     /* u8 */
-    IP_DIR_RESERVED = 14,    /* u8 x 2, 0 */
-    IP_DIR_RESERVED_SIZE = 2,
-    IP_DIR_CHECKSUM = 16     /* u64 */
+    IP_DIR_OFFSET = 0,        /* u64 */
+    IP_DIR_STORED_SIZE = 8,   /* u32 */
+    IP_DIR_ENCODING = 12,     /* u8 */
+    IP_DIR_FILTERS = 13,      /* u8 */
+    IP_DIR_RESERVED = 14,     /* u8 x 2, 0 */
+    IP_DIR_RESERVED_SIZE = 2, /* bytes reserved */
+    IP_DIR_CHECKSUM = 16      /* u64 */
 };
 
 /* Range (IP_RANGE_SIZE = 8 bytes) */

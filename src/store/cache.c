@@ -436,7 +436,8 @@ static ip_status decode_into(ip_cache *c, uint64_t g, entry *e, ip_error *err)
 {
     void *work = take_work(c);
     if (!work)
-        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for brick %llu",
+                       ip_store_path(c->store), (unsigned long long)g);
     double t0 = ip_now_seconds();
     ip_status st = ip_store_read_brick(c->store, g, e->samples, work, err);
     double t1 = ip_now_seconds();
@@ -476,7 +477,9 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
         free_entry(c, e);
         pthread_mutex_unlock(&c->evict_lock);
         atomic_fetch_add(&c->errors, 1);
-        return st == IP_ERR_NOMEM ? ip__fail(err, st, "out of memory") : st;
+        return st == IP_ERR_NOMEM ? ip__fail(err, st, "%s: out of memory for brick %llu",
+                                             ip_store_path(c->store), (unsigned long long)g)
+                                  : st;
     }
     atomic_store(&e->brick, g);
     atomic_store(&e->pins, 1);
