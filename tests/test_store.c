@@ -3,6 +3,7 @@
  * file changes after opening (truncated, rewritten in place): a clear error naming the file
  * and the brick, never a signal and never unverified samples. */
 #include <fcntl.h>
+#include <math.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -259,12 +260,75 @@ static void test_reads(const char *ibv)
     free(work);
 }
 
+/* The accessors without a test through the others: the path, the octree's node ranges (the
+ * top node of each level covers all its bricks), ip_store_check_summary() on good and altered
+ * samples, and the prefetch hint (which must leave reads unchanged). */
+static void test_accessors(const char *ibv)
+{
+    ip_store *s;
+    ip_error err;
+    REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
+    CHECK(strcmp(ip_store_path(s), ibv) == 0);
+    const ip_layout *l = ip_store_layout(s);
+    CHECK(l->level_count > 1);
+    for (uint32_t k = 0; k < l->level_count; k++) {
+        const ip_level_layout *lv = &l->levels[k];
+        float lo = INFINITY, hi = -INFINITY, r[2];
+        for (uint64_t g = lv->first_brick; g < lv->first_brick + lv->brick_count; g++) {
+            ip_store_brick_range(s, g, r);
+            lo = r[0] < lo ? r[0] : lo;
+            hi = r[1] > hi ? r[1] : hi;
+        }
+        const uint32_t root[3] = {0, 0, 0};
+        const float *top = ip_store_node_range(s, k, lv->octree_depth, root);
+        CHECK_MSG(top[0] == lo && top[1] == hi, "level %u: top node [%g, %g], bricks [%g, %g]", k,
+                  top[0], top[1], lo, hi);
+        CHECK(lv->value_min == lo && lv->value_max == hi);
+        /* depth 0 is the brick grid itself */
+        const uint32_t last[3] = {lv->bricks[0] - 1, lv->bricks[1] - 1, lv->bricks[2] - 1};
+        ip_store_brick_range(s, ip_brick_global_index(l, k, last), r);
+        const float *node = ip_store_node_range(s, k, 0, last);
+        CHECK(node[0] == r[0] && node[1] == r[1]);
+    }
+    ip_brick_entry e;
+    uint64_t g = first_payload(s, &e);
+    uint64_t count = ip_store_brick_samples(s, g);
+    uint16_t *dst = malloc(count * sizeof *dst);
+    void *work = malloc(ip_store_read_work_size(s));
+    REQUIRE(dst && work && l->type == IP_UINT16);
+    ip_store_prefetch_brick(s, g);
+    REQUIRE(ip_store_read_brick(s, g, dst, work, &err) == IP_OK);
+    CHECK(ip_store_check_summary(s, g, dst, &err) == IP_OK);
+    float range[2];
+    ip_store_brick_range(s, g, range);
+    /* one sample past the brick's maximum, then one sample moved inside the range but into a
+     * sub-block whose range it leaves */
+    uint16_t kept = dst[count - 1];
+    dst[count - 1] = (uint16_t)(range[1] < 65535 ? range[1] + 1 : 0);
+    CHECK(ip_store_check_summary(s, g, dst, &err) == IP_ERR_CORRUPT);
+    CHECK_CONTAINS(err.message, ibv);
+    CHECK_CONTAINS(err.message, "samples disagree with the summary");
+    dst[count - 1] = kept;
+    /* sample 0 lies in sub-block 0 only, whose range is narrower than the brick's here */
+    const float *sub = ip_store_subblock_ranges(s, g);
+    REQUIRE(sub[0] > range[0] || sub[1] < range[1]);
+    dst[0] = (uint16_t)(sub[0] > range[0] ? range[0] : range[1]);
+    CHECK(ip_store_check_summary(s, g, dst, &err) == IP_ERR_CORRUPT);
+    CHECK_CONTAINS(err.message, "samples disagree with the summary");
+    REQUIRE(ip_store_read_brick(s, g, dst, work, &err) == IP_OK);
+    CHECK(ip_store_check_summary(s, g, dst, &err) == IP_OK);
+    ip_store_close(s);
+    free(dst);
+    free(work);
+}
+
 int main(void)
 {
     const char *dir = test_tmp_dir("test_store");
     char ibv[4200];
     make_file(dir, ibv, sizeof ibv);
     test_reads(ibv);
+    test_accessors(ibv);
     test_zero_fields(dir, ibv);
     test_not_regular(dir);
     test_truncated_while_open(dir, ibv);

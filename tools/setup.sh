@@ -3,8 +3,9 @@
 # configures and builds, then runs one job.
 #
 #   tools/setup.sh demo    build, then generate, brick, describe and render the default volume
-#   tools/setup.sh test    build, then run the whole test suite: a -Werror build, a build under
-#                          AddressSanitizer + UndefinedBehaviorSanitizer (with the fuzzers), and
+#   tools/setup.sh test    build, then run the whole test suite: a -Werror build, a Debug build
+#                          (internal assertions on) under AddressSanitizer +
+#                          UndefinedBehaviorSanitizer (with the fuzzers), and
 #                          the threaded tests under ThreadSanitizer; the final summary lists,
 #                          per build, the tests that were skipped (whole or in part) and why
 #   tools/setup.sh build   build only (into build/)
@@ -16,10 +17,11 @@ cd "$root"
 jobs=$(nproc 2>/dev/null || echo 2)
 
 # Debian packages: compiler and build tools, the libraries, clang for the sanitizer and fuzzer
-# builds, and the lz4/zstd programs the benchmark compares against; GLFW and stb_easy_font for
-# the viewer, and a virtual X server (xvfb-run) for its test.
-packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang lz4 zstd
-          libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri
+# builds and clang-format for tools/check_format.sh, and the lz4/zstd programs the benchmark
+# compares against; GLFW and stb_easy_font for the viewer, and a virtual X server (xvfb-run) for
+# its test.
+packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang clang-format
+          lz4 zstd libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri
           libglfw3-dev libstb-dev xvfb xauth"
 
 install_missing() {
@@ -40,11 +42,17 @@ install_missing() {
     apt-get install -y -qq --no-install-recommends $missing >/dev/null
 }
 
-# configure_and_build DIR [cmake options...]
+# configure_and_build DIR [cmake options...]: a RelWithDebInfo build (-O3, NDEBUG) unless the
+# options name another -DCMAKE_BUILD_TYPE
 configure_and_build() {
     dir=$1
     shift
-    cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo "$@" >/dev/null
+    case " $* " in
+    *" -DCMAKE_BUILD_TYPE="*) type="" ;;
+    *) type=-DCMAKE_BUILD_TYPE=RelWithDebInfo ;;
+    esac
+    # shellcheck disable=SC2086 # $type is one option or none
+    cmake -S . -B "$dir" $type "$@" >/dev/null
     cmake --build "$dir" -j "$jobs" -- --no-print-directory >/dev/null
 }
 
@@ -113,9 +121,10 @@ run_tests() {
     configure_and_build build -DIP_WERROR=ON
     run_ctest build "" --output-on-failure -j "$jobs" || status=1
     { echo "  build (gcc, -Werror):"; skip_report build; } >>"$skips"
-    echo "== AddressSanitizer + UndefinedBehaviorSanitizer (clang), fuzzers included"
-    CC=clang configure_and_build build-asan -DIP_WERROR=ON -DIP_SANITIZE=address,undefined \
-        -DIP_FUZZ=ON
+    # a Debug build (-O1, no NDEBUG): the internal assertions (IP_ASSERT) are checked here
+    echo "== AddressSanitizer + UndefinedBehaviorSanitizer (clang, Debug), fuzzers included"
+    CC=clang configure_and_build build-asan -DCMAKE_BUILD_TYPE=Debug -DIP_WERROR=ON \
+        -DIP_SANITIZE=address,undefined -DIP_FUZZ=ON
     run_ctest build-asan "ASAN_OPTIONS=detect_leaks=1" --output-on-failure -j "$jobs" ||
         status=1
     { echo "  build-asan (clang, ASan + UBSan):"; skip_report build-asan; } >>"$skips"

@@ -216,6 +216,7 @@ ip_status ip__codec_encode(const void *samples, const uint32_t extent[3], ip_typ
     size_t size = ip_type_size(type);
     size_t count = (size_t)extent[0] * extent[1] * extent[2];
     size_t raw = count * size;
+    IP_ASSERT(samples != NULL && out != NULL && work != NULL && entry != NULL);
     if (size == 0 || count == 0 || raw > (size_t)LZ4_MAX_INPUT_SIZE)
         return IP_ERR_ARGUMENT;
     entry->offset = 0;
@@ -311,6 +312,8 @@ ip_status ip__codec_decode(const ip_brick_entry *entry, const void *payload,
     size_t size = ip_type_size(type);
     size_t count = (size_t)extent[0] * extent[1] * extent[2];
     size_t raw = count * size;
+    IP_ASSERT(entry != NULL && dst != NULL);
+    IP_ASSERT(entry->encoding == IP_BRICK_CONSTANT || (payload != NULL && work != NULL));
     if (size == 0 || count == 0)
         return IP_ERR_ARGUMENT;
     switch (entry->encoding) {

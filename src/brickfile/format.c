@@ -6,6 +6,7 @@
 
 #include "internal.h"
 #include "format.h"
+#include "format_offsets.h"
 
 uint64_t ip__format_checksum(const void *data, size_t size)
 {
@@ -175,6 +176,7 @@ void ip_brick_coords(const ip_layout *layout, uint64_t global, uint32_t *level,
 
 void ip__octree_grid(const ip_layout *layout, uint32_t level, uint32_t depth, uint32_t grid[3])
 {
+    IP_ASSERT(level < layout->level_count && depth < 32);
     for (int a = 0; a < 3; a++)
         grid[a] = ceil_div(layout->levels[level].bricks[a], 1ull << depth);
 }
@@ -182,6 +184,8 @@ void ip__octree_grid(const ip_layout *layout, uint32_t level, uint32_t depth, ui
 uint64_t ip__octree_node_index(const ip_layout *layout, uint32_t level, uint32_t depth,
                               const uint32_t node[3])
 {
+    IP_ASSERT(level < layout->level_count);
+    IP_ASSERT(depth >= 1 && depth <= layout->levels[level].octree_depth);
     uint64_t index = layout->levels[level].first_node;
     uint32_t grid[3];
     for (uint32_t j = 1; j < depth; j++) {
@@ -189,6 +193,7 @@ uint64_t ip__octree_node_index(const ip_layout *layout, uint32_t level, uint32_t
         index += (uint64_t)grid[0] * grid[1] * grid[2];
     }
     ip__octree_grid(layout, level, depth, grid);
+    IP_ASSERT(node[0] < grid[0] && node[1] < grid[1] && node[2] < grid[2]);
     return index + node[0] + (uint64_t)grid[0] * (node[1] + (uint64_t)grid[1] * node[2]);
 }
 
@@ -216,6 +221,7 @@ static int compare_morton(const void *a, const void *b)
 
 ip_status ip__morton_order(const ip_layout *layout, uint32_t level, uint64_t *order)
 {
+    IP_ASSERT(level < layout->level_count && order != NULL);
     const ip_level_layout *lv = &layout->levels[level];
     morton_key *keys = malloc(lv->brick_count * sizeof *keys);
     if (!keys)
@@ -269,67 +275,71 @@ static double load_f64(const unsigned char *p)
 void ip__format_header_encode(const ip_layout *layout, unsigned char out[IP_HEADER_SIZE])
 {
     memset(out, 0, IP_HEADER_SIZE);
-    memcpy(out, IP_MAGIC, 8);
-    ip__store_u32le(out + 8, IP_FORMAT_VERSION);
-    ip__store_u32le(out + 12, IP_HEADER_SIZE);
+    memcpy(out + IP_HDR_MAGIC, IP_MAGIC, IP_HDR_MAGIC_SIZE);
+    ip__store_u32le(out + IP_HDR_VERSION, IP_FORMAT_VERSION);
+    ip__store_u32le(out + IP_HDR_HEADER_SIZE, IP_HEADER_SIZE);
     for (int a = 0; a < 3; a++) {
-        ip__store_u32le(out + 16 + 4 * a, layout->dims[a]);
-        store_f64(out + 32 + 8 * a, layout->spacing[a]);
+        ip__store_u32le(out + IP_HDR_DIMS + 4 * a, layout->dims[a]);
+        store_f64(out + IP_HDR_SPACING + 8 * a, layout->spacing[a]);
     }
-    ip__store_u32le(out + 28, (uint32_t)layout->type);
-    ip__store_u32le(out + 56, layout->brick_edge);
-    ip__store_u32le(out + 60, layout->subblock_edge);
-    ip__store_u32le(out + 64, layout->level_count);
-    ip__store_u32le(out + 68, 0); /* flags */
-    store_f32(out + 72, layout->value_min);
-    store_f32(out + 76, layout->value_max);
-    ip__store_u64le(out + 80, layout->brick_count);
-    ip__store_u64le(out + 88, layout->node_count);
-    ip__store_u64le(out + 96, layout->data_offset);
-    ip__store_u64le(out + 104, layout->data_size);
-    ip__store_u64le(out + 112, layout->summary_offset);
-    ip__store_u64le(out + 120, layout->summary_size);
-    ip__store_u64le(out + 128, layout->summary_checksum);
-    ip__store_u64le(out + 136, layout->file_size);
-    ip__store_u64le(out + 248, ip__format_checksum(out, 248));
+    ip__store_u32le(out + IP_HDR_TYPE, (uint32_t)layout->type);
+    ip__store_u32le(out + IP_HDR_BRICK_EDGE, layout->brick_edge);
+    ip__store_u32le(out + IP_HDR_SUBBLOCK_EDGE, layout->subblock_edge);
+    ip__store_u32le(out + IP_HDR_LEVEL_COUNT, layout->level_count);
+    ip__store_u32le(out + IP_HDR_FLAGS, 0);
+    store_f32(out + IP_HDR_VALUE_MIN, layout->value_min);
+    store_f32(out + IP_HDR_VALUE_MAX, layout->value_max);
+    ip__store_u64le(out + IP_HDR_BRICK_COUNT, layout->brick_count);
+    ip__store_u64le(out + IP_HDR_NODE_COUNT, layout->node_count);
+    ip__store_u64le(out + IP_HDR_DATA_OFFSET, layout->data_offset);
+    ip__store_u64le(out + IP_HDR_DATA_SIZE, layout->data_size);
+    ip__store_u64le(out + IP_HDR_SUMMARY_OFFSET, layout->summary_offset);
+    ip__store_u64le(out + IP_HDR_SUMMARY_SIZE, layout->summary_size);
+    ip__store_u64le(out + IP_HDR_SUMMARY_CHECKSUM, layout->summary_checksum);
+    ip__store_u64le(out + IP_HDR_FILE_SIZE, layout->file_size);
+    ip__store_u64le(out + IP_HDR_CHECKSUM, ip__format_checksum(out, IP_HDR_CHECKSUM));
 }
 
 void ip__format_level_table_encode(const ip_layout *layout, unsigned char *out)
 {
+    IP_ASSERT(layout->level_count >= 1 && layout->level_count <= IP_MAX_LEVELS);
     for (uint32_t k = 0; k < layout->level_count; k++) {
         const ip_level_layout *lv = &layout->levels[k];
         unsigned char *e = out + (size_t)k * IP_LEVEL_ENTRY_SIZE;
         memset(e, 0, IP_LEVEL_ENTRY_SIZE);
         for (int a = 0; a < 3; a++) {
-            ip__store_u32le(e + 4 * a, lv->dims[a]);
-            ip__store_u32le(e + 12 + 4 * a, lv->bricks[a]);
+            ip__store_u32le(e + IP_LVL_DIMS + 4 * a, lv->dims[a]);
+            ip__store_u32le(e + IP_LVL_BRICKS + 4 * a, lv->bricks[a]);
         }
-        ip__store_u64le(e + 24, lv->first_brick);
-        ip__store_u32le(e + 32, lv->octree_depth);
-        ip__store_u64le(e + 40, lv->first_node);
-        store_f32(e + 48, lv->value_min);
-        store_f32(e + 52, lv->value_max);
+        ip__store_u64le(e + IP_LVL_FIRST_BRICK, lv->first_brick);
+        ip__store_u32le(e + IP_LVL_OCTREE_DEPTH, lv->octree_depth);
+        ip__store_u64le(e + IP_LVL_FIRST_NODE, lv->first_node);
+        store_f32(e + IP_LVL_VALUE_MIN, lv->value_min);
+        store_f32(e + IP_LVL_VALUE_MAX, lv->value_max);
     }
 }
 
-void ip__format_entry_encode(const ip_brick_entry *entry, unsigned char out[24])
+void ip__format_entry_encode(const ip_brick_entry *entry,
+                             unsigned char out[IP_DIRECTORY_ENTRY_SIZE])
 {
-    ip__store_u64le(out, entry->offset);
-    ip__store_u32le(out + 8, entry->stored_size);
-    out[12] = entry->encoding;
-    out[13] = entry->filters;
-    out[14] = 0;
-    out[15] = 0;
-    ip__store_u64le(out + 16, entry->checksum);
+    IP_ASSERT(entry->encoding <= IP_BRICK_LZ4);
+    IP_ASSERT(entry->encoding == IP_BRICK_LZ4 || entry->filters == 0);
+    ip__store_u64le(out + IP_DIR_OFFSET, entry->offset);
+    ip__store_u32le(out + IP_DIR_STORED_SIZE, entry->stored_size);
+    out[IP_DIR_ENCODING] = entry->encoding;
+    out[IP_DIR_FILTERS] = entry->filters;
+    memset(out + IP_DIR_RESERVED, 0, IP_DIR_RESERVED_SIZE);
+    ip__store_u64le(out + IP_DIR_CHECKSUM, entry->checksum);
 }
 
-void ip__format_entry_decode(const unsigned char in[24], ip_brick_entry *entry)
+void ip__format_entry_decode(const unsigned char in[IP_DIRECTORY_ENTRY_SIZE],
+                             ip_brick_entry *entry)
 {
-    entry->offset = ip__load_u64le(in);
-    entry->stored_size = ip__load_u32le(in + 8);
-    entry->encoding = in[12];
-    entry->filters = in[13];
-    entry->checksum = ip__load_u64le(in + 16);
+    entry->offset = ip__load_u64le(in + IP_DIR_OFFSET);
+    entry->stored_size = ip__load_u32le(in + IP_DIR_STORED_SIZE);
+    entry->encoding = in[IP_DIR_ENCODING];
+    entry->filters = in[IP_DIR_FILTERS];
+    entry->checksum = ip__load_u64le(in + IP_DIR_CHECKSUM);
 }
 
 /* ---- parsing ---- */
@@ -337,57 +347,58 @@ void ip__format_entry_decode(const unsigned char in[24], ip_brick_entry *entry)
 static ip_status parse_header(const unsigned char *h, const char *name, unsigned flags,
                               ip_layout *layout, ip_error *err)
 {
-    if (memcmp(h, IP_MAGIC, 8) != 0)
+    if (memcmp(h + IP_HDR_MAGIC, IP_MAGIC, IP_HDR_MAGIC_SIZE) != 0)
         return ip__fail(err, IP_ERR_FORMAT, "%s: not a brick file (bad magic)", name);
-    uint32_t version = ip__load_u32le(h + 8);
+    uint32_t version = ip__load_u32le(h + IP_HDR_VERSION);
     if (version != IP_FORMAT_VERSION)
         return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: format version %u is not supported (this "
                        "build reads version %u)", name, version, IP_FORMAT_VERSION);
-    if (ip__load_u32le(h + 12) != IP_HEADER_SIZE)
+    if (ip__load_u32le(h + IP_HDR_HEADER_SIZE) != IP_HEADER_SIZE)
         return ip__fail(err, IP_ERR_FORMAT, "%s: header size %u is not %u", name,
-                       ip__load_u32le(h + 12), IP_HEADER_SIZE);
+                       ip__load_u32le(h + IP_HDR_HEADER_SIZE), IP_HEADER_SIZE);
     if (!(flags & IP_PARSE_SKIP_CHECKSUMS) &&
-        ip__load_u64le(h + 248) != ip__format_checksum(h, 248))
+        ip__load_u64le(h + IP_HDR_CHECKSUM) != ip__format_checksum(h, IP_HDR_CHECKSUM))
         return ip__fail(err, IP_ERR_CHECKSUM, "%s: header checksum mismatch", name);
     uint32_t dims[3];
     double spacing[3];
     for (int a = 0; a < 3; a++) {
-        dims[a] = ip__load_u32le(h + 16 + 4 * a);
-        spacing[a] = load_f64(h + 32 + 8 * a);
+        dims[a] = ip__load_u32le(h + IP_HDR_DIMS + 4 * a);
+        spacing[a] = load_f64(h + IP_HDR_SPACING + 8 * a);
     }
-    uint32_t type = ip__load_u32le(h + 28);
+    uint32_t type = ip__load_u32le(h + IP_HDR_TYPE);
     if (type >= IP_TYPE_COUNT)
         return ip__fail(err, IP_ERR_FORMAT, "%s: unknown sample type %u", name, type);
-    if (ip__load_u32le(h + 68) != 0)
+    if (ip__load_u32le(h + IP_HDR_FLAGS) != 0)
         return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: unknown header flags 0x%x", name,
-                       ip__load_u32le(h + 68));
+                       ip__load_u32le(h + IP_HDR_FLAGS));
     ip_error why;
-    if (ip__layout_init(layout, dims, (ip_type)type, spacing, ip__load_u32le(h + 56),
-                       ip__load_u32le(h + 60), &why) != IP_OK)
+    if (ip__layout_init(layout, dims, (ip_type)type, spacing,
+                       ip__load_u32le(h + IP_HDR_BRICK_EDGE),
+                       ip__load_u32le(h + IP_HDR_SUBBLOCK_EDGE), &why) != IP_OK)
         return ip__fail(err, IP_ERR_FORMAT, "%s: %s", name, why.message);
     /* a spacing nothing downstream renders correctly (a file from before the bounds, or a
      * hostile one): refused here, so that no reader of the library reaches the engine with it */
     ip_status st = ip_spacing_check(spacing, name, err);
     if (st != IP_OK)
         return st;
-    for (int i = 144; i < 248; i++)
+    for (int i = IP_HDR_RESERVED; i < IP_HDR_CHECKSUM; i++)
         if (h[i] != 0)
             return ip__fail(err, IP_ERR_FORMAT, "%s: reserved header byte %d is not zero", name, i);
-    if (ip__load_u32le(h + 64) != layout->level_count ||
-        ip__load_u64le(h + 80) != layout->brick_count ||
-        ip__load_u64le(h + 88) != layout->node_count)
+    if (ip__load_u32le(h + IP_HDR_LEVEL_COUNT) != layout->level_count ||
+        ip__load_u64le(h + IP_HDR_BRICK_COUNT) != layout->brick_count ||
+        ip__load_u64le(h + IP_HDR_NODE_COUNT) != layout->node_count)
         return ip__fail(err, IP_ERR_FORMAT,
                        "%s: level, brick or node counts disagree with the dimensions", name);
-    layout->value_min = load_f32(h + 72);
-    layout->value_max = load_f32(h + 76);
-    layout->data_offset = ip__load_u64le(h + 96);
-    layout->data_size = ip__load_u64le(h + 104);
-    layout->summary_offset = ip__load_u64le(h + 112);
-    layout->summary_checksum = ip__load_u64le(h + 128);
-    layout->file_size = ip__load_u64le(h + 136);
-    if (ip__load_u64le(h + 120) != layout->summary_size)
+    layout->value_min = load_f32(h + IP_HDR_VALUE_MIN);
+    layout->value_max = load_f32(h + IP_HDR_VALUE_MAX);
+    layout->data_offset = ip__load_u64le(h + IP_HDR_DATA_OFFSET);
+    layout->data_size = ip__load_u64le(h + IP_HDR_DATA_SIZE);
+    layout->summary_offset = ip__load_u64le(h + IP_HDR_SUMMARY_OFFSET);
+    layout->summary_checksum = ip__load_u64le(h + IP_HDR_SUMMARY_CHECKSUM);
+    layout->file_size = ip__load_u64le(h + IP_HDR_FILE_SIZE);
+    if (ip__load_u64le(h + IP_HDR_SUMMARY_SIZE) != layout->summary_size)
         return ip__fail(err, IP_ERR_FORMAT, "%s: summary size %llu is not the expected %llu",
-                       name, (unsigned long long)ip__load_u64le(h + 120),
+                       name, (unsigned long long)ip__load_u64le(h + IP_HDR_SUMMARY_SIZE),
                        (unsigned long long)layout->summary_size);
     return IP_OK;
 }
@@ -419,18 +430,19 @@ static ip_status check_level_table(const ip_layout *l, const unsigned char *tabl
     for (uint32_t k = 0; k < l->level_count; k++) {
         const unsigned char *e = table + (size_t)k * IP_LEVEL_ENTRY_SIZE;
         const ip_level_layout *lv = &l->levels[k];
-        int same = ip__load_u64le(e + 24) == lv->first_brick &&
-                   ip__load_u32le(e + 32) == lv->octree_depth &&
-                   ip__load_u64le(e + 40) == lv->first_node && ip__load_u32le(e + 36) == 0 &&
-                   ip__load_u64le(e + 56) == 0;
+        int same = ip__load_u64le(e + IP_LVL_FIRST_BRICK) == lv->first_brick &&
+                   ip__load_u32le(e + IP_LVL_OCTREE_DEPTH) == lv->octree_depth &&
+                   ip__load_u64le(e + IP_LVL_FIRST_NODE) == lv->first_node &&
+                   ip__load_u32le(e + IP_LVL_RESERVED_A) == 0 &&
+                   ip__load_u64le(e + IP_LVL_RESERVED_B) == 0;
         for (int a = 0; a < 3; a++)
-            same = same && ip__load_u32le(e + 4 * a) == lv->dims[a] &&
-                   ip__load_u32le(e + 12 + 4 * a) == lv->bricks[a];
+            same = same && ip__load_u32le(e + IP_LVL_DIMS + 4 * a) == lv->dims[a] &&
+                   ip__load_u32le(e + IP_LVL_BRICKS + 4 * a) == lv->bricks[a];
         if (!same)
             return ip__fail(err, IP_ERR_FORMAT, "%s: level %u of the level table disagrees with "
                            "the header", name, k);
-        out->levels[k].value_min = load_f32(e + 48);
-        out->levels[k].value_max = load_f32(e + 52);
+        out->levels[k].value_min = load_f32(e + IP_LVL_VALUE_MIN);
+        out->levels[k].value_max = load_f32(e + IP_LVL_VALUE_MAX);
         if (!range_ok(out->levels[k].value_min, out->levels[k].value_max))
             return ip__fail(err, IP_ERR_FORMAT, "%s: level %u has an invalid value range", name, k);
     }
@@ -512,7 +524,8 @@ ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
         const unsigned char *r = summary + o.brick_ranges + g * IP_RANGE_SIZE;
         ip_brick_entry e;
         ip__format_entry_decode(d, &e);
-        st = check_entry(layout, g, &e, d[14] | d[15], load_f32(r), load_f32(r + 4), name, err);
+        st = check_entry(layout, g, &e, d[IP_DIR_RESERVED] | d[IP_DIR_RESERVED + 1],
+                         load_f32(r + IP_RANGE_MIN), load_f32(r + IP_RANGE_MAX), name, err);
         if (st != IP_OK)
             return st;
     }

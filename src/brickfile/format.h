@@ -53,8 +53,10 @@ void ip__format_header_encode(const ip_layout *layout, unsigned char out[IP_HEAD
 void ip__format_level_table_encode(const ip_layout *layout, unsigned char *out);
 
 /*! ip__format_entry_encode() / _decode() : one 24-byte directory entry. */
-void ip__format_entry_encode(const ip_brick_entry *entry, unsigned char out[24]);
-void ip__format_entry_decode(const unsigned char in[24], ip_brick_entry *entry);
+void ip__format_entry_encode(const ip_brick_entry *entry,
+                             unsigned char out[IP_DIRECTORY_ENTRY_SIZE]);
+void ip__format_entry_decode(const unsigned char in[IP_DIRECTORY_ENTRY_SIZE],
+                             ip_brick_entry *entry);
 
 enum {
     IP_PARSE_SKIP_CHECKSUMS = 1 /* for fuzzing the structure checks behind the checksums */

@@ -2,6 +2,7 @@
 #include <math.h>
 
 #include "format.h"
+#include "internal.h"
 #include "summary.h"
 
 #define BOX_RANGE(T)                                                               \
@@ -37,6 +38,10 @@ void ip__summarise_brick(const void *samples, ip_type type, const uint32_t exten
                         uint32_t brick_edge, uint32_t subblock_edge, float brick_range[2],
                         float *ranges)
 {
+    IP_ASSERT(subblock_edge >= 1 && subblock_edge <= brick_edge &&
+              brick_edge % subblock_edge == 0);
+    for (int a = 0; a < 3; a++)
+        IP_ASSERT(extent[a] >= 2 && extent[a] <= brick_edge + 1);
     uint32_t per_axis = brick_edge / subblock_edge;
     uint32_t last[3] = {extent[0] - 1, extent[1] - 1, extent[2] - 1};
     size_t i = 0;

@@ -2,6 +2,7 @@
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
@@ -61,4 +62,11 @@ ip_status ip__fail_errno(ip_error *err, ip_status code, int errnum, const char *
         snprintf(err->message + used, sizeof err->message - used, ": %s", strerror(errnum));
     }
     return code;
+}
+
+void ip__assert_fail(const char *file, int line, const char *condition)
+{
+    fprintf(stderr, "%s:%d: internal assertion failed: %s\n", file, line, condition);
+    fflush(stderr);
+    abort();
 }

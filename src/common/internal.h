@@ -15,6 +15,23 @@
 #define IP_PRINTF(a, b)
 #endif
 
+/* IP_ASSERT(cond): an internal invariant (a precondition of an internal function: an index in
+ * range, a size, a pointer that is not NULL), never a check of input, which gets an ip_status.
+ * Without NDEBUG (the Debug build that tools/setup.sh test runs under the sanitizers) a false
+ * condition prints "file:line: internal assertion failed: cond" to stderr and aborts: the one
+ * place the library prints. With NDEBUG (every other build) the condition is not evaluated. */
+#ifdef NDEBUG
+#define IP_ASSERT(cond) ((void)sizeof((cond) ? 1 : 0))
+#else
+#define IP_ASSERT(cond) ((cond) ? (void)0 : ip__assert_fail(__FILE__, __LINE__, #cond))
+#endif
+
+/* Prints the failed IP_ASSERT condition with its place and aborts. */
+#if defined(__GNUC__)
+__attribute__((noreturn))
+#endif
+void ip__assert_fail(const char *file, int line, const char *condition);
+
 /* Fills err (may be NULL) with code and a formatted one-line message; returns code. */
 ip_status ip__fail(ip_error *err, ip_status code, const char *fmt, ...) IP_PRINTF(3, 4);
 

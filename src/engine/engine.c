@@ -70,6 +70,12 @@ void ip_engine_options_default(ip_engine_options *o)
     o->cell_ids = 0;
 }
 
+/* The brick file an engine extracts from, which its messages name. */
+static const char *path_of(const ip_cache *cache)
+{
+    return ip_store_path(ip_cache_store(cache));
+}
+
 ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
                            ip_error *err)
 {
@@ -83,7 +89,7 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
                        options->pixel_error);
     ip_engine *e = calloc(1, sizeof *e);
     if (!e)
-        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for an engine", path_of(cache));
     e->cache = cache;
     e->options = *options;
     e->threads = ip_thread_count(options->threads);
@@ -104,7 +110,7 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     }
     if (st != IP_OK) {
         ip_engine_destroy(e);
-        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for an engine", path_of(cache));
     }
     *out = e;
     return IP_OK;
@@ -172,7 +178,8 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     if (st != IP_OK)
         return st;
     if (!isfinite(iso))
-        return ip__fail(err, IP_ERR_ARGUMENT, "the isovalue must be finite");
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: the isovalue must be finite",
+                       path_of(e->cache));
     ip__visited_clear(&e->visited);
     ip_mesh_clear(&e->mesh);
     e->camera = *camera;
@@ -195,7 +202,8 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
             level_tools *lt = &w->level[k];
             if (!lt->ready) {
                 if (ip__sampler_init(&lt->sampler, e->cache, k) != IP_OK)
-                    return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+                    return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory",
+                                   path_of(e->cache));
                 lt->ready = 1;
             }
             ip__sampler_release(&lt->sampler);
@@ -205,7 +213,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
             if (ip__propagator_init(&lt->propagator, &lt->sampler, &e->visited, &w->mesh,
                                    &e->camera, iso, &e->options, e->lod_distance[k],
                                    e->lod_distance[k + 1]) != IP_OK)
-                return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+                return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
         }
     }
     atomic_store(&e->cancel, 0);
@@ -364,7 +372,7 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
     if (!e->begun)
         return ip__fail(err, IP_ERR_ARGUMENT, "ip_engine_step() before ip_engine_begin()");
     if (atomic_load(&e->cancel))
-        return ip__fail(err, IP_ERR_CANCELLED, "extraction cancelled");
+        return ip__fail(err, IP_ERR_CANCELLED, "%s: extraction cancelled", path_of(e->cache));
     e->step_rays_left = max_rays ? max_rays : UINT64_MAX;
     e->step_deadline = max_seconds > 0 ? ip_now_seconds() + max_seconds : 0;
     unsigned threads = e->threads;
@@ -386,9 +394,9 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
         if (st == IP_OK && w->status != IP_OK) {
             st = w->status;
             if (st == IP_ERR_CANCELLED)
-                ip__fail(err, st, "extraction cancelled");
+                ip__fail(err, st, "%s: extraction cancelled", path_of(e->cache));
             else if (st == IP_ERR_NOMEM)
-                ip__fail(err, st, "out of memory");
+                ip__fail(err, st, "%s: out of memory", path_of(e->cache));
             else if (err)
                 *err = w->level[w->failed_level].sampler.error;
         }

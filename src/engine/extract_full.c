@@ -122,12 +122,13 @@ ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned t
                           ip_mesh *mesh, ip_engine_counts *counts, ip_error *err)
 {
     const ip_layout *l = ip_store_layout(ip_cache_store(cache));
+    const char *path = ip_store_path(ip_cache_store(cache));
     if (level >= l->level_count)
-        return ip__fail(err, IP_ERR_ARGUMENT, "level %u does not exist", level);
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: level %u does not exist", path, level);
     threads = ip_thread_count(threads);
     full_worker *w = calloc(threads, sizeof *w);
     if (!w)
-        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path);
     atomic_uint_fast64_t next;
     atomic_init(&next, 0);
     ip_status st = IP_OK;
@@ -135,8 +136,8 @@ ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned t
         w[t] = (full_worker){.cache = cache, .iso = iso, .level = level, .next = &next};
         ip_mesh_init(&w[t].mesh);
         w[t].mesh.with_cells = mesh->with_cells;
-        if (ip__sampler_init(&w[t].sampler, cache, level) != IP_OK)
-            st = IP_ERR_NOMEM;
+        if (ip__sampler_init(&w[t].sampler, cache, level) != IP_OK && st == IP_OK)
+            st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path);
     }
     ip__pool *pool = NULL;
     if (st == IP_OK)
@@ -155,13 +156,13 @@ ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned t
         if (st == IP_OK && w[t].status != IP_OK) {
             st = w[t].status;
             if (st == IP_ERR_NOMEM)
-                ip__fail(err, st, "out of memory");
+                ip__fail(err, st, "%s: out of memory", path);
             else if (err)
                 *err = w[t].sampler.error;
         }
     }
     if (st == IP_OK && merge_in_brick_order(w, threads, mesh) != IP_OK)
-        st = ip__fail(err, IP_ERR_NOMEM, "out of memory");
+        st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path);
     for (unsigned t = 0; t < threads; t++) {
         ip__sampler_free(&w[t].sampler);
         ip_mesh_free(&w[t].mesh);

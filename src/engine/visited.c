@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "internal.h"
 #include "visited.h"
 
 ip_status ip__visited_init(ip_visited *v, const ip_layout *layout)
@@ -38,7 +39,9 @@ void ip__visited_free(ip_visited *v)
 static uint64_t locate(const ip_visited *v, uint32_t level, const uint32_t cell[3], uint64_t *bit)
 {
     uint32_t b = v->layout->brick_edge, brick[3], local[3];
+    IP_ASSERT(level < v->layout->level_count);
     for (int a = 0; a < 3; a++) {
+        IP_ASSERT(cell[a] < v->layout->levels[level].dims[a] - 1);
         brick[a] = cell[a] / b;
         local[a] = cell[a] - brick[a] * b;
     }

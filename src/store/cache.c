@@ -90,7 +90,7 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
                        ip_store_path(store));
     ip_cache *c = calloc(1, sizeof *c);
     if (!c)
-        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for a cache", ip_store_path(store));
     c->store = store;
     c->layout = ip_store_layout(store);
     c->budget = budget_bytes;
@@ -101,8 +101,8 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
     c->work_size = ip_store_read_work_size(store);
     if (!c->slots || !c->touched || !c->loading) {
         ip_cache_destroy(c);
-        return ip__fail(err, IP_ERR_NOMEM, "out of memory for a cache of %llu bricks",
-                       (unsigned long long)n);
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for a cache of %llu bricks",
+                       ip_store_path(store), (unsigned long long)n);
     }
     for (int i = 0; i < STRIPES; i++) {
         pthread_mutex_init(&c->stripe_lock[i], NULL);
@@ -358,7 +358,8 @@ static ip_status decode_into(ip_cache *c, uint64_t g, entry *e, ip_error *err)
 {
     void *work = take_work(c);
     if (!work)
-        return ip__fail(err, IP_ERR_NOMEM, "out of memory");
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for brick %llu",
+                       ip_store_path(c->store), (unsigned long long)g);
     double t0 = ip_now_seconds();
     ip_status st = ip_store_read_brick(c->store, g, e->samples, work, err);
     double t1 = ip_now_seconds();
@@ -398,7 +399,9 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
         free_entry(c, e);
         pthread_mutex_unlock(&c->evict_lock);
         atomic_fetch_add(&c->errors, 1);
-        return st == IP_ERR_NOMEM ? ip__fail(err, st, "out of memory") : st;
+        return st == IP_ERR_NOMEM ? ip__fail(err, st, "%s: out of memory for brick %llu",
+                                             ip_store_path(c->store), (unsigned long long)g)
+                                  : st;
     }
     atomic_store(&e->brick, g);
     atomic_store(&e->pins, 1);

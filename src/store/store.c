@@ -179,6 +179,7 @@ const char *ip_store_path(const ip_store *s)
 
 void ip_store_brick_entry(const ip_store *s, uint64_t g, ip_brick_entry *entry)
 {
+    IP_ASSERT(g < s->layout.brick_count);
     ip__format_entry_decode(s->summary + s->offsets.directory + g * IP_DIRECTORY_ENTRY_SIZE,
                               entry);
 }

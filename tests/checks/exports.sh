@@ -7,7 +7,10 @@ lib=$1
 include=$2
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
-nm -D --defined-only "$lib" | awk 'NF == 3 { print $3 }' | sort -u >"$dir/exported"
+# (less the __start_SECTION / __stop_SECTION bounds the linker defines for the coverage sections
+# of a fuzzer build, -fsanitize=fuzzer-no-link: no code of ours)
+nm -D --defined-only "$lib" | awk 'NF == 3 && $3 !~ /^__(start|stop)___sancov_/ { print $3 }' |
+    sort -u >"$dir/exported"
 # the name of each IP_API declaration: the identifier before the first '('
 grep -h '^IP_API ' "$include"/isoprop/*.h | sed 's/(.*//; s/.*[ *]//' | sort -u >"$dir/declared"
 failed=0

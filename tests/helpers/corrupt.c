@@ -37,6 +37,7 @@
 #include <unistd.h>
 
 #include "format.h"
+#include "format_offsets.h"
 
 #define NOOP 3
 
@@ -207,9 +208,9 @@ static int cmd_plan(const char *path, int quick, uint64_t seed)
      * summary */
     uint64_t cuts[128];
     unsigned ncut = 0, spread = quick ? 3 : 16;
-    uint64_t fixed[] = {0, 1, 8, IP_HEADER_SIZE - 1, IP_HEADER_SIZE, IP_HEADER_SIZE + 1,
-                        data_end, l.summary_offset - 1, l.summary_offset,
-                        l.summary_offset + 64, size - 1, size / 2};
+    uint64_t fixed[] = {0, 1, IP_HDR_VERSION, IP_HEADER_SIZE - 1, IP_HEADER_SIZE,
+                        IP_HEADER_SIZE + 1, data_end, l.summary_offset - 1, l.summary_offset,
+                        l.summary_offset + IP_LEVEL_ENTRY_SIZE, size - 1, size / 2};
     for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
         if (!quick || i % 3 == 0 || fixed[i] == size - 1)
             cuts[ncut++] = fixed[i];

@@ -1,0 +1,716 @@
+/* The brick file format (src/brickfile/format.c) on its own, in memory: the layout derived from
+ * odd dimensions and brick edges against the formulas of docs/format.md, brick coordinates and
+ * extents, the octree numbering, the Morton order, header and directory entry round trips
+ * through the named offsets (format_offsets.h), and every validation of the parser: each
+ * header field, reserved byte, level table field and directory entry field made wrong on its
+ * own (the checksums resealed, so that the check behind them is the one reached) is refused
+ * with its code and a message naming the file. */
+#include <math.h>
+
+#include "check.h"
+#include "format.h"
+#include "format_offsets.h"
+#include "internal.h"
+
+#define NAME "memory.ibv"
+
+static uint32_t ceil_div_u64(uint64_t a, uint64_t b)
+{
+    return (uint32_t)((a + b - 1) / b);
+}
+
+/* The layout of docs/format.md "Levels", "Bricks" and "Octree nodes", computed again here. */
+static void check_layout_against_spec(const uint32_t dims[3], uint32_t B, uint32_t s)
+{
+    const double spacing[3] = {1, 2, 0.5};
+    ip_layout l;
+    ip_error err;
+    char what[96];
+    snprintf(what, sizeof what, "%ux%ux%u B=%u s=%u", dims[0], dims[1], dims[2], B, s);
+    REQUIRE(ip__layout_init(&l, dims, IP_INT16, spacing, B, s, &err) == IP_OK);
+    uint64_t bricks_total = 0, nodes_total = 0;
+    uint32_t k = 0;
+    for (;; k++) {
+        REQUIRE(k < IP_MAX_LEVELS);
+        uint64_t bricks = 1;
+        uint32_t depth = 0;
+        for (int a = 0; a < 3; a++) {
+            uint32_t n = ceil_div_u64(dims[a] - 1, 1ull << k) + 1;
+            uint32_t nb = ceil_div_u64(n - 1, B);
+            CHECK_MSG(l.levels[k].dims[a] == n, "%s: level %u dims[%d] %u, wanted %u", what, k, a,
+                      l.levels[k].dims[a], n);
+            CHECK_MSG(l.levels[k].bricks[a] == nb, "%s: level %u bricks[%d]", what, k, a);
+            bricks *= nb;
+            uint32_t d = 0;
+            while ((1u << d) < nb)
+                d++;
+            if (d > depth)
+                depth = d;
+        }
+        uint64_t nodes = 0;
+        for (uint32_t j = 1; j <= depth; j++) {
+            uint64_t n = 1;
+            for (int a = 0; a < 3; a++)
+                n *= ceil_div_u64(l.levels[k].bricks[a], 1ull << j);
+            nodes += n;
+        }
+        CHECK_MSG(l.levels[k].brick_count == bricks, "%s: level %u brick count", what, k);
+        CHECK_MSG(l.levels[k].first_brick == bricks_total, "%s: level %u first brick", what, k);
+        CHECK_MSG(l.levels[k].octree_depth == depth, "%s: level %u depth", what, k);
+        CHECK_MSG(l.levels[k].node_count == nodes, "%s: level %u nodes", what, k);
+        CHECK_MSG(l.levels[k].first_node == nodes_total, "%s: level %u first node", what, k);
+        bricks_total += bricks;
+        nodes_total += nodes;
+        if (bricks == 1)
+            break;
+    }
+    CHECK_MSG(l.level_count == k + 1, "%s: %u levels, wanted %u", what, l.level_count, k + 1);
+    CHECK(l.brick_count == bricks_total && l.node_count == nodes_total);
+    CHECK(l.data_offset == IP_HEADER_SIZE);
+    uint64_t P = B / s;
+    CHECK_MSG(l.summary_size ==
+                  l.level_count * 64ull + bricks_total * (24 + 8 + 8 * P * P * P) + nodes_total * 8,
+              "%s: summary size", what);
+    CHECK(ip_layout_subblocks_per_brick(&l) == P * P * P);
+
+    /* every brick: coordinates and global index agree, extents tile the level's cells */
+    for (uint32_t lv = 0; lv < l.level_count; lv++) {
+        uint64_t cells_x = 0;
+        for (uint32_t bx = 0; bx < l.levels[lv].bricks[0]; bx++) {
+            uint32_t b[3] = {bx, l.levels[lv].bricks[1] - 1, 0}, o[3], ext[3];
+            ip_brick_extent(&l, lv, b, o, ext);
+            CHECK(o[0] == bx * B && ext[0] >= 2 && ext[0] <= B + 1);
+            cells_x += ext[0] - 1;
+        }
+        CHECK_MSG(cells_x == l.levels[lv].dims[0] - 1, "%s: level %u bricks cover x", what, lv);
+    }
+    for (uint64_t g = 0; g < l.brick_count; g++) {
+        uint32_t level, b[3];
+        ip_brick_coords(&l, g, &level, b);
+        CHECK_MSG(ip_brick_global_index(&l, level, b) == g, "%s: brick %llu", what,
+                  (unsigned long long)g);
+    }
+    /* octree nodes: depth by depth, each level's nodes numbered exactly once */
+    for (uint32_t lv = 0; lv < l.level_count; lv++) {
+        const ip_level_layout *L = &l.levels[lv];
+        uint64_t expect = L->first_node;
+        for (uint32_t j = 1; j <= L->octree_depth; j++) {
+            uint32_t grid[3];
+            ip__octree_grid(&l, lv, j, grid);
+            for (int a = 0; a < 3; a++)
+                CHECK(grid[a] == ceil_div_u64(L->bricks[a], 1ull << j));
+            for (uint32_t z = 0; z < grid[2]; z++)
+                for (uint32_t y = 0; y < grid[1]; y++)
+                    for (uint32_t x = 0; x < grid[0]; x++) {
+                        uint32_t node[3] = {x, y, z};
+                        CHECK(ip__octree_node_index(&l, lv, j, node) == expect);
+                        expect++;
+                    }
+            if (j == L->octree_depth)
+                CHECK(grid[0] == 1 && grid[1] == 1 && grid[2] == 1);
+        }
+        CHECK_MSG(expect == L->first_node + L->node_count, "%s: level %u node numbering", what, lv);
+        /* Morton order: a permutation, by increasing interleaved code */
+        uint64_t *order = malloc(L->brick_count * sizeof *order);
+        char *seen = calloc(L->brick_count, 1);
+        REQUIRE(order && seen && ip__morton_order(&l, lv, order) == IP_OK);
+        uint64_t last = 0;
+        int ok = 1;
+        for (uint64_t i = 0; i < L->brick_count; i++) {
+            uint64_t idx = order[i];
+            ok &= idx < L->brick_count && !seen[idx];
+            if (idx >= L->brick_count)
+                break;
+            seen[idx] = 1;
+            uint32_t c[3] = {(uint32_t)(idx % L->bricks[0]),
+                             (uint32_t)(idx / L->bricks[0] % L->bricks[1]),
+                             (uint32_t)(idx / L->bricks[0] / L->bricks[1])};
+            uint64_t code = 0;
+            for (int bit = 0; bit < 21; bit++)
+                for (int a = 0; a < 3; a++)
+                    code |= (uint64_t)((c[a] >> bit) & 1) << (3 * bit + a);
+            ok &= i == 0 || code > last;
+            last = code;
+        }
+        CHECK_MSG(ok, "%s: level %u Morton order", what, lv);
+        free(order);
+        free(seen);
+    }
+}
+
+static void test_layouts(void)
+{
+    static const uint32_t shapes[][3] = {{2, 2, 2},   {3, 2, 2},  {21, 18, 19},  {33, 33, 33},
+                                         {100, 7, 2}, {65, 2, 9}, {257, 3, 130}, {5, 300, 17}};
+    static const uint32_t edges[][2] = {{2, 1}, {2, 2}, {4, 2}, {8, 8}, {16, 4}, {32, 8}};
+    for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++)
+        for (size_t j = 0; j < sizeof edges / sizeof edges[0]; j++)
+            check_layout_against_spec(shapes[i], edges[j][0], edges[j][1]);
+
+    /* the smallest volume: one level, one brick, no nodes */
+    ip_layout l;
+    ip_error err;
+    const uint32_t two[3] = {2, 2, 2};
+    const double one[3] = {1, 1, 1};
+    REQUIRE(ip__layout_init(&l, two, IP_UINT8, one, 32, 8, &err) == IP_OK);
+    CHECK(l.level_count == 1 && l.brick_count == 1 && l.node_count == 0);
+    uint32_t b[3] = {0, 0, 0}, o[3], e[3];
+    ip_brick_extent(&l, 0, b, o, e);
+    CHECK(e[0] == 2 && e[1] == 2 && e[2] == 2);
+}
+
+static void layout_refused(const uint32_t dims[3], ip_type type, const double spacing[3],
+                           uint32_t B, uint32_t s, const char *text)
+{
+    ip_layout l;
+    ip_error err;
+    ip_status st = ip__layout_init(&l, dims, type, spacing, B, s, &err);
+    CHECK_MSG(st == IP_ERR_ARGUMENT, "%s: status %d", text, (int)st);
+    if (st != IP_OK)
+        CHECK_CONTAINS(err.message, text);
+}
+
+static void test_layout_arguments(void)
+{
+    const uint32_t dims[3] = {10, 11, 12}, one[3] = {10, 1, 12}, huge[3] = {10, 11, 1u << 31};
+    const double sp[3] = {1, 1, 1}, zero[3] = {1, 0, 1}, nan[3] = {NAN, 1, 1};
+    const double inf[3] = {1, 1, INFINITY};
+    layout_refused(one, IP_UINT8, sp, 8, 4, "dimension 1 along y");
+    layout_refused(huge, IP_UINT8, sp, 8, 4, "along z is outside [2, 2^31)");
+    layout_refused(dims, IP_UINT8, zero, 8, 4, "spacing 0 along y");
+    layout_refused(dims, IP_UINT8, nan, 8, 4, "along x is not positive");
+    layout_refused(dims, IP_UINT8, inf, 8, 4, "along z is not positive");
+    layout_refused(dims, (ip_type)IP_TYPE_COUNT, sp, 8, 4, "unknown sample type");
+    layout_refused(dims, IP_UINT8, sp, 1, 1, "brick edge 1");
+    layout_refused(dims, IP_UINT8, sp, 12, 4, "brick edge 12");
+    layout_refused(dims, IP_UINT8, sp, 512, 4, "brick edge 512");
+    layout_refused(dims, IP_UINT8, sp, 8, 3, "sub-block edge 3");
+    layout_refused(dims, IP_UINT8, sp, 8, 16, "sub-block edge 16");
+    layout_refused(dims, IP_UINT8, sp, 8, 0, "sub-block edge 0");
+}
+
+/* ---- a whole, valid file in memory: every brick constant (no payload) but one raw ---- */
+
+typedef struct image {
+    ip_layout layout;
+    unsigned char *bytes;
+    uint64_t size;
+    ip_summary_offsets o;
+} image;
+
+/* Recomputes the summary checksum (into the header) and the header checksum. */
+static void reseal(image *m)
+{
+    unsigned char *h = m->bytes;
+    uint64_t so = ip__load_u64le(h + IP_HDR_SUMMARY_OFFSET);
+    uint64_t ss = ip__load_u64le(h + IP_HDR_SUMMARY_SIZE);
+    if (so + ss <= m->size)
+        ip__store_u64le(h + IP_HDR_SUMMARY_CHECKSUM, ip__format_checksum(h + so, ss));
+    ip__store_u64le(h + IP_HDR_CHECKSUM, ip__format_checksum(h, IP_HDR_CHECKSUM));
+}
+
+static void put_f32(unsigned char *p, float v)
+{
+    uint32_t bits;
+    memcpy(&bits, &v, 4);
+    ip__store_u32le(p, bits);
+}
+
+static float get_f32(const unsigned char *p)
+{
+    uint32_t bits = ip__load_u32le(p);
+    float v;
+    memcpy(&v, &bits, 4);
+    return v;
+}
+
+static void put_f64(unsigned char *p, double v)
+{
+    uint64_t bits;
+    memcpy(&bits, &v, 8);
+    ip__store_u64le(p, bits);
+}
+
+static void make_image(image *m)
+{
+    const uint32_t dims[3] = {13, 9, 6};
+    const double spacing[3] = {0.5, 0.25, 2};
+    ip_error err;
+    REQUIRE(ip__layout_init(&m->layout, dims, IP_UINT16, spacing, 4, 2, &err) == IP_OK);
+    ip_layout *l = &m->layout;
+    /* brick 0 is raw (its samples all 5 but for one 9), every other brick constant 5 */
+    uint32_t b0[3] = {0, 0, 0}, origin[3], extent[3];
+    ip_brick_extent(l, 0, b0, origin, extent);
+    uint32_t raw = extent[0] * extent[1] * extent[2] * 2;
+    l->data_size = raw;
+    l->summary_offset =
+        (IP_HEADER_SIZE + raw + IP_SUMMARY_ALIGN - 1) / IP_SUMMARY_ALIGN * IP_SUMMARY_ALIGN;
+    l->file_size = l->summary_offset + l->summary_size;
+    l->value_min = 5;
+    l->value_max = 9;
+    for (uint32_t k = 0; k < l->level_count; k++) {
+        l->levels[k].value_min = 5;
+        l->levels[k].value_max = 9;
+    }
+    m->size = l->file_size;
+    m->bytes = calloc(1, m->size);
+    REQUIRE(m->bytes != NULL);
+    unsigned char *payload = m->bytes + IP_HEADER_SIZE;
+    for (uint32_t i = 0; i < raw / 2; i++) {
+        payload[2 * i] = i == 3 ? 9 : 5;
+        payload[2 * i + 1] = 0;
+    }
+    unsigned char *summary = m->bytes + l->summary_offset;
+    ip__summary_offsets_of(l, &m->o);
+    ip__format_level_table_encode(l, summary + m->o.level_table);
+    uint32_t P3 = ip_layout_subblocks_per_brick(l);
+    for (uint64_t g = 0; g < l->brick_count; g++) {
+        ip_brick_entry e = {0, 0, IP_BRICK_CONSTANT, 0, 0};
+        if (g == 0)
+            e = (ip_brick_entry){IP_HEADER_SIZE, raw, IP_BRICK_RAW, 0,
+                                 ip__format_checksum(payload, raw)};
+        ip__format_entry_encode(&e, summary + m->o.directory + g * IP_DIRECTORY_ENTRY_SIZE);
+        unsigned char *r = summary + m->o.brick_ranges + g * IP_RANGE_SIZE;
+        put_f32(r + IP_RANGE_MIN, 5);
+        put_f32(r + IP_RANGE_MAX, g == 0 ? 9 : 5);
+        for (uint32_t i = 0; i < P3; i++) {
+            unsigned char *sr = summary + m->o.subblock_ranges + (g * P3 + i) * IP_RANGE_SIZE;
+            put_f32(sr + IP_RANGE_MIN, 5);
+            put_f32(sr + IP_RANGE_MAX, 5);
+        }
+    }
+    for (uint64_t n = 0; n < l->node_count; n++) {
+        put_f32(summary + m->o.nodes + n * IP_RANGE_SIZE + IP_RANGE_MIN, 5);
+        put_f32(summary + m->o.nodes + n * IP_RANGE_SIZE + IP_RANGE_MAX, 9);
+    }
+    ip__format_header_encode(l, m->bytes);
+    reseal(m);
+}
+
+static ip_status parse(const image *m, ip_layout *out, ip_error *err)
+{
+    return ip__format_parse(m->bytes, m->size, NAME, 0, out, err);
+}
+
+static void test_header_round_trip(void)
+{
+    image m;
+    make_image(&m);
+    const ip_layout *l = &m.layout;
+    const unsigned char *h = m.bytes;
+    /* the named offsets hold the fields of docs/format.md */
+    CHECK(memcmp(h + IP_HDR_MAGIC, "\x89IBV\r\n\x1a\n", 8) == 0);
+    CHECK(ip__load_u32le(h + IP_HDR_VERSION) == 1);
+    CHECK(ip__load_u32le(h + IP_HDR_HEADER_SIZE) == 256);
+    CHECK(ip__load_u32le(h + IP_HDR_DIMS) == 13 && ip__load_u32le(h + IP_HDR_DIMS + 4) == 9 &&
+          ip__load_u32le(h + IP_HDR_DIMS + 8) == 6);
+    CHECK(ip__load_u32le(h + IP_HDR_TYPE) == IP_UINT16);
+    double sp;
+    uint64_t bits = ip__load_u64le(h + IP_HDR_SPACING + 8);
+    memcpy(&sp, &bits, 8);
+    CHECK(sp == 0.25);
+    CHECK(ip__load_u32le(h + IP_HDR_BRICK_EDGE) == 4 &&
+          ip__load_u32le(h + IP_HDR_SUBBLOCK_EDGE) == 2);
+    CHECK(ip__load_u32le(h + IP_HDR_LEVEL_COUNT) == l->level_count);
+    CHECK(ip__load_u32le(h + IP_HDR_FLAGS) == 0);
+    CHECK(get_f32(h + IP_HDR_VALUE_MIN) == 5 && get_f32(h + IP_HDR_VALUE_MAX) == 9);
+    CHECK(ip__load_u64le(h + IP_HDR_BRICK_COUNT) == l->brick_count);
+    CHECK(ip__load_u64le(h + IP_HDR_NODE_COUNT) == l->node_count);
+    CHECK(ip__load_u64le(h + IP_HDR_DATA_OFFSET) == 256);
+    CHECK(ip__load_u64le(h + IP_HDR_DATA_SIZE) == l->data_size);
+    CHECK(ip__load_u64le(h + IP_HDR_SUMMARY_OFFSET) == l->summary_offset);
+    CHECK(ip__load_u64le(h + IP_HDR_SUMMARY_SIZE) == l->summary_size);
+    CHECK(ip__load_u64le(h + IP_HDR_FILE_SIZE) == m.size);
+    for (int i = IP_HDR_RESERVED; i < IP_HDR_CHECKSUM; i++)
+        CHECK(h[i] == 0);
+    CHECK(ip__load_u64le(h + IP_HDR_CHECKSUM) == ip__format_checksum(h, 248));
+
+    ip_layout parsed;
+    ip_error err;
+    REQUIRE(parse(&m, &parsed, &err) == IP_OK);
+    CHECK(memcmp(parsed.dims, l->dims, sizeof l->dims) == 0);
+    CHECK(memcmp(parsed.spacing, l->spacing, sizeof l->spacing) == 0);
+    CHECK(parsed.type == l->type && parsed.brick_edge == 4 && parsed.subblock_edge == 2);
+    CHECK(parsed.level_count == l->level_count && parsed.brick_count == l->brick_count &&
+          parsed.node_count == l->node_count);
+    CHECK(parsed.value_min == 5 && parsed.value_max == 9);
+    CHECK(parsed.data_offset == 256 && parsed.data_size == l->data_size);
+    CHECK(parsed.summary_offset == l->summary_offset && parsed.summary_size == l->summary_size &&
+          parsed.file_size == m.size);
+    CHECK(parsed.summary_checksum == ip__load_u64le(h + IP_HDR_SUMMARY_CHECKSUM));
+    for (uint32_t k = 0; k < l->level_count; k++) {
+        CHECK(memcmp(parsed.levels[k].dims, l->levels[k].dims, sizeof l->levels[k].dims) == 0);
+        CHECK(parsed.levels[k].first_brick == l->levels[k].first_brick);
+        CHECK(parsed.levels[k].value_min == 5 && parsed.levels[k].value_max == 9);
+    }
+    /* re-encoding the parsed layout gives the same header bytes */
+    unsigned char again[IP_HEADER_SIZE];
+    ip__format_header_encode(&parsed, again);
+    CHECK(memcmp(again, h, IP_HEADER_SIZE) == 0);
+    free(m.bytes);
+}
+
+static void test_entry_round_trip(void)
+{
+    ip_brick_entry e = {0x0102030405060708ull, 0xA0B0C0D0u, IP_BRICK_LZ4, 6, 0x1122334455667788ull},
+                   back;
+    unsigned char d[IP_DIRECTORY_ENTRY_SIZE];
+    memset(d, 0xFF, sizeof d);
+    ip__format_entry_encode(&e, d);
+    CHECK(ip__load_u64le(d + IP_DIR_OFFSET) == e.offset);
+    CHECK(ip__load_u32le(d + IP_DIR_STORED_SIZE) == e.stored_size);
+    CHECK(d[IP_DIR_ENCODING] == IP_BRICK_LZ4 && d[IP_DIR_FILTERS] == 6);
+    CHECK(d[IP_DIR_RESERVED] == 0 && d[IP_DIR_RESERVED + 1] == 0);
+    CHECK(ip__load_u64le(d + IP_DIR_CHECKSUM) == e.checksum);
+    ip__format_entry_decode(d, &back);
+    CHECK(back.offset == e.offset && back.stored_size == e.stored_size &&
+          back.encoding == e.encoding && back.filters == e.filters && back.checksum == e.checksum);
+}
+
+/* Parsing the image after `change` (then resealed unless `keep_checksums`) fails with `code`
+ * and a message naming the file and holding `text`; the image is restored afterwards. */
+typedef void (*change_fn)(image *m, uint64_t arg);
+
+static void refused(image *m, change_fn change, uint64_t arg, int reseal_after, ip_status code,
+                    const char *text)
+{
+    unsigned char *saved = malloc(m->size);
+    REQUIRE(saved != NULL);
+    memcpy(saved, m->bytes, m->size);
+    uint64_t size = m->size;
+    change(m, arg);
+    if (reseal_after)
+        reseal(m);
+    ip_layout l;
+    ip_error err;
+    ip_status st = ip__format_parse(m->bytes, m->size, NAME, 0, &l, &err);
+    CHECK_MSG(st == code, "%s (%llu): status %d, wanted %d (%s)", text, (unsigned long long)arg,
+              (int)st, (int)code, st != IP_OK ? err.message : "");
+    if (st != IP_OK) {
+        CHECK_CONTAINS(err.message, NAME);
+        CHECK_CONTAINS(err.message, text);
+    }
+    m->size = size;
+    memcpy(m->bytes, saved, m->size);
+    free(saved);
+}
+
+static void set_u32(image *m, uint64_t packed)
+{
+    ip__store_u32le(m->bytes + (packed >> 32), (uint32_t)packed);
+}
+
+static void set_u64_field(image *m, uint64_t offset, uint64_t v)
+{
+    ip__store_u64le(m->bytes + offset, v);
+}
+
+static uint64_t at(uint64_t offset, uint32_t value)
+{
+    return offset << 32 | value;
+}
+
+static void flip_byte(image *m, uint64_t offset)
+{
+    m->bytes[offset] ^= 0x40;
+}
+
+static void set_spacing_y(image *m, uint64_t bits)
+{
+    double v;
+    memcpy(&v, &bits, 8);
+    put_f64(m->bytes + IP_HDR_SPACING + 8, v);
+}
+
+static uint64_t double_bits(double v)
+{
+    uint64_t bits;
+    memcpy(&bits, &v, 8);
+    return bits;
+}
+
+static void add_to_brick_count(image *m, uint64_t n)
+{
+    set_u64_field(m, IP_HDR_BRICK_COUNT, m->layout.brick_count + n);
+}
+
+static void add_to_node_count(image *m, uint64_t n)
+{
+    set_u64_field(m, IP_HDR_NODE_COUNT, m->layout.node_count + n);
+}
+
+static void add_to_summary_size(image *m, uint64_t n)
+{
+    set_u64_field(m, IP_HDR_SUMMARY_SIZE, m->layout.summary_size + n);
+}
+
+static void add_to_file_size(image *m, uint64_t n)
+{
+    set_u64_field(m, IP_HDR_FILE_SIZE, m->size + n);
+}
+
+static void set_data_offset(image *m, uint64_t v)
+{
+    set_u64_field(m, IP_HDR_DATA_OFFSET, v);
+}
+
+static void add_to_summary_offset(image *m, uint64_t n)
+{
+    set_u64_field(m, IP_HDR_SUMMARY_OFFSET, m->layout.summary_offset + n);
+}
+
+static void set_value_max(image *m, uint64_t bits)
+{
+    float v;
+    uint32_t b = (uint32_t)bits;
+    memcpy(&v, &b, 4);
+    put_f32(m->bytes + IP_HDR_VALUE_MAX, v);
+}
+
+static void shorten(image *m, uint64_t n)
+{
+    m->size -= n;
+}
+
+static void test_header_refusals(void)
+{
+    image m;
+    make_image(&m);
+    ip_layout l;
+    ip_error err;
+    REQUIRE(parse(&m, &l, &err) == IP_OK);
+
+    for (uint64_t i = 0; i < IP_HDR_MAGIC_SIZE; i++)
+        refused(&m, flip_byte, IP_HDR_MAGIC + i, 1, IP_ERR_FORMAT, "bad magic");
+    refused(&m, set_u32, at(IP_HDR_VERSION, 2), 1, IP_ERR_UNSUPPORTED, "format version 2");
+    refused(&m, set_u32, at(IP_HDR_VERSION, 0), 1, IP_ERR_UNSUPPORTED, "format version 0");
+    refused(&m, set_u32, at(IP_HDR_HEADER_SIZE, 255), 1, IP_ERR_FORMAT, "header size 255");
+    /* any header byte changed without resealing: the header checksum */
+    for (uint64_t i = IP_HDR_DIMS; i < IP_HDR_CHECKSUM + 8; i += 7)
+        refused(&m, flip_byte, i, 0, IP_ERR_CHECKSUM, "header checksum mismatch");
+    refused(&m, set_u32, at(IP_HDR_TYPE, IP_TYPE_COUNT), 1, IP_ERR_FORMAT, "unknown sample type");
+    refused(&m, set_u32, at(IP_HDR_FLAGS, 1), 1, IP_ERR_UNSUPPORTED, "unknown header flags");
+    refused(&m, set_u32, at(IP_HDR_DIMS, 1), 1, IP_ERR_FORMAT, "dimension 1 along x");
+    refused(&m, set_u32, at(IP_HDR_DIMS + 8, 1u << 31), 1, IP_ERR_FORMAT, "along z is outside");
+    refused(&m, set_u32, at(IP_HDR_BRICK_EDGE, 6), 1, IP_ERR_FORMAT, "brick edge 6");
+    refused(&m, set_u32, at(IP_HDR_BRICK_EDGE, 512), 1, IP_ERR_FORMAT, "brick edge 512");
+    refused(&m, set_u32, at(IP_HDR_SUBBLOCK_EDGE, 8), 1, IP_ERR_FORMAT, "sub-block edge 8");
+    refused(&m, set_spacing_y, double_bits(0), 1, IP_ERR_FORMAT, "spacing 0 along y");
+    refused(&m, set_spacing_y, double_bits(-1), 1, IP_ERR_FORMAT, "along y is not positive");
+    refused(&m, set_spacing_y, double_bits(NAN), 1, IP_ERR_FORMAT, "along y is not positive");
+    refused(&m, set_spacing_y, double_bits(1e7), 1, IP_ERR_UNSUPPORTED,
+            "outside the range that renders correctly");
+    refused(&m, set_spacing_y, double_bits(1e-3), 1, IP_ERR_UNSUPPORTED, "times");
+    for (uint64_t i = IP_HDR_RESERVED; i < IP_HDR_CHECKSUM; i++) {
+        char text[64];
+        snprintf(text, sizeof text, "reserved header byte %llu is not zero", (unsigned long long)i);
+        refused(&m, flip_byte, i, 1, IP_ERR_FORMAT, text);
+    }
+    refused(&m, set_u32, at(IP_HDR_LEVEL_COUNT, m.layout.level_count + 1), 1, IP_ERR_FORMAT,
+            "counts disagree with the dimensions");
+    refused(&m, add_to_brick_count, 1, 1, IP_ERR_FORMAT, "counts disagree");
+    refused(&m, add_to_node_count, 1, 1, IP_ERR_FORMAT, "counts disagree");
+    refused(&m, add_to_summary_size, 8, 1, IP_ERR_FORMAT, "summary size");
+    refused(&m, add_to_file_size, 1, 1, IP_ERR_FORMAT, "truncated or extended");
+    refused(&m, shorten, 1, 1, IP_ERR_FORMAT, "truncated or extended");
+    refused(&m, shorten, m.size - 255, 0, IP_ERR_FORMAT, "too short for a brick file");
+    refused(&m, set_data_offset, IP_HEADER_SIZE + 8, 1, IP_ERR_FORMAT, "section offsets");
+    refused(&m, add_to_summary_offset, 8, 1, IP_ERR_FORMAT, "section offsets");
+    refused(&m, add_to_summary_offset, IP_SUMMARY_ALIGN, 1, IP_ERR_FORMAT, "section offsets");
+    /* the header's value range must be level 0's */
+    float eight = 8;
+    uint32_t eight_bits;
+    memcpy(&eight_bits, &eight, 4);
+    refused(&m, set_value_max, eight_bits, 1, IP_ERR_FORMAT, "the value range is invalid");
+
+    /* with IP_PARSE_SKIP_CHECKSUMS a wrong header checksum passes */
+    m.bytes[IP_HDR_CHECKSUM] ^= 1;
+    CHECK(ip__format_parse(m.bytes, m.size, NAME, IP_PARSE_SKIP_CHECKSUMS, &l, &err) == IP_OK);
+    CHECK(ip__format_parse(m.bytes, m.size, NAME, 0, &l, &err) == IP_ERR_CHECKSUM);
+    free(m.bytes);
+}
+
+/* ---- the summary section ---- */
+
+static unsigned char *summary_of(image *m)
+{
+    return m->bytes + m->layout.summary_offset;
+}
+
+static void set_level_u32(image *m, uint64_t packed)
+{
+    ip__store_u32le(summary_of(m) + m->o.level_table + (packed >> 32), (uint32_t)packed);
+}
+
+static void set_level_u64(image *m, uint64_t offset)
+{
+    ip__store_u64le(summary_of(m) + m->o.level_table + offset,
+                    ip__load_u64le(summary_of(m) + m->o.level_table + offset) + 1);
+}
+
+static void set_level_nan(image *m, uint64_t offset)
+{
+    put_f32(summary_of(m) + m->o.level_table + offset, NAN);
+}
+
+/* arg: brick g << 8 | field offset in the directory entry; the byte is or'ed with 0x10 */
+static void poke_entry_byte(image *m, uint64_t arg)
+{
+    summary_of(m)[m->o.directory + (arg >> 8) * IP_DIRECTORY_ENTRY_SIZE + (arg & 0xFF)] ^= 0x10;
+}
+
+static void set_entry_encoding(image *m, uint64_t arg)
+{
+    summary_of(m)[m->o.directory + (arg >> 8) * IP_DIRECTORY_ENTRY_SIZE + IP_DIR_ENCODING] =
+        (unsigned char)(arg & 0xFF);
+}
+
+static void set_entry_filters(image *m, uint64_t arg)
+{
+    summary_of(m)[m->o.directory + (arg >> 8) * IP_DIRECTORY_ENTRY_SIZE + IP_DIR_FILTERS] =
+        (unsigned char)(arg & 0xFF);
+}
+
+static void set_entry_offset(image *m, uint64_t offset)
+{
+    ip__store_u64le(summary_of(m) + m->o.directory + IP_DIR_OFFSET, offset);
+}
+
+static void set_entry_size(image *m, uint64_t arg)
+{
+    ip__store_u32le(summary_of(m) + m->o.directory + (arg >> 32) * IP_DIRECTORY_ENTRY_SIZE +
+                        IP_DIR_STORED_SIZE,
+                    (uint32_t)arg);
+}
+
+static void set_brick_max(image *m, uint64_t arg)
+{
+    float v;
+    uint32_t bits = (uint32_t)arg;
+    memcpy(&v, &bits, 4);
+    put_f32(summary_of(m) + m->o.brick_ranges + (arg >> 32) * IP_RANGE_SIZE + IP_RANGE_MAX, v);
+}
+
+static void gap_byte(image *m, uint64_t i)
+{
+    m->bytes[IP_HEADER_SIZE + m->layout.data_size + i] = 1;
+}
+
+static void summary_byte(image *m, uint64_t i)
+{
+    summary_of(m)[i] ^= 0x01;
+}
+
+static uint64_t f32_bits(float v)
+{
+    uint32_t bits;
+    memcpy(&bits, &v, 4);
+    return bits;
+}
+
+static void test_summary_refusals(void)
+{
+    image m;
+    make_image(&m);
+    uint64_t last = m.layout.brick_count - 1, raw = m.layout.data_size;
+    for (uint32_t k = 0; k < m.layout.level_count; k++) {
+        uint64_t e = (uint64_t)k * IP_LEVEL_ENTRY_SIZE;
+        char text[64];
+        snprintf(text, sizeof text, "level %u of the level table disagrees", k);
+        refused(&m, set_level_u32, at(e + IP_LVL_DIMS + 4, 99), 1, IP_ERR_FORMAT, text);
+        refused(&m, set_level_u32, at(e + IP_LVL_BRICKS + 8, 99), 1, IP_ERR_FORMAT, text);
+        refused(&m, set_level_u64, e + IP_LVL_FIRST_BRICK, 1, IP_ERR_FORMAT, text);
+        refused(&m, set_level_u32, at(e + IP_LVL_OCTREE_DEPTH, 9), 1, IP_ERR_FORMAT, text);
+        refused(&m, set_level_u32, at(e + IP_LVL_RESERVED_A, 1), 1, IP_ERR_FORMAT, text);
+        refused(&m, set_level_u64, e + IP_LVL_FIRST_NODE, 1, IP_ERR_FORMAT, text);
+        refused(&m, set_level_u64, e + IP_LVL_RESERVED_B, 1, IP_ERR_FORMAT, text);
+        snprintf(text, sizeof text, "level %u has an invalid value range", k);
+        refused(&m, set_level_nan, e + IP_LVL_VALUE_MIN, 1, IP_ERR_FORMAT, text);
+        refused(&m, set_level_nan, e + IP_LVL_VALUE_MAX, 1, IP_ERR_FORMAT, text);
+    }
+    for (uint64_t g = 0; g <= last; g += last) {
+        for (uint64_t i = 0; i < IP_DIR_RESERVED_SIZE; i++)
+            refused(&m, poke_entry_byte, g << 8 | (IP_DIR_RESERVED + i), 1, IP_ERR_FORMAT,
+                    "non-zero reserved bytes");
+        refused(&m, set_entry_encoding, g << 8 | 3, 1, IP_ERR_FORMAT, "an unknown encoding");
+        refused(&m, set_brick_max, g << 32 | f32_bits(NAN), 1, IP_ERR_FORMAT,
+                "an invalid value range");
+        refused(&m, set_brick_max, g << 32 | f32_bits(1), 1, IP_ERR_FORMAT,
+                "an invalid value range");
+    }
+    /* a constant brick: no payload, no filters, no checksum, equal range ends */
+    refused(&m, set_entry_size, last << 32 | 4, 1, IP_ERR_FORMAT, "inconsistent constant");
+    refused(&m, set_entry_filters, last << 8 | 1, 1, IP_ERR_FORMAT, "inconsistent constant");
+    refused(&m, poke_entry_byte, last << 8 | IP_DIR_CHECKSUM, 1, IP_ERR_FORMAT,
+            "inconsistent constant");
+    refused(&m, set_brick_max, last << 32 | f32_bits(6), 1, IP_ERR_FORMAT, "inconsistent constant");
+    refused(&m, set_brick_max, last << 32 | f32_bits(5.5f), 0, IP_ERR_CHECKSUM,
+            "summary section checksum mismatch");
+    /* a raw brick: exact size, no filters */
+    refused(&m, set_entry_size, 0ull << 32 | (raw - 2), 1, IP_ERR_FORMAT,
+            "a raw payload of the wrong size");
+    refused(&m, set_entry_filters, 0 << 8 | 2, 1, IP_ERR_FORMAT, "a raw payload of the wrong");
+    /* LZ4: a size within LZ4's bound and known filters, one predictor at most */
+    refused(&m, set_entry_encoding, 0 << 8 | IP_BRICK_LZ4, 0, IP_ERR_CHECKSUM, "summary");
+    ip_layout l;
+    ip_error err;
+    set_entry_encoding(&m, 0 << 8 | IP_BRICK_LZ4);
+    reseal(&m);
+    CHECK(parse(&m, &l, &err) == IP_OK); /* a raw-sized LZ4 block is a possible size */
+    refused(&m, set_entry_size, 0ull << 32 | 0, 1, IP_ERR_FORMAT, "an LZ4 payload of impossible");
+    refused(&m, set_entry_size, 0ull << 32 | (raw + raw / 255 + 17), 1, IP_ERR_FORMAT,
+            "an LZ4 payload of impossible");
+    refused(&m, set_entry_filters, 0 << 8 | 5, 1, IP_ERR_FORMAT, "unknown filters");
+    refused(&m, set_entry_filters, 0 << 8 | 8, 1, IP_ERR_FORMAT, "unknown filters");
+    set_entry_encoding(&m, 0 << 8 | IP_BRICK_RAW);
+    reseal(&m);
+    REQUIRE(parse(&m, &l, &err) == IP_OK);
+    /* the payload inside the data section */
+    refused(&m, set_entry_offset, IP_HEADER_SIZE - 1, 1, IP_ERR_FORMAT,
+            "a payload outside the data section");
+    refused(&m, set_entry_offset, IP_HEADER_SIZE + 1, 1, IP_ERR_FORMAT,
+            "a payload outside the data section");
+    /* padding before the summary, and the summary checksum over every array */
+    uint64_t gap = m.layout.summary_offset - IP_HEADER_SIZE - m.layout.data_size;
+    REQUIRE(gap > 0);
+    refused(&m, gap_byte, 0, 1, IP_ERR_FORMAT, "in the padding before the summary section");
+    refused(&m, gap_byte, gap - 1, 1, IP_ERR_FORMAT, "is not zero");
+    const uint64_t arrays[] = {m.o.level_table,     m.o.directory, m.o.brick_ranges,
+                               m.o.subblock_ranges, m.o.nodes,     m.o.end - 1};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+        refused(&m, summary_byte, arrays[i], 0, IP_ERR_CHECKSUM,
+                "summary section checksum mismatch");
+    free(m.bytes);
+}
+
+/* The parser on every truncation and on random bytes: refused, never out of bounds. */
+static void test_truncations(void)
+{
+    image m;
+    make_image(&m);
+    int bad = 0;
+    for (uint64_t size = 0; size < m.size; size += size < 300 ? 1 : 97) {
+        unsigned char *copy = malloc(size ? size : 1);
+        REQUIRE(copy != NULL);
+        memcpy(copy, m.bytes, size);
+        ip_layout l;
+        ip_error err;
+        if (ip__format_parse(copy, size, NAME, 0, &l, &err) != IP_ERR_FORMAT)
+            bad++;
+        free(copy);
+    }
+    CHECK_MSG(bad == 0, "%d truncations not refused as malformed", bad);
+    free(m.bytes);
+}
+
+int main(void)
+{
+    test_layouts();
+    test_layout_arguments();
+    test_header_round_trip();
+    test_entry_round_trip();
+    test_header_refusals();
+    test_summary_refusals();
+    test_truncations();
+    return test_summary("test_format");
+}
