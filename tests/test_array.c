@@ -67,7 +67,10 @@ static void test_resize_and_reserve(void)
     free(a);
 
     /* arrays of pointers and of structs, through the same helper */
-    struct pair { double x; char c; } *p = NULL;
+    struct pair {
+        double x;
+        char c;
+    } *p = NULL;
     uint64_t pcap = 0;
     CHECK(ip__array_reserve(&p, &pcap, 3, sizeof *p, 2) == IP_OK && pcap == 4);
     p[3] = (struct pair){1.5, 'z'};

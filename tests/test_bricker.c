@@ -134,7 +134,7 @@ static void check_file(const char *ibv, const volume *v)
                     for (int a = 0; a < 3; a++) {
                         b0[a] = c[a] * l->subblock_edge;
                         b1[a] = b0[a] + l->subblock_edge < extent[a] - 1 ? b0[a] + l->subblock_edge
-                                                                          : extent[a] - 1;
+                                                                         : extent[a] - 1;
                         empty |= b0[a] >= extent[a] - 1;
                     }
                     if (empty)
@@ -169,8 +169,8 @@ static void check_file(const char *ibv, const volume *v)
     ip_store_close(s);
 }
 
-static int brick_file_at(const char *raw, const char *ibv, uint32_t b, uint32_t s,
-                         unsigned threads, int level, ip_bricker_report *report)
+static int brick_file_at(const char *raw, const char *ibv, uint32_t b, uint32_t s, unsigned threads,
+                         int level, ip_bricker_report *report)
 {
     ip_input_desc desc;
     ip_error err;
@@ -351,7 +351,8 @@ static void test_shared_data(const char *dir)
         for (size_t i = 0; i < n; i++)
             v.values[i] = ip_sample_get(bytes, v.type, i);
         free(bytes);
-        CHECK_MSG(brick_file(raw, ibv, IP_DEFAULT_BRICK_EDGE, IP_DEFAULT_SUBBLOCK_EDGE, 2, NULL) == 0,
+        CHECK_MSG(brick_file(raw, ibv, IP_DEFAULT_BRICK_EDGE, IP_DEFAULT_SUBBLOCK_EDGE, 2, NULL) ==
+                      0,
                   "%s", raw);
         check_file(ibv, &v);
         unlink(ibv);
@@ -365,12 +366,12 @@ int main(void)
 {
     const char *dir = test_tmp_dir("test_bricker");
     for (int t = 0; t < IP_TYPE_COUNT; t++) {
-        round_trip(dir, 2, 2, 2, (ip_type)t, 0, 32, 8);        /* tiny */
-        round_trip(dir, 103, 94, 161, (ip_type)t, 0, 32, 8);   /* odd dims */
-        round_trip(dir, 33, 17, 9, (ip_type)t, 0, 8, 2);       /* cells a multiple of B */
-        round_trip(dir, 32, 16, 8, (ip_type)t, 0, 8, 2);       /* samples a multiple of B */
-        round_trip(dir, 40, 30, 20, (ip_type)t, 1, 8, 4);      /* constant */
-        round_trip(dir, 37, 2, 29, (ip_type)t, 0, 4, 4);       /* flat axis, many levels */
+        round_trip(dir, 2, 2, 2, (ip_type)t, 0, 32, 8);      /* tiny */
+        round_trip(dir, 103, 94, 161, (ip_type)t, 0, 32, 8); /* odd dims */
+        round_trip(dir, 33, 17, 9, (ip_type)t, 0, 8, 2);     /* cells a multiple of B */
+        round_trip(dir, 32, 16, 8, (ip_type)t, 0, 8, 2);     /* samples a multiple of B */
+        round_trip(dir, 40, 30, 20, (ip_type)t, 1, 8, 4);    /* constant */
+        round_trip(dir, 37, 2, 29, (ip_type)t, 0, 4, 4);     /* flat axis, many levels */
     }
     for (int t = 0; t < IP_TYPE_COUNT; t++)
         round_trip_hc(dir, (ip_type)t);

@@ -319,8 +319,8 @@ static void test_threads(const ip_store *s)
     CHECK(st.hits + st.misses == pins);
     CHECK(st.misses == st.resident_bricks + st.evictions);
     CHECK(st.pinned_bytes == 0 && st.errors == 0);
-    CHECK_MSG(st.resident_bytes <= 12 * BRICK_BYTES || st.over_budget_pins > 0,
-              "resident %llu", (unsigned long long)st.resident_bytes);
+    CHECK_MSG(st.resident_bytes <= 12 * BRICK_BYTES || st.over_budget_pins > 0, "resident %llu",
+              (unsigned long long)st.resident_bytes);
     CHECK(st.resident_peak_bytes <= (12 + 16) * BRICK_BYTES); /* budget + what 8 threads pin */
 }
 

@@ -66,12 +66,12 @@ static void test_orbit(void)
     /* a whole turn either way returns to the start */
     ip_camera c = start;
     ip_camera_orbit(&c, 360.0, 0.0);
-    CHECK_MSG(same_point(c.eye, start.eye, 1e-9), "360 right: eye %g %g %g", c.eye[0],
-              c.eye[1], c.eye[2]);
+    CHECK_MSG(same_point(c.eye, start.eye, 1e-9), "360 right: eye %g %g %g", c.eye[0], c.eye[1],
+              c.eye[2]);
     c = start;
     ip_camera_orbit(&c, 0.0, 360.0);
-    CHECK_MSG(same_point(c.eye, start.eye, 1e-9), "360 down: eye %g %g %g", c.eye[0],
-              c.eye[1], c.eye[2]);
+    CHECK_MSG(same_point(c.eye, start.eye, 1e-9), "360 down: eye %g %g %g", c.eye[0], c.eye[1],
+              c.eye[2]);
     c = start;
     for (int k = 0; k < 36; k++)
         ip_camera_orbit(&c, 10.0, 0.0);
@@ -82,8 +82,8 @@ static void test_orbit(void)
     for (int k = 0; k < 200; k++) {
         ip_camera_orbit(&c, 7.3 * (k % 5) - 11.0, 13.1 - 3.7 * (k % 7));
         CHECK(same_point(c.target, start.target, 0.0));
-        CHECK_MSG(NEAR(ip_camera_distance(&c), distance, 1e-9 * distance), "step %d: %.17g",
-                  k, ip_camera_distance(&c));
+        CHECK_MSG(NEAR(ip_camera_distance(&c), distance, 1e-9 * distance), "step %d: %.17g", k,
+                  ip_camera_distance(&c));
     }
     check_up_orthonormal(&c, "after 200 orbits");
 
@@ -144,8 +144,7 @@ static void test_dolly(void)
 
     ip_camera c = start;
     ip_camera_dolly(&c, 2.0, 0.0, INFINITY);
-    CHECK_MSG(NEAR(ip_camera_distance(&c), distance / 2.0, 1e-12), "%.17g",
-              ip_camera_distance(&c));
+    CHECK_MSG(NEAR(ip_camera_distance(&c), distance / 2.0, 1e-12), "%.17g", ip_camera_distance(&c));
     direction(&c, d1);
     CHECK(same_point(d0, d1, 1e-12));
     CHECK(same_point(c.target, start.target, 0.0) && same_point(c.up, start.up, 0.0));

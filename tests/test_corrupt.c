@@ -221,8 +221,7 @@ static void open_subject(subject *s, const char *name, const char *path, float i
     s->bytes = read_file(path, &s->size);
     REQUIRE(ip__format_parse(s->bytes, s->size, path, 0, &s->layout, &err) == IP_OK);
     ip_layout_world_box(&s->layout, s->lo, s->hi);
-    REQUIRE(ip_camera_fit_axis(s->lo, s->hi, axis, 30.0, WIDTH, HEIGHT, &s->camera, &err) ==
-            IP_OK);
+    REQUIRE(ip_camera_fit_axis(s->lo, s->hi, axis, 30.0, WIDTH, HEIGHT, &s->camera, &err) == IP_OK);
     for (int k = 0; k < 4; k++) {
         s->reference[k] = malloc((size_t)WIDTH * HEIGHT * 4);
         REQUIRE(s->reference[k]);
@@ -240,11 +239,11 @@ static void open_subject(subject *s, const char *name, const char *path, float i
         covered += memcmp(s->reference[0] + 4 * i, background + 4 * i, 4) != 0;
     free(background);
     printf("test_corrupt: %s: %llu bytes, %llu bricks, %u levels; the surface covers %zu of "
-           "%d pixels\n", name, (unsigned long long)s->size,
-           (unsigned long long)s->layout.brick_count, s->layout.level_count, covered,
-           WIDTH * HEIGHT);
-    CHECK_MSG(covered * 10 > (size_t)WIDTH * HEIGHT, "%s: the surface covers only %zu pixels",
-              name, covered);
+           "%d pixels\n",
+           name, (unsigned long long)s->size, (unsigned long long)s->layout.brick_count,
+           s->layout.level_count, covered, WIDTH * HEIGHT);
+    CHECK_MSG(covered * 10 > (size_t)WIDTH * HEIGHT, "%s: the surface covers only %zu pixels", name,
+              covered);
 }
 
 static void close_subject(subject *s)
@@ -317,8 +316,10 @@ static void report(const char *name, const char *kind, int copies, const tally r
         printf("test_corrupt:   %-22s %3d runs: %3d errors, %3d identical, %d SILENT, %d unclear\n",
                run_names[k], runs[k].runs, runs[k].errors, runs[k].identical, runs[k].silent,
                runs[k].unclear);
-        CHECK_MSG(runs[k].silent == 0, "%s, %s, %s: %d of %d runs gave a different image "
-                  "without an error", name, kind, run_names[k], runs[k].silent, runs[k].runs);
+        CHECK_MSG(runs[k].silent == 0,
+                  "%s, %s, %s: %d of %d runs gave a different image "
+                  "without an error",
+                  name, kind, run_names[k], runs[k].silent, runs[k].runs);
     }
 }
 
@@ -331,8 +332,8 @@ static void check_payload_flips(const subject *s, const char *dir)
     REQUIRE(bricks);
     for (uint64_t g = 0; g < s->layout.brick_count; g++) {
         ip_brick_entry e;
-        ip__format_entry_decode(s->bytes + s->layout.summary_offset + so.directory +
-                                      g * IP_DIRECTORY_ENTRY_SIZE, &e);
+        ip__format_entry_decode(
+            s->bytes + s->layout.summary_offset + so.directory + g * IP_DIRECTORY_ENTRY_SIZE, &e);
         if (e.stored_size > 0)
             bricks[count++] = g;
     }
@@ -347,8 +348,8 @@ static void check_payload_flips(const subject *s, const char *dir)
     for (uint64_t i = 0; i < count; i += step) {
         uint64_t g = bricks[i];
         ip_brick_entry e;
-        ip__format_entry_decode(s->bytes + s->layout.summary_offset + so.directory +
-                                      g * IP_DIRECTORY_ENTRY_SIZE, &e);
+        ip__format_entry_decode(
+            s->bytes + s->layout.summary_offset + so.directory + g * IP_DIRECTORY_ENTRY_SIZE, &e);
         /* a different spot and bit in each brick: first bytes, middle, last */
         uint64_t byte = e.offset + (e.stored_size - 1) * (i % 5) / 4;
         memcpy(copy, s->bytes, s->size);
@@ -430,8 +431,8 @@ static void overwrite_payloads(const char *path, void *user)
     static const unsigned char zeros[32];
     for (uint64_t g = 0; g < s->layout.brick_count; g++) {
         ip_brick_entry e;
-        ip__format_entry_decode(s->bytes + s->layout.summary_offset + so.directory +
-                                      g * IP_DIRECTORY_ENTRY_SIZE, &e);
+        ip__format_entry_decode(
+            s->bytes + s->layout.summary_offset + so.directory + g * IP_DIRECTORY_ENTRY_SIZE, &e);
         if (e.stored_size == 0)
             continue;
         uint64_t at = e.offset + e.stored_size / 2, n = e.stored_size - e.stored_size / 2;
@@ -474,11 +475,11 @@ static void check_changing(const subject *s, const char *dir)
                            strstr(err.message, "rewritten");
         printf("test_corrupt: %s, truncated to half mid-render, %u thread%s: status %d \"%s\"\n",
                s->name, threads, threads > 1 ? "s" : "", (int)st, err.message);
-        CHECK_MSG(st != IP_OK, "%s: truncated mid-render, %u threads: no error", s->name,
-                  threads);
+        CHECK_MSG(st != IP_OK, "%s: truncated mid-render, %u threads: no error", s->name, threads);
         CHECK_MSG(st == IP_OK || (err.code == st && strstr(err.message, path) && says_changed),
                   "%s: truncated mid-render: the message \"%s\" should name the file and say "
-                  "it is shorter or changed", s->name, err.message);
+                  "it is shorter or changed",
+                  s->name, err.message);
         unlink(path);
 
         /* payload bytes overwritten in place after the first rays */
@@ -489,7 +490,8 @@ static void check_changing(const subject *s, const char *dir)
         st = run_progressive(s, path, threads, 4096, &rewrite, rgba, &err);
         CHECK(rewrite.done);
         printf("test_corrupt: %s, payloads overwritten mid-render, %u thread%s: status %d "
-               "\"%s\"\n", s->name, threads, threads > 1 ? "s" : "", (int)st, err.message);
+               "\"%s\"\n",
+               s->name, threads, threads > 1 ? "s" : "", (int)st, err.message);
         tally t = {0};
         char label[256];
         snprintf(label, sizeof label, "%s: payloads overwritten mid-render, %u threads", s->name,

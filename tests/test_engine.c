@@ -82,7 +82,7 @@ static int compare_cells(const void *x, const void *y)
  * and in a fixed order, so a cell's triangles are looked up by binary search over cell ids. */
 static uint64_t triangles_not_in(const ip_mesh *part, const ip_mesh *full)
 {
-    uint64_t (*keys)[2] = malloc(full->triangle_count * sizeof *keys);
+    uint64_t(*keys)[2] = malloc(full->triangle_count * sizeof *keys);
     REQUIRE(keys || full->triangle_count == 0);
     for (uint64_t i = 0; i < full->triangle_count; i++) {
         keys[i][0] = full->cells[i];
@@ -147,8 +147,8 @@ static void check_view(scene *s, const char *what, const char *axis, float iso, 
               "%s %s: %llu progressive, %llu full triangles", what, axis,
               (unsigned long long)part->triangle_count, (unsigned long long)full.triangle_count);
     uint64_t missing = triangles_not_in(part, &full);
-    CHECK_MSG(missing == 0, "%s %s: %llu progressive triangles are not full triangles", what,
-              axis, (unsigned long long)missing);
+    CHECK_MSG(missing == 0, "%s %s: %llu progressive triangles are not full triangles", what, axis,
+              (unsigned long long)missing);
 
     size_t n = (size_t)w * h;
     uint32_t *ia = malloc(n * 4), *ib = malloc(n * 4);
@@ -314,8 +314,8 @@ static void check_threads(scene *s, float iso)
         covered += index[0][i] != UINT32_MAX;
         differ += (index[0][i] != UINT32_MAX) != (index[1][i] != UINT32_MAX);
     }
-    CHECK_MSG(differ == 0 && covered > 0, "8 threads cover %zu pixels differently (of %zu)",
-              differ, covered);
+    CHECK_MSG(differ == 0 && covered > 0, "8 threads cover %zu pixels differently (of %zu)", differ,
+              covered);
     free(index[0]);
     free(index[1]);
 }
@@ -331,8 +331,12 @@ static void check_empty_space(scene *s, float iso)
     ip_engine_options_default(&o);
     REQUIRE(ip_engine_create(cache, &o, &e, &err) == IP_OK);
     /* a narrow view past the sphere's edge, through the volume's empty corner region */
-    ip_camera cam = {{-40, -40, -40}, {s->hi[0] * 0.02, s->hi[1] * 0.02, s->hi[2] * 0.98},
-                     {0, 0, 1}, 2.0, 16, 16};
+    ip_camera cam = {{-40, -40, -40},
+                     {s->hi[0] * 0.02, s->hi[1] * 0.02, s->hi[2] * 0.98},
+                     {0, 0, 1},
+                     2.0,
+                     16,
+                     16};
     ip_engine_counts t;
     run_all_rays(e, &cam, iso, &t);
     ip_cache_stats st;
@@ -374,8 +378,7 @@ static void check_cancel_restart(scene *s, float iso_a, float iso_b)
     run_all_rays(e, &cam, iso_b, &ta);
     run_all_rays(fresh, &cam, iso_b, &tb);
     const ip_mesh *a = ip_engine_mesh(e), *b = ip_engine_mesh(fresh);
-    int same = a->triangle_count == b->triangle_count && ta.rays == tb.rays &&
-               ta.seeds == tb.seeds;
+    int same = a->triangle_count == b->triangle_count && ta.rays == tb.rays && ta.seeds == tb.seeds;
     for (uint64_t i = 0; same && i < a->triangle_count; i++)
         same = same_triangle(a, i, b, i);
     CHECK_MSG(same, "restart: %llu triangles against %llu from a fresh engine",
@@ -387,15 +390,16 @@ static void check_cancel_restart(scene *s, float iso_a, float iso_b)
 static void check_shared_data(void)
 {
     const char *data = getenv("IP_SKIP_SHARED_DATA") ? NULL : getenv("IP_SHARED_DATA");
-    static const struct { const char *file; float iso; } volumes[] = {
-        {"neghip_66x66x66_uint8.raw", 40.5f}, {"tooth_103x94x161_uint8.raw", 120.5f}};
+    static const struct {
+        const char *file;
+        float iso;
+    } volumes[] = {{"neghip_66x66x66_uint8.raw", 40.5f}, {"tooth_103x94x161_uint8.raw", 120.5f}};
     for (size_t v = 0; v < sizeof volumes / sizeof volumes[0]; v++) {
         char raw[4096], ibv[4200];
         snprintf(raw, sizeof raw, "%s/%s", data ? data : "", volumes[v].file);
         FILE *f = data ? fopen(raw, "rb") : NULL;
         if (!f) {
-            printf("test_engine: skipping %s: the shared data folder is absent\n",
-                   volumes[v].file);
+            printf("test_engine: skipping %s: the shared data folder is absent\n", volumes[v].file);
             continue;
         }
         fclose(f);

@@ -193,7 +193,10 @@ static void test_determinism(void)
 /* The [0,1] field maps to 0..255, 0..4095, -1024..3071 and 0..1; the phantom reaches both ends. */
 static void test_type_ranges(void)
 {
-    static const struct { ip_type type; double lo, hi; } cases[] = {
+    static const struct {
+        ip_type type;
+        double lo, hi;
+    } cases[] = {
         {IP_UINT8, 0, 255}, {IP_UINT16, 0, 4095}, {IP_INT16, -1024, 3071}, {IP_FLOAT32, 0, 1}};
     for (size_t c = 0; c < 4; c++) {
         ip_gen_params p = params_of(IP_FIELD_SHEPP_LOGAN, 41, 41, 41, cases[c].type);
@@ -203,8 +206,8 @@ static void test_type_ranges(void)
         REQUIRE(data);
         CHECK(size == 41u * 41 * 41 * ip_type_size(cases[c].type));
         double lo = min_of(data, cases[c].type, 41u * 41 * 41, &hi);
-        CHECK_MSG(lo == cases[c].lo && hi == cases[c].hi, "%s: %g..%g",
-                  ip_type_name(cases[c].type), lo, hi);
+        CHECK_MSG(lo == cases[c].lo && hi == cases[c].hi, "%s: %g..%g", ip_type_name(cases[c].type),
+                  lo, hi);
         free(data);
     }
     for (int f = 1; f < 4; f++) {
@@ -214,8 +217,8 @@ static void test_type_ranges(void)
         unsigned char *data = generate_file(&p, "range_field.raw", &size);
         REQUIRE(data);
         double lo = min_of(data, IP_FLOAT32, 24u * 20 * 16, &hi);
-        CHECK_MSG(lo >= 0.0 && hi <= 1.0 && hi - lo > 0.5, "%s: %g..%g",
-                  ip_field_name((ip_field)f), lo, hi);
+        CHECK_MSG(lo >= 0.0 && hi <= 1.0 && hi - lo > 0.5, "%s: %g..%g", ip_field_name((ip_field)f),
+                  lo, hi);
         free(data);
     }
 }
@@ -488,7 +491,7 @@ int main(void)
     test_upsample_rounding();
     test_upsample_errors();
     /* Only the inputs and outputs named above remain: no temporary files. */
-    CHECK_MSG(count_entries(tmp) == before + 12, "%d entries, expected %d",
-              count_entries(tmp), before + 12);
+    CHECK_MSG(count_entries(tmp) == before + 12, "%d entries, expected %d", count_entries(tmp),
+              before + 12);
     return test_summary("test_generate");
 }

@@ -115,8 +115,8 @@ static unsigned char *make_volume(ip_type type, const uint32_t dims[3], int big_
     return data;
 }
 
-static void write_volume(const char *path, const char *mode, ip_type type,
-                         const uint32_t dims[3], int big_endian)
+static void write_volume(const char *path, const char *mode, ip_type type, const uint32_t dims[3],
+                         int big_endian)
 {
     size_t size;
     unsigned char *data = make_volume(type, dims, big_endian, &size);
@@ -184,8 +184,8 @@ static int describe_ok(const char *path, const ip_input_overrides *overrides, ip
 }
 
 /* Describes `path`, expecting `code` and a message that names `name` and holds `needle`. */
-static void describe_fails(const char *path, const ip_input_overrides *overrides,
-                           ip_status code, const char *name, const char *needle)
+static void describe_fails(const char *path, const ip_input_overrides *overrides, ip_status code,
+                           const char *name, const char *needle)
 {
     ip_input_desc d;
     ip_error err;
@@ -222,7 +222,11 @@ static void read_fails(const ip_input_desc *desc, ip_status code, const char *ne
 
 static void test_raw_by_name(void)
 {
-    static const struct { const char *name; ip_type type; uint32_t dims[3]; } files[] = {
+    static const struct {
+        const char *name;
+        ip_type type;
+        uint32_t dims[3];
+    } files[] = {
         {"tiny_ct_scan_5x4x3_uint8.raw", IP_UINT8, {5, 4, 3}},
         {"a_6x5x4_uint16.raw", IP_UINT16, {6, 5, 4}},
         {"b_3x3x7_int16.raw", IP_INT16, {3, 3, 7}},
@@ -382,19 +386,33 @@ static void test_nrrd_attached(void)
         read_and_compare(&d, 1);
     }
     /* CRLF line endings and every type spelling of the format. */
-    static const struct { const char *spelling; ip_type type; } types[] = {
-        {"uchar", IP_UINT8},          {"unsigned char", IP_UINT8},  {"uint8", IP_UINT8},
-        {"uint8_t", IP_UINT8},        {"ushort", IP_UINT16},        {"unsigned short", IP_UINT16},
-        {"unsigned short int", IP_UINT16}, {"uint16", IP_UINT16},   {"uint16_t", IP_UINT16},
-        {"short", IP_INT16},          {"short int", IP_INT16},      {"signed short", IP_INT16},
-        {"signed short int", IP_INT16}, {"int16", IP_INT16},        {"int16_t", IP_INT16},
+    static const struct {
+        const char *spelling;
+        ip_type type;
+    } types[] = {
+        {"uchar", IP_UINT8},
+        {"unsigned char", IP_UINT8},
+        {"uint8", IP_UINT8},
+        {"uint8_t", IP_UINT8},
+        {"ushort", IP_UINT16},
+        {"unsigned short", IP_UINT16},
+        {"unsigned short int", IP_UINT16},
+        {"uint16", IP_UINT16},
+        {"uint16_t", IP_UINT16},
+        {"short", IP_INT16},
+        {"short int", IP_INT16},
+        {"signed short", IP_INT16},
+        {"signed short int", IP_INT16},
+        {"int16", IP_INT16},
+        {"int16_t", IP_INT16},
         {"float", IP_FLOAT32},
     };
     for (size_t i = 0; i < sizeof types / sizeof types[0]; i++) {
         char text[512];
         snprintf(text, sizeof text,
                  "NRRD0005\r\ntype: %s\r\ndimension: 3\r\nsizes: 5 4 3\r\nendian: big\r\n"
-                 "encoding: raw\r\n\r\n", types[i].spelling);
+                 "encoding: raw\r\n\r\n",
+                 types[i].spelling);
         write_text(path, text);
         write_volume(path, "ab", types[i].type, dims, 1);
         if (describe_ok(path, NULL, &d)) {
@@ -427,8 +445,10 @@ static void test_nrrd_detached(void)
     char text[8192];
     in_scratch(data, "detached_plain.raw");
     write_volume(data, "wb", IP_UINT8, dims, 0);
-    snprintf(text, sizeof text, "NRRD0001\ntype: uchar\ndimension: 3\nsizes: 6 5 4\n"
-                                "encoding: raw\ndatafile: %s\n", data);
+    snprintf(text, sizeof text,
+             "NRRD0001\ntype: uchar\ndimension: 3\nsizes: 6 5 4\n"
+             "encoding: raw\ndatafile: %s\n",
+             data);
     write_text(header, text);
     if (describe_ok(header, NULL, &d)) {
         CHECK(strcmp(d.data_path, data) == 0 && d.data_offset == 0);
@@ -624,8 +644,9 @@ static void test_mhd(void)
     write_volume(data, "ab", IP_UINT8, dims, 0);
     in_scratch(header, "meta_skip.mhd");
     for (int at_end = 0; at_end < 2; at_end++) {
-        snprintf(text, sizeof text, "NDims = 3\nDimSize = 7 5 3\nElementType = MET_UCHAR\n"
-                                    "HeaderSize = %d\nElementDataFile = meta_skip.raw\n",
+        snprintf(text, sizeof text,
+                 "NDims = 3\nDimSize = 7 5 3\nElementType = MET_UCHAR\n"
+                 "HeaderSize = %d\nElementDataFile = meta_skip.raw\n",
                  at_end ? -1 : 16);
         write_text(header, text);
         if (describe_ok(header, NULL, &d)) {
@@ -753,7 +774,11 @@ static void test_dimension_under_2(void)
 static void test_bad_headers(void)
 {
     char path[4096];
-    static const struct { const char *name; const char *text; const char *needle; } cases[] = {
+    static const struct {
+        const char *name;
+        const char *text;
+        const char *needle;
+    } cases[] = {
         {"garbage.nrrd", "\x89PNG\r\n\x1a\n not a volume at all", "not a NRRD file"},
         {"empty.nrrd", "", "not a NRRD file"},
         {"nomagic.nrrd", "type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n",
@@ -776,48 +801,69 @@ static void test_bad_headers(void)
          "bad sizes"},
         {"count.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2 2\nencoding: raw\n\n",
          "sizes has 4 values"},
-        {"spacings.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspacings: 1 1\n"
-                          "encoding: raw\n\n", "spacings has 2 values"},
-        {"zerospace.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspacings: 1 0 1\n"
-                           "encoding: raw\n\n01234567", "spacing 0 along y"},
-        {"badvec.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\n"
-                        "space directions: (1,0,0) (0,1 (0,0,1)\nencoding: raw\n\n",
+        {"spacings.nrrd",
+         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspacings: 1 1\n"
+         "encoding: raw\n\n",
+         "spacings has 2 values"},
+        {"zerospace.nrrd",
+         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspacings: 1 0 1\n"
+         "encoding: raw\n\n01234567",
+         "spacing 0 along y"},
+        {"badvec.nrrd",
+         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\n"
+         "space directions: (1,0,0) (0,1 (0,0,1)\nencoding: raw\n\n",
          "bad space directions"},
         {"ascii.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: ascii\n\n",
          "unsupported NRRD encoding 'ascii'"},
-        {"endian.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nendian: middle\n"
-                        "encoding: raw\n\n", "bad endian 'middle'"},
+        {"endian.nrrd",
+         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nendian: middle\n"
+         "encoding: raw\n\n",
+         "bad endian 'middle'"},
         {"noblank.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n",
          "no blank line"},
         {"nocolon.nrrd", "NRRD0004\ntype uint8\n\n", "line 2 is not 'field: value'"},
         {"case.nrrd", "NRRD0004\nType: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n",
          "missing field 'type'"},
-        {"gzskip.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n"
-                        "byte skip: -1\n\n", "byte skip -1 needs raw encoding"},
-        {"badskip.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
-                         "byte skip: -2\n\n", "bad byte skip"},
-        {"list.nhdr", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
-                      "data file: LIST\na.raw\nb.raw\n", "not supported"},
-        {"lines.nhdr", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
-                       "line skip: 30\ndata file: lines.nhdr\n", "line skip 30 passes the end"},
+        {"gzskip.nrrd",
+         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n"
+         "byte skip: -1\n\n",
+         "byte skip -1 needs raw encoding"},
+        {"badskip.nrrd",
+         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+         "byte skip: -2\n\n",
+         "bad byte skip"},
+        {"list.nhdr",
+         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+         "data file: LIST\na.raw\nb.raw\n",
+         "not supported"},
+        {"lines.nhdr",
+         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+         "line skip: 30\ndata file: lines.nhdr\n",
+         "line skip 30 passes the end"},
         {"nodata.nhdr", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n",
          "no blank line"},
         {"garbage.mhd", "this is not a MetaImage header\n", "not 'Key = Value'"},
         {"empty.mhd", "", "empty MetaImage header"},
-        {"ndims.mhd", "NDims = 2\nDimSize = 4 4\nElementType = MET_UCHAR\n"
-                      "ElementDataFile = LOCAL\n", "NDims 2 is not supported"},
+        {"ndims.mhd",
+         "NDims = 2\nDimSize = 4 4\nElementType = MET_UCHAR\n"
+         "ElementDataFile = LOCAL\n",
+         "NDims 2 is not supported"},
         {"nodims.mhd", "NDims = 3\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n",
          "missing key 'DimSize'"},
         {"nofile.mhd", "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n",
          "missing key 'ElementDataFile'"},
-        {"badmsb.mhd", "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
-                       "BinaryDataByteOrderMSB = Maybe\nElementDataFile = LOCAL\n",
+        {"badmsb.mhd",
+         "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+         "BinaryDataByteOrderMSB = Maybe\nElementDataFile = LOCAL\n",
          "bad BinaryDataByteOrderMSB 'Maybe'"},
-        {"channels.mhd", "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
-                         "ElementNumberOfChannels = 3\nElementDataFile = LOCAL\n",
+        {"channels.mhd",
+         "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+         "ElementNumberOfChannels = 3\nElementDataFile = LOCAL\n",
          "ElementNumberOfChannels 3"},
-        {"pattern.mhd", "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
-                        "ElementDataFile = slice%03d.raw 1 2 1\n", "not supported"},
+        {"pattern.mhd",
+         "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+         "ElementDataFile = slice%03d.raw 1 2 1\n",
+         "not supported"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         in_scratch(path, cases[i].name);
@@ -1004,7 +1050,8 @@ static void test_limits(void)
     describe_fails(path, NULL, IP_ERR_INPUT, "huge_", "more than 2^63 bytes");
     in_scratch(path, "toobig_2147483648x2x2_uint8.raw");
     write_text(path, "");
-    describe_fails(path, NULL, IP_ERR_INPUT, "toobig_", "dimension 2147483648 along x is too large");
+    describe_fails(path, NULL, IP_ERR_INPUT, "toobig_",
+                   "dimension 2147483648 along x is too large");
     in_scratch(path, "digits_2x99999999999999999999999999x2_uint8.raw");
     write_text(path, "");
     describe_fails(path, NULL, IP_ERR_INPUT, "digits_", "along y is too large");

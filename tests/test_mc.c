@@ -13,7 +13,10 @@
  * rule; it traces the surface's outline across the 6 faces, chains the segments into closed
  * outlines and fans each one from a vertex whose diagonals stay off the cell's faces. */
 
-enum { RULE_SEPARATE_INSIDE, RULE_SEPARATE_OUTSIDE };
+enum {
+    RULE_SEPARATE_INSIDE,
+    RULE_SEPARATE_OUTSIDE
+};
 
 typedef struct generated_case {
     unsigned edge_mask;
@@ -412,8 +415,8 @@ typedef struct mesh_report {
     long open_edges;     /* a directed edge without its reverse */
     long repeated_edges; /* a directed edge used twice */
     long ambiguous_faces;
-    long inward;         /* sphere only: triangles or normals facing the centre */
-    long slivers;        /* sphere only: too thin to orient numerically */
+    long inward;  /* sphere only: triangles or normals facing the centre */
+    long slivers; /* sphere only: too thin to orient numerically */
 } mesh_report;
 
 static uint64_t next_random(uint64_t *state)
@@ -483,8 +486,8 @@ static int vertex_on_edge(const ip_mc_vertex *v, unsigned edge, const float orig
             return 0;
         }
     }
-    float n2 = v->normal[0] * v->normal[0] + v->normal[1] * v->normal[1] +
-               v->normal[2] * v->normal[2];
+    float n2 =
+        v->normal[0] * v->normal[0] + v->normal[1] * v->normal[1] + v->normal[2] * v->normal[2];
     return fabsf(n2 - 1.0f) < 1e-4f;
 }
 
@@ -506,8 +509,8 @@ static void check_sphere_triangle(const ip_mc_vertex *t, const double centre[3],
     for (int a = 0; a < 3; a++) {
         e1[a] = (double)t[1].position[a] - t[0].position[a];
         e2[a] = (double)t[2].position[a] - t[0].position[a];
-        radial[a] = ((double)t[0].position[a] + t[1].position[a] + t[2].position[a]) / 3.0 -
-                    centre[a];
+        radial[a] =
+            ((double)t[0].position[a] + t[1].position[a] + t[2].position[a]) / 3.0 - centre[a];
     }
     n[0] = e1[1] * e2[2] - e1[2] * e2[1];
     n[1] = e1[2] * e2[0] - e1[0] * e2[2];
@@ -548,7 +551,7 @@ static mesh_report mesh_grid(const grid *gr, float iso, int use_gradients, const
                 float origin[3] = {(float)x * size[0], (float)y * size[1], (float)z * size[2]};
                 ip_mc_vertex out[IP_MC_MAX_VERTICES];
                 int n = ip__mc_triangulate_cell(values, use_gradients ? grads : NULL, iso, origin,
-                                               size, out);
+                                                size, out);
                 unsigned c = ip__mc_case(values, iso);
                 REQUIRE(n == ip__mc_triangle_count[c]);
                 if (used + 3 * (size_t)n > capacity) {

@@ -40,7 +40,9 @@ static void fill(float *p, float *n, uint64_t *cells, uint64_t count, uint64_t f
 
 static void test_appends(void)
 {
-    enum { N = 700 }; /* more than the 256 triangles ip_mesh_append_float_normals packs at once */
+    enum {
+        N = 700
+    }; /* more than the 256 triangles ip_mesh_append_float_normals packs at once */
     float *p = malloc(N * 9 * sizeof *p), *n = malloc(N * 9 * sizeof *n);
     uint64_t *cells = malloc(N * sizeof *cells);
     REQUIRE(p && n && cells);
@@ -71,7 +73,7 @@ static void test_appends(void)
     CHECK(ip_mesh_append_mesh(&part, &with, 100, 50) == IP_OK);
     CHECK(part.triangle_count == 50 && part.cells[0] == 1100 && part.cells[49] == 1149);
     CHECK(part.positions[0] == p[900] && part.normals[9 * 49 + 4] == with.normals[9 * 149 + 4]);
-    CHECK(ip_mesh_append_mesh(&part, &plain, 0, 10) == IP_ERR_ARGUMENT); /* no ids to copy */
+    CHECK(ip_mesh_append_mesh(&part, &plain, 0, 10) == IP_ERR_ARGUMENT);   /* no ids to copy */
     CHECK(ip_mesh_append_mesh(&part, &with, N - 5, 6) == IP_ERR_ARGUMENT); /* past the end */
     CHECK(ip_mesh_append_mesh(&part, &with, N + 1, 0) == IP_ERR_ARGUMENT);
     CHECK(ip_mesh_append_mesh(&part, &with, N, 0) == IP_OK);

@@ -30,8 +30,8 @@ static int check_node(void *user, uint32_t level, uint32_t depth, const uint32_t
 {
     visit_log *v = user;
     /* level by level, depth 1 first within a level */
-    if (v->visits > 0 && (level < v->last_level ||
-                          (level == v->last_level && depth < v->last_depth)))
+    if (v->visits > 0 &&
+        (level < v->last_level || (level == v->last_level && depth < v->last_depth)))
         v->order_ok = 0;
     v->visits++;
     v->last_level = level;

@@ -71,8 +71,7 @@ static int temporaries_left(void)
 static void test_version(void)
 {
     char want[64];
-    snprintf(want, sizeof want, "%d.%d.%d", IP_VERSION_MAJOR, IP_VERSION_MINOR,
-             IP_VERSION_PATCH);
+    snprintf(want, sizeof want, "%d.%d.%d", IP_VERSION_MAJOR, IP_VERSION_MINOR, IP_VERSION_PATCH);
     CHECK(ip_version() != NULL);
     CHECK_MSG(strcmp(ip_version(), want) == 0, "ip_version() %s, header %s", ip_version(), want);
 }
@@ -207,8 +206,10 @@ static void test_output_is_input(void)
     at(header, "detached.nhdr");
     at(data, "sphere_8x6x5_uint8.raw");
     char text[8192];
-    snprintf(text, sizeof text, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 8 6 5\n"
-             "encoding: raw\ndata file: %s\n", data);
+    snprintf(text, sizeof text,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 8 6 5\n"
+             "encoding: raw\ndata file: %s\n",
+             data);
     write_text(header, text);
     REQUIRE(ip_input_describe(header, NULL, &desc, &err) == IP_OK);
     CHECK(ip_bricker_run(&desc, data, &options, NULL, &err) == IP_ERR_ARGUMENT);

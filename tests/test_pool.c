@@ -46,8 +46,8 @@ static void check_run(ip__pool *pool, tally *t, unsigned jobs)
             wrong++;
     }
     CHECK_MSG(wrong == 0 && atomic_load(&t->total) == jobs,
-              "%u jobs on %u threads: %u indices wrong, %u calls", jobs,
-              ip__pool_threads(pool), wrong, atomic_load(&t->total));
+              "%u jobs on %u threads: %u indices wrong, %u calls", jobs, ip__pool_threads(pool),
+              wrong, atomic_load(&t->total));
 }
 
 /* A rendezvous: each job waits until `expected` jobs have arrived, then notes its thread.
@@ -106,8 +106,7 @@ static void check_concurrent(unsigned threads)
         CHECK_MSG(distinct == threads && caller == 1,
                   "%u threads: %u distinct threads, the caller ran %u jobs", threads, distinct,
                   caller);
-        CHECK_MSG(blocked == threads, "%u threads: %u signal masks as expected", threads,
-                  blocked);
+        CHECK_MSG(blocked == threads, "%u threads: %u signal masks as expected", threads, blocked);
         pthread_cond_destroy(&m.all_here);
         pthread_mutex_destroy(&m.lock);
     }

@@ -10,15 +10,22 @@
 #include "check.h"
 #include "isoprop/render.h"
 
-enum { W = 64, H = 48 };
+enum {
+    W = 64,
+    H = 48
+};
 
 static const double box_lo[3] = {-20, -20, -20}, box_hi[3] = {20, 20, 5};
 
 /* Looks down -z from z = 10: depth 10 is the plane z = 0. */
 static ip_camera front_camera(uint32_t width, uint32_t height)
 {
-    ip_camera c = {.eye = {0, 0, 10}, .target = {0, 0, 0}, .up = {0, 1, 0}, .fov_y = 60,
-                   .width = width, .height = height};
+    ip_camera c = {.eye = {0, 0, 10},
+                   .target = {0, 0, 0},
+                   .up = {0, 1, 0},
+                   .fov_y = 60,
+                   .width = width,
+                   .height = height};
     return c;
 }
 
@@ -172,7 +179,7 @@ static void test_depth(void)
         add_screen_triangle(&m, &c, order ? big : small, order ? 10.0 : 8.0);
         REQUIRE(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, NULL) == IP_OK);
         uint32_t near_index = order ? 0 : 1;
-        CHECK(index[15 * W + 15] == near_index); /* inside both: the nearer one */
+        CHECK(index[15 * W + 15] == near_index);    /* inside both: the nearer one */
         CHECK(index[5 * W + 40] == 1 - near_index); /* the big one alone */
         CHECK(index[40 * W + 40] == UINT32_MAX);
         ip_mesh_free(&m);
@@ -195,15 +202,14 @@ static void test_depth(void)
 /* A cube [-1, 1]^3 with outward normals: 12 triangles, each face's normal in `face`. */
 static void build_cube(ip_mesh *m, float face[12][3])
 {
-    static const int quads[6][4][3] = {
-        {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},
-        {{-1, -1, -1}, {-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}},
-        {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},
-        {{-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}},
-        {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},
-        {{-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {1, -1, -1}}};
-    static const float normals[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                        {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const int quads[6][4][3] = {{{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},
+                                       {{-1, -1, -1}, {-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}},
+                                       {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},
+                                       {{-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}},
+                                       {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},
+                                       {{-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {1, -1, -1}}};
+    static const float normals[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                        {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     ip_mesh_init(m);
     for (int f = 0; f < 6; f++)
         for (int half = 0; half < 2; half++) {
@@ -234,8 +240,12 @@ static int ray_hits_cube(const double o[3], const double d[3])
 
 static void test_cube(void)
 {
-    ip_camera c = {.eye = {3.1, 2.3, 4.7}, .target = {0, 0, 0}, .up = {0, 0, 1}, .fov_y = 40,
-                   .width = 160, .height = 120};
+    ip_camera c = {.eye = {3.1, 2.3, 4.7},
+                   .target = {0, 0, 0},
+                   .up = {0, 0, 1},
+                   .fov_y = 40,
+                   .width = 160,
+                   .height = 120};
     const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
     ip_mesh m;
     float face[12][3];
@@ -325,11 +335,15 @@ static void test_head_on_shading(void)
  * guard-band clipping must leave exactly the pixels whose rays meet it. */
 static void test_clipping(void)
 {
-    ip_camera c = {.eye = {0, -5, 2}, .target = {0, 10, 0}, .up = {0, 0, 1}, .fov_y = 70,
-                   .width = 120, .height = 90};
+    ip_camera c = {.eye = {0, -5, 2},
+                   .target = {0, 10, 0},
+                   .up = {0, 0, 1},
+                   .fov_y = 70,
+                   .width = 120,
+                   .height = 90};
     const double lo[3] = {-1000, -1000, -1}, hi[3] = {1000, 1000, 1};
-    const float p[18] = {-1000, -1000, 0, 1000, -1000, 0, 1000, 1000, 0,
-                         -1000, -1000, 0, 1000, 1000, 0, -1000, 1000, 0};
+    const float p[18] = {-1000, -1000, 0, 1000, -1000, 0, 1000,  1000, 0,
+                         -1000, -1000, 0, 1000, 1000,  0, -1000, 1000, 0};
     const float n[18] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
     const uint64_t cells[2] = {0, 1};
     ip_mesh m;
@@ -431,7 +445,10 @@ static void test_png(void)
     const char *dir = test_tmp_dir("test_raster");
     char path[4200];
     snprintf(path, sizeof path, "%s/image.png", dir);
-    enum { PW = 37, PH = 23 };
+    enum {
+        PW = 37,
+        PH = 23
+    };
     uint8_t rgba[PW * PH * 4];
     srand(3);
     for (int opaque = 0; opaque < 2; opaque++) {

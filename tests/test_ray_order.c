@@ -44,7 +44,7 @@ static uint64_t walk_once(uint32_t w, uint32_t h, uint64_t *hash)
 static void test_every_pixel_once(void)
 {
     static const uint32_t sizes[][2] = {
-        {1, 1},  {1, 7},   {7, 1},   {2, 2},   {3, 5},    {5, 3},     {16, 16},    {17, 13},
+        {1, 1},  {1, 7},    {7, 1},    {2, 2},     {3, 5},       {5, 3},       {16, 16},   {17, 13},
         {33, 2}, {1, 1000}, {1000, 1}, {640, 480}, {1600, 1200}, {1920, 1080}, {255, 257},
     };
     for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
@@ -128,16 +128,15 @@ static void test_matches_reference(void)
     CHECK(mismatches == 0);
     static const uint32_t sizes[][2] = {{640, 480}, {255, 257}, {1000, 3}, {129, 1025}};
     for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
-        CHECK_MSG(same_as_reference(sizes[i][0], sizes[i][1]), "%ux%u", sizes[i][0],
-                  sizes[i][1]);
+        CHECK_MSG(same_as_reference(sizes[i][0], sizes[i][1]), "%ux%u", sizes[i][0], sizes[i][1]);
 }
 
 static void test_first_rays(void)
 {
     /* 16 x 16: the centre, then the 4 quadrant centres in Bayer order, then the 16 sub-quadrant
      * centres starting with the lattice of every other one. */
-    static const uint32_t expected[][2] = {{8, 8}, {4, 4}, {12, 12}, {12, 4}, {4, 12},
-                                           {2, 2}, {10, 10}, {10, 2}, {2, 10}, {6, 6}};
+    static const uint32_t expected[][2] = {{8, 8}, {4, 4},   {12, 12}, {12, 4}, {4, 12},
+                                           {2, 2}, {10, 10}, {10, 2},  {2, 10}, {6, 6}};
     ip_ray_order order;
     REQUIRE(ip__ray_order_init(&order, 16, 16) == IP_OK);
     for (size_t i = 0; i < sizeof expected / sizeof expected[0]; i++) {
@@ -276,8 +275,7 @@ static uint32_t max_chessboard_distance(const unsigned char *cast, uint32_t w, u
 }
 
 /* Brute force, to check the distance transforms themselves on small images. */
-static double max_distance_brute(const unsigned char *cast, uint32_t w, uint32_t h,
-                                 int chessboard)
+static double max_distance_brute(const unsigned char *cast, uint32_t w, uint32_t h, int chessboard)
 {
     double worst = 0.0;
     for (uint32_t py = 0; py < h; py++)
@@ -334,10 +332,10 @@ static void test_spread(uint32_t w, uint32_t h)
             uint32_t chess = max_chessboard_distance(cast, w, h);
             double euclid = max_distance(cast, w, h), bound = cell_size(side, k);
             printf(" %u/%.2f", chess, euclid);
-            CHECK_MSG(chess <= bound, "%ux%u after 4^%u rays: chessboard %u > %.0f", w, h, k,
-                      chess, bound);
-            CHECK_MSG(euclid <= sqrt(2.0) * bound + 1e-9, "%ux%u after 4^%u rays: %.3f > %.3f",
-                      w, h, k, euclid, sqrt(2.0) * bound);
+            CHECK_MSG(chess <= bound, "%ux%u after 4^%u rays: chessboard %u > %.0f", w, h, k, chess,
+                      bound);
+            CHECK_MSG(euclid <= sqrt(2.0) * bound + 1e-9, "%ux%u after 4^%u rays: %.3f > %.3f", w,
+                      h, k, euclid, sqrt(2.0) * bound);
             next_checkpoint *= 4;
             k++;
         }
@@ -430,14 +428,13 @@ static void test_local_levels(uint32_t w, uint32_t h, uint32_t local_from)
     }
     CHECK_MSG(differ == 0, "%ux%u local from %u: %llu rays in another level", w, h, local_from,
               (unsigned long long)differ);
-    CHECK_MSG(order_differs == 0, "%ux%u local from %u: coarse levels reordered", w, h,
-              local_from);
+    CHECK_MSG(order_differs == 0, "%ux%u local from %u: coarse levels reordered", w, h, local_from);
     if (step_count > 0) {
         double mean = steps / (double)step_count, bayer_mean = bayer_steps / (double)step_count;
         printf("%ux%u local from level %u: mean step %.2f pixels (Bayer order: %.2f)\n", w, h,
                local_from, mean, bayer_mean);
-        CHECK_MSG(mean * 16 < bayer_mean, "%ux%u: mean step %.2f, Bayer %.2f", w,
-                  h, mean, bayer_mean);
+        CHECK_MSG(mean * 16 < bayer_mean, "%ux%u: mean step %.2f, Bayer %.2f", w, h, mean,
+                  bayer_mean);
     }
     free(in_level);
     free(a);

@@ -28,8 +28,12 @@ static const double scene_lo[3] = {-1.2, -1.2, -1.2}, scene_hi[3] = {1.5, 1.5, 1
 
 static ip_camera scene_camera(uint32_t width, uint32_t height)
 {
-    ip_camera c = {.eye = {2.5, -3.0, 1.8}, .target = {0.1, 0, 0.1}, .up = {0, 0, 1},
-                   .fov_y = 45, .width = width, .height = height};
+    ip_camera c = {.eye = {2.5, -3.0, 1.8},
+                   .target = {0.1, 0, 0.1},
+                   .up = {0, 0, 1},
+                   .fov_y = 45,
+                   .width = width,
+                   .height = height};
     return c;
 }
 
@@ -159,8 +163,8 @@ static void compare_with_raster(const ip_mesh *m, const ip_camera *c, const uint
             worst = diff > worst ? diff : worst;
         }
     printf("%ux%u: %zu covered, %zu coverage mismatches, %zu shading outliers (> %d levels) "
-           "of %zu, worst %d\n", c->width, c->height, covered, coverage_mismatch, outliers,
-           SHADE_LEVELS, both, worst);
+           "of %zu, worst %d\n",
+           c->width, c->height, covered, coverage_mismatch, outliers, SHADE_LEVELS, both, worst);
     CHECK(covered > pixels / 10);
     CHECK(coverage_mismatch <= COVERAGE_MISMATCH_FRACTION * covered);
     CHECK(outliers <= SHADE_OUTLIER_FRACTION * both);
@@ -188,8 +192,12 @@ static void test_against_raster(ip_renderer *r, const ip_mesh *m)
     draw_and_read(r, &c, gl);
     compare_with_raster(m, &c, gl);
     /* the eye inside the sphere: triangles cross the near plane and reach behind the eye */
-    ip_camera inside = {.eye = {0.1, 0.2, 0.0}, .target = {0.8, -0.9, -0.4}, .up = {0, 0, 1},
-                        .fov_y = 80, .width = 320, .height = 240};
+    ip_camera inside = {.eye = {0.1, 0.2, 0.0},
+                        .target = {0.8, -0.9, -0.4},
+                        .up = {0, 0, 1},
+                        .fov_y = 80,
+                        .width = 320,
+                        .height = 240};
     draw_and_read(r, &inside, gl);
     compare_with_raster(m, &inside, gl);
     free(gl);
@@ -225,8 +233,7 @@ static void test_incremental_upload(ip_renderer *r, const ip_mesh *m)
     /* nothing to append, then a first triangle past the end */
     ip_error err;
     CHECK(ip_renderer_upload(fresh, &partial, partial.triangle_count, &err) == IP_OK);
-    CHECK(ip_renderer_upload(fresh, &partial, partial.triangle_count + 1, &err) ==
-          IP_ERR_ARGUMENT);
+    CHECK(ip_renderer_upload(fresh, &partial, partial.triangle_count + 1, &err) == IP_ERR_ARGUMENT);
     CHECK(ip_renderer_triangle_count(fresh) == m->triangle_count);
 
     /* cleared: the background alone, as the rasterizer draws it for an empty mesh */

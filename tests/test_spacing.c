@@ -28,8 +28,8 @@ static void check_refused(double x, double y, double z, const char *needle)
     const double s[3] = {x, y, z};
     ip_error err;
     ip_error_clear(&err);
-    CHECK_MSG(ip_spacing_check(s, "v.raw", &err) == IP_ERR_UNSUPPORTED, "%g,%g,%g accepted", x,
-              y, z);
+    CHECK_MSG(ip_spacing_check(s, "v.raw", &err) == IP_ERR_UNSUPPORTED, "%g,%g,%g accepted", x, y,
+              z);
     CHECK_CONTAINS(err.message, "v.raw: spacing");
     CHECK_CONTAINS(err.message, needle);
     CHECK(strchr(err.message, '\n') == NULL);
@@ -40,8 +40,8 @@ static void test_bounds(void)
     check_accepted(1, 1, 1);
     check_accepted(IP_SPACING_MIN, IP_SPACING_MIN, IP_SPACING_MIN);
     check_accepted(IP_SPACING_MAX, IP_SPACING_MAX, IP_SPACING_MAX);
-    check_accepted(1e-6, 1e-6, 2e-6);   /* micrometre voxels in metres */
-    check_accepted(4e-9, 4e-9, 4e-8);   /* nanometre voxels in metres */
+    check_accepted(1e-6, 1e-6, 2e-6); /* micrometre voxels in metres */
+    check_accepted(4e-9, 4e-9, 4e-8); /* nanometre voxels in metres */
     check_accepted(0.3, 0.3, 0.3 * IP_SPACING_RATIO_MAX);
     check_accepted(1e-9, 1e-6, 1e-9 * IP_SPACING_RATIO_MAX);
     check_refused(1e-12, 1e-12, 1e-12, "1e-09 to 1e+06");
@@ -118,8 +118,10 @@ static void check_depth_range_scales(const double cells[3])
         double ratio = far_plane / near_plane;
         if (i == 0)
             reference = ratio;
-        CHECK_MSG(fabs(ratio - reference) <= 1e-9 * reference, "scale %g: far / near %.12g, "
-                  "at the smallest scale %.12g", k, ratio, reference);
+        CHECK_MSG(fabs(ratio - reference) <= 1e-9 * reference,
+                  "scale %g: far / near %.12g, "
+                  "at the smallest scale %.12g",
+                  k, ratio, reference);
     }
 }
 

@@ -219,7 +219,7 @@ static void test_rewritten_while_open(const char *dir, const char *ibv)
     uint64_t g = first_payload(s, &e);
     float before[2];
     ip_store_brick_range(s, g, before);
-    static const unsigned char junk[16] = {0xde, 0xad, 0xbe, 0xef, 1, 2, 3, 4,
+    static const unsigned char junk[16] = {0xde, 0xad, 0xbe, 0xef, 1, 2,  3,  4,
                                            5,    6,    7,    8,    9, 10, 11, 12};
     poke(path, e.offset, junk, e.stored_size < sizeof junk ? e.stored_size : sizeof junk);
     poke(path, l->summary_offset + 16, junk, sizeof junk); /* the summary too */

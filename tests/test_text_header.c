@@ -44,10 +44,9 @@ static const ip_text_key toy_key_list[] = {
     {"Custom", BY_NOTHING, parse_custom, 0, 0},
     {"Other name", BY_ENDIAN, parse_custom, 0, 0},
 };
-static const ip_text_keys nocase_keys = {toy_key_list, 6, 1, NULL, "Toy",
-                                         IP_TYPE_SPELLING_METAIMAGE};
-static const ip_text_keys field_keys = {toy_key_list, 6, 0, "field", "TOY",
-                                        IP_TYPE_SPELLING_NRRD};
+static const ip_text_keys nocase_keys = {toy_key_list, 6,     1,
+                                         NULL,         "Toy", IP_TYPE_SPELLING_METAIMAGE};
+static const ip_text_keys field_keys = {toy_key_list, 6, 0, "field", "TOY", IP_TYPE_SPELLING_NRRD};
 
 static void fresh(toy_header *h, const ip_text_keys *keys)
 {
@@ -205,13 +204,11 @@ static void toy_init(void *header)
     h->sizes_count = h->spacing_count = -1;
 }
 
-static ip_status toy_finish(void *header, uint64_t header_end,
-                            const ip_input_overrides *overrides, ip_input_desc *desc,
-                            ip_text_found *found, ip_error *err)
+static ip_status toy_finish(void *header, uint64_t header_end, const ip_input_overrides *overrides,
+                            ip_input_desc *desc, ip_text_found *found, ip_error *err)
 {
     toy_header *h = header;
-    ip_status st = ip__text_check_dims(h, h->dims, "Dims", h->sizes_count, "Sizes", overrides,
-                                       err);
+    ip_status st = ip__text_check_dims(h, h->dims, "Dims", h->sizes_count, "Sizes", overrides, err);
     if (st != IP_OK)
         return st;
     ip__text_found_layout(h->has_type, h->type, h->sizes_count, h->sizes, desc, found);
@@ -271,8 +268,9 @@ static void test_type_names(void)
     t = IP_UINT8;
     CHECK(ip__type_from_name("uint64", IP_TYPE_SPELLING_ALL, &t) == IP_ERR_ARGUMENT);
     CHECK(t == IP_UINT8);
-    const char *every[] = {"uint8", "uchar", "unsigned char", "uint8_t", "MET_UCHAR", "u8",
-                           "signed short int", "i16", "MET_FLOAT", "f32", "float32"};
+    const char *every[] = {"uint8",     "uchar", "unsigned char",    "uint8_t",
+                           "MET_UCHAR", "u8",    "signed short int", "i16",
+                           "MET_FLOAT", "f32",   "float32"};
     int all = 1;
     for (size_t i = 0; i < sizeof every / sizeof every[0]; i++)
         all &= ip_type_parse(every[i], &t) == IP_OK;

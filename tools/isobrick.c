@@ -48,8 +48,8 @@ static int report_progress(void *user, uint64_t done, uint64_t total)
             double eta = rate > 0 ? (double)(total - done) / rate : 0;
             int width = 30, fill = total ? (int)((double)done / (double)total * width) : width;
             fprintf(stderr, "\r[%-*.*s] %5.1f%% %7.1f MB/s ETA %4.0fs", width, fill,
-                    "##############################", total ? 100.0 * (double)done / (double)total : 100.0,
-                    rate / 1e6, eta);
+                    "##############################",
+                    total ? 100.0 * (double)done / (double)total : 100.0, rate / 1e6, eta);
             if (done == total)
                 fputc('\n', stderr);
             p->last = now;
@@ -169,8 +169,8 @@ static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     ip_bricker_options_default(&o->brick);
-    const tool_option_table table = {
-        isobrick_options, sizeof isobrick_options / sizeof isobrick_options[0], o};
+    const tool_option_table table = {isobrick_options,
+                                     sizeof isobrick_options / sizeof isobrick_options[0], o};
     const tool_command_line line = {"isobrick", usage, &table, 1, &o->input, "input"};
     int rc = tool_parse_command_line(&line, argc, argv);
     if (rc)
@@ -196,11 +196,14 @@ static void print_summary(const ip_bricker_report *r, const char *out)
 {
     char in_b[32], file_b[32], rss_b[32];
     printf("wrote %s\n", out);
-    printf("  input       %s (%llu bytes)\n", tool_format_bytes(in_b, sizeof in_b, (double)r->input_bytes),
+    printf("  input       %s (%llu bytes)\n",
+           tool_format_bytes(in_b, sizeof in_b, (double)r->input_bytes),
            (unsigned long long)r->input_bytes);
-    printf("  file        %s (%llu bytes)\n", tool_format_bytes(file_b, sizeof file_b, (double)r->file_bytes),
+    printf("  file        %s (%llu bytes)\n",
+           tool_format_bytes(file_b, sizeof file_b, (double)r->file_bytes),
            (unsigned long long)r->file_bytes);
-    printf("  ratio       %.2fx\n", r->file_bytes ? (double)r->input_bytes / (double)r->file_bytes : 0.0);
+    printf("  ratio       %.2fx\n",
+           r->file_bytes ? (double)r->input_bytes / (double)r->file_bytes : 0.0);
     printf("  bricks      %llu in %u levels: %llu constant, %llu compressed, %llu raw\n",
            (unsigned long long)r->bricks, r->levels, (unsigned long long)r->bricks_constant,
            (unsigned long long)r->bricks_compressed, (unsigned long long)r->bricks_raw);

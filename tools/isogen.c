@@ -40,8 +40,8 @@ static const char usage_text[] =
     "Exit status: 0 success, 1 failure, 2 bad command line.\n";
 
 typedef struct options {
-    const char *positional;  /* FIELD, or INPUT with --upsample */
-    uint32_t factor;         /* 0 unless --upsample */
+    const char *positional; /* FIELD, or INPUT with --upsample */
+    uint32_t factor;        /* 0 unless --upsample */
     int has_dims;
     uint32_t dims[3];
     int has_type;
@@ -116,7 +116,7 @@ static int apply_value(options *o, const char *name, const char *value)
  * --version. */
 static int parse_argument(options *o, int argc, char **argv, int *i)
 {
-    static const char *const valued[] = {"--dims", "--type", "--endian", "--noise",
+    static const char *const valued[] = {"--dims", "--type",     "--endian", "--noise",
                                          "--seed", "--upsample", "-o"};
     const char *arg = argv[*i];
     if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0)
@@ -161,8 +161,10 @@ static int check_mode(const options *o, ip_field *field)
         return tool_usage_error(PROGRAM, "missing FIELD (shepp-logan, sphere, gyroid or "
                                          "marschner-lobb)");
     if (ip_field_parse(o->positional, field) != IP_OK)
-        return tool_usage_error(PROGRAM, "unknown field '%s' (shepp-logan, sphere, gyroid or "
-                                         "marschner-lobb)", o->positional);
+        return tool_usage_error(PROGRAM,
+                                "unknown field '%s' (shepp-logan, sphere, gyroid or "
+                                "marschner-lobb)",
+                                o->positional);
     if (o->has_endian)
         return tool_usage_error(PROGRAM, "--endian applies only to --upsample");
     if (o->has_dims && (o->dims[0] < 2 || o->dims[1] < 2 || o->dims[2] < 2))

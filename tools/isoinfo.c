@@ -202,8 +202,7 @@ int main(int argc, char **argv)
     if (rc == 0 && tool_signal_caught())
         rc = 1; /* the last brick was checked, but the run was interrupted: no output */
     if (stats_path && !tool_signal_caught() &&
-        tool_write_stats_file("isoinfo", stats_path, force, &stats, summary_bytes, NULL,
-                              NULL) != 0)
+        tool_write_stats_file("isoinfo", stats_path, force, &stats, summary_bytes, NULL, NULL) != 0)
         rc = 1;
     if (rc == 0) {
         if (json)

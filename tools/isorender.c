@@ -72,8 +72,8 @@ typedef struct run {
     size_t checkpoint_count;
     double extraction_wall, progress_render_seconds, final_pct;
     const char *renderer_name;
-    char warning[600];    /* the --iso warning, "" when none */
-    int writing;          /* 1 once the outputs are being written */
+    char warning[600]; /* the --iso warning, "" when none */
+    int writing;       /* 1 once the outputs are being written */
 } run;
 
 static const tool_option isorender_options[] = {
@@ -90,16 +90,15 @@ static int parse_args(int argc, char **argv, options *o)
     memset(o, 0, sizeof *o);
     o->out = "isorender.png";
     tool_view_options_default(&o->common, 1600, 1200);
-    int rc = tool_parse_view_command_line(
-        "isorender", usage, &o->common, isorender_options,
-        sizeof isorender_options / sizeof isorender_options[0], o, &o->file, argc, argv);
+    int rc = tool_parse_view_command_line("isorender", usage, &o->common, isorender_options,
+                                          sizeof isorender_options / sizeof isorender_options[0], o,
+                                          &o->file, argc, argv);
     if (rc)
         return rc;
     if (o->full && (o->common.rays || o->common.time_limit > 0))
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
     return 0;
 }
-
 
 static int setup_camera(run *r, ip_error *err)
 {
@@ -112,8 +111,10 @@ static int setup_camera(run *r, ip_error *err)
             return -1;
         return ip_camera_check(&r->camera, err) == IP_OK ? 0 : -1;
     }
-    return ip_camera_fit_axis(r->lo, r->hi, r->o.common.view, 30.0, r->o.common.width, r->o.common.height, &r->camera,
-                              err) == IP_OK ? 0 : -1;
+    return ip_camera_fit_axis(r->lo, r->hi, r->o.common.view, 30.0, r->o.common.width,
+                              r->o.common.height, &r->camera, err) == IP_OK
+               ? 0
+               : -1;
 }
 
 static int add_checkpoint(run *r, double start)
@@ -152,7 +153,8 @@ static int extract_progressive(run *r, ip_error *err)
         ip_engine_totals(r->engine, &t);
         if (t.rays >= limit)
             break;
-        double left = r->o.common.time_limit > 0 ? r->o.common.time_limit - (ip_now_seconds() - start) : 0;
+        double left =
+            r->o.common.time_limit > 0 ? r->o.common.time_limit - (ip_now_seconds() - start) : 0;
         if (r->o.common.time_limit > 0 && left <= 0)
             break;
         uint64_t batch = (target < limit ? target : limit) - t.rays;
@@ -172,12 +174,14 @@ static int extract_full(run *r, ip_error *err)
 {
     ip_mesh_init(&r->full_mesh);
     if (r->o.warm) {
-        if (ip_extract_full(r->cache, (float)r->o.common.iso, 0, r->o.common.threads, &r->full_mesh, NULL, err) != IP_OK)
+        if (ip_extract_full(r->cache, (float)r->o.common.iso, 0, r->o.common.threads, &r->full_mesh,
+                            NULL, err) != IP_OK)
             return -1;
         ip_mesh_clear(&r->full_mesh);
     }
     double start = ip_now_seconds();
-    if (ip_extract_full(r->cache, (float)r->o.common.iso, 0, r->o.common.threads, &r->full_mesh, &r->totals, err) != IP_OK)
+    if (ip_extract_full(r->cache, (float)r->o.common.iso, 0, r->o.common.threads, &r->full_mesh,
+                        &r->totals, err) != IP_OK)
         return -1;
     r->extraction_wall = ip_now_seconds() - start;
     r->mesh = &r->full_mesh;
@@ -261,8 +265,7 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
             r->renderer_name = "opengl";
             return st == IP_OK ? 0 : -1;
         }
-        fprintf(stderr, "isorender: no headless OpenGL (%s); rendering in software\n",
-                why.message);
+        fprintf(stderr, "isorender: no headless OpenGL (%s); rendering in software\n", why.message);
     }
     r->renderer_name = "software";
     int rc = ip_raster_mesh(r->mesh, &r->camera, r->lo, r->hi, NULL, rgba, err) == IP_OK ? 0 : -1;
@@ -273,10 +276,17 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
 static void json_counts(FILE *f, void *user)
 {
     const run *r = user;
-    const tool_run_json j = {r->o.file, r->o.common.iso, r->o.full, &r->camera,
-                             r->renderer_name ? r->renderer_name : "none", &r->o.common,
-                             r->o.warm, r->o.full || (r->engine && ip_engine_done(r->engine)),
-                             &r->totals, r->totals.rendering_seconds, r->extraction_wall,
+    const tool_run_json j = {r->o.file,
+                             r->o.common.iso,
+                             r->o.full,
+                             &r->camera,
+                             r->renderer_name ? r->renderer_name : "none",
+                             &r->o.common,
+                             r->o.warm,
+                             r->o.full || (r->engine && ip_engine_done(r->engine)),
+                             &r->totals,
+                             r->totals.rendering_seconds,
+                             r->extraction_wall,
                              r->progress_render_seconds};
     tool_write_run_json(f, &j);
     if (r->checkpoint_count)
@@ -291,8 +301,8 @@ static void json_counts(FILE *f, void *user)
 static void print_summary(const run *r)
 {
     const ip_engine_counts *t = &r->totals;
-    printf("%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso, r->o.full ? "full extraction" : "progressive",
-           r->camera.width, r->camera.height);
+    printf("%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso,
+           r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
     printf("  rays          %llu of %llu\n", (unsigned long long)t->rays,
            (unsigned long long)r->camera.width * r->camera.height);
     printf("  seeds         %llu\n", (unsigned long long)t->seeds);
@@ -301,8 +311,7 @@ static void print_summary(const run *r)
     printf("  time          %.3f s extraction (wall); CPU s summed over %u threads: "
            "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
            r->extraction_wall, ip_thread_count(r->o.common.threads), t->intersection_seconds,
-           t->propagation_seconds, t->extraction_seconds, t->rendering_seconds,
-           r->renderer_name);
+           t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
     printf("  image         %s\n", r->o.out);
 }
 
@@ -338,8 +347,8 @@ static int finish(run *r, ip_error *err)
         return rc != 0 ? tool_fail("isorender", err) : 1;
     }
     r->writing = 1;
-    if (ip_png_write(r->o.out, rgba, r->camera.width, r->camera.height, r->o.common.force,
-                     err) != IP_OK)
+    if (ip_png_write(r->o.out, rgba, r->camera.width, r->camera.height, r->o.common.force, err) !=
+        IP_OK)
         rc = -1;
     free(rgba);
     if (rc == 0 && r->o.mesh &&
@@ -355,9 +364,9 @@ static int finish(run *r, ip_error *err)
         print_summary(r);
         tool_print_cache_table(stdout, &st, summary);
     }
-    if (r->o.common.stats && tool_write_stats_file("isorender", r->o.common.stats,
-                                                   r->o.common.force, &st, summary,
-                                                   json_counts, r) != 0)
+    if (r->o.common.stats &&
+        tool_write_stats_file("isorender", r->o.common.stats, r->o.common.force, &st, summary,
+                              json_counts, r) != 0)
         return 1;
     return 0;
 }
@@ -383,7 +392,7 @@ int main(int argc, char **argv)
     }
     rc = 1;
     if (ip_cache_create(r.store, r.o.common.cache_bytes, &r.cache, &err) != IP_OK ||
-               setup_camera(&r, &err) != 0) {
+        setup_camera(&r, &err) != 0) {
         rc = tool_fail("isorender", &err);
     } else {
         /* the errors above come first: a bad command line is one line, not a warning too */

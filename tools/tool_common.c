@@ -80,8 +80,7 @@ int tool_parse_double3(const char *text, double out[3])
     return tok ? -1 : 0;
 }
 
-int tool_parse_dims(const char *program, const char *option, const char *text,
-                    uint32_t dims[3])
+int tool_parse_dims(const char *program, const char *option, const char *text, uint32_t dims[3])
 {
     static const char axes[3] = {'x', 'y', 'z'};
     unsigned long long value[3];
@@ -103,15 +102,21 @@ int tool_parse_dims(const char *program, const char *option, const char *text,
         }
     }
     if (count < 3 || *p != '\0')
-        return tool_usage_error(program, "%s '%s' is not XxYxZ (three whole numbers, e.g. "
-                                "512x512x234)", option, text);
+        return tool_usage_error(program,
+                                "%s '%s' is not XxYxZ (three whole numbers, e.g. "
+                                "512x512x234)",
+                                option, text);
     for (int k = 0; k < 3; k++) {
         if (value[k] < 2)
-            return tool_usage_error(program, "%s '%s': the dimension along %c is %llu; each "
-                                    "must be at least 2", option, text, axes[k], value[k]);
+            return tool_usage_error(program,
+                                    "%s '%s': the dimension along %c is %llu; each "
+                                    "must be at least 2",
+                                    option, text, axes[k], value[k]);
         if (value[k] >= (1ull << 31))
-            return tool_usage_error(program, "%s '%s': the dimension along %c is too large "
-                                    "(at most %llu)", option, text, axes[k], (1ull << 31) - 1);
+            return tool_usage_error(program,
+                                    "%s '%s': the dimension along %c is too large "
+                                    "(at most %llu)",
+                                    option, text, axes[k], (1ull << 31) - 1);
     }
     if (ip_dims_parse(text, dims) != IP_OK) /* cannot fail after the checks above */
         return tool_usage_error(program, "%s '%s' is not XxYxZ", option, text);
@@ -164,8 +169,7 @@ static int check_output_folder(const char *program, const char *path)
     if (stat(folder, &st) != 0 || !S_ISDIR(st.st_mode) || access(folder, W_OK | X_OK) != 0) {
         int e = errno;
         fprintf(stderr, "%s: %s: cannot write in folder %s: %s\n", program, path, folder,
-                stat(folder, &st) == 0 && !S_ISDIR(st.st_mode) ? "not a directory"
-                                                               : strerror(e));
+                stat(folder, &st) == 0 && !S_ISDIR(st.st_mode) ? "not a directory" : strerror(e));
         return 1;
     }
     return 0;
@@ -187,11 +191,15 @@ int tool_check_paths(const char *program, const char *const *inputs, size_t inpu
         for (size_t k = 0; k < o; k++)
             if (outputs[k] && ip_path_same_file(outputs[o], outputs[k])) {
                 if (strcmp(outputs[o], outputs[k]) == 0)
-                    fprintf(stderr, "%s: %s: named for two outputs; each output needs a file "
-                            "of its own\n", program, outputs[o]);
+                    fprintf(stderr,
+                            "%s: %s: named for two outputs; each output needs a file "
+                            "of its own\n",
+                            program, outputs[o]);
                 else
-                    fprintf(stderr, "%s: %s: is the same file as the output %s; each output "
-                            "needs a file of its own\n", program, outputs[o], outputs[k]);
+                    fprintf(stderr,
+                            "%s: %s: is the same file as the output %s; each output "
+                            "needs a file of its own\n",
+                            program, outputs[o], outputs[k]);
                 return 1;
             }
         if (ip_output_check(outputs[o], force, &err) != IP_OK)
@@ -298,7 +306,8 @@ int tool_warn_iso_range(const char *program, const ip_store *store, double iso, 
     if (v > l->value_min && v <= l->value_max)
         return 0;
     char text[512];
-    snprintf(text, sizeof text, "--iso %g is outside the value range of %s, %g .. %g: there "
+    snprintf(text, sizeof text,
+             "--iso %g is outside the value range of %s, %g .. %g: there "
              "is no surface (an isovalue must be above the minimum and at most the maximum)",
              iso, ip_store_path(store), (double)l->value_min, (double)l->value_max);
     fprintf(stderr, "%s: warning: %s\n", program, text);
@@ -371,21 +380,25 @@ void tool_print_cache_table(FILE *out, const ip_cache_stats *s, uint64_t summary
                 (unsigned long long)s->level[k].bricks_total);
     fprintf(out, "%s\n", s->levels ? ")" : "");
     if (s->over_budget_pins || s->errors)
-        fprintf(out, "  warnings        %llu loads over budget (all resident bricks pinned), "
-                     "%llu bad bricks\n",
+        fprintf(out,
+                "  warnings        %llu loads over budget (all resident bricks pinned), "
+                "%llu bad bricks\n",
                 (unsigned long long)s->over_budget_pins, (unsigned long long)s->errors);
     fprintf(out, "  summaries       %s\n", tool_format_bytes(a, sizeof a, (double)summary_bytes));
-    fprintf(out, "  peak RSS        %s\n", tool_format_bytes(b, sizeof b, (double)ip_peak_rss_bytes()));
+    fprintf(out, "  peak RSS        %s\n",
+            tool_format_bytes(b, sizeof b, (double)ip_peak_rss_bytes()));
 }
 
 void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_bytes)
 {
-    fprintf(out, "\"budget_bytes\": %llu, \"resident_bytes\": %llu, "
-                 "\"resident_peak_bytes\": %llu, \"resident_bricks\": %llu, ",
+    fprintf(out,
+            "\"budget_bytes\": %llu, \"resident_bytes\": %llu, "
+            "\"resident_peak_bytes\": %llu, \"resident_bricks\": %llu, ",
             (unsigned long long)s->budget_bytes, (unsigned long long)s->resident_bytes,
             (unsigned long long)s->resident_peak_bytes, (unsigned long long)s->resident_bricks);
-    fprintf(out, "\"hits\": %llu, \"misses\": %llu, \"evictions\": %llu, \"waits\": %llu, "
-                 "\"hit_rate\": %.6f, ",
+    fprintf(out,
+            "\"hits\": %llu, \"misses\": %llu, \"evictions\": %llu, \"waits\": %llu, "
+            "\"hit_rate\": %.6f, ",
             (unsigned long long)s->hits, (unsigned long long)s->misses,
             (unsigned long long)s->evictions, (unsigned long long)s->waits, hit_rate(s));
     fprintf(out, "\"bytes_decompressed\": %llu, \"bytes_read\": %llu, \"decode_seconds\": %.6f, ",
@@ -397,8 +410,9 @@ void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_
     fprintf(out, "\"bricks_touched\": %llu, \"bricks_total\": %llu, \"levels\": [",
             (unsigned long long)s->bricks_touched, (unsigned long long)s->bricks_total);
     for (uint32_t k = 0; k < s->levels; k++)
-        fprintf(out, "%s{\"level\": %u, \"bricks_touched\": %llu, \"bricks_total\": %llu, "
-                     "\"misses\": %llu}",
+        fprintf(out,
+                "%s{\"level\": %u, \"bricks_touched\": %llu, \"bricks_total\": %llu, "
+                "\"misses\": %llu}",
                 k ? ", " : "", k, (unsigned long long)s->level[k].bricks_touched,
                 (unsigned long long)s->level[k].bricks_total,
                 (unsigned long long)s->level[k].misses);
@@ -426,9 +440,8 @@ static void fill_stats(FILE *out, void *user)
     fprintf(out, "}\n");
 }
 
-int tool_write_stats_file(const char *program, const char *path, int force,
-                          const ip_cache_stats *s, uint64_t summary_bytes,
-                          void (*extra)(FILE *out, void *user), void *user)
+int tool_write_stats_file(const char *program, const char *path, int force, const ip_cache_stats *s,
+                          uint64_t summary_bytes, void (*extra)(FILE *out, void *user), void *user)
 {
     stats_json j = {s, summary_bytes, extra, user};
     return tool_write_text_file(program, path, force, fill_stats, &j);
@@ -482,9 +495,10 @@ static int parse_size(const char *p, const char *text, uint32_t *w, uint32_t *h)
         return tool_usage_error(p, "--size '%s' is not WxH (e.g. 1600x1200)", text);
     for (int k = 0; k < 2; k++)
         if (side[k] < 1 || side[k] > MAX_IMAGE_SIDE)
-            return tool_usage_error(p, "--size '%s': the %s, %llu pixels, is not within 1 .. "
-                                    "%d", text, k ? "height" : "width", side[k],
-                                    MAX_IMAGE_SIDE);
+            return tool_usage_error(p,
+                                    "--size '%s': the %s, %llu pixels, is not within 1 .. "
+                                    "%d",
+                                    text, k ? "height" : "width", side[k], MAX_IMAGE_SIDE);
     *w = (uint32_t)side[0];
     *h = (uint32_t)side[1];
     return 0;
@@ -492,8 +506,8 @@ static int parse_size(const char *p, const char *text, uint32_t *w, uint32_t *h)
 
 /* ---- option parsers ---- */
 
-static int parse_double_option(const char *p, const tool_option *opt, const char *value,
-                               void *base, int positive)
+static int parse_double_option(const char *p, const tool_option *opt, const char *value, void *base,
+                               int positive)
 {
     double *out = (double *)(void *)((char *)base + opt->offset);
     if (tool_parse_double(value, out) != 0 || (positive && *out <= 0))
@@ -506,8 +520,7 @@ int tool_option_number(const char *p, const tool_option *opt, const char *const 
     return parse_double_option(p, opt, v[0], base, 0);
 }
 
-int tool_option_positive(const char *p, const tool_option *opt, const char *const *v,
-                         void *base)
+int tool_option_positive(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     return parse_double_option(p, opt, v[0], base, 1);
 }
@@ -608,8 +621,7 @@ int tool_is_u64(const char *text)
 
 /* ---- the command-line engine ---- */
 
-static const tool_option *find_option(const tool_command_line *c, const char *name,
-                                      void **base)
+static const tool_option *find_option(const tool_command_line *c, const char *name, void **base)
 {
     for (size_t t = 0; t < c->table_count; t++)
         for (size_t k = 0; k < c->tables[t].count; k++) {
@@ -624,8 +636,8 @@ static const tool_option *find_option(const tool_command_line *c, const char *na
 
 /* Takes the option at argv[*i] and its values, advancing *i past them. Returns 0, 1 when
  * its values are missing, or 2 after a usage error. */
-static int take_option(const tool_command_line *c, const tool_option *opt, void *base,
-                       int argc, char **argv, int *i)
+static int take_option(const tool_command_line *c, const tool_option *opt, void *base, int argc,
+                       char **argv, int *i)
 {
     int available = argc - 1 - *i;
     int count = opt->values;
@@ -669,8 +681,7 @@ int tool_parse_command_line(const tool_command_line *c, int argc, char **argv)
         } else if (c->positional && !*c->positional) {
             *c->positional = a;
         } else {
-            return tool_usage_error(c->program, "more than one %s ('%s')", c->positional_name,
-                                    a);
+            return tool_usage_error(c->program, "more than one %s ('%s')", c->positional_name, a);
         }
     }
     return 0;
@@ -699,27 +710,29 @@ void tool_write_run_json(FILE *f, const tool_run_json *j)
     const ip_engine_counts *t = j->counts;
     fprintf(f, "\"file\": ");
     tool_json_string(f, j->file);
-    fprintf(f, ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
-               "\"renderer\": \"%s\"",
+    fprintf(f,
+            ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
+            "\"renderer\": \"%s\"",
             j->iso, j->full ? "full" : "progressive", c->width, c->height, j->renderer);
-    fprintf(f, ", \"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"target\": [%.9g, %.9g, %.9g], "
-               "\"up\": [%.9g, %.9g, %.9g], \"fov\": %.9g}",
-            c->eye[0], c->eye[1], c->eye[2], c->target[0], c->target[1], c->target[2],
-            c->up[0], c->up[1], c->up[2], c->fov_y);
-    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", o->lod ? "true" : "false",
-            o->pixel_error);
+    fprintf(f,
+            ", \"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"target\": [%.9g, %.9g, %.9g], "
+            "\"up\": [%.9g, %.9g, %.9g], \"fov\": %.9g}",
+            c->eye[0], c->eye[1], c->eye[2], c->target[0], c->target[1], c->target[2], c->up[0],
+            c->up[1], c->up[2], c->fov_y);
+    fprintf(f, ", \"lod\": %s, \"pixel_error\": %.9g", o->lod ? "true" : "false", o->pixel_error);
     fprintf(f, ", \"warm\": %s, \"threads\": %u", j->warm ? "true" : "false",
             ip_thread_count(o->threads));
-    fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", o->cutoff,
-            o->foldback);
-    fprintf(f, ", \"rays\": %llu, \"rays_total\": %llu, \"done\": %s, \"seeds\": %llu, "
-               "\"cells\": %llu, \"triangles\": %llu",
+    fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", o->cutoff, o->foldback);
+    fprintf(f,
+            ", \"rays\": %llu, \"rays_total\": %llu, \"done\": %s, \"seeds\": %llu, "
+            "\"cells\": %llu, \"triangles\": %llu",
             (unsigned long long)t->rays, (unsigned long long)c->width * c->height,
-            j->done ? "true" : "false", (unsigned long long)t->seeds,
-            (unsigned long long)t->cells, (unsigned long long)t->triangles);
-    fprintf(f, ", \"time\": {\"intersection_s\": %.6f, \"propagation_s\": %.6f, "
-               "\"extraction_s\": %.6f, \"rendering_s\": %.6f, \"extraction_wall_s\": %.6f, "
-               "\"progress_render_s\": %.6f}",
+            j->done ? "true" : "false", (unsigned long long)t->seeds, (unsigned long long)t->cells,
+            (unsigned long long)t->triangles);
+    fprintf(f,
+            ", \"time\": {\"intersection_s\": %.6f, \"propagation_s\": %.6f, "
+            "\"extraction_s\": %.6f, \"rendering_s\": %.6f, \"extraction_wall_s\": %.6f, "
+            "\"progress_render_s\": %.6f}",
             t->intersection_seconds, t->propagation_seconds, t->extraction_seconds,
             j->rendering_seconds, j->extraction_wall_seconds, j->progress_render_seconds);
 }

@@ -26,8 +26,7 @@ int tool_parse_double3(const char *text, double out[3]);
 /* Parses the value of a dims option ("XxYxZ", each 2 .. 2^31 - 1). Returns 0, or 2 after a
  * usage error that says what is wrong (not three numbers, a dimension that is zero or under 2,
  * one too large). */
-int tool_parse_dims(const char *program, const char *option, const char *text,
-                    uint32_t dims[3]);
+int tool_parse_dims(const char *program, const char *option, const char *text, uint32_t dims[3]);
 
 /* Handles --version: prints "PROGRAM VERSION" (the library's, isoprop/version.h) on stdout. */
 void tool_print_version(const char *program);
@@ -75,16 +74,16 @@ int tool_parse_cache_mb(const char *text, uint64_t *bytes);
 typedef struct tool_view_options {
     double iso;
     int has_iso;
-    uint32_t width, height;     /* pixels */
-    const char *view, *camera;  /* --view AXIS, --camera E,T,U,FOV (NULL: none) */
-    uint64_t rays;              /* 0: every pixel */
-    double time_limit;          /* seconds; 0: none */
-    double cutoff, foldback;    /* degrees */
-    unsigned threads;           /* 0: every core */
+    uint32_t width, height;    /* pixels */
+    const char *view, *camera; /* --view AXIS, --camera E,T,U,FOV (NULL: none) */
+    uint64_t rays;             /* 0: every pixel */
+    double time_limit;         /* seconds; 0: none */
+    double cutoff, foldback;   /* degrees */
+    unsigned threads;          /* 0: every core */
     int lod;
     double pixel_error;
     uint64_t cache_bytes;
-    const char *stats;          /* --stats OUT.json (NULL: none) */
+    const char *stats; /* --stats OUT.json (NULL: none) */
     int force, quiet;
 } tool_view_options;
 
@@ -117,14 +116,14 @@ typedef int tool_option_parse(const char *program, const tool_option *option,
                               const char *const *values, void *base);
 
 struct tool_option {
-    const char *name;           /* "--size" */
-    const char *alias;          /* a second name ("-q"), or NULL */
-    int values;                 /* the values after the name: 0, 1, 2 or TOOL_OPTIONAL_VALUE */
+    const char *name;  /* "--size" */
+    const char *alias; /* a second name ("-q"), or NULL */
+    int values;        /* the values after the name: 0, 1, 2 or TOOL_OPTIONAL_VALUE */
     /* without parse: a flag (values 0) sets the int at base + offset to 1, a text (values 1)
      * stores the value as the const char * at base + offset */
     size_t offset;
-    tool_option_parse *parse;   /* NULL: a flag or a text, as above */
-    const char *problem;        /* for parsers that use it: "is not a number" */
+    tool_option_parse *parse;          /* NULL: a flag or a text, as above */
+    const char *problem;               /* for parsers that use it: "is not a number" */
     int (*accepts)(const char *value); /* TOOL_OPTIONAL_VALUE: whether it is the value */
 };
 
@@ -144,11 +143,11 @@ typedef struct tool_option_table {
 } tool_option_table;
 
 typedef struct tool_command_line {
-    const char *program;        /* for messages: "isorender" */
-    const char *usage;          /* --help's text */
+    const char *program; /* for messages: "isorender" */
+    const char *usage;   /* --help's text */
     const tool_option_table *tables;
     size_t table_count;
-    const char **positional;    /* receives the positional argument (NULL when none) */
+    const char **positional;     /* receives the positional argument (NULL when none) */
     const char *positional_name; /* for "more than one NAME ('...')": "file", "input" */
 } tool_command_line;
 
@@ -182,9 +181,9 @@ void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_
 typedef struct tool_run_json {
     const char *file;
     double iso;
-    int full;                       /* full extraction, else progressive */
+    int full; /* full extraction, else progressive */
     const ip_camera *camera;
-    const char *renderer;           /* "opengl", "software", "none" */
+    const char *renderer; /* "opengl", "software", "none" */
     const tool_view_options *options;
     int warm, done;
     const ip_engine_counts *counts;
@@ -198,9 +197,8 @@ void tool_write_run_json(FILE *out, const tool_run_json *j);
  * prints (preceded by ", "), to `path` with tool_write_text_file() (all-or-nothing; an
  * existing file is replaced only with `force`).
  * Returns 0, or -1 after printing "PROGRAM: path: reason" on stderr. */
-int tool_write_stats_file(const char *program, const char *path, int force,
-                          const ip_cache_stats *s, uint64_t summary_bytes,
-                          void (*extra)(FILE *out, void *user), void *user);
+int tool_write_stats_file(const char *program, const char *path, int force, const ip_cache_stats *s,
+                          uint64_t summary_bytes, void (*extra)(FILE *out, void *user), void *user);
 
 /* Warns (one line on stderr, "PROGRAM: warning: ...") when `iso` cannot cross the file's
  * value range (a cell is active when min < iso <= max), so that the image is legitimately

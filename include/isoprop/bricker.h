@@ -27,26 +27,26 @@ typedef int (*ip_progress_fn)(void *user, uint64_t done_bytes, uint64_t total_by
 #define IP_LZ4_HC_DEFAULT 9
 
 typedef struct ip_bricker_options {
-    uint32_t brick_edge;      /* B, cells per brick edge; default IP_DEFAULT_BRICK_EDGE */
-    uint32_t subblock_edge;   /* s, cells per sub-block edge; default IP_DEFAULT_SUBBLOCK_EDGE */
-    int lz4_level;            /* IP_LZ4_FAST (default) or an LZ4HC level 1..12 */
-    unsigned threads;         /* compression threads; 0 = every online core */
-    uint64_t memory_limit;    /* bytes of working memory allowed; 0 = no limit */
-    int force;                /* replace an existing output */
-    ip_progress_fn progress;  /* may be NULL */
+    uint32_t brick_edge;     /* B, cells per brick edge; default IP_DEFAULT_BRICK_EDGE */
+    uint32_t subblock_edge;  /* s, cells per sub-block edge; default IP_DEFAULT_SUBBLOCK_EDGE */
+    int lz4_level;           /* IP_LZ4_FAST (default) or an LZ4HC level 1..12 */
+    unsigned threads;        /* compression threads; 0 = every online core */
+    uint64_t memory_limit;   /* bytes of working memory allowed; 0 = no limit */
+    int force;               /* replace an existing output */
+    ip_progress_fn progress; /* may be NULL */
     void *progress_user;
 } ip_bricker_options;
 
 typedef struct ip_bricker_report {
-    uint64_t input_bytes;     /* dims x type size */
-    uint64_t file_bytes;      /* size of the brick file written */
-    uint64_t bricks;          /* all levels */
+    uint64_t input_bytes; /* dims x type size */
+    uint64_t file_bytes;  /* size of the brick file written */
+    uint64_t bricks;      /* all levels */
     uint64_t bricks_constant, bricks_compressed, bricks_raw;
     uint32_t levels;
     unsigned threads;
-    double seconds;           /* wall time of the whole run */
-    uint64_t memory_planned;  /* working memory the run reserved for itself, bytes */
-    uint64_t peak_rss;        /* the process's peak resident set at the end (VmHWM), bytes */
+    double seconds;          /* wall time of the whole run */
+    uint64_t memory_planned; /* working memory the run reserved for itself, bytes */
+    uint64_t peak_rss;       /* the process's peak resident set at the end (VmHWM), bytes */
 } ip_bricker_report;
 
 /*! ip_bricker_options_default() : fills `options` with the defaults above. */
@@ -54,8 +54,9 @@ IP_API void ip_bricker_options_default(ip_bricker_options *options);
 
 /*! ip_bricker_memory_needed() : working memory (bytes) a run with `options` needs for `input`.
  *  @return IP_OK, or an error for options the layout rejects. */
-IP_API ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_bricker_options *options,
-                                 uint64_t *bytes, ip_error *err);
+IP_API ip_status ip_bricker_memory_needed(const ip_input_desc *input,
+                                          const ip_bricker_options *options, uint64_t *bytes,
+                                          ip_error *err);
 
 /*! ip_bricker_run() : bricks `input` into a new brick file at `out_path`. On any failure,
  *  cancellation included, nothing is left at out_path (an existing file there is untouched).
@@ -68,8 +69,8 @@ IP_API ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_b
  *  than a regular file, or an argument is NULL; IP_ERR_UNSUPPORTED for a spacing outside the
  *  bounds of ip_spacing_check(). */
 IP_API ip_status ip_bricker_run(const ip_input_desc *input, const char *out_path,
-                          const ip_bricker_options *options, ip_bricker_report *report,
-                          ip_error *err);
+                                const ip_bricker_options *options, ip_bricker_report *report,
+                                ip_error *err);
 
 #ifdef __cplusplus
 }

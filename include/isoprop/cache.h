@@ -35,32 +35,32 @@ typedef struct ip_cache ip_cache;
 
 /* A pinned, decoded brick. Owned by the cache; valid until ip_cache_unpin_brick(). */
 typedef struct ip_brick {
-    const void *samples;  /* extent[0] * extent[1] * extent[2] samples, host order, x fastest */
-    uint32_t extent[3];   /* samples along each axis, the + face layer included */
-    uint32_t origin[3];   /* level coordinates of sample (0,0,0) */
+    const void *samples; /* extent[0] * extent[1] * extent[2] samples, host order, x fastest */
+    uint32_t extent[3];  /* samples along each axis, the + face layer included */
+    uint32_t origin[3];  /* level coordinates of sample (0,0,0) */
     uint32_t level;
-    uint64_t index;       /* global brick index */
+    uint64_t index; /* global brick index */
 } ip_brick;
 
 typedef struct ip_cache_level_stats {
-    uint64_t bricks_total;    /* bricks of this level in the file */
-    uint64_t bricks_touched;  /* distinct bricks of this level pinned at least once */
-    uint64_t misses;          /* decodes of this level's bricks */
+    uint64_t bricks_total;   /* bricks of this level in the file */
+    uint64_t bricks_touched; /* distinct bricks of this level pinned at least once */
+    uint64_t misses;         /* decodes of this level's bricks */
 } ip_cache_level_stats;
 
 typedef struct ip_cache_stats {
     uint64_t budget_bytes;
-    uint64_t resident_bytes;       /* decoded bytes held now */
-    uint64_t resident_peak_bytes;  /* most decoded bytes held at once */
+    uint64_t resident_bytes;      /* decoded bytes held now */
+    uint64_t resident_peak_bytes; /* most decoded bytes held at once */
     uint64_t resident_bricks;
     uint64_t hits, misses, evictions; /* evictions: bricks evicted to make room */
-    uint64_t waits;                /* misses that waited for another thread's decode */
-    uint64_t bytes_decompressed;   /* decoded bytes produced by misses */
-    uint64_t bytes_read;           /* compressed payload bytes read by misses */
-    double decode_seconds;         /* time in checksum + decode, summed over threads */
-    uint64_t over_budget_pins;     /* loads that found every resident brick pinned */
-    uint64_t pinned_bytes;         /* decoded bytes pinned now */
-    uint64_t errors;               /* loads that failed: read, checksum or decode */
+    uint64_t waits;                   /* misses that waited for another thread's decode */
+    uint64_t bytes_decompressed;      /* decoded bytes produced by misses */
+    uint64_t bytes_read;              /* compressed payload bytes read by misses */
+    double decode_seconds;            /* time in checksum + decode, summed over threads */
+    uint64_t over_budget_pins;        /* loads that found every resident brick pinned */
+    uint64_t pinned_bytes;            /* decoded bytes pinned now */
+    uint64_t errors;                  /* loads that failed: read, checksum or decode */
     uint64_t bricks_touched, bricks_total;
     uint32_t levels;
     ip_cache_level_stats level[32];
@@ -73,7 +73,7 @@ IP_API uint64_t ip_cache_default_budget(void);
  *  `budget_bytes` of decoded bricks. *out is owned by the caller, released with
  *  ip_cache_destroy(). @return IP_OK, IP_ERR_ARGUMENT (budget 0) or IP_ERR_NOMEM. */
 IP_API ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache **out,
-                          ip_error *err);
+                                 ip_error *err);
 
 /*! ip_cache_destroy() : frees every brick; no brick may still be pinned. NULL is allowed. */
 IP_API void ip_cache_destroy(ip_cache *cache);

@@ -18,10 +18,10 @@ extern "C" {
 #endif
 
 typedef struct ip_camera {
-    double eye[3];     /* world units */
-    double target[3];  /* the point the view is centred on */
-    double up[3];      /* need not be orthogonal to the view direction, must not be parallel */
-    double fov_y;      /* vertical field of view, degrees, in (0, 180) */
+    double eye[3];          /* world units */
+    double target[3];       /* the point the view is centred on */
+    double up[3];           /* need not be orthogonal to the view direction, must not be parallel */
+    double fov_y;           /* vertical field of view, degrees, in (0, 180) */
     uint32_t width, height; /* pixels */
 } ip_camera;
 
@@ -41,32 +41,32 @@ IP_API void ip_camera_basis_of(const ip_camera *camera, ip_camera_basis *basis);
 /*! ip_camera_pixel_ray() : the unit world direction of the ray through image point (px, py)
  *  (pixels from the top-left corner; a pixel's centre is at +0.5). */
 IP_API void ip_camera_pixel_ray(const ip_camera_basis *basis, const ip_camera *camera, double px,
-                         double py, double dir[3]);
+                                double py, double dir[3]);
 
 /*! ip_camera_project() : image coordinates (pixels, top-left origin) and depth along the view
  *  direction of world point `p`; returns 0 when p is not in front of the eye. */
-IP_API int ip_camera_project(const ip_camera_basis *basis, const ip_camera *camera, const double p[3],
-                      double *px, double *py, double *depth);
+IP_API int ip_camera_project(const ip_camera_basis *basis, const ip_camera *camera,
+                             const double p[3], double *px, double *py, double *depth);
 
 /*! ip_camera_view_matrix() : the OpenGL view matrix (column-major 4x4). */
 IP_API void ip_camera_view_matrix(const ip_camera *camera, float m[16]);
 
 /*! ip_camera_projection_matrix() : the OpenGL perspective matrix (column-major 4x4) for the
  *  camera's field of view and aspect, with near and far planes in world units (0 < near < far). */
-IP_API void ip_camera_projection_matrix(const ip_camera *camera, double near_plane, double far_plane,
-                                 float m[16]);
+IP_API void ip_camera_projection_matrix(const ip_camera *camera, double near_plane,
+                                        double far_plane, float m[16]);
 
 /*! ip_camera_depth_range() : near and far planes that enclose the box [lo, hi] (world units)
  *  as seen from the camera, with near > 0 even when the eye is inside the box. */
 IP_API void ip_camera_depth_range(const ip_camera *camera, const double lo[3], const double hi[3],
-                           double *near_plane, double *far_plane);
+                                  double *near_plane, double *far_plane);
 
 /*! ip_camera_fit_axis() : a camera on the `axis` side ("+x", "-x", "+y", "-y", "+z", "-z") of
  *  the box [lo, hi] (world units) looking at its centre, far enough for the whole box to fit
  *  the frame; up is +z, or +y for the z views. @return IP_OK or IP_ERR_ARGUMENT. */
 IP_API ip_status ip_camera_fit_axis(const double lo[3], const double hi[3], const char *axis,
-                             double fov_y, uint32_t width, uint32_t height, ip_camera *out,
-                             ip_error *err);
+                                    double fov_y, uint32_t width, uint32_t height, ip_camera *out,
+                                    ip_error *err);
 
 /*! ip_camera_parse() : parses "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov" (world units, degrees) into
  *  the camera's eye, target, up and fov; width and height are left untouched.

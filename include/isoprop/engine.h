@@ -55,13 +55,13 @@ extern "C" {
 #define IP_DEFAULT_FOLDBACK_DEGREES 0.25 /* fold-back tolerance */
 
 typedef struct ip_engine_options {
-    double cutoff_degrees;    /* propagation cut-off angle around the seed's ray */
-    double foldback_degrees;  /* fold-back tolerance */
-    unsigned threads;         /* worker threads for seeding and propagation; 0 = every core */
-    int lod;                  /* adaptive resolution: far regions from coarser pyramid levels */
-    double pixel_error;       /* with lod: a meta-cell is used once it projects to at most this
+    double cutoff_degrees;   /* propagation cut-off angle around the seed's ray */
+    double foldback_degrees; /* fold-back tolerance */
+    unsigned threads;        /* worker threads for seeding and propagation; 0 = every core */
+    int lod;                 /* adaptive resolution: far regions from coarser pyramid levels */
+    double pixel_error;      /* with lod: a meta-cell is used once it projects to at most this
                                  many pixels (1: the paper's sub-pixel rule) */
-    int cell_ids;             /* keep each triangle's cell id in the mesh (8 bytes a triangle
+    int cell_ids;            /* keep each triangle's cell id in the mesh (8 bytes a triangle
                                  more; for comparing extractions) */
 } ip_engine_options;
 
@@ -70,9 +70,9 @@ typedef struct ip_engine_options {
  * propagation measured inside it) and, within a propagation, one extraction in 16 is timed
  * and counted 16 times: the split between propagation and extraction is an estimate. */
 typedef struct ip_engine_counts {
-    uint64_t rays;            /* rays cast */
-    uint64_t seeds;           /* rays whose seed cell was new and started a propagation */
-    uint64_t cells;           /* cells extracted (triangulated) */
+    uint64_t rays;  /* rays cast */
+    uint64_t seeds; /* rays whose seed cell was new and started a propagation */
+    uint64_t cells; /* cells extracted (triangulated) */
     uint64_t triangles;
     double intersection_seconds; /* ray seeding: octree walks and ray-triangle tests */
     double propagation_seconds;  /* queue, neighbour and criteria work */
@@ -90,8 +90,8 @@ IP_API void ip_engine_options_default(ip_engine_options *options);
  *  worker threads started: ip_thread_count(options.threads) - 1 of them, idle until a step
  *  (see Threads above). *out is the caller's, released with ip_engine_destroy().
  *  @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM. */
-IP_API ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
-                           ip_error *err);
+IP_API ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options,
+                                  ip_engine **out, ip_error *err);
 
 /*! ip_engine_destroy() : stops and joins the engine's worker threads and frees the engine and
  *  its mesh; not during a step. NULL is allowed. */
@@ -99,7 +99,8 @@ IP_API void ip_engine_destroy(ip_engine *engine);
 
 /*! ip_engine_begin() : starts over with a new view and isovalue: drops the mesh, the visited
  *  cells and the ray order, and clears a pending cancel. @return IP_OK or IP_ERR_ARGUMENT. */
-IP_API ip_status ip_engine_begin(ip_engine *engine, const ip_camera *camera, float iso, ip_error *err);
+IP_API ip_status ip_engine_begin(ip_engine *engine, const ip_camera *camera, float iso,
+                                 ip_error *err);
 
 /*! ip_engine_step() : casts up to `max_rays` more rays (0: no limit) for at most `max_seconds`
  *  (0: no limit; checked between rays), appending new triangles to the mesh. `counts` (may be
@@ -107,7 +108,7 @@ IP_API ip_status ip_engine_begin(ip_engine *engine, const ip_camera *camera, flo
  *  or the error of a brick that could not be read (IP_ERR_CHECKSUM, IP_ERR_CORRUPT, naming it);
  *  the mesh keeps what was extracted before. */
 IP_API ip_status ip_engine_step(ip_engine *engine, uint64_t max_rays, double max_seconds,
-                         ip_engine_counts *counts, ip_error *err);
+                                ip_engine_counts *counts, ip_error *err);
 
 /*! ip_engine_done() : 1 once every pixel has had its ray. */
 IP_API int ip_engine_done(const ip_engine *engine);
@@ -138,8 +139,7 @@ IP_API void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
  *  for any number of threads. Times are summed over threads.
  *  @return IP_OK or a brick read error. */
 IP_API ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,
-                          ip_mesh *mesh, ip_engine_counts *counts, ip_error *err);
-
+                                 ip_mesh *mesh, ip_engine_counts *counts, ip_error *err);
 
 #ifdef __cplusplus
 }

@@ -35,11 +35,11 @@ typedef enum ip_field {
 
 typedef struct ip_gen_params {
     ip_field field;
-    uint32_t dims[3];   /* samples along x, y, z; each >= 2 */
+    uint32_t dims[3]; /* samples along x, y, z; each >= 2 */
     ip_type type;
-    double noise;       /* standard deviation of added Gaussian noise, in the field's [0,1]
+    double noise;  /* standard deviation of added Gaussian noise, in the field's [0,1]
                            units before conversion to `type`; 0 for none */
-    uint64_t seed;      /* noise seed; the noise of a sample depends only on seed and index */
+    uint64_t seed; /* noise seed; the noise of a sample depends only on seed and index */
 } ip_gen_params;
 
 /*! ip_field_name() : "shepp-logan", "sphere", "gyroid" or "marschner-lobb". */
@@ -50,7 +50,8 @@ IP_API ip_status ip_field_parse(const char *name, ip_field *out);
 
 /*! ip_generate_plane() : writes z-plane `z` (dims[0]*dims[1] samples of params->type, host
  *  byte order) into `dst`, which the caller owns. Thread-safe. @return IP_OK or IP_ERR_ARGUMENT. */
-IP_API ip_status ip_generate_plane(const ip_gen_params *params, uint32_t z, void *dst, ip_error *err);
+IP_API ip_status ip_generate_plane(const ip_gen_params *params, uint32_t z, void *dst,
+                                   ip_error *err);
 
 /*! ip_generate_write() : writes the whole volume as a little-endian raw file at `path`,
  *  atomically (a temporary file in the same folder, fsync, rename); memory is one group of
@@ -61,7 +62,7 @@ IP_API ip_status ip_generate_plane(const ip_gen_params *params, uint32_t z, void
  *  @return IP_OK, IP_ERR_ARGUMENT, IP_ERR_EXISTS, IP_ERR_IO or IP_ERR_NOMEM, with
  *  err->message naming `path`; on error no file is left at `path` (or the old one is kept). */
 IP_API ip_status ip_generate_write(const ip_gen_params *params, const char *path, int force,
-                            ip_error *err);
+                                   ip_error *err);
 
 /*! ip_upsample_write() : writes `input` enlarged `factor` times along each axis (dims * factor
  *  samples) by trilinear interpolation, as a little-endian raw file of the input's type at
@@ -72,12 +73,12 @@ IP_API ip_status ip_generate_write(const ip_gen_params *params, const char *path
  *  (IP_ERR_ARGUMENT, whatever force says). @return as ip_generate_write(), plus the reader's
  *  IP_ERR_INPUT. */
 IP_API ip_status ip_upsample_write(const ip_input_desc *input, uint32_t factor, const char *path,
-                            int force, ip_error *err);
+                                   int force, ip_error *err);
 
 /*! ip_raw_file_name() : writes the conventional name "NAME_XxYxZ_TYPE.raw" for `name`, `dims`
  *  and `type` into buf (size bytes). @return IP_OK, or IP_ERR_ARGUMENT if it does not fit. */
 IP_API ip_status ip_raw_file_name(char *buf, size_t size, const char *name, const uint32_t dims[3],
-                           ip_type type);
+                                  ip_type type);
 
 #ifdef __cplusplus
 }

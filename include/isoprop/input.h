@@ -29,8 +29,8 @@ typedef struct ip_input_desc {
     uint64_t data_offset;        /* byte offset of the first sample in data_path */
     uint32_t dims[3];            /* samples along x, y, z; each >= 2 */
     ip_type type;
-    int big_endian;              /* 1 when the stored samples are big-endian */
-    double spacing[3];           /* world units between samples; default 1,1,1 */
+    int big_endian;    /* 1 when the stored samples are big-endian */
+    double spacing[3]; /* world units between samples; default 1,1,1 */
     ip_encoding encoding;
 } ip_input_desc;
 
@@ -66,7 +66,7 @@ typedef struct ip_input_overrides {
  *  IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an override type that is not
  *  an ip_type; IP_ERR_NOMEM when an allocation fails. */
 IP_API ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
-                            ip_input_desc *out, ip_error *err);
+                                   ip_input_desc *out, ip_error *err);
 
 /* A sequential plane reader. Not thread-safe; one owner at a time. */
 typedef struct ip_input_reader ip_input_reader;
@@ -88,7 +88,7 @@ IP_API ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out,
  *  IP_ERR_ARGUMENT for reading past the last plane
  *  or a NULL reader or dst. */
 IP_API ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count,
-                               ip_error *err);
+                                      ip_error *err);
 
 /*! ip_input_close() : releases the reader (NULL is allowed). */
 IP_API void ip_input_close(ip_input_reader *reader);

@@ -25,7 +25,7 @@ extern "C" {
 #define IP_MAX_LEVELS 32
 #define IP_LEVEL_ENTRY_SIZE 64u
 #define IP_DIRECTORY_ENTRY_SIZE 24u
-#define IP_RANGE_SIZE 8u              /* float32 min, float32 max */
+#define IP_RANGE_SIZE 8u /* float32 min, float32 max */
 #define IP_SUMMARY_ALIGN 4096u
 #define IP_DEFAULT_BRICK_EDGE 32u
 #define IP_DEFAULT_SUBBLOCK_EDGE 8u
@@ -50,13 +50,13 @@ enum {
 
 /* One level of the pyramid: level k samples the volume at every 2^k-th sample. */
 typedef struct ip_level_layout {
-    uint32_t dims[3];          /* samples along each axis: ceil((d - 1) / 2^k) + 1 */
-    uint32_t bricks[3];        /* bricks along each axis: ceil((dims - 1) / B) */
-    uint64_t first_brick;      /* global index of brick (0,0,0) of this level */
-    uint64_t brick_count;      /* bricks[0] * bricks[1] * bricks[2] */
-    uint32_t octree_depth;     /* octree levels above the bricks (0 when one brick) */
-    uint64_t first_node;       /* index of this level's first octree node in the node array */
-    uint64_t node_count;       /* octree nodes of this level, all depths */
+    uint32_t dims[3];      /* samples along each axis: ceil((d - 1) / 2^k) + 1 */
+    uint32_t bricks[3];    /* bricks along each axis: ceil((dims - 1) / B) */
+    uint64_t first_brick;  /* global index of brick (0,0,0) of this level */
+    uint64_t brick_count;  /* bricks[0] * bricks[1] * bricks[2] */
+    uint32_t octree_depth; /* octree levels above the bricks (0 when one brick) */
+    uint64_t first_node;   /* index of this level's first octree node in the node array */
+    uint64_t node_count;   /* octree nodes of this level, all depths */
     float value_min, value_max;
 } ip_level_layout;
 
@@ -65,12 +65,12 @@ typedef struct ip_layout {
     uint32_t dims[3];
     ip_type type;
     double spacing[3];
-    uint32_t brick_edge;       /* B: cells per brick edge, a power of two in [2, 256] */
-    uint32_t subblock_edge;    /* s: cells per sub-block edge, a power of two dividing B */
+    uint32_t brick_edge;    /* B: cells per brick edge, a power of two in [2, 256] */
+    uint32_t subblock_edge; /* s: cells per sub-block edge, a power of two dividing B */
     uint32_t level_count;
     float value_min, value_max;
-    uint64_t brick_count;      /* all levels */
-    uint64_t node_count;       /* octree nodes, all levels */
+    uint64_t brick_count; /* all levels */
+    uint64_t node_count;  /* octree nodes, all levels */
     uint64_t data_offset, data_size;
     uint64_t summary_offset, summary_size;
     uint64_t summary_checksum;
@@ -80,11 +80,11 @@ typedef struct ip_layout {
 
 /* A brick directory entry (24 bytes on disk). */
 typedef struct ip_brick_entry {
-    uint64_t offset;       /* absolute file offset of the payload */
-    uint32_t stored_size;  /* payload bytes (0 for a constant brick) */
-    uint8_t encoding;      /* ip_brick_encoding */
-    uint8_t filters;       /* IP_FILTER_* bits (0 unless LZ4) */
-    uint64_t checksum;     /* XXH64 (seed 0) of the payload; 0 for a constant brick */
+    uint64_t offset;      /* absolute file offset of the payload */
+    uint32_t stored_size; /* payload bytes (0 for a constant brick) */
+    uint8_t encoding;     /* ip_brick_encoding */
+    uint8_t filters;      /* IP_FILTER_* bits (0 unless LZ4) */
+    uint64_t checksum;    /* XXH64 (seed 0) of the payload; 0 for a constant brick */
 } ip_brick_entry;
 
 /*! ip_layout_subblocks_per_brick() : (B / s)^3. */
@@ -97,14 +97,15 @@ IP_API uint32_t ip_level_sample_index(uint32_t dim, uint32_t level, uint32_t i);
 /*! ip_brick_extent() : samples along each axis of brick (bx,by,bz) of `level`, including its
  *  + face layer: min(B, cells - b*B) + 1. Writes origin (first sample, level coordinates). */
 IP_API void ip_brick_extent(const ip_layout *layout, uint32_t level, const uint32_t brick[3],
-                     uint32_t origin[3], uint32_t extent[3]);
+                            uint32_t origin[3], uint32_t extent[3]);
 
 /*! ip_brick_global_index() : directory index of brick (bx,by,bz) of `level`. */
-IP_API uint64_t ip_brick_global_index(const ip_layout *layout, uint32_t level, const uint32_t brick[3]);
+IP_API uint64_t ip_brick_global_index(const ip_layout *layout, uint32_t level,
+                                      const uint32_t brick[3]);
 
 /*! ip_brick_coords() : inverse of ip_brick_global_index(); fills level and brick. */
 IP_API void ip_brick_coords(const ip_layout *layout, uint64_t global, uint32_t *level,
-                     uint32_t brick[3]);
+                            uint32_t brick[3]);
 
 /*! ip_layout_world_box() : the volume's world-space box: lo = 0, hi = (dims - 1) * spacing
  *  along each axis (world units). */

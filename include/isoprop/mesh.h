@@ -19,13 +19,13 @@ extern "C" {
 #endif
 
 typedef struct ip_mesh {
-    float *positions;        /* 9 floats per triangle: x,y,z of its 3 vertices, world units */
-    int16_t *normals;        /* 9 per triangle: unit normals of its 3 vertices, ip_normal_pack() */
-    uint64_t *cells;         /* per triangle: ip_cell_id() of the cell it came from; NULL
+    float *positions; /* 9 floats per triangle: x,y,z of its 3 vertices, world units */
+    int16_t *normals; /* 9 per triangle: unit normals of its 3 vertices, ip_normal_pack() */
+    uint64_t *cells;  /* per triangle: ip_cell_id() of the cell it came from; NULL
                                 unless with_cells */
     uint64_t triangle_count;
-    uint64_t capacity;       /* triangles allocated */
-    int with_cells;          /* keep cell ids: set before the first append, or by ip_mesh_init_with_cells() */
+    uint64_t capacity; /* triangles allocated */
+    int with_cells; /* keep cell ids: set before the first append, or by ip_mesh_init_with_cells() */
 } ip_mesh;
 
 /*! ip_normal_pack() : a normal component in [-1, 1] as a signed normalised 16-bit integer
@@ -73,20 +73,20 @@ IP_API ip_status ip_mesh_reserve(ip_mesh *mesh, uint64_t triangles);
  *  `cells` is read only when the mesh keeps cell ids (and may be NULL otherwise).
  *  @return IP_OK or IP_ERR_NOMEM. */
 IP_API ip_status ip_mesh_append(ip_mesh *mesh, const float *positions, const int16_t *normals,
-                         const uint64_t *cells, uint64_t count);
+                                const uint64_t *cells, uint64_t count);
 
 /*! ip_mesh_append_float_normals() : ip_mesh_append() with normals given as 9 floats per
  *  triangle, packed with ip_normal_pack(). @return IP_OK or IP_ERR_NOMEM. */
 IP_API ip_status ip_mesh_append_float_normals(ip_mesh *mesh, const float *positions,
-                                       const float *normals, const uint64_t *cells,
-                                       uint64_t count);
+                                              const float *normals, const uint64_t *cells,
+                                              uint64_t count);
 
 /*! ip_mesh_append_mesh() : appends triangles [first, first + count) of `from` (which must
  *  hold them), with their cell ids when `mesh` keeps them, in which case `from` must too.
  *  @return IP_OK, IP_ERR_ARGUMENT (a range past `from`, or no cell ids to copy) or
  *  IP_ERR_NOMEM. */
 IP_API ip_status ip_mesh_append_mesh(ip_mesh *mesh, const ip_mesh *from, uint64_t first,
-                              uint64_t count);
+                                     uint64_t count);
 
 /*! ip_mesh_write_ply() : writes the mesh as binary little-endian PLY (float x,y,z,nx,ny,nz per
  *  vertex, 3 vertices per triangle, faces as uchar-counted int lists), atomically; only a

@@ -42,7 +42,8 @@ IP_API int ip_path_same_file(const char *a, const char *b);
 /*! ip_output_not_input() : refuses an output that is an input.
  *  @return IP_OK when `output_path` and `input_path` are different files (ip_path_same_file()),
  *  else IP_ERR_ARGUMENT with a message naming both. */
-IP_API ip_status ip_output_not_input(const char *output_path, const char *input_path, ip_error *err);
+IP_API ip_status ip_output_not_input(const char *output_path, const char *input_path,
+                                     ip_error *err);
 
 /*! ip_output_write() : writes `size` bytes from `data` as the whole file at `path`,
  *  all-or-nothing (durable and visible only when complete; nothing is left on failure),
@@ -50,7 +51,7 @@ IP_API ip_status ip_output_not_input(const char *output_path, const char *input_
  *  @return IP_OK, IP_ERR_EXISTS, IP_ERR_ARGUMENT (not a regular file, path too long) or
  *  IP_ERR_IO, with err->message naming the path. */
 IP_API ip_status ip_output_write(const char *path, const void *data, size_t size, int force,
-                          ip_error *err);
+                                 ip_error *err);
 
 #ifdef __cplusplus
 }

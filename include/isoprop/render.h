@@ -72,8 +72,8 @@ IP_API ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_
  *  with UINT32_MAX triangles or more) or IP_ERR_NOMEM (working buffers: about 12 bytes a
  *  pixel, 24 with rgba). */
 IP_API ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
-                         const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
-                         ip_error *err);
+                                const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
+                                ip_error *err);
 
 /*! ip_png_write() : writes an image given as width * height * 4 bytes (RGBA, top row first)
  *  as an 8-bit PNG: RGB when every alpha is 255, RGBA otherwise. The file appears only once
@@ -81,8 +81,8 @@ IP_API ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, co
  *  only when it is a regular file (isoprop/output.h).
  *  Reentrant. @return IP_OK, IP_ERR_EXISTS, IP_ERR_ARGUMENT (an empty image, or a path that
  *  is not a regular file), IP_ERR_NOMEM or IP_ERR_IO. */
-IP_API ip_status ip_png_write(const char *path, const uint8_t *rgba, uint32_t width, uint32_t height,
-                       int force, ip_error *err);
+IP_API ip_status ip_png_write(const char *path, const uint8_t *rgba, uint32_t width,
+                              uint32_t height, int force, ip_error *err);
 
 /* A headless OpenGL 3.3 core context: EGL on Mesa's surfaceless platform (no window, no
  * display server; llvmpipe where no GPU is present). It has no default framebuffer: draw into
@@ -133,7 +133,7 @@ typedef struct ip_renderer ip_renderer;
  *  @return IP_OK, IP_ERR_ARGUMENT (a size of 0 or over the GL limit), IP_ERR_UNSUPPORTED
  *  (no headless OpenGL 3.3 core here) or IP_ERR_NOMEM; *out is NULL on failure. */
 IP_API ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip_renderer **out,
-                                      ip_error *err);
+                                             ip_error *err);
 
 /*! ip_renderer_create_current() : a renderer on the OpenGL 3.3 core (or later) context that
  *  is current on the calling thread (for example a window's), drawing into `framebuffer` (0:
@@ -142,13 +142,13 @@ IP_API ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip
  *  @return IP_OK, IP_ERR_ARGUMENT, IP_ERR_UNSUPPORTED (no current context, or older than 3.3
  *  core) or IP_ERR_NOMEM. */
 IP_API ip_status ip_renderer_create_current(uint32_t width, uint32_t height, uint32_t framebuffer,
-                                     ip_renderer **out, ip_error *err);
+                                            ip_renderer **out, ip_error *err);
 
 /*! ip_renderer_resize() : changes the image size (pixels). A headless renderer reallocates
  *  its off-screen framebuffer; otherwise the caller has resized its framebuffer already.
  *  @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM (the old size remains). */
 IP_API ip_status ip_renderer_resize(ip_renderer *renderer, uint32_t width, uint32_t height,
-                             ip_error *err);
+                                    ip_error *err);
 
 /*! ip_renderer_upload() : appends the triangles [first_triangle, mesh->triangle_count) of
  *  `mesh` to the renderer's GPU buffers. The buffers grow geometrically, copying what they
@@ -158,7 +158,7 @@ IP_API ip_status ip_renderer_resize(ip_renderer *renderer, uint32_t width, uint3
  *  @return IP_OK, IP_ERR_ARGUMENT (first_triangle > mesh->triangle_count) or IP_ERR_NOMEM
  *  (GPU memory; nothing of this call is kept). */
 IP_API ip_status ip_renderer_upload(ip_renderer *renderer, const ip_mesh *mesh,
-                             uint64_t first_triangle, ip_error *err);
+                                    uint64_t first_triangle, ip_error *err);
 
 /*! ip_renderer_clear_mesh() : forgets every uploaded triangle, keeping the GPU buffers. */
 IP_API void ip_renderer_clear_mesh(ip_renderer *renderer);
@@ -173,8 +173,8 @@ IP_API uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
  *  still be working: ip_renderer_read_rgba() waits for it).
  *  @return IP_OK, IP_ERR_ARGUMENT (bad camera or box, size mismatch) or IP_ERR_UNSUPPORTED
  *  (an OpenGL error, named in the message). */
-IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera, const double lo[3],
-                           const double hi[3], ip_error *err);
+IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera,
+                                  const double lo[3], const double hi[3], ip_error *err);
 
 /*! ip_renderer_draw_mesh() : draws the background and the triangles of `mesh`, in order,
  *  like ip_renderer_draw() would after uploading exactly `mesh` (the same image), but
@@ -183,8 +183,8 @@ IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera
  *  left alone and not drawn. `mesh` is read during the call only.
  *  @return as ip_renderer_draw(). */
 IP_API ip_status ip_renderer_draw_mesh(ip_renderer *renderer, const ip_mesh *mesh,
-                                const ip_camera *camera, const double lo[3],
-                                const double hi[3], ip_error *err);
+                                       const ip_camera *camera, const double lo[3],
+                                       const double hi[3], ip_error *err);
 
 /*! ip_renderer_read_rgba() : copies the image drawn last into `rgba` (width * height * 4
  *  bytes, caller-owned), top row first, waiting for OpenGL to finish.

@@ -22,17 +22,17 @@ extern "C" {
 
 typedef enum ip_status {
     IP_OK = 0,
-    IP_ERR_IO = -1,          /* a read, write, open, map or rename failed */
-    IP_ERR_NOMEM = -2,       /* an allocation failed */
-    IP_ERR_ARGUMENT = -3,    /* the caller passed a value out of range */
-    IP_ERR_INPUT = -4,       /* an input volume (raw, NRRD, MetaImage) is inconsistent */
-    IP_ERR_FORMAT = -5,      /* a brick file's header or summary is malformed */
-    IP_ERR_CHECKSUM = -6,    /* stored bytes do not match their checksum */
-    IP_ERR_CORRUPT = -7,     /* a brick decodes wrongly or disagrees with its summary */
-    IP_ERR_EXISTS = -8,      /* the output exists and overwriting was not asked for */
-    IP_ERR_LIMIT = -9,       /* a memory cap or budget is too small for the work */
-    IP_ERR_UNSUPPORTED = -10,/* a valid but unsupported feature (version, encoding) */
-    IP_ERR_CANCELLED = -11   /* the caller asked the work to stop */
+    IP_ERR_IO = -1,           /* a read, write, open, map or rename failed */
+    IP_ERR_NOMEM = -2,        /* an allocation failed */
+    IP_ERR_ARGUMENT = -3,     /* the caller passed a value out of range */
+    IP_ERR_INPUT = -4,        /* an input volume (raw, NRRD, MetaImage) is inconsistent */
+    IP_ERR_FORMAT = -5,       /* a brick file's header or summary is malformed */
+    IP_ERR_CHECKSUM = -6,     /* stored bytes do not match their checksum */
+    IP_ERR_CORRUPT = -7,      /* a brick decodes wrongly or disagrees with its summary */
+    IP_ERR_EXISTS = -8,       /* the output exists and overwriting was not asked for */
+    IP_ERR_LIMIT = -9,        /* a memory cap or budget is too small for the work */
+    IP_ERR_UNSUPPORTED = -10, /* a valid but unsupported feature (version, encoding) */
+    IP_ERR_CANCELLED = -11    /* the caller asked the work to stop */
 } ip_status;
 
 /*! ip_status_message() : a short constant English description of `code` (never NULL). */

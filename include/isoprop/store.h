@@ -55,7 +55,7 @@ IP_API const float *ip_store_subblock_ranges(const ip_store *store, uint64_t g);
 /*! ip_store_node_range() : range of octree node `node` at `depth` (1..octree_depth) of
  *  `level`; depth 0 is the brick itself. Owned by the store. */
 IP_API const float *ip_store_node_range(const ip_store *store, uint32_t level, uint32_t depth,
-                                 const uint32_t node[3]);
+                                        const uint32_t node[3]);
 
 /*! ip_store_brick_samples() : number of samples of brick `g` (its extent's product). */
 IP_API uint64_t ip_store_brick_samples(const ip_store *store, uint64_t g);
@@ -72,7 +72,7 @@ IP_API size_t ip_store_read_work_size(const ip_store *store);
  *  coordinates; IP_ERR_IO when the read fails or the file ends before the payload (it shrank
  *  since it was opened: the message gives both sizes). */
 IP_API ip_status ip_store_read_brick(const ip_store *store, uint64_t g, void *dst, void *work,
-                              ip_error *err);
+                                     ip_error *err);
 
 /*! ip_store_prefetch_brick() : asks the kernel to start reading brick `g`'s payload into the
  *  page cache in the background (posix_fadvise WILLNEED); returns at once, waits for nothing.
@@ -83,13 +83,13 @@ IP_API void ip_store_prefetch_brick(const ip_store *store, uint64_t g);
  *  decoded `samples` (as ip_store_read_brick() or the cache give them) and compares them with
  *  the summary section. @return IP_OK, or IP_ERR_CORRUPT naming the brick. */
 IP_API ip_status ip_store_check_summary(const ip_store *store, uint64_t g, const void *samples,
-                                 ip_error *err);
+                                        ip_error *err);
 
 /*! ip_store_verify_brick() : ip_store_read_brick() (same buffers), then recomputes the brick's range and
  *  sub-block ranges from the decoded samples and compares them with the summary section.
  *  @return IP_OK, or IP_ERR_CHECKSUM / IP_ERR_CORRUPT naming the brick. */
 IP_API ip_status ip_store_verify_brick(const ip_store *store, uint64_t g, void *dst, void *work,
-                                ip_error *err);
+                                       ip_error *err);
 
 /*! ip_store_verify_octree() : recomputes every octree node from the brick ranges and compares.
  *  @return IP_OK or IP_ERR_CORRUPT naming the first wrong node. */

@@ -22,10 +22,10 @@
 typedef struct level_slab {
     unsigned char *planes;
     size_t plane_bytes;
-    uint32_t filled;       /* planes currently held */
-    uint32_t next_plane;   /* index of the next level plane to arrive */
-    uint32_t layer;        /* next brick layer (bz) to emit */
-    uint32_t *x_index;     /* level-0 x of each level x (levels >= 1) */
+    uint32_t filled;     /* planes currently held */
+    uint32_t next_plane; /* index of the next level plane to arrive */
+    uint32_t layer;      /* next brick layer (bz) to emit */
+    uint32_t *x_index;   /* level-0 x of each level x (levels >= 1) */
     uint32_t *y_index;
 } level_slab;
 
@@ -41,9 +41,9 @@ typedef struct layer_job {
     bricker *b;
     uint32_t level, bz;
     const level_slab *slab;
-    uint64_t brick_total;       /* bricks in the layer */
-    atomic_uint_fast64_t next;  /* next brick to take */
-    unsigned char **payloads;   /* per brick, malloc'ed copies; NULL for constant bricks */
+    uint64_t brick_total;      /* bricks in the layer */
+    atomic_uint_fast64_t next; /* next brick to take */
+    unsigned char **payloads;  /* per brick, malloc'ed copies; NULL for constant bricks */
     atomic_int failed;
 } layer_job;
 
@@ -53,13 +53,13 @@ struct bricker {
     const char *out_path;
     size_t sample_size;
     unsigned threads;
-    ip__pool *pool;             /* compresses every layer; started at init */
+    ip__pool *pool; /* compresses every layer; started at init */
     level_slab slabs[IP_MAX_LEVELS];
-    brick_scratch *scratch;     /* one per job of a layer (per thread) */
-    ip_brick_entry *entries;    /* offsets point into the spill file until the end */
-    float *brick_ranges;        /* 2 per brick */
-    float *subblock_ranges;     /* 2 per sub-block */
-    uint32_t subblocks;         /* per brick */
+    brick_scratch *scratch;  /* one per job of a layer (per thread) */
+    ip_brick_entry *entries; /* offsets point into the spill file until the end */
+    float *brick_ranges;     /* 2 per brick */
+    float *subblock_ranges;  /* 2 per sub-block */
+    uint32_t subblocks;      /* per brick */
     int spill_fd;
     uint64_t spill_size;
     ip_bricker_report report;
@@ -94,8 +94,7 @@ static uint64_t memory_for(const ip_layout *l, unsigned threads)
             widest = slab_bytes(l, k);
     }
     total += widest + widest / 128; /* one layer's payloads, incompressible worst case */
-    total += (uint64_t)threads * (bs * ip_type_size(l->type) +
-                                  ip__codec_bound(bs, l->type) +
+    total += (uint64_t)threads * (bs * ip_type_size(l->type) + ip__codec_bound(bs, l->type) +
                                   ip__codec_work_size(bs, l->type));
     total += 2 * ip__layout_summary_size(l); /* the arrays, then their encoded copy */
     return total;
@@ -110,11 +109,11 @@ void ip_bricker_options_default(ip_bricker_options *options)
 }
 
 ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_bricker_options *options,
-                                 uint64_t *bytes, ip_error *err)
+                                   uint64_t *bytes, ip_error *err)
 {
     ip_layout l;
     ip_status st = ip__layout_init(&l, input->dims, input->type, input->spacing,
-                                  options->brick_edge, options->subblock_edge, err);
+                                   options->brick_edge, options->subblock_edge, err);
     if (st == IP_OK)
         *bytes = memory_for(&l, thread_count(options));
     return st;
@@ -148,7 +147,7 @@ static int process_brick(layer_job *job, uint64_t i, brick_scratch *s)
     uint64_t g = ip_brick_global_index(l, job->level, brick);
     gather_brick(job->slab, l, job->level, origin, extent, s->samples);
     ip__summarise_brick(s->samples, l->type, extent, l->brick_edge, l->subblock_edge,
-                       &b->brick_ranges[2 * g], &b->subblock_ranges[2 * g * b->subblocks]);
+                        &b->brick_ranges[2 * g], &b->subblock_ranges[2 * g * b->subblocks]);
     ip_brick_entry *e = &b->entries[g];
     if (ip__codec_encode(s->samples, extent, l->type, b->options->lz4_level, s->out, s->work, e) !=
         IP_OK)
@@ -207,10 +206,10 @@ static ip_status emit_layer(bricker *b, uint32_t level, ip_error *err)
     if (jobs > job.brick_total)
         jobs = (unsigned)(job.brick_total > 0 ? job.brick_total : 1);
     ip__pool_run(b->pool, jobs, layer_worker, &job);
-    ip_status st = atomic_load(&job.failed)
-                       ? ip__fail(err, IP_ERR_NOMEM, "%s: out of memory while compressing",
-                                 b->out_path)
-                       : IP_OK;
+    ip_status st =
+        atomic_load(&job.failed)
+            ? ip__fail(err, IP_ERR_NOMEM, "%s: out of memory while compressing", b->out_path)
+            : IP_OK;
     for (uint64_t i = 0; i < job.brick_total; i++) {
         uint32_t brick[3] = {(uint32_t)(i % l->levels[level].bricks[0]),
                              (uint32_t)(i / l->levels[level].bricks[0]), job.bz};
@@ -314,7 +313,7 @@ static ip_status open_spill(bricker *b, ip_error *err)
     b->spill_fd = mkstemp(name);
     if (b->spill_fd < 0)
         return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot create a spill file in %s",
-                             b->out_path, folder);
+                              b->out_path, folder);
     unlink(name); /* unnamed from now on: it vanishes with the process */
     return IP_OK;
 }
@@ -328,7 +327,7 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
     b->out_path = out_path;
     ip_error why;
     ip_status st = ip__layout_init(&b->layout, in->dims, in->type, in->spacing, o->brick_edge,
-                                  o->subblock_edge, &why);
+                                   o->subblock_edge, &why);
     if (st != IP_OK)
         return ip__fail(err, st, "%s: %s", in->path, why.message);
     b->sample_size = ip_type_size(in->type);
@@ -336,11 +335,11 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
     uint64_t need = memory_for(&b->layout, b->threads);
     b->report.memory_planned = need;
     if (o->memory_limit && need > o->memory_limit)
-        return ip__fail(err, IP_ERR_LIMIT, "%s: bricking needs %llu MiB of working memory "
-                       "(%u-cell bricks, %u threads) but the limit is %llu MiB",
-                       in->path, (unsigned long long)((need + (1 << 20) - 1) >> 20),
-                       o->brick_edge, b->threads,
-                       (unsigned long long)(o->memory_limit >> 20));
+        return ip__fail(err, IP_ERR_LIMIT,
+                        "%s: bricking needs %llu MiB of working memory "
+                        "(%u-cell bricks, %u threads) but the limit is %llu MiB",
+                        in->path, (unsigned long long)((need + (1 << 20) - 1) >> 20), o->brick_edge,
+                        b->threads, (unsigned long long)(o->memory_limit >> 20));
     b->subblocks = ip_layout_subblocks_per_brick(&b->layout);
     b->entries = calloc(b->layout.brick_count, sizeof *b->entries);
     b->brick_ranges = calloc(2 * b->layout.brick_count, sizeof(float));
@@ -395,14 +394,13 @@ static ip_status stream_input(bricker *b, const ip_input_desc *in, ip_error *err
     uint64_t total = plane_bytes * in->dims[2];
     for (uint32_t z = 0; st == IP_OK && z < in->dims[2]; z++) {
         level_slab *slab = &b->slabs[0];
-        st = ip_input_read_planes(reader, slab->planes + (size_t)slab->filled * plane_bytes, 1,
-                                  err);
+        st =
+            ip_input_read_planes(reader, slab->planes + (size_t)slab->filled * plane_bytes, 1, err);
         if (st == IP_OK)
             st = feed_plane(b, z, err);
         if (st == IP_OK && b->options->progress &&
             b->options->progress(b->options->progress_user, (z + 1) * plane_bytes, total))
-            st = ip__fail(err, IP_ERR_CANCELLED, "%s: cancelled; no output written",
-                         b->out_path);
+            st = ip__fail(err, IP_ERR_CANCELLED, "%s: cancelled; no output written", b->out_path);
     }
     ip_input_close(reader);
     return st;
@@ -564,13 +562,14 @@ static ip_status check_request(const ip_input_desc *in, const char *out_path, ip
 }
 
 ip_status ip_bricker_run(const ip_input_desc *input, const char *out_path,
-                          const ip_bricker_options *options, ip_bricker_report *report,
-                          ip_error *err)
+                         const ip_bricker_options *options, ip_bricker_report *report,
+                         ip_error *err)
 {
     double start = ip_now_seconds();
     if (!input || !out_path || !options)
-        return ip__fail(err, IP_ERR_ARGUMENT, "ip_bricker_run: input, out_path and options "
-                       "are required");
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "ip_bricker_run: input, out_path and options "
+                        "are required");
     ip_status st = check_request(input, out_path, err);
     if (st != IP_OK)
         return st;

@@ -40,75 +40,74 @@ static int all_equal(const unsigned char *p, size_t count, size_t size)
 #define UNZIGZAG(U, z) ((U)(((z) >> 1) ^ (U)(0u - (U)((z)&1u))))
 
 /* Median edge predictor (LOCO-I) from left a, up b and up-left c. */
-#define MED(a, b, c)                                                              \
-    ((c) >= ((a) > (b) ? (a) : (b))   ? ((a) < (b) ? (a) : (b))                   \
-     : (c) <= ((a) < (b) ? (a) : (b)) ? ((a) > (b) ? (a) : (b))                   \
+#define MED(a, b, c)                                            \
+    ((c) >= ((a) > (b) ? (a) : (b))   ? ((a) < (b) ? (a) : (b)) \
+     : (c) <= ((a) < (b) ? (a) : (b)) ? ((a) > (b) ? (a) : (b)) \
                                       : (a) + (b) - (c))
 
-#define DEFINE_PREDICTORS(U, W)                                                              \
-    static void delta_encode_##W(const U *s, U *d, size_t n)                                 \
-    {                                                                                        \
-        U prev = 0;                                                                          \
-        for (size_t i = 0; i < n; i++) {                                                     \
-            U r = (U)(s[i] - prev);                                                          \
-            d[i] = ZIGZAG(U, W, r);                                                          \
-            prev = s[i];                                                                     \
-        }                                                                                    \
-    }                                                                                        \
-    static void delta_decode_##W(U *d, size_t n)                                             \
-    {                                                                                        \
-        U prev = 0;                                                                          \
-        for (size_t i = 0; i < n; i++) {                                                     \
-            prev = (U)(prev + UNZIGZAG(U, d[i]));                                            \
-            d[i] = prev;                                                                     \
-        }                                                                                    \
-    }                                                                                        \
-    static U med_predict_##W(const U *v, size_t i, uint32_t x, uint32_t y, size_t row)       \
-    {                                                                                        \
-        if (x > 0 && y > 0) {                                                                \
-            int64_t a = v[i - 1], b = v[i - row], c = v[i - row - 1];                        \
-            return (U)MED(a, b, c);                                                          \
-        }                                                                                    \
-        return x > 0 ? v[i - 1] : y > 0 ? v[i - row] : 0;                                    \
-    }                                                                                        \
-    static void med_encode_##W(const U *s, U *d, const uint32_t e[3])                        \
-    {                                                                                        \
-        size_t i = 0;                                                                        \
-        for (uint32_t z = 0; z < e[2]; z++)                                                  \
-            for (uint32_t y = 0; y < e[1]; y++)                                              \
-                for (uint32_t x = 0; x < e[0]; x++, i++) {                                   \
-                    U r = (U)(s[i] - med_predict_##W(s, i, x, y, e[0]));                     \
-                    d[i] = ZIGZAG(U, W, r);                                                  \
-                }                                                                            \
-    }                                                                                        \
-    static void med_decode_##W(U *d, const uint32_t e[3])                                    \
-    {                                                                                        \
-        size_t row = e[0];                                                                   \
-        for (uint32_t z = 0; z < e[2]; z++) {                                                \
-            U *r = d + (size_t)z * row * e[1];                                               \
-            U left = 0;                                                                      \
-            for (uint32_t x = 0; x < e[0]; x++) /* first row: from the left */              \
-                r[x] = left = (U)(left + UNZIGZAG(U, r[x]));                                 \
-            for (uint32_t y = 1; y < e[1]; y++) {                                            \
-                U *cur = r + (size_t)y * row;                                                \
-                const U *up = cur - row;                                                     \
-                left = cur[0] = (U)(up[0] + UNZIGZAG(U, cur[0]));                            \
-                for (uint32_t x = 1; x < e[0]; x++) {                                        \
-                    int64_t a = left, b = up[x], c = up[x - 1];                              \
-                    int64_t lo = a < b ? a : b, hi = a < b ? b : a;                          \
-                    int64_t p = c >= hi ? lo : c <= lo ? hi : a + b - c;                     \
-                    cur[x] = left = (U)((U)p + UNZIGZAG(U, cur[x]));                         \
-                }                                                                            \
-            }                                                                                \
-        }                                                                                    \
+#define DEFINE_PREDICTORS(U, W)                                                        \
+    static void delta_encode_##W(const U *s, U *d, size_t n)                           \
+    {                                                                                  \
+        U prev = 0;                                                                    \
+        for (size_t i = 0; i < n; i++) {                                               \
+            U r = (U)(s[i] - prev);                                                    \
+            d[i] = ZIGZAG(U, W, r);                                                    \
+            prev = s[i];                                                               \
+        }                                                                              \
+    }                                                                                  \
+    static void delta_decode_##W(U *d, size_t n)                                       \
+    {                                                                                  \
+        U prev = 0;                                                                    \
+        for (size_t i = 0; i < n; i++) {                                               \
+            prev = (U)(prev + UNZIGZAG(U, d[i]));                                      \
+            d[i] = prev;                                                               \
+        }                                                                              \
+    }                                                                                  \
+    static U med_predict_##W(const U *v, size_t i, uint32_t x, uint32_t y, size_t row) \
+    {                                                                                  \
+        if (x > 0 && y > 0) {                                                          \
+            int64_t a = v[i - 1], b = v[i - row], c = v[i - row - 1];                  \
+            return (U)MED(a, b, c);                                                    \
+        }                                                                              \
+        return x > 0 ? v[i - 1] : y > 0 ? v[i - row] : 0;                              \
+    }                                                                                  \
+    static void med_encode_##W(const U *s, U *d, const uint32_t e[3])                  \
+    {                                                                                  \
+        size_t i = 0;                                                                  \
+        for (uint32_t z = 0; z < e[2]; z++)                                            \
+            for (uint32_t y = 0; y < e[1]; y++)                                        \
+                for (uint32_t x = 0; x < e[0]; x++, i++) {                             \
+                    U r = (U)(s[i] - med_predict_##W(s, i, x, y, e[0]));               \
+                    d[i] = ZIGZAG(U, W, r);                                            \
+                }                                                                      \
+    }                                                                                  \
+    static void med_decode_##W(U *d, const uint32_t e[3])                              \
+    {                                                                                  \
+        size_t row = e[0];                                                             \
+        for (uint32_t z = 0; z < e[2]; z++) {                                          \
+            U *r = d + (size_t)z * row * e[1];                                         \
+            U left = 0;                                                                \
+            for (uint32_t x = 0; x < e[0]; x++) /* first row: from the left */         \
+                r[x] = left = (U)(left + UNZIGZAG(U, r[x]));                           \
+            for (uint32_t y = 1; y < e[1]; y++) {                                      \
+                U *cur = r + (size_t)y * row;                                          \
+                const U *up = cur - row;                                               \
+                left = cur[0] = (U)(up[0] + UNZIGZAG(U, cur[0]));                      \
+                for (uint32_t x = 1; x < e[0]; x++) {                                  \
+                    int64_t a = left, b = up[x], c = up[x - 1];                        \
+                    int64_t lo = a < b ? a : b, hi = a < b ? b : a;                    \
+                    int64_t p = c >= hi ? lo : c <= lo ? hi : a + b - c;               \
+                    cur[x] = left = (U)((U)p + UNZIGZAG(U, cur[x]));                   \
+                }                                                                      \
+            }                                                                          \
+        }                                                                              \
     }
 
 DEFINE_PREDICTORS(uint8_t, 8)
 DEFINE_PREDICTORS(uint16_t, 16)
 DEFINE_PREDICTORS(uint32_t, 32)
 
-static void predict(const void *src, void *dst, const uint32_t e[3], size_t size,
-                    unsigned filters)
+static void predict(const void *src, void *dst, const uint32_t e[3], size_t size, unsigned filters)
 {
     size_t n = (size_t)e[0] * e[1] * e[2];
     int med = (filters & IP_FILTER_MED) != 0;
@@ -210,8 +209,8 @@ static int compress_block(const void *src, size_t bytes, void *dst, size_t capac
     return LZ4_compress_default(src, dst, (int)bytes, (int)capacity);
 }
 
-ip_status ip__codec_encode(const void *samples, const uint32_t extent[3], ip_type type,
-                          int level, void *out, void *work, ip_brick_entry *entry)
+ip_status ip__codec_encode(const void *samples, const uint32_t extent[3], ip_type type, int level,
+                           void *out, void *work, ip_brick_entry *entry)
 {
     size_t size = ip_type_size(type);
     size_t count = (size_t)extent[0] * extent[1] * extent[2];
@@ -306,8 +305,8 @@ static void fill_constant(void *dst, size_t count, ip_type type, float value)
 }
 
 ip_status ip__codec_decode(const ip_brick_entry *entry, const void *payload,
-                          const uint32_t extent[3], ip_type type, float constant_value, void *dst,
-                          void *work)
+                           const uint32_t extent[3], ip_type type, float constant_value, void *dst,
+                           void *work)
 {
     size_t size = ip_type_size(type);
     size_t count = (size_t)extent[0] * extent[1] * extent[2];
@@ -317,9 +316,7 @@ ip_status ip__codec_decode(const ip_brick_entry *entry, const void *payload,
     if (size == 0 || count == 0)
         return IP_ERR_ARGUMENT;
     switch (entry->encoding) {
-    case IP_BRICK_CONSTANT:
-        fill_constant(dst, count, type, constant_value);
-        return IP_OK;
+    case IP_BRICK_CONSTANT: fill_constant(dst, count, type, constant_value); return IP_OK;
     case IP_BRICK_RAW:
         if (entry->stored_size != raw || entry->filters != 0)
             return IP_ERR_CORRUPT;
@@ -327,8 +324,8 @@ ip_status ip__codec_decode(const ip_brick_entry *entry, const void *payload,
         break;
     case IP_BRICK_LZ4: {
         unsigned f = entry->filters;
-        if ((f & ~7u) || (f & (IP_FILTER_DELTA | IP_FILTER_MED)) ==
-                             (IP_FILTER_DELTA | IP_FILTER_MED))
+        if ((f & ~7u) ||
+            (f & (IP_FILTER_DELTA | IP_FILTER_MED)) == (IP_FILTER_DELTA | IP_FILTER_MED))
             return IP_ERR_CORRUPT;
         void *target = (f & IP_FILTER_SHUFFLE) ? work : dst;
         int n = LZ4_decompress_safe(payload, target, (int)entry->stored_size, (int)raw);
@@ -346,8 +343,7 @@ ip_status ip__codec_decode(const ip_brick_entry *entry, const void *payload,
             unpredict(dst, extent, size, f);
         break;
     }
-    default:
-        return IP_ERR_CORRUPT;
+    default: return IP_ERR_CORRUPT;
     }
     if (!ip__host_little_endian() && size > 1)
         ip__swap_bytes(dst, count, size);

@@ -21,7 +21,6 @@
 extern "C" {
 #endif
 
-
 /*! ip__codec_bound() : the largest payload ip__codec_encode() can write for `count`
  *  samples of `type`, in bytes. */
 size_t ip__codec_bound(size_t count, ip_type type);
@@ -37,8 +36,8 @@ size_t ip__codec_work_size(size_t count, ip_type type);
  *  `work` is caller-owned scratch of ip__codec_work_size() bytes. `level` is IP_LZ4_FAST or an
  *  LZ4HC level. A constant brick writes nothing: its value is the brick's min in the summary.
  *  @return IP_OK or IP_ERR_ARGUMENT. */
-ip_status ip__codec_encode(const void *samples, const uint32_t extent[3], ip_type type,
-                          int level, void *out, void *work, ip_brick_entry *entry);
+ip_status ip__codec_encode(const void *samples, const uint32_t extent[3], ip_type type, int level,
+                           void *out, void *work, ip_brick_entry *entry);
 
 /*! ip__codec_decode() : decodes a payload described by `entry` into `dst` (the brick's
  *  extent[0] x extent[1] x extent[2] samples of `type`, host byte order, caller-owned). A constant brick is filled with `constant_value`.
@@ -47,8 +46,8 @@ ip_status ip__codec_encode(const void *samples, const uint32_t extent[3], ip_typ
  *  bounds. @return IP_OK, or IP_ERR_CORRUPT when the payload does not decode to exactly
  *  count samples. */
 ip_status ip__codec_decode(const ip_brick_entry *entry, const void *payload,
-                          const uint32_t extent[3], ip_type type, float constant_value, void *dst,
-                          void *work);
+                           const uint32_t extent[3], ip_type type, float constant_value, void *dst,
+                           void *work);
 
 #ifdef __cplusplus
 }

@@ -61,28 +61,27 @@ static void level_shape(const ip_layout *layout, uint32_t k, ip_level_layout *lv
 }
 
 ip_status ip__layout_init(ip_layout *layout, const uint32_t dims[3], ip_type type,
-                         const double spacing[3], uint32_t brick_edge, uint32_t subblock_edge,
-                         ip_error *err)
+                          const double spacing[3], uint32_t brick_edge, uint32_t subblock_edge,
+                          ip_error *err)
 {
     memset(layout, 0, sizeof *layout);
     for (int a = 0; a < 3; a++) {
         if (dims[a] < 2 || dims[a] >= (1u << 31))
             return ip__fail(err, IP_ERR_ARGUMENT, "dimension %u along %c is outside [2, 2^31)",
-                           dims[a], "xyz"[a]);
+                            dims[a], "xyz"[a]);
         if (!(spacing[a] > 0.0) || !isfinite(spacing[a]))
-            return ip__fail(err, IP_ERR_ARGUMENT, "spacing %g along %c is not positive",
-                           spacing[a], "xyz"[a]);
+            return ip__fail(err, IP_ERR_ARGUMENT, "spacing %g along %c is not positive", spacing[a],
+                            "xyz"[a]);
     }
     if (ip_type_size(type) == 0)
         return ip__fail(err, IP_ERR_ARGUMENT, "unknown sample type %d", (int)type);
     if (!is_power_of_two(brick_edge) || brick_edge < 2 || brick_edge > IP_MAX_BRICK_EDGE)
-        return ip__fail(err, IP_ERR_ARGUMENT,
-                       "brick edge %u is not a power of two in [2, %u]", brick_edge,
-                       IP_MAX_BRICK_EDGE);
+        return ip__fail(err, IP_ERR_ARGUMENT, "brick edge %u is not a power of two in [2, %u]",
+                        brick_edge, IP_MAX_BRICK_EDGE);
     if (!is_power_of_two(subblock_edge) || subblock_edge > brick_edge)
         return ip__fail(err, IP_ERR_ARGUMENT,
-                       "sub-block edge %u is not a power of two no larger than the brick edge %u",
-                       subblock_edge, brick_edge);
+                        "sub-block edge %u is not a power of two no larger than the brick edge %u",
+                        subblock_edge, brick_edge);
     memcpy(layout->dims, dims, sizeof layout->dims);
     memcpy(layout->spacing, spacing, sizeof layout->spacing);
     layout->type = type;
@@ -159,8 +158,7 @@ uint64_t ip_brick_global_index(const ip_layout *layout, uint32_t level, const ui
            (uint64_t)lv->bricks[0] * (brick[1] + (uint64_t)lv->bricks[1] * brick[2]);
 }
 
-void ip_brick_coords(const ip_layout *layout, uint64_t global, uint32_t *level,
-                     uint32_t brick[3])
+void ip_brick_coords(const ip_layout *layout, uint64_t global, uint32_t *level, uint32_t brick[3])
 {
     uint32_t k = 0;
     while (k + 1 < layout->level_count && global >= layout->levels[k + 1].first_brick)
@@ -182,7 +180,7 @@ void ip__octree_grid(const ip_layout *layout, uint32_t level, uint32_t depth, ui
 }
 
 uint64_t ip__octree_node_index(const ip_layout *layout, uint32_t level, uint32_t depth,
-                              const uint32_t node[3])
+                               const uint32_t node[3])
 {
     IP_ASSERT(level < layout->level_count);
     IP_ASSERT(depth >= 1 && depth <= layout->levels[level].octree_depth);
@@ -332,8 +330,7 @@ void ip__format_entry_encode(const ip_brick_entry *entry,
     ip__store_u64le(out + IP_DIR_CHECKSUM, entry->checksum);
 }
 
-void ip__format_entry_decode(const unsigned char in[IP_DIRECTORY_ENTRY_SIZE],
-                             ip_brick_entry *entry)
+void ip__format_entry_decode(const unsigned char in[IP_DIRECTORY_ENTRY_SIZE], ip_brick_entry *entry)
 {
     entry->offset = ip__load_u64le(in + IP_DIR_OFFSET);
     entry->stored_size = ip__load_u32le(in + IP_DIR_STORED_SIZE);
@@ -351,11 +348,13 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
         return ip__fail(err, IP_ERR_FORMAT, "%s: not a brick file (bad magic)", name);
     uint32_t version = ip__load_u32le(h + IP_HDR_VERSION);
     if (version != IP_FORMAT_VERSION)
-        return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: format version %u is not supported (this "
-                       "build reads version %u)", name, version, IP_FORMAT_VERSION);
+        return ip__fail(err, IP_ERR_UNSUPPORTED,
+                        "%s: format version %u is not supported (this "
+                        "build reads version %u)",
+                        name, version, IP_FORMAT_VERSION);
     if (ip__load_u32le(h + IP_HDR_HEADER_SIZE) != IP_HEADER_SIZE)
         return ip__fail(err, IP_ERR_FORMAT, "%s: header size %u is not %u", name,
-                       ip__load_u32le(h + IP_HDR_HEADER_SIZE), IP_HEADER_SIZE);
+                        ip__load_u32le(h + IP_HDR_HEADER_SIZE), IP_HEADER_SIZE);
     if (!(flags & IP_PARSE_SKIP_CHECKSUMS) &&
         ip__load_u64le(h + IP_HDR_CHECKSUM) != ip__format_checksum(h, IP_HDR_CHECKSUM))
         return ip__fail(err, IP_ERR_CHECKSUM, "%s: header checksum mismatch", name);
@@ -370,11 +369,10 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
         return ip__fail(err, IP_ERR_FORMAT, "%s: unknown sample type %u", name, type);
     if (ip__load_u32le(h + IP_HDR_FLAGS) != 0)
         return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: unknown header flags 0x%x", name,
-                       ip__load_u32le(h + IP_HDR_FLAGS));
+                        ip__load_u32le(h + IP_HDR_FLAGS));
     ip_error why;
-    if (ip__layout_init(layout, dims, (ip_type)type, spacing,
-                       ip__load_u32le(h + IP_HDR_BRICK_EDGE),
-                       ip__load_u32le(h + IP_HDR_SUBBLOCK_EDGE), &why) != IP_OK)
+    if (ip__layout_init(layout, dims, (ip_type)type, spacing, ip__load_u32le(h + IP_HDR_BRICK_EDGE),
+                        ip__load_u32le(h + IP_HDR_SUBBLOCK_EDGE), &why) != IP_OK)
         return ip__fail(err, IP_ERR_FORMAT, "%s: %s", name, why.message);
     /* a spacing nothing downstream renders correctly (a file from before the bounds, or a
      * hostile one): refused here, so that no reader of the library reaches the engine with it */
@@ -388,7 +386,7 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
         ip__load_u64le(h + IP_HDR_BRICK_COUNT) != layout->brick_count ||
         ip__load_u64le(h + IP_HDR_NODE_COUNT) != layout->node_count)
         return ip__fail(err, IP_ERR_FORMAT,
-                       "%s: level, brick or node counts disagree with the dimensions", name);
+                        "%s: level, brick or node counts disagree with the dimensions", name);
     layout->value_min = load_f32(h + IP_HDR_VALUE_MIN);
     layout->value_max = load_f32(h + IP_HDR_VALUE_MAX);
     layout->data_offset = ip__load_u64le(h + IP_HDR_DATA_OFFSET);
@@ -397,19 +395,19 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
     layout->summary_checksum = ip__load_u64le(h + IP_HDR_SUMMARY_CHECKSUM);
     layout->file_size = ip__load_u64le(h + IP_HDR_FILE_SIZE);
     if (ip__load_u64le(h + IP_HDR_SUMMARY_SIZE) != layout->summary_size)
-        return ip__fail(err, IP_ERR_FORMAT, "%s: summary size %llu is not the expected %llu",
-                       name, (unsigned long long)ip__load_u64le(h + IP_HDR_SUMMARY_SIZE),
-                       (unsigned long long)layout->summary_size);
+        return ip__fail(err, IP_ERR_FORMAT, "%s: summary size %llu is not the expected %llu", name,
+                        (unsigned long long)ip__load_u64le(h + IP_HDR_SUMMARY_SIZE),
+                        (unsigned long long)layout->summary_size);
     return IP_OK;
 }
 
-static ip_status check_sections(const ip_layout *l, uint64_t size, const char *name,
-                                ip_error *err)
+static ip_status check_sections(const ip_layout *l, uint64_t size, const char *name, ip_error *err)
 {
     if (l->file_size != size)
-        return ip__fail(err, IP_ERR_FORMAT, "%s: file is %llu bytes but its header says %llu "
-                       "(truncated or extended)", name, (unsigned long long)size,
-                       (unsigned long long)l->file_size);
+        return ip__fail(err, IP_ERR_FORMAT,
+                        "%s: file is %llu bytes but its header says %llu "
+                        "(truncated or extended)",
+                        name, (unsigned long long)size, (unsigned long long)l->file_size);
     if (l->data_offset != IP_HEADER_SIZE || l->data_size > size ||
         l->summary_offset % IP_SUMMARY_ALIGN != 0 ||
         l->summary_offset < l->data_offset + l->data_size ||
@@ -424,8 +422,8 @@ static int range_ok(float lo, float hi)
     return isfinite(lo) && isfinite(hi) && lo <= hi;
 }
 
-static ip_status check_level_table(const ip_layout *l, const unsigned char *table,
-                                   const char *name, ip_layout *out, ip_error *err)
+static ip_status check_level_table(const ip_layout *l, const unsigned char *table, const char *name,
+                                   ip_layout *out, ip_error *err)
 {
     for (uint32_t k = 0; k < l->level_count; k++) {
         const unsigned char *e = table + (size_t)k * IP_LEVEL_ENTRY_SIZE;
@@ -439,8 +437,10 @@ static ip_status check_level_table(const ip_layout *l, const unsigned char *tabl
             same = same && ip__load_u32le(e + IP_LVL_DIMS + 4 * a) == lv->dims[a] &&
                    ip__load_u32le(e + IP_LVL_BRICKS + 4 * a) == lv->bricks[a];
         if (!same)
-            return ip__fail(err, IP_ERR_FORMAT, "%s: level %u of the level table disagrees with "
-                           "the header", name, k);
+            return ip__fail(err, IP_ERR_FORMAT,
+                            "%s: level %u of the level table disagrees with "
+                            "the header",
+                            name, k);
         out->levels[k].value_min = load_f32(e + IP_LVL_VALUE_MIN);
         out->levels[k].value_max = load_f32(e + IP_LVL_VALUE_MAX);
         if (!range_ok(out->levels[k].value_min, out->levels[k].value_max))
@@ -454,8 +454,7 @@ static ip_status check_level_table(const ip_layout *l, const unsigned char *tabl
 
 /* `reserved`: the entry's reserved bytes or'ed together. */
 static ip_status check_entry(const ip_layout *l, uint64_t g, const ip_brick_entry *e,
-                             unsigned reserved, float lo, float hi, const char *name,
-                             ip_error *err)
+                             unsigned reserved, float lo, float hi, const char *name, ip_error *err)
 {
     uint32_t level, brick[3], origin[3], extent[3];
     ip_brick_coords(l, g, &level, brick);
@@ -476,7 +475,7 @@ static ip_status check_entry(const ip_layout *l, uint64_t g, const ip_brick_entr
             why = "a raw payload of the wrong size";
     } else if (e->encoding == IP_BRICK_LZ4) {
         if (e->stored_size == 0 || e->stored_size > raw + raw / 255 + 16 || (e->filters & ~7u) ||
-                 (e->filters & 5u) == 5u)
+            (e->filters & 5u) == 5u)
             why = "an LZ4 payload of impossible size or unknown filters";
     } else
         why = "an unknown encoding";
@@ -486,31 +485,33 @@ static ip_status check_entry(const ip_layout *l, uint64_t g, const ip_brick_entr
         why = "a payload outside the data section";
     if (why)
         return ip__fail(err, IP_ERR_FORMAT, "%s: brick %llu (level %u, %u,%u,%u) has %s", name,
-                       (unsigned long long)g, level, brick[0], brick[1], brick[2], why);
+                        (unsigned long long)g, level, brick[0], brick[1], brick[2], why);
     return IP_OK;
 }
 
 ip_status ip__format_parse_header(const unsigned char header[IP_HEADER_SIZE], uint64_t file_size,
-                                 const char *name, unsigned flags, ip_layout *layout,
-                                 ip_error *err)
+                                  const char *name, unsigned flags, ip_layout *layout,
+                                  ip_error *err)
 {
     if (file_size < IP_HEADER_SIZE)
-        return ip__fail(err, IP_ERR_FORMAT, "%s: %llu bytes is too short for a brick file",
-                       name, (unsigned long long)file_size);
+        return ip__fail(err, IP_ERR_FORMAT, "%s: %llu bytes is too short for a brick file", name,
+                        (unsigned long long)file_size);
     ip_status st = parse_header(header, name, flags, layout, err);
     return st == IP_OK ? check_sections(layout, file_size, name, err) : st;
 }
 
 ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
-                                  const unsigned char *summary, const char *name,
-                                  unsigned flags, ip_error *err)
+                                   const unsigned char *summary, const char *name, unsigned flags,
+                                   ip_error *err)
 {
     uint64_t gap_size = layout->summary_offset - (layout->data_offset + layout->data_size);
     for (uint64_t i = 0; i < gap_size; i++)
         if (gap[i] != 0)
-            return ip__fail(err, IP_ERR_FORMAT, "%s: byte %llu, in the padding before the "
-                           "summary section, is not zero", name,
-                           (unsigned long long)(layout->data_offset + layout->data_size + i));
+            return ip__fail(err, IP_ERR_FORMAT,
+                            "%s: byte %llu, in the padding before the "
+                            "summary section, is not zero",
+                            name,
+                            (unsigned long long)(layout->data_offset + layout->data_size + i));
     if (!(flags & IP_PARSE_SKIP_CHECKSUMS) &&
         ip__format_checksum(summary, layout->summary_size) != layout->summary_checksum)
         return ip__fail(err, IP_ERR_CHECKSUM, "%s: summary section checksum mismatch", name);
@@ -533,11 +534,11 @@ ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
 }
 
 ip_status ip__format_parse(const unsigned char *file, uint64_t size, const char *name,
-                          unsigned flags, ip_layout *layout, ip_error *err)
+                           unsigned flags, ip_layout *layout, ip_error *err)
 {
     ip_status st = ip__format_parse_header(file, size, name, flags, layout, err);
     if (st != IP_OK)
         return st;
     return ip__format_parse_summary(layout, file + layout->data_offset + layout->data_size,
-                                   file + layout->summary_offset, name, flags, err);
+                                    file + layout->summary_offset, name, flags, err);
 }

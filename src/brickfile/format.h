@@ -18,8 +18,8 @@
  *  samples of `type` with brick edge `brick_edge` and sub-block edge `subblock_edge` (cells).
  *  Leaves offsets, sizes and value ranges zero. @return IP_OK or IP_ERR_ARGUMENT. */
 ip_status ip__layout_init(ip_layout *layout, const uint32_t dims[3], ip_type type,
-                         const double spacing[3], uint32_t brick_edge, uint32_t subblock_edge,
-                         ip_error *err);
+                          const double spacing[3], uint32_t brick_edge, uint32_t subblock_edge,
+                          ip_error *err);
 
 /*! ip__layout_summary_size() : bytes of the summary section implied by the layout. */
 uint64_t ip__layout_summary_size(const ip_layout *layout);
@@ -31,7 +31,7 @@ void ip__octree_grid(const ip_layout *layout, uint32_t level, uint32_t depth, ui
 /*! ip__octree_node_index() : index into the node range array of node `node` at `depth`
  *  (1..octree_depth) of `level`. */
 uint64_t ip__octree_node_index(const ip_layout *layout, uint32_t level, uint32_t depth,
-                              const uint32_t node[3]);
+                               const uint32_t node[3]);
 
 /*! ip__morton_order() : fills order[0 .. level brick_count) with the level-local brick indices
  *  (x fastest) sorted by the Morton code of their coordinates: the order payloads are stored in.
@@ -68,8 +68,8 @@ enum {
  *  the summary). `name` is used in messages. Safe on arbitrary bytes.
  *  @return IP_OK, IP_ERR_FORMAT, IP_ERR_CHECKSUM or IP_ERR_UNSUPPORTED. */
 ip_status ip__format_parse_header(const unsigned char header[IP_HEADER_SIZE], uint64_t file_size,
-                                 const char *name, unsigned flags, ip_layout *layout,
-                                 ip_error *err);
+                                  const char *name, unsigned flags, ip_layout *layout,
+                                  ip_error *err);
 
 /*! ip__format_parse_summary() : validates the rest of the metadata of a file whose header
  *  ip__format_parse_header() accepted into *layout: `gap` holds the padding between the data
@@ -80,14 +80,14 @@ ip_status ip__format_parse_header(const unsigned char header[IP_HEADER_SIZE], ui
  *  Touches no payload byte. Safe on arbitrary bytes.
  *  @return IP_OK, IP_ERR_FORMAT or IP_ERR_CHECKSUM. */
 ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
-                                  const unsigned char *summary, const char *name,
-                                  unsigned flags, ip_error *err);
+                                   const unsigned char *summary, const char *name, unsigned flags,
+                                   ip_error *err);
 
 /*! ip__format_parse() : ip__format_parse_header() then ip__format_parse_summary() on a whole
  *  brick file image (`file`, `size` bytes) held in memory.
  *  @return IP_OK and *layout filled, or IP_ERR_FORMAT / IP_ERR_CHECKSUM / IP_ERR_UNSUPPORTED. */
 ip_status ip__format_parse(const unsigned char *file, uint64_t size, const char *name,
-                          unsigned flags, ip_layout *layout, ip_error *err);
+                           unsigned flags, ip_layout *layout, ip_error *err);
 
 /*! ip__format_checksum() : XXH64 (seed 0) of `size` bytes, the checksum used throughout. */
 uint64_t ip__format_checksum(const void *data, size_t size);

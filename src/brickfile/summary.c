@@ -5,26 +5,26 @@
 #include "internal.h"
 #include "summary.h"
 
-#define BOX_RANGE(T)                                                               \
-    do {                                                                           \
-        const T *s = samples;                                                      \
+#define BOX_RANGE(T)                                                                 \
+    do {                                                                             \
+        const T *s = samples;                                                        \
         T lo_v = s[lo[0] + (size_t)extent[0] * (lo[1] + (size_t)extent[1] * lo[2])]; \
-        T hi_v = lo_v;                                                             \
-        for (uint32_t z = lo[2]; z <= hi[2]; z++)                                  \
-            for (uint32_t y = lo[1]; y <= hi[1]; y++) {                            \
-                const T *row = s + (size_t)extent[0] * (y + (size_t)extent[1] * z); \
-                for (uint32_t x = lo[0]; x <= hi[0]; x++) {                        \
-                    T v = row[x];                                                  \
-                    lo_v = v < lo_v ? v : lo_v;                                    \
-                    hi_v = v > hi_v ? v : hi_v;                                    \
-                }                                                                  \
-            }                                                                      \
-        *min = (float)lo_v;                                                        \
-        *max = (float)hi_v;                                                        \
+        T hi_v = lo_v;                                                               \
+        for (uint32_t z = lo[2]; z <= hi[2]; z++)                                    \
+            for (uint32_t y = lo[1]; y <= hi[1]; y++) {                              \
+                const T *row = s + (size_t)extent[0] * (y + (size_t)extent[1] * z);  \
+                for (uint32_t x = lo[0]; x <= hi[0]; x++) {                          \
+                    T v = row[x];                                                    \
+                    lo_v = v < lo_v ? v : lo_v;                                      \
+                    hi_v = v > hi_v ? v : hi_v;                                      \
+                }                                                                    \
+            }                                                                        \
+        *min = (float)lo_v;                                                          \
+        *max = (float)hi_v;                                                          \
     } while (0)
 
 void ip__box_range(const void *samples, ip_type type, const uint32_t extent[3],
-                  const uint32_t lo[3], const uint32_t hi[3], float *min, float *max)
+                   const uint32_t lo[3], const uint32_t hi[3], float *min, float *max)
 {
     switch (type) {
     case IP_UINT8: BOX_RANGE(uint8_t); break;
@@ -35,11 +35,10 @@ void ip__box_range(const void *samples, ip_type type, const uint32_t extent[3],
 }
 
 void ip__summarise_brick(const void *samples, ip_type type, const uint32_t extent[3],
-                        uint32_t brick_edge, uint32_t subblock_edge, float brick_range[2],
-                        float *ranges)
+                         uint32_t brick_edge, uint32_t subblock_edge, float brick_range[2],
+                         float *ranges)
 {
-    IP_ASSERT(subblock_edge >= 1 && subblock_edge <= brick_edge &&
-              brick_edge % subblock_edge == 0);
+    IP_ASSERT(subblock_edge >= 1 && subblock_edge <= brick_edge && brick_edge % subblock_edge == 0);
     for (int a = 0; a < 3; a++)
         IP_ASSERT(extent[a] >= 2 && extent[a] <= brick_edge + 1);
     uint32_t per_axis = brick_edge / subblock_edge;
@@ -63,7 +62,7 @@ void ip__summarise_brick(const void *samples, ip_type type, const uint32_t exten
                     ranges[2 * i + 1] = -INFINITY;
                 } else {
                     ip__box_range(samples, type, extent, lo, hi, &ranges[2 * i],
-                                 &ranges[2 * i + 1]);
+                                  &ranges[2 * i + 1]);
                 }
             }
     /* The non-empty sub-blocks cover every sample of the brick, so their union is its range. */
@@ -108,8 +107,7 @@ int ip__octree_walk(const ip_layout *l, const float *brick_ranges, const float *
                     for (uint32_t x = 0; x < grid[0]; x++) {
                         uint32_t node[3] = {x, y, z};
                         float range[2];
-                        node_range(l, k, depth, node, child_grid, brick_ranges, node_ranges,
-                                   range);
+                        node_range(l, k, depth, node, child_grid, brick_ranges, node_ranges, range);
                         int stop = visit(user, k, depth, node,
                                          ip__octree_node_index(l, k, depth, node), range);
                         if (stop)

@@ -9,21 +9,20 @@
 
 /* Range of the samples in the inclusive box [lo, hi] of a brick of `extent` samples. */
 void ip__box_range(const void *samples, ip_type type, const uint32_t extent[3],
-                  const uint32_t lo[3], const uint32_t hi[3], float *min, float *max);
+                   const uint32_t lo[3], const uint32_t hi[3], float *min, float *max);
 
 /* The brick's range and the ranges of its (B/s)^3 sub-blocks, x fastest. A sub-block covers
  * cells [c*s, (c+1)*s) clipped to the brick, so samples [c*s, min((c+1)*s, extent-1)]; one
  * with no cells (an edge brick) gets the empty range [+inf, -inf], which contains no value.
  * `ranges` receives 2 floats per sub-block (min, max). */
 void ip__summarise_brick(const void *samples, ip_type type, const uint32_t extent[3],
-                        uint32_t brick_edge, uint32_t subblock_edge, float brick_range[2],
-                        float *ranges);
+                         uint32_t brick_edge, uint32_t subblock_edge, float brick_range[2],
+                         float *ranges);
 
 /* Called by ip__octree_walk() once per node with the union of its children's ranges, as
  * read at that moment; a nonzero return stops the walk and is returned by it. */
-typedef int (*ip_octree_node_fn)(void *user, uint32_t level, uint32_t depth,
-                                 const uint32_t node[3], uint64_t node_index,
-                                 const float range[2]);
+typedef int (*ip_octree_node_fn)(void *user, uint32_t level, uint32_t depth, const uint32_t node[3],
+                                 uint64_t node_index, const float range[2]);
 
 /*! ip__octree_walk() : visits every node of the min/max octree (docs/format.md) level by level,
  *  depth 1 first, z slowest and x fastest within a depth, and passes `visit` the union of the

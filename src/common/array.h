@@ -9,7 +9,10 @@
 
 /* How a capacity grows: doubling, or by half (for arrays that may hold millions of elements,
  * where the slack of doubling costs more than the extra moves). */
-typedef enum ip_array_growth { IP_ARRAY_DOUBLE = 1, IP_ARRAY_HALF = 2 } ip_array_growth;
+typedef enum ip_array_growth {
+    IP_ARRAY_DOUBLE = 1,
+    IP_ARRAY_HALF = 2
+} ip_array_growth;
 
 /*! ip__array_capacity() : the capacity, in elements, that an array of `capacity` elements grows
  *  to so that it holds at least `needed`: `capacity` (or `first` when it is 0) grown by

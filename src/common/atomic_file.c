@@ -36,7 +36,7 @@ static ip_status open_named_temp(ip_atomic_file *file, const char *folder, ip_er
     file->fd = mkstemp(file->temp_path);
     if (file->fd < 0)
         return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot create a temporary file in %s",
-                             file->path, folder);
+                              file->path, folder);
     mode_t mask = umask(0);
     umask(mask);
     (void)fchmod(file->fd, 0666 & ~mask);
@@ -68,13 +68,13 @@ static ip_status check_replaceable(const char *path, int force, ip_error *err)
     if (stat(path, &st) != 0) {
         if (errno == ENOENT)
             return IP_OK;
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot examine the output path",
-                             path);
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot examine the output path", path);
     }
     if (!S_ISREG(st.st_mode))
         return ip__fail(err, IP_ERR_ARGUMENT,
-                       "%s: exists and is %s, not a regular file; refusing to replace it "
-                       "(even with --force)", path, kind_of(st.st_mode));
+                        "%s: exists and is %s, not a regular file; refusing to replace it "
+                        "(even with --force)",
+                        path, kind_of(st.st_mode));
     if (!force)
         return ip__fail(err, IP_ERR_EXISTS, "%s: exists (use --force to overwrite)", path);
     return IP_OK;
@@ -124,10 +124,14 @@ ip_status ip_output_not_input(const char *output_path, const char *input_path, i
     if (!ip_path_same_file(output_path, input_path))
         return IP_OK;
     if (strcmp(output_path, input_path) == 0)
-        return ip__fail(err, IP_ERR_ARGUMENT, "%s: is an input of this run; refusing to write "
-                       "over it", output_path);
-    return ip__fail(err, IP_ERR_ARGUMENT, "%s: is the same file as the input %s; refusing to "
-                   "write over it", output_path, input_path);
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "%s: is an input of this run; refusing to write "
+                        "over it",
+                        output_path);
+    return ip__fail(err, IP_ERR_ARGUMENT,
+                    "%s: is the same file as the input %s; refusing to "
+                    "write over it",
+                    output_path, input_path);
 }
 
 ip_status ip__atomic_create(ip_atomic_file *file, const char *path, int force, ip_error *err)
@@ -147,8 +151,7 @@ ip_status ip__atomic_create(ip_atomic_file *file, const char *path, int force, i
     if (file->fd >= 0)
         return IP_OK;
     if (errno == ENOENT || errno == EACCES || errno == ENOTDIR || errno == EROFS)
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot write in folder %s", path,
-                             folder);
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot write in folder %s", path, folder);
     return open_named_temp(file, folder, err);
 }
 
@@ -173,7 +176,7 @@ static ip_status link_unnamed(ip_atomic_file *file, ip_error *err)
             return IP_OK;
         if (errno == EEXIST)
             return ip__fail(err, IP_ERR_EXISTS, "%s: exists (use --force to overwrite)",
-                           file->path);
+                            file->path);
         return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot create", file->path);
     }
     char folder[IP_PATH_MAX], base[IP_PATH_MAX], temp[2 * IP_PATH_MAX + 64];
@@ -203,7 +206,7 @@ static ip_status rename_named(ip_atomic_file *file, ip_error *err)
             int e = errno;
             if (e == EEXIST)
                 return ip__fail(err, IP_ERR_EXISTS, "%s: exists (use --force to overwrite)",
-                               file->path);
+                                file->path);
             return ip__fail_errno(err, IP_ERR_IO, e, "%s: cannot create", file->path);
         }
         unlink(file->temp_path);
@@ -248,8 +251,8 @@ void ip__atomic_abort(ip_atomic_file *file)
     file->named = 0;
 }
 
-ip_status ip__pwrite_all(int fd, const void *data, size_t size, uint64_t offset,
-                        const char *path, ip_error *err)
+ip_status ip__pwrite_all(int fd, const void *data, size_t size, uint64_t offset, const char *path,
+                         ip_error *err)
 {
     const unsigned char *p = data;
     while (size > 0) {
@@ -269,7 +272,7 @@ ip_status ip__pwrite_all(int fd, const void *data, size_t size, uint64_t offset,
 }
 
 ip_status ip__pread_all(int fd, void *data, size_t size, uint64_t offset, const char *path,
-                       ip_error *err)
+                        ip_error *err)
 {
     unsigned char *p = data;
     while (size > 0) {
@@ -281,7 +284,7 @@ ip_status ip__pread_all(int fd, void *data, size_t size, uint64_t offset, const 
         }
         if (n == 0)
             return ip__fail(err, IP_ERR_IO, "%s: unexpected end of file at byte %llu", path,
-                           (unsigned long long)offset);
+                            (unsigned long long)offset);
         p += n;
         size -= (size_t)n;
         offset += (uint64_t)n;
@@ -289,8 +292,7 @@ ip_status ip__pread_all(int fd, void *data, size_t size, uint64_t offset, const 
     return IP_OK;
 }
 
-ip_status ip_output_write(const char *path, const void *data, size_t size, int force,
-                          ip_error *err)
+ip_status ip_output_write(const char *path, const void *data, size_t size, int force, ip_error *err)
 {
     ip_atomic_file out;
     if (!path || (!data && size))

@@ -18,11 +18,11 @@
 #include "isoprop/status.h"
 
 typedef struct ip_atomic_file {
-    int fd;                        /* write here (pwrite or write) */
-    int force;                     /* replace an existing file at commit */
-    int named;                     /* 1 when the fallback temporary name is in use */
-    char path[IP_PATH_MAX];        /* the final name */
-    char temp_path[IP_PATH_MAX];   /* the fallback temporary name, when named */
+    int fd;                      /* write here (pwrite or write) */
+    int force;                   /* replace an existing file at commit */
+    int named;                   /* 1 when the fallback temporary name is in use */
+    char path[IP_PATH_MAX];      /* the final name */
+    char temp_path[IP_PATH_MAX]; /* the fallback temporary name, when named */
 } ip_atomic_file;
 
 /* Starts an output at `path`. Without force, an existing path fails at once (IP_ERR_EXISTS);
@@ -39,11 +39,11 @@ ip_status ip__atomic_commit(ip_atomic_file *file, ip_error *err);
 void ip__atomic_abort(ip_atomic_file *file);
 
 /* Writes all `size` bytes at `offset` (retrying short writes); names `path` in the error. */
-ip_status ip__pwrite_all(int fd, const void *data, size_t size, uint64_t offset,
-                        const char *path, ip_error *err);
+ip_status ip__pwrite_all(int fd, const void *data, size_t size, uint64_t offset, const char *path,
+                         ip_error *err);
 
 /* Reads exactly `size` bytes at `offset`; a short read is IP_ERR_IO naming `path`. */
 ip_status ip__pread_all(int fd, void *data, size_t size, uint64_t offset, const char *path,
-                       ip_error *err);
+                        ip_error *err);
 
 #endif

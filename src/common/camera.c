@@ -17,7 +17,7 @@ ip_status ip_camera_check(const ip_camera *c, ip_error *err)
             return ip__fail(err, IP_ERR_ARGUMENT, "camera: coordinates must be finite");
     if (!(c->fov_y > 0.0 && c->fov_y < 180.0))
         return ip__fail(err, IP_ERR_ARGUMENT, "camera: field of view %g is not in (0, 180) degrees",
-                       c->fov_y);
+                        c->fov_y);
     if (c->width < 1 || c->height < 1)
         return ip__fail(err, IP_ERR_ARGUMENT, "camera: image size must be at least 1x1");
     double f[3], u[3] = {c->up[0], c->up[1], c->up[2]}, r[3];
@@ -54,8 +54,8 @@ void ip_camera_pixel_ray(const ip_camera_basis *b, const ip_camera *c, double px
     ip__vec3_normalize(dir);
 }
 
-int ip_camera_project(const ip_camera_basis *b, const ip_camera *c, const double p[3],
-                      double *px, double *py, double *depth)
+int ip_camera_project(const ip_camera_basis *b, const ip_camera *c, const double p[3], double *px,
+                      double *py, double *depth)
 {
     double v[3];
     ip__vec3_sub(p, c->eye, v);
@@ -75,10 +75,22 @@ void ip_camera_view_matrix(const ip_camera *c, float m[16])
     ip_camera_basis b;
     ip_camera_basis_of(c, &b);
     const double *r = b.right, *u = b.up, *f = b.forward;
-    float v[16] = {(float)r[0], (float)u[0], (float)-f[0], 0,
-                   (float)r[1], (float)u[1], (float)-f[1], 0,
-                   (float)r[2], (float)u[2], (float)-f[2], 0,
-                   (float)-ip__vec3_dot(r, c->eye), (float)-ip__vec3_dot(u, c->eye), (float)ip__vec3_dot(f, c->eye), 1};
+    float v[16] = {(float)r[0],
+                   (float)u[0],
+                   (float)-f[0],
+                   0,
+                   (float)r[1],
+                   (float)u[1],
+                   (float)-f[1],
+                   0,
+                   (float)r[2],
+                   (float)u[2],
+                   (float)-f[2],
+                   0,
+                   (float)-ip__vec3_dot(r, c->eye),
+                   (float)-ip__vec3_dot(u, c->eye),
+                   (float)ip__vec3_dot(f, c->eye),
+                   1};
     memcpy(m, v, sizeof v);
 }
 
@@ -119,14 +131,13 @@ void ip_camera_depth_range(const ip_camera *c, const double lo[3], const double 
     *near_plane = fmax(zmin * 0.99, *far_plane * 1e-5);
 }
 
-ip_status ip_camera_fit_axis(const double lo[3], const double hi[3], const char *axis,
-                             double fov_y, uint32_t width, uint32_t height, ip_camera *out,
-                             ip_error *err)
+ip_status ip_camera_fit_axis(const double lo[3], const double hi[3], const char *axis, double fov_y,
+                             uint32_t width, uint32_t height, ip_camera *out, ip_error *err)
 {
     if (!axis || strlen(axis) != 2 || (axis[0] != '+' && axis[0] != '-') || axis[1] < 'x' ||
         axis[1] > 'z')
         return ip__fail(err, IP_ERR_ARGUMENT, "view '%s' is not one of +x -x +y -y +z -z",
-                       axis ? axis : "");
+                        axis ? axis : "");
     int a = axis[1] - 'x';
     double sign = axis[0] == '+' ? 1.0 : -1.0, centre[3];
     for (int i = 0; i < 3; i++)
@@ -166,7 +177,7 @@ ip_status ip_camera_parse(const char *text, ip_camera *c, ip_error *err)
         v[i] = strtod(p, &end);
         if (end == p || !isfinite(v[i]) || (i < 9 ? *end != ',' : *end != '\0'))
             return ip__fail(err, IP_ERR_ARGUMENT,
-                           "--camera '%s' is not ex,ey,ez,tx,ty,tz,ux,uy,uz,fov", text);
+                            "--camera '%s' is not ex,ey,ez,tx,ty,tz,ux,uy,uz,fov", text);
         p = end + 1;
     }
     for (int i = 0; i < 3; i++) {

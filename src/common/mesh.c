@@ -40,8 +40,8 @@ ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
         return IP_OK;
     /* Growth by half (not doubling) keeps the slack small for meshes of millions of triangles;
      * large blocks are moved by remapping pages, not copied, so the cost stays low. */
-    uint64_t cap = ip__array_capacity(m->capacity, triangles, 1024, 9 * sizeof(float),
-                                      IP_ARRAY_HALF);
+    uint64_t cap =
+        ip__array_capacity(m->capacity, triangles, 1024, 9 * sizeof(float), IP_ARRAY_HALF);
     /* the arrays that grew keep the old contents when a later one cannot */
     ip_status st = cap ? ip__array_resize(&m->positions, cap, 9 * sizeof(float)) : IP_ERR_NOMEM;
     if (st == IP_OK)
@@ -72,14 +72,16 @@ ip_status ip_mesh_append(ip_mesh *m, const float *positions, const int16_t *norm
 ip_status ip_mesh_append_float_normals(ip_mesh *m, const float *positions, const float *normals,
                                        const uint64_t *cells, uint64_t count)
 {
-    enum { PART = 256 };
+    enum {
+        PART = 256
+    };
     int16_t packed[9 * PART];
     for (uint64_t done = 0; done < count; done += PART) {
         uint64_t n = count - done < PART ? count - done : PART;
         for (uint64_t i = 0; i < 9 * n; i++)
             packed[i] = ip_normal_pack(normals[9 * done + i]);
-        ip_status st = ip_mesh_append(m, positions + 9 * done, packed,
-                                      cells ? cells + done : NULL, n);
+        ip_status st =
+            ip_mesh_append(m, positions + 9 * done, packed, cells ? cells + done : NULL, n);
         if (st != IP_OK)
             return st;
     }
@@ -121,7 +123,9 @@ ip_status ip_mesh_write_ply(const ip_mesh *m, const char *path, int force, ip_er
     uint64_t offset = 0;
     st = ip__pwrite_all(out.fd, header, (size_t)n, 0, path, err);
     offset += (uint64_t)n;
-    enum { CHUNK = 4096 };
+    enum {
+        CHUNK = 4096
+    };
     unsigned char *buf = malloc((size_t)CHUNK * 3 * 24);
     if (!buf && st == IP_OK)
         st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path);

@@ -10,12 +10,12 @@
 
 struct ip__pool {
     pthread_mutex_t lock;
-    pthread_cond_t work_ready;  /* helpers: a new run (generation changed) or stop */
-    pthread_cond_t work_done;   /* the caller: done reached jobs */
-    unsigned helpers;           /* helper threads started */
+    pthread_cond_t work_ready; /* helpers: a new run (generation changed) or stop */
+    pthread_cond_t work_done;  /* the caller: done reached jobs */
+    unsigned helpers;          /* helper threads started */
     pthread_t *tids;
     /* The current run, guarded by lock. */
-    unsigned long generation;   /* runs started so far */
+    unsigned long generation; /* runs started so far */
     ip__pool_job fn;
     void *user;
     unsigned jobs, next, done;

@@ -100,8 +100,7 @@ void ip__type_names(unsigned spellings, char *out, size_t size)
         for (size_t i = 0; i < sizeof type_names / sizeof type_names[0]; i++) {
             if ((int)type_names[i].type != type || !(type_names[i].spellings & spellings))
                 continue;
-            int n = snprintf(out + used, size - used, "%s%s", used ? ", " : "",
-                             type_names[i].name);
+            int n = snprintf(out + used, size - used, "%s%s", used ? ", " : "", type_names[i].name);
             if (n < 0 || (size_t)n >= size - used)
                 return; /* cut short, terminated */
             used += (size_t)n;
@@ -155,12 +154,12 @@ ip_status ip_spacing_check(const double spacing[3], const char *name, ip_error *
         double s = spacing[a];
         if (!(s >= IP_SPACING_MIN && s <= IP_SPACING_MAX))
             return ip__fail(err, IP_ERR_UNSUPPORTED,
-                           "%s%s %g along %c is outside the range that renders correctly, "
-                           "%g to %g world units (express the spacing in another unit, e.g. "
-                           "%s)",
-                           who, sep, s, axes[a], IP_SPACING_MIN, IP_SPACING_MAX,
-                           s < IP_SPACING_MIN ? "micrometres instead of metres"
-                                              : "kilometres instead of metres");
+                            "%s%s %g along %c is outside the range that renders correctly, "
+                            "%g to %g world units (express the spacing in another unit, e.g. "
+                            "%s)",
+                            who, sep, s, axes[a], IP_SPACING_MIN, IP_SPACING_MAX,
+                            s < IP_SPACING_MIN ? "micrometres instead of metres"
+                                               : "kilometres instead of metres");
     }
     int lo = 0, hi = 0;
     for (int a = 1; a < 3; a++) {
@@ -171,11 +170,11 @@ ip_status ip_spacing_check(const double spacing[3], const char *name, ip_error *
     }
     if (spacing[hi] > IP_SPACING_RATIO_MAX * spacing[lo])
         return ip__fail(err, IP_ERR_UNSUPPORTED,
-                       "%s%s %g,%g,%g: %g along %c is %g times %g along %c, more than the "
-                       "%g times that renders correctly (resample the volume to a less "
-                       "anisotropic grid)",
-                       who, sep, spacing[0], spacing[1], spacing[2], spacing[hi], axes[hi],
-                       spacing[hi] / spacing[lo], spacing[lo], axes[lo], IP_SPACING_RATIO_MAX);
+                        "%s%s %g,%g,%g: %g along %c is %g times %g along %c, more than the "
+                        "%g times that renders correctly (resample the volume to a less "
+                        "anisotropic grid)",
+                        who, sep, spacing[0], spacing[1], spacing[2], spacing[hi], axes[hi],
+                        spacing[hi] / spacing[lo], spacing[lo], axes[lo], IP_SPACING_RATIO_MAX);
     return IP_OK;
 }
 

@@ -15,7 +15,7 @@
 #include "seed.h"
 #include "vec3.h"
 
-#define RAY_BATCH 16 /* rays a worker takes at once: small, so the order stays progressive */
+#define RAY_BATCH 16   /* rays a worker takes at once: small, so the order stays progressive */
 #define LOCAL_LEVELS 3 /* ray order: the finest levels cast in Z-order (see begin) */
 #define FLUSH_TRIANGLES 16384 /* a worker's buffer moves to the engine's mesh past this size */
 
@@ -42,20 +42,20 @@ struct ip_engine {
     ip_engine_options options;
     unsigned threads;
     worker *workers;
-    ip__pool *pool;             /* runs the workers of every step; started at create */
+    ip__pool *pool; /* runs the workers of every step; started at create */
     ip_visited visited;
     ip_mesh mesh;
-    pthread_mutex_t mesh_lock;  /* workers append their buffers to `mesh` during a step */
+    pthread_mutex_t mesh_lock; /* workers append their buffers to `mesh` during a step */
     ip_camera camera;
     ip_camera_basis basis;
     float iso;
     int begun;
-    uint32_t levels_used;       /* levels 0 .. levels_used - 1 have a distance band */
+    uint32_t levels_used;                   /* levels 0 .. levels_used - 1 have a distance band */
     double lod_distance[IP_MAX_LEVELS + 1]; /* D[k]; D[levels_used] = infinity */
-    pthread_mutex_t order_lock; /* the shared ray sequence */
+    pthread_mutex_t order_lock;             /* the shared ray sequence */
     ip_ray_order order;
-    uint64_t step_rays_left;    /* rays the current step may still hand out */
-    double step_deadline;       /* 0: none */
+    uint64_t step_rays_left; /* rays the current step may still hand out */
+    double step_deadline;    /* 0: none */
     ip_engine_counts totals;
     atomic_int cancel;
 };
@@ -81,12 +81,13 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
 {
     if (!(options->cutoff_degrees > 0 && options->cutoff_degrees <= 180) ||
         !(options->foldback_degrees >= 0 && options->foldback_degrees <= 180))
-        return ip__fail(err, IP_ERR_ARGUMENT, "cut-off %g and fold-back %g must be in degrees, "
-                       "0 < cut-off <= 180, 0 <= fold-back <= 180",
-                       options->cutoff_degrees, options->foldback_degrees);
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "cut-off %g and fold-back %g must be in degrees, "
+                        "0 < cut-off <= 180, 0 <= fold-back <= 180",
+                        options->cutoff_degrees, options->foldback_degrees);
     if (options->lod && !(options->pixel_error > 0 && isfinite(options->pixel_error)))
         return ip__fail(err, IP_ERR_ARGUMENT, "the pixel error %g must be positive",
-                       options->pixel_error);
+                        options->pixel_error);
     ip_engine *e = calloc(1, sizeof *e);
     if (!e)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for an engine", path_of(cache));
@@ -99,8 +100,9 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     ip_mesh_init(&e->mesh);
     e->mesh.with_cells = options->cell_ids != 0;
     e->workers = calloc(e->threads, sizeof *e->workers);
-    ip_status st = e->workers ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
-                              : IP_ERR_NOMEM;
+    ip_status st = e->workers
+                       ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
+                       : IP_ERR_NOMEM;
     if (st == IP_OK)
         st = ip__pool_create(e->threads, &e->pool, NULL);
     for (unsigned t = 0; st == IP_OK && t < e->threads; t++) {
@@ -178,8 +180,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     if (st != IP_OK)
         return st;
     if (!isfinite(iso))
-        return ip__fail(err, IP_ERR_ARGUMENT, "%s: the isovalue must be finite",
-                       path_of(e->cache));
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: the isovalue must be finite", path_of(e->cache));
     ip__visited_clear(&e->visited);
     ip_mesh_clear(&e->mesh);
     e->camera = *camera;
@@ -202,8 +203,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
             level_tools *lt = &w->level[k];
             if (!lt->ready) {
                 if (ip__sampler_init(&lt->sampler, e->cache, k) != IP_OK)
-                    return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory",
-                                   path_of(e->cache));
+                    return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
                 lt->ready = 1;
             }
             ip__sampler_release(&lt->sampler);
@@ -211,8 +211,8 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
             ip__seeder_init(&lt->seeder, &lt->sampler, iso, pixel_angle);
             ip__propagator_free(&lt->propagator);
             if (ip__propagator_init(&lt->propagator, &lt->sampler, &e->visited, &w->mesh,
-                                   &e->camera, iso, &e->options, e->lod_distance[k],
-                                   e->lod_distance[k + 1]) != IP_OK)
+                                    &e->camera, iso, &e->options, e->lod_distance[k],
+                                    e->lod_distance[k + 1]) != IP_OK)
                 return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
         }
     }
@@ -273,7 +273,7 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
         unsigned count;
         int seed_index;
         int found = ip__seed_find(&lt->seeder, e->camera.eye, dir, e->lod_distance[k],
-                                 e->lod_distance[k + 1], cells, &count, &seed_index);
+                                  e->lod_distance[k + 1], cells, &count, &seed_index);
         if (found < 0) {
             w->failed_level = k;
             return lt->sampler.status;

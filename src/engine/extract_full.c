@@ -50,11 +50,11 @@ typedef struct full_worker {
     ip_cache *cache;
     float iso;
     uint32_t level;
-    atomic_uint_fast64_t *next;   /* next level-local brick to take */
+    atomic_uint_fast64_t *next; /* next level-local brick to take */
     ip_sampler sampler;
     ip_mesh mesh;
-    uint64_t *brick_of;           /* per chunk of this worker: the brick */
-    uint64_t *start_of;           /* per chunk: its first triangle in mesh */
+    uint64_t *brick_of; /* per chunk of this worker: the brick */
+    uint64_t *start_of; /* per chunk: its first triangle in mesh */
     uint64_t chunks, capacity;
     ip_engine_counts counts;
     ip_status status;
@@ -109,8 +109,8 @@ static ip_status merge_in_brick_order(full_worker *w, unsigned threads, ip_mesh 
             break;
         full_worker *b = &w[best];
         uint64_t first = b->start_of[cursor[best]];
-        uint64_t end = cursor[best] + 1 < b->chunks ? b->start_of[cursor[best] + 1]
-                                                    : b->mesh.triangle_count;
+        uint64_t end =
+            cursor[best] + 1 < b->chunks ? b->start_of[cursor[best] + 1] : b->mesh.triangle_count;
         st = ip_mesh_append_mesh(mesh, &b->mesh, first, end - first);
         cursor[best]++;
     }

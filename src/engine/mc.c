@@ -97,7 +97,7 @@ static void edge_normal(const float values[8], const float gradients[8][3], floa
 }
 
 int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], float iso,
-                           const float origin[3], const float size[3], ip_mc_vertex *out)
+                            const float origin[3], const float size[3], ip_mc_vertex *out)
 {
     unsigned mc_case = ip__mc_case(values, iso);
     unsigned crossed = ip__mc_edge_table[mc_case];
@@ -109,8 +109,8 @@ int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], 
     for (unsigned e = 0; e < 12; e++) {
         if (!(crossed >> e & 1u))
             continue;
-        float t = edge_fraction(values[ip__mc_edge_corners[e][0]], values[ip__mc_edge_corners[e][1]],
-                                iso);
+        float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
+                                values[ip__mc_edge_corners[e][1]], iso);
         edge_position(e, t, origin, size, at_edge[e].position);
         edge_normal(values, gradients, iso, e, t, inverse_size, at_edge[e].normal);
     }
@@ -122,7 +122,7 @@ int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], 
 }
 
 unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float origin[3],
-                                const float size[3], float points[12][3])
+                                 const float size[3], float points[12][3])
 {
     unsigned crossed = ip__mc_edge_table[ip__mc_case(values, iso)];
     for (unsigned e = 0; e < 12; e++)
@@ -163,8 +163,8 @@ static int ray_hits_triangle(const double o[3], const double d[3], const double 
 }
 
 int ip__mc_ray_hits_cell(const float values[8], float iso, const float origin[3],
-                        const float size[3], const float ray_origin[3], const float ray_dir[3],
-                        float *t_hit)
+                         const float size[3], const float ray_origin[3], const float ray_dir[3],
+                         float *t_hit)
 {
     unsigned mc_case = ip__mc_case(values, iso);
     unsigned crossed = ip__mc_edge_table[mc_case];
@@ -174,8 +174,8 @@ int ip__mc_ray_hits_cell(const float values[8], float iso, const float origin[3]
     for (unsigned e = 0; e < 12; e++) {
         if (!(crossed >> e & 1u))
             continue;
-        float t = edge_fraction(values[ip__mc_edge_corners[e][0]], values[ip__mc_edge_corners[e][1]],
-                                iso);
+        float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
+                                values[ip__mc_edge_corners[e][1]], iso);
         float p[3];
         edge_position(e, t, origin, size, p);
         for (unsigned a = 0; a < 3; a++)

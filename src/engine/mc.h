@@ -107,7 +107,7 @@ unsigned ip__mc_crossed_faces(unsigned mc_case);
  *  so no output is ever NaN for finite inputs.
  *  @return the number of triangles written, 0 to IP_MC_MAX_TRIANGLES. No allocation. */
 int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], float iso,
-                           const float origin[3], const float size[3], ip_mc_vertex *out);
+                            const float origin[3], const float size[3], ip_mc_vertex *out);
 
 /*! ip__mc_cell_edge_points() : the points where the surface crosses the cell's edges, exactly
  *  where ip__mc_triangulate_cell() (same values, iso, origin, size) puts its vertices, without
@@ -115,7 +115,7 @@ int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], 
  *  (ip__mc_edge_table of the cell's case); the others are left alone. A cell's triangles are
  *  then the rows of ip__mc_triangle_table. No allocation. */
 unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float origin[3],
-                                const float size[3], float points[12][3]);
+                                 const float size[3], float points[12][3]);
 
 /*! ip__mc_ray_hits_cell() : whether the ray ray_origin + t * ray_dir, t >= 0, hits a triangle of
  *  the cell's triangulation (either side), as produced by ip__mc_triangulate_cell with the same
@@ -126,8 +126,8 @@ unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float o
  *  Triangle edges count as hits, so a ray through an edge shared by two triangles is not lost.
  *  @return 1 on a hit, 0 otherwise. No allocation. */
 int ip__mc_ray_hits_cell(const float values[8], float iso, const float origin[3],
-                        const float size[3], const float ray_origin[3], const float ray_dir[3],
-                        float *t_hit);
+                         const float size[3], const float ray_origin[3], const float ray_dir[3],
+                         float *t_hit);
 
 #ifdef __cplusplus
 }

@@ -3,6 +3,8 @@
  * test run and compares: edit the generator, not this file. */
 #include "mc.h"
 
+/* The tables keep their rows of 8 and 16 entries. */
+/* clang-format off */
 const uint8_t ip__mc_edge_corners[12][2] = {
     {0, 1}, {2, 3}, {4, 5}, {6, 7},
     {0, 2}, {1, 3}, {4, 6}, {5, 7},
@@ -321,3 +323,4 @@ const int8_t ip__mc_triangle_table[256][16] = {
     /* 0xfe */ {0, 8, 4, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1},
     /* 0xff */ {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1},
 };
+/* clang-format on */

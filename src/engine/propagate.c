@@ -13,9 +13,9 @@
 #define TIMING_STRIDE 16 /* extractions per timed extraction */
 
 ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
-                             ip_mesh *mesh, const ip_camera *camera, float iso,
-                             const ip_engine_options *options, double near_distance,
-                             double far_distance)
+                              ip_mesh *mesh, const ip_camera *camera, float iso,
+                              const ip_engine_options *options, double near_distance,
+                              double far_distance)
 {
     memset(p, 0, sizeof *p);
     p->sampler = sampler;
@@ -41,7 +41,7 @@ void ip__propagator_free(ip_propagator *p)
 }
 
 int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float iso,
-                    unsigned *mc_case, ip_status *st)
+                     unsigned *mc_case, ip_status *st)
 {
     ip_mc_vertex v[IP_MC_MAX_VERTICES];
     int n = ip__sampler_triangulate(s, cell, iso, v, mc_case);
@@ -55,8 +55,8 @@ int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float
     int16_t nor[9 * IP_MC_MAX_TRIANGLES];
     uint64_t ids[IP_MC_MAX_TRIANGLES];
     const ip_level_layout *lv = &s->layout->levels[s->level];
-    uint64_t linear = cell[0] + (uint64_t)(lv->dims[0] - 1) *
-                                    (cell[1] + (uint64_t)(lv->dims[1] - 1) * cell[2]);
+    uint64_t linear =
+        cell[0] + (uint64_t)(lv->dims[0] - 1) * (cell[1] + (uint64_t)(lv->dims[1] - 1) * cell[2]);
     for (int t = 0; t < n; t++) {
         ids[t] = ip_cell_id(s->level, linear);
         for (int k = 0; k < 3; k++)
@@ -116,9 +116,9 @@ static ip_status grow_queue(ip_propagator *p, uint64_t head, uint64_t tail)
 }
 
 ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
-                       ip_engine_counts *counts)
+                        ip_engine_counts *counts)
 {
-    static const int offsets[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0},
+    static const int offsets[6][3] = {{-1, 0, 0}, {1, 0, 0},  {0, -1, 0},
                                       {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
     const uint32_t *dims = p->sampler->dims;
     const double *eye = p->camera->eye;
@@ -127,8 +127,8 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
     double centre[3], diagonal;
     cell_centre(p->sampler, seed, centre, &diagonal);
     uint64_t head = 0, tail = 0;
-    p->queue[tail++] = (ip_queued_cell){{seed[0], seed[1], seed[2]},
-                                        (float)angle_to(eye, dir, centre)};
+    p->queue[tail++] =
+        (ip_queued_cell){{seed[0], seed[1], seed[2]}, (float)angle_to(eye, dir, centre)};
     ip_status st = IP_OK;
     while (head < tail && st == IP_OK) {
         ip_queued_cell q = p->queue[head++];
@@ -178,8 +178,8 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
             if (was < 0)
                 st = IP_ERR_NOMEM;
             else if (!was)
-                p->queue[tail++] = (ip_queued_cell){{n3[0], n3[1], n3[2]},
-                                                    (float)fmax(q.max_angle, a)};
+                p->queue[tail++] =
+                    (ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_angle, a)};
         }
     }
     double total = ip_now_seconds() - start;

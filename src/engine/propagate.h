@@ -21,9 +21,9 @@ typedef struct ip_propagator {
     const ip_camera *camera;
     ip_camera_basis basis;
     float iso;
-    double cutoff;      /* radians */
-    double foldback;    /* radians */
-    double pixel_scale; /* pixels per unit of (size / depth) */
+    double cutoff;                      /* radians */
+    double foldback;                    /* radians */
+    double pixel_scale;                 /* pixels per unit of (size / depth) */
     double near_distance, far_distance; /* the level's distance band from the eye */
     ip_queued_cell *queue;
     uint64_t queue_capacity;
@@ -33,20 +33,20 @@ typedef struct ip_propagator {
  * [near_distance, far_distance) from the eye belong to another level and stop it (the paper's
  * resolution boundary). */
 ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
-                             ip_mesh *mesh, const ip_camera *camera, float iso,
-                             const ip_engine_options *options, double near_distance,
-                             double far_distance);
+                              ip_mesh *mesh, const ip_camera *camera, float iso,
+                              const ip_engine_options *options, double near_distance,
+                              double far_distance);
 void ip__propagator_free(ip_propagator *p);
 
 /* Propagates from `seed` (already marked visited) along the surface, for the ray `dir` (unit,
  * world) from the camera's eye. Adds to counts' cells, triangles and times.
  * @return IP_OK, IP_ERR_NOMEM or the sampler's error. */
 ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
-                       ip_engine_counts *counts);
+                        ip_engine_counts *counts);
 
 /* Triangulates `cell` and appends its triangles to `mesh`. Sets *mc_case. Returns the number of
  * triangles, or -1 on a read failure / out of memory (status in *st). */
 int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float iso,
-                    unsigned *mc_case, ip_status *st);
+                     unsigned *mc_case, ip_status *st);
 
 #endif

@@ -103,8 +103,7 @@ static void next_cell(ip_ray_order *order, uint32_t nx, uint32_t ny)
 /* The pixel span [*first, *end) of cell `cell` when a side is cut into 2^splits cells. The
  * boundaries floor(i * side / 2^splits) of a level are among those of every finer level, so a
  * cell's span is the union of its children's. */
-static void cell_span(uint32_t side, uint32_t splits, uint32_t cell, uint32_t *first,
-                      uint32_t *end)
+static void cell_span(uint32_t side, uint32_t splits, uint32_t cell, uint32_t *first, uint32_t *end)
 {
     *first = (uint32_t)(((uint64_t)cell * side) >> splits);
     *end = (uint32_t)(((uint64_t)(cell + 1) * side) >> splits);

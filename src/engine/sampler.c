@@ -80,8 +80,8 @@ const ip_brick *ip__sampler_cell_brick(ip_sampler *s, const uint32_t cell[3])
      * A brick's cells are origin .. origin + B - 1 (the unsigned difference wraps below). */
     const ip_brick *last = &s->held[s->last];
     uint32_t edge = s->layout->brick_edge;
-    if (s->used[s->last] && cell[0] - last->origin[0] < edge &&
-        cell[1] - last->origin[1] < edge && cell[2] - last->origin[2] < edge)
+    if (s->used[s->last] && cell[0] - last->origin[0] < edge && cell[1] - last->origin[1] < edge &&
+        cell[2] - last->origin[2] < edge)
         return last;
     uint32_t b[3];
     for (int a = 0; a < 3; a++)
@@ -101,7 +101,7 @@ int ip__sampler_cell_values(ip_sampler *s, const uint32_t cell[3], float values[
 }
 
 void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float origin[3],
-                         float size[3])
+                          float size[3])
 {
     for (int a = 0; a < 3; a++) {
         origin[a] = (float)s->world[a][cell[a]];
@@ -155,8 +155,8 @@ static int gradient_neighbours(ip_sampler *s, const uint32_t cell[3], const ip_b
         for (int c = 0; c < 8; c++)
             for (int a = 0; a < 3; a++)
                 offsets[3 * c + a] = corners[c] + ((c >> a) & 1 ? above[a] : below[a]);
-        ip__samples_gather(b->samples, s->layout->type, ip__sample_index(b, cell), offsets,
-                          24, out);
+        ip__samples_gather(b->samples, s->layout->type, ip__sample_index(b, cell), offsets, 24,
+                           out);
         return 1;
     }
     /* A brick read here may take the slot of `b`: the slot then describes the new brick,
@@ -182,7 +182,7 @@ static double span(const ip_sampler *s, int a, int64_t i)
 }
 
 int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
-                           unsigned *mc_case)
+                            unsigned *mc_case)
 {
     float values[8], outer[24], gradients[8][3], origin[3], size[3];
     /* The case first, from the 8 corners alone: most cells of an active sub-block are not

@@ -18,14 +18,14 @@ typedef struct ip_sampler {
     ip_cache *cache;
     const ip_layout *layout;
     uint32_t level;
-    uint32_t dims[3];         /* the level's samples */
-    double *world[3];         /* world coordinate of each level sample along each axis */
+    uint32_t dims[3]; /* the level's samples */
+    double *world[3]; /* world coordinate of each level sample along each axis */
     ip_brick held[IP_SAMPLER_SLOTS];
     int used[IP_SAMPLER_SLOTS];
     unsigned next_victim;
-    unsigned last;            /* the slot returned last: the first one tried for a cell */
-    unsigned edge_shift;      /* log2 of the brick edge: brick coordinates without a divide */
-    ip_status status;         /* the first failure, IP_OK until then */
+    unsigned last;       /* the slot returned last: the first one tried for a cell */
+    unsigned edge_shift; /* log2 of the brick edge: brick coordinates without a divide */
+    ip_status status;    /* the first failure, IP_OK until then */
     ip_error error;
 } ip_sampler;
 
@@ -50,14 +50,14 @@ int ip__sampler_cell_values(ip_sampler *s, const uint32_t cell[3], float values[
  * sample, and inlined with a constant count the loops unroll: the samplers' hot paths read
  * 8 (a cell) or 24 (its gradient neighbours) samples at a time. */
 static inline void ip__samples_gather(const void *samples, ip_type type, size_t first,
-                                     const ptrdiff_t *offsets, int count, float *out)
+                                      const ptrdiff_t *offsets, int count, float *out)
 {
-#define IP_GATHER_AS(T)                                                                    \
-    do {                                                                                   \
-        const T *p = (const T *)samples + first;                                           \
-        for (int i = 0; i < count; i++)                                                    \
-            out[i] = (float)p[offsets[i]];                                                 \
-        return;                                                                            \
+#define IP_GATHER_AS(T)                          \
+    do {                                         \
+        const T *p = (const T *)samples + first; \
+        for (int i = 0; i < count; i++)          \
+            out[i] = (float)p[offsets[i]];       \
+        return;                                  \
     } while (0)
     switch (type) {
     case IP_UINT8: IP_GATHER_AS(uint8_t);
@@ -88,21 +88,20 @@ static inline size_t ip__sample_index(const ip_brick *b, const uint32_t p[3])
 
 /* The 8 corner values of `cell`, which brick `b` holds, with the brick's corner offsets:
  * ip__sampler_cell_values() without the brick lookup, for loops over the cells of one brick. */
-static inline void ip__cell_values(const ip_brick *b, ip_type type,
-                                        const ptrdiff_t offsets[8], const uint32_t cell[3],
-                                        float values[8])
+static inline void ip__cell_values(const ip_brick *b, ip_type type, const ptrdiff_t offsets[8],
+                                   const uint32_t cell[3], float values[8])
 {
     ip__samples_gather(b->samples, type, ip__sample_index(b, cell), offsets, 8, values);
 }
 
 /* World origin and size of `cell`. */
 void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float origin[3],
-                         float size[3]);
+                          float size[3]);
 
 /* Triangulates `cell` with gradient normals: writes up to IP_MC_MAX_VERTICES vertices and the
  * marching-cubes case. Returns the number of triangles, or -1 after a failure. */
-int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso,
-                           ip_mc_vertex *out, unsigned *mc_case);
+int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
+                            unsigned *mc_case);
 
 /* 1 when the range [lo, hi] (over cell corners) may hold an active cell for `iso`: some corner
  * >= iso and some corner < iso. */

@@ -10,10 +10,10 @@
  * parameter t stays the world distance along the ray. */
 typedef struct index_ray {
     double origin[3], dir[3];
-    double inv_dir[3];  /* 1 / dir (0 where dir is 0, unused there): clip() runs per node */
-    double len;         /* the largest |dir| component, for dda_init()'s nudge */
+    double inv_dir[3]; /* 1 / dir (0 where dir is 0, unused there): clip() runs per node */
+    double len;        /* the largest |dir| component, for dda_init()'s nudge */
     const double *world_origin, *world_dir;
-    double u[3], w[3];  /* a unit basis across world_dir, for classify_cell() */
+    double u[3], w[3]; /* a unit basis across world_dir, for classify_cell() */
 } index_ray;
 
 /* A unit basis (u, w) across the unit direction d. */
@@ -31,8 +31,7 @@ static void across_basis(const double d[3], double u[3], double w[3])
 }
 
 /* Clips the ray to the index box [lo, hi]; returns 0 when it misses it or only behind t0. */
-static int clip(const index_ray *r, const double lo[3], const double hi[3], double *t0,
-                double *t1)
+static int clip(const index_ray *r, const double lo[3], const double hi[3], double *t0, double *t1)
 {
     double a = *t0, b = *t1;
     for (int k = 0; k < 3; k++) {
@@ -119,8 +118,8 @@ static int active(const float *range, float iso)
  * the margin of its edge; 1: outside every triangle, within the margin of one; 0: none.
  * `mc` is the cell's case; `ro` the ray's origin in the cell's frame (corner 0 at the origin),
  * its direction and the basis across it are r's. */
-static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc,
-                         const float values[8], const float size[3], const double ro[3])
+static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc, const float values[8],
+                         const float size[3], const double ro[3])
 {
     static const float zero[3] = {0, 0, 0};
     float points[12][3];
@@ -155,9 +154,9 @@ static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc,
             least = fmin(least, area >= 0 ? dist : -dist);
         }
         int kind = area != 0 && least >= s->margin ? 3
-                   : area != 0 && least >= 0      ? 2
-                   : least >= -s->margin          ? 1
-                                                  : 0;
+                   : area != 0 && least >= 0       ? 2
+                   : least >= -s->margin           ? 1
+                                                   : 0;
         best = kind > best ? kind : best;
     }
     return best;
@@ -179,7 +178,8 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
     dda d;
     dda_init(&d, r, base, 1.0, n, t0, t1);
     for (;;) {
-        uint32_t c[3] = {lo[0] + (uint32_t)d.i[0], lo[1] + (uint32_t)d.i[1], lo[2] + (uint32_t)d.i[2]};
+        uint32_t c[3] = {lo[0] + (uint32_t)d.i[0], lo[1] + (uint32_t)d.i[1],
+                         lo[2] + (uint32_t)d.i[2]};
         float values[8];
         ip__cell_values(brick, s->layout->type, corners, c, values);
         unsigned mc = ip__mc_case(values, s->iso);
@@ -320,7 +320,7 @@ void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_
 }
 
 int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
-                 double t_max, uint32_t cells[][3], unsigned *count, int *seed_index)
+                  double t_max, uint32_t cells[][3], unsigned *count, int *seed_index)
 {
     s->found = cells;
     s->found_count = 0;

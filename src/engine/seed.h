@@ -15,17 +15,17 @@ typedef struct ip_seeder {
     const ip_layout *layout;
     uint32_t level;
     float iso;
-    double scale[3];     /* world units per level cell along each axis (uniform part) */
+    double scale[3];       /* world units per level cell along each axis (uniform part) */
     uint64_t cells_tested; /* active cells whose triangles were tested against a ray */
     uint32_t (*found)[3];  /* the cells of the current ray (see ip__seed_find) */
     unsigned found_count;
-    int seed_index;        /* position in found of the first cell the ray is inside, or -1 */
-    double margin;         /* IP_SEED_MARGIN_PIXELS as an angle, radians */
+    int seed_index; /* position in found of the first cell the ray is inside, or -1 */
+    double margin;  /* IP_SEED_MARGIN_PIXELS as an angle, radians */
     /* Per octree depth of the level (0: the bricks): the node grid and the range of its
      * node (0, 0, 0), the others following x fastest. */
     uint32_t grid[IP_SEED_MAX_DEPTH + 1][3];
     const float *ranges[IP_SEED_MAX_DEPTH + 1];
-    uint64_t first_brick;  /* global index of the level's brick (0, 0, 0) */
+    uint64_t first_brick; /* global index of the level's brick (0, 0, 0) */
 } ip_seeder;
 
 /* A ray whose pixel centre lies within this distance of a triangle's projected edge extracts
@@ -47,6 +47,6 @@ void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_
  * @return 1 when there is a seed, 0 when not (the cells are near misses only, possibly none),
  * -1 when a brick could not be read (see the sampler's status). */
 int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
-                 double t_max, uint32_t cells[][3], unsigned *count, int *seed_index);
+                  double t_max, uint32_t cells[][3], unsigned *count, int *seed_index);
 
 #endif

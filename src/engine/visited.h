@@ -14,7 +14,7 @@ typedef struct ip_visited {
     const ip_layout *layout;
     _Atomic(atomic_uint_fast64_t *) *bitmaps; /* one per brick of every level, or NULL */
     uint64_t words_per_brick;
-    atomic_uint_fast64_t bytes;                /* allocated bitmap bytes */
+    atomic_uint_fast64_t bytes; /* allocated bitmap bytes */
 } ip_visited;
 
 ip_status ip__visited_init(ip_visited *v, const ip_layout *layout);

@@ -73,7 +73,7 @@ typedef struct plane_context {
     const ip_gen_params *params;
     uint32_t z_index;
     double z;
-    double half_voxel[3];  /* half a voxel along each axis, normalised units */
+    double half_voxel[3]; /* half a voxel along each axis, normalised units */
     plane_ellipsoid ellipsoids[PARTIAL][ELLIPSOID_COUNT]; /* per sub-plane in z */
     size_t ellipsoid_count[PARTIAL];
     double gyroid_sin_z, gyroid_cos_z;
@@ -86,8 +86,8 @@ typedef struct axis_point {
     double sin_k, cos_k;
 } axis_point;
 
-static const char *const field_names[FIELD_COUNT] = {
-    "shepp-logan", "sphere", "gyroid", "marschner-lobb"};
+static const char *const field_names[FIELD_COUNT] = {"shepp-logan", "sphere", "gyroid",
+                                                     "marschner-lobb"};
 
 const char *ip_field_name(ip_field field)
 {
@@ -283,23 +283,23 @@ static ip_status check_params(const ip_gen_params *params, const char *what, ip_
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: unknown field %d", what, (int)params->field);
     if (ip_type_size(params->type) == 0)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: unknown sample type %d", what,
-                       (int)params->type);
+                        (int)params->type);
     for (int axis = 0; axis < 3; axis++) {
         if (params->dims[axis] < 2)
             return ip__fail(err, IP_ERR_ARGUMENT,
-                           "%s: dimensions %" PRIu32 "x%" PRIu32 "x%" PRIu32
-                           " must each be at least 2", what,
-                           params->dims[0], params->dims[1], params->dims[2]);
+                            "%s: dimensions %" PRIu32 "x%" PRIu32 "x%" PRIu32
+                            " must each be at least 2",
+                            what, params->dims[0], params->dims[1], params->dims[2]);
     }
     if (!(params->noise >= 0.0) || !isfinite(params->noise))
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: noise %g must be finite and >= 0", what,
-                       params->noise);
+                        params->noise);
     return IP_OK;
 }
 
 /* Fills samples x0 .. x0 + count - 1 of rows y_first .. y_end - 1 of the plane at dst. */
-static void generate_columns(const plane_context *pc, uint32_t x0, uint32_t count,
-                             uint32_t y_first, uint32_t y_end, void *dst)
+static void generate_columns(const plane_context *pc, uint32_t x0, uint32_t count, uint32_t y_first,
+                             uint32_t y_end, void *dst)
 {
     const ip_gen_params *params = pc->params;
     uint32_t nx = params->dims[0], ny = params->dims[1];
@@ -321,8 +321,8 @@ static void generate_columns(const plane_context *pc, uint32_t x0, uint32_t coun
 }
 
 /* Fills rows y_first .. y_end - 1 of plane z into the plane at dst. */
-static void generate_rows(const ip_gen_params *params, uint32_t z, uint32_t y_first,
-                          uint32_t y_end, void *dst)
+static void generate_rows(const ip_gen_params *params, uint32_t z, uint32_t y_first, uint32_t y_end,
+                          void *dst)
 {
     plane_context pc;
     prepare_plane(&pc, params, z);
@@ -339,7 +339,7 @@ ip_status ip_generate_plane(const ip_gen_params *params, uint32_t z, void *dst, 
         return st;
     if (z >= params->dims[2])
         return ip__fail(err, IP_ERR_ARGUMENT, "generate: plane %" PRIu32 " is outside 0..%" PRIu32,
-                       z, params->dims[2] - 1);
+                        z, params->dims[2] - 1);
     if (!dst)
         return ip__fail(err, IP_ERR_ARGUMENT, "generate: no destination buffer");
     generate_rows(params, z, 0, params->dims[1], dst);
@@ -396,16 +396,15 @@ static ip_status plane_size(const uint32_t dims[3], ip_type type, const char *pa
     uint64_t plane = (uint64_t)dims[0] * dims[1] * ip_type_size(type);
     if (plane / ip_type_size(type) / dims[0] != dims[1] || plane > SIZE_MAX / 2 ||
         plane > (uint64_t)INT64_MAX / dims[2])
-        return ip__fail(err, IP_ERR_ARGUMENT, "%s: a %" PRIu32 "x%" PRIu32 "x%" PRIu32
-                       " %s volume is too large", path, dims[0], dims[1], dims[2],
-                       ip_type_name(type));
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "%s: a %" PRIu32 "x%" PRIu32 "x%" PRIu32 " %s volume is too large", path,
+                        dims[0], dims[1], dims[2], ip_type_name(type));
     *plane_bytes = (size_t)plane;
     return IP_OK;
 }
 
-static ip_status write_planes(const ip_gen_params *params, ip_atomic_file *out,
-                              unsigned char *buf, size_t plane_bytes, uint32_t group,
-                              ip_error *err)
+static ip_status write_planes(const ip_gen_params *params, ip_atomic_file *out, unsigned char *buf,
+                              size_t plane_bytes, uint32_t group, ip_error *err)
 {
     size_t size = ip_type_size(params->type);
     ip__pool *pool;
@@ -417,15 +416,14 @@ static ip_status write_planes(const ip_gen_params *params, ip_atomic_file *out,
         generate_group(params, z, count, buf, plane_bytes, pool);
         if (!ip__host_little_endian())
             ip__swap_bytes(buf, (size_t)count * plane_bytes / size, size);
-        st = ip__pwrite_all(out->fd, buf, (size_t)count * plane_bytes,
-                            (uint64_t)z * plane_bytes, out->path, err);
+        st = ip__pwrite_all(out->fd, buf, (size_t)count * plane_bytes, (uint64_t)z * plane_bytes,
+                            out->path, err);
     }
     ip__pool_destroy(pool);
     return st;
 }
 
-ip_status ip_generate_write(const ip_gen_params *params, const char *path, int force,
-                            ip_error *err)
+ip_status ip_generate_write(const ip_gen_params *params, const char *path, int force, ip_error *err)
 {
     size_t plane_bytes = 0;
     ip_atomic_file out;
@@ -443,7 +441,7 @@ ip_status ip_generate_write(const ip_gen_params *params, const char *path, int f
     unsigned char *buf = malloc(group * plane_bytes);
     if (!buf)
         return ip__fail(err, IP_ERR_NOMEM, "%s: cannot allocate %zu bytes for %zu planes", path,
-                       group * plane_bytes, group);
+                        group * plane_bytes, group);
     st = ip__atomic_create(&out, path, force, err);
     if (st == IP_OK)
         st = write_planes(params, &out, buf, plane_bytes, (uint32_t)group, err);

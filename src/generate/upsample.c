@@ -28,15 +28,15 @@ typedef struct upsampler {
     uint32_t in[3], out[3];
     size_t sample_size;
     size_t out_plane_bytes;
-    uint32_t group;           /* output planes per write */
+    uint32_t group; /* output planes per write */
     axis_table axes[3];
-    void *raw;                /* one input plane as read */
-    float *lower, *upper;     /* input planes index and index + 1 of the z table */
-    uint32_t lower_z;         /* input plane held in `lower` */
-    uint32_t planes_read;     /* input planes consumed from the reader */
-    float *blend_z;           /* lower and upper blended for one output plane */
-    float *rows;              /* blend_z's rows interpolated along x: in[1] x out[0] */
-    unsigned char *out_buf;   /* `group` output planes */
+    void *raw;              /* one input plane as read */
+    float *lower, *upper;   /* input planes index and index + 1 of the z table */
+    uint32_t lower_z;       /* input plane held in `lower` */
+    uint32_t planes_read;   /* input planes consumed from the reader */
+    float *blend_z;         /* lower and upper blended for one output plane */
+    float *rows;            /* blend_z's rows interpolated along x: in[1] x out[0] */
+    unsigned char *out_buf; /* `group` output planes */
     ip_input_reader *reader;
     ip_atomic_file file;
 } upsampler;
@@ -90,11 +90,11 @@ static ip_status upsampler_size(upsampler *u, const char *path, ip_error *err)
         uint64_t n = (uint64_t)u->input->dims[axis] * u->factor;
         if (u->input->dims[axis] < 2)
             return ip__fail(err, IP_ERR_ARGUMENT, "%s: input dimension %" PRIu32 " is under 2",
-                           path, u->input->dims[axis]);
+                            path, u->input->dims[axis]);
         if (n >= MAX_DIM)
             return ip__fail(err, IP_ERR_ARGUMENT,
-                           "%s: %" PRIu32 " x %" PRIu32 " samples is too many along an axis",
-                           path, u->input->dims[axis], u->factor);
+                            "%s: %" PRIu32 " x %" PRIu32 " samples is too many along an axis", path,
+                            u->input->dims[axis], u->factor);
         u->in[axis] = u->input->dims[axis];
         u->out[axis] = (uint32_t)n;
     }
@@ -103,8 +103,9 @@ static ip_status upsampler_size(upsampler *u, const char *path, ip_error *err)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: unknown input sample type", path);
     uint64_t plane = (uint64_t)u->out[0] * u->out[1] * u->sample_size;
     if (plane > SIZE_MAX / 4 || plane > (uint64_t)INT64_MAX / u->out[2])
-        return ip__fail(err, IP_ERR_ARGUMENT, "%s: output of %" PRIu32 "x%" PRIu32 "x%" PRIu32
-                       " samples is too large", path, u->out[0], u->out[1], u->out[2]);
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "%s: output of %" PRIu32 "x%" PRIu32 "x%" PRIu32 " samples is too large",
+                        path, u->out[0], u->out[1], u->out[2]);
     u->out_plane_bytes = (size_t)plane;
     size_t group = plane >= WRITE_GROUP_BYTES ? 1 : WRITE_GROUP_BYTES / (size_t)plane;
     u->group = group > u->out[2] ? u->out[2] : (uint32_t)group;
@@ -149,9 +150,7 @@ static ip_status read_plane(upsampler *u, float *dst, ip_error *err)
         for (size_t i = 0; i < n; i++)
             dst[i] = (float)((const int16_t *)u->raw)[i];
         break;
-    case IP_FLOAT32:
-        memcpy(dst, u->raw, n * sizeof(float));
-        break;
+    case IP_FLOAT32: memcpy(dst, u->raw, n * sizeof(float)); break;
     }
     return IP_OK;
 }
@@ -202,8 +201,7 @@ static void interpolate_rows(upsampler *u)
 /* Stores `n` interpolated values as `type`, rounding integers to nearest; the values are convex
  * combinations of samples, so they are already inside the type's range. The offsets keep the
  * truncating conversion's argument positive, which makes it round to nearest. */
-static void store_row(const float *a, const float *b, float w, ip_type type, void *dst,
-                      size_t n)
+static void store_row(const float *a, const float *b, float w, ip_type type, void *dst, size_t n)
 {
     float v = 1.0f - w;
     switch (type) {
@@ -230,8 +228,7 @@ static void make_plane(upsampler *u, uint32_t z, unsigned char *dst)
 {
     const axis_table *ty = &u->axes[1];
     size_t row_bytes = (size_t)u->out[0] * u->sample_size;
-    blend_planes(u->lower, u->upper, u->axes[2].weight[z], u->blend_z,
-                 (size_t)u->in[0] * u->in[1]);
+    blend_planes(u->lower, u->upper, u->axes[2].weight[z], u->blend_z, (size_t)u->in[0] * u->in[1]);
     interpolate_rows(u);
     for (uint32_t j = 0; j < u->out[1]; j++) {
         const float *r0 = u->rows + (size_t)ty->index[j] * u->out[0];
@@ -254,7 +251,7 @@ static ip_status write_all_planes(upsampler *u, ip_error *err)
         if (!ip__host_little_endian())
             ip__swap_bytes(u->out_buf, bytes / u->sample_size, u->sample_size);
         ip_status st = ip__pwrite_all(u->file.fd, u->out_buf, bytes,
-                                     (uint64_t)z * u->out_plane_bytes, u->file.path, err);
+                                      (uint64_t)z * u->out_plane_bytes, u->file.path, err);
         if (st != IP_OK)
             return st;
     }

@@ -111,14 +111,16 @@ static ip_status describe_from_name(const char *path, const ip_input_overrides *
         size_t type_len = len - dims_end - 1;
         if (type_len >= sizeof type_text)
             return ip__fail(err, IP_ERR_INPUT,
-                           "%s: unknown type '%.*s' in the file name (use uint8, uint16, int16 "
-                           "or float32)", path, (int)type_len, type_sep + 1);
+                            "%s: unknown type '%.*s' in the file name (use uint8, uint16, int16 "
+                            "or float32)",
+                            path, (int)type_len, type_sep + 1);
         memcpy(type_text, type_sep + 1, type_len);
         type_text[type_len] = '\0';
         if (ip_type_parse(type_text, &desc->type) != IP_OK)
             return ip__fail(err, IP_ERR_INPUT,
-                           "%s: unknown type '%s' in the file name (use uint8, uint16, int16 "
-                           "or float32)", path, type_text);
+                            "%s: unknown type '%s' in the file name (use uint8, uint16, int16 "
+                            "or float32)",
+                            path, type_text);
         found->has_type = 1;
     }
     return IP_OK;
@@ -150,7 +152,7 @@ static ip_status apply_overrides(const ip_input_overrides *overrides, ip_input_d
     if (overrides->has_type) {
         if (ip_type_size(overrides->type) == 0)
             return ip__fail(err, IP_ERR_ARGUMENT, "%s: unknown type %d in the overrides",
-                           desc->path, (int)overrides->type);
+                            desc->path, (int)overrides->type);
         desc->type = overrides->type;
         found->has_type = 1;
     }
@@ -163,19 +165,18 @@ static ip_status apply_overrides(const ip_input_overrides *overrides, ip_input_d
     return IP_OK;
 }
 
-static ip_status validate_dims(ip_input_desc *desc, const ip_text_found *found,
-                               ip_error *err)
+static ip_status validate_dims(ip_input_desc *desc, const ip_text_found *found, ip_error *err)
 {
     for (int axis = 0; axis < 3; axis++) {
         uint64_t n = found->dims[axis];
         if (n < 2)
-            return ip__fail(err, IP_ERR_INPUT, "%s: dimension %llu along %c is under 2",
-                           desc->path, (unsigned long long)n, axis_names[axis]);
+            return ip__fail(err, IP_ERR_INPUT, "%s: dimension %llu along %c is under 2", desc->path,
+                            (unsigned long long)n, axis_names[axis]);
         if (n >= IP_INPUT_DIM_LIMIT)
             return ip__fail(err, IP_ERR_INPUT,
-                           "%s: dimension %llu along %c is too large (the limit is %llu)",
-                           desc->path, (unsigned long long)n, axis_names[axis],
-                           (unsigned long long)(IP_INPUT_DIM_LIMIT - 1));
+                            "%s: dimension %llu along %c is too large (the limit is %llu)",
+                            desc->path, (unsigned long long)n, axis_names[axis],
+                            (unsigned long long)(IP_INPUT_DIM_LIMIT - 1));
         desc->dims[axis] = (uint32_t)n;
     }
     return IP_OK;
@@ -187,7 +188,7 @@ static ip_status validate_spacing(const ip_input_desc *desc, ip_error *err)
         double s = desc->spacing[axis];
         if (!isfinite(s) || s <= 0.0)
             return ip__fail(err, IP_ERR_INPUT, "%s: spacing %g along %c is not a positive number",
-                           desc->path, s, axis_names[axis]);
+                            desc->path, s, axis_names[axis]);
     }
     /* a positive spacing can still be one that nothing downstream renders correctly */
     return ip_spacing_check(desc->spacing, desc->path, err);
@@ -201,9 +202,8 @@ static ip_status data_bytes(const ip_input_desc *desc, uint64_t *out, ip_error *
     for (int axis = 0; axis < 3; axis++) {
         if (bytes > limit / desc->dims[axis])
             return ip__fail(err, IP_ERR_INPUT,
-                           "%s: %ux%ux%u samples of %s are more than 2^63 bytes", desc->path,
-                           desc->dims[0], desc->dims[1], desc->dims[2],
-                           ip_type_name(desc->type));
+                            "%s: %ux%ux%u samples of %s are more than 2^63 bytes", desc->path,
+                            desc->dims[0], desc->dims[1], desc->dims[2], ip_type_name(desc->type));
         bytes *= desc->dims[axis];
     }
     *out = bytes;
@@ -226,16 +226,16 @@ static ip_status size_mismatch(const ip_input_desc *desc, const char *label, uin
     const char *unit = sample == 1 ? "byte" : "bytes";
     if (desc->data_offset == 0)
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: file size %llu bytes does not equal %ux%ux%u x %zu %s = %llu bytes",
-                       label, (unsigned long long)file_size, desc->dims[0], desc->dims[1],
-                       desc->dims[2], sample, unit, (unsigned long long)bytes);
+                        "%s: file size %llu bytes does not equal %ux%ux%u x %zu %s = %llu bytes",
+                        label, (unsigned long long)file_size, desc->dims[0], desc->dims[1],
+                        desc->dims[2], sample, unit, (unsigned long long)bytes);
     return ip__fail(err, IP_ERR_INPUT,
-                   "%s: data size %llu bytes (file size %llu - offset %llu) does not equal "
-                   "%ux%ux%u x %zu %s = %llu bytes",
-                   label, (unsigned long long)(file_size - desc->data_offset),
-                   (unsigned long long)file_size, (unsigned long long)desc->data_offset,
-                   desc->dims[0], desc->dims[1], desc->dims[2], sample, unit,
-                   (unsigned long long)bytes);
+                    "%s: data size %llu bytes (file size %llu - offset %llu) does not equal "
+                    "%ux%ux%u x %zu %s = %llu bytes",
+                    label, (unsigned long long)(file_size - desc->data_offset),
+                    (unsigned long long)file_size, (unsigned long long)desc->data_offset,
+                    desc->dims[0], desc->dims[1], desc->dims[2], sample, unit,
+                    (unsigned long long)bytes);
 }
 
 /* Opens the data file (so that a missing or unreadable one is caught now), places data that
@@ -263,27 +263,26 @@ static ip_status check_data_file(ip_input_desc *desc, int data_at_end, uint64_t 
     if (data_at_end) {
         if (file_size < bytes)
             return ip__fail(err, IP_ERR_INPUT,
-                           "%s: file size %llu bytes is under the %ux%ux%u x %zu = %llu bytes "
-                           "of data", label, (unsigned long long)file_size, desc->dims[0],
-                           desc->dims[1], desc->dims[2], ip_type_size(desc->type),
-                           (unsigned long long)bytes);
+                            "%s: file size %llu bytes is under the %ux%ux%u x %zu = %llu bytes "
+                            "of data",
+                            label, (unsigned long long)file_size, desc->dims[0], desc->dims[1],
+                            desc->dims[2], ip_type_size(desc->type), (unsigned long long)bytes);
         desc->data_offset = file_size - bytes;
         return IP_OK;
     }
     if (desc->encoding == IP_ENCODING_GZIP) {
         if (desc->data_offset >= file_size)
             return ip__fail(err, IP_ERR_INPUT,
-                           "%s: no gzip data: the data offset %llu is at or past the end of "
-                           "the file (%llu bytes)", label,
-                           (unsigned long long)desc->data_offset,
-                           (unsigned long long)file_size);
+                            "%s: no gzip data: the data offset %llu is at or past the end of "
+                            "the file (%llu bytes)",
+                            label, (unsigned long long)desc->data_offset,
+                            (unsigned long long)file_size);
         return IP_OK;
     }
     if (desc->data_offset > file_size)
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: the data offset %llu is past the end of the file (%llu bytes)",
-                       label, (unsigned long long)desc->data_offset,
-                       (unsigned long long)file_size);
+                        "%s: the data offset %llu is past the end of the file (%llu bytes)", label,
+                        (unsigned long long)desc->data_offset, (unsigned long long)file_size);
     if (file_size - desc->data_offset != bytes)
         return size_mismatch(desc, label, file_size, bytes, err);
     return IP_OK;
@@ -297,8 +296,9 @@ static ip_status require_layout(const ip_input_desc *desc, const ip_text_found *
     if (found->has_dims && found->has_type)
         return IP_OK;
     return ip__fail(err, IP_ERR_INPUT,
-                   "%s: cannot tell dims and type: name it NAME_XxYxZ_TYPE.raw or pass --dims "
-                   "and --type", desc->path);
+                    "%s: cannot tell dims and type: name it NAME_XxYxZ_TYPE.raw or pass --dims "
+                    "and --type",
+                    desc->path);
 }
 
 static ip_status read_layout(const char *path, const ip_input_overrides *overrides,

@@ -11,15 +11,15 @@
 #include "text_header.h"
 
 typedef struct mhd_header {
-    ip_text_place at;       /* first: see ip_text_place */
-    int64_t ndims;          /* 0 until the key is seen */
-    int dims_count;         /* -1 until the key is seen */
+    ip_text_place at; /* first: see ip_text_place */
+    int64_t ndims;    /* 0 until the key is seen */
+    int dims_count;   /* -1 until the key is seen */
     uint64_t dims[3];
     int has_type;
     ip_type type;
-    int spacing_count;      /* -1 until the key is seen */
+    int spacing_count; /* -1 until the key is seen */
     double spacing[3];
-    int size_count;         /* ElementSize: the spacing when ElementSpacing is absent */
+    int size_count; /* ElementSize: the spacing when ElementSpacing is absent */
     double size[3];
     int has_msb;
     int msb;
@@ -63,8 +63,8 @@ static ip_status parse_channels(void *header, const ip_text_key *key, char *valu
         return ip__text_bad_value(h, key->name, value, "not a positive whole number", err);
     if (channels != 1)
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: ElementNumberOfChannels %lld is not supported (need 1)", h->at.path,
-                       (long long)channels);
+                        "%s: ElementNumberOfChannels %lld is not supported (need 1)", h->at.path,
+                        (long long)channels);
     return IP_OK;
 }
 
@@ -76,7 +76,7 @@ static ip_status parse_binary(void *header, const ip_text_key *key, char *value,
         return ip__text_bad_value(h, key->name, value, "not True or False", err);
     if (!binary)
         return ip__fail(err, IP_ERR_INPUT, "%s: text data (BinaryData = False) are not supported",
-                       h->at.path);
+                        h->at.path);
     return IP_OK;
 }
 
@@ -92,14 +92,21 @@ static ip_status parse_data_file(void *header, const ip_text_key *key, char *val
     /* "LIST" and "pattern%03d.raw first last step" spread the data over several files. */
     if (strncmp(value, "LIST", 4) == 0 || strchr(value, '%'))
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: data split over several files ('ElementDataFile = %.80s') is not "
-                       "supported", h->at.path, value);
+                        "%s: data split over several files ('ElementDataFile = %.80s') is not "
+                        "supported",
+                        h->at.path, value);
     return ip__text_data_path(h->at.path, value, h->data_path, err);
 }
 
 /* MetaImage keys are words: KEY(ElementType, ...) names the key "ElementType". */
-#define KEY(name, by, parse) {#name, by, parse, 0, 0}
-#define VALUE(name, by, parse, field, seen) {#name, by, parse, offsetof(mhd_header, field), seen}
+#define KEY(name, by, parse)   \
+    {                          \
+#name, by, parse, 0, 0 \
+    }
+#define VALUE(name, by, parse, field, seen)                 \
+    {                                                       \
+#name, by, parse, offsetof(mhd_header, field), seen \
+    }
 #define LIST(name, by, parse, field) \
     VALUE(name, by, parse, field, offsetof(mhd_header, field##_count))
 static const ip_text_key mhd_key_list[] = {
@@ -119,8 +126,12 @@ static const ip_text_key mhd_key_list[] = {
 #undef KEY
 #undef VALUE
 #undef LIST
-static const ip_text_keys mhd_keys = {mhd_key_list, sizeof mhd_key_list / sizeof mhd_key_list[0],
-                                      1, NULL, "MetaImage", IP_TYPE_SPELLING_METAIMAGE};
+static const ip_text_keys mhd_keys = {mhd_key_list,
+                                      sizeof mhd_key_list / sizeof mhd_key_list[0],
+                                      1,
+                                      NULL,
+                                      "MetaImage",
+                                      IP_TYPE_SPELLING_METAIMAGE};
 
 /* One "Key = Value" line; keys the reader does not need (ObjectType, Offset,
  * TransformMatrix, ...) are skipped. */
@@ -130,15 +141,15 @@ static ip_status parse_line(mhd_header *h, char *line, const ip_input_overrides 
     char *equals = strchr(line, '=');
     if (!equals)
         return ip__fail(err, IP_ERR_INPUT, "%s: line %lu is not 'Key = Value': '%.80s'", h->at.path,
-                       h->at.line_number, line);
+                        h->at.line_number, line);
     *equals = '\0';
     return ip__text_dispatch(&mhd_keys, h, ip__text_trim(line), ip__text_trim(equals + 1),
                              overrides, err);
 }
 
 /* Reads keys up to ElementDataFile, which the format puts last. */
-static ip_status read_keys(ip_text_file *file, void *header,
-                           const ip_input_overrides *overrides, ip_error *err)
+static ip_status read_keys(ip_text_file *file, void *header, const ip_input_overrides *overrides,
+                           ip_error *err)
 {
     mhd_header *h = header;
     int got;
@@ -160,24 +171,22 @@ static ip_status read_keys(ip_text_file *file, void *header,
     return ip__fail(err, IP_ERR_INPUT, "%s: missing key 'ElementDataFile'", h->at.path);
 }
 
-static ip_status check_keys(const mhd_header *h, const ip_input_overrides *overrides,
-                            ip_error *err)
+static ip_status check_keys(const mhd_header *h, const ip_input_overrides *overrides, ip_error *err)
 {
-    ip_status st = ip__text_check_dims(h, h->ndims, "NDims", h->dims_count, "DimSize", overrides,
-                                       err);
+    ip_status st =
+        ip__text_check_dims(h, h->ndims, "NDims", h->dims_count, "DimSize", overrides, err);
     if (st != IP_OK)
         return st;
     if (!(overrides && overrides->has_type) && !h->has_type)
         return ip__text_missing(h, "ElementType", err);
     if (h->spacing_count >= 0 && h->spacing_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: ElementSpacing has %d values, NDims is 3",
-                       h->at.path, h->spacing_count);
+                        h->at.path, h->spacing_count);
     if (h->spacing_count < 0 && h->size_count >= 0 && h->size_count != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: ElementSize has %d values, NDims is 3",
-                       h->at.path, h->size_count);
+        return ip__fail(err, IP_ERR_INPUT, "%s: ElementSize has %d values, NDims is 3", h->at.path,
+                        h->size_count);
     if (h->compressed && h->header_size == -1)
-        return ip__fail(err, IP_ERR_INPUT, "%s: HeaderSize -1 needs uncompressed data",
-                       h->at.path);
+        return ip__fail(err, IP_ERR_INPUT, "%s: HeaderSize -1 needs uncompressed data", h->at.path);
     return IP_OK;
 }
 

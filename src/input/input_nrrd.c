@@ -17,17 +17,17 @@
 #include "text_header.h"
 
 typedef struct nrrd_header {
-    ip_text_place at;    /* first: see ip_text_place */
+    ip_text_place at; /* first: see ip_text_place */
     int has_type;
     ip_type type;
-    int64_t dimension;   /* 0 until the field is seen */
-    int sizes_count;     /* -1 until the field is seen */
+    int64_t dimension; /* 0 until the field is seen */
+    int sizes_count;   /* -1 until the field is seen */
     uint64_t sizes[3];
     int has_endian;
     int big_endian;
     int has_encoding;
     ip_encoding encoding;
-    int spacings_count;  /* -1 until the field is seen */
+    int spacings_count; /* -1 until the field is seen */
     double spacings[3];
     int directions_count;
     double directions[3];
@@ -35,7 +35,7 @@ typedef struct nrrd_header {
     int64_t line_skip;
     int has_data_file;
     char data_path[IP_PATH_MAX];
-    int blank_line;      /* a blank line ended the header: attached data follow it */
+    int blank_line; /* a blank line ended the header: attached data follow it */
 } nrrd_header;
 
 static ip_status parse_endian(void *header, const ip_text_key *key, char *value, ip_error *err)
@@ -61,8 +61,8 @@ static ip_status parse_encoding(void *header, const ip_text_key *key, char *valu
         h->encoding = IP_ENCODING_GZIP;
     else
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: unsupported NRRD encoding '%.80s' (supported: raw, gzip)", h->at.path,
-                       value);
+                        "%s: unsupported NRRD encoding '%.80s' (supported: raw, gzip)", h->at.path,
+                        value);
     h->has_encoding = 1;
     return IP_OK;
 }
@@ -124,11 +124,9 @@ static ip_status parse_directions(void *header, const ip_text_key *key, char *va
         if (strncmp(p, "none", 4) == 0)
             p += 4;
         else if (parse_vector_norm(&p, &norm) != 0)
-            return ip__text_bad_value(h, key->name, value, "not '(x,y,z)' vectors or 'none'",
-                                      err);
+            return ip__text_bad_value(h, key->name, value, "not '(x,y,z)' vectors or 'none'", err);
         if (*p != '\0' && *p != ' ' && *p != '\t')
-            return ip__text_bad_value(h, key->name, value, "not '(x,y,z)' vectors or 'none'",
-                                      err);
+            return ip__text_bad_value(h, key->name, value, "not '(x,y,z)' vectors or 'none'", err);
         if (h->directions_count < 3)
             h->directions[h->directions_count] = spacing_of(norm);
         h->directions_count++;
@@ -160,8 +158,8 @@ static ip_status parse_data_file(void *header, const ip_text_key *key, char *val
     /* "LIST" and "printf-pattern min max step" spread the data over several files. */
     if (strncmp(value, "LIST", 4) == 0 || strchr(value, '%'))
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: data split over several files ('data file: %.80s') is not supported",
-                       h->at.path, value);
+                        "%s: data split over several files ('data file: %.80s') is not supported",
+                        h->at.path, value);
     h->has_data_file = 1;
     return ip__text_data_path(h->at.path, value, h->data_path, err);
 }
@@ -185,7 +183,7 @@ static const ip_text_key nrrd_field_list[] = {
     {"datafile", BY_NOTHING, parse_data_file, 0, 0},
 };
 static const ip_text_keys nrrd_fields = {
-    nrrd_field_list, sizeof nrrd_field_list / sizeof nrrd_field_list[0], 0, "field", "NRRD",
+    nrrd_field_list,      sizeof nrrd_field_list / sizeof nrrd_field_list[0], 0, "field", "NRRD",
     IP_TYPE_SPELLING_NRRD};
 
 /* One "field: value" line. Key/value pairs ("key:=value") and fields that describe anything
@@ -201,7 +199,7 @@ static ip_status parse_line(nrrd_header *h, char *line, const ip_input_overrides
         size_t len = strlen(line);
         if (len == 0 || line[len - 1] != ':')
             return ip__fail(err, IP_ERR_INPUT, "%s: line %lu is not 'field: value': '%.80s'",
-                           h->at.path, h->at.line_number, line);
+                            h->at.path, h->at.line_number, line);
         colon = line + len - 1;
     }
     *colon = '\0';
@@ -210,8 +208,8 @@ static ip_status parse_line(nrrd_header *h, char *line, const ip_input_overrides
 
 /* Reads the magic and the fields; h->blank_line tells whether a blank line ended the header
  * (attached data follow it) or the end of the file did. */
-static ip_status read_fields(ip_text_file *file, void *header,
-                             const ip_input_overrides *overrides, ip_error *err)
+static ip_status read_fields(ip_text_file *file, void *header, const ip_input_overrides *overrides,
+                             ip_error *err)
 {
     nrrd_header *h = header;
     int got;
@@ -220,8 +218,8 @@ static ip_status read_fields(ip_text_file *file, void *header,
         return status;
     if (!got || strncmp(file->line, "NRRD000", 7) != 0)
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: not a NRRD file (the first line does not start with NRRD000)",
-                       h->at.path);
+                        "%s: not a NRRD file (the first line does not start with NRRD000)",
+                        h->at.path);
     h->blank_line = 0;
     while ((status = ip__text_next_line(file, &got, err)) == IP_OK && got) {
         if (file->line[0] == '\0') {
@@ -246,18 +244,18 @@ static ip_status skip_lines(const nrrd_header *h, const char *data_path, int64_t
     int fd = open(data_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0)
         return ip__fail_errno(err, IP_ERR_IO, errno, "%s: data file %s: cannot open", h->at.path,
-                             data_path);
+                              data_path);
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         close(fd);
         return ip__fail(err, IP_ERR_INPUT, "%s: data file %s: not a regular file", h->at.path,
-                       data_path);
+                        data_path);
     }
     FILE *f = fdopen(fd, "rb");
     if (!f) {
         int e = errno;
         close(fd);
         return ip__fail_errno(err, IP_ERR_NOMEM, e, "%s: data file %s: cannot read", h->at.path,
-                             data_path);
+                              data_path);
     }
     if (fseeko(f, (off_t)*offset, SEEK_SET) != 0) {
         int e = errno;
@@ -277,7 +275,7 @@ static ip_status skip_lines(const nrrd_header *h, const char *data_path, int64_t
         return ip__fail(err, IP_ERR_IO, "%s: cannot read %s", h->at.path, data_path);
     if (seen < lines)
         return ip__fail(err, IP_ERR_INPUT, "%s: line skip %lld passes the end of %s", h->at.path,
-                       (long long)lines, data_path);
+                        (long long)lines, data_path);
     return IP_OK;
 }
 
@@ -293,18 +291,18 @@ static ip_status check_layout_fields(const nrrd_header *h, const ip_input_overri
     if (!h->has_encoding)
         return ip__text_missing(h, "encoding", err);
     if (h->spacings_count >= 0 && h->spacings_count != 3)
-        return ip__fail(err, IP_ERR_INPUT, "%s: spacings has %d values, dimension is 3",
-                       h->at.path, h->spacings_count);
+        return ip__fail(err, IP_ERR_INPUT, "%s: spacings has %d values, dimension is 3", h->at.path,
+                        h->spacings_count);
     if (h->directions_count >= 0 && h->directions_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: space directions has %d vectors, dimension is 3",
-                       h->at.path, h->directions_count);
+                        h->at.path, h->directions_count);
     if (h->encoding == IP_ENCODING_GZIP && h->byte_skip == -1)
         return ip__fail(err, IP_ERR_INPUT, "%s: byte skip -1 needs raw encoding, not gzip",
-                       h->at.path);
+                        h->at.path);
     /* For compressed data the format applies the byte skip after inflating. */
     if (h->encoding == IP_ENCODING_GZIP && h->byte_skip > 0)
         return ip__fail(err, IP_ERR_INPUT, "%s: byte skip with gzip encoding is not supported",
-                       h->at.path);
+                        h->at.path);
     return IP_OK;
 }
 
@@ -318,7 +316,7 @@ static ip_status check_endian(const nrrd_header *h, const ip_input_overrides *ov
     if (ip_type_size(type) <= 1)
         return IP_OK;
     return ip__fail(err, IP_ERR_INPUT, "%s: missing field 'endian' (needed for %s samples)",
-                   h->at.path, ip_type_name(type));
+                    h->at.path, ip_type_name(type));
 }
 
 static void fill_desc(const nrrd_header *h, ip_input_desc *desc, ip_text_found *found)
@@ -346,8 +344,9 @@ static ip_status place_data(const nrrd_header *h, uint64_t header_end, ip_input_
         offset = header_end;
     } else {
         return ip__fail(err, IP_ERR_INPUT,
-                       "%s: no blank line ends the header and no 'data file' field names the "
-                       "data", h->at.path);
+                        "%s: no blank line ends the header and no 'data file' field names the "
+                        "data",
+                        h->at.path);
     }
     if (h->line_skip > 0) {
         ip_status status = skip_lines(h, desc->data_path, h->line_skip, &offset, err);

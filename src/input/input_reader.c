@@ -55,17 +55,16 @@ static ip_status measure(ip_input_reader *r, ip_error *err)
     const ip_input_desc *d = &r->desc;
     r->sample_size = ip_type_size(d->type);
     if (r->sample_size == 0 || d->dims[0] < 1 || d->dims[1] < 1 || d->dims[2] < 1)
-        return ip__fail(err, IP_ERR_ARGUMENT, "%s: the description has no type or dims",
-                       d->path);
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: the description has no type or dims", d->path);
     uint64_t plane = (uint64_t)d->dims[0] * d->dims[1];
     if (plane > UINT64_MAX / r->sample_size / d->dims[2])
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: %ux%ux%u samples overflow 64 bits", d->path,
-                       d->dims[0], d->dims[1], d->dims[2]);
+                        d->dims[0], d->dims[1], d->dims[2]);
     r->plane_bytes = plane * r->sample_size;
     r->total_bytes = r->plane_bytes * d->dims[2];
     if (r->plane_bytes > SIZE_MAX)
         return ip__fail(err, IP_ERR_NOMEM, "%s: a plane of %llu bytes does not fit in memory",
-                       d->path, (unsigned long long)r->plane_bytes);
+                        d->path, (unsigned long long)r->plane_bytes);
     return IP_OK;
 }
 
@@ -79,7 +78,7 @@ static ip_status start_gzip(ip_input_reader *r, ip_error *err)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the gzip decoder", r->label);
     if (ret != Z_OK)
         return ip__fail(err, IP_ERR_IO, "%s: cannot start the gzip decoder (zlib error %d)",
-                       r->label, ret);
+                        r->label, ret);
     r->zs_live = 1;
     r->file_pos = r->desc.data_offset;
     return IP_OK;
@@ -177,7 +176,7 @@ static ip_status gzip_member_end(ip_input_reader *r, ip_error *err)
         return IP_OK;
     }
     return ip__fail(err, IP_ERR_INPUT, "%s: unexpected bytes after the end of the gzip data",
-                   r->label);
+                    r->label);
 }
 
 /* Inflates once into out[0..avail). *made counts the bytes produced; *starved is set when the
@@ -215,13 +214,13 @@ static ip_status gzip_step(ip_input_reader *r, unsigned char *out, size_t avail,
     default: break;
     }
     return ip__fail(err, IP_ERR_INPUT, "%s: gzip data are corrupt after %llu bytes: %s", r->label,
-                   (unsigned long long)r->produced, r->zs.msg ? r->zs.msg : "invalid data");
+                    (unsigned long long)r->produced, r->zs.msg ? r->zs.msg : "invalid data");
 }
 
 static ip_status gzip_ends_early(const ip_input_reader *r, ip_error *err)
 {
     return ip__fail(err, IP_ERR_INPUT, "%s: gzip data ends after %llu of %llu bytes", r->label,
-                   (unsigned long long)r->produced, (unsigned long long)r->total_bytes);
+                    (unsigned long long)r->produced, (unsigned long long)r->total_bytes);
 }
 
 static ip_status gzip_read(ip_input_reader *r, unsigned char *dst, size_t size, ip_error *err)
@@ -254,13 +253,14 @@ static ip_status gzip_finish(ip_input_reader *r, ip_error *err)
             return status;
         if (made > 0)
             return ip__fail(err, IP_ERR_INPUT,
-                           "%s: gzip data are longer than the %ux%ux%u x %zu = %llu bytes of the "
-                           "dims", r->label, r->desc.dims[0], r->desc.dims[1], r->desc.dims[2],
-                           r->sample_size, (unsigned long long)r->total_bytes);
+                            "%s: gzip data are longer than the %ux%ux%u x %zu = %llu bytes of the "
+                            "dims",
+                            r->label, r->desc.dims[0], r->desc.dims[1], r->desc.dims[2],
+                            r->sample_size, (unsigned long long)r->total_bytes);
         if (starved)
             return ip__fail(err, IP_ERR_INPUT,
-                           "%s: gzip data end without their end marker after all %llu bytes",
-                           r->label, (unsigned long long)r->total_bytes);
+                            "%s: gzip data end without their end marker after all %llu bytes",
+                            r->label, (unsigned long long)r->total_bytes);
     }
     return IP_OK;
 }
@@ -290,7 +290,7 @@ static ip_status check_finite(const ip_input_reader *r, const void *samples, siz
         unsigned y = (unsigned)((i / r->desc.dims[0]) % r->desc.dims[1]);
         unsigned long long z = r->next_z + i / plane;
         return ip__fail(err, IP_ERR_INPUT, "%s: float32 sample at (x,y,z) = (%u,%u,%llu) is %s",
-                       r->label, x, y, z, (bits & 0x007fffffu) ? "NaN" : "infinite");
+                        r->label, x, y, z, (bits & 0x007fffffu) ? "NaN" : "infinite");
     }
     return IP_OK;
 }
@@ -301,7 +301,7 @@ static ip_status read_samples(ip_input_reader *r, void *dst, uint32_t count, ip_
     ip_status status;
     if (bytes > SIZE_MAX)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: %u planes are too many to read at once",
-                       r->label, count);
+                        r->label, count);
     if (r->desc.encoding == IP_ENCODING_GZIP) {
         status = gzip_read(r, dst, (size_t)bytes, err);
         if (status == IP_OK && r->next_z + count == r->desc.dims[2])
@@ -319,18 +319,17 @@ static ip_status read_samples(ip_input_reader *r, void *dst, uint32_t count, ip_
     return IP_OK;
 }
 
-ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count,
-                               ip_error *err)
+ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count, ip_error *err)
 {
     if (!reader || (!dst && count > 0))
         return ip__fail(err, IP_ERR_ARGUMENT, "ip_input_read_planes: reader and dst are required");
     if (reader->failed != IP_OK)
         return ip__fail(err, reader->failed, "%s: the reader stopped at an earlier error",
-                       reader->label);
+                        reader->label);
     if (count > reader->desc.dims[2] - reader->next_z)
         return ip__fail(err, IP_ERR_ARGUMENT,
-                       "%s: cannot read %u planes from z = %u: the volume has %u planes",
-                       reader->label, count, reader->next_z, reader->desc.dims[2]);
+                        "%s: cannot read %u planes from z = %u: the volume has %u planes",
+                        reader->label, count, reader->next_z, reader->desc.dims[2]);
     if (count == 0)
         return IP_OK;
     ip_status status = read_samples(reader, dst, count, err);

@@ -45,7 +45,7 @@ static ip_status grow_line(ip_text_file *header, ip_error *err)
 {
     if (header->capacity > IP_TEXT_LINE_MAX)
         return ip__fail(err, IP_ERR_INPUT, "%s: header line %lu is longer than %d bytes",
-                       header->path, header->line_number + 1, IP_TEXT_LINE_MAX);
+                        header->path, header->line_number + 1, IP_TEXT_LINE_MAX);
     uint64_t capacity =
         ip__array_capacity(header->capacity, header->capacity + 1, 256, 1, IP_ARRAY_DOUBLE);
     if (capacity > IP_TEXT_LINE_MAX + 1)
@@ -69,8 +69,8 @@ ip_status ip__text_next_line(ip_text_file *header, int *got, ip_error *err)
         if (c == '\n')
             break;
         if (c == '\0')
-            return ip__fail(err, IP_ERR_INPUT, "%s: header line %lu holds a NUL byte",
-                           header->path, header->line_number + 1);
+            return ip__fail(err, IP_ERR_INPUT, "%s: header line %lu holds a NUL byte", header->path,
+                            header->line_number + 1);
         if (len + 1 >= header->capacity && (status = grow_line(header, err)) != IP_OK)
             return status;
         header->line[len++] = (char)c;
@@ -106,7 +106,7 @@ char *ip__text_trim(char *text)
 }
 
 ip_status ip__text_data_path(const char *header_path, const char *name, char out[IP_PATH_MAX],
-                              ip_error *err)
+                             ip_error *err)
 {
     int n;
     if (name[0] == '\0')
@@ -216,7 +216,7 @@ ip_status ip__text_bad_value(const void *header, const char *key, const char *va
 {
     const ip_text_place *at = header;
     return ip__fail(err, IP_ERR_INPUT, "%s: line %lu: bad %s '%.80s': %s", at->path,
-                   at->line_number, key, value, why);
+                    at->line_number, key, value, why);
 }
 
 static ip_status key_list(void *header, const ip_text_key *key, char *value, int whole,
@@ -251,11 +251,10 @@ ip_status ip__text_key_type(void *header, const ip_text_key *key, char *value, i
     char names[64];
     ip__type_names(at->keys->type_spellings, names, sizeof names);
     return ip__fail(err, IP_ERR_INPUT, "%s: unsupported %s %s '%.80s' (supported: %s)", at->path,
-                   at->keys->format, key->name, value, names);
+                    at->keys->format, key->name, value, names);
 }
 
-ip_status ip__text_key_dimensions(void *header, const ip_text_key *key, char *value,
-                                  ip_error *err)
+ip_status ip__text_key_dimensions(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
     const ip_text_place *at = header;
     int64_t *dimensions = (int64_t *)((char *)header + key->field);
@@ -263,8 +262,8 @@ ip_status ip__text_key_dimensions(void *header, const ip_text_key *key, char *va
         return ip__text_bad_value(header, key->name, value, "not a positive whole number", err);
     if (*dimensions != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: %s%s%s %lld is not supported (need 3)", at->path,
-                       at->keys->key_word ? at->keys->format : "",
-                       at->keys->key_word ? " " : "", key->name, (long long)*dimensions);
+                        at->keys->key_word ? at->keys->format : "", at->keys->key_word ? " " : "",
+                        key->name, (long long)*dimensions);
     return IP_OK;
 }
 
@@ -272,7 +271,7 @@ ip_status ip__text_missing(const void *header, const char *key, ip_error *err)
 {
     const ip_text_place *at = header;
     return ip__fail(err, IP_ERR_INPUT, "%s: missing %s '%s'", at->path,
-                   at->keys->key_word ? at->keys->key_word : "key", key);
+                    at->keys->key_word ? at->keys->key_word : "key", key);
 }
 
 ip_status ip__text_check_dims(const void *header, int64_t dimensions, const char *dimensions_key,
@@ -288,7 +287,7 @@ ip_status ip__text_check_dims(const void *header, int64_t dimensions, const char
         return ip__text_missing(header, sizes_key, err);
     if (sizes_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: %s has %d values, %s is 3", at->path, sizes_key,
-                       sizes_count, dimensions_key);
+                        sizes_count, dimensions_key);
     return IP_OK;
 }
 
@@ -328,8 +327,8 @@ ip_status ip__text_read_header(const ip_text_format *format, const char *path,
     return status;
 }
 
-ip_status ip__text_dispatch(const ip_text_keys *table, void *header, const char *key,
-                            char *value, const ip_input_overrides *overrides, ip_error *err)
+ip_status ip__text_dispatch(const ip_text_keys *table, void *header, const char *key, char *value,
+                            const ip_input_overrides *overrides, ip_error *err)
 {
     ip_text_place *at = header;
     at->keys = table;
@@ -341,10 +340,10 @@ ip_status ip__text_dispatch(const ip_text_keys *table, void *header, const char 
             return IP_OK;
         if (value[0] == '\0' && table->key_word)
             return ip__fail(err, IP_ERR_INPUT, "%s: line %lu: %s '%s' has no value", at->path,
-                           at->line_number, table->key_word, key);
+                            at->line_number, table->key_word, key);
         if (value[0] == '\0')
             return ip__fail(err, IP_ERR_INPUT, "%s: line %lu: %s has no value", at->path,
-                           at->line_number, k->name);
+                            at->line_number, k->name);
         return k->parse(header, k, value, err);
     }
     return IP_OK;

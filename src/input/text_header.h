@@ -20,9 +20,9 @@
 typedef struct ip_text_file {
     FILE *file;
     const char *path;
-    char *line;               /* the current line without its "\n" or "\r\n" */
+    char *line; /* the current line without its "\n" or "\r\n" */
     size_t capacity;
-    uint64_t offset;          /* bytes consumed so far: where the next line starts */
+    uint64_t offset; /* bytes consumed so far: where the next line starts */
     unsigned long line_number;
 } ip_text_file;
 
@@ -40,8 +40,8 @@ char *ip__text_trim(char *text);
 
 /* Resolves a data file name found in the header at `header_path`: absolute names stay as
  * they are, relative ones are taken from the header's folder. */
-ip_status ip__text_data_path(const char *header_path, const char *name,
-                              char out[IP_PATH_MAX], ip_error *err);
+ip_status ip__text_data_path(const char *header_path, const char *name, char out[IP_PATH_MAX],
+                             ip_error *err);
 
 /* Strict number parsers over the whole text (surrounding white space allowed): 0 on
  * success, -1 on anything else, including a value out of range. */
@@ -96,17 +96,17 @@ struct ip_text_key {
 struct ip_text_keys {
     const ip_text_key *keys;
     size_t count;
-    int ignore_case;      /* MetaImage keys are case-insensitive, NRRD fields are not */
-    const char *key_word; /* a key in messages: "field 'sizes'" (NRRD); NULL: "DimSize" */
-    const char *format;   /* the format's name in messages */
+    int ignore_case;         /* MetaImage keys are case-insensitive, NRRD fields are not */
+    const char *key_word;    /* a key in messages: "field 'sizes'" (NRRD); NULL: "DimSize" */
+    const char *format;      /* the format's name in messages */
     unsigned type_spellings; /* the type names it uses: IP_TYPE_SPELLING_* (internal.h) */
 };
 
 /*! ip__text_dispatch() : finds `key` in `table` and has its parser read `value` into `header`;
  *  a key that an override replaces is skipped, one not in the table ignored.
  *  @return : IP_OK, the parser's error, or IP_ERR_INPUT for an empty value. */
-ip_status ip__text_dispatch(const ip_text_keys *table, void *header, const char *key,
-                            char *value, const ip_input_overrides *overrides, ip_error *err);
+ip_status ip__text_dispatch(const ip_text_keys *table, void *header, const char *key, char *value,
+                            const ip_input_overrides *overrides, ip_error *err);
 
 /* IP_ERR_INPUT "PATH: line N: bad KEY 'VALUE': WHY" for `header` (an ip_text_place first). */
 ip_status ip__text_bad_value(const void *header, const char *key, const char *value,
@@ -123,8 +123,7 @@ ip_status ip__text_key_type(void *header, const ip_text_key *key, char *value, i
 
 /* Key parser for the number of dimensions (int64_t at the key's `field`), which must be 3. A
  * format whose keys are "field"s (NRRD) is named before the key in the message. */
-ip_status ip__text_key_dimensions(void *header, const ip_text_key *key, char *value,
-                                  ip_error *err);
+ip_status ip__text_key_dimensions(void *header, const ip_text_key *key, char *value, ip_error *err);
 
 /* What a parser found beyond the ip_input_desc fields it fills directly (data_path,
  * data_offset, type, big_endian, spacing, encoding). Dims stay 64-bit until ip_input_describe

@@ -14,8 +14,8 @@ typedef struct png_sink {
     uint64_t offset;
     const char *path;
     ip_error *err;
-    ip_status status;       /* the first failure */
-    char message[256];      /* libpng's own error message */
+    ip_status status;  /* the first failure */
+    char message[256]; /* libpng's own error message */
 } png_sink;
 
 static void sink_write(png_structp png, png_bytep data, size_t size)
@@ -75,11 +75,10 @@ static int encode(png_structp png, png_infop info, const uint8_t *rgba, uint32_t
     return 0;
 }
 
-static ip_status write_stream(png_sink *sink, const uint8_t *rgba, uint32_t width,
-                              uint32_t height)
+static ip_status write_stream(png_sink *sink, const uint8_t *rgba, uint32_t width, uint32_t height)
 {
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, sink, sink_error,
-                                              sink_warning);
+    png_structp png =
+        png_create_write_struct(PNG_LIBPNG_VER_STRING, sink, sink_error, sink_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!info) {
         png_destroy_write_struct(&png, NULL);
@@ -93,7 +92,7 @@ static ip_status write_stream(png_sink *sink, const uint8_t *rgba, uint32_t widt
         return IP_OK;
     if (sink->message[0])
         return ip__fail(sink->err, sink->status, "%s: PNG encoding failed: %s", sink->path,
-                       sink->message);
+                        sink->message);
     return sink->status; /* a write error, already reported by ip__pwrite_all */
 }
 
@@ -101,8 +100,8 @@ ip_status ip_png_write(const char *path, const uint8_t *rgba, uint32_t width, ui
                        int force, ip_error *err)
 {
     if (width == 0 || height == 0 || width > PNG_UINT_31_MAX || height > PNG_UINT_31_MAX)
-        return ip__fail(err, IP_ERR_ARGUMENT, "%s: image size %ux%u is not a PNG size", path,
-                       width, height);
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: image size %ux%u is not a PNG size", path, width,
+                        height);
     ip_atomic_file out;
     ip_status st = ip__atomic_create(&out, path, force, err);
     if (st != IP_OK)

@@ -11,7 +11,12 @@
  * two triangles sharing an edge agree on every pixel centre. Clipping to a guard band keeps
  * snapped coordinates within 2^20 pixels of the image, so products of coordinate differences
  * stay below 2^60. */
-enum { SUBPIXEL_BITS = 8, MAX_SIDE = 65536, MAX_POLYGON = 9, PLANE_COUNT = 6 };
+enum {
+    SUBPIXEL_BITS = 8,
+    MAX_SIDE = 65536,
+    MAX_POLYGON = 9,
+    PLANE_COUNT = 6
+};
 #define SUBPIXEL ((int64_t)1 << SUBPIXEL_BITS)
 #define GUARD_PIXELS 1048576.0
 
@@ -39,14 +44,13 @@ static void shade_background(const ip_shading *s, uint32_t row, uint32_t height,
 {
     double t = (row + 0.5) / height;
     for (int i = 0; i < 3; i++)
-        out[i] = to_unorm8(s->background_top[i] + t * (s->background_bottom[i] -
-                                                         (double)s->background_top[i]));
+        out[i] = to_unorm8(s->background_top[i] +
+                           t * (s->background_bottom[i] - (double)s->background_top[i]));
     out[3] = 255;
 }
 
 /* n: the interpolated normal (any length); v: the unit vector toward the eye. */
-static void shade_surface(const ip_shading *s, const float n[3], const double v[3],
-                          uint8_t out[4])
+static void shade_surface(const ip_shading *s, const float n[3], const double v[3], uint8_t out[4])
 {
     const double normal[3] = {n[0], n[1], n[2]};
     double len = ip__vec3_length(normal);
@@ -78,7 +82,7 @@ typedef struct raster_target {
     uint32_t width, height;
     double *inverse_depth; /* 1 / view depth of the nearest surface; 0 where empty */
     uint32_t *index;
-    float *normal;         /* 3 per pixel, or NULL when no image is wanted */
+    float *normal; /* 3 per pixel, or NULL when no image is wanted */
 } raster_target;
 
 static void setup_view(raster_view *v, const ip_camera *c, const double lo[3], const double hi[3])
@@ -177,10 +181,10 @@ static int64_t floor_div(int64_t a, int64_t b)
 
 /* One edge function E(P) = (b - a) x (P - a), positive inside, stepped per pixel. */
 typedef struct edge {
-    int64_t value;   /* at the current pixel centre, minus the fill-rule bias */
-    int64_t step_x;  /* change per pixel to the right */
-    int64_t step_y;  /* change per pixel down */
-    int64_t bias;    /* 0 on a top or left edge, 1 otherwise */
+    int64_t value;  /* at the current pixel centre, minus the fill-rule bias */
+    int64_t step_x; /* change per pixel to the right */
+    int64_t step_y; /* change per pixel down */
+    int64_t bias;   /* 0 on a top or left edge, 1 otherwise */
 } edge;
 
 static edge make_edge(const screen_vertex *a, const screen_vertex *b, int64_t px, int64_t py)
@@ -215,8 +219,7 @@ static void write_fragment(raster_target *t, size_t pixel, const screen_vertex v
             (float)((q[0] * v[0].n[k] + q[1] * v[1].n[k] + q[2] * v[2].n[k]) / inverse_depth);
 }
 
-static void scan_triangle(raster_target *t, const screen_vertex v[3], int64_t area,
-                          uint32_t index)
+static void scan_triangle(raster_target *t, const screen_vertex v[3], int64_t area, uint32_t index)
 {
     int64_t min_x = v[0].x, max_x = v[0].x, min_y = v[0].y, max_y = v[0].y;
     for (int i = 1; i < 3; i++) {
@@ -264,8 +267,7 @@ static void raster_triangle(raster_target *t, const raster_view *view, const vie
     to_screen(view, a, &v[0]);
     to_screen(view, b, &v[1]);
     to_screen(view, c, &v[2]);
-    int64_t area =
-        (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[1].y - v[0].y) * (v[2].x - v[0].x);
+    int64_t area = (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[1].y - v[0].y) * (v[2].x - v[0].x);
     if (area == 0)
         return;
     if (area < 0) {
@@ -338,13 +340,15 @@ ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_error *
 {
     for (int i = 0; i < 3; i++)
         if (!isfinite(lo[i]) || !isfinite(hi[i]) || lo[i] > hi[i])
-            return ip__fail(err, IP_ERR_ARGUMENT, "render: box [%g,%g,%g]-[%g,%g,%g] is not a "
-                           "finite box with lo <= hi", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+            return ip__fail(err, IP_ERR_ARGUMENT,
+                            "render: box [%g,%g,%g]-[%g,%g,%g] is not a "
+                            "finite box with lo <= hi",
+                            lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
     return IP_OK;
 }
 
-static ip_status check_arguments(const ip_mesh *mesh, const ip_camera *camera,
-                                 const double lo[3], const double hi[3], ip_error *err)
+static ip_status check_arguments(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
+                                 const double hi[3], ip_error *err)
 {
     ip_status st = ip_camera_check(camera, err);
     if (st == IP_OK)
@@ -353,10 +357,10 @@ static ip_status check_arguments(const ip_mesh *mesh, const ip_camera *camera,
         return st;
     if (camera->width > MAX_SIDE || camera->height > MAX_SIDE)
         return ip__fail(err, IP_ERR_ARGUMENT, "raster: image %ux%u is larger than %dx%d",
-                       camera->width, camera->height, MAX_SIDE, MAX_SIDE);
+                        camera->width, camera->height, MAX_SIDE, MAX_SIDE);
     if (mesh->triangle_count >= UINT32_MAX)
         return ip__fail(err, IP_ERR_ARGUMENT, "raster: %llu triangles are too many",
-                       (unsigned long long)mesh->triangle_count);
+                        (unsigned long long)mesh->triangle_count);
     return IP_OK;
 }
 
@@ -371,8 +375,8 @@ static ip_status allocate_target(raster_target *t, const ip_camera *camera,
     t->index = triangle_index ? triangle_index : malloc(pixels * sizeof *t->index);
     t->normal = with_normals ? malloc(pixels * 3 * sizeof *t->normal) : NULL;
     if (!t->inverse_depth || !t->index || (with_normals && !t->normal))
-        return ip__fail(err, IP_ERR_NOMEM, "raster: out of memory for a %ux%u image",
-                       camera->width, camera->height);
+        return ip__fail(err, IP_ERR_NOMEM, "raster: out of memory for a %ux%u image", camera->width,
+                        camera->height);
     for (size_t i = 0; i < pixels; i++)
         t->index[i] = UINT32_MAX;
     return IP_OK;
@@ -387,8 +391,7 @@ static void free_target(raster_target *t, const uint32_t *triangle_index)
 }
 
 ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
-                         const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
-                         ip_error *err)
+                         const double hi[3], uint32_t *triangle_index, uint8_t *rgba, ip_error *err)
 {
     ip_status st = check_arguments(mesh, camera, lo, hi, err);
     if (st != IP_OK)

@@ -25,7 +25,7 @@ static int has_extension(const char *list, const char *name)
 static ip_status egl_fail(ip_error *err, const char *what)
 {
     return ip__fail(err, IP_ERR_UNSUPPORTED, "headless OpenGL: %s (EGL error 0x%04x)", what,
-                   (unsigned)eglGetError());
+                    (unsigned)eglGetError());
 }
 
 /* The surfaceless display needs no window system and no GPU: Mesa falls back to llvmpipe. */
@@ -35,8 +35,8 @@ static ip_status open_display(EGLDisplay *out, ip_error *err)
     if (!client || !has_extension(client, "EGL_EXT_platform_base") ||
         !has_extension(client, "EGL_MESA_platform_surfaceless"))
         return ip__fail(err, IP_ERR_UNSUPPORTED,
-                       "headless OpenGL: EGL lacks the surfaceless platform "
-                       "(EGL_MESA_platform_surfaceless; install Mesa's libegl-mesa0)");
+                        "headless OpenGL: EGL lacks the surfaceless platform "
+                        "(EGL_MESA_platform_surfaceless; install Mesa's libegl-mesa0)");
     PFNEGLGETPLATFORMDISPLAYEXTPROC get_display =
         (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
     if (!get_display)
@@ -57,11 +57,13 @@ static ip_status choose_config(EGLDisplay display, EGLConfig *out, ip_error *err
 {
     const char *ext = eglQueryString(display, EGL_EXTENSIONS);
     if (!has_extension(ext, "EGL_KHR_surfaceless_context"))
-        return ip__fail(err, IP_ERR_UNSUPPORTED, "headless OpenGL: EGL lacks "
-                                                "EGL_KHR_surfaceless_context");
+        return ip__fail(err, IP_ERR_UNSUPPORTED,
+                        "headless OpenGL: EGL lacks "
+                        "EGL_KHR_surfaceless_context");
     if (!has_extension(ext, "EGL_KHR_create_context"))
-        return ip__fail(err, IP_ERR_UNSUPPORTED, "headless OpenGL: EGL lacks "
-                                                "EGL_KHR_create_context");
+        return ip__fail(err, IP_ERR_UNSUPPORTED,
+                        "headless OpenGL: EGL lacks "
+                        "EGL_KHR_create_context");
     *out = EGL_NO_CONFIG_KHR;
     if (has_extension(ext, "EGL_KHR_no_config_context"))
         return IP_OK;
@@ -80,8 +82,10 @@ static ip_status create_core_context(ip_gl_context *c, ip_error *err)
         return st;
     if (!eglBindAPI(EGL_OPENGL_API))
         return egl_fail(err, "EGL cannot bind desktop OpenGL");
-    const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION_KHR, 3,
-                                 EGL_CONTEXT_MINOR_VERSION_KHR, 3,
+    const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION_KHR,
+                                 3,
+                                 EGL_CONTEXT_MINOR_VERSION_KHR,
+                                 3,
                                  EGL_CONTEXT_OPENGL_PROFILE_MASK_KHR,
                                  EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT_KHR,
                                  EGL_NONE};

@@ -8,19 +8,19 @@
 #include "isoprop/render.h"
 
 enum {
-    POSITION_BYTES = 9 * sizeof(float),  /* a triangle's positions */
-    NORMAL_BYTES = 9 * sizeof(int16_t),  /* a triangle's packed normals */
-    MIN_CAPACITY = 4096,                 /* triangles; growth is geometric */
-    STREAM_TRIANGLES = 65536,            /* triangles per draw of ip_renderer_draw_mesh() */
+    POSITION_BYTES = 9 * sizeof(float), /* a triangle's positions */
+    NORMAL_BYTES = 9 * sizeof(int16_t), /* a triangle's packed normals */
+    MIN_CAPACITY = 4096,                /* triangles; growth is geometric */
+    STREAM_TRIANGLES = 65536,           /* triangles per draw of ip_renderer_draw_mesh() */
 };
 /* glDrawArrays counts vertices in a GLint */
 #define MAX_TRIANGLES ((uint64_t)INT32_MAX / 3)
 
 struct ip_renderer {
-    ip_gl_context *context;           /* owned; NULL on the caller's context */
-    int has_objects;                  /* OpenGL objects may exist (a context was current) */
-    uint32_t width, height;           /* pixels */
-    GLuint framebuffer;               /* drawn into and read from */
+    ip_gl_context *context;            /* owned; NULL on the caller's context */
+    int has_objects;                   /* OpenGL objects may exist (a context was current) */
+    uint32_t width, height;            /* pixels */
+    GLuint framebuffer;                /* drawn into and read from */
     GLuint color_buffer, depth_buffer; /* the headless renderer's own framebuffer */
     GLuint mesh_program, background_program;
     GLint view_at, projection_at, eye_at, surface_at, terms_at; /* mesh uniforms */
@@ -28,8 +28,9 @@ struct ip_renderer {
     GLuint mesh_array, background_array; /* vertex arrays; the background has no attributes */
     GLuint positions, normals;           /* POSITION_BYTES and NORMAL_BYTES per triangle */
     uint64_t triangle_count, triangle_capacity;
-    GLuint stream_array;                 /* ip_renderer_draw_mesh(): its vertex array, */
-    GLuint stream_positions, stream_normals; /* and buffers of STREAM_TRIANGLES, made on first use */
+    GLuint stream_array; /* ip_renderer_draw_mesh(): its vertex array, */
+    GLuint stream_positions,
+        stream_normals; /* and buffers of STREAM_TRIANGLES, made on first use */
     ip_shading shading;
 };
 
@@ -109,7 +110,7 @@ static ip_status check_gl(const char *what, ip_error *err)
         return IP_OK;
     drain_gl_errors();
     return ip__fail(err, e == GL_OUT_OF_MEMORY ? IP_ERR_NOMEM : IP_ERR_UNSUPPORTED,
-                   "renderer: %s: %s", what, gl_error_name(e));
+                    "renderer: %s: %s", what, gl_error_name(e));
 }
 
 static ip_status make_current(ip_renderer *r, ip_error *err)
@@ -122,8 +123,8 @@ static ip_status make_current(ip_renderer *r, ip_error *err)
 
 /* IP_OK when the shader or program `object` compiled or linked; otherwise deletes it and
  * fails with "WHAT: PROBLEM: its info log". */
-static ip_status check_built(GLuint object, int is_program, const char *what,
-                             const char *problem, ip_error *err)
+static ip_status check_built(GLuint object, int is_program, const char *what, const char *problem,
+                             ip_error *err)
 {
     GLint ok = GL_FALSE;
     char log[512] = "";
@@ -179,8 +180,8 @@ static ip_status link_program(const char *vertex, const char *fragment, const ch
     return st;
 }
 
-ip_status ip_gl_program(const char *vertex_source, const char *fragment_source,
-                        unsigned *program, ip_error *err)
+ip_status ip_gl_program(const char *vertex_source, const char *fragment_source, unsigned *program,
+                        ip_error *err)
 {
     GLuint built = 0;
     ip_status st = link_program(vertex_source, fragment_source, "OpenGL", &built, err);
@@ -190,8 +191,8 @@ ip_status ip_gl_program(const char *vertex_source, const char *fragment_source,
 
 static ip_status build_programs(ip_renderer *r, ip_error *err)
 {
-    ip_status st = link_program(mesh_vertex_source, mesh_fragment_source, "renderer",
-                                &r->mesh_program, err);
+    ip_status st =
+        link_program(mesh_vertex_source, mesh_fragment_source, "renderer", &r->mesh_program, err);
     if (st == IP_OK)
         st = link_program(background_vertex_source, background_fragment_source, "renderer",
                           &r->background_program, err);
@@ -237,7 +238,7 @@ static ip_status allocate_framebuffer(ip_renderer *r, uint32_t width, uint32_t h
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
     if (width > (uint32_t)max_size || height > (uint32_t)max_size)
         return ip__fail(err, IP_ERR_ARGUMENT, "renderer: %ux%u exceeds the OpenGL limit of %d",
-                       width, height, (int)max_size);
+                        width, height, (int)max_size);
     if (!r->framebuffer) {
         glGenFramebuffers(1, &r->framebuffer);
         glGenRenderbuffers(1, &r->color_buffer);
@@ -257,7 +258,7 @@ static ip_status allocate_framebuffer(ip_renderer *r, uint32_t width, uint32_t h
     ip_status st = check_gl("allocating the framebuffer", err);
     if (st == IP_OK && complete != GL_FRAMEBUFFER_COMPLETE)
         st = ip__fail(err, IP_ERR_UNSUPPORTED, "renderer: framebuffer incomplete (0x%04x)",
-                     (unsigned)complete);
+                      (unsigned)complete);
     if (st == IP_OK) {
         r->width = width;
         r->height = height;
@@ -269,7 +270,7 @@ static ip_status check_size(uint32_t width, uint32_t height, ip_error *err)
 {
     if (width == 0 || height == 0 || width > INT32_MAX || height > INT32_MAX)
         return ip__fail(err, IP_ERR_ARGUMENT, "renderer: image size %ux%u is invalid", width,
-                       height);
+                        height);
     return IP_OK;
 }
 
@@ -324,7 +325,7 @@ ip_status ip_renderer_create_current(uint32_t width, uint32_t height, uint32_t f
         return ip__fail(err, IP_ERR_UNSUPPORTED, "renderer: no OpenGL context is current");
     if (!epoxy_is_desktop_gl() || epoxy_gl_version() < 33)
         return ip__fail(err, IP_ERR_UNSUPPORTED, "renderer: OpenGL %s is older than 3.3 core",
-                       (const char *)glGetString(GL_VERSION));
+                        (const char *)glGetString(GL_VERSION));
     ip_renderer *r = calloc(1, sizeof *r);
     if (!r)
         return ip__fail(err, IP_ERR_NOMEM, "renderer: out of memory");
@@ -372,8 +373,7 @@ static ip_status reserve_triangles(ip_renderer *r, uint64_t needed, ip_error *er
     glGenBuffers(2, grown);
     for (int i = 0; i < 2; i++) {
         glBindBuffer(GL_COPY_WRITE_BUFFER, grown[i]);
-        glBufferData(GL_COPY_WRITE_BUFFER, (GLsizeiptr)(capacity * bytes[i]), NULL,
-                     GL_STATIC_DRAW);
+        glBufferData(GL_COPY_WRITE_BUFFER, (GLsizeiptr)(capacity * bytes[i]), NULL, GL_STATIC_DRAW);
         glBindBuffer(GL_COPY_READ_BUFFER, old[i]);
         if (r->triangle_count)
             glCopyBufferSubData(GL_COPY_READ_BUFFER, GL_COPY_WRITE_BUFFER, 0, 0,
@@ -397,15 +397,16 @@ static ip_status reserve_triangles(ip_renderer *r, uint64_t needed, ip_error *er
 ip_status ip_renderer_upload(ip_renderer *r, const ip_mesh *m, uint64_t first, ip_error *err)
 {
     if (first > m->triangle_count)
-        return ip__fail(err, IP_ERR_ARGUMENT, "renderer: first triangle %llu is past the %llu "
-                       "of the mesh", (unsigned long long)first,
-                       (unsigned long long)m->triangle_count);
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "renderer: first triangle %llu is past the %llu "
+                        "of the mesh",
+                        (unsigned long long)first, (unsigned long long)m->triangle_count);
     uint64_t added = m->triangle_count - first;
     if (added == 0)
         return IP_OK;
     if (added > MAX_TRIANGLES - r->triangle_count)
         return ip__fail(err, IP_ERR_LIMIT, "renderer: more than %llu triangles",
-                       (unsigned long long)MAX_TRIANGLES);
+                        (unsigned long long)MAX_TRIANGLES);
     ip_status st = make_current(r, err);
     if (st == IP_OK)
         st = reserve_triangles(r, r->triangle_count + added, err);
@@ -504,7 +505,7 @@ static ip_status begin_image(ip_renderer *r, const ip_camera *camera, const doub
         return st;
     if (camera->width != r->width || camera->height != r->height)
         return ip__fail(err, IP_ERR_ARGUMENT, "renderer: camera is %ux%u, the image %ux%u",
-                       camera->width, camera->height, r->width, r->height);
+                        camera->width, camera->height, r->width, r->height);
     st = make_current(r, err);
     if (st != IP_OK)
         return st;
@@ -561,8 +562,8 @@ ip_status ip_renderer_draw_mesh(ip_renderer *r, const ip_mesh *m, const ip_camer
         glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(count * POSITION_BYTES),
                      m->positions + 9 * first, GL_STREAM_DRAW);
         glBindBuffer(GL_ARRAY_BUFFER, r->stream_normals);
-        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(count * NORMAL_BYTES),
-                     m->normals + 9 * first, GL_STREAM_DRAW);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(count * NORMAL_BYTES), m->normals + 9 * first,
+                     GL_STREAM_DRAW);
         glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * count));
     }
     glBindBuffer(GL_ARRAY_BUFFER, 0);

@@ -24,10 +24,10 @@ typedef struct entry {
     atomic_uint_fast64_t brick;
     void *samples;
     size_t bytes;
-    size_t capacity;           /* of samples */
+    size_t capacity; /* of samples */
     uint32_t extent[3], origin[3], level;
     struct entry *next_free;
-    uint32_t resident_slot;    /* position in the resident array */
+    uint32_t resident_slot; /* position in the resident array */
 } entry;
 
 typedef struct slot {
@@ -48,27 +48,27 @@ struct ip_cache {
     const ip_store *store;
     const ip_layout *layout;
     uint64_t budget;
-    slot *slots;               /* one per brick of every level */
-    atomic_uchar *touched;     /* one flag per brick */
-    unsigned char *loading;    /* one flag per brick, under its stripe lock */
+    slot *slots;            /* one per brick of every level */
+    atomic_uchar *touched;  /* one flag per brick */
+    unsigned char *loading; /* one flag per brick, under its stripe lock */
     pthread_mutex_t stripe_lock[STRIPES];
     pthread_cond_t stripe_done[STRIPES];
     pthread_mutex_t evict_lock; /* resident set, free list, accounting */
-    entry **resident;          /* resident entries, unordered */
+    entry **resident;           /* resident entries, unordered */
     uint64_t resident_count, resident_capacity;
-    ip_lru_heap heap;          /* every resident entry once, keyed by a tick <= its last pin;
+    ip_lru_heap heap; /* every resident entry once, keyed by a tick <= its last pin;
                                   its parking room holds the pinned ones evict_one() sets aside */
     entry *free_entries;
-    void **spare_work;         /* decode scratch buffers not in use, under evict_lock */
+    void **spare_work; /* decode scratch buffers not in use, under evict_lock */
     uint64_t spare_count, spare_capacity;
-    entry **all_entries;       /* every entry ever made, for destroy */
+    entry **all_entries; /* every entry ever made, for destroy */
     uint64_t all_count, all_capacity;
     size_t work_size;
     atomic_uint_fast64_t clock;
     padded_counter hits[HIT_STRIPES]; /* striped by brick: hits on different bricks do not
                                          contend for one cache line */
-    atomic_uint_fast64_t misses, evictions, waits, bytes_decompressed, bytes_read,
-        decode_ns, over_budget_pins, errors, touched_count;
+    atomic_uint_fast64_t misses, evictions, waits, bytes_decompressed, bytes_read, decode_ns,
+        over_budget_pins, errors, touched_count;
     atomic_uint_fast64_t level_touched[32], level_misses[32];
     uint64_t resident_bytes, resident_peak; /* under evict_lock */
 };
@@ -87,7 +87,7 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
 {
     if (budget_bytes == 0)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: the cache budget must be positive",
-                       ip_store_path(store));
+                        ip_store_path(store));
     ip_cache *c = calloc(1, sizeof *c);
     if (!c)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for a cache", ip_store_path(store));
@@ -102,7 +102,7 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
     if (!c->slots || !c->touched || !c->loading) {
         ip_cache_destroy(c);
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for a cache of %llu bricks",
-                       ip_store_path(store), (unsigned long long)n);
+                        ip_store_path(store), (unsigned long long)n);
     }
     for (int i = 0; i < STRIPES; i++) {
         pthread_mutex_init(&c->stripe_lock[i], NULL);
@@ -155,7 +155,10 @@ static void fill_brick(const entry *e, ip_brick *b)
 }
 
 /* Bits of a brick's `touched` byte: pinned at least once; its payload asked for in advance. */
-enum { TOUCHED = 1, PREFETCHED = 2 };
+enum {
+    TOUCHED = 1,
+    PREFETCHED = 2
+};
 
 static void note_touch(ip_cache *c, uint64_t g, uint32_t level)
 {
@@ -359,7 +362,7 @@ static ip_status decode_into(ip_cache *c, uint64_t g, entry *e, ip_error *err)
     void *work = take_work(c);
     if (!work)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for brick %llu",
-                       ip_store_path(c->store), (unsigned long long)g);
+                        ip_store_path(c->store), (unsigned long long)g);
     double t0 = ip_now_seconds();
     ip_status st = ip_store_read_brick(c->store, g, e->samples, work, err);
     double t1 = ip_now_seconds();
@@ -383,7 +386,7 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
     pthread_mutex_unlock(&c->evict_lock);
     if (!e)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for brick %llu",
-                       ip_store_path(c->store), (unsigned long long)g);
+                        ip_store_path(c->store), (unsigned long long)g);
     e->bytes = bytes;
     e->level = level;
     memcpy(e->extent, extent, sizeof extent);
@@ -418,7 +421,7 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
 {
     if (g >= c->layout->brick_count)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: brick %llu does not exist",
-                       ip_store_path(c->store), (unsigned long long)g);
+                        ip_store_path(c->store), (unsigned long long)g);
     uint32_t level, brick[3];
     ip_brick_coords(c->layout, g, &level, brick);
     note_touch(c, g, level);

@@ -9,13 +9,13 @@
 #include "isoprop/status.h"
 
 typedef struct ip_lru_item {
-    uint64_t key;  /* smallest first: the cache's last-pin tick */
-    void *value;   /* not owned */
+    uint64_t key; /* smallest first: the cache's last-pin tick */
+    void *value;  /* not owned */
 } ip_lru_item;
 
 typedef struct ip_lru_heap {
-    ip_lru_item *items;   /* the heap, items[0] the smallest key */
-    ip_lru_item *parked;  /* items set aside by ip__lru_heap_park() */
+    ip_lru_item *items;                     /* the heap, items[0] the smallest key */
+    ip_lru_item *parked;                    /* items set aside by ip__lru_heap_park() */
     uint64_t count, parked_count, capacity; /* capacity: of items and of parked alike */
 } ip_lru_heap;
 

@@ -16,15 +16,15 @@
 struct ip_store {
     char path[IP_PATH_MAX];
     int fd;
-    uint64_t size;            /* the file's size when opened */
+    uint64_t size; /* the file's size when opened */
     ip_layout layout;
     ip_summary_offsets offsets;
-    unsigned char *summary;   /* the summary section, read and verified once at open; owned */
-    const float *ranges;      /* brick, sub-block and node ranges, host floats */
-    float *ranges_copy;       /* owned copy on big-endian hosts, else NULL */
+    unsigned char *summary; /* the summary section, read and verified once at open; owned */
+    const float *ranges;    /* brick, sub-block and node ranges, host floats */
+    float *ranges_copy;     /* owned copy on big-endian hosts, else NULL */
     uint32_t subblocks;
-    size_t largest_payload;   /* bytes of the largest stored payload */
-    size_t largest_samples;   /* samples of the largest brick */
+    size_t largest_payload; /* bytes of the largest stored payload */
+    size_t largest_samples; /* samples of the largest brick */
 };
 
 /* Opens without blocking (a FIFO would wait for a writer) and accepts only a regular file. */
@@ -62,10 +62,11 @@ static ip_status read_at(const ip_store *s, void *dst, size_t size, uint64_t off
         if (n < 0)
             return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot read %s", s->path, what);
         if (n == 0)
-            return ip__fail(err, IP_ERR_IO, "%s: the file ends at byte %llu, before the end of "
-                           "%s (it was %llu bytes when opened: truncated or rewritten since)",
-                           s->path, (unsigned long long)size_now(s), what,
-                           (unsigned long long)s->size);
+            return ip__fail(err, IP_ERR_IO,
+                            "%s: the file ends at byte %llu, before the end of "
+                            "%s (it was %llu bytes when opened: truncated or rewritten since)",
+                            s->path, (unsigned long long)size_now(s), what,
+                            (unsigned long long)s->size);
         p += n;
         size -= (size_t)n;
         offset += (uint64_t)n;
@@ -78,8 +79,8 @@ static ip_status read_metadata(ip_store *s, ip_error *err)
 {
     unsigned char header[IP_HEADER_SIZE], gap[IP_SUMMARY_ALIGN];
     if (s->size < IP_HEADER_SIZE)
-        return ip__fail(err, IP_ERR_FORMAT, "%s: %llu bytes is too short for a brick file",
-                       s->path, (unsigned long long)s->size);
+        return ip__fail(err, IP_ERR_FORMAT, "%s: %llu bytes is too short for a brick file", s->path,
+                        (unsigned long long)s->size);
     ip_status st = read_at(s, header, sizeof header, 0, "the header", err);
     if (st == IP_OK)
         st = ip__format_parse_header(header, s->size, s->path, 0, &s->layout, err);
@@ -90,11 +91,10 @@ static ip_status read_metadata(ip_store *s, ip_error *err)
     s->summary = malloc(l->summary_size ? l->summary_size : 1);
     if (!s->summary)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the %llu-byte summary section",
-                       s->path, (unsigned long long)l->summary_size);
+                        s->path, (unsigned long long)l->summary_size);
     st = read_at(s, gap, l->summary_offset - data_end, data_end, "the data section", err);
     if (st == IP_OK)
-        st = read_at(s, s->summary, l->summary_size, l->summary_offset, "the summary section",
-                     err);
+        st = read_at(s, s->summary, l->summary_size, l->summary_offset, "the summary section", err);
     if (st == IP_OK)
         st = ip__format_parse_summary(&s->layout, gap, s->summary, s->path, 0, err);
     return st;
@@ -180,8 +180,7 @@ const char *ip_store_path(const ip_store *s)
 void ip_store_brick_entry(const ip_store *s, uint64_t g, ip_brick_entry *entry)
 {
     IP_ASSERT(g < s->layout.brick_count);
-    ip__format_entry_decode(s->summary + s->offsets.directory + g * IP_DIRECTORY_ENTRY_SIZE,
-                              entry);
+    ip__format_entry_decode(s->summary + s->offsets.directory + g * IP_DIRECTORY_ENTRY_SIZE, entry);
 }
 
 void ip_store_brick_range(const ip_store *s, uint64_t g, float range[2])
@@ -223,7 +222,7 @@ static ip_status brick_fail(const ip_store *s, uint64_t g, ip_status code, ip_er
     uint32_t level, brick[3];
     ip_brick_coords(&s->layout, g, &level, brick);
     return ip__fail(err, code, "%s: brick %llu (level %u, brick %u,%u,%u): %s", s->path,
-                   (unsigned long long)g, level, brick[0], brick[1], brick[2], what);
+                    (unsigned long long)g, level, brick[0], brick[1], brick[2], what);
 }
 
 /* Scratch of ip_store_read_brick(): the payload, then the codec's own scratch. */
@@ -237,8 +236,7 @@ size_t ip_store_read_work_size(const ip_store *s)
     return payload_room(s) + ip__codec_work_size(s->largest_samples, s->layout.type);
 }
 
-ip_status ip_store_read_brick(const ip_store *s, uint64_t g, void *dst, void *work,
-                              ip_error *err)
+ip_status ip_store_read_brick(const ip_store *s, uint64_t g, void *dst, void *work, ip_error *err)
 {
     ip_brick_entry e;
     ip_store_brick_entry(s, g, &e);
@@ -249,9 +247,11 @@ ip_status ip_store_read_brick(const ip_store *s, uint64_t g, void *dst, void *wo
         char what[160];
         uint32_t level, b[3];
         ip_brick_coords(&s->layout, g, &level, b);
-        snprintf(what, sizeof what, "the payload of brick %llu (level %u, brick %u,%u,%u; "
-                 "bytes %llu-%llu)", (unsigned long long)g, level, b[0], b[1], b[2],
-                 (unsigned long long)e.offset, (unsigned long long)(e.offset + e.stored_size));
+        snprintf(what, sizeof what,
+                 "the payload of brick %llu (level %u, brick %u,%u,%u; "
+                 "bytes %llu-%llu)",
+                 (unsigned long long)g, level, b[0], b[1], b[2], (unsigned long long)e.offset,
+                 (unsigned long long)(e.offset + e.stored_size));
         ip_status st = read_at(s, payload, e.stored_size, e.offset, what, err);
         if (st != IP_OK)
             return st;
@@ -262,7 +262,7 @@ ip_status ip_store_read_brick(const ip_store *s, uint64_t g, void *dst, void *wo
     ip_brick_coords(&s->layout, g, &level, brick);
     ip_brick_extent(&s->layout, level, brick, origin, extent);
     if (ip__codec_decode(&e, payload, extent, s->layout.type, s->ranges[2 * g], dst,
-                        payload + payload_room(s)) != IP_OK)
+                         payload + payload_room(s)) != IP_OK)
         return brick_fail(s, g, IP_ERR_CORRUPT, err, "payload does not decode");
     return IP_OK;
 }
@@ -281,8 +281,7 @@ static int same_range(const float *a, const float *b)
     return a[0] == b[0] && a[1] == b[1];
 }
 
-ip_status ip_store_check_summary(const ip_store *s, uint64_t g, const void *samples,
-                                 ip_error *err)
+ip_status ip_store_check_summary(const ip_store *s, uint64_t g, const void *samples, ip_error *err)
 {
     uint32_t level, brick[3], origin[3], extent[3];
     ip_brick_coords(&s->layout, g, &level, brick);
@@ -292,7 +291,7 @@ ip_status ip_store_check_summary(const ip_store *s, uint64_t g, const void *samp
     if (!sub)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", s->path);
     ip__summarise_brick(samples, s->layout.type, extent, s->layout.brick_edge,
-                       s->layout.subblock_edge, range, sub);
+                        s->layout.subblock_edge, range, sub);
     const float *stored = ip_store_subblock_ranges(s, g);
     int ok = same_range(range, &s->ranges[2 * g]);
     for (uint32_t i = 0; ok && i < s->subblocks; i++)
@@ -301,8 +300,7 @@ ip_status ip_store_check_summary(const ip_store *s, uint64_t g, const void *samp
     return ok ? IP_OK : brick_fail(s, g, IP_ERR_CORRUPT, err, "samples disagree with the summary");
 }
 
-ip_status ip_store_verify_brick(const ip_store *s, uint64_t g, void *dst, void *work,
-                                ip_error *err)
+ip_status ip_store_verify_brick(const ip_store *s, uint64_t g, void *dst, void *work, ip_error *err)
 {
     ip_status st = ip_store_read_brick(s, g, dst, work, err);
     return st == IP_OK ? ip_store_check_summary(s, g, dst, err) : st;
@@ -330,6 +328,6 @@ ip_status ip_store_verify_octree(const ip_store *s, ip_error *err)
     if (ip__octree_walk(&s->layout, s->ranges, c.stored, check_node, &c) == 0)
         return IP_OK;
     return ip__fail(err, IP_ERR_CORRUPT,
-                   "%s: octree node %u,%u,%u at depth %u of level %u disagrees with its children",
-                   s->path, c.node[0], c.node[1], c.node[2], c.depth, c.level);
+                    "%s: octree node %u,%u,%u at depth %u of level %u disagrees with its children",
+                    s->path, c.node[0], c.node[1], c.node[2], c.depth, c.level);
 }

@@ -65,9 +65,10 @@ int main(int argc, char **argv)
     ip_cache_stats cs;
     ip_cache_get_stats(cache, &cs);
     printf("embed: isoprop %s: %llu rays, %llu triangles progressive (visible side), %llu full; "
-           "cache peak %llu of %llu bytes\n", ip_version(), (unsigned long long)t.rays,
-           (unsigned long long)progressive, (unsigned long long)full.triangle_count,
-           (unsigned long long)cs.resident_peak_bytes, (unsigned long long)cs.budget_bytes);
+           "cache peak %llu of %llu bytes\n",
+           ip_version(), (unsigned long long)t.rays, (unsigned long long)progressive,
+           (unsigned long long)full.triangle_count, (unsigned long long)cs.resident_peak_bytes,
+           (unsigned long long)cs.budget_bytes);
     int ok = t.rays == 64u * 48u && progressive > 0 && full.triangle_count >= progressive &&
              cs.resident_peak_bytes <= cs.budget_bytes;
     ip_mesh_free(&full);

@@ -75,7 +75,8 @@ static void recompute_checksums(unsigned char *file, size_t size)
     if (summary_offset <= size && summary_size <= size - summary_offset) {
         uint64_t directory = (uint64_t)level_count * IP_LEVEL_ENTRY_SIZE;
         for (uint64_t g = 0; g < brick_count && directory <= summary_size &&
-                             g < (summary_size - directory) / IP_DIRECTORY_ENTRY_SIZE; g++) {
+                             g < (summary_size - directory) / IP_DIRECTORY_ENTRY_SIZE;
+             g++) {
             unsigned char *entry = file + summary_offset + directory + g * IP_DIRECTORY_ENTRY_SIZE;
             uint64_t offset = load_u64(entry);
             uint32_t stored = load_u32(entry + 8);
@@ -109,8 +110,7 @@ static void run_engine(ip_cache *cache, const ip_layout *l, const uint8_t contro
     }
     static const char *const axes[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
     ip_camera cam;
-    if (ip_camera_fit_axis(lo, hi, axes[control[1] % 6], 30.0, WIDTH, HEIGHT, &cam, &err) !=
-        IP_OK)
+    if (ip_camera_fit_axis(lo, hi, axes[control[1] % 6], 30.0, WIDTH, HEIGHT, &cam, &err) != IP_OK)
         return;
     if (control[1] >= 192) { /* inside the volume, looking along a diagonal */
         for (int a = 0; a < 3; a++) {

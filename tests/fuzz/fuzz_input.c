@@ -175,8 +175,7 @@ static void read_volume(const ip_input_desc *d, const uint8_t *file, size_t file
             abort();
         check_error(status, &err);
         /* describe measured raw data exactly: only a non-finite float may stop the read */
-        if (d->encoding == IP_ENCODING_RAW &&
-            (d->type != IP_FLOAT32 || status != IP_ERR_INPUT))
+        if (d->encoding == IP_ENCODING_RAW && (d->type != IP_FLOAT32 || status != IP_ERR_INPUT))
             abort();
         ip_status again = ip_input_read_planes(reader, samples + z * plane_bytes, 1, &err);
         if (again != status)

@@ -43,8 +43,10 @@
 
 static int usage(void)
 {
-    fputs("usage: corrupt info FILE | plan FILE [--quick] [--seed N] | apply IN OUT SPEC [--rehash] | "
-          "inplace FILE SPEC...\n", stderr);
+    fputs(
+        "usage: corrupt info FILE | plan FILE [--quick] [--seed N] | apply IN OUT SPEC [--rehash] | "
+        "inplace FILE SPEC...\n",
+        stderr);
     return 2;
 }
 
@@ -127,8 +129,8 @@ static payload *payloads_of(const unsigned char *bytes, const ip_layout *l, uint
     *count = 0;
     for (uint64_t g = 0; g < l->brick_count; g++) {
         ip_brick_entry e;
-        ip__format_entry_decode(bytes + l->summary_offset + so.directory +
-                                      g * IP_DIRECTORY_ENTRY_SIZE, &e);
+        ip__format_entry_decode(
+            bytes + l->summary_offset + so.directory + g * IP_DIRECTORY_ENTRY_SIZE, &e);
         if (e.stored_size > 0)
             p[(*count)++] = (payload){g, e.offset, e.stored_size};
     }
@@ -167,8 +169,7 @@ static uint64_t next_random(uint64_t *state)
 }
 
 /* A bit flip at a byte spread evenly over [start, start + size): the i-th of n. */
-static void plan_flips(const char *cls, uint64_t start, uint64_t size, unsigned n,
-                       uint64_t *rng)
+static void plan_flips(const char *cls, uint64_t start, uint64_t size, unsigned n, uint64_t *rng)
 {
     if (size == 0)
         return;
@@ -208,9 +209,18 @@ static int cmd_plan(const char *path, int quick, uint64_t seed)
      * summary */
     uint64_t cuts[128];
     unsigned ncut = 0, spread = quick ? 3 : 16;
-    uint64_t fixed[] = {0, 1, IP_HDR_VERSION, IP_HEADER_SIZE - 1, IP_HEADER_SIZE,
-                        IP_HEADER_SIZE + 1, data_end, l.summary_offset - 1, l.summary_offset,
-                        l.summary_offset + IP_LEVEL_ENTRY_SIZE, size - 1, size / 2};
+    uint64_t fixed[] = {0,
+                        1,
+                        IP_HDR_VERSION,
+                        IP_HEADER_SIZE - 1,
+                        IP_HEADER_SIZE,
+                        IP_HEADER_SIZE + 1,
+                        data_end,
+                        l.summary_offset - 1,
+                        l.summary_offset,
+                        l.summary_offset + IP_LEVEL_ENTRY_SIZE,
+                        size - 1,
+                        size / 2};
     for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
         if (!quick || i % 3 == 0 || fixed[i] == size - 1)
             cuts[ncut++] = fixed[i];
@@ -228,8 +238,8 @@ static int cmd_plan(const char *path, int quick, uint64_t seed)
 
     /* summary: spread over the whole section, and a few in each of its arrays */
     plan_flips("summary-flip", l.summary_offset, l.summary_size, quick ? 6 : 40, &rng);
-    uint64_t arrays[6] = {so.level_table, so.directory, so.brick_ranges, so.subblock_ranges,
-                          so.nodes, so.end};
+    uint64_t arrays[6] = {so.level_table,     so.directory, so.brick_ranges,
+                          so.subblock_ranges, so.nodes,     so.end};
     for (int a = 0; a < 5; a++)
         plan_flips("summary-flip", l.summary_offset + arrays[a], arrays[a + 1] - arrays[a],
                    quick ? (a < 2 ? 1 : 0) : 4, &rng);
@@ -318,7 +328,7 @@ static int parse_spec(const char *spec, char kind[16], uint64_t v[3])
 /* Mutates `bytes` (*size of them; appending reallocates) in memory; returns 0, NOOP or 2. */
 static int hex_digit(char c)
 {
-    return c >= '0' && c <= '9' ? c - '0'
+    return c >= '0' && c <= '9'   ? c - '0'
            : c >= 'a' && c <= 'f' ? c - 'a' + 10
            : c >= 'A' && c <= 'F' ? c - 'A' + 10
                                   : -1;
@@ -438,7 +448,8 @@ static void rehash(unsigned char *file, uint64_t size)
     if (summary_offset <= size && summary_size <= size - summary_offset) {
         uint64_t directory = (uint64_t)level_count * IP_LEVEL_ENTRY_SIZE;
         for (uint64_t g = 0; g < brick_count && directory <= summary_size &&
-                             g < (summary_size - directory) / IP_DIRECTORY_ENTRY_SIZE; g++) {
+                             g < (summary_size - directory) / IP_DIRECTORY_ENTRY_SIZE;
+             g++) {
             unsigned char *e = file + summary_offset + directory + g * IP_DIRECTORY_ENTRY_SIZE;
             uint64_t offset = load_u64(e);
             uint32_t stored = (uint32_t)load_u64(e + 8);

@@ -41,7 +41,12 @@ static const char usage[] =
     "  --quick          fewer and shorter repetitions, a random run of 1 x (not 4 x) the\n"
     "                   level-0 brick count: a smoke run, not figures to quote\n";
 
-enum { PART_DECODE = 1, PART_HITS = 2, PART_RANDOM = 4, PART_SEQUENTIAL = 8 };
+enum {
+    PART_DECODE = 1,
+    PART_HITS = 2,
+    PART_RANDOM = 4,
+    PART_SEQUENTIAL = 8
+};
 
 typedef struct options {
     const char *path;
@@ -52,8 +57,6 @@ typedef struct options {
 } options;
 
 /* ---- small helpers: time, memory, statistics ---- */
-
-
 
 /* Resets the process's peak RSS to its current RSS (Linux >= 4.0); 0 on success. */
 static int reset_peak_rss(void)
@@ -174,15 +177,15 @@ typedef struct brick_info {
 typedef struct bench_file {
     ip_store *store;
     const ip_layout *layout;
-    unsigned char *payloads;      /* the file up to its summary section, read once: the bytes
+    unsigned char *payloads; /* the file up to its summary section, read once: the bytes
                                      the stages below other than ip_store_read_brick work on */
     size_t type_size;
-    uint64_t level0_count;        /* every level-0 brick */
-    uint64_t level0_decoded;      /* their decoded bytes */
-    brick_info *bricks;           /* every level-0 brick, in directory order */
-    brick_info *payload;          /* the level-0 bricks with a payload (LZ4 or raw) */
+    uint64_t level0_count;   /* every level-0 brick */
+    uint64_t level0_decoded; /* their decoded bytes */
+    brick_info *bricks;      /* every level-0 brick, in directory order */
+    brick_info *payload;     /* the level-0 bricks with a payload (LZ4 or raw) */
     uint64_t payload_count;
-    uint64_t counts[3];           /* level-0 bricks by encoding */
+    uint64_t counts[3]; /* level-0 bricks by encoding */
     uint64_t with_delta, with_med, with_shuffle;
     uint64_t largest_brick_bytes; /* decoded bytes of the largest brick */
     size_t work_size;
@@ -277,8 +280,8 @@ static void print_file_facts(const bench_file *f, const options *o)
     const ip_layout *l = f->layout;
     printf("## %s\n\n", ip_store_path(f->store));
     printf("- volume: %u x %u x %u %s, bricks of %u^3 cells, %u levels, %llu bricks in all\n",
-           l->dims[0], l->dims[1], l->dims[2], ip_type_name(l->type), l->brick_edge,
-           l->level_count, (unsigned long long)l->brick_count);
+           l->dims[0], l->dims[1], l->dims[2], ip_type_name(l->type), l->brick_edge, l->level_count,
+           (unsigned long long)l->brick_count);
     printf("- level 0: %llu bricks (%llu constant, %llu LZ4, %llu raw), %.1f MiB decoded\n",
            (unsigned long long)f->level0_count, (unsigned long long)f->counts[IP_BRICK_CONSTANT],
            (unsigned long long)f->counts[IP_BRICK_LZ4], (unsigned long long)f->counts[IP_BRICK_RAW],
@@ -299,9 +302,9 @@ typedef enum stage {
     STAGE_XXH64   /* XXH64 alone */
 } stage;
 
-static const char *const stage_names[] = {
-    "ip_store_read_brick (XXH64 + LZ4 + filters)", "ip__codec_decode (LZ4 + filters)",
-    "LZ4_decompress_safe alone", "XXH64 alone"};
+static const char *const stage_names[] = {"ip_store_read_brick (XXH64 + LZ4 + filters)",
+                                          "ip__codec_decode (LZ4 + filters)",
+                                          "LZ4_decompress_safe alone", "XXH64 alone"};
 
 typedef struct decode_job {
     const bench_file *file;
@@ -311,7 +314,7 @@ typedef struct decode_job {
     unsigned thread, threads;
     uint64_t passes;
     void *dst, *work;
-    uint64_t sink;  /* keeps the checksums alive */
+    uint64_t sink; /* keeps the checksums alive */
     int failed;
 } decode_job;
 
@@ -330,18 +333,15 @@ static void *decode_work(void *p)
                 break;
             case STAGE_DECODE:
                 j->failed |= ip__codec_decode(&b->entry, src, b->extent, f->layout->type,
-                                             b->constant_value, j->dst, j->work) != IP_OK;
+                                              b->constant_value, j->dst, j->work) != IP_OK;
                 break;
             case STAGE_LZ4:
                 if (b->entry.encoding == IP_BRICK_LZ4)
-                    j->failed |= LZ4_decompress_safe((const char *)src, j->dst,
-                                                     (int)b->entry.stored_size,
-                                                     (int)b->decoded_bytes) !=
-                                 (int)b->decoded_bytes;
+                    j->failed |=
+                        LZ4_decompress_safe((const char *)src, j->dst, (int)b->entry.stored_size,
+                                            (int)b->decoded_bytes) != (int)b->decoded_bytes;
                 break;
-            case STAGE_XXH64:
-                j->sink += XXH64(src, b->entry.stored_size, 0);
-                break;
+            case STAGE_XXH64: j->sink += XXH64(src, b->entry.stored_size, 0); break;
             }
         }
     return NULL;
@@ -363,8 +363,8 @@ static void stage_bytes(const brick_info *list, uint64_t count, stage what, uint
 }
 
 /* Times `passes` passes of a stage over `list` on `threads` threads; returns wall seconds. */
-static double time_stage(const bench_file *f, const brick_info *list, uint64_t count,
-                         stage what, unsigned threads, uint64_t passes, decode_job *jobs)
+static double time_stage(const bench_file *f, const brick_info *list, uint64_t count, stage what,
+                         unsigned threads, uint64_t passes, decode_job *jobs)
 {
     for (unsigned t = 0; t < threads; t++) {
         jobs[t].file = f;
@@ -384,9 +384,8 @@ typedef struct rate {
 
 /* Calibrates passes so that one timing lasts at least min_seconds (which also warms up), then
  * takes `samples` timings. Returns -1 after printing a message if a brick failed. */
-static int measure_stage(const bench_file *f, const brick_info *list, uint64_t count,
-                         stage what, unsigned threads, const options *o, decode_job *jobs,
-                         rate *out)
+static int measure_stage(const bench_file *f, const brick_info *list, uint64_t count, stage what,
+                         unsigned threads, const options *o, decode_job *jobs, rate *out)
 {
     const int samples = o->quick ? 3 : 5;
     const double min_seconds = o->quick ? 0.05 : 0.25;
@@ -507,13 +506,12 @@ static int bench_decode(const bench_file *f, const options *o)
             continue;
         for (int r = 0; r < rows; r++) {
             rate m;
-            if (measure_stage(f, f->payload, f->payload_count, (stage)s, thread_counts[r], o,
-                              jobs, &m) != 0)
+            if (measure_stage(f, f->payload, f->payload_count, (stage)s, thread_counts[r], o, jobs,
+                              &m) != 0)
                 return 1;
-            printf("| %s | %u | %llu | %.1f | %.1f | %.2f (%.2f) | %.2f | %.1f |\n",
-                   stage_names[s], thread_counts[r], (unsigned long long)bricks, mib(stored),
-                   mib(decoded), m.median / 1e9, m.best / 1e9,
-                   m.median * (double)stored / (double)decoded / 1e9,
+            printf("| %s | %u | %llu | %.1f | %.1f | %.2f (%.2f) | %.2f | %.1f |\n", stage_names[s],
+                   thread_counts[r], (unsigned long long)bricks, mib(stored), mib(decoded),
+                   m.median / 1e9, m.best / 1e9, m.median * (double)stored / (double)decoded / 1e9,
                    (double)decoded / m.median / (double)bricks * 1e6);
         }
     }
@@ -612,11 +610,12 @@ static int bench_hits(const bench_file *f, const options *o)
     const uint64_t iterations = o->quick ? 200000 : 2000000;
     const int runs = o->quick ? 3 : 7;
     printf("### Hit path: pin + unpin of a resident brick\n\n");
-    printf("Every level-0 brick is resident (budget %.0f MiB). Each thread does %llu pin + "
-           "unpin pairs per run; ns per pair is a thread's own time / its pairs (the latency a "
-           "caller sees), averaged over the threads, the median of %d runs (fastest and slowest "
-           "in brackets); pairs per second counts all threads over the run's wall time (median).\n\n",
-           mib(budget), (unsigned long long)iterations, runs);
+    printf(
+        "Every level-0 brick is resident (budget %.0f MiB). Each thread does %llu pin + "
+        "unpin pairs per run; ns per pair is a thread's own time / its pairs (the latency a "
+        "caller sees), averaged over the threads, the median of %d runs (fastest and slowest "
+        "in brackets); pairs per second counts all threads over the run's wall time (median).\n\n",
+        mib(budget), (unsigned long long)iterations, runs);
     printf("| case | threads | ns per pair | million pairs per second, all threads |\n");
     printf("| --- | ---: | ---: | ---: |\n");
     hit_job *jobs = calloc(threads, sizeof *jobs);
@@ -631,8 +630,9 @@ static int bench_hits(const bench_file *f, const options *o)
         for (unsigned t = 0; t < hc->threads; t++) {
             /* different bricks lie far apart in the directory, so on distinct cache lines */
             own[t] = hc->same_brick ? order[0] : order[(uint64_t)t * n / hc->threads];
-            jobs[t] = (hit_job){cache, hc->cycle_all ? order : &own[t], hc->cycle_all ? n : 1,
-                                iterations, &counter, 0};
+            jobs[t] = (hit_job){
+                cache, hc->cycle_all ? order : &own[t], hc->cycle_all ? n : 1, iterations, &counter,
+                0};
         }
         double ns[16], rates[16];
         for (int r = 0; r < runs; r++) {
@@ -804,10 +804,11 @@ static int bench_runs(const bench_file *f, const options *o, const budget_list *
         if ((budgets->mib[b] << 20) >= f->level0_decoded)
             printf("%s %llu MiB", holding++ ? "," : "", (unsigned long long)budgets->mib[b]);
     printf("%s.\n", holding ? "" : " none");
-    printf("- decode s: time inside checksum + decode summed over threads "
-           "(ip_cache_stats.decode_seconds); other us per miss: (wall x threads - decode s) / "
-           "misses, i.e. everything else a miss costs (victim scan, allocation, locks, the payload's read) "
-           "plus the hits' share.\n");
+    printf(
+        "- decode s: time inside checksum + decode summed over threads "
+        "(ip_cache_stats.decode_seconds); other us per miss: (wall x threads - decode s) / "
+        "misses, i.e. everything else a miss costs (victim scan, allocation, locks, the payload's read) "
+        "plus the hits' share.\n");
     if (peak_resets)
         printf("- peak RSS is the process's high-water mark during the run alone: it is reset "
                "before each run (/proc/self/clear_refs), after the previous cache is freed "
@@ -933,8 +934,7 @@ int main(int argc, char **argv)
     if (warm_page_cache(o.path) != 0)
         return 1;
     print_file_facts(&f, &o);
-    if ((o.parts & PART_DECODE) &&
-        (read_payloads(o.path, &f) != 0 || bench_decode(&f, &o) != 0))
+    if ((o.parts & PART_DECODE) && (read_payloads(o.path, &f) != 0 || bench_decode(&f, &o) != 0))
         return 1;
     free(f.payloads); /* the runs below measure memory: only the store's own reads count */
     f.payloads = NULL;

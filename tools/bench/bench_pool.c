@@ -75,9 +75,10 @@ int main(int argc, char **argv)
 {
     unsigned threads = 0, steps = 2000, rounds = 9, until = 0;
     for (int i = 1; i < argc; i++) {
-        unsigned *to = !strcmp(argv[i], "--threads") ? &threads
-                       : !strcmp(argv[i], "--steps") ? &steps
-                       : !strcmp(argv[i], "--rounds") ? &rounds : NULL;
+        unsigned *to = !strcmp(argv[i], "--threads")  ? &threads
+                       : !strcmp(argv[i], "--steps")  ? &steps
+                       : !strcmp(argv[i], "--rounds") ? &rounds
+                                                      : NULL;
         if (!to || i + 1 >= argc) {
             fputs(usage, stderr);
             return 2;
@@ -112,8 +113,7 @@ int main(int argc, char **argv)
     ip__pool_destroy(pool);
     unsigned expect = 2 * rounds * steps * threads;
     if (atomic_load(&jobs_done) != expect) {
-        fprintf(stderr, "bench_pool: %u jobs ran, %u expected\n", atomic_load(&jobs_done),
-                expect);
+        fprintf(stderr, "bench_pool: %u jobs ran, %u expected\n", atomic_load(&jobs_done), expect);
         return 1;
     }
     qsort(created, rounds, sizeof *created, compare_double);

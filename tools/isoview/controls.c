@@ -10,16 +10,13 @@
 #define ORBIT_DEGREES_PER_PIXEL 0.3
 #define WHEEL_ZOOM 1.1 /* per wheel notch */
 
-int camera_from(viewer *v, const char *camera_text, const char *axis, ip_camera *out,
-                ip_error *err)
+int camera_from(viewer *v, const char *camera_text, const char *axis, ip_camera *out, ip_error *err)
 {
     ip_camera c = v->camera;
     if (camera_text) {
-        if (ip_camera_parse(camera_text, &c, err) != IP_OK ||
-            ip_camera_check(&c, err) != IP_OK)
+        if (ip_camera_parse(camera_text, &c, err) != IP_OK || ip_camera_check(&c, err) != IP_OK)
             return -1;
-    } else if (ip_camera_fit_axis(v->lo, v->hi, axis, 30.0, c.width, c.height, &c, err) !=
-               IP_OK) {
+    } else if (ip_camera_fit_axis(v->lo, v->hi, axis, 30.0, c.width, c.height, &c, err) != IP_OK) {
         return -1;
     }
     *out = c;

@@ -18,7 +18,7 @@
 #include "tool_common.h"
 
 typedef struct options {
-    tool_view_options common;   /* with --stats, --force and --quiet */
+    tool_view_options common; /* with --stats, --force and --quiet */
     const char *file, *script, *screenshot_path;
     double screenshot_at, exit_after;
 } options;
@@ -54,14 +54,14 @@ typedef struct overlay {
 
 /* Frames per second, for the overlay (a short window) and the stats (whole seconds). */
 typedef struct frame_clock {
-    double first, last;                /* times of the first and last frame, seconds */
+    double first, last; /* times of the first and last frame, seconds */
     uint64_t frames;
     double window_start;
     uint64_t window_frames;
-    double shown;                      /* the overlay's figure */
+    double shown; /* the overlay's figure */
     double second_start;
-    uint64_t second_frames, seconds;   /* whole-second windows completed */
-    double slowest, fastest;           /* frames in the slowest and fastest whole second */
+    uint64_t second_frames, seconds; /* whole-second windows completed */
+    double slowest, fastest;         /* frames in the slowest and fastest whole second */
 } frame_clock;
 
 typedef struct viewer {
@@ -75,12 +75,12 @@ typedef struct viewer {
     double lo[3], hi[3];
     float value_min, value_max;
     ip_camera camera;
-    double iso;              /* the engine takes it as a float */
-    int restart;             /* the view or the isovalue changed: begin again */
-    uint64_t uploaded;       /* triangles of the engine's mesh on the GPU */
-    uint64_t passes;         /* ip_engine_begin() calls */
+    double iso;                    /* the engine takes it as a float */
+    int restart;                   /* the view or the isovalue changed: begin again */
+    uint64_t uploaded;             /* triangles of the engine's mesh on the GPU */
+    uint64_t passes;               /* ip_engine_begin() calls */
     double pass_wall, pass_render; /* this pass: seconds stepping, seconds drawing */
-    double draw_seconds;     /* the last frame, from the end of its slice to its swap */
+    double draw_seconds;           /* the last frame, from the end of its slice to its swap */
     int paused, want_full, full_shown, overlay_on, help_on;
     ip_mesh full_mesh;
     ip_engine_counts full_counts;
@@ -89,7 +89,7 @@ typedef struct viewer {
     char typed[48];
     char message[160];
     double message_until;
-    int drag_button;         /* GLFW_MOUSE_BUTTON_LEFT or _RIGHT while dragging, else -1 */
+    int drag_button; /* GLFW_MOUSE_BUTTON_LEFT or _RIGHT while dragging, else -1 */
     double drag_x, drag_y;
     command *commands;
     size_t command_count, next_command;

@@ -98,7 +98,7 @@ static void frame_done(frame_clock *k, double t)
 static double frames_per_second(const frame_clock *k)
 {
     return k->frames > 1 && k->last > k->first ? (double)(k->frames - 1) / (k->last - k->first)
-                                                : 0.0;
+                                               : 0.0;
 }
 
 /* ---- the progressive engine and the mesh on the GPU ---- */
@@ -122,15 +122,15 @@ static int refine(viewer *v)
     if (v->paused || v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v))
         return 0;
     double slice = v->draw_seconds < FRAME_BUDGET_SECONDS ? FRAME_BUDGET_SECONDS
-                   : v->draw_seconds > MAX_SLICE_SECONDS ? MAX_SLICE_SECONDS
-                   : v->draw_seconds;
+                   : v->draw_seconds > MAX_SLICE_SECONDS  ? MAX_SLICE_SECONDS
+                                                          : v->draw_seconds;
     if (v->o.common.time_limit > 0 && slice > v->o.common.time_limit - v->pass_wall)
         slice = v->o.common.time_limit - v->pass_wall;
     ip_engine_counts t;
     ip_engine_totals(v->engine, &t);
     double start = ip_now_seconds();
-    ip_status st = ip_engine_step(v->engine, v->o.common.rays ? v->o.common.rays - t.rays : 0, slice, NULL,
-                                  &v->err);
+    ip_status st = ip_engine_step(v->engine, v->o.common.rays ? v->o.common.rays - t.rays : 0,
+                                  slice, NULL, &v->err);
     v->pass_wall += ip_now_seconds() - start;
     if (st != IP_OK && st != IP_ERR_CANCELLED)
         return -1;
@@ -148,8 +148,8 @@ static int extract_full(viewer *v)
     ip_mesh_clear(&v->full_mesh);
     memset(&v->full_counts, 0, sizeof v->full_counts);
     double start = ip_now_seconds();
-    if (ip_extract_full(v->cache, (float)v->iso, 0, v->o.common.threads, &v->full_mesh, &v->full_counts,
-                        &v->err) != IP_OK)
+    if (ip_extract_full(v->cache, (float)v->iso, 0, v->o.common.threads, &v->full_mesh,
+                        &v->full_counts, &v->err) != IP_OK)
         return -1;
     v->full_wall = ip_now_seconds() - start;
     v->pass_render = 0;
@@ -295,7 +295,8 @@ static int open_window(viewer *v)
     glfwWindowHint(GLFW_SAMPLES, 0); /* the image must match isorender's */
     char title[256];
     snprintf(title, sizeof title, "isoview: %s", v->o.file);
-    v->window = glfwCreateWindow((int)v->o.common.width, (int)v->o.common.height, title, NULL, NULL);
+    v->window =
+        glfwCreateWindow((int)v->o.common.width, (int)v->o.common.height, title, NULL, NULL);
     if (!v->window) {
         fprintf(stderr, "isoview: cannot open a window: %s\n",
                 glfw_error[0] ? glfw_error : "no OpenGL 3.3 core context");
@@ -309,8 +310,8 @@ static int open_window(viewer *v)
     glfwGetFramebufferSize(v->window, &width, &height);
     v->camera.width = width > 0 ? (uint32_t)width : v->o.common.width;
     v->camera.height = height > 0 ? (uint32_t)height : v->o.common.height;
-    if (ip_renderer_create_current(v->camera.width, v->camera.height, 0, &v->renderer,
-                                   &v->err) != IP_OK ||
+    if (ip_renderer_create_current(v->camera.width, v->camera.height, 0, &v->renderer, &v->err) !=
+            IP_OK ||
         overlay_create(&v->text, &v->err) != 0) {
         fprintf(stderr, "isoview: %s\n", v->err.message);
         return -1;
@@ -328,16 +329,26 @@ static void json_counts(FILE *f, void *user)
     else
         ip_engine_totals(v->engine, &t);
     int done = full || ip_engine_done(v->engine);
-    const tool_run_json j = {v->o.file, v->iso, full, &v->camera, "opengl", &v->o.common, 0,
-                             done, &t, full ? v->pass_render : t.rendering_seconds,
-                             full ? v->full_wall : v->pass_wall, 0.0};
+    const tool_run_json j = {v->o.file,
+                             v->iso,
+                             full,
+                             &v->camera,
+                             "opengl",
+                             &v->o.common,
+                             0,
+                             done,
+                             &t,
+                             full ? v->pass_render : t.rendering_seconds,
+                             full ? v->full_wall : v->pass_wall,
+                             0.0};
     tool_write_run_json(f, &j);
     if (done)
         fprintf(f, ", \"final_pixel_pct\": %.4f", 100.0);
     const frame_clock *k = &v->clock;
     double mean = frames_per_second(k);
-    fprintf(f, ", \"passes\": %llu, \"fps\": {\"frames\": %llu, \"seconds\": %.6f, "
-               "\"mean\": %.3f, \"min\": %.3f, \"max\": %.3f}",
+    fprintf(f,
+            ", \"passes\": %llu, \"fps\": {\"frames\": %llu, \"seconds\": %.6f, "
+            "\"mean\": %.3f, \"min\": %.3f, \"max\": %.3f}",
             (unsigned long long)v->passes, (unsigned long long)k->frames,
             k->frames ? k->last - k->first : 0.0, mean, k->seconds ? k->slowest : mean,
             k->seconds ? k->fastest : mean);
@@ -351,14 +362,12 @@ static void print_summary(const viewer *v)
     else
         ip_engine_totals(v->engine, &t);
     printf("%s: iso %g, %s, %ux%u\n", v->o.file, v->iso,
-           v->full_shown ? "full extraction" : "progressive", v->camera.width,
-           v->camera.height);
+           v->full_shown ? "full extraction" : "progressive", v->camera.width, v->camera.height);
     printf("  rays          %llu of %llu\n", (unsigned long long)t.rays,
            (unsigned long long)v->camera.width * v->camera.height);
     printf("  triangles     %llu\n", (unsigned long long)t.triangles);
-    printf("  frames        %llu, %.1f fps (passes: %llu)\n",
-           (unsigned long long)v->clock.frames, frames_per_second(&v->clock),
-           (unsigned long long)v->passes);
+    printf("  frames        %llu, %.1f fps (passes: %llu)\n", (unsigned long long)v->clock.frames,
+           frames_per_second(&v->clock), (unsigned long long)v->passes);
 }
 
 static int finish(viewer *v)
@@ -372,8 +381,8 @@ static int finish(viewer *v)
     }
     /* a failed run (a bad brick, a renderer error) writes no statistics, as isorender */
     if (v->o.common.stats && !v->failed && !tool_signal_caught() &&
-        tool_write_stats_file("isoview", v->o.common.stats, v->o.common.force, &s, summary, json_counts, v) !=
-            0)
+        tool_write_stats_file("isoview", v->o.common.stats, v->o.common.force, &s, summary,
+                              json_counts, v) != 0)
         return 1;
     return 0;
 }
@@ -492,4 +501,3 @@ int main(int argc, char **argv)
     tool_signals_reraise();
     return rc;
 }
-

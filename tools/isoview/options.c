@@ -72,7 +72,7 @@ int parse_args(int argc, char **argv, options *o)
     tool_view_options_default(&o->common, 1280, 960);
     o->screenshot_at = -1;
     o->exit_after = -1;
-    return tool_parse_view_command_line(
-        "isoview", usage, &o->common, isoview_options,
-        sizeof isoview_options / sizeof isoview_options[0], o, &o->file, argc, argv);
+    return tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
+                                        sizeof isoview_options / sizeof isoview_options[0], o,
+                                        &o->file, argc, argv);
 }

@@ -14,21 +14,20 @@
 
 #include "isoview.h"
 
-static const char help_text[] =
-    "left drag      orbit around the target\n"
-    "right drag     pan\n"
-    "wheel          zoom\n"
-    "Up / Down      isovalue +/- 1 % of the value range\n"
-    "Shift+Up/Down  isovalue +/- 0.1 %\n"
-    "PgUp / PgDn    isovalue +/- 10 %\n"
-    "i              type an isovalue (Enter applies, Esc cancels)\n"
-    "r              reset the view\n"
-    "p              pause / resume refinement\n"
-    "f              full extraction (until the next change)\n"
-    "s              save a screenshot (isoview-NNN.png)\n"
-    "o              overlay on / off\n"
-    "h              this help\n"
-    "Esc            quit";
+static const char help_text[] = "left drag      orbit around the target\n"
+                                "right drag     pan\n"
+                                "wheel          zoom\n"
+                                "Up / Down      isovalue +/- 1 % of the value range\n"
+                                "Shift+Up/Down  isovalue +/- 0.1 %\n"
+                                "PgUp / PgDn    isovalue +/- 10 %\n"
+                                "i              type an isovalue (Enter applies, Esc cancels)\n"
+                                "r              reset the view\n"
+                                "p              pause / resume refinement\n"
+                                "f              full extraction (until the next change)\n"
+                                "s              save a screenshot (isoview-NNN.png)\n"
+                                "o              overlay on / off\n"
+                                "h              this help\n"
+                                "Esc            quit";
 
 static const char *const overlay_vertex_source =
     "#version 330 core\n"
@@ -41,15 +40,17 @@ static const char *const overlay_vertex_source =
     "    gl_Position = vec4(p.x, -p.y, 0.0, 1.0);\n"
     "}\n";
 
-static const char *const overlay_fragment_source =
-    "#version 330 core\n"
-    "uniform vec4 colour;\n"
-    "out vec4 result;\n"
-    "void main() {\n"
-    "    result = colour;\n"
-    "}\n";
+static const char *const overlay_fragment_source = "#version 330 core\n"
+                                                   "uniform vec4 colour;\n"
+                                                   "out vec4 result;\n"
+                                                   "void main() {\n"
+                                                   "    result = colour;\n"
+                                                   "}\n";
 
-enum { FONT_VERTEX_BYTES = 16, QUAD_BYTES = 4 * FONT_VERTEX_BYTES };
+enum {
+    FONT_VERTEX_BYTES = 16,
+    QUAD_BYTES = 4 * FONT_VERTEX_BYTES
+};
 
 int overlay_create(overlay *t, ip_error *err)
 {
@@ -126,8 +127,8 @@ static void overlay_draw(overlay *t, char *text, float x, float y, float scale, 
 {
     const float pad = 4;
     /* quad 0 is the panel; the text follows */
-    int quads = stb_easy_font_print(0, 0, text, NULL, t->quads + QUAD_BYTES,
-                                    t->quads_size - QUAD_BYTES);
+    int quads =
+        stb_easy_font_print(0, 0, text, NULL, t->quads + QUAD_BYTES, t->quads_size - QUAD_BYTES);
     if ((uint32_t)quads + 1 > t->index_quads)
         quads = (int)t->index_quads - 1;
     float w = (float)stb_easy_font_width(text), h = (float)stb_easy_font_height(text);
@@ -144,13 +145,11 @@ static void overlay_draw(overlay *t, char *text, float x, float y, float scale, 
     glUniform2f(t->offset_at, x + pad * scale, y + pad * scale);
     glBindVertexArray(t->array);
     glBindBuffer(GL_ARRAY_BUFFER, t->vertices);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(quads + 1) * QUAD_BYTES, t->quads,
-                 GL_STREAM_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(quads + 1) * QUAD_BYTES, t->quads, GL_STREAM_DRAW);
     glUniform4f(t->colour_at, 0.0f, 0.0f, 0.0f, 0.6f);
     glDrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, NULL);
     glUniform4f(t->colour_at, 1.0f, 1.0f, 0.85f, 1.0f);
-    glDrawElements(GL_TRIANGLES, 6 * quads, GL_UNSIGNED_INT,
-                   (const void *)(6 * sizeof(uint32_t)));
+    glDrawElements(GL_TRIANGLES, 6 * quads, GL_UNSIGNED_INT, (const void *)(6 * sizeof(uint32_t)));
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     glBindVertexArray(0);
     glUseProgram(0);
@@ -171,8 +170,8 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
     if (v->typing)
         snprintf(iso, sizeof iso, "iso> %s_  (Enter applies, Esc cancels)", v->typed);
     else
-        snprintf(iso, sizeof iso, "iso %.7g  (values %.7g .. %.7g)", v->iso,
-                 (double)v->value_min, (double)v->value_max);
+        snprintf(iso, sizeof iso, "iso %.7g  (values %.7g .. %.7g)", v->iso, (double)v->value_min,
+                 (double)v->value_max);
     if (working_on_full)
         snprintf(state, sizeof state, "  [extracting all...]");
     else if (v->full_shown)
@@ -183,14 +182,19 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
         snprintf(state, sizeof state, "  [%s reached]",
                  pass_limit_reached(v) == 1 ? "--rays" : "--time");
     if (v->full_shown)
-        snprintf(progress, sizeof progress, "full: %llu cells in %.2f s   final px 100 %%\n"
-                 "triangles %llu", (unsigned long long)v->full_counts.cells, v->full_wall,
+        snprintf(progress, sizeof progress,
+                 "full: %llu cells in %.2f s   final px 100 %%\n"
+                 "triangles %llu",
+                 (unsigned long long)v->full_counts.cells, v->full_wall,
                  (unsigned long long)v->full_counts.triangles);
     else
-        snprintf(progress, sizeof progress, "rays %.1f %% of %.0f   final px %s\n"
-                 "triangles %llu", pixels > 0 ? 100.0 * (double)t.rays / pixels : 0.0, pixels,
+        snprintf(progress, sizeof progress,
+                 "rays %.1f %% of %.0f   final px %s\n"
+                 "triangles %llu",
+                 pixels > 0 ? 100.0 * (double)t.rays / pixels : 0.0, pixels,
                  ip_engine_done(v->engine) ? "100 %" : "-", (unsigned long long)t.triangles);
-    int n = snprintf(text, size, "%s%s\n%s\nfps %.1f\ncache %.1f / %.1f MiB   hit rate %.1f %%\n"
+    int n = snprintf(text, size,
+                     "%s%s\n%s\nfps %.1f\ncache %.1f / %.1f MiB   hit rate %.1f %%\n"
                      "misses %llu   bricks %llu / %llu",
                      iso, state, progress, v->clock.shown, (double)s.resident_bytes / 1048576.0,
                      (double)s.budget_bytes / 1048576.0,

@@ -219,9 +219,7 @@ void run_script(viewer *v, double t)
             }
             change_view(v);
             break;
-        case COMMAND_ISO:
-            change_iso(v, c->a);
-            break;
+        case COMMAND_ISO: change_iso(v, c->a); break;
         case COMMAND_ORBIT:
             ip_camera_orbit(&v->camera, c->a, c->b);
             change_view(v);
@@ -230,24 +228,12 @@ void run_script(viewer *v, double t)
             zoom_view(v, c->a);
             change_view(v);
             break;
-        case COMMAND_WAIT:
-            v->wait_until = t + c->a;
-            break;
-        case COMMAND_WAIT_DONE:
-            v->waiting_done = 1;
-            break;
-        case COMMAND_FULL:
-            v->want_full = 1;
-            break;
-        case COMMAND_OVERLAY:
-            v->overlay_on = c->a != 0;
-            break;
-        case COMMAND_SCREENSHOT:
-            request_screenshot(v, c->text);
-            return;
-        case COMMAND_QUIT:
-            v->quit = 1;
-            return;
+        case COMMAND_WAIT: v->wait_until = t + c->a; break;
+        case COMMAND_WAIT_DONE: v->waiting_done = 1; break;
+        case COMMAND_FULL: v->want_full = 1; break;
+        case COMMAND_OVERLAY: v->overlay_on = c->a != 0; break;
+        case COMMAND_SCREENSHOT: request_screenshot(v, c->text); return;
+        case COMMAND_QUIT: v->quit = 1; return;
         }
     }
 }
