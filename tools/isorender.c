@@ -29,14 +29,17 @@ static const char usage[] =
     "  --foldback DEGREES  fold-back tolerance (default 0.25)\n"
     "  --lod on|off        adaptive resolution: far regions from coarser levels (default on)\n"
     "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n"
+    "  --occlusion on|off  propagation skips cells that extracted surface hides (default on)\n"
     "  --full              triangulate every active cell instead (the baseline)\n"
     "  --warm              extract once untimed first, so the timed run finds a warm cache\n"
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
     "  --threads N         threads for seeding, propagation and --full (default: all cores)\n"
     "  -o OUT.png          the image (default isorender.png)\n"
     "  --mesh OUT.ply      also write the triangles as binary PLY\n"
-    "  --stats OUT.json    counts, times, warnings and the cache statistics as JSON\n"
-    "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct at checkpoints\n"
+    "  --stats OUT.json    counts, times, warnings, the cache statistics and the overdraw\n"
+    "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
+    "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
+    "                      overdraw at checkpoints\n"
     "  --software          render with the software rasterizer instead of OpenGL\n"
     "  --force             replace existing outputs (regular files only; never an input)\n"
     "  --quiet             print nothing but errors and warnings\n"
@@ -56,6 +59,7 @@ typedef struct checkpoint {
     double time;
     uint64_t rays, seeds, cells, triangles;
     double final_pct;
+    uint64_t visible; /* triangles extracted by then that own a pixel of the final image */
 } checkpoint;
 
 typedef struct run {
@@ -71,6 +75,8 @@ typedef struct run {
     checkpoint *checkpoints;
     size_t checkpoint_count;
     double extraction_wall, progress_render_seconds, final_pct;
+    uint64_t visible_triangles; /* triangles of the mesh that own a pixel of its image */
+    int owners_known;           /* visible_triangles and the checkpoints' `visible` are set */
     const char *renderer_name;
     char warning[600]; /* the --iso warning, "" when none */
     int writing;       /* 1 once the outputs are being written */
@@ -126,7 +132,7 @@ static int add_checkpoint(run *r, double start)
         return -1;
     r->checkpoints = grown;
     r->checkpoints[r->checkpoint_count++] =
-        (checkpoint){ip_now_seconds() - start, t.rays, t.seeds, t.cells, t.triangles, 0};
+        (checkpoint){ip_now_seconds() - start, t.rays, t.seeds, t.cells, t.triangles, 0, 0};
     return 0;
 }
 
@@ -188,9 +194,25 @@ static int extract_full(run *r, ip_error *err)
     return 0;
 }
 
+/* The first checkpoint whose mesh holds triangle i (checkpoint_count when none). */
+static size_t checkpoint_of(const run *r, uint64_t i)
+{
+    size_t lo = 0, hi = r->checkpoint_count;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (r->checkpoints[mid].triangles > i)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo;
+}
+
 /* Final pixels of every checkpoint from one raster of the final mesh: a pixel has its final
  * colour at a checkpoint when the triangle it finally shows was already extracted (the mesh
- * only grows by appending, and the nearest triangle wins). */
+ * only grows by appending, and the nearest triangle wins). The same raster gives the visible
+ * triangles, those that own at least one pixel of the final image, in all and as extracted
+ * by each checkpoint: overdraw = triangles extracted / visible triangles. */
 static int final_pixels(run *r, ip_error *err)
 {
     double start = ip_now_seconds();
@@ -206,45 +228,62 @@ static int final_pixels(run *r, ip_error *err)
     for (size_t c = 0; c < r->checkpoint_count; c++)
         r->checkpoints[c].final_pct = 0;
     uint64_t *shown = calloc(r->checkpoint_count + 1, sizeof *shown);
-    if (!shown) {
+    uint64_t *owners = calloc(r->checkpoint_count + 1, sizeof *owners);
+    uint8_t *owns = calloc(r->mesh->triangle_count / 8 + 1, 1); /* a bit per triangle */
+    if (!shown || !owners || !owns) {
+        free(shown);
+        free(owners);
+        free(owns);
         free(index);
         return -1;
     }
+    r->visible_triangles = 0;
     for (size_t p = 0; p < n; p++) {
-        if (index[p] == UINT32_MAX)
+        uint32_t i = index[p];
+        if (i == UINT32_MAX)
             continue;
         covered++;
-        /* the first checkpoint whose mesh holds that triangle */
-        size_t lo = 0, hi = r->checkpoint_count;
-        while (lo < hi) {
-            size_t mid = (lo + hi) / 2;
-            if (r->checkpoints[mid].triangles > index[p])
-                hi = mid;
-            else
-                lo = mid + 1;
+        size_t c = checkpoint_of(r, i);
+        shown[c]++;
+        if (!(owns[i / 8] & (1u << (i % 8)))) {
+            owns[i / 8] |= (uint8_t)(1u << (i % 8));
+            owners[c]++;
+            r->visible_triangles++;
         }
-        shown[lo]++;
     }
-    uint64_t running = 0;
+    uint64_t running = 0, visible = 0;
     for (size_t c = 0; c < r->checkpoint_count; c++) {
         running += shown[c];
+        visible += owners[c];
         r->checkpoints[c].final_pct = covered ? 100.0 * (double)running / (double)covered : 100.0;
+        r->checkpoints[c].visible = visible;
     }
+    r->owners_known = 1;
     free(shown);
+    free(owners);
+    free(owns);
     free(index);
     r->progress_render_seconds = ip_now_seconds() - start;
     return 0;
 }
 
+/* Triangles extracted per visible triangle; 0 when none is visible. */
+static double overdraw(uint64_t triangles, uint64_t visible)
+{
+    return visible ? (double)triangles / (double)visible : 0.0;
+}
+
 static void progress_csv(FILE *f, void *user)
 {
     const run *r = user;
-    fprintf(f, "time_s,rays,seeds,cells,triangles,final_pixel_pct\n");
+    /* the columns scripts read come first, unchanged; later ones are appended */
+    fprintf(f, "time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,overdraw\n");
     for (size_t c = 0; c < r->checkpoint_count; c++) {
         const checkpoint *k = &r->checkpoints[c];
-        fprintf(f, "%.6f,%llu,%llu,%llu,%llu,%.4f\n", k->time, (unsigned long long)k->rays,
-                (unsigned long long)k->seeds, (unsigned long long)k->cells,
-                (unsigned long long)k->triangles, k->final_pct);
+        fprintf(f, "%.6f,%llu,%llu,%llu,%llu,%.4f,%llu,%.4f\n", k->time,
+                (unsigned long long)k->rays, (unsigned long long)k->seeds,
+                (unsigned long long)k->cells, (unsigned long long)k->triangles, k->final_pct,
+                (unsigned long long)k->visible, overdraw(k->triangles, k->visible));
     }
 }
 
@@ -292,6 +331,13 @@ static void json_counts(FILE *f, void *user)
     if (r->checkpoint_count)
         fprintf(f, ", \"final_pixel_pct\": %.4f",
                 r->checkpoints[r->checkpoint_count - 1].final_pct);
+    if (r->owners_known)
+        fprintf(f, ", \"visible_triangles\": %llu, \"overdraw\": %.4f",
+                (unsigned long long)r->visible_triangles,
+                overdraw(r->mesh->triangle_count, r->visible_triangles));
+    if (!r->o.full)
+        fprintf(f, ", \"occlusion\": %s, \"deferred_cells\": %llu",
+                r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred);
     fprintf(f, ", \"warnings\": [");
     if (r->warning[0])
         tool_json_string(f, r->warning);
@@ -308,6 +354,10 @@ static void print_summary(const run *r)
     printf("  seeds         %llu\n", (unsigned long long)t->seeds);
     printf("  cells         %llu\n", (unsigned long long)t->cells);
     printf("  triangles     %llu\n", (unsigned long long)t->triangles);
+    if (r->owners_known)
+        printf("  visible       %llu triangles own a pixel: overdraw %.2f\n",
+               (unsigned long long)r->visible_triangles,
+               overdraw(r->mesh->triangle_count, r->visible_triangles));
     printf("  time          %.3f s extraction (wall); CPU s summed over %u threads: "
            "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
            r->extraction_wall, ip_thread_count(r->o.common.threads), t->intersection_seconds,
@@ -340,7 +390,8 @@ static int finish(run *r, ip_error *err)
         return 1;
     }
     int rc = render_image(r, rgba, err);
-    if (rc == 0 && r->o.progress && !r->o.full && final_pixels(r, err) != 0)
+    if (rc == 0 && ((r->o.progress && !r->o.full) || r->o.common.stats) &&
+        final_pixels(r, err) != 0)
         rc = -1;
     if (rc != 0 || tool_signal_caught()) {
         free(rgba);

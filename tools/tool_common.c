@@ -457,6 +457,7 @@ void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t he
     o->foldback = IP_DEFAULT_FOLDBACK_DEGREES;
     o->lod = 1;
     o->pixel_error = 1.0;
+    o->occlusion = 1;
     o->cache_bytes = ip_cache_default_budget();
 }
 
@@ -468,6 +469,7 @@ void tool_engine_options(const tool_view_options *o, ip_engine_options *eo)
     eo->threads = o->threads;
     eo->lod = o->lod;
     eo->pixel_error = o->pixel_error;
+    eo->occlusion = o->occlusion;
 }
 
 #define MAX_IMAGE_SIDE 16384 /* pixels; OpenGL's common maximum renderbuffer size */
@@ -568,13 +570,25 @@ static int parse_view_threads(const char *p, const tool_option *opt, const char 
     return tool_parse_threads(p, v[0], 64, &((tool_view_options *)base)->threads);
 }
 
+/* An on|off switch: *out = 1 or 0. */
+static int parse_on_off(const char *p, const char *value, int *out, const char *option)
+{
+    if (strcmp(value, "on") && strcmp(value, "off"))
+        return tool_usage_error(p, "%s must be on or off", option);
+    *out = !strcmp(value, "on");
+    return 0;
+}
+
 static int parse_lod(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     (void)opt;
-    if (strcmp(v[0], "on") && strcmp(v[0], "off"))
-        return tool_usage_error(p, "--lod must be on or off");
-    ((tool_view_options *)base)->lod = !strcmp(v[0], "on");
-    return 0;
+    return parse_on_off(p, v[0], &((tool_view_options *)base)->lod, "--lod");
+}
+
+static int parse_occlusion(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    (void)opt;
+    return parse_on_off(p, v[0], &((tool_view_options *)base)->occlusion, "--occlusion");
 }
 
 static int parse_cache_budget(const char *p, const tool_option *opt, const char *const *v,
@@ -602,6 +616,7 @@ static const tool_option view_options[] = {
     {"--lod", NULL, 1, 0, parse_lod, NULL, NULL},
     {"--pixel-error", NULL, 1, VIEW_FIELD(pixel_error), tool_option_positive, "is not positive",
      NULL},
+    {"--occlusion", NULL, 1, 0, parse_occlusion, NULL, NULL},
     {"--cache-mb", NULL, 1, 0, parse_cache_budget, NULL, NULL},
     {"--stats", NULL, 1, VIEW_FIELD(stats), NULL, NULL, NULL},
     {"--force", NULL, 0, VIEW_FIELD(force), NULL, NULL, NULL},

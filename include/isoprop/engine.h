@@ -25,6 +25,13 @@
  * the band boundaries are sub-pixel, as in the paper; the exact-image guarantee above holds
  * with lod off (or wherever every D[k >= 1] lies beyond the volume).
  *
+ * Occlusion (options.occlusion, on by default): the engine keeps a coverage depth buffer of
+ * the image, the nearest depth of the triangles extracted so far at each pixel centre, and
+ * propagation does not queue a cell whose box that surface hides at every pixel centre the box
+ * may cover (it stays unvisited). Such a cell cannot show in the final image, and since every
+ * pixel's ray still extracts its own first-hit cell, the guarantee above is unchanged; what
+ * changes is how much hidden surface is extracted (docs/occlusion.md). 4 bytes a pixel.
+ *
  * Threads: an engine is driven by one thread. ip_engine_create() starts its worker threads
  * (ip_thread_count(options.threads) in all, the driving thread counted), which sleep between
  * steps; ip_engine_step() wakes them, works as one of them and returns when all have stopped.
@@ -63,6 +70,7 @@ typedef struct ip_engine_options {
                                  many pixels (1: the paper's sub-pixel rule) */
     int cell_ids;            /* keep each triangle's cell id in the mesh (8 bytes a triangle
                                  more; for comparing extractions) */
+    int occlusion;           /* occlusion-aware propagation (see Occlusion above; default on) */
 } ip_engine_options;
 
 /* Counters and times, per step or in total. Times are wall seconds, split as the paper does.
@@ -78,12 +86,15 @@ typedef struct ip_engine_counts {
     double propagation_seconds;  /* queue, neighbour and criteria work */
     double extraction_seconds;   /* marching cubes: samples, gradients, triangles */
     double rendering_seconds;    /* reported by the caller, ip_engine_add_rendering_time() */
+    uint64_t deferred; /* with occlusion: neighbours propagation left because surface already
+                          extracted hid them (a cell may count more than once) */
 } ip_engine_counts;
 
 typedef struct ip_engine ip_engine;
 
 /*! ip_engine_options_default() : the paper's cut-off (1.81 degrees), a 0.25 degree
- *  fold-back tolerance, every core, adaptive resolution with a 1-pixel error, no cell ids. */
+ *  fold-back tolerance, every core, adaptive resolution with a 1-pixel error, no cell ids,
+ *  occlusion on. */
 IP_API void ip_engine_options_default(ip_engine_options *options);
 
 /*! ip_engine_create() : an engine reading through `cache` (which must outlive it), with its

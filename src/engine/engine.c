@@ -7,6 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "coverage.h"
 #include "internal.h"
 #include "isoprop/engine.h"
 #include "pool.h"
@@ -44,6 +45,7 @@ struct ip_engine {
     worker *workers;
     ip__pool *pool; /* runs the workers of every step; started at create */
     ip_visited visited;
+    ip_coverage coverage; /* with options.occlusion: what extracted surface hides */
     ip_mesh mesh;
     pthread_mutex_t mesh_lock; /* workers append their buffers to `mesh` during a step */
     ip_camera camera;
@@ -68,6 +70,7 @@ void ip_engine_options_default(ip_engine_options *o)
     o->lod = 1;
     o->pixel_error = 1.0;
     o->cell_ids = 0;
+    o->occlusion = 1;
 }
 
 /* The brick file an engine extracts from, which its messages name. */
@@ -135,6 +138,7 @@ void ip_engine_destroy(ip_engine *e)
     }
     free(e->workers);
     ip__visited_free(&e->visited);
+    ip__coverage_free(&e->coverage);
     ip_mesh_free(&e->mesh);
     pthread_mutex_destroy(&e->order_lock);
     pthread_mutex_destroy(&e->mesh_lock);
@@ -195,6 +199,12 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     uint32_t last = ip__ray_order_last_level(&e->order);
     ip__ray_order_set_local_from(&e->order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
     set_lod_distances(e);
+    if (e->options.occlusion) {
+        double lo[3], hi[3];
+        ip_layout_world_box(ip_store_layout(ip_cache_store(e->cache)), lo, hi);
+        if (ip__coverage_reset(&e->coverage, camera, lo, hi) != IP_OK)
+            return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
+    }
     double pixel_angle = 2.0 * e->basis.tan_half_y / camera->height;
     for (unsigned t = 0; t < e->threads; t++) {
         worker *w = &e->workers[t];
@@ -212,7 +222,8 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
             ip__propagator_free(&lt->propagator);
             if (ip__propagator_init(&lt->propagator, &lt->sampler, &e->visited, &w->mesh,
                                     &e->camera, iso, &e->options, e->lod_distance[k],
-                                    e->lod_distance[k + 1]) != IP_OK)
+                                    e->lod_distance[k + 1],
+                                    e->options.occlusion ? &e->coverage : NULL) != IP_OK)
                 return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
         }
     }
@@ -241,6 +252,7 @@ static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
     to->propagation_seconds += from->propagation_seconds;
     to->extraction_seconds += from->extraction_seconds;
     to->rendering_seconds += from->rendering_seconds;
+    to->deferred += from->deferred;
 }
 
 /* Extracts one cell without propagating from it. */

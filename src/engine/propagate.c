@@ -15,7 +15,7 @@
 ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
                               ip_mesh *mesh, const ip_camera *camera, float iso,
                               const ip_engine_options *options, double near_distance,
-                              double far_distance)
+                              double far_distance, ip_coverage *coverage)
 {
     memset(p, 0, sizeof *p);
     p->sampler = sampler;
@@ -29,6 +29,7 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
     p->near_distance = near_distance;
     p->far_distance = far_distance;
+    p->coverage = coverage;
     p->queue_capacity = 4096;
     p->queue = malloc(p->queue_capacity * sizeof *p->queue);
     return p->queue ? IP_OK : IP_ERR_NOMEM;
@@ -105,6 +106,17 @@ static int in_frustum(const ip_propagator *p, const double centre[3], double dia
            y <= p->camera->height + margin;
 }
 
+/* Whether surface extracted so far hides the cell's box at every pixel centre it may cover. */
+static int hidden(const ip_propagator *p, const uint32_t cell[3])
+{
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = p->sampler->world[a][cell[a]];
+        hi[a] = p->sampler->world[a][cell[a] + 1];
+    }
+    return ip__coverage_hides(p->coverage, lo, hi);
+}
+
 static ip_status grow_queue(ip_propagator *p, uint64_t head, uint64_t tail)
 {
     /* keep the live part [head, tail) and move it to the front */
@@ -144,6 +156,9 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
             break;
         counts->cells++;
         counts->triangles += (uint64_t)n;
+        if (p->coverage && n > 0)
+            ip__coverage_add(p->coverage, p->mesh->positions + 9 * (p->mesh->triangle_count - n),
+                             (uint64_t)n);
         unsigned faces = ip__mc_crossed_faces(mc);
         if (tail + 6 > p->queue_capacity && (st = grow_queue(p, head, tail)) == IP_OK) {
             tail -= head;
@@ -173,6 +188,10 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
                 double d = ip__vec3_length(v);
                 if (d < p->near_distance || d >= p->far_distance)
                     continue; /* another level's band: the resolution boundary */
+            }
+            if (p->coverage && hidden(p, n3)) {
+                counts->deferred++; /* left unmarked: a ray that seeds it extracts it */
+                continue;
             }
             int was = ip__visited_mark(p->visited, p->sampler->level, n3);
             if (was < 0)

@@ -6,6 +6,7 @@
 #include "isoprop/camera.h"
 #include "isoprop/engine.h"
 #include "isoprop/mesh.h"
+#include "coverage.h"
 #include "sampler.h"
 #include "visited.h"
 
@@ -25,21 +26,24 @@ typedef struct ip_propagator {
     double foldback;                    /* radians */
     double pixel_scale;                 /* pixels per unit of (size / depth) */
     double near_distance, far_distance; /* the level's distance band from the eye */
+    ip_coverage *coverage;              /* occlusion: shared by the workers; NULL when off */
     ip_queued_cell *queue;
     uint64_t queue_capacity;
 } ip_propagator;
 
 /* Propagation within one level: cells whose centre lies outside the distance band
  * [near_distance, far_distance) from the eye belong to another level and stop it (the paper's
- * resolution boundary). */
+ * resolution boundary). With `coverage` (NULL: off), the triangles it extracts are recorded
+ * there, and a neighbour that recorded surface already hides is deferred: neither queued nor
+ * marked visited, so that a ray seeding it later still extracts it (coverage.c). */
 ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
                               ip_mesh *mesh, const ip_camera *camera, float iso,
                               const ip_engine_options *options, double near_distance,
-                              double far_distance);
+                              double far_distance, ip_coverage *coverage);
 void ip__propagator_free(ip_propagator *p);
 
 /* Propagates from `seed` (already marked visited) along the surface, for the ray `dir` (unit,
- * world) from the camera's eye. Adds to counts' cells, triangles and times.
+ * world) from the camera's eye. Adds to counts' cells, triangles, deferred cells and times.
  * @return IP_OK, IP_ERR_NOMEM or the sampler's error. */
 ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
                         ip_engine_counts *counts);

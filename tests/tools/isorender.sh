@@ -15,18 +15,36 @@ json=$(cat p.json)
 for key in cache budget_bytes resident_bytes resident_peak_bytes hits misses evictions \
            bytes_decompressed decode_seconds bricks_touched bricks_total hit_rate \
            peak_rss_bytes rays seeds cells triangles intersection_s propagation_s \
-           extraction_s rendering_s; do
+           extraction_s rendering_s visible_triangles overdraw occlusion deferred_cells; do
     check "stats has \"$key\"" sh -c 'printf "%s" "$0" | grep -q "\"$1\":"' "$json" "$key"
 done
 check "every pixel had its ray" sh -c 'printf "%s" "$0" | grep -q "\"rays\": 19200, \"rays_total\": 19200, \"done\": true"' "$json"
-check "progress header" test "$(head -1 p.csv)" = "time_s,rays,seeds,cells,triangles,final_pixel_pct"
-check "progress ends with every ray and 100 % final pixels" sh -c 'tail -1 p.csv | grep -q "^[0-9.]*,19200,.*,100.0000$"'
+# the first six columns are those scripts read since the start; later ones are appended
+check "progress header" test "$(head -1 p.csv)" = \
+    "time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,overdraw"
+check "progress ends with every ray and 100 % final pixels" sh -c 'tail -1 p.csv | grep -q "^[0-9.]*,19200,[0-9]*,[0-9]*,[0-9]*,100.0000,"'
 check "a checkpoint each time the ray count doubles" test "$(grep -c . p.csv)" = 17
 # final_pixel_pct never decreases
 check "final pixels only grow" awk -F, 'NR > 2 && $6 + 0 < prev { exit 1 } { prev = $6 + 0 }' p.csv
 triangles=$(printf '%s' "$json" | sed 's/.*"triangles": \([0-9]*\).*/\1/')
 faces=$(head -c 400 p.ply | sed -n 's/^element face \([0-9]*\).*/\1/p')
 check "the PLY holds every triangle ($faces = $triangles)" test "$faces" = "$triangles"
+# overdraw: the visible triangles (owning a final pixel) are among the extracted ones
+visible=$(printf '%s' "$json" | sed 's/.*"visible_triangles": \([0-9]*\).*/\1/')
+check "0 < visible ($visible) <= triangles ($triangles)" test "$visible" -gt 0 -a "$visible" -le "$triangles"
+check "the last checkpoint's visible triangles are the stats'" sh -c \
+    'tail -1 p.csv | cut -d, -f7 | grep -qx "$0"' "$visible"
+check "visible triangles only grow" awk -F, 'NR > 2 && $7 + 0 < prev { exit 1 } { prev = $7 + 0 }' p.csv
+
+# occlusion off extracts at least as much and makes the same picture
+run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o o.png --lod off \
+    --occlusion off --stats o.json --software --quiet
+check "occlusion off succeeds" test "$rc" = 0
+check "occlusion off says so" grep -q '"occlusion": false, "deferred_cells": 0' o.json
+off=$(sed 's/.*"triangles": \([0-9]*\).*/\1/' o.json)
+check "occlusion on extracts no more ($triangles <= $off)" test "$triangles" -le "$off"
+check "occlusion on and off make the same picture" cmp -s p.png o.png
+expect_error 2 "--occlusion" "$bin/isorender" s.ibv --iso 1 --occlusion maybe -o x.png
 
 # the full extraction and the progressive one make the same picture
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o f.png --full --software --quiet

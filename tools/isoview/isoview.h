@@ -85,6 +85,8 @@ typedef struct viewer {
     ip_mesh full_mesh;
     ip_engine_counts full_counts;
     double full_wall;
+    int overdraw_state; /* 0: not measured for the mesh shown, 1: measured, -1: failed */
+    double overdraw;    /* triangles / those owning a pixel of the finished image */
     int typing;
     char typed[48];
     char message[160];

@@ -107,6 +107,7 @@ static int begin_pass(viewer *v)
 {
     v->restart = 0;
     v->full_shown = 0;
+    v->overdraw_state = 0;
     v->passes++;
     v->pass_wall = v->pass_render = 0;
     ip_renderer_clear_mesh(v->renderer);
@@ -157,6 +158,7 @@ static int extract_full(viewer *v)
     if (ip_renderer_upload(v->renderer, &v->full_mesh, 0, &v->err) != IP_OK)
         return -1;
     v->full_shown = 1;
+    v->overdraw_state = 0;
     return 0;
 }
 

@@ -19,6 +19,7 @@ static const char usage[] =
     "  --foldback DEGREES  fold-back tolerance (default 0.25)\n"
     "  --lod on|off        adaptive resolution: far regions from coarser levels (default on)\n"
     "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n"
+    "  --occlusion on|off  propagation skips cells that extracted surface hides (default on)\n"
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
     "  --threads N         threads for seeding, propagation and full extraction\n"
     "                      (default: all cores)\n"

@@ -1,5 +1,6 @@
 /* isoview's overlay: the heads-up text and the help, stb_easy_font's quads drawn as indexed
  * triangles in pixel coordinates over the rendered frame. */
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -156,8 +157,46 @@ static void overlay_draw(overlay *t, char *text, float x, float y, float scale, 
     glDisable(GL_BLEND);
 }
 
+/* Overdraw of the finished image: the mesh's triangles over those that own at least one pixel
+ * (from the software rasterizer's triangle ids at the window's size); measured once per
+ * finished pass, as "final px" is known only then. */
+static void measure_overdraw(viewer *v, const ip_mesh *mesh)
+{
+    size_t n = (size_t)v->camera.width * v->camera.height;
+    uint32_t *index = malloc(n * sizeof *index);
+    uint8_t *owns = calloc(mesh->triangle_count / 8 + 1, 1);
+    v->overdraw_state = -1;
+    if (index && owns &&
+        ip_raster_mesh(mesh, &v->camera, v->lo, v->hi, index, NULL, NULL) == IP_OK) {
+        uint64_t visible = 0;
+        for (size_t p = 0; p < n; p++) {
+            uint32_t i = index[p];
+            if (i != UINT32_MAX && !(owns[i / 8] & (1u << (i % 8)))) {
+                owns[i / 8] |= (uint8_t)(1u << (i % 8));
+                visible++;
+            }
+        }
+        v->overdraw = visible ? (double)mesh->triangle_count / (double)visible : 0.0;
+        v->overdraw_state = 1;
+    }
+    free(index);
+    free(owns);
+}
+
+static const char *overdraw_text(viewer *v, char *text, size_t size)
+{
+    int finished = v->full_shown || ip_engine_done(v->engine);
+    if (finished && v->overdraw_state == 0)
+        measure_overdraw(v, v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine));
+    if (!finished || v->overdraw_state != 1)
+        return "-";
+    snprintf(text, size, "%.2f", v->overdraw);
+    return text;
+}
+
 /* The heads-up text. "final px" is the share of pixels already showing their final colour: it
- * is known exactly once every ray has been cast (100 %), and shown as "-" before. */
+ * is known exactly once every ray has been cast (100 %), and shown as "-" before; so is the
+ * overdraw (triangles extracted per triangle visible in the finished image). */
 static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
 {
     ip_engine_counts t;
@@ -166,7 +205,7 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
     ip_cache_get_stats(v->cache, &s);
     double pixels = (double)v->camera.width * v->camera.height;
     uint64_t lookups = s.hits + s.misses;
-    char iso[96], state[48] = "", progress[128];
+    char iso[96], state[48] = "", progress[160], overdraw[32];
     if (v->typing)
         snprintf(iso, sizeof iso, "iso> %s_  (Enter applies, Esc cancels)", v->typed);
     else
@@ -184,15 +223,17 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
     if (v->full_shown)
         snprintf(progress, sizeof progress,
                  "full: %llu cells in %.2f s   final px 100 %%\n"
-                 "triangles %llu",
+                 "triangles %llu   overdraw %s",
                  (unsigned long long)v->full_counts.cells, v->full_wall,
-                 (unsigned long long)v->full_counts.triangles);
+                 (unsigned long long)v->full_counts.triangles,
+                 overdraw_text(v, overdraw, sizeof overdraw));
     else
         snprintf(progress, sizeof progress,
                  "rays %.1f %% of %.0f   final px %s\n"
-                 "triangles %llu",
+                 "triangles %llu   overdraw %s",
                  pixels > 0 ? 100.0 * (double)t.rays / pixels : 0.0, pixels,
-                 ip_engine_done(v->engine) ? "100 %" : "-", (unsigned long long)t.triangles);
+                 ip_engine_done(v->engine) ? "100 %" : "-", (unsigned long long)t.triangles,
+                 overdraw_text(v, overdraw, sizeof overdraw));
     int n = snprintf(text, size,
                      "%s%s\n%s\nfps %.1f\ncache %.1f / %.1f MiB   hit rate %.1f %%\n"
                      "misses %llu   bricks %llu / %llu",

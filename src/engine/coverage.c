@@ -1,0 +1,234 @@
+/* The coverage depth buffer: what extracted surface already hides, for occlusion-aware
+ * propagation.
+ *
+ * Why deferring hidden cells keeps the image exact. The image (ip_raster_mesh()) shows at each
+ * pixel centre the nearest triangle there. Every pixel's own ray still extracts its first-hit
+ * cell, the seed, whatever the coverage says: the test below only keeps propagation from
+ * queueing a cell, never stops a ray. So once every pixel has had its ray, each pixel centre
+ * holds its first-hit triangle, as in the full extraction, and no extracted triangle is
+ * nearer there (all are triangles of the full surface). A deferred cell is therefore never
+ * needed at a pixel centre unless some ray seeds it, and then that ray extracts it.
+ *
+ * The test is conservative besides, so that deferring costs no pixel even mid-way: a cell is
+ * deferred only when, at every pixel centre its box may cover, surface already extracted (and
+ * kept: the mesh only grows) is strictly nearer than the box's nearest point; its triangles
+ * could never win such a pixel. To that end:
+ *  - a recorded depth is the largest view depth of its triangle's vertices (the triangle's
+ *    depth anywhere is no larger), rounded up to a float;
+ *  - a triangle records the pixel centres inside its exact projection or on its edges (within
+ *    EDGE_TOLERANCE pixels, for rounding), so that a centre on an edge two triangles share is
+ *    recorded by both: either depth bounds the one the rasterizer shows there. It records
+ *    only when it lies wholly between the near and far planes the renderers clip at;
+ *  - a box's pixel centres are those within BOX_MARGIN pixels of the bounding rectangle of its
+ *    corners' projections (more than the rasterizer's 1/256-pixel vertex snapping moves a
+ *    triangle of the box), its nearest depth is its nearest corner's (depth is linear) less a
+ *    relative BOX_DEPTH_MARGIN for the float rounding of vertices;
+ *  - a box not wholly in front of the near plane (crossing it, or behind the eye), or whose
+ *    projection holds no pixel centre or more than IP_COVERAGE_MAX_PIXELS, is never hidden.
+ * One approximation is left: where a triangle's edge is a silhouette, the rasterizer's
+ * snapping may leave uncovered a pixel centre within 1/256 pixel of the exact edge, which the
+ * buffer counts as covered. A cell whose surface shows only at such a centre may be deferred
+ * until that pixel's own ray seeds it; the final image is unaffected. (Requiring centres to
+ * lie 1/256 pixel inside every edge instead leaves the centres on shared edges uncovered: on
+ * the head that kept a third of the deferrals from happening.) */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "coverage.h"
+#include "vec3.h"
+
+#define EDGE_TOLERANCE 1e-7      /* pixels */
+#define BOX_MARGIN (1.0 / 64)    /* pixels */
+#define BOX_DEPTH_MARGIN 1e-5    /* relative */
+#define NEAR_MARGIN (1.0 + 1e-6) /* relative to the near plane */
+
+ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const double lo[3],
+                             const double hi[3])
+{
+    size_t n = (size_t)camera->width * camera->height;
+    if (n > c->capacity) {
+        free(c->depth);
+        c->depth = malloc(n * sizeof *c->depth);
+        c->capacity = c->depth ? n : 0;
+        if (!c->depth)
+            return IP_ERR_NOMEM;
+    }
+    c->camera = *camera;
+    ip_camera_basis_of(camera, &c->basis);
+    ip_camera_depth_range(camera, lo, hi, &c->near_plane, &c->far_plane);
+    c->width = camera->width;
+    c->height = camera->height;
+    /* ip_camera_project() with one division */
+    for (int a = 0; a < 3; a++) {
+        c->to_x[a] = c->basis.right[a] * 0.5 * c->width / c->basis.tan_half_x;
+        c->to_y[a] = -c->basis.up[a] * 0.5 * c->height / c->basis.tan_half_y;
+    }
+    c->centre_x = 0.5 * c->width;
+    c->centre_y = 0.5 * c->height;
+    float inf = INFINITY;
+    unsigned bits;
+    memcpy(&bits, &inf, sizeof bits);
+    for (size_t i = 0; i < n; i++)
+        atomic_init(&c->depth[i], bits);
+    return IP_OK;
+}
+
+void ip__coverage_free(ip_coverage *c)
+{
+    free(c->depth);
+    c->depth = NULL;
+    c->capacity = 0;
+}
+
+/* Image position (pixels) and view depth of world point p. */
+static void project(const ip_coverage *c, const double p[3], double *x, double *y, double *z)
+{
+    double v[3];
+    ip__vec3_sub(p, c->camera.eye, v);
+    *z = ip__vec3_dot(v, c->basis.forward);
+    double r = 1.0 / *z;
+    *x = ip__vec3_dot(v, c->to_x) * r + c->centre_x;
+    *y = ip__vec3_dot(v, c->to_y) * r + c->centre_y;
+}
+
+static double min3(double a, double b, double c)
+{
+    double m = a < b ? a : b;
+    return m < c ? m : c;
+}
+
+static double max3(double a, double b, double c)
+{
+    double m = a > b ? a : b;
+    return m > c ? m : c;
+}
+
+/* The pixel centres (x + 0.5) within [lo - margin, hi + margin], clamped to [0, side). */
+static int centre_range(double lo, double hi, double margin, uint32_t side, int64_t *first,
+                        int64_t *last)
+{
+    double a = ceil(lo - 0.5 - margin), b = floor(hi - 0.5 + margin);
+    a = a < 0 ? 0 : a;
+    b = b > side - 1.0 ? side - 1.0 : b;
+    if (!(a <= b))
+        return 0;
+    *first = (int64_t)a;
+    *last = (int64_t)b;
+    return 1;
+}
+
+static unsigned float_bits(float f)
+{
+    unsigned u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+/* Lowers entry i to `bits` (a non-negative float's bits, so integer order is float order). */
+static void lower(atomic_uint *entry, unsigned bits)
+{
+    unsigned old = atomic_load_explicit(entry, memory_order_relaxed);
+    while (bits < old && !atomic_compare_exchange_weak_explicit(
+                             entry, &old, bits, memory_order_relaxed, memory_order_relaxed))
+        ;
+}
+
+static void add_triangle(ip_coverage *c, const float *t)
+{
+    double x[3], y[3], z[3], zmax = 0;
+    for (int k = 0; k < 3; k++) {
+        double p[3] = {t[3 * k], t[3 * k + 1], t[3 * k + 2]};
+        project(c, p, &x[k], &y[k], &z[k]);
+        if (!(z[k] >= c->near_plane * NEAR_MARGIN && z[k] <= c->far_plane))
+            return; /* clipped by the renderers, or behind the eye */
+        zmax = z[k] > zmax ? z[k] : zmax;
+    }
+    double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    if (!(fabs(area) > 1e-9))
+        return;
+    if (area < 0) { /* counter-clockwise in (x, y): inside is left of every edge */
+        double s = x[1];
+        x[1] = x[2];
+        x[2] = s;
+        s = y[1];
+        y[1] = y[2];
+        y[2] = s;
+    }
+    int64_t x0, x1, y0, y1;
+    if (!centre_range(min3(x[0], x[1], x[2]), max3(x[0], x[1], x[2]), 0, c->width, &x0, &x1) ||
+        !centre_range(min3(y[0], y[1], y[2]), max3(y[0], y[1], y[2]), 0, c->height, &y0, &y1) ||
+        (x1 - x0 + 1) * (y1 - y0 + 1) > IP_COVERAGE_MAX_PIXELS)
+        return;
+    double ex[3], ey[3], need[3];
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3;
+        ex[i] = x[j] - x[i];
+        ey[i] = y[j] - y[i];
+        need[i] = -EDGE_TOLERANCE * (fabs(ex[i]) + fabs(ey[i])); /* >= the edge's length */
+    }
+    unsigned bits = float_bits(nextafterf((float)zmax, INFINITY));
+    for (int64_t py = y0; py <= y1; py++)
+        for (int64_t px = x0; px <= x1; px++) {
+            double cx = px + 0.5, cy = py + 0.5;
+            int inside = 1;
+            for (int i = 0; i < 3 && inside; i++)
+                inside = ex[i] * (cy - y[i]) - ey[i] * (cx - x[i]) >= need[i];
+            if (inside)
+                lower(&c->depth[(size_t)py * c->width + (size_t)px], bits);
+        }
+}
+
+void ip__coverage_add(ip_coverage *c, const float *positions, uint64_t count)
+{
+    for (uint64_t i = 0; i < count; i++)
+        add_triangle(c, positions + 9 * i);
+}
+
+int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi[3])
+{
+    /* The nearest depth first (depth is linear: the centre's less the half extents along the
+     * view), then the entry under the centre: most boxes tested are in view, and fail there
+     * without the projection of the 8 corners. */
+    double centre[3], v[3], reach = 0;
+    for (int a = 0; a < 3; a++) {
+        centre[a] = 0.5 * (lo[a] + hi[a]);
+        reach += 0.5 * (hi[a] - lo[a]) * fabs(c->basis.forward[a]);
+    }
+    ip__vec3_sub(centre, c->camera.eye, v);
+    double zc = ip__vec3_dot(v, c->basis.forward), zmin = zc - reach;
+    if (!(zmin >= c->near_plane * NEAR_MARGIN))
+        return 0; /* crosses the near plane or lies behind the eye: never deferred */
+    double limit = zmin * (1.0 - BOX_DEPTH_MARGIN);
+    float f = (float)limit;
+    if ((double)f > limit)
+        f = nextafterf(f, 0.0f);
+    unsigned bits = float_bits(f);
+    double xc = ip__vec3_dot(v, c->to_x) / zc + c->centre_x;
+    double yc = ip__vec3_dot(v, c->to_y) / zc + c->centre_y;
+    if (xc >= 0 && xc < c->width && yc >= 0 && yc < c->height &&
+        atomic_load_explicit(&c->depth[(size_t)yc * c->width + (size_t)xc], memory_order_relaxed) >=
+            bits)
+        return 0;
+    double min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY;
+    for (int k = 0; k < 8; k++) {
+        double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
+        double x, y, z;
+        project(c, p, &x, &y, &z);
+        min_x = x < min_x ? x : min_x;
+        max_x = x > max_x ? x : max_x;
+        min_y = y < min_y ? y : min_y;
+        max_y = y > max_y ? y : max_y;
+    }
+    int64_t x0, x1, y0, y1;
+    if (!centre_range(min_x, max_x, BOX_MARGIN, c->width, &x0, &x1) ||
+        !centre_range(min_y, max_y, BOX_MARGIN, c->height, &y0, &y1) ||
+        (x1 - x0 + 1) * (y1 - y0 + 1) > IP_COVERAGE_MAX_PIXELS)
+        return 0;
+    for (int64_t py = y0; py <= y1; py++)
+        for (int64_t px = x0; px <= x1; px++)
+            if (atomic_load_explicit(&c->depth[(size_t)py * c->width + (size_t)px],
+                                     memory_order_relaxed) >= bits)
+                return 0;
+    return 1;
+}

@@ -1,0 +1,58 @@
+/* The coverage depth buffer of occlusion-aware propagation. Internal.
+ *
+ * One entry per pixel of the image: an upper bound on the view depth of the nearest extracted
+ * triangle whose projection holds the pixel's centre (+infinity where none is known yet).
+ * Workers add the triangles they extract and test, before queueing a cell, whether extracted
+ * surface already hides it (docs/occlusion.md; the argument is in coverage.c).
+ *
+ * Granularity: cells, the unit propagation queues. At the sizes the engine makes them (about
+ * a pixel with lod, a few pixels at full resolution) a cell's box holds a handful of pixel
+ * centres, so the test reads those entries directly and stops at the first one not covered;
+ * a max-depth pyramid (hierarchical Z) would pay only for boxes of hundreds of pixels, which
+ * propagation never tests, and would need its levels kept conservative under concurrent
+ * writes. Boxes and triangles larger than IP_COVERAGE_MAX_PIXELS are simply not used (not
+ * deferred, not recorded), which is always safe.
+ *
+ * Thread-safe: entries are atomic; a write is an atomic minimum (compare-and-swap), a read a
+ * relaxed load. Entries only decrease, and every value ever stored is backed by a triangle
+ * already in a worker's mesh, so a stale read only makes the test less eager. */
+#ifndef ISOPROP_COVERAGE_H
+#define ISOPROP_COVERAGE_H
+
+#include <stdatomic.h>
+#include <stdint.h>
+
+#include "isoprop/camera.h"
+#include "isoprop/status.h"
+
+#define IP_COVERAGE_MAX_PIXELS 1024 /* the largest box or triangle (bounding pixels) used */
+
+typedef struct ip_coverage {
+    ip_camera camera;
+    ip_camera_basis basis;
+    double near_plane, far_plane; /* the renderers' clip planes for the volume's box */
+    double to_x[3], to_y[3];      /* image x, y = dot(p - eye, to_x or to_y) / depth + centre */
+    double centre_x, centre_y;
+    uint32_t width, height;
+    atomic_uint *depth; /* width * height entries: the bits of a float depth, +inf: unknown */
+    size_t capacity;    /* entries allocated */
+} ip_coverage;
+
+/* Starts over for `camera` (image size and view) and the volume's world box [lo, hi]: every
+ * entry unknown. Reallocates when the image grew. Not while other threads use it.
+ * @return IP_OK or IP_ERR_NOMEM. */
+ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const double lo[3],
+                             const double hi[3]);
+
+void ip__coverage_free(ip_coverage *c);
+
+/* Records `count` triangles (9 floats each, world units). Any thread. */
+void ip__coverage_add(ip_coverage *c, const float *positions, uint64_t count);
+
+/* 1 when the world box [lo, hi] is certainly hidden: it lies wholly in front of the eye and
+ * beyond the near plane, its projection holds at least one pixel centre, and at every pixel
+ * centre it may cover the recorded surface is nearer than the box's nearest point. 0 when
+ * in doubt. Any thread. */
+int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi[3]);
+
+#endif
