@@ -500,6 +500,46 @@ static void check_occlusion(const char *dir)
     close_scene(&s);
 }
 
+/* Step budgets with the ray order handed out in ranges to several workers: each step casts
+ * exactly its budget (the rest at the end), a step cut short by its deadline leaves no pixel
+ * out, and the rays add up to the pixels once the engine is done. */
+static void check_ray_budgets(scene *s, float iso)
+{
+    ip_error err;
+    ip_camera cam;
+    REQUIRE(ip_camera_fit_axis(s->lo, s->hi, "-x", 30.0, 97, 61, &cam, &err) == IP_OK);
+    ip_engine *e;
+    ip_engine_options o;
+    ip_engine_options_default(&o);
+    o.threads = 4;
+    REQUIRE(ip_engine_create(s->cache, &o, &e, &err) == IP_OK);
+    REQUIRE(ip_engine_begin(e, &cam, iso, &err) == IP_OK);
+    uint64_t pixels = 97 * 61, cast = 0, exact = 0, steps = 0;
+    static const uint64_t budgets[] = {1, 5, 37, 64, 100, 1000};
+    while (!ip_engine_done(e)) {
+        uint64_t budget = budgets[steps % (sizeof budgets / sizeof budgets[0])];
+        ip_engine_counts c;
+        REQUIRE(ip_engine_step(e, budget, 0, &c, &err) == IP_OK);
+        uint64_t expected = pixels - cast < budget ? pixels - cast : budget;
+        exact += c.rays == expected;
+        cast += c.rays;
+        steps++;
+        if (steps == 7) { /* a step that may stop anywhere: its deadline is already near */
+            REQUIRE(ip_engine_step(e, 0, 1e-9, &c, &err) == IP_OK);
+            cast += c.rays;
+        }
+    }
+    CHECK_MSG(exact == steps && cast == pixels,
+              "%llu of %llu steps cast their budget; %llu rays "
+              "for %llu pixels",
+              (unsigned long long)exact, (unsigned long long)steps, (unsigned long long)cast,
+              (unsigned long long)pixels);
+    ip_engine_counts t;
+    ip_engine_totals(e, &t);
+    CHECK(t.rays == pixels);
+    ip_engine_destroy(e);
+}
+
 static void check_shared_data(void)
 {
     const char *data = getenv("IP_SKIP_SHARED_DATA") ? NULL : getenv("IP_SHARED_DATA");
@@ -549,6 +589,7 @@ int main(void)
     check_view(&s, "gyroid", "-x", 0.5f, 128, 96);
     check_view(&s, "gyroid", "+y", 0.6f, 96, 128);
     check_cancel_restart(&s, 0.5f, 0.45f);
+    check_ray_budgets(&s, 0.5f);
     check_threads(&s, 0.5f);
     close_scene(&s);
 

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "internal.h"
 #include "isoprop/mesh.h"
 
 static void test_normal_packing(void)
@@ -140,9 +141,59 @@ static void test_ply(void)
     ip_mesh_free(&m);
 }
 
+/* Appends across many populated stretches of the arrays (mesh.c maps them ahead in one system
+ * call each) keep every triangle; populating memory keeps its contents. */
+static void test_populated_growth(void)
+{
+    ip_mesh m;
+    ip_mesh_init_with_cells(&m);
+    float p[9 * 3];
+    int16_t n[9 * 3];
+    uint64_t cells[3];
+    uint64_t total = 0;
+    for (uint64_t i = 0; i < 40000; i++) {
+        uint64_t count = 1 + i % 3;
+        for (uint64_t t = 0; t < count; t++) {
+            for (int k = 0; k < 9; k++) {
+                p[9 * t + k] = (float)(total + t) + (float)k / 16;
+                n[9 * t + k] = (int16_t)((total + t + (uint64_t)k) % 30000);
+            }
+            cells[t] = (total + t) * 7;
+        }
+        REQUIRE(ip_mesh_append(&m, p, n, cells, count) == IP_OK);
+        total += count;
+    }
+    int same = m.triangle_count == total;
+    for (uint64_t t = 0; same && t < total; t++)
+        for (int k = 0; k < 9; k++)
+            same &= m.positions[9 * t + k] == (float)t + (float)k / 16 &&
+                    m.normals[9 * t + k] == (int16_t)((t + (uint64_t)k) % 30000) &&
+                    m.cells[t] == t * 7;
+    CHECK_MSG(same, "%llu triangles appended, %llu kept", (unsigned long long)total,
+              (unsigned long long)m.triangle_count);
+    ip_mesh_clear(&m);
+    REQUIRE(ip_mesh_append(&m, p, n, cells, 1) == IP_OK);
+    CHECK(m.triangle_count == 1 && m.cells[0] == cells[0]);
+
+    unsigned char *buffer = malloc(3 << 20);
+    REQUIRE(buffer);
+    for (size_t i = 0; i < 3 << 20; i += 4096)
+        buffer[i] = (unsigned char)(i >> 12);
+    ip__memory_populate(buffer + 100, (3 << 20) - 200);
+    ip__memory_populate(NULL, 0);
+    ip__memory_populate(buffer, 10); /* no whole page inside */
+    int kept = 1;
+    for (size_t i = 0; i < 3 << 20; i += 4096)
+        kept &= buffer[i] == (unsigned char)(i >> 12);
+    CHECK_MSG(kept, "ip__memory_populate changed the contents");
+    free(buffer);
+    ip_mesh_free(&m);
+}
+
 int main(void)
 {
     test_normal_packing();
+    test_populated_growth();
     test_appends();
     test_ply();
     return test_summary("test_mesh");

@@ -459,6 +459,34 @@ static int bench(uint32_t w, uint32_t h)
     return 0;
 }
 
+/* Ranges of positions walked by separate iterators, each from a seek, give exactly the pixels
+ * of one uninterrupted walk in the same order, for ranges of any length and local levels. */
+static void test_ranges(uint32_t w, uint32_t h, uint32_t local_from, uint64_t range)
+{
+    ip_ray_order whole, part;
+    REQUIRE(ip__ray_order_init(&whole, w, h) == IP_OK);
+    REQUIRE(ip__ray_order_init(&part, w, h) == IP_OK);
+    ip__ray_order_set_local_from(&whole, local_from);
+    ip__ray_order_set_local_from(&part, local_from);
+    uint64_t cells = ip__ray_order_cells(&whole), n = 0, differ = 0;
+    CHECK(cells >= (uint64_t)w * h);
+    for (uint64_t start = 0; start < cells; start += range) {
+        uint64_t end = cells - start < range ? cells : start + range;
+        ip__ray_order_seek(&part, start);
+        CHECK(ip__ray_order_position(&part) == start);
+        uint32_t x, y, ex, ey;
+        while (ip__ray_order_next_before(&part, end, &x, &y)) {
+            n++;
+            differ += !ip__ray_order_next(&whole, &ex, &ey) || ex != x || ey != y;
+        }
+        differ += ip__ray_order_position(&part) != end;
+    }
+    uint32_t x, y;
+    CHECK_MSG(differ == 0 && n == (uint64_t)w * h && !ip__ray_order_next(&whole, &x, &y),
+              "%ux%u, ranges of %llu: %llu differ, %llu pixels", w, h, (unsigned long long)range,
+              (unsigned long long)differ, (unsigned long long)n);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 3 && strcmp(argv[1], "--bench") == 0)
@@ -479,5 +507,11 @@ int main(int argc, char **argv)
     test_local_levels(255, 257, 5);
     test_local_levels(1000, 1, 3);
     test_local_levels(17, 13, 40); /* past the last level: Bayer order throughout */
+    test_ranges(1600, 1200, 8, 64);
+    test_ranges(1600, 1200, UINT32_MAX, 1000);
+    test_ranges(17, 13, 2, 1);
+    test_ranges(1000, 1, 3, 7);
+    test_ranges(1, 1, 0, 1);
+    test_ranges(255, 257, 5, 3);
     return test_summary("test_ray_order");
 }

@@ -35,7 +35,10 @@
  * Threads: an engine is driven by one thread. ip_engine_create() starts its worker threads
  * (ip_thread_count(options.threads) in all, the driving thread counted), which sleep between
  * steps; ip_engine_step() wakes them, works as one of them and returns when all have stopped.
- * They share the progressive ray sequence (handed out in small batches, in order), the
+ * They share the progressive ray sequence (handed out without a lock in ranges that each
+ * worker walks on its own: short ones first, so that the order holds nearly exactly, longer
+ * ones later; what a step's budget or deadline leaves of a range is cast first by the next
+ * step, so every pixel has one ray and one thread casts exactly the sequential order), the
  * visited set (an atomic bit per cell) and the cache, and keep their own triangle buffers,
  * moved to the mesh every few thousand triangles and at the end of the step. Which thread extracts a cell varies from run to
  * run, so the triangles' order and, where propagations meet, which cells are extracted may

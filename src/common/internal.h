@@ -68,6 +68,13 @@ static inline int ip__host_little_endian(void)
     return *(const unsigned char *)&one == 1;
 }
 
+/* Maps the whole pages inside [p, p + bytes) into the process, writable, in one system call
+ * (MADV_POPULATE_WRITE), for memory about to be written: first touches of fresh memory then find
+ * their pages present instead of taking a page fault each, which costs several times more in a
+ * virtual machine (docs/performance.md, part 6). Contents are unchanged. Best effort: does
+ * nothing where the kernel (before Linux 5.14) or the range does not allow it. */
+void ip__memory_populate(void *p, size_t bytes);
+
 /* Reverses the bytes of each of `count` elements of `size` bytes (2 or 4) in place. */
 void ip__swap_bytes(void *data, size_t count, size_t size);
 

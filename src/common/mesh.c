@@ -53,14 +53,39 @@ ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
     return st;
 }
 
+#define POPULATE_TRIANGLES 16384 /* the arrays are populated this many triangles ahead */
+
+/* Populates the arrays' pages up to the next multiple of POPULATE_TRIANGLES past `new_count`
+ * (or the capacity): the part of [0, that) not populated before this append, which grows the
+ * mesh from `old_count` triangles in arrays of `old_capacity`. Appends are small (a cell's triangles),
+ * so this is one system call per POPULATE_TRIANGLES triangles or growth of the arrays instead
+ * of a page fault per page written (internal.h). */
+static void populate_ahead(ip_mesh *m, uint64_t old_count, uint64_t old_capacity,
+                           uint64_t new_count)
+{
+    uint64_t before =
+        (old_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES * POPULATE_TRIANGLES;
+    uint64_t after = (new_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES * POPULATE_TRIANGLES;
+    before = before < old_capacity ? before : old_capacity;
+    after = after < m->capacity ? after : m->capacity;
+    if (after <= before)
+        return;
+    ip__memory_populate(m->positions + 9 * before, (after - before) * 9 * sizeof(float));
+    ip__memory_populate(m->normals + 9 * before, (after - before) * 9 * sizeof(int16_t));
+    if (m->with_cells)
+        ip__memory_populate(m->cells + before, (after - before) * sizeof(uint64_t));
+}
+
 ip_status ip_mesh_append(ip_mesh *m, const float *positions, const int16_t *normals,
                          const uint64_t *cells, uint64_t count)
 {
     if (count == 0)
         return IP_OK; /* the arrays of an empty mesh may be NULL */
+    uint64_t old_count = m->triangle_count, old_capacity = m->capacity;
     ip_status st = ip_mesh_reserve(m, m->triangle_count + count);
     if (st != IP_OK)
         return st;
+    populate_ahead(m, old_count, old_capacity, old_count + count);
     memcpy(m->positions + 9 * m->triangle_count, positions, count * 9 * sizeof(float));
     memcpy(m->normals + 9 * m->triangle_count, normals, count * 9 * sizeof(int16_t));
     if (m->with_cells)

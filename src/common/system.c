@@ -3,10 +3,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "internal.h"
 #include "isoprop/system.h"
+
+#ifndef MADV_POPULATE_WRITE
+#define MADV_POPULATE_WRITE 23 /* Linux 5.14 */
+#endif
 
 /* A field of /proc/self/status given in KiB ("VmRSS:", "VmHWM:"), in bytes; 0 when unknown. */
 static uint64_t status_bytes(const char *field)
@@ -35,6 +41,16 @@ uint64_t ip_peak_rss_bytes(void)
 uint64_t ip_rss_bytes(void)
 {
     return status_bytes("VmRSS:");
+}
+
+void ip__memory_populate(void *p, size_t bytes)
+{
+    long size = sysconf(_SC_PAGESIZE);
+    size_t page = size > 0 ? (size_t)size : 4096;
+    uintptr_t first = ((uintptr_t)p + page - 1) & ~(uintptr_t)(page - 1);
+    uintptr_t end = ((uintptr_t)p + bytes) & ~(uintptr_t)(page - 1);
+    if (p && end > first)
+        (void)madvise((void *)first, end - first, MADV_POPULATE_WRITE);
 }
 
 double ip_now_seconds(void)

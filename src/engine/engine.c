@@ -17,6 +17,8 @@
 #include "vec3.h"
 
 #define RAY_BATCH 16   /* rays a worker takes at once: small, so the order stays progressive */
+#define RANGE_MIN 16   /* positions of the ray order a worker claims at once, at the start... */
+#define RANGE_MAX 1024 /* ...and at most, later: 1/256 of the positions already handed out */
 #define LOCAL_LEVELS 3 /* ray order: the finest levels cast in Z-order (see begin) */
 #define FLUSH_TRIANGLES 16384 /* a worker's buffer moves to the engine's mesh past this size */
 
@@ -28,9 +30,18 @@ typedef struct level_tools {
     ip_propagator propagator;
 } level_tools;
 
-/* One worker's private state: its tools per level and its triangles. */
+/* Positions [start, end) of the ray order (ray_order.h) that no worker has walked yet. */
+typedef struct order_range {
+    uint64_t start, end;
+} order_range;
+
+/* One worker's private state: its tools per level, its triangles, and its range of the ray
+ * order with an iterator over it. */
 typedef struct worker {
     ip_engine *engine;
+    ip_ray_order order;
+    uint64_t range_end;
+    int holding; /* a range: the iterator's position up to range_end */
     level_tools level[IP_MAX_LEVELS];
     ip_mesh mesh;
     ip_engine_counts counts;
@@ -54,10 +65,22 @@ struct ip_engine {
     int begun;
     uint32_t levels_used;                   /* levels 0 .. levels_used - 1 have a distance band */
     double lod_distance[IP_MAX_LEVELS + 1]; /* D[k]; D[levels_used] = infinity */
-    pthread_mutex_t order_lock;             /* the shared ray sequence */
-    ip_ray_order order;
-    uint64_t step_rays_left; /* rays the current step may still hand out */
-    double step_deadline;    /* 0: none */
+    /* The ray order is handed out in ranges of positions: a worker claims the next range
+     * with one atomic add (or takes a range another worker left unfinished at the end of a
+     * step, the earliest first) and walks it with its own iterator, so no lock is held while
+     * the order is computed. */
+    ip_ray_order order; /* the view's order, copied into each worker's iterator */
+    uint64_t order_cells;
+    atomic_uint_fast64_t next_position; /* the first position no worker has claimed */
+    atomic_uint_fast64_t rays_taken;    /* pixels handed out since begin */
+    pthread_mutex_t leftover_lock;
+    order_range *leftovers; /* at most one per worker (each holds one range at a time) */
+    unsigned leftover_count;
+    atomic_uint leftovers_waiting;       /* leftover_count, readable without the lock */
+    int step_limited;                    /* the step has a ray budget */
+    atomic_uint_fast64_t step_rays_left; /* rays the current step may still hand out */
+    atomic_int step_stopped;             /* a worker failed: the others take no more rays */
+    double step_deadline;                /* 0: none */
     ip_engine_counts totals;
     atomic_int cancel;
 };
@@ -98,12 +121,18 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     e->options = *options;
     e->threads = ip_thread_count(options->threads);
     atomic_init(&e->cancel, 0);
-    pthread_mutex_init(&e->order_lock, NULL);
+    atomic_init(&e->next_position, 0);
+    atomic_init(&e->rays_taken, 0);
+    atomic_init(&e->leftovers_waiting, 0);
+    atomic_init(&e->step_rays_left, 0);
+    atomic_init(&e->step_stopped, 0);
+    pthread_mutex_init(&e->leftover_lock, NULL);
     pthread_mutex_init(&e->mesh_lock, NULL);
     ip_mesh_init(&e->mesh);
     e->mesh.with_cells = options->cell_ids != 0;
     e->workers = calloc(e->threads, sizeof *e->workers);
-    ip_status st = e->workers
+    e->leftovers = calloc(e->threads, sizeof *e->leftovers);
+    ip_status st = e->workers && e->leftovers
                        ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
                        : IP_ERR_NOMEM;
     if (st == IP_OK)
@@ -137,10 +166,11 @@ void ip_engine_destroy(ip_engine *e)
         ip_mesh_free(&e->workers[t].mesh);
     }
     free(e->workers);
+    free(e->leftovers);
     ip__visited_free(&e->visited);
     ip__coverage_free(&e->coverage);
     ip_mesh_free(&e->mesh);
-    pthread_mutex_destroy(&e->order_lock);
+    pthread_mutex_destroy(&e->leftover_lock);
     pthread_mutex_destroy(&e->mesh_lock);
     free(e);
 }
@@ -198,6 +228,11 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
      * the coarser levels, which make it, keep their spread-out order. */
     uint32_t last = ip__ray_order_last_level(&e->order);
     ip__ray_order_set_local_from(&e->order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
+    e->order_cells = ip__ray_order_cells(&e->order);
+    atomic_store(&e->next_position, 0);
+    atomic_store(&e->rays_taken, 0);
+    e->leftover_count = 0;
+    atomic_store(&e->leftovers_waiting, 0);
     set_lod_distances(e);
     if (e->options.occlusion) {
         double lo[3], hi[3];
@@ -209,6 +244,8 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     for (unsigned t = 0; t < e->threads; t++) {
         worker *w = &e->workers[t];
         ip_mesh_clear(&w->mesh);
+        w->order = e->order;
+        w->holding = 0;
         for (uint32_t k = 0; k < e->levels_used; k++) {
             level_tools *lt = &w->level[k];
             if (!lt->ready) {
@@ -239,7 +276,7 @@ void ip_engine_cancel(ip_engine *e)
 
 int ip_engine_done(const ip_engine *e)
 {
-    return e->begun && ip__ray_order_emitted(&e->order) == ip__ray_order_count(&e->order);
+    return e->begun && atomic_load(&((ip_engine *)e)->rays_taken) == ip__ray_order_count(&e->order);
 }
 
 static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
@@ -314,18 +351,81 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
     return IP_OK;
 }
 
-/* Takes up to RAY_BATCH pixels of the shared order for this step; returns how many. */
-static unsigned take_rays(ip_engine *e, uint32_t xy[][2])
+/* Gives the worker a range of the order to walk: the earliest one left unfinished by a step,
+ * else the next unclaimed one. Ranges start small, so that the first rays (the coarsest levels)
+ * keep their order closely, and grow with the position to at most RANGE_MAX. Returns 0 once
+ * every position has been claimed. */
+static int claim_range(ip_engine *e, worker *w)
 {
-    unsigned n = 0;
-    pthread_mutex_lock(&e->order_lock);
-    int late = e->step_deadline > 0 && ip_now_seconds() >= e->step_deadline;
-    while (!late && n < RAY_BATCH && e->step_rays_left > 0 &&
-           ip__ray_order_next(&e->order, &xy[n][0], &xy[n][1])) {
-        n++;
-        e->step_rays_left--;
+    if (atomic_load(&e->leftovers_waiting) > 0) {
+        pthread_mutex_lock(&e->leftover_lock);
+        unsigned first = 0;
+        for (unsigned i = 1; i < e->leftover_count; i++)
+            if (e->leftovers[i].start < e->leftovers[first].start)
+                first = i;
+        int found = e->leftover_count > 0;
+        if (found) {
+            ip__ray_order_seek(&w->order, e->leftovers[first].start);
+            w->range_end = e->leftovers[first].end;
+            e->leftovers[first] = e->leftovers[--e->leftover_count];
+            atomic_store(&e->leftovers_waiting, e->leftover_count);
+        }
+        pthread_mutex_unlock(&e->leftover_lock);
+        if (found)
+            return w->holding = 1;
     }
-    pthread_mutex_unlock(&e->order_lock);
+    uint64_t start = atomic_load(&e->next_position), length;
+    do {
+        if (start >= e->order_cells)
+            return 0;
+        length = start / 256 < RANGE_MIN   ? RANGE_MIN
+                 : start / 256 > RANGE_MAX ? RANGE_MAX
+                                           : start / 256;
+    } while (!atomic_compare_exchange_weak(&e->next_position, &start, start + length));
+    ip__ray_order_seek(&w->order, start);
+    w->range_end = e->order_cells - start < length ? e->order_cells : start + length;
+    return w->holding = 1;
+}
+
+/* Hands the unwalked rest of the worker's range back for a later step. */
+static void leave_range(ip_engine *e, worker *w)
+{
+    uint64_t position = ip__ray_order_position(&w->order);
+    if (w->holding && position < w->range_end) {
+        pthread_mutex_lock(&e->leftover_lock);
+        e->leftovers[e->leftover_count++] = (order_range){position, w->range_end};
+        atomic_store(&e->leftovers_waiting, e->leftover_count);
+        pthread_mutex_unlock(&e->leftover_lock);
+    }
+    w->holding = 0;
+}
+
+/* Takes up to RAY_BATCH pixels of the order for this step from the worker's ranges; returns
+ * how many. */
+static unsigned take_rays(ip_engine *e, worker *w, uint32_t xy[][2])
+{
+    if (atomic_load_explicit(&e->step_stopped, memory_order_relaxed) ||
+        (e->step_deadline > 0 && ip_now_seconds() >= e->step_deadline))
+        return 0;
+    uint64_t want = RAY_BATCH;
+    if (e->step_limited) { /* take the batch's share of the budget first */
+        uint64_t left = atomic_load(&e->step_rays_left);
+        do {
+            if (left == 0)
+                return 0;
+            want = left < RAY_BATCH ? left : RAY_BATCH;
+        } while (!atomic_compare_exchange_weak(&e->step_rays_left, &left, left - want));
+    }
+    unsigned n = 0;
+    while (n < want && (w->holding || claim_range(e, w))) {
+        if (ip__ray_order_next_before(&w->order, w->range_end, &xy[n][0], &xy[n][1]))
+            n++;
+        else
+            w->holding = 0;
+    }
+    if (e->step_limited && n < want) /* the order ran out: give the rest of the share back */
+        atomic_fetch_add(&e->step_rays_left, want - n);
+    atomic_fetch_add(&e->rays_taken, n);
     return n;
 }
 
@@ -348,7 +448,7 @@ static void work(void *user, unsigned index)
     worker *w = &e->workers[index];
     uint32_t xy[RAY_BATCH][2];
     unsigned n;
-    while (w->status == IP_OK && (n = take_rays(e, xy)) > 0) {
+    while (w->status == IP_OK && (n = take_rays(e, w, xy)) > 0) {
         /* The clock is read once per batch: seeding is the batch's time less what
          * propagation and extraction measured of it. */
         double t0 = ip_now_seconds();
@@ -369,11 +469,9 @@ static void work(void *user, unsigned index)
     }
     if (flush_triangles(w) != IP_OK && w->status == IP_OK)
         w->status = IP_ERR_NOMEM;
-    if (w->status != IP_OK) { /* the step fails: the other workers take no more rays */
-        pthread_mutex_lock(&e->order_lock);
-        e->step_rays_left = 0;
-        pthread_mutex_unlock(&e->order_lock);
-    }
+    if (w->status != IP_OK) /* the step fails: the other workers take no more rays */
+        atomic_store(&e->step_stopped, 1);
+    leave_range(e, w);
     for (uint32_t k = 0; k < e->levels_used; k++) /* let the cache evict freely between steps */
         ip__sampler_release(&w->level[k].sampler);
 }
@@ -385,7 +483,9 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
         return ip__fail(err, IP_ERR_ARGUMENT, "ip_engine_step() before ip_engine_begin()");
     if (atomic_load(&e->cancel))
         return ip__fail(err, IP_ERR_CANCELLED, "%s: extraction cancelled", path_of(e->cache));
-    e->step_rays_left = max_rays ? max_rays : UINT64_MAX;
+    e->step_limited = max_rays != 0;
+    atomic_store(&e->step_rays_left, max_rays);
+    atomic_store(&e->step_stopped, 0);
     e->step_deadline = max_seconds > 0 ? ip_now_seconds() + max_seconds : 0;
     unsigned threads = e->threads;
     if (max_rays && max_rays < (uint64_t)threads * RAY_BATCH)

@@ -50,8 +50,28 @@ void ip__ray_order_reset(ip_ray_order *order)
 {
     order->level = 0;
     order->next_cell = 0;
+    order->level_base = 0;
     order->cell_x = order->cell_y = 0;
     order->emitted = 0;
+}
+
+/* The cells of level `level`. */
+static uint64_t level_cells(const ip_ray_order *order, uint32_t level)
+{
+    return (uint64_t)1 << (min_u32(level, order->x_levels) + min_u32(level, order->y_levels));
+}
+
+uint64_t ip__ray_order_cells(const ip_ray_order *order)
+{
+    uint64_t cells = 0;
+    for (uint32_t k = 0; k <= ip__ray_order_last_level(order); k++)
+        cells += level_cells(order, k);
+    return cells;
+}
+
+uint64_t ip__ray_order_position(const ip_ray_order *order)
+{
+    return order->level_base + order->next_cell;
 }
 
 uint64_t ip__ray_order_count(const ip_ray_order *order)
@@ -146,13 +166,60 @@ static int cast_before(const ip_ray_order *order, uint32_t nx, uint32_t ny, uint
     return (in_x & centre_levels(order->height, order->y_levels, level, ny, cy, py)) != 0;
 }
 
+/* The cell at `position` of the current level, decoded from scratch: every digit that
+ * next_cell() sets on its way there. */
+static void decode_cell(ip_ray_order *order, uint64_t position)
+{
+    static const uint8_t digit_x[4] = {0, 1, 1, 0}, digit_y[4] = {0, 1, 0, 1};
+    uint32_t nx = min_u32(order->level, order->x_levels),
+             ny = min_u32(order->level, order->y_levels);
+    uint32_t both = min_u32(nx, ny), s = 0;
+    int local = order->level >= order->local_from;
+    order->cell_x = order->cell_y = 0;
+    for (; s < both; s++) {
+        uint32_t digit = (uint32_t)(position >> 2 * s) & 3u;
+        set_bit(&order->cell_x, local ? s : nx - 1 - s, digit_x[digit]);
+        set_bit(&order->cell_y, local ? s : ny - 1 - s, digit_y[digit]);
+    }
+    uint32_t *cell = nx > both ? &order->cell_x : &order->cell_y;
+    uint32_t splits = nx > both ? nx : ny;
+    for (; s < splits; s++)
+        set_bit(cell, local ? s : splits - 1 - s, (uint32_t)(position >> (both + s)) & 1u);
+}
+
+void ip__ray_order_seek(ip_ray_order *order, uint64_t position)
+{
+    uint32_t last_level = ip__ray_order_last_level(order);
+    order->level = 0;
+    order->level_base = 0;
+    while (order->level <= last_level &&
+           position - order->level_base >= level_cells(order, order->level)) {
+        order->level_base += level_cells(order, order->level);
+        order->level++;
+    }
+    order->next_cell = position - order->level_base;
+    if (order->level <= last_level)
+        decode_cell(order, order->next_cell);
+    else
+        order->cell_x = order->cell_y = 0;
+}
+
 int ip__ray_order_next(ip_ray_order *order, uint32_t *x, uint32_t *y)
+{
+    return ip__ray_order_next_before(order, UINT64_MAX, x, y);
+}
+
+int ip__ray_order_next_before(ip_ray_order *order, uint64_t end, uint32_t *x, uint32_t *y)
 {
     uint32_t last_level = order->x_levels > order->y_levels ? order->x_levels : order->y_levels;
     while (order->level <= last_level) {
         uint32_t level = order->level;
         uint32_t nx = min_u32(level, order->x_levels), ny = min_u32(level, order->y_levels);
-        uint64_t cells = (uint64_t)1 << (nx + ny);
+        uint64_t level_end = (uint64_t)1 << (nx + ny), cells = level_end;
+        if (end <= order->level_base)
+            cells = 0;
+        else if (end - order->level_base < level_end)
+            cells = end - order->level_base;
         while (order->next_cell < cells) {
             uint32_t cx = order->cell_x, cy = order->cell_y, x0, x1, y0, y1;
             next_cell(order, nx, ny);
@@ -170,7 +237,10 @@ int ip__ray_order_next(ip_ray_order *order, uint32_t *x, uint32_t *y)
             order->emitted++;
             return 1;
         }
+        if (order->next_cell < level_end)
+            return 0; /* stopped at `end` */
         order->level++;
+        order->level_base += cells;
         order->next_cell = 0;
         order->cell_x = order->cell_y = 0;
     }

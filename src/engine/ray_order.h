@@ -58,6 +58,7 @@ typedef struct ip_ray_order {
     uint32_t x_levels, y_levels; /* levels until a cell is at most one pixel along x, y */
     uint32_t level;              /* the level being walked (that of the last pixel returned) */
     uint64_t next_cell;          /* the position in the level of the next cell to examine */
+    uint64_t level_base;         /* cells of the levels before `level` */
     uint32_t cell_x, cell_y;     /* that cell's column and row among the level's cells */
     uint64_t emitted;            /* pixels returned since init or reset */
     uint32_t local_from;         /* the first level walked in Z-order (UINT32_MAX: none) */
@@ -92,6 +93,28 @@ void ip__ray_order_set_local_from(ip_ray_order *order, uint32_t level);
 
 /*! ip__ray_order_last_level() : the finest level, whose cells are at most one pixel. */
 uint32_t ip__ray_order_last_level(const ip_ray_order *order);
+
+/* Cells. The order examines the cells of every level in turn, empty ones and those whose centre
+ * was cast before included; cell i of that sequence is its *position*. The positions cut the
+ * order into ranges that separate iterators can walk at once (one per thread), each from
+ * ip__ray_order_seek() up to a bound given to ip__ray_order_next_before(): walking the ranges
+ * [0, a), [a, b), ... [z, cells) one after the other returns exactly the pixels of next(), in
+ * the same order. */
+
+/*! ip__ray_order_cells() : the number of positions, over every level (>= width * height). */
+uint64_t ip__ray_order_cells(const ip_ray_order *order);
+
+/*! ip__ray_order_position() : the position of the next cell the iterator examines
+ *  (ip__ray_order_cells() once it is done). */
+uint64_t ip__ray_order_position(const ip_ray_order *order);
+
+/*! ip__ray_order_seek() : moves the iterator to position `position` (at most
+ *  ip__ray_order_cells()), in O(levels) time; emitted() is not changed. */
+void ip__ray_order_seek(ip_ray_order *order, uint64_t position);
+
+/*! ip__ray_order_next_before() : next(), but only from cells before position `end`: returns 0,
+ *  with the iterator at `end` (or done), when no cell before `end` has a pixel left. */
+int ip__ray_order_next_before(ip_ray_order *order, uint64_t end, uint32_t *x, uint32_t *y);
 
 /*! ip__ray_order_reset() : starts the same order again from its first pixel. */
 void ip__ray_order_reset(ip_ray_order *order);
