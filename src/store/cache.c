@@ -396,9 +396,19 @@ static uint32_t group_last_sample(uint32_t g, uint32_t extent)
             for (uint32_t gy = 0; gy < e[1] / 2; gy++) {                                      \
                 layers_##name(row_lo, row_hi, lo, hi, row, row, 2 * gy,                       \
                               group_last_sample(gy, e[1]));                                   \
-                for (uint32_t gx = 0; gx < e[0] / 2; gx++, out += 2)                          \
-                    layers_##name(&out[0], &out[1], row_lo, row_hi, 1, 1, 2 * gx,             \
-                                  group_last_sample(gx, e[0]));                               \
+                /* the groups of 3 samples along x (all but the last where e[0] is even),  \
+                 * unrolled; then the last one of 2 */  \
+                const T *a = row_lo, *b = row_hi;                                             \
+                for (uint32_t gx = 0; gx < (e[0] - 1) / 2; gx++, a += 2, b += 2, out += 2) {  \
+                    T least = a[0] < a[1] ? a[0] : a[1], most = b[0] > b[1] ? b[0] : b[1];    \
+                    out[0] = a[2] < least ? a[2] : least;                                     \
+                    out[1] = b[2] > most ? b[2] : most;                                       \
+                }                                                                             \
+                if (e[0] % 2 == 0) {                                                          \
+                    out[0] = a[0] < a[1] ? a[0] : a[1];                                       \
+                    out[1] = b[0] > b[1] ? b[0] : b[1];                                       \
+                    out += 2;                                                                 \
+                }                                                                             \
             }                                                                                 \
         }                                                                                     \
     }
