@@ -1,16 +1,19 @@
 /* The brick cache: exact LRU counts against a reference model, pinning over budget,
- * a corrupted brick, and many threads pinning at once (decode-once, counts that agree). */
+ * a corrupted brick, many threads pinning at once (decode-once, counts that agree), and the
+ * cell-group ranges of every brick against brute force. */
 #include <pthread.h>
 #include <stdatomic.h>
 #include <sys/stat.h>
 
 #include "check.h"
-#include "isoprop/bricker.h"
 #include "isoprop/cache.h"
-#include "isoprop/generate.h"
 #include "isoprop/store.h"
+#include "volumes.h"
 
-#define BRICK_BYTES 729 /* 9^3 uint8 samples: every level-0 brick of the test volume */
+/* Every level-0 brick of the test volume: 9^3 uint8 samples (729 bytes, padded to 736), then
+ * the least and greatest sample of each of its 4^3 cell groups. */
+#define SAMPLE_BYTES 729
+#define BRICK_BYTES (736 + 4 * 4 * 4 * 2)
 
 /* 33^3 uint8 samples, B = 8: 4x4x4 full level-0 bricks, then the pyramid. Sample value
  * depends on the brick so contents can be checked. */
@@ -26,15 +29,7 @@ static void make_file(const char *dir, char *ibv, size_t size)
             for (int x = 0; x < 33; x++)
                 fputc((x * 3 + y * 5 + z * 7) % 251, f);
     REQUIRE(fclose(f) == 0);
-    ip_input_desc desc;
-    ip_bricker_options o;
-    ip_error err;
-    REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
-    ip_bricker_options_default(&o);
-    o.brick_edge = 8;
-    o.subblock_edge = 4;
-    o.force = 1;
-    REQUIRE(ip_bricker_run(&desc, ibv, &o, NULL, &err) == IP_OK);
+    test_brick_raw(raw, ibv, 8, 4);
 }
 
 static int expected_sample(const ip_brick *b, uint32_t x, uint32_t y, uint32_t z)
@@ -105,7 +100,7 @@ static void test_scripted_lru(const ip_store *s)
               "hits %llu misses %llu evictions %llu", (unsigned long long)st.hits,
               (unsigned long long)st.misses, (unsigned long long)st.evictions);
     CHECK(st.resident_bytes == 4 * BRICK_BYTES && st.resident_peak_bytes == 4 * BRICK_BYTES);
-    CHECK(st.bricks_touched == 5 && st.bytes_decompressed == 7 * BRICK_BYTES);
+    CHECK(st.bricks_touched == 5 && st.bytes_decompressed == 7 * SAMPLE_BYTES);
     CHECK(st.pinned_bytes == 0 && st.over_budget_pins == 0);
     /* brick 4 was evicted last: asking again is a miss; brick 2 (just used) is a hit */
     pin_unpin(c, 2);
@@ -324,6 +319,65 @@ static void test_threads(const ip_store *s)
     CHECK(st.resident_peak_bytes <= (12 + 16) * BRICK_BYTES); /* budget + what 8 threads pin */
 }
 
+/* The cell-group ranges (ip_brick.group_ranges) of every brick of every level, against the
+ * least and greatest corner of the group's cells sample by sample; dims whose bricks end with
+ * odd cell counts (a last group one cell wide), int16 samples. */
+static void test_group_ranges(const char *dir)
+{
+    char raw[4200], ibv[4200];
+    snprintf(raw, sizeof raw, "%s/groups_27x22x19_int16.raw", dir);
+    snprintf(ibv, sizeof ibv, "%s/groups.ibv", dir);
+    FILE *f = fopen(raw, "wb");
+    REQUIRE(f);
+    uint64_t x = 88172645463325252ull;
+    for (int i = 0; i < 27 * 22 * 19; i++) {
+        x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+        int16_t v = (int16_t)((int)(x % 4001) - 2000);
+        REQUIRE(fwrite(&v, sizeof v, 1, f) == 1);
+    }
+    REQUIRE(fclose(f) == 0);
+    test_brick_raw(raw, ibv, 8, 4);
+    ip_error err;
+    ip_store *s;
+    ip_cache *c;
+    REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
+    REQUIRE(ip_cache_create(s, 1u << 20, &c, &err) == IP_OK);
+    uint64_t groups = 0, bad = 0, odd = 0;
+    for (uint64_t g = 0; g < ip_store_layout(s)->brick_count; g++) {
+        ip_brick b;
+        REQUIRE(ip_cache_pin_brick(c, g, &b, &err) == IP_OK);
+        const int16_t *v = b.samples, *r = b.group_ranges;
+        const uint32_t *e = b.extent, n[3] = {e[0] / 2, e[1] / 2, e[2] / 2};
+        odd += (e[0] - 1) % 2 || (e[1] - 1) % 2 || (e[2] - 1) % 2;
+        for (uint32_t gz = 0; gz < n[2]; gz++)
+            for (uint32_t gy = 0; gy < n[1]; gy++)
+                for (uint32_t gx = 0; gx < n[0]; gx++) {
+                    int least = INT16_MAX, most = INT16_MIN;
+                    /* every corner of every cell of the group: cells 2g and 2g + 1 where
+                     * the brick has it (cells are samples 0 .. extent - 2) */
+                    for (uint32_t cz = 2 * gz; cz < 2 * gz + 2 && cz + 1 < e[2]; cz++)
+                        for (uint32_t cy = 2 * gy; cy < 2 * gy + 2 && cy + 1 < e[1]; cy++)
+                            for (uint32_t cx = 2 * gx; cx < 2 * gx + 2 && cx + 1 < e[0]; cx++)
+                                for (int k = 0; k < 8; k++) {
+                                    int sample = v[cx + (k & 1) +
+                                                   e[0] * (cy + ((k >> 1) & 1) +
+                                                           e[1] * (cz + ((k >> 2) & 1)))];
+                                    least = sample < least ? sample : least;
+                                    most = sample > most ? sample : most;
+                                }
+                    size_t i = gx + n[0] * (gy + (size_t)n[1] * gz);
+                    bad += r[2 * i] != least || r[2 * i + 1] != most;
+                    groups++;
+                }
+        ip_cache_unpin_brick(c, &b);
+    }
+    CHECK_MSG(bad == 0, "%llu of %llu cell groups with a wrong range", (unsigned long long)bad,
+              (unsigned long long)groups);
+    CHECK(odd > 0 && groups > 0);
+    ip_cache_destroy(c);
+    ip_store_close(s);
+}
+
 int main(void)
 {
     const char *dir = test_tmp_dir("test_cache");
@@ -338,5 +392,6 @@ int main(void)
     test_threads(s);
     ip_store_close(s);
     test_corrupt_brick(dir, ibv);
+    test_group_ranges(dir);
     return test_summary("test_cache");
 }

@@ -23,6 +23,7 @@
 #include "isoprop/engine.h"
 #include "isoprop/generate.h"
 #include "isoprop/render.h"
+#include "volumes.h"
 
 #define WIDTH 48
 #define HEIGHT 36
@@ -55,21 +56,10 @@ static void make_volume(const char *dir, ip_field field, const uint32_t dims[3],
                         uint32_t edge, uint32_t subblock, char *ibv, size_t size)
 {
     ip_gen_params p = {field, {dims[0], dims[1], dims[2]}, type, 0.02, 7};
-    char name[256], raw[4400];
-    ip_error err;
-    REQUIRE(ip_raw_file_name(name, sizeof name, ip_field_name(field), p.dims, type) == IP_OK);
-    snprintf(raw, sizeof raw, "%s/%s", dir, name);
-    REQUIRE(ip_generate_write(&p, raw, 1, &err) == IP_OK);
+    char raw[4400];
+    test_generate_raw(dir, ip_field_name(field), &p, raw, sizeof raw);
     snprintf(ibv, size, "%s/%s.b%u.ibv", dir, ip_field_name(field), edge);
-    ip_input_desc d;
-    ip_bricker_options o;
-    REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
-    ip_bricker_options_default(&o);
-    o.brick_edge = edge;
-    o.subblock_edge = subblock;
-    o.force = 1;
-    o.threads = 2;
-    REQUIRE(ip_bricker_run(&d, ibv, &o, NULL, &err) == IP_OK);
+    test_brick_raw(raw, ibv, edge, subblock);
     unlink(raw);
 }
 

@@ -175,14 +175,33 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
         return -1;
     ptrdiff_t corners[8];
     ip__corner_offsets(brick, corners);
+    /* The cells come in runs through one cell group (cache.h): its range is read when the run
+     * enters it, and the corners of none of its cells when no cell of it can be active. The
+     * cells visited and their order stay those of the cell DDA. */
+    size_t groups_x = brick->extent[0] / 2, groups_xy = groups_x * (brick->extent[1] / 2);
+    size_t group = SIZE_MAX;
+    int group_active = 1;
     dda d;
     dda_init(&d, r, base, 1.0, n, t0, t1);
     for (;;) {
         uint32_t c[3] = {lo[0] + (uint32_t)d.i[0], lo[1] + (uint32_t)d.i[1],
                          lo[2] + (uint32_t)d.i[2]};
+        size_t at = ((c[0] - brick->origin[0]) >> 1) + groups_x * ((c[1] - brick->origin[1]) >> 1) +
+                    groups_xy * ((c[2] - brick->origin[2]) >> 1);
+        if (at != group && s->use_group_ranges) {
+            static const ptrdiff_t pair[2] = {0, 1};
+            float range[2];
+            ip__samples_gather(brick->group_ranges, s->layout->type, 2 * at, pair, 2, range);
+            group = at;
+            group_active = ip__range_active(range[0], range[1], s->iso);
+        }
         float values[8];
-        ip__cell_values(brick, s->layout->type, corners, c, values);
-        unsigned mc = ip__mc_case(values, s->iso);
+        unsigned mc = 0;
+        if (group_active) {
+            ip__cell_values(brick, s->layout->type, corners, c, values);
+            mc = ip__mc_case(values, s->iso);
+            s->cells_read++;
+        }
         if (mc != 0 && mc != 255) {
             float origin[3], size[3];
             double ro[3];
@@ -268,6 +287,25 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
     int count = 0;
     const uint32_t *grid = s->grid[depth - 1];
     const float *ranges = s->ranges[depth - 1];
+    /* The children's boxes (node_box()) share their planes: along each axis, the ray's
+     * parameters at the low and high planes of the low (0) and high (1) children, ordered as
+     * clip() orders them, computed once for the 8 children from the same operands as clip()
+     * would (so the same values): a child is then clip() by lookups. */
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    uint64_t span = (uint64_t)s->layout->brick_edge << (depth - 1);
+    double enter[3][2], leave[3][2];
+    int within[3][2]; /* where the ray runs along the planes: inside the child's slab */
+    for (int k = 0; k < 3; k++) {
+        uint64_t cells = lv->dims[k] - 1, a = 2 * node[k] * span;
+        for (int h = 0; h < 2; h++, a += span) {
+            double lo = (double)a, hi = (double)(a + span < cells ? a + span : cells);
+            within[k][h] = !(r->origin[k] < lo || r->origin[k] > hi);
+            double ta = (lo - r->origin[k]) * r->inv_dir[k];
+            double tb = (hi - r->origin[k]) * r->inv_dir[k];
+            enter[k][h] = ta > tb ? tb : ta;
+            leave[k][h] = ta > tb ? ta : tb;
+        }
+    }
     for (int c = 0; c < 8; c++) {
         uint32_t ch[3] = {2 * node[0] + (c & 1), 2 * node[1] + ((c >> 1) & 1),
                           2 * node[2] + ((c >> 2) & 1)};
@@ -276,9 +314,18 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
         uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
         if (!active(&ranges[2 * i], s->iso))
             continue;
-        double lo[3], hi[3], a = t0, b = t1;
-        node_box(s, depth - 1, ch, lo, hi);
-        if (!clip(r, lo, hi, &a, &b))
+        double a = t0, b = t1;
+        int missed = 0;
+        for (int k = 0; k < 3; k++) {
+            int h = (c >> k) & 1;
+            if (r->dir[k] == 0.0) {
+                missed |= !within[k][h];
+                continue;
+            }
+            a = enter[k][h] > a ? enter[k][h] : a;
+            b = leave[k][h] < b ? leave[k][h] : b;
+        }
+        if (missed || !(a <= b))
             continue;
         int at = count++;
         while (at > 0 && hits[at - 1].t0 > a) { /* insertion sort: front to back */
@@ -303,6 +350,7 @@ void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_
     s->layout = sampler->layout;
     s->level = sampler->level;
     s->iso = iso;
+    s->use_group_ranges = 1;
     s->margin = IP_SEED_MARGIN_PIXELS * pixel_angle;
     for (int k = 0; k < 3; k++)
         s->scale[k] = s->layout->spacing[k] * (double)(1u << s->level);

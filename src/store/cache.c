@@ -22,9 +22,10 @@ typedef struct entry {
     atomic_int pins;           /* >= 0: pins; -1: free or being evicted */
     atomic_uint_fast64_t tick; /* last pin time, for LRU */
     atomic_uint_fast64_t brick;
-    void *samples;
-    size_t bytes;
+    void *samples;   /* the samples, then (at group_offset) the cell-group ranges */
+    size_t bytes;    /* of both */
     size_t capacity; /* of samples */
+    size_t group_offset;
     uint32_t extent[3], origin[3], level;
     struct entry *next_free;
     uint32_t resident_slot; /* position in the resident array */
@@ -148,6 +149,7 @@ const ip_store *ip_cache_store(const ip_cache *c)
 static void fill_brick(const entry *e, ip_brick *b)
 {
     b->samples = e->samples;
+    b->group_ranges = (const char *)e->samples + e->group_offset;
     memcpy(b->extent, e->extent, sizeof b->extent);
     memcpy(b->origin, e->origin, sizeof b->origin);
     b->level = e->level;
@@ -356,7 +358,96 @@ static void give_work(ip_cache *c, void *w)
     free(w);
 }
 
-/* Decodes brick g into e (not yet published). */
+/* The last sample of cell group g along an axis of `extent` samples: the group's cells are
+ * 2g and 2g + 1, or only 2g where that is the last cell. */
+static uint32_t group_last_sample(uint32_t g, uint32_t extent)
+{
+    return 2 * g + 2 < extent - 1 ? 2 * g + 2 : extent - 1;
+}
+
+/* The cell-group ranges of a brick (ip_brick.group_ranges) from its samples `s` of type T, in
+ * one pass over the samples: each pair of cell layers along z (3 sample slices) is reduced to
+ * one slice of least and greatest values (`lo`, `hi`: extent[0] * extent[1] samples each),
+ * each pair of cell rows of that along y to one row (`row_lo`, `row_hi`: extent[0] each),
+ * whose windows of 3 samples along x are the groups. The first two steps are elementwise
+ * over contiguous samples, which the compiler vectorises. */
+#define GROUP_RANGES_AS(T, name)                                                              \
+    /* lo, hi[0 .. n) = the least of src_lo, the greatest of src_hi over the layers `first` \
+     * .. `last` (inclusive), `stride` apart */ \
+    static void layers_##name(T *lo, T *hi, const T *src_lo, const T *src_hi, size_t stride,  \
+                              size_t n, uint32_t first, uint32_t last)                        \
+    {                                                                                         \
+        memcpy(lo, src_lo + first * stride, n * sizeof(T));                                   \
+        memcpy(hi, src_hi + first * stride, n * sizeof(T));                                   \
+        for (uint32_t l = first + 1; l <= last; l++) {                                        \
+            const T *p = src_lo + l * stride, *q = src_hi + l * stride;                       \
+            for (size_t i = 0; i < n; i++) {                                                  \
+                lo[i] = p[i] < lo[i] ? p[i] : lo[i];                                          \
+                hi[i] = q[i] > hi[i] ? q[i] : hi[i];                                          \
+            }                                                                                 \
+        }                                                                                     \
+    }                                                                                         \
+    static void name(const T *s, const uint32_t e[3], T *out, T *scratch)                     \
+    {                                                                                         \
+        size_t row = e[0], slice = row * e[1];                                                \
+        T *lo = scratch, *hi = lo + slice, *row_lo = hi + slice, *row_hi = row_lo + row;      \
+        for (uint32_t gz = 0; gz < e[2] / 2; gz++) {                                          \
+            layers_##name(lo, hi, s, s, slice, slice, 2 * gz, group_last_sample(gz, e[2]));   \
+            for (uint32_t gy = 0; gy < e[1] / 2; gy++) {                                      \
+                layers_##name(row_lo, row_hi, lo, hi, row, row, 2 * gy,                       \
+                              group_last_sample(gy, e[1]));                                   \
+                /* the groups of 3 samples along x (all but the last where e[0] is even),  \
+                 * unrolled; then the last one of 2 */  \
+                const T *a = row_lo, *b = row_hi;                                             \
+                for (uint32_t gx = 0; gx < (e[0] - 1) / 2; gx++, a += 2, b += 2, out += 2) {  \
+                    T least = a[0] < a[1] ? a[0] : a[1], most = b[0] > b[1] ? b[0] : b[1];    \
+                    out[0] = a[2] < least ? a[2] : least;                                     \
+                    out[1] = b[2] > most ? b[2] : most;                                       \
+                }                                                                             \
+                if (e[0] % 2 == 0) {                                                          \
+                    out[0] = a[0] < a[1] ? a[0] : a[1];                                       \
+                    out[1] = b[0] > b[1] ? b[0] : b[1];                                       \
+                    out += 2;                                                                 \
+                }                                                                             \
+            }                                                                                 \
+        }                                                                                     \
+    }
+GROUP_RANGES_AS(uint8_t, group_ranges_uint8)
+GROUP_RANGES_AS(uint16_t, group_ranges_uint16)
+GROUP_RANGES_AS(int16_t, group_ranges_int16)
+GROUP_RANGES_AS(float, group_ranges_float32)
+#undef GROUP_RANGES_AS
+
+/* Bytes of a brick's entry: its samples, padded to 8, then its cell-group ranges. */
+static size_t entry_bytes(const uint32_t extent[3], ip_type type, size_t *group_offset)
+{
+    size_t size = ip_type_size(type);
+    size_t samples = (size_t)extent[0] * extent[1] * extent[2] * size;
+    size_t groups = (size_t)(extent[0] / 2) * (extent[1] / 2) * (extent[2] / 2);
+    *group_offset = (samples + 7) & ~(size_t)7;
+    return *group_offset + 2 * groups * size;
+}
+
+/* Fills the cell-group ranges of e from its samples. */
+static ip_status fill_group_ranges(ip_cache *c, entry *e)
+{
+    ip_type type = c->layout->type;
+    size_t row = e->extent[0], slice = row * e->extent[1];
+    void *scratch = malloc(2 * (slice + row) * ip_type_size(type)), *out;
+    if (!scratch)
+        return IP_ERR_NOMEM;
+    out = (char *)e->samples + e->group_offset;
+    switch (type) {
+    case IP_UINT8: group_ranges_uint8(e->samples, e->extent, out, scratch); break;
+    case IP_UINT16: group_ranges_uint16(e->samples, e->extent, out, scratch); break;
+    case IP_INT16: group_ranges_int16(e->samples, e->extent, out, scratch); break;
+    case IP_FLOAT32: group_ranges_float32(e->samples, e->extent, out, scratch); break;
+    }
+    free(scratch);
+    return IP_OK;
+}
+
+/* Decodes brick g into e (not yet published), and computes its cell-group ranges. */
 static ip_status decode_into(ip_cache *c, uint64_t g, entry *e, ip_error *err)
 {
     void *work = take_work(c);
@@ -365,8 +456,11 @@ static ip_status decode_into(ip_cache *c, uint64_t g, entry *e, ip_error *err)
                         ip_store_path(c->store), (unsigned long long)g);
     double t0 = ip_now_seconds();
     ip_status st = ip_store_read_brick(c->store, g, e->samples, work, err);
-    double t1 = ip_now_seconds();
     give_work(c, work);
+    if (st == IP_OK && fill_group_ranges(c, e) != IP_OK)
+        st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for brick %llu",
+                      ip_store_path(c->store), (unsigned long long)g);
+    double t1 = ip_now_seconds();
     atomic_fetch_add(&c->decode_ns, (uint64_t)((t1 - t0) * 1e9));
     ip_brick_entry be;
     ip_store_brick_entry(c->store, g, &be);
@@ -380,7 +474,7 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
     uint32_t level, brick[3], origin[3], extent[3];
     ip_brick_coords(c->layout, g, &level, brick);
     ip_brick_extent(c->layout, level, brick, origin, extent);
-    size_t bytes = (size_t)extent[0] * extent[1] * extent[2] * ip_type_size(c->layout->type);
+    size_t group_offset, bytes = entry_bytes(extent, c->layout->type, &group_offset);
     pthread_mutex_lock(&c->evict_lock);
     entry *e = reserve_entry(c, bytes);
     pthread_mutex_unlock(&c->evict_lock);
@@ -391,6 +485,7 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
      * fault per page of a fresh buffer; next to nothing for a recycled one. */
     ip__memory_populate(e->samples, bytes);
     e->bytes = bytes;
+    e->group_offset = group_offset;
     e->level = level;
     memcpy(e->extent, extent, sizeof extent);
     memcpy(e->origin, origin, sizeof origin);
@@ -415,7 +510,8 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
     pthread_mutex_unlock(&c->evict_lock);
     atomic_fetch_add(&c->misses, 1);
     atomic_fetch_add(&c->level_misses[level], 1);
-    atomic_fetch_add(&c->bytes_decompressed, bytes);
+    atomic_fetch_add(&c->bytes_decompressed,
+                     (uint64_t)extent[0] * extent[1] * extent[2] * ip_type_size(c->layout->type));
     fill_brick(e, b);
     return IP_OK;
 }
