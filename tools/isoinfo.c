@@ -1,4 +1,5 @@
 /* isoinfo: describe a brick file (.ibv), as text or JSON, and verify it. */
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -143,39 +144,35 @@ static int verify(const ip_store *s, ip_cache *cache, int quiet)
     return 0;
 }
 
+/* The command line of isoinfo (tool_parse_command_line()). */
+typedef struct info_options {
+    const char *stats_path;
+    int json, check, force;
+    uint64_t budget; /* bytes */
+} info_options;
+
+#define INFO_FIELD(member) offsetof(info_options, member)
+static const tool_option info_table[] = {
+    {"--json", NULL, 0, INFO_FIELD(json), NULL, NULL, NULL},
+    {"--verify", NULL, 0, INFO_FIELD(check), NULL, NULL, NULL},
+    {"--force", NULL, 0, INFO_FIELD(force), NULL, NULL, NULL},
+    {"--stats", NULL, 1, INFO_FIELD(stats_path), NULL, NULL, NULL},
+    {"--cache-mb", NULL, 1, INFO_FIELD(budget), tool_option_cache_mb, NULL, NULL},
+};
+
 int main(int argc, char **argv)
 {
-    const char *path = NULL, *stats_path = NULL;
-    int json = 0, check = 0, force = 0;
-    uint64_t budget = ip_cache_default_budget();
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
-            fputs(usage, stdout);
-            return 0;
-        } else if (!strcmp(argv[i], "--version")) {
-            tool_print_version("isoinfo");
-            return 0;
-        } else if (!strcmp(argv[i], "--force")) {
-            force = 1;
-        } else if (!strcmp(argv[i], "--json")) {
-            json = 1;
-        } else if (!strcmp(argv[i], "--verify")) {
-            check = 1;
-        } else if (!strcmp(argv[i], "--cache-mb") && i + 1 < argc) {
-            if (tool_parse_cache_mb(argv[++i], &budget) != 0)
-                return tool_usage_error("isoinfo", "bad --cache-mb '%s'", argv[i]);
-        } else if (!strcmp(argv[i], "--stats") && i + 1 < argc) {
-            stats_path = argv[++i];
-        } else if (argv[i][0] == '-') {
-            return tool_usage_error("isoinfo", "unknown option '%s'", argv[i]);
-        } else if (!path) {
-            path = argv[i];
-        } else {
-            return tool_usage_error("isoinfo", "more than one file ('%s')", argv[i]);
-        }
-    }
+    const char *path = NULL;
+    info_options o = {NULL, 0, 0, 0, ip_cache_default_budget()};
+    tool_option_table table = {info_table, sizeof info_table / sizeof info_table[0], &o};
+    tool_command_line c = {"isoinfo", usage, &table, 1, &path, "file"};
+    if (tool_parse_command_line(&c, argc, argv) != 0)
+        return 2;
     if (!path)
         return tool_usage_error("isoinfo", "no file");
+    const char *stats_path = o.stats_path;
+    int json = o.json, check = o.check, force = o.force;
+    uint64_t budget = o.budget;
     const char *inputs[] = {path}, *outputs[] = {stats_path};
     if (tool_check_paths("isoinfo", inputs, 1, outputs, 1, force) != 0)
         return 1;

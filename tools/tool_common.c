@@ -591,11 +591,9 @@ static int parse_occlusion(const char *p, const tool_option *opt, const char *co
     return parse_on_off(p, v[0], &((tool_view_options *)base)->occlusion, "--occlusion");
 }
 
-static int parse_cache_budget(const char *p, const tool_option *opt, const char *const *v,
-                              void *base)
+int tool_option_cache_mb(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
-    (void)opt;
-    if (tool_parse_cache_mb(v[0], &((tool_view_options *)base)->cache_bytes) != 0)
+    if (tool_parse_cache_mb(v[0], (uint64_t *)((char *)base + opt->offset)) != 0)
         return tool_usage_error(p, "bad --cache-mb '%s'", v[0]);
     return 0;
 }
@@ -617,7 +615,7 @@ static const tool_option view_options[] = {
     {"--pixel-error", NULL, 1, VIEW_FIELD(pixel_error), tool_option_positive, "is not positive",
      NULL},
     {"--occlusion", NULL, 1, 0, parse_occlusion, NULL, NULL},
-    {"--cache-mb", NULL, 1, 0, parse_cache_budget, NULL, NULL},
+    {"--cache-mb", NULL, 1, VIEW_FIELD(cache_bytes), tool_option_cache_mb, NULL, NULL},
     {"--stats", NULL, 1, VIEW_FIELD(stats), NULL, NULL, NULL},
     {"--force", NULL, 0, VIEW_FIELD(force), NULL, NULL, NULL},
     {"--quiet", "-q", 0, VIEW_FIELD(quiet), NULL, NULL, NULL},

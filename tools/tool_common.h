@@ -132,6 +132,10 @@ struct tool_option {
  * a bad value is "NAME 'VALUE' PROBLEM" (option->problem). */
 tool_option_parse tool_option_number, tool_option_positive;
 
+/* Parses --cache-mb N (tool_parse_cache_mb()) into the uint64_t (bytes) at base + offset; a
+ * bad value is "bad --cache-mb 'VALUE'". */
+tool_option_parse tool_option_cache_mb;
+
 /* Parses --threads N: 1 .. max, else "--threads must be 1-MAX". Returns 0, or 2 after the
  * usage error. */
 int tool_parse_threads(const char *program, const char *text, unsigned max, unsigned *threads);
