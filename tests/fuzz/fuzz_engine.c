@@ -36,6 +36,7 @@
 #include "format.h"
 #include "isoprop/render.h"
 #include "isoprop/store.h"
+#include "rehash.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -43,50 +44,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 #define WIDTH 16
 #define HEIGHT 12
 #define MAX_VERIFIED_BRICKS 4096 /* keeps one input fast */
-
-static uint64_t load_u64(const unsigned char *p)
-{
-    uint64_t v = 0;
-    for (int i = 7; i >= 0; i--)
-        v = v << 8 | p[i];
-    return v;
-}
-
-static uint32_t load_u32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static void store_u64(unsigned char *p, uint64_t v)
-{
-    for (int i = 0; i < 8; i++)
-        p[i] = (unsigned char)(v >> (8 * i));
-}
-
-/* Recomputes the checksums from the header's own fields, trusting nothing: every offset is
- * bounds-checked against the file, and what does not fit is left alone. */
-static void recompute_checksums(unsigned char *file, size_t size)
-{
-    if (size < IP_HEADER_SIZE)
-        return;
-    uint32_t level_count = load_u32(file + 64);
-    uint64_t brick_count = load_u64(file + 80);
-    uint64_t summary_offset = load_u64(file + 112), summary_size = load_u64(file + 120);
-    if (summary_offset <= size && summary_size <= size - summary_offset) {
-        uint64_t directory = (uint64_t)level_count * IP_LEVEL_ENTRY_SIZE;
-        for (uint64_t g = 0; g < brick_count && directory <= summary_size &&
-                             g < (summary_size - directory) / IP_DIRECTORY_ENTRY_SIZE;
-             g++) {
-            unsigned char *entry = file + summary_offset + directory + g * IP_DIRECTORY_ENTRY_SIZE;
-            uint64_t offset = load_u64(entry);
-            uint32_t stored = load_u32(entry + 8);
-            if (stored > 0 && offset <= size && stored <= size - offset)
-                store_u64(entry + 16, ip__format_checksum(file + offset, stored));
-        }
-        store_u64(file + 128, ip__format_checksum(file + summary_offset, summary_size));
-    }
-    store_u64(file + 248, ip__format_checksum(file, 248));
-}
 
 /* Every error must say something, on one line. */
 static void check_error(ip_status st, const ip_error *err)
@@ -104,10 +61,7 @@ static void run_engine(ip_cache *cache, const ip_layout *l, const uint8_t contro
 {
     ip_error err;
     double lo[3], hi[3];
-    for (int a = 0; a < 3; a++) {
-        lo[a] = 0;
-        hi[a] = (l->dims[a] - 1) * l->spacing[a];
-    }
+    ip_layout_world_box(l, lo, hi);
     static const char *const axes[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
     ip_camera cam;
     if (ip_camera_fit_axis(lo, hi, axes[control[1] % 6], 30.0, WIDTH, HEIGHT, &cam, &err) != IP_OK)
@@ -176,7 +130,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     memcpy(file, data + CONTROL, file_size);
     if (control[0] & 1)
-        recompute_checksums(file, file_size);
+        test_rehash(file, file_size);
 
     int fd = memfd_create("fuzz_engine.ibv", MFD_CLOEXEC);
     if (fd < 0) {

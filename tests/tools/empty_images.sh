@@ -81,14 +81,8 @@ done
 
 # isoview warns the same way, before its window opens
 if command -v xvfb-run >/dev/null 2>&1; then
-    preload=""
-    # display numbers from 200: away from the other window tests running at the same time
-    case "${IP_SANITIZE:-}" in
-    *address*) # as in isoview.sh: keep Mesa's driver loaded to the end for LeakSanitizer
-        for f in /usr/lib/*/dri/swrast_dri.so /usr/lib/dri/swrast_dri.so; do
-            if [ -e "$f" ]; then preload=$f; break; fi
-        done ;;
-    esac
+    # display numbers from 200: away from the other window tests running at the same time;
+    # $preload (lib.sh) keeps Mesa's driver loaded under AddressSanitizer
     timeout 120 xvfb-run -a -n 200 -s "-screen 0 640x480x24" env ${preload:+LD_PRELOAD=$preload} \
         "$bin/isoview" s.ibv --iso 1000 \
         --size 160x120 --exit-after 0.5 --quiet >"$work/.out" 2>"$work/.err"

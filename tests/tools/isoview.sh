@@ -24,18 +24,7 @@ if ! command -v xvfb-run >/dev/null 2>&1; then
     finish
 fi
 
-# Under AddressSanitizer: Mesa unloads its driver when the window's display closes, and
-# LeakSanitizer cannot then name the few bytes the driver still held (frames in an "unknown
-# module", which no suppression matches). Preloading the driver keeps it loaded to the end, so
-# they stay reachable from its globals; leaks of isoprop's own code are still reported.
-preload=""
-case "${IP_SANITIZE:-}" in
-*address*)
-    for f in /usr/lib/*/dri/swrast_dri.so /usr/lib/dri/swrast_dri.so; do
-        if [ -e "$f" ]; then preload=$f; break; fi
-    done
-    ;;
-esac
+# (under AddressSanitizer, $preload from lib.sh keeps Mesa's driver loaded to the end)
 
 # view ARGS...: runs isoview in its own virtual screen; sets $rc, $out, $err and $elapsed (s).
 view() {

@@ -74,13 +74,7 @@ check "isoinfo --verify writes no --stats" none_of v.json
 
 # isoview: in a virtual X server, when there is one
 if command -v xvfb-run >/dev/null 2>&1; then
-    preload=""
-    case "${IP_SANITIZE:-}" in
-    *address*) # as in isoview.sh: keep Mesa's driver loaded to the end for LeakSanitizer
-        for f in /usr/lib/*/dri/swrast_dri.so /usr/lib/dri/swrast_dri.so; do
-            if [ -e "$f" ]; then preload=$f; break; fi
-        done ;;
-    esac
+    # ($preload, from lib.sh, keeps Mesa's driver loaded under AddressSanitizer)
     printf 'wait 60\nscreenshot late.png\nquit\n' >late.txt
     # isoview's own status, kept in a file: xvfb-run's status also reflects its own clean-up,
     # which can fail when another test's virtual server starts or stops at the same time (its
