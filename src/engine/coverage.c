@@ -134,55 +134,69 @@ static void lower(atomic_uint *entry, unsigned bits)
         ;
 }
 
-static void add_triangle(ip_coverage *c, const float *t)
+/* Records one triangle, its corners projected: image x, y (pixels) and view depth z. */
+static void add_projected(ip_coverage *c, const double *x, const double *y, const double *z)
 {
-    double x[3], y[3], z[3], zmax = 0;
+    double zmax = 0;
     for (int k = 0; k < 3; k++) {
-        double p[3] = {t[3 * k], t[3 * k + 1], t[3 * k + 2]};
-        project(c, p, &x[k], &y[k], &z[k]);
         if (!(z[k] >= c->near_plane * NEAR_MARGIN && z[k] <= c->far_plane))
             return; /* clipped by the renderers, or behind the eye */
         zmax = z[k] > zmax ? z[k] : zmax;
     }
-    double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
-    if (!(fabs(area) > 1e-9))
-        return;
-    if (area < 0) { /* counter-clockwise in (x, y): inside is left of every edge */
-        double s = x[1];
-        x[1] = x[2];
-        x[2] = s;
-        s = y[1];
-        y[1] = y[2];
-        y[2] = s;
-    }
+    /* Most triangles are smaller than a pixel: the pixel centres of the bounding rectangle
+     * first, and nothing more when it holds none. */
     int64_t x0, x1, y0, y1;
     if (!centre_range(min3(x[0], x[1], x[2]), max3(x[0], x[1], x[2]), 0, c->width, &x0, &x1) ||
         !centre_range(min3(y[0], y[1], y[2]), max3(y[0], y[1], y[2]), 0, c->height, &y0, &y1) ||
         (x1 - x0 + 1) * (y1 - y0 + 1) > IP_COVERAGE_MAX_PIXELS)
         return;
+    double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    if (!(fabs(area) > 1e-9))
+        return;
+    int o1 = area < 0 ? 2 : 1, o2 = 3 - o1; /* counter-clockwise: inside is left of every edge */
+    double vx[3] = {x[0], x[o1], x[o2]}, vy[3] = {y[0], y[o1], y[o2]};
     double ex[3], ey[3], need[3];
     for (int i = 0; i < 3; i++) {
-        int j = (i + 1) % 3;
-        ex[i] = x[j] - x[i];
-        ey[i] = y[j] - y[i];
+        int j = i == 2 ? 0 : i + 1;
+        ex[i] = vx[j] - vx[i];
+        ey[i] = vy[j] - vy[i];
         need[i] = -EDGE_TOLERANCE * (fabs(ex[i]) + fabs(ey[i])); /* >= the edge's length */
     }
-    unsigned bits = float_bits(nextafterf((float)zmax, INFINITY));
-    for (int64_t py = y0; py <= y1; py++)
+    /* the next float above zmax (a positive finite float: its bits plus one) */
+    unsigned bits = float_bits((float)zmax) + 1;
+    for (int64_t py = y0; py <= y1; py++) {
+        double cy = py + 0.5;
         for (int64_t px = x0; px <= x1; px++) {
-            double cx = px + 0.5, cy = py + 0.5;
-            int inside = 1;
-            for (int i = 0; i < 3 && inside; i++)
-                inside = ex[i] * (cy - y[i]) - ey[i] * (cx - x[i]) >= need[i];
-            if (inside)
+            double cx = px + 0.5;
+            if (ex[0] * (cy - vy[0]) - ey[0] * (cx - vx[0]) >= need[0] &&
+                ex[1] * (cy - vy[1]) - ey[1] * (cx - vx[1]) >= need[1] &&
+                ex[2] * (cy - vy[2]) - ey[2] * (cx - vx[2]) >= need[2])
                 lower(&c->depth[(size_t)py * c->width + (size_t)px], bits);
         }
+    }
 }
 
 void ip__coverage_add(ip_coverage *c, const float *positions, uint64_t count)
 {
-    for (uint64_t i = 0; i < count; i++)
-        add_triangle(c, positions + 9 * i);
+    /* The corners are projected a chunk at a time, in one loop without branches. */
+    enum {
+        CHUNK = 16
+    };
+    double x[3 * CHUNK], y[3 * CHUNK], z[3 * CHUNK];
+    for (uint64_t first = 0; first < count; first += CHUNK) {
+        unsigned n = count - first < CHUNK ? (unsigned)(count - first) : CHUNK;
+        const float *p = positions + 9 * first;
+        for (unsigned k = 0; k < 3 * n; k++) {
+            double v[3] = {p[3 * k] - c->camera.eye[0], p[3 * k + 1] - c->camera.eye[1],
+                           p[3 * k + 2] - c->camera.eye[2]};
+            z[k] = ip__vec3_dot(v, c->basis.forward);
+            double r = 1.0 / z[k];
+            x[k] = ip__vec3_dot(v, c->to_x) * r + c->centre_x;
+            y[k] = ip__vec3_dot(v, c->to_y) * r + c->centre_y;
+        }
+        for (unsigned t = 0; t < n; t++)
+            add_projected(c, x + 3 * t, y + 3 * t, z + 3 * t);
+    }
 }
 
 int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi[3])

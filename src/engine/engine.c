@@ -78,6 +78,7 @@ struct ip_engine {
     unsigned leftover_count;
     atomic_uint leftovers_waiting;       /* leftover_count, readable without the lock */
     int step_limited;                    /* the step has a ray budget */
+    unsigned step_batch;                 /* rays a worker takes at once in this step */
     atomic_uint_fast64_t step_rays_left; /* rays the current step may still hand out */
     atomic_int step_stopped;             /* a worker failed: the others take no more rays */
     double step_deadline;                /* 0: none */
@@ -407,13 +408,13 @@ static unsigned take_rays(ip_engine *e, worker *w, uint32_t xy[][2])
     if (atomic_load_explicit(&e->step_stopped, memory_order_relaxed) ||
         (e->step_deadline > 0 && ip_now_seconds() >= e->step_deadline))
         return 0;
-    uint64_t want = RAY_BATCH;
+    uint64_t want = e->step_batch;
     if (e->step_limited) { /* take the batch's share of the budget first */
         uint64_t left = atomic_load(&e->step_rays_left);
         do {
             if (left == 0)
                 return 0;
-            want = left < RAY_BATCH ? left : RAY_BATCH;
+            want = left < e->step_batch ? left : e->step_batch;
         } while (!atomic_compare_exchange_weak(&e->step_rays_left, &left, left - want));
     }
     unsigned n = 0;
@@ -487,9 +488,14 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
     atomic_store(&e->step_rays_left, max_rays);
     atomic_store(&e->step_stopped, 0);
     e->step_deadline = max_seconds > 0 ? ip_now_seconds() + max_seconds : 0;
+    /* A small step shares its rays between the threads (each ray may propagate a large part
+     * of the surface): a batch of ceil(rays / threads), one thread per ray at most. */
     unsigned threads = e->threads;
-    if (max_rays && max_rays < (uint64_t)threads * RAY_BATCH)
-        threads = (unsigned)((max_rays + RAY_BATCH - 1) / RAY_BATCH); /* few rays: few threads */
+    e->step_batch = RAY_BATCH;
+    if (max_rays && max_rays < (uint64_t)threads * RAY_BATCH) {
+        threads = max_rays < threads ? (unsigned)max_rays : threads;
+        e->step_batch = (unsigned)((max_rays + threads - 1) / threads);
+    }
     for (unsigned t = 0; t < threads; t++) {
         worker *w = &e->workers[t];
         memset(&w->counts, 0, sizeof w->counts);

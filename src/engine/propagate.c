@@ -24,8 +24,9 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     p->camera = camera;
     ip_camera_basis_of(camera, &p->basis);
     p->iso = iso;
-    p->cutoff = options->cutoff_degrees * DEG;
-    p->foldback = options->foldback_degrees * DEG;
+    p->cutoff_versine = 1.0 - cos(options->cutoff_degrees * DEG);
+    p->cos_foldback = cos(options->foldback_degrees * DEG);
+    p->sin_foldback = sin(options->foldback_degrees * DEG);
     p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
     p->near_distance = near_distance;
     p->far_distance = far_distance;
@@ -73,13 +74,25 @@ int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float
     return n;
 }
 
-/* Angle between the unit ray `dir` and the direction from the eye to `p` (radians). */
-static double angle_to(const double eye[3], const double dir[3], const double p[3])
+/* 1 - cos of the angle between the unit ray `dir` and the direction from the eye to `p`: it
+ * grows with the angle over [0, pi], so it orders angles as they do, without atan2. */
+static double versine_to(const double eye[3], const double dir[3], const double p[3])
 {
-    double v[3], c[3];
+    double v[3];
     ip__vec3_sub(p, eye, v);
-    ip__vec3_cross(dir, v, c);
-    return atan2(ip__vec3_length(c), ip__vec3_dot(dir, v));
+    double length = ip__vec3_length(v);
+    return length > 0 ? 1.0 - ip__vec3_dot(dir, v) / length : 0.0;
+}
+
+/* The versine below which an angle is smaller than (the angle of versine `max`) less the
+ * fold-back tolerance: 1 - cos(m - f) = 1 - cos m cos f - sin m sin f. Negative (no angle
+ * qualifies) when m <= f. */
+static double foldback_limit(const ip_propagator *p, double max)
+{
+    double cos_m = 1.0 - max, sin_m = sqrt(fmax(0.0, max * (2.0 - max)));
+    if (cos_m >= p->cos_foldback) /* m <= f */
+        return -1.0;
+    return 1.0 - cos_m * p->cos_foldback - sin_m * p->sin_foldback;
 }
 
 static void cell_centre(const ip_sampler *s, const uint32_t cell[3], double centre[3],
@@ -140,7 +153,7 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
     cell_centre(p->sampler, seed, centre, &diagonal);
     uint64_t head = 0, tail = 0;
     p->queue[tail++] =
-        (ip_queued_cell){{seed[0], seed[1], seed[2]}, (float)angle_to(eye, dir, centre)};
+        (ip_queued_cell){{seed[0], seed[1], seed[2]}, (float)versine_to(eye, dir, centre)};
     ip_status st = IP_OK;
     while (head < tail && st == IP_OK) {
         ip_queued_cell q = p->queue[head++];
@@ -160,6 +173,7 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
             ip__coverage_add(p->coverage, p->mesh->positions + 9 * (p->mesh->triangle_count - n),
                              (uint64_t)n);
         unsigned faces = ip__mc_crossed_faces(mc);
+        double folded = faces ? foldback_limit(p, q.max_versine) : 0.0;
         if (tail + 6 > p->queue_capacity && (st = grow_queue(p, head, tail)) == IP_OK) {
             tail -= head;
             head = 0;
@@ -179,8 +193,8 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
             if (ip__visited_test(p->visited, p->sampler->level, n3))
                 continue;
             cell_centre(p->sampler, n3, centre, &diagonal);
-            double a = angle_to(eye, dir, centre);
-            if (a > p->cutoff || a < q.max_angle - p->foldback || !in_frustum(p, centre, diagonal))
+            double a = versine_to(eye, dir, centre);
+            if (a > p->cutoff_versine || a < folded || !in_frustum(p, centre, diagonal))
                 continue;
             if (p->near_distance > 0 || p->far_distance < INFINITY) {
                 double v[3];
@@ -198,7 +212,7 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
                 st = IP_ERR_NOMEM;
             else if (!was)
                 p->queue[tail++] =
-                    (ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_angle, a)};
+                    (ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)};
         }
     }
     double total = ip_now_seconds() - start;

@@ -12,7 +12,8 @@
 
 typedef struct ip_queued_cell {
     uint32_t cell[3];
-    float max_angle; /* the largest angle to the seed's ray among the cell's predecessors */
+    float max_versine; /* 1 - cos of the largest angle to the seed's ray among the cell's
+                        * predecessors (angles compare as their versines, without atan2) */
 } ip_queued_cell;
 
 typedef struct ip_propagator {
@@ -22,8 +23,8 @@ typedef struct ip_propagator {
     const ip_camera *camera;
     ip_camera_basis basis;
     float iso;
-    double cutoff;                      /* radians */
-    double foldback;                    /* radians */
+    double cutoff_versine;              /* 1 - cos(cut-off angle) */
+    double cos_foldback, sin_foldback;  /* of the fold-back tolerance */
     double pixel_scale;                 /* pixels per unit of (size / depth) */
     double near_distance, far_distance; /* the level's distance band from the eye */
     ip_coverage *coverage;              /* occlusion: shared by the workers; NULL when off */

@@ -11,6 +11,8 @@ ip_status ip__visited_init(ip_visited *v, const ip_layout *layout)
     v->layout = layout;
     uint64_t b = layout->brick_edge;
     v->words_per_brick = (b * b * b + 63) / 64;
+    while ((UINT64_C(1) << v->edge_shift) < b)
+        v->edge_shift++;
     v->bitmaps = calloc(layout->brick_count, sizeof *v->bitmaps);
     atomic_init(&v->bytes, 0);
     return v->bitmaps ? IP_OK : IP_ERR_NOMEM;
@@ -38,14 +40,15 @@ void ip__visited_free(ip_visited *v)
 /* The brick of a cell and the cell's bit inside it. */
 static uint64_t locate(const ip_visited *v, uint32_t level, const uint32_t cell[3], uint64_t *bit)
 {
-    uint32_t b = v->layout->brick_edge, brick[3], local[3];
+    unsigned shift = v->edge_shift;
+    uint32_t brick[3], local[3], mask = (UINT32_C(1) << shift) - 1;
     IP_ASSERT(level < v->layout->level_count);
     for (int a = 0; a < 3; a++) {
         IP_ASSERT(cell[a] < v->layout->levels[level].dims[a] - 1);
-        brick[a] = cell[a] / b;
-        local[a] = cell[a] - brick[a] * b;
+        brick[a] = cell[a] >> shift;
+        local[a] = cell[a] & mask;
     }
-    *bit = local[0] + (uint64_t)b * (local[1] + (uint64_t)b * local[2]);
+    *bit = local[0] + ((uint64_t)local[1] << shift) + ((uint64_t)local[2] << (2 * shift));
     return ip_brick_global_index(v->layout, level, brick);
 }
 

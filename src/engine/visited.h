@@ -14,6 +14,7 @@ typedef struct ip_visited {
     const ip_layout *layout;
     _Atomic(atomic_uint_fast64_t *) *bitmaps; /* one per brick of every level, or NULL */
     uint64_t words_per_brick;
+    unsigned edge_shift;        /* log2 of the brick edge (a power of two) */
     atomic_uint_fast64_t bytes; /* allocated bitmap bytes */
 } ip_visited;
 
