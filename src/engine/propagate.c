@@ -10,7 +10,9 @@
 #include "vec3.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
-#define TIMING_STRIDE 16 /* extractions per timed extraction */
+#define TIMING_STRIDE 16    /* extractions per timed extraction */
+#define MIN_TEST_PIXELS 2.0 /* the smallest box (projected diagonal) tested for occlusion */
+#define MAX_TEST_SHIFT 3    /* ...grown to at most 8 cells a side */
 
 ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
                               ip_mesh *mesh, const ip_camera *camera, float iso,
@@ -108,24 +110,37 @@ static void cell_centre(const ip_sampler *s, const uint32_t cell[3], double cent
 }
 
 /* Whether any part of the cell may project into the image (a conservative test on its centre,
- * widened by the cell's projected size and a 2-pixel margin). */
-static int in_frustum(const ip_propagator *p, const double centre[3], double diagonal)
+ * widened by the cell's projected size and a 2-pixel margin). Sets *pixels to the cell's
+ * projected size (its diagonal, in pixels) when it does. */
+static int in_frustum(const ip_propagator *p, const double centre[3], double diagonal,
+                      double *pixels)
 {
     double x, y, depth;
     if (!ip_camera_project(&p->basis, p->camera, centre, &x, &y, &depth))
         return 0;
-    double margin = 2.0 + diagonal / depth * p->pixel_scale;
+    *pixels = diagonal / depth * p->pixel_scale;
+    double margin = 2.0 + *pixels;
     return x >= -margin && x <= p->camera->width + margin && y >= -margin &&
            y <= p->camera->height + margin;
 }
 
-/* Whether surface extracted so far hides the cell's box at every pixel centre it may cover. */
-static int hidden(const ip_propagator *p, const uint32_t cell[3])
+/* Whether surface extracted so far hides the cell at every pixel centre it may cover. A cell
+ * smaller than MIN_TEST_PIXELS on screen is tested through the aligned block of 2^k cells
+ * around it that is not (up to 2^MAX_TEST_SHIFT cells a side): a box under a pixel holds no
+ * pixel centre and could never be found hidden, and whatever hides the block hides every cell
+ * in it (its pixel centres are among the block's, its nearest point no nearer). */
+static int hidden(const ip_propagator *p, const uint32_t cell[3], double pixels)
 {
+    unsigned k = 0;
+    while (k < MAX_TEST_SHIFT && pixels * (double)(1u << k) < MIN_TEST_PIXELS)
+        k++;
     double lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
-        lo[a] = p->sampler->world[a][cell[a]];
-        hi[a] = p->sampler->world[a][cell[a] + 1];
+        uint32_t first = cell[a] >> k << k, end = first + (1u << k),
+                 cells = p->sampler->dims[a] - 1;
+        end = end < cells ? end : cells;
+        lo[a] = p->sampler->world[a][first];
+        hi[a] = p->sampler->world[a][end];
     }
     return ip__coverage_hides(p->coverage, lo, hi);
 }
@@ -194,7 +209,8 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
                 continue;
             cell_centre(p->sampler, n3, centre, &diagonal);
             double a = versine_to(eye, dir, centre);
-            if (a > p->cutoff_versine || a < folded || !in_frustum(p, centre, diagonal))
+            double pixels;
+            if (a > p->cutoff_versine || a < folded || !in_frustum(p, centre, diagonal, &pixels))
                 continue;
             if (p->near_distance > 0 || p->far_distance < INFINITY) {
                 double v[3];
@@ -203,7 +219,7 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
                 if (d < p->near_distance || d >= p->far_distance)
                     continue; /* another level's band: the resolution boundary */
             }
-            if (p->coverage && hidden(p, n3)) {
+            if (p->coverage && hidden(p, n3, pixels)) {
                 counts->deferred++; /* left unmarked: a ray that seeds it extracts it */
                 continue;
             }
