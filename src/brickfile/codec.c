@@ -138,42 +138,231 @@ static void shuffle(const unsigned char *src, unsigned char *dst, size_t count, 
             dst[b * count + i] = src[i * size + b];
 }
 
-/* Unshuffles 2- or 4-byte samples into host integers (little-endian hosts) and, when asked,
- * undoes the delta predictor: a first pass that the compiler vectorises (byte planes to
- * integers, zigzag undone), then a running sum, the only serial part. */
-static void unshuffle_fast(const unsigned char *src, void *dst, size_t count, size_t size,
-                           int delta)
+/* ---- decoding the delta predictor at memory speed (little-endian hosts) ----
+ *
+ * The running sum that undoes the delta predictor is serial, but within a vector it is a
+ * prefix sum of log2(lanes) shifted adds, and across vectors only the carry (the last sum,
+ * broadcast) depends on the previous vector: one add per 16 samples. Each function below
+ * takes the byte planes straight from the LZ4 output and writes the samples once: unshuffle,
+ * zigzag and running sum in one pass. SSE2 is the x86-64 baseline; elsewhere, or built with
+ * IP_CODEC_PORTABLE (the tests build both), the same loops run one sample at a time. */
+
+#if defined(__SSE2__) && !defined(IP_CODEC_PORTABLE)
+#include <emmintrin.h>
+#define CODEC_SSE2 1
+#else
+#define CODEC_SSE2 0
+#endif
+
+#if CODEC_SSE2
+/* Every 16-bit lane set to the last one. */
+static inline __m128i last16(__m128i v)
 {
-    if (size == 2) {
-        const unsigned char *restrict b0 = src, *restrict b1 = src + count;
-        uint16_t *restrict d = dst;
-        if (!delta) {
-            for (size_t i = 0; i < count; i++)
-                d[i] = (uint16_t)(b0[i] | b1[i] << 8);
-            return;
-        }
-        for (size_t i = 0; i < count; i++) {
-            uint16_t z = (uint16_t)(b0[i] | b1[i] << 8);
-            d[i] = UNZIGZAG(uint16_t, z);
-        }
-        uint16_t sum = 0;
-        for (size_t i = 0; i < count; i++)
-            d[i] = sum = (uint16_t)(sum + d[i]);
-    } else {
-        const unsigned char *restrict b0 = src, *restrict b1 = src + count,
-                                      *restrict b2 = b1 + count, *restrict b3 = b2 + count;
-        uint32_t *restrict d = dst;
-        for (size_t i = 0; i < count; i++) {
-            uint32_t z = (uint32_t)b0[i] | (uint32_t)b1[i] << 8 | (uint32_t)b2[i] << 16 |
-                         (uint32_t)b3[i] << 24;
-            d[i] = delta ? UNZIGZAG(uint32_t, z) : z;
-        }
-        if (delta) {
-            uint32_t sum = 0;
-            for (size_t i = 0; i < count; i++)
-                d[i] = sum = sum + d[i];
-        }
+    v = _mm_shufflehi_epi16(v, 0xFF);
+    return _mm_unpackhi_epi64(v, v);
+}
+
+/* Zigzag undone, then lane k = the sum of lanes 0..k (mod 2^16). */
+static inline __m128i unzigzag_prefix16(__m128i z)
+{
+    __m128i d = _mm_xor_si128(_mm_srli_epi16(z, 1), _mm_srai_epi16(_mm_slli_epi16(z, 15), 15));
+    d = _mm_add_epi16(d, _mm_slli_si128(d, 2));
+    d = _mm_add_epi16(d, _mm_slli_si128(d, 4));
+    return _mm_add_epi16(d, _mm_slli_si128(d, 8));
+}
+
+/* The whole vectors of unshuffle_undelta16(); returns the samples done, their sum in *sum. */
+static size_t undelta16_sse2(const uint8_t *b0, const uint8_t *b1, uint16_t *d, size_t n,
+                             uint16_t *sum)
+{
+    __m128i carry = _mm_setzero_si128();
+    size_t i = 0;
+    for (; i + 16 <= n; i += 16) {
+        __m128i lo = _mm_loadu_si128((const __m128i *)(const void *)(b0 + i));
+        __m128i hi = _mm_loadu_si128((const __m128i *)(const void *)(b1 + i));
+        __m128i p0 = unzigzag_prefix16(_mm_unpacklo_epi8(lo, hi));
+        __m128i p1 = _mm_add_epi16(unzigzag_prefix16(_mm_unpackhi_epi8(lo, hi)), last16(p0));
+        _mm_storeu_si128((__m128i *)(void *)(d + i), _mm_add_epi16(p0, carry));
+        _mm_storeu_si128((__m128i *)(void *)(d + i + 8), _mm_add_epi16(p1, carry));
+        carry = _mm_add_epi16(carry, last16(p1));
     }
+    *sum = (uint16_t)_mm_cvtsi128_si32(carry);
+    return i;
+}
+
+/* Every 32-bit lane set to the last one. */
+static inline __m128i last32(__m128i v)
+{
+    return _mm_shuffle_epi32(v, 0xFF);
+}
+
+/* Zigzag undone, then lane k = the sum of lanes 0..k (mod 2^32). */
+static inline __m128i unzigzag_prefix32(__m128i z)
+{
+    __m128i d = _mm_xor_si128(_mm_srli_epi32(z, 1), _mm_srai_epi32(_mm_slli_epi32(z, 31), 31));
+    d = _mm_add_epi32(d, _mm_slli_si128(d, 4));
+    return _mm_add_epi32(d, _mm_slli_si128(d, 8));
+}
+
+/* The whole vectors of unshuffle_undelta32(); returns the samples done, their sum in *sum. */
+static size_t undelta32_sse2(const uint8_t *const b[4], uint32_t *d, size_t n, uint32_t *sum)
+{
+    __m128i carry = _mm_setzero_si128();
+    size_t i = 0;
+    for (; i + 16 <= n; i += 16) {
+        __m128i p[4], z[4];
+        for (int k = 0; k < 4; k++)
+            p[k] = _mm_loadu_si128((const __m128i *)(const void *)(b[k] + i));
+        __m128i w01lo = _mm_unpacklo_epi8(p[0], p[1]), w23lo = _mm_unpacklo_epi8(p[2], p[3]);
+        __m128i w01hi = _mm_unpackhi_epi8(p[0], p[1]), w23hi = _mm_unpackhi_epi8(p[2], p[3]);
+        z[0] = unzigzag_prefix32(_mm_unpacklo_epi16(w01lo, w23lo));
+        z[1] = unzigzag_prefix32(_mm_unpackhi_epi16(w01lo, w23lo));
+        z[2] = unzigzag_prefix32(_mm_unpacklo_epi16(w01hi, w23hi));
+        z[3] = unzigzag_prefix32(_mm_unpackhi_epi16(w01hi, w23hi));
+        for (int k = 1; k < 4; k++)
+            z[k] = _mm_add_epi32(z[k], last32(z[k - 1]));
+        for (int k = 0; k < 4; k++)
+            _mm_storeu_si128((__m128i *)(void *)(d + i + 4 * k), _mm_add_epi32(z[k], carry));
+        carry = _mm_add_epi32(carry, last32(z[3]));
+    }
+    *sum = (uint32_t)_mm_cvtsi128_si32(carry);
+    return i;
+}
+
+/* Every 8-bit lane set to the last one. */
+static inline __m128i last8(__m128i v)
+{
+    v = _mm_unpackhi_epi8(v, v);
+    v = _mm_shufflehi_epi16(v, 0xFF);
+    return _mm_unpackhi_epi64(v, v);
+}
+
+/* Zigzag undone, then lane k = the sum of lanes 0..k (mod 2^8). */
+static inline __m128i unzigzag_prefix8(__m128i z)
+{
+    const __m128i one = _mm_set1_epi8(1), low7 = _mm_set1_epi8(0x7F);
+    __m128i half = _mm_and_si128(_mm_srli_epi16(z, 1), low7);
+    __m128i d = _mm_xor_si128(half, _mm_sub_epi8(_mm_setzero_si128(), _mm_and_si128(z, one)));
+    d = _mm_add_epi8(d, _mm_slli_si128(d, 1));
+    d = _mm_add_epi8(d, _mm_slli_si128(d, 2));
+    d = _mm_add_epi8(d, _mm_slli_si128(d, 4));
+    return _mm_add_epi8(d, _mm_slli_si128(d, 8));
+}
+
+/* The whole vectors of undelta8(); returns the samples done, their sum in *sum. */
+static size_t undelta8_sse2(uint8_t *d, size_t n, uint8_t *sum)
+{
+    __m128i carry = _mm_setzero_si128();
+    size_t i = 0;
+    for (; i + 32 <= n; i += 32) {
+        __m128i p0 = unzigzag_prefix8(_mm_loadu_si128((const __m128i *)(void *)(d + i)));
+        __m128i p1 = unzigzag_prefix8(_mm_loadu_si128((const __m128i *)(void *)(d + i + 16)));
+        p1 = _mm_add_epi8(p1, last8(p0));
+        _mm_storeu_si128((__m128i *)(void *)(d + i), _mm_add_epi8(p0, carry));
+        _mm_storeu_si128((__m128i *)(void *)(d + i + 16), _mm_add_epi8(p1, carry));
+        carry = _mm_add_epi8(carry, last8(p1));
+    }
+    *sum = (uint8_t)_mm_cvtsi128_si32(carry);
+    return i;
+}
+#endif
+
+/* 2-byte planes to host samples, zigzag and delta undone. */
+static void unshuffle_undelta16(const uint8_t *b0, const uint8_t *b1, uint16_t *d, size_t n)
+{
+    size_t i = 0;
+    uint16_t sum = 0;
+#if CODEC_SSE2
+    i = undelta16_sse2(b0, b1, d, n, &sum);
+#endif
+    for (; i < n; i++) {
+        uint16_t z = (uint16_t)(b0[i] | b1[i] << 8);
+        d[i] = sum = (uint16_t)(sum + UNZIGZAG(uint16_t, z));
+    }
+}
+
+/* 4-byte planes to host samples, zigzag and delta undone. */
+static void unshuffle_undelta32(const uint8_t *const b[4], uint32_t *d, size_t n)
+{
+    size_t i = 0;
+    uint32_t sum = 0;
+#if CODEC_SSE2
+    i = undelta32_sse2(b, d, n, &sum);
+#endif
+    for (; i < n; i++) {
+        uint32_t z = (uint32_t)b[0][i] | (uint32_t)b[1][i] << 8 | (uint32_t)b[2][i] << 16 |
+                     (uint32_t)b[3][i] << 24;
+        d[i] = sum = sum + UNZIGZAG(uint32_t, z);
+    }
+}
+
+/* Zigzag and delta undone on bytes, in place. */
+static void undelta8(uint8_t *d, size_t n)
+{
+    size_t i = 0;
+    uint8_t sum = 0;
+#if CODEC_SSE2
+    i = undelta8_sse2(d, n, &sum);
+#endif
+    for (; i < n; i++)
+        d[i] = sum = (uint8_t)(sum + UNZIGZAG(uint8_t, d[i]));
+}
+
+/* 2-byte planes to host samples. */
+static void unshuffle16(const uint8_t *restrict b0, const uint8_t *restrict b1,
+                        uint16_t *restrict d, size_t n)
+{
+    size_t i = 0;
+#if CODEC_SSE2
+    for (; i + 16 <= n; i += 16) { /* GCC's own vectorisation of the loop takes 10 operations */
+        __m128i lo = _mm_loadu_si128((const __m128i *)(const void *)(b0 + i));
+        __m128i hi = _mm_loadu_si128((const __m128i *)(const void *)(b1 + i));
+        _mm_storeu_si128((__m128i *)(void *)(d + i), _mm_unpacklo_epi8(lo, hi));
+        _mm_storeu_si128((__m128i *)(void *)(d + i + 8), _mm_unpackhi_epi8(lo, hi));
+    }
+#endif
+    for (; i < n; i++)
+        d[i] = (uint16_t)(b0[i] | b1[i] << 8);
+}
+
+/* 4-byte planes to host samples (the compiler vectorises it). */
+static void unshuffle32(const uint8_t *restrict b0, const uint8_t *restrict b1,
+                        const uint8_t *restrict b2, const uint8_t *restrict b3,
+                        uint32_t *restrict d, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        d[i] =
+            (uint32_t)b0[i] | (uint32_t)b1[i] << 8 | (uint32_t)b2[i] << 16 | (uint32_t)b3[i] << 24;
+}
+
+/* Undoes `filters` on a little-endian host: `src` is the LZ4 output, byte planes when
+ * `planes`, else dst itself; `dst` receives the host samples. One pass over the samples, plus
+ * a second for the median edge predictor. Wide samples without the shuffle (the encoder
+ * never writes them) take the plain loops. */
+static void unfilter_little_endian(const unsigned char *src, void *dst, const uint32_t e[3],
+                                   size_t size, unsigned filters, int planes)
+{
+    size_t n = (size_t)e[0] * e[1] * e[2];
+    int delta = (filters & IP_FILTER_DELTA) != 0;
+    if (size == 1 && delta) {
+        undelta8(dst, n);
+    } else if (!planes) {
+        if (delta)
+            unpredict(dst, e, size, filters);
+    } else if (size == 2) {
+        if (delta)
+            unshuffle_undelta16(src, src + n, dst, n);
+        else
+            unshuffle16(src, src + n, dst, n);
+    } else {
+        const uint8_t *const b[4] = {src, src + n, src + 2 * n, src + 3 * n};
+        if (delta)
+            unshuffle_undelta32(b, dst, n);
+        else
+            unshuffle32(b[0], b[1], b[2], b[3], dst, n);
+    }
+    if (filters & IP_FILTER_MED)
+        unpredict(dst, e, size, filters);
 }
 
 static void unshuffle(const unsigned char *src, unsigned char *dst, size_t count, size_t size)
@@ -327,17 +516,18 @@ ip_status ip__codec_decode(const ip_brick_entry *entry, const void *payload,
         if ((f & ~7u) ||
             (f & (IP_FILTER_DELTA | IP_FILTER_MED)) == (IP_FILTER_DELTA | IP_FILTER_MED))
             return IP_ERR_CORRUPT;
-        void *target = (f & IP_FILTER_SHUFFLE) ? work : dst;
+        /* byte planes go to the scratch and come back as samples; bytes (whose shuffle is
+         * the identity) decode in place */
+        int planes = (f & IP_FILTER_SHUFFLE) && size > 1;
+        void *target = planes ? work : dst;
         int n = LZ4_decompress_safe(payload, target, (int)entry->stored_size, (int)raw);
         if (n < 0 || (size_t)n != raw)
             return IP_ERR_CORRUPT;
-        if ((f & IP_FILTER_SHUFFLE) && size > 1 && ip__host_little_endian()) {
-            unshuffle_fast(work, dst, count, size, (f & IP_FILTER_DELTA) != 0);
-            if (f & IP_FILTER_MED)
-                unpredict(dst, extent, size, f);
+        if (ip__host_little_endian()) {
+            unfilter_little_endian(target, dst, extent, size, f, planes);
             return IP_OK;
         }
-        if (f & IP_FILTER_SHUFFLE)
+        if (planes)
             unshuffle(work, dst, count, size);
         if (f & (IP_FILTER_DELTA | IP_FILTER_MED))
             unpredict(dst, extent, size, f);

@@ -50,9 +50,8 @@ static uint64_t size_now(const ip_store *s)
     return fstat(s->fd, &st) == 0 ? (uint64_t)st.st_size : 0;
 }
 
-/* Reads `size` bytes at `offset`; a short read means the file shrank since it was opened. */
-static ip_status read_at(const ip_store *s, void *dst, size_t size, uint64_t offset,
-                         const char *what, ip_error *err)
+/* Reads `size` bytes at `offset`: 0, an errno value, or -1 when the file ends first. */
+static int read_fully(const ip_store *s, void *dst, size_t size, uint64_t offset)
 {
     unsigned char *p = dst;
     while (size > 0) {
@@ -60,18 +59,34 @@ static ip_status read_at(const ip_store *s, void *dst, size_t size, uint64_t off
         if (n < 0 && errno == EINTR)
             continue;
         if (n < 0)
-            return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot read %s", s->path, what);
+            return errno;
         if (n == 0)
-            return ip__fail(err, IP_ERR_IO,
-                            "%s: the file ends at byte %llu, before the end of "
-                            "%s (it was %llu bytes when opened: truncated or rewritten since)",
-                            s->path, (unsigned long long)size_now(s), what,
-                            (unsigned long long)s->size);
+            return -1;
         p += n;
         size -= (size_t)n;
         offset += (uint64_t)n;
     }
-    return IP_OK;
+    return 0;
+}
+
+/* The message of a failed read_fully() of `what`; a short read means the file shrank since
+ * it was opened. */
+static ip_status read_failed(const ip_store *s, int failure, const char *what, ip_error *err)
+{
+    if (failure > 0)
+        return ip__fail_errno(err, IP_ERR_IO, failure, "%s: cannot read %s", s->path, what);
+    return ip__fail(err, IP_ERR_IO,
+                    "%s: the file ends at byte %llu, before the end of "
+                    "%s (it was %llu bytes when opened: truncated or rewritten since)",
+                    s->path, (unsigned long long)size_now(s), what, (unsigned long long)s->size);
+}
+
+/* Reads `size` bytes at `offset`, or fails with a message about `what`. */
+static ip_status read_at(const ip_store *s, void *dst, size_t size, uint64_t offset,
+                         const char *what, ip_error *err)
+{
+    int failure = read_fully(s, dst, size, offset);
+    return failure == 0 ? IP_OK : read_failed(s, failure, what, err);
 }
 
 /* The header, then the padding and the summary section, each read once and validated. */
@@ -236,6 +251,25 @@ size_t ip_store_read_work_size(const ip_store *s)
     return payload_room(s) + ip__codec_work_size(s->largest_samples, s->layout.type);
 }
 
+/* Reads brick g's payload into `payload`; the message, which names the brick and its bytes,
+ * is written only on failure (a read that succeeds costs a pread and nothing else). */
+static ip_status read_payload(const ip_store *s, uint64_t g, const ip_brick_entry *e,
+                              unsigned char *payload, ip_error *err)
+{
+    int failure = read_fully(s, payload, e->stored_size, e->offset);
+    if (failure == 0)
+        return IP_OK;
+    char what[160];
+    uint32_t level, b[3];
+    ip_brick_coords(&s->layout, g, &level, b);
+    snprintf(what, sizeof what,
+             "the payload of brick %llu (level %u, brick %u,%u,%u; "
+             "bytes %llu-%llu)",
+             (unsigned long long)g, level, b[0], b[1], b[2], (unsigned long long)e->offset,
+             (unsigned long long)(e->offset + e->stored_size));
+    return read_failed(s, failure, what, err);
+}
+
 ip_status ip_store_read_brick(const ip_store *s, uint64_t g, void *dst, void *work, ip_error *err)
 {
     ip_brick_entry e;
@@ -244,15 +278,7 @@ ip_status ip_store_read_brick(const ip_store *s, uint64_t g, void *dst, void *wo
     if (e.stored_size > 0) {
         /* Read once into memory of our own, then checked and decoded there: the bytes decoded
          * are the bytes verified, whatever happens to the file meanwhile. */
-        char what[160];
-        uint32_t level, b[3];
-        ip_brick_coords(&s->layout, g, &level, b);
-        snprintf(what, sizeof what,
-                 "the payload of brick %llu (level %u, brick %u,%u,%u; "
-                 "bytes %llu-%llu)",
-                 (unsigned long long)g, level, b[0], b[1], b[2], (unsigned long long)e.offset,
-                 (unsigned long long)(e.offset + e.stored_size));
-        ip_status st = read_at(s, payload, e.stored_size, e.offset, what, err);
+        ip_status st = read_payload(s, g, &e, payload, err);
         if (st != IP_OK)
             return st;
         if (ip__format_checksum(payload, e.stored_size) != e.checksum)
