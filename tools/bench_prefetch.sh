@@ -1,7 +1,7 @@
 #!/bin/bash
 # Cold views with reading ahead on and off, interleaved (docs/performance.md, part 13). Needs
 # root for drop_caches; writes its files to /tmp/pf/r.
-# usage: measure.sh BUILD RUNS FILE...   cold runs, prefetch on/off interleaved
+# usage: tools/bench_prefetch.sh BUILD RUNS FILE.ibv...: cold runs, prefetch on/off interleaved
 B=$1; RUNS=$2; shift 2
 mkdir -p /tmp/pf/r
 for f in "$@"; do
