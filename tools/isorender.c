@@ -30,6 +30,8 @@ static const char usage[] =
     "  --lod on|off        adaptive resolution: far regions from coarser levels (default on)\n"
     "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n"
     "  --occlusion on|off  propagation skips cells that extracted surface hides (default on)\n"
+    "  --prefetch on|off   a background thread reads and decodes the bricks the next rays need\n"
+    "                      (default on)\n"
     "  --full              triangulate every active cell instead (the baseline)\n"
     "  --warm              extract once untimed first, so the timed run finds a warm cache\n"
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
@@ -336,8 +338,9 @@ static void json_counts(FILE *f, void *user)
                 (unsigned long long)r->visible_triangles,
                 overdraw(r->mesh->triangle_count, r->visible_triangles));
     if (!r->o.full)
-        fprintf(f, ", \"occlusion\": %s, \"deferred_cells\": %llu",
-                r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred);
+        fprintf(f, ", \"occlusion\": %s, \"deferred_cells\": %llu, \"prefetch\": %s",
+                r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred,
+                r->o.common.prefetch ? "true" : "false");
     fprintf(f, ", \"warnings\": [");
     if (r->warning[0])
         tool_json_string(f, r->warning);

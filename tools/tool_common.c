@@ -372,6 +372,11 @@ void tool_print_cache_table(FILE *out, const ip_cache_stats *s, uint64_t summary
     fprintf(out, "  decoded         %s from %s in %.3f s\n",
             tool_format_bytes(d, sizeof d, (double)s->bytes_decompressed),
             tool_format_bytes(e, sizeof e, (double)s->bytes_read), s->decode_seconds);
+    fprintf(out, "  read ahead      %llu bricks, %llu of them pinned later; waited %.3f s\n",
+            (unsigned long long)s->prefetched, (unsigned long long)s->prefetch_hits,
+            s->wait_seconds);
+    fprintf(out, "  from the disk   %s\n",
+            tool_format_bytes(a, sizeof a, (double)s->bytes_read_disk));
     fprintf(out, "  bricks touched  %llu of %llu", (unsigned long long)s->bricks_touched,
             (unsigned long long)s->bricks_total);
     for (uint32_t k = 0; k < s->levels; k++)
@@ -407,6 +412,11 @@ void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_
     fprintf(out, "\"over_budget_pins\": %llu, \"pinned_bytes\": %llu, \"errors\": %llu, ",
             (unsigned long long)s->over_budget_pins, (unsigned long long)s->pinned_bytes,
             (unsigned long long)s->errors);
+    fprintf(out,
+            "\"prefetched\": %llu, \"prefetch_hits\": %llu, \"bytes_read_disk\": %llu, "
+            "\"wait_seconds\": %.6f, ",
+            (unsigned long long)s->prefetched, (unsigned long long)s->prefetch_hits,
+            (unsigned long long)s->bytes_read_disk, s->wait_seconds);
     fprintf(out, "\"bricks_touched\": %llu, \"bricks_total\": %llu, \"levels\": [",
             (unsigned long long)s->bricks_touched, (unsigned long long)s->bricks_total);
     for (uint32_t k = 0; k < s->levels; k++)
@@ -458,6 +468,7 @@ void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t he
     o->lod = 1;
     o->pixel_error = 1.0;
     o->occlusion = 1;
+    o->prefetch = 1;
     o->cache_bytes = ip_cache_default_budget();
 }
 
@@ -470,6 +481,7 @@ void tool_engine_options(const tool_view_options *o, ip_engine_options *eo)
     eo->lod = o->lod;
     eo->pixel_error = o->pixel_error;
     eo->occlusion = o->occlusion;
+    eo->prefetch = o->prefetch;
 }
 
 #define MAX_IMAGE_SIDE 16384 /* pixels; OpenGL's common maximum renderbuffer size */
@@ -591,6 +603,12 @@ static int parse_occlusion(const char *p, const tool_option *opt, const char *co
     return parse_on_off(p, v[0], &((tool_view_options *)base)->occlusion, "--occlusion");
 }
 
+static int parse_prefetch(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    (void)opt;
+    return parse_on_off(p, v[0], &((tool_view_options *)base)->prefetch, "--prefetch");
+}
+
 int tool_option_cache_mb(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     if (tool_parse_cache_mb(v[0], (uint64_t *)((char *)base + opt->offset)) != 0)
@@ -615,6 +633,7 @@ static const tool_option view_options[] = {
     {"--pixel-error", NULL, 1, VIEW_FIELD(pixel_error), tool_option_positive, "is not positive",
      NULL},
     {"--occlusion", NULL, 1, 0, parse_occlusion, NULL, NULL},
+    {"--prefetch", NULL, 1, 0, parse_prefetch, NULL, NULL},
     {"--cache-mb", NULL, 1, VIEW_FIELD(cache_bytes), tool_option_cache_mb, NULL, NULL},
     {"--stats", NULL, 1, VIEW_FIELD(stats), NULL, NULL, NULL},
     {"--force", NULL, 0, VIEW_FIELD(force), NULL, NULL, NULL},

@@ -83,12 +83,14 @@ typedef struct tool_view_options {
     int lod;
     double pixel_error;
     int occlusion; /* --occlusion on|off */
+    int prefetch;  /* --prefetch on|off */
     uint64_t cache_bytes;
     const char *stats; /* --stats OUT.json (NULL: none) */
     int force, quiet;
 } tool_view_options;
 
-/* The defaults: view -y, the paper's angles, lod on with a 1-pixel error, occlusion on, every core, the
+/* The defaults: view -y, the paper's angles, lod on with a 1-pixel error, occlusion on, reading
+ * ahead on, every core, the
  * default cache budget, an image of width x height. */
 void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t height);
 
@@ -161,7 +163,7 @@ typedef struct tool_command_line {
 int tool_parse_command_line(const tool_command_line *c, int argc, char **argv);
 
 /* The shared options of tool_view_options as a table over `o`: --iso, --size, --view,
- * --camera, --rays, --time, --cutoff, --foldback, --threads, --lod, --pixel-error, --occlusion,
+ * --camera, --rays, --time, --cutoff, --foldback, --threads, --lod, --pixel-error, --occlusion, --prefetch,
  * --cache-mb, --stats, --force and --quiet (-q). */
 tool_option_table tool_view_option_table(tool_view_options *o);
 

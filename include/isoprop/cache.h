@@ -16,6 +16,11 @@
  * payload into a scratch buffer (ip_store_read_brick()), so the process holds the budget, the
  * summaries and a fixed overhead, whatever the file's size.
  *
+ * Loading ahead: a background reader (the engine's, with ip_engine_options.prefetch) may load
+ * bricks before their first pin, within the budget (docs/cache.md, "Prefetching"); such loads
+ * count in `prefetched` and `prefetch_hits`, not in `misses`; their reads and decodes count in
+ * `bytes_read`, `bytes_decompressed` and `decode_seconds` like those of misses.
+ *
  * Read-ahead: a miss also asks the kernel to read the compressed payloads of the brick's six
  * face neighbours in the background (once per brick), the bricks propagation crosses into
  * next, so that a cold start does not stall on their reads.
@@ -65,13 +70,19 @@ typedef struct ip_cache_stats {
     uint64_t resident_bricks;
     uint64_t hits, misses, evictions; /* evictions: bricks evicted to make room */
     uint64_t waits;                   /* misses that waited for another thread's decode */
-    uint64_t bytes_decompressed;      /* decoded sample bytes produced by misses */
-    uint64_t bytes_read;              /* compressed payload bytes read by misses */
+    uint64_t bytes_decompressed;      /* decoded sample bytes produced by loads */
+    uint64_t bytes_read;              /* compressed payload bytes read by loads */
     double decode_seconds;            /* time in checksum + decode + cell-group ranges,
                                          summed over threads */
     uint64_t over_budget_pins;        /* loads that found every resident brick pinned */
     uint64_t pinned_bytes;            /* decoded bytes pinned now */
     uint64_t errors;                  /* loads that failed: read, checksum or decode */
+    uint64_t prefetched;      /* bricks loaded ahead by a background reader (not in misses) */
+    uint64_t prefetch_hits;   /* bricks loaded ahead and then pinned before their eviction */
+    uint64_t bytes_read_disk; /* bytes the process read from the block device since the cache
+                                 was created (Linux /proc/self/io read_bytes; 0 elsewhere) */
+    double wait_seconds;      /* time pin calls waited for a brick: their own read + decode on a
+                                 miss, or another thread's load in flight; summed over threads */
     uint64_t bricks_touched, bricks_total;
     uint32_t levels;
     ip_cache_level_stats level[32];

@@ -32,6 +32,15 @@
  * pixel's ray still extracts its own first-hit cell, the guarantee above is unchanged; what
  * changes is how much hidden surface is extracted (docs/occlusion.md). 4 bytes a pixel.
  *
+ * Reading ahead (options.prefetch, on by default): one more thread per engine reads and
+ * decodes into the cache, from the first step after ip_engine_begin() on and between steps,
+ * the bricks that the next rays of the order will seed in (found from the summaries) and
+ * their neighbours across brick faces, within the cache's budget and without evicting a
+ * brick of the current view (docs/cache.md, "Prefetching"). The triangles do not depend on
+ * it; only who reads a brick first and when. A brick that fails to load in the background is
+ * read again by the worker that needs it, which reports the error as without reading ahead.
+ * It stops at ip_engine_begin() (for the new view), ip_engine_cancel() and ip_engine_destroy().
+ *
  * Threads: an engine is driven by one thread. ip_engine_create() starts its worker threads
  * (ip_thread_count(options.threads) in all, the driving thread counted), which sleep between
  * steps; ip_engine_step() wakes them, works as one of them and returns when all have stopped.
@@ -74,6 +83,8 @@ typedef struct ip_engine_options {
     int cell_ids;            /* keep each triangle's cell id in the mesh (8 bytes a triangle
                                  more; for comparing extractions) */
     int occlusion;           /* occlusion-aware propagation (see Occlusion above; default on) */
+    int prefetch;            /* a background reader loads the bricks the next rays need (see
+                                Reading ahead above; default on) */
 } ip_engine_options;
 
 /* Counters and times, per step or in total. Times are wall seconds, split as the paper does.
@@ -97,7 +108,7 @@ typedef struct ip_engine ip_engine;
 
 /*! ip_engine_options_default() : the paper's cut-off (1.81 degrees), a 0.25 degree
  *  fold-back tolerance, every core, adaptive resolution with a 1-pixel error, no cell ids,
- *  occlusion on. */
+ *  occlusion on, reading ahead on. */
 IP_API void ip_engine_options_default(ip_engine_options *options);
 
 /*! ip_engine_create() : an engine reading through `cache` (which must outlive it), with its

@@ -172,6 +172,23 @@ void ip_brick_coords(const ip_layout *layout, uint64_t global, uint32_t *level, 
     brick[2] = (uint32_t)(local / lv->bricks[1]);
 }
 
+unsigned ip__brick_face_neighbours(const ip_layout *layout, uint64_t g, uint64_t out[6])
+{
+    uint32_t level, b[3];
+    unsigned count = 0;
+    ip_brick_coords(layout, g, &level, b);
+    const uint32_t *grid = layout->levels[level].bricks;
+    for (int f = 0; f < 6; f++) {
+        uint32_t n[3] = {b[0], b[1], b[2]};
+        int axis = f / 2;
+        if (f % 2 == 0 ? n[axis] == 0 : n[axis] + 1 >= grid[axis])
+            continue;
+        n[axis] += f % 2 == 0 ? (uint32_t)-1 : 1u;
+        out[count++] = ip_brick_global_index(layout, level, n);
+    }
+    return count;
+}
+
 void ip__octree_grid(const ip_layout *layout, uint32_t level, uint32_t depth, uint32_t grid[3])
 {
     IP_ASSERT(level < layout->level_count && depth < 32);

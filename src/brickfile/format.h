@@ -24,6 +24,10 @@ ip_status ip__layout_init(ip_layout *layout, const uint32_t dims[3], ip_type typ
 /*! ip__layout_summary_size() : bytes of the summary section implied by the layout. */
 uint64_t ip__layout_summary_size(const ip_layout *layout);
 
+/*! ip__brick_face_neighbours() : the global indices of the bricks of brick `g`'s level that
+ *  share a face with it (up to 6: fewer at the level's boundary), into out; @return how many. */
+unsigned ip__brick_face_neighbours(const ip_layout *layout, uint64_t g, uint64_t out[6]);
+
 /*! ip__octree_grid() : node grid size of `level` at octree depth `depth` (1..octree_depth):
  *  ceil(bricks / 2^depth). Depth 0 is the brick grid itself. */
 void ip__octree_grid(const ip_layout *layout, uint32_t level, uint32_t depth, uint32_t grid[3]);

@@ -75,6 +75,12 @@ static inline int ip__host_little_endian(void)
  * nothing where the kernel (before Linux 5.14) or the range does not allow it. */
 void ip__memory_populate(void *p, size_t bytes);
 
+/* Bytes this process (all its threads, those that ended included) made the kernel read from
+ * a block device: Linux's /proc/self/io `read_bytes`, which counts the reads the process
+ * caused (its read-ahead included) and not those served from the page cache; 0 where the
+ * kernel does not keep it. */
+uint64_t ip__process_read_bytes(void);
+
 /* Reverses the bytes of each of `count` elements of `size` bytes (2 or 4) in place. */
 void ip__swap_bytes(void *data, size_t count, size_t size);
 

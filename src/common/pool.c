@@ -55,6 +55,18 @@ static void *helper(void *arg)
     return NULL;
 }
 
+int ip__thread_start(pthread_t *thread, void *(*fn)(void *), void *arg)
+{
+    /* Every signal blocked, so that a signal for the process (Ctrl-C) goes to the program's
+     * own threads, which may be waiting for it, and never to a thread of the library. */
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_SETMASK, &all, &old);
+    int rc = pthread_create(thread, NULL, fn, arg);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    return rc;
+}
+
 ip_status ip__pool_create(unsigned threads, ip__pool **out, ip_error *err)
 {
     if (threads < 1)
@@ -69,16 +81,9 @@ ip_status ip__pool_create(unsigned threads, ip__pool **out, ip_error *err)
     pthread_mutex_init(&p->lock, NULL);
     pthread_cond_init(&p->work_ready, NULL);
     pthread_cond_init(&p->work_done, NULL);
-    /* Helpers start with every signal blocked, so that a signal for the process (Ctrl-C)
-     * goes to the program's own threads, which may be waiting for it, and never to a helper
-     * that lives as long as the pool. */
-    sigset_t all, old;
-    sigfillset(&all);
-    pthread_sigmask(SIG_SETMASK, &all, &old);
     for (unsigned t = 0; t + 1 < threads; t++)
-        if (pthread_create(&p->tids[p->helpers], NULL, helper, p) == 0)
+        if (ip__thread_start(&p->tids[p->helpers], helper, p) == 0)
             p->helpers++;
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
     *out = p;
     return IP_OK;
 }

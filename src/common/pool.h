@@ -3,9 +3,15 @@
 #ifndef ISOPROP_POOL_H
 #define ISOPROP_POOL_H
 
+#include <pthread.h>
+
 #include "isoprop/status.h"
 
 typedef struct ip__pool ip__pool;
+
+/* Starts a library thread running fn(arg) with every signal blocked (a signal for the process
+ * then goes to the program's own threads). @return pthread_create()'s answer: 0 or an errno. */
+int ip__thread_start(pthread_t *thread, void *(*fn)(void *), void *arg);
 
 /* The work of one ip__pool_run(): called once for each index 0 .. jobs - 1, on any of the
  * pool's threads or the caller's, several at once. */

@@ -14,23 +14,34 @@
 #define MADV_POPULATE_WRITE 23 /* Linux 5.14 */
 #endif
 
-/* A field of /proc/self/status given in KiB ("VmRSS:", "VmHWM:"), in bytes; 0 when unknown. */
-static uint64_t status_bytes(const char *field)
+/* The number after `field` on its line of the text file `path`; 0 when unknown. */
+static uint64_t proc_field(const char *path, const char *field)
 {
-    FILE *f = fopen("/proc/self/status", "r");
+    FILE *f = fopen(path, "r");
     char line[256];
-    uint64_t kib = 0;
+    uint64_t value = 0;
     size_t n = strlen(field);
     if (!f)
         return 0;
     while (fgets(line, sizeof line, f)) {
         if (strncmp(line, field, n) == 0) {
-            kib = strtoull(line + n, NULL, 10);
+            value = strtoull(line + n, NULL, 10);
             break;
         }
     }
     fclose(f);
-    return kib * 1024u;
+    return value;
+}
+
+/* A field of /proc/self/status given in KiB ("VmRSS:", "VmHWM:"), in bytes; 0 when unknown. */
+static uint64_t status_bytes(const char *field)
+{
+    return proc_field("/proc/self/status", field) * 1024u;
+}
+
+uint64_t ip__process_read_bytes(void)
+{
+    return proc_field("/proc/self/io", "read_bytes:");
 }
 
 uint64_t ip_peak_rss_bytes(void)

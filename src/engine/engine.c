@@ -11,6 +11,7 @@
 #include "internal.h"
 #include "isoprop/engine.h"
 #include "pool.h"
+#include "prefetch.h"
 #include "ray_order.h"
 #include "propagate.h"
 #include "seed.h"
@@ -54,7 +55,8 @@ struct ip_engine {
     ip_engine_options options;
     unsigned threads;
     worker *workers;
-    ip__pool *pool; /* runs the workers of every step; started at create */
+    ip__pool *pool;             /* runs the workers of every step; started at create */
+    ip__prefetcher *prefetcher; /* with options.prefetch: the background reader */
     ip_visited visited;
     ip_coverage coverage; /* with options.occlusion: what extracted surface hides */
     ip_mesh mesh;
@@ -95,6 +97,7 @@ void ip_engine_options_default(ip_engine_options *o)
     o->pixel_error = 1.0;
     o->cell_ids = 0;
     o->occlusion = 1;
+    o->prefetch = 1;
 }
 
 /* The brick file an engine extracts from, which its messages name. */
@@ -138,6 +141,8 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
                        : IP_ERR_NOMEM;
     if (st == IP_OK)
         st = ip__pool_create(e->threads, &e->pool, NULL);
+    if (st == IP_OK && options->prefetch)
+        st = ip__prefetcher_create(cache, &e->prefetcher);
     for (unsigned t = 0; st == IP_OK && t < e->threads; t++) {
         e->workers[t].engine = e;
         ip_mesh_init(&e->workers[t].mesh);
@@ -155,6 +160,7 @@ void ip_engine_destroy(ip_engine *e)
 {
     if (!e)
         return;
+    ip__prefetcher_destroy(e->prefetcher); /* first: it reads the view */
     ip__pool_destroy(e->pool);
     for (unsigned t = 0; e->workers && t < e->threads; t++) {
         for (uint32_t k = 0; k < IP_MAX_LEVELS; k++) {
@@ -216,6 +222,8 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
         return st;
     if (!isfinite(iso))
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: the isovalue must be finite", path_of(e->cache));
+    if (e->prefetcher) /* it reads the view about to change */
+        ip__prefetcher_pause(e->prefetcher);
     ip__visited_clear(&e->visited);
     ip_mesh_clear(&e->mesh);
     e->camera = *camera;
@@ -267,6 +275,12 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     }
     atomic_store(&e->cancel, 0);
     e->begun = 1;
+    if (e->prefetcher) {
+        ip__prefetch_view view = {e->camera,      e->basis,          e->iso,
+                                  e->levels_used, e->lod_distance,   e->order,
+                                  e->order_cells, &e->next_position, &e->cancel};
+        ip__prefetcher_begin(e->prefetcher, &view);
+    }
     return IP_OK;
 }
 
@@ -502,6 +516,8 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
         w->status = IP_OK;
         w->mesh.triangle_count = 0;
     }
+    if (e->prefetcher) /* it keeps reading ahead between steps */
+        ip__prefetcher_resume(e->prefetcher);
     ip__pool_run(e->pool, threads, work, e);
     ip_engine_counts c;
     memset(&c, 0, sizeof c);

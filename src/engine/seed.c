@@ -367,6 +367,81 @@ void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_
     s->first_brick = lv->first_brick;
 }
 
+/* The ray eye + t * dir in the index space of a level whose cells are `scale` world units. */
+static void index_ray_init(index_ray *r, const double scale[3], const double eye[3],
+                           const double dir[3])
+{
+    for (int k = 0; k < 3; k++) {
+        r->origin[k] = eye[k] / scale[k];
+        r->dir[k] = dir[k] / scale[k];
+        r->inv_dir[k] = r->dir[k] != 0.0 ? 1.0 / r->dir[k] : 0.0;
+    }
+    r->len = fmax(fabs(r->dir[0]), fmax(fabs(r->dir[1]), fabs(r->dir[2])));
+    r->world_origin = eye;
+    r->world_dir = dir;
+}
+
+/* 1 when the ray crosses, between t0 and t1, a sub-block of brick g (of `level`, coordinates
+ * b) whose range holds the isovalue. */
+static int brick_crossed_active(const ip_store *store, uint32_t level, float iso,
+                                const index_ray *r, uint64_t g, const uint32_t b[3], double t0,
+                                double t1)
+{
+    const ip_layout *l = ip_store_layout(store);
+    uint32_t origin[3], extent[3], n[3], se = l->subblock_edge, per = l->brick_edge / se;
+    ip_brick_extent(l, level, b, origin, extent);
+    for (int k = 0; k < 3; k++)
+        n[k] = (extent[k] - 1 + se - 1) / se;
+    const float *ranges = ip_store_subblock_ranges(store, g);
+    double base[3] = {origin[0], origin[1], origin[2]};
+    dda d;
+    dda_init(&d, r, base, se, n, t0, t1);
+    for (;;) {
+        uint32_t sb = (uint32_t)d.i[0] + per * ((uint32_t)d.i[1] + per * (uint32_t)d.i[2]);
+        if (active(&ranges[2 * sb], iso))
+            return 1;
+        double exit_t;
+        if (!dda_next(&d, &exit_t))
+            return 0;
+    }
+}
+
+unsigned ip__seed_ray_bricks(const ip_store *store, uint32_t level, float iso, const double eye[3],
+                             const double dir[3], double t_min, double t_max, uint64_t *bricks,
+                             unsigned max)
+{
+    const ip_layout *l = ip_store_layout(store);
+    const ip_level_layout *lv = &l->levels[level];
+    double scale[3], lo[3] = {0, 0, 0}, hi[3], t0 = t_min, t1 = t_max;
+    index_ray r;
+    for (int k = 0; k < 3; k++) {
+        scale[k] = l->spacing[k] * (double)(1u << level);
+        hi[k] = (double)(lv->dims[k] - 1);
+    }
+    index_ray_init(&r, scale, eye, dir);
+    unsigned count = 0;
+    if (max == 0 || !clip(&r, lo, hi, &t0, &t1))
+        return 0;
+    dda d;
+    dda_init(&d, &r, lo, l->brick_edge, lv->bricks, t0, t1);
+    for (;;) {
+        uint32_t b[3] = {(uint32_t)d.i[0], (uint32_t)d.i[1], (uint32_t)d.i[2]};
+        double enter_t = d.t, exit_t;
+        int more = dda_next(&d, &exit_t);
+        uint64_t g = ip_brick_global_index(l, level, b);
+        float range[2];
+        ip_store_brick_range(store, g, range);
+        if (active(range, iso) &&
+            brick_crossed_active(store, level, iso, &r, g, b, enter_t, exit_t)) {
+            bricks[count++] = g;
+            if (count == max)
+                return count;
+        }
+        if (!more)
+            return count;
+    }
+}
+
 int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
                   double t_max, uint32_t cells[][3], unsigned *count, int *seed_index)
 {
@@ -381,14 +456,7 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
     if (!active(s->ranges[depth], s->iso))
         return 0;
     index_ray r;
-    for (int k = 0; k < 3; k++) {
-        r.origin[k] = eye[k] / s->scale[k];
-        r.dir[k] = dir[k] / s->scale[k];
-        r.inv_dir[k] = r.dir[k] != 0.0 ? 1.0 / r.dir[k] : 0.0;
-    }
-    r.len = fmax(fabs(r.dir[0]), fmax(fabs(r.dir[1]), fabs(r.dir[2])));
-    r.world_origin = eye;
-    r.world_dir = dir;
+    index_ray_init(&r, s->scale, eye, dir);
     across_basis(dir, r.u, r.w);
     double lo[3], hi[3], t0 = t_min, t1 = t_max;
     node_box(s, depth, root, lo, hi);

@@ -51,4 +51,12 @@ void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_
 int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
                   double t_max, uint32_t cells[][3], unsigned *count, int *seed_index);
 
+/* The bricks of pyramid level `level` that the ray eye + t * dir (world units, t_min <= t <=
+ * t_max) would seed in, front to back, up to `max` of them: those whose range holds `iso` and
+ * where the ray crosses a sub-block whose range holds it. From the summaries alone (no brick
+ * is read); for reading bricks ahead of the rays. @return how many were written to bricks. */
+unsigned ip__seed_ray_bricks(const ip_store *store, uint32_t level, float iso, const double eye[3],
+                             const double dir[3], double t_min, double t_max, uint64_t *bricks,
+                             unsigned max);
+
 #endif

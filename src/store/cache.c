@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include "array.h"
+#include "cache_prefetch.h"
+#include "format.h"
 #include "internal.h"
 #include "lru_heap.h"
 #include "isoprop/cache.h"
@@ -22,9 +24,10 @@ typedef struct entry {
     atomic_int pins;           /* >= 0: pins; -1: free or being evicted */
     atomic_uint_fast64_t tick; /* last pin time, for LRU */
     atomic_uint_fast64_t brick;
-    void *samples;   /* the samples, then (at group_offset) the cell-group ranges */
-    size_t bytes;    /* of both */
-    size_t capacity; /* of samples */
+    atomic_int prefetched; /* 1: loaded ahead and not pinned since */
+    void *samples;         /* the samples, then (at group_offset) the cell-group ranges */
+    size_t bytes;          /* of both */
+    size_t capacity;       /* of samples */
     size_t group_offset;
     uint32_t extent[3], origin[3], level;
     struct entry *next_free;
@@ -70,6 +73,9 @@ struct ip_cache {
                                          contend for one cache line */
     atomic_uint_fast64_t misses, evictions, waits, bytes_decompressed, bytes_read, decode_ns,
         over_budget_pins, errors, touched_count;
+    atomic_uint_fast64_t prefetched, prefetch_hits, wait_ns;
+    atomic_uint_fast64_t prefetch_unused; /* prefetched bricks resident and not pinned yet */
+    uint64_t disk_bytes_at_create;        /* ip__process_read_bytes() then */
     atomic_uint_fast64_t level_touched[32], level_misses[32];
     uint64_t resident_bytes, resident_peak; /* under evict_lock */
 };
@@ -110,6 +116,7 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
         pthread_cond_init(&c->stripe_done[i], NULL);
     }
     pthread_mutex_init(&c->evict_lock, NULL);
+    c->disk_bytes_at_create = ip__process_read_bytes();
     *out = c;
     return IP_OK;
 }
@@ -190,6 +197,11 @@ static int try_pin(ip_cache *c, uint64_t g, ip_brick *b)
         return 0;
     }
     atomic_store_explicit(&e->tick, atomic_fetch_add(&c->clock, 1) + 1, memory_order_relaxed);
+    if (atomic_load_explicit(&e->prefetched, memory_order_relaxed) &&
+        atomic_exchange(&e->prefetched, 0)) { /* the first pin of a brick loaded ahead */
+        atomic_fetch_add(&c->prefetch_hits, 1);
+        atomic_fetch_sub(&c->prefetch_unused, 1);
+    }
     fill_brick(e, b);
     return 1;
 }
@@ -202,9 +214,10 @@ static void heap_push(ip_cache *c, entry *e)
 }
 
 /* Removes the least recently pinned unpinned entry from the resident set and returns it (still
- * holding its samples buffer), or NULL when every resident entry is pinned. O(log n) per call,
- * amortised over the hits since. evict_lock held. */
-static entry *evict_one(ip_cache *c)
+ * holding its samples buffer), or NULL when every resident entry is pinned or when that entry
+ * was pinned (or loaded) at tick `below` or later. O(log n) per call, amortised over the hits
+ * since. evict_lock held. */
+static entry *evict_one(ip_cache *c, uint64_t below)
 {
     entry *victim = NULL;
     while (c->heap.count > 0) {
@@ -214,6 +227,10 @@ static entry *evict_one(ip_cache *c)
         if (tick != top.key) { /* pinned since its key was taken: re-key it */
             ip__lru_heap_push(&c->heap, tick, e);
             continue;
+        }
+        if (tick >= below) { /* too recent: every other unpinned entry is more recent still */
+            ip__lru_heap_push(&c->heap, tick, e);
+            break;
         }
         int zero = 0;
         if (atomic_compare_exchange_strong(&e->pins, &zero, -1)) {
@@ -225,6 +242,8 @@ static entry *evict_one(ip_cache *c)
     ip__lru_heap_unpark(&c->heap);
     if (!victim)
         return NULL;
+    if (atomic_exchange(&victim->prefetched, 0)) /* loaded ahead for nothing */
+        atomic_fetch_sub(&c->prefetch_unused, 1);
     atomic_store(&c->slots[atomic_load(&victim->brick)].entry, NULL);
     c->resident[victim->resident_slot] = c->resident[--c->resident_count];
     c->resident[victim->resident_slot]->resident_slot = victim->resident_slot;
@@ -254,6 +273,7 @@ static entry *new_entry(ip_cache *c)
         return NULL;
     atomic_init(&e->pins, -1);
     atomic_init(&e->brick, UINT64_MAX);
+    atomic_init(&e->prefetched, 0);
     c->all_entries[c->all_count++] = e;
     return e;
 }
@@ -261,12 +281,21 @@ static entry *new_entry(ip_cache *c)
 /* Makes room for `bytes`, counts them as resident (a load in flight holds its memory too, so
  * parallel misses cannot overshoot the budget), and returns a free entry whose buffer holds
  * exactly `bytes`. The last victim's buffer is reused when it has the right size, which is
- * the common case of equal bricks. evict_lock held. */
-static entry *reserve_entry(ip_cache *c, size_t bytes)
+ * the common case of equal bricks. A load ahead (`ahead`, evicting only entries last pinned
+ * before tick `below`) never goes over budget: it returns NULL with *full set when the room
+ * is not there. evict_lock held. */
+static entry *reserve_entry(ip_cache *c, size_t bytes, int ahead, uint64_t below, int *full)
 {
     entry *spare = NULL;
-    while (c->resident_bytes + bytes > c->budget && c->resident_count > 0) {
-        entry *victim = evict_one(c);
+    *full = 0;
+    while (c->resident_bytes + bytes > c->budget && (c->resident_count > 0 || ahead)) {
+        entry *victim = c->resident_count > 0 ? evict_one(c, ahead ? below : UINT64_MAX) : NULL;
+        if (!victim && ahead) {
+            if (spare)
+                free_entry(c, spare);
+            *full = 1;
+            return NULL;
+        }
         if (!victim) {
             atomic_fetch_add(&c->over_budget_pins, 1);
             break;
@@ -312,21 +341,17 @@ static ip_status add_resident(ip_cache *c, entry *e)
     return IP_OK;
 }
 
-/* Asks the kernel to read, in the background, the payloads of the face neighbours of brick g
- * (level `level`, coordinates b) that were never pinned nor asked for: propagation crosses
+/* Asks the kernel to read, in the background, the payloads of the face neighbours of `brick`
+ * that were never pinned nor asked for: propagation crosses
  * brick faces, so on a cold page cache they are the next reads, and their I/O then overlaps
  * the decoding and extraction of this one instead of stalling a worker on a read. Costs
  * a system call per neighbour, once per brick; no thread of ours waits for the reads. */
-static void prefetch_neighbours(ip_cache *c, uint32_t level, const uint32_t b[3])
+static void prefetch_neighbours(ip_cache *c, uint64_t brick)
 {
-    const uint32_t *grid = c->layout->levels[level].bricks;
-    for (int f = 0; f < 6; f++) {
-        uint32_t n[3] = {b[0], b[1], b[2]};
-        int axis = f / 2;
-        if (f % 2 == 0 ? n[axis] == 0 : n[axis] + 1 >= grid[axis])
-            continue;
-        n[axis] += f % 2 == 0 ? (uint32_t)-1 : 1u;
-        uint64_t g = ip_brick_global_index(c->layout, level, n);
+    uint64_t neighbours[6];
+    unsigned count = ip__brick_face_neighbours(c->layout, brick, neighbours);
+    for (unsigned i = 0; i < count; i++) {
+        uint64_t g = neighbours[i];
         if (atomic_load_explicit(&c->touched[g], memory_order_relaxed) ||
             atomic_fetch_or(&c->touched[g], PREFETCHED))
             continue;
@@ -468,19 +493,24 @@ static ip_status decode_into(ip_cache *c, uint64_t g, entry *e, ip_error *err)
     return st;
 }
 
-/* The miss path for brick g, which this thread has marked as loading. */
-static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
+/* Loads brick g, which this thread has marked as loading, and publishes it: pinned once into
+ * *b (a miss), or unpinned and marked as loaded ahead (`ahead`, see ip__cache_prefetch_brick():
+ * it evicts only entries last pinned before tick `below`, and when there is no such room it
+ * publishes nothing, sets *full and returns IP_OK). */
+static ip_status load_brick(ip_cache *c, uint64_t g, int ahead, uint64_t below, ip_brick *b,
+                            int *full, ip_error *err)
 {
     uint32_t level, brick[3], origin[3], extent[3];
     ip_brick_coords(c->layout, g, &level, brick);
     ip_brick_extent(c->layout, level, brick, origin, extent);
     size_t group_offset, bytes = entry_bytes(extent, c->layout->type, &group_offset);
     pthread_mutex_lock(&c->evict_lock);
-    entry *e = reserve_entry(c, bytes);
+    entry *e = reserve_entry(c, bytes, ahead, below, full);
     pthread_mutex_unlock(&c->evict_lock);
     if (!e)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for brick %llu",
-                        ip_store_path(c->store), (unsigned long long)g);
+        return *full ? IP_OK
+                     : ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for brick %llu",
+                                ip_store_path(c->store), (unsigned long long)g);
     /* The decoder writes every byte: one system call (outside the lock) instead of a page
      * fault per page of a fresh buffer; next to nothing for a recycled one. */
     ip__memory_populate(e->samples, bytes);
@@ -489,7 +519,8 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
     e->level = level;
     memcpy(e->extent, extent, sizeof extent);
     memcpy(e->origin, origin, sizeof origin);
-    prefetch_neighbours(c, level, brick);
+    if (!ahead) /* a load ahead follows its own plan */
+        prefetch_neighbours(c, g);
     ip_status st = decode_into(c, g, e, err);
     pthread_mutex_lock(&c->evict_lock);
     atomic_store(&e->tick, atomic_fetch_add(&c->clock, 1) + 1);
@@ -499,21 +530,59 @@ static ip_status load_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
         c->resident_bytes -= bytes;
         free_entry(c, e);
         pthread_mutex_unlock(&c->evict_lock);
-        atomic_fetch_add(&c->errors, 1);
+        if (!ahead)
+            atomic_fetch_add(&c->errors, 1);
         return st == IP_ERR_NOMEM ? ip__fail(err, st, "%s: out of memory for brick %llu",
                                              ip_store_path(c->store), (unsigned long long)g)
                                   : st;
     }
     atomic_store(&e->brick, g);
-    atomic_store(&e->pins, 1);
+    atomic_store(&e->prefetched, ahead);
+    if (ahead) { /* counted before the slot shows it, so that its first pin finds it counted */
+        atomic_fetch_add(&c->prefetched, 1);
+        atomic_fetch_add(&c->prefetch_unused, 1);
+    }
+    atomic_store(&e->pins, ahead ? 0 : 1);
     atomic_store_explicit(&c->slots[g].entry, e, memory_order_release);
     pthread_mutex_unlock(&c->evict_lock);
-    atomic_fetch_add(&c->misses, 1);
-    atomic_fetch_add(&c->level_misses[level], 1);
     atomic_fetch_add(&c->bytes_decompressed,
                      (uint64_t)extent[0] * extent[1] * extent[2] * ip_type_size(c->layout->type));
+    if (ahead)
+        return IP_OK;
+    atomic_fetch_add(&c->misses, 1);
+    atomic_fetch_add(&c->level_misses[level], 1);
     fill_brick(e, b);
     return IP_OK;
+}
+
+/* Adds the time since t0 to the time callers waited for bricks. */
+static void add_wait(ip_cache *c, double t0)
+{
+    double waited = ip_now_seconds() - t0;
+    atomic_fetch_add(&c->wait_ns, waited > 0 ? (uint64_t)(waited * 1e9) : 0);
+}
+
+/* Marks brick g as loading by this thread (0), or returns 1 when it is resident or another
+ * thread is loading it. Stripe lock held. */
+static int claim_load(ip_cache *c, uint64_t g)
+{
+    if (c->loading[g])
+        return 1;
+    entry *e = atomic_load(&c->slots[g].entry); /* published while loading: final now */
+    if (e && atomic_load(&e->brick) == g && atomic_load(&e->pins) >= 0)
+        return 1;
+    c->loading[g] = 1;
+    return 0;
+}
+
+/* Clears brick g's loading mark and wakes the threads waiting for it. */
+static void end_load(ip_cache *c, uint64_t g)
+{
+    pthread_mutex_t *lock = &c->stripe_lock[g % STRIPES];
+    pthread_mutex_lock(lock);
+    c->loading[g] = 0;
+    pthread_cond_broadcast(&c->stripe_done[g % STRIPES]);
+    pthread_mutex_unlock(lock);
 }
 
 ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err)
@@ -528,6 +597,7 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
         atomic_fetch_add_explicit(&c->hits[g % HIT_STRIPES].value, 1, memory_order_relaxed);
         return IP_OK;
     }
+    double t0 = ip_now_seconds(); /* from here on the caller waits for the brick */
     pthread_mutex_t *lock = &c->stripe_lock[g % STRIPES];
     pthread_mutex_lock(lock);
     int waited = 0;
@@ -537,6 +607,7 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
             atomic_fetch_add(&c->hits[g % HIT_STRIPES].value, 1);
             if (waited)
                 atomic_fetch_add(&c->waits, 1);
+            add_wait(c, t0);
             return IP_OK;
         }
         if (!c->loading[g])
@@ -546,12 +617,37 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
     }
     c->loading[g] = 1;
     pthread_mutex_unlock(lock);
-    ip_status st = load_brick(c, g, b, err);
-    pthread_mutex_lock(lock);
-    c->loading[g] = 0;
-    pthread_cond_broadcast(&c->stripe_done[g % STRIPES]);
-    pthread_mutex_unlock(lock);
+    int full;
+    ip_status st = load_brick(c, g, 0, UINT64_MAX, b, &full, err);
+    end_load(c, g);
+    add_wait(c, t0);
     return st;
+}
+
+uint64_t ip__cache_tick_now(const ip_cache *c)
+{
+    return atomic_load(&((ip_cache *)c)->clock) + 1;
+}
+
+uint64_t ip__cache_prefetch_unused(const ip_cache *c)
+{
+    return atomic_load(&((ip_cache *)c)->prefetch_unused);
+}
+
+ip__prefetch_outcome ip__cache_prefetch_brick(ip_cache *c, uint64_t g, uint64_t below)
+{
+    if (g >= c->layout->brick_count)
+        return IP__PREFETCH_FAILED;
+    pthread_mutex_t *lock = &c->stripe_lock[g % STRIPES];
+    pthread_mutex_lock(lock);
+    int present = claim_load(c, g);
+    pthread_mutex_unlock(lock);
+    if (present)
+        return IP__PREFETCH_PRESENT;
+    int full = 0;
+    ip_status st = load_brick(c, g, 1, below, NULL, &full, NULL);
+    end_load(c, g);
+    return st != IP_OK ? IP__PREFETCH_FAILED : full ? IP__PREFETCH_FULL : IP__PREFETCH_LOADED;
 }
 
 void ip_cache_unpin_brick(ip_cache *c, const ip_brick *b)
@@ -566,7 +662,7 @@ uint64_t ip_cache_trim(ip_cache *c, uint64_t keep_bytes)
     uint64_t freed = 0;
     pthread_mutex_lock(&c->evict_lock);
     while (c->resident_bytes > keep_bytes) {
-        entry *victim = evict_one(c);
+        entry *victim = evict_one(c, UINT64_MAX);
         if (!victim)
             break; /* the rest is pinned */
         freed += victim->bytes;
@@ -599,6 +695,11 @@ void ip_cache_get_stats(const ip_cache *cc, ip_cache_stats *s)
     s->decode_seconds = (double)atomic_load(&c->decode_ns) * 1e-9;
     s->over_budget_pins = atomic_load(&c->over_budget_pins);
     s->errors = atomic_load(&c->errors);
+    s->prefetched = atomic_load(&c->prefetched);
+    s->prefetch_hits = atomic_load(&c->prefetch_hits);
+    uint64_t disk = ip__process_read_bytes();
+    s->bytes_read_disk = disk > c->disk_bytes_at_create ? disk - c->disk_bytes_at_create : 0;
+    s->wait_seconds = (double)atomic_load(&c->wait_ns) * 1e-9;
     s->bricks_touched = atomic_load(&c->touched_count);
     s->bricks_total = c->layout->brick_count;
     s->levels = c->layout->level_count;

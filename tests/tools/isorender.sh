@@ -10,12 +10,14 @@ check "progressive render succeeds" test "$rc" = 0
 check "the image is a PNG" sh -c 'head -c 8 p.png | od -An -tx1 | grep -q "89 50 4e 47 0d 0a 1a 0a"'
 check "the summary is printed" grep -q "triangles" "$work/.out"
 check "the cache table is printed" grep -q "cache statistics" "$work/.out"
+check "the cache table shows reading ahead" grep -q "read ahead" "$work/.out"
 check "the PLY header" sh -c 'head -c 200 p.ply | grep -q "format binary_little_endian 1.0"'
 json=$(cat p.json)
 for key in cache budget_bytes resident_bytes resident_peak_bytes hits misses evictions \
            bytes_decompressed decode_seconds bricks_touched bricks_total hit_rate \
            peak_rss_bytes rays seeds cells triangles intersection_s propagation_s \
-           extraction_s rendering_s visible_triangles overdraw occlusion deferred_cells; do
+           extraction_s rendering_s visible_triangles overdraw occlusion deferred_cells \
+           prefetch prefetched prefetch_hits bytes_read_disk wait_seconds; do
     check "stats has \"$key\"" sh -c 'printf "%s" "$0" | grep -q "\"$1\":"' "$json" "$key"
 done
 check "every pixel had its ray" sh -c 'printf "%s" "$0" | grep -q "\"rays\": 19200, \"rays_total\": 19200, \"done\": true"' "$json"
@@ -45,6 +47,15 @@ off=$(sed 's/.*"triangles": \([0-9]*\).*/\1/' o.json)
 check "occlusion on extracts no more ($triangles <= $off)" test "$triangles" -le "$off"
 check "occlusion on and off make the same picture" cmp -s p.png o.png
 expect_error 2 "--occlusion" "$bin/isorender" s.ibv --iso 1 --occlusion maybe -o x.png
+
+# reading ahead off: the same picture, nothing loaded ahead
+run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o n.png \
+    --prefetch off --stats n.json --software --quiet
+check "prefetch off succeeds" test "$rc" = 0
+check "prefetch off says so" grep -q '"prefetch": false' n.json
+check "prefetch off loads nothing ahead" grep -q '"prefetched": 0, "prefetch_hits": 0' n.json
+check "prefetch on and off make the same picture" cmp -s p.png n.png
+expect_error 2 "--prefetch" "$bin/isorender" s.ibv --iso 1 --prefetch maybe -o x.png
 
 # the full extraction and the progressive one make the same picture
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o f.png --full --software --quiet

@@ -20,6 +20,8 @@ static const char usage[] =
     "  --lod on|off        adaptive resolution: far regions from coarser levels (default on)\n"
     "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n"
     "  --occlusion on|off  propagation skips cells that extracted surface hides (default on)\n"
+    "  --prefetch on|off   a background thread reads and decodes the bricks the next rays need\n"
+    "                      (default on)\n"
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
     "  --threads N         threads for seeding, propagation and full extraction\n"
     "                      (default: all cores)\n"
