@@ -321,6 +321,34 @@ static void test_cancel_and_limits(const char *dir)
     free(v.values);
 }
 
+/* The plan is a count of what the run allocates: for the head upsampled 6 times (3072 x 3072 x
+ * 1404 uint16, 26.5 GB) on 2 threads it fits 1 GiB, holds the level-0 slab (33 planes), and a
+ * volume 10 times deeper adds only 48 bytes per brick (directory entry, brick range, octree
+ * node share, Morton order): the sub-block ranges wait on disk. */
+static void test_memory_plan(void)
+{
+    ip_input_desc desc;
+    memset(&desc, 0, sizeof desc);
+    desc.dims[0] = 3072;
+    desc.dims[1] = 3072;
+    desc.dims[2] = 1404;
+    desc.type = IP_UINT16;
+    desc.spacing[0] = desc.spacing[1] = desc.spacing[2] = 1;
+    ip_bricker_options o;
+    ip_bricker_options_default(&o);
+    o.threads = 2;
+    uint64_t plan = 0, deeper = 0;
+    ip_error err;
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &plan, &err) == IP_OK);
+    CHECK_MSG(plan <= (uint64_t)1024 << 20, "plan %llu bytes", (unsigned long long)plan);
+    CHECK(plan >= (uint64_t)33 * 3072 * 3072 * 2);
+    desc.dims[2] = 14040;
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &deeper, &err) == IP_OK);
+    uint64_t more_bricks = (uint64_t)96 * 96 * (14040 / 32 - 1404 / 32) * 8 / 7 + 1;
+    CHECK_MSG(deeper - plan <= more_bricks * 48, "plan grows by %llu bytes",
+              (unsigned long long)(deeper - plan));
+}
+
 static void test_shared_data(const char *dir)
 {
     const char *data = getenv("IP_SKIP_SHARED_DATA") ? NULL : getenv("IP_SHARED_DATA");
@@ -377,6 +405,7 @@ int main(void)
         round_trip_hc(dir, (ip_type)t);
     test_deterministic(dir);
     test_cancel_and_limits(dir);
+    test_memory_plan();
     test_shared_data(dir);
     return test_summary("test_bricker");
 }

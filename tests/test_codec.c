@@ -76,7 +76,7 @@ static void fill(void *dst, ip_type type, const uint32_t e[3], enum pattern p)
                     break;
                 case IP_INT16:
                     ((int16_t *)dst)[i] =
-                        (int16_t)(p == NOISE ? (int16_t)next_random() : (int16_t)(v * 100 - 9000));
+                        (int16_t)(p == NOISE ? (int16_t)next_random() : (int32_t)(v * 100 - 9000));
                     break;
                 case IP_FLOAT32:
                     if (p == NOISE) {
@@ -90,7 +90,9 @@ static void fill(void *dst, ip_type type, const uint32_t e[3], enum pattern p)
             }
 }
 
-static const uint32_t extents[][3] = {{2, 2, 2}, {3, 5, 7}, {9, 9, 9}, {33, 17, 9}, {17, 2, 31}};
+/* {33, 33, 33} and {4, 3, 16}: bricks thick enough for the fast level's trial slices */
+static const uint32_t extents[][3] = {{2, 2, 2},   {3, 5, 7},    {9, 9, 9}, {33, 17, 9},
+                                      {17, 2, 31}, {33, 33, 33}, {4, 3, 16}};
 #define EXTENT_COUNT (sizeof extents / sizeof extents[0])
 
 /* Encodes and decodes one brick; checks the entry and that the samples come back bit for
@@ -410,10 +412,57 @@ static void test_arguments(void)
     CHECK(ip__codec_work_size(100, IP_UINT16) >= 3 * 200 + ip__codec_bound(100, IP_UINT16));
 }
 
+/* The fast level's filter choice: its payload is exactly the specification's encoding with
+ * the filters it names (no predictor or delta, shuffled when wide), and on every pattern it is
+ * within 10 % of the smaller of the two whole-brick trials it replaces. */
+static void test_fast_filter_choice(void)
+{
+    static const uint32_t e[3] = {33, 33, 33};
+    size_t count = (size_t)e[0] * e[1] * e[2];
+    for (int t = 0; t < IP_TYPE_COUNT; t++)
+        for (int p = 0; p < PATTERN_COUNT; p++) {
+            size_t w = ip_type_size((ip_type)t), raw = count * w;
+            int cap = LZ4_compressBound((int)raw);
+            void *samples = malloc(raw);
+            unsigned char *out = malloc(ip__codec_bound(count, (ip_type)t));
+            unsigned char *work = malloc(ip__codec_work_size(count, (ip_type)t));
+            unsigned char *ref = malloc((size_t)cap);
+            REQUIRE(samples && out && work && ref);
+            fill(samples, (ip_type)t, e, (enum pattern)p);
+            ip_brick_entry entry;
+            REQUIRE(ip__codec_encode(samples, e, (ip_type)t, IP_LZ4_FAST, out, work, &entry) ==
+                    IP_OK);
+            if (entry.encoding == IP_BRICK_LZ4) {
+                unsigned shuffled = w > 1 ? IP_FILTER_SHUFFLE : 0;
+                CHECK_MSG(entry.filters == shuffled ||
+                              entry.filters == (shuffled | IP_FILTER_DELTA),
+                          "type %d, %s: filters %u", t, pattern_names[p], entry.filters);
+                int size = reference_encode(samples, e, w, entry.filters, ref, cap);
+                CHECK_MSG(size == (int)entry.stored_size && memcmp(ref, out, (size_t)size) == 0,
+                          "type %d, %s: payload differs from the specification's", t,
+                          pattern_names[p]);
+                int plain = reference_encode(samples, e, w, shuffled, ref, cap);
+                int delta = reference_encode(samples, e, w, shuffled | IP_FILTER_DELTA, ref, cap);
+                int best = plain < delta ? plain : delta;
+                CHECK_MSG((int)entry.stored_size <= best + best / 10,
+                          "type %d, %s: %u bytes, best whole-brick trial %d", t, pattern_names[p],
+                          entry.stored_size, best);
+            }
+            if (p == SMOOTH || p == PLANE)
+                CHECK_MSG(entry.encoding == IP_BRICK_LZ4 && (entry.filters & IP_FILTER_DELTA),
+                          "type %d, %s: smooth data take the delta predictor", t, pattern_names[p]);
+            free(samples);
+            free(out);
+            free(work);
+            free(ref);
+        }
+}
+
 int main(void)
 {
     test_arguments();
     test_round_trips();
+    test_fast_filter_choice();
     test_constant_fill();
     test_decoder_against_spec();
     test_malformed();

@@ -209,6 +209,8 @@ static void print_summary(const ip_bricker_report *r, const char *out)
            (unsigned long long)r->bricks_compressed, (unsigned long long)r->bricks_raw);
     printf("  time        %.2f s, %.1f MB/s on %u threads\n", r->seconds,
            r->seconds > 0 ? (double)r->input_bytes / r->seconds / 1e6 : 0.0, r->threads);
+    printf("  phases      read %.2f s, encode %.2f s, write %.2f s\n", r->seconds_read,
+           r->seconds_encode, r->seconds_write);
     printf("  peak RSS    %s (working memory planned: %s)\n",
            tool_format_bytes(rss_b, sizeof rss_b, (double)r->peak_rss),
            tool_format_bytes(in_b, sizeof in_b, (double)r->memory_planned));

@@ -47,6 +47,10 @@ typedef struct ip_bricker_report {
     double seconds;          /* wall time of the whole run */
     uint64_t memory_planned; /* working memory the run reserved for itself, bytes */
     uint64_t peak_rss;       /* the process's peak resident set at the end (VmHWM), bytes */
+    /* Where the wall time went, seconds: reading the input and subsampling the pyramid;
+     * summarising, filtering, compressing, checksumming and spilling the bricks; putting the
+     * payloads in order and writing the summary. */
+    double seconds_read, seconds_encode, seconds_write;
 } ip_bricker_report;
 
 /*! ip_bricker_options_default() : fills `options` with the defaults above. */

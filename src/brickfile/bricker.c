@@ -6,46 +6,61 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <xxhash.h>
 
 #include "atomic_file.h"
 #include "internal.h"
 #include "isoprop/bricker.h"
 #include "codec.h"
 #include "format.h"
+#include "input_positioned.h"
 #include "isoprop/output.h"
 #include "pool.h"
 #include "summary.h"
 
-/* One pyramid level's slab: up to B+1 consecutive planes of the level. */
+/* One pyramid level's slab: the B+1 planes of the brick layer being filled, kept in a ring
+ * of B+1 slots (level plane p lives in slot p % (B+1)), so that the + face of a layer stays
+ * where it is when it becomes the - face of the next. */
 typedef struct level_slab {
     unsigned char *planes;
     size_t plane_bytes;
-    uint32_t filled;     /* planes currently held */
-    uint32_t next_plane; /* index of the next level plane to arrive */
-    uint32_t layer;      /* next brick layer (bz) to emit */
-    uint32_t *x_index;   /* level-0 x of each level x (levels >= 1) */
+    uint32_t arrived;  /* level planes placed so far: planes [0, arrived) */
+    uint32_t layer;    /* next brick layer (bz) to compress */
+    uint32_t *x_index; /* level-0 x of each level x (levels >= 1) */
     uint32_t *y_index;
+    float *layer_ranges; /* sub-block ranges of one layer of bricks, until they are spilled */
 } level_slab;
 
 typedef struct bricker bricker;
 
-/* Per-thread scratch for gathering and encoding one brick. */
+/* Per-thread scratch for gathering and encoding one brick, and the thread's first error. */
 typedef struct brick_scratch {
     unsigned char *samples, *out, *work;
+    ip_status status;
+    ip_error error;
 } brick_scratch;
 
-/* One layer of bricks being compressed by the worker threads. */
-typedef struct layer_job {
-    bricker *b;
+/* The layers of bricks that one chunk of planes completed (at most one per level). */
+typedef struct layer_ref {
     uint32_t level, bz;
-    const level_slab *slab;
-    uint64_t brick_total;      /* bricks in the layer */
-    atomic_uint_fast64_t next; /* next brick to take */
-    unsigned char **payloads;  /* per brick, malloc'ed copies; NULL for constant bricks */
+    uint64_t first; /* index of the layer's first brick among the job's bricks */
+    uint64_t count;
+} layer_ref;
+
+/* One run of the pool: the planes of a chunk to read, or the bricks of its layers to encode. */
+typedef struct chunk_job {
+    bricker *b;
+    const ip_input_reader *reader;
+    uint32_t z0; /* reading: first level-0 plane */
+    layer_ref layers[IP_MAX_LEVELS];
+    uint32_t layer_count;
+    uint64_t total;            /* planes or bricks */
+    atomic_uint_fast64_t next; /* next plane or brick to take */
     atomic_int failed;
-} layer_job;
+} chunk_job;
 
 struct bricker {
     ip_layout layout;
@@ -53,17 +68,22 @@ struct bricker {
     const char *out_path;
     size_t sample_size;
     unsigned threads;
-    ip__pool *pool; /* compresses every layer; started at init */
+    ip__pool *pool; /* reads and encodes every chunk; started at init */
     level_slab slabs[IP_MAX_LEVELS];
-    brick_scratch *scratch;  /* one per job of a layer (per thread) */
+    brick_scratch *scratch;  /* one per job of a run (per thread) */
     ip_brick_entry *entries; /* offsets point into the spill file until the end */
     float *brick_ranges;     /* 2 per brick */
-    float *subblock_ranges;  /* 2 per sub-block */
     uint32_t subblocks;      /* per brick */
+    /* The spill file: the sub-block ranges (host floats, by global brick index) in
+     * [0, ranges_bytes), then the payloads in the order the threads finish them. */
     int spill_fd;
-    uint64_t spill_size;
+    uint64_t ranges_bytes;
+    atomic_uint_fast64_t spill_end;
     ip_bricker_report report;
 };
+
+/* Bytes of the summary section written per pwrite while it is streamed out. */
+#define SUMMARY_CHUNK ((size_t)1 << 20)
 
 /* ---- memory ---- */
 
@@ -79,24 +99,47 @@ static uint64_t slab_bytes(const ip_layout *l, uint32_t k)
     return (uint64_t)(l->brick_edge + 1) * lv->dims[0] * lv->dims[1] * ip_type_size(l->type);
 }
 
+/* Slabs are allocated in whole huge pages (alloc_slab()). */
+#define SLAB_ALIGN ((size_t)2 << 20)
+
+static size_t slab_rounded(uint64_t bytes)
+{
+    return (size_t)((bytes + SLAB_ALIGN - 1) / SLAB_ALIGN * SLAB_ALIGN);
+}
+
+/* Bytes of one layer of sub-block ranges of level k. */
+static uint64_t layer_ranges_bytes(const ip_layout *l, uint32_t k)
+{
+    const ip_level_layout *lv = &l->levels[k];
+    return (uint64_t)lv->bricks[0] * lv->bricks[1] * ip_layout_subblocks_per_brick(l) * 2 *
+           sizeof(float);
+}
+
 static unsigned thread_count(const ip_bricker_options *o)
 {
     return ip_thread_count(o->threads);
 }
 
+/* Everything the run allocates, counted from the same sizes the allocations use: the slabs and
+ * their index tables, a layer of sub-block ranges per level, the per-thread scratch, the
+ * directory and brick ranges (the sub-block ranges wait in the spill file), the octree nodes,
+ * the Morton order of the largest level and the buffer the summary is streamed through. */
 static uint64_t memory_for(const ip_layout *l, unsigned threads)
 {
-    uint64_t total = 0, widest = 0;
+    uint64_t total = 0, widest_level = 0;
     size_t bs = brick_samples_max(l);
     for (uint32_t k = 0; k < l->level_count; k++) {
-        total += slab_bytes(l, k);
-        if (slab_bytes(l, k) > widest)
-            widest = slab_bytes(l, k);
+        const ip_level_layout *lv = &l->levels[k];
+        total += slab_rounded(slab_bytes(l, k)) + layer_ranges_bytes(l, k);
+        total += (uint64_t)(lv->dims[0] + lv->dims[1]) * sizeof(uint32_t);
+        if (lv->brick_count > widest_level)
+            widest_level = lv->brick_count;
     }
-    total += widest + widest / 128; /* one layer's payloads, incompressible worst case */
     total += (uint64_t)threads * (bs * ip_type_size(l->type) + ip__codec_bound(bs, l->type) +
                                   ip__codec_work_size(bs, l->type));
-    total += 2 * ip__layout_summary_size(l); /* the arrays, then their encoded copy */
+    total += l->brick_count * (sizeof(ip_brick_entry) + 2 * sizeof(float));
+    total += 2 * sizeof(float) * (l->node_count ? l->node_count : 1);
+    total += widest_level * sizeof(uint64_t) + SUMMARY_CHUNK;
     return total;
 }
 
@@ -119,175 +162,308 @@ ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_bricker_
     return st;
 }
 
+/* Records a worker's first failure; the run stops taking work. */
+static void worker_failed(chunk_job *job, brick_scratch *s, ip_status st)
+{
+    if (s->status == IP_OK)
+        s->status = st;
+    atomic_store(&job->failed, 1);
+}
+
 /* ---- one brick ---- */
 
-static void gather_brick(const level_slab *slab, const ip_layout *l, uint32_t level,
-                         const uint32_t origin[3], const uint32_t extent[3], unsigned char *dst)
+static const unsigned char *slab_plane(const level_slab *slab, uint32_t edge, uint32_t plane)
+{
+    return slab->planes + (size_t)(plane % (edge + 1)) * slab->plane_bytes;
+}
+
+/* Where the brick's slices lie in the slab: slice z of the brick starts at planes[z]. */
+static void brick_planes(const level_slab *slab, const ip_layout *l, uint32_t level,
+                         const uint32_t origin[3], const uint32_t extent[3],
+                         const unsigned char **planes)
 {
     size_t ss = ip_type_size(l->type);
-    size_t row_bytes = (size_t)extent[0] * ss;
     size_t level_row = (size_t)l->levels[level].dims[0] * ss;
     for (uint32_t z = 0; z < extent[2]; z++)
+        planes[z] = slab_plane(slab, l->brick_edge, origin[2] + z) + (size_t)origin[1] * level_row +
+                    origin[0] * ss;
+}
+
+static void gather_brick(const unsigned char *const *planes, size_t level_row,
+                         const uint32_t extent[3], size_t ss, unsigned char *dst)
+{
+    size_t row_bytes = (size_t)extent[0] * ss;
+    for (uint32_t z = 0; z < extent[2]; z++)
         for (uint32_t y = 0; y < extent[1]; y++) {
-            const unsigned char *src = slab->planes + (size_t)z * slab->plane_bytes +
-                                       (size_t)(origin[1] + y) * level_row + origin[0] * ss;
-            memcpy(dst, src, row_bytes);
+            memcpy(dst, planes[z] + y * level_row, row_bytes);
             dst += row_bytes;
         }
 }
 
-static int process_brick(layer_job *job, uint64_t i, brick_scratch *s)
+/* Appends a payload to the spill file at a place reserved for it alone, so that the threads
+ * write concurrently; write_payloads() puts the payloads in order at the end. */
+static ip_status spill_payload(bricker *b, ip_brick_entry *e, const unsigned char *payload,
+                               ip_error *err)
 {
-    bricker *b = job->b;
-    const ip_layout *l = &b->layout;
-    uint32_t brick[3] = {(uint32_t)(i % l->levels[job->level].bricks[0]),
-                         (uint32_t)(i / l->levels[job->level].bricks[0]), job->bz};
-    uint32_t origin[3], extent[3];
-    ip_brick_extent(l, job->level, brick, origin, extent);
-    uint64_t g = ip_brick_global_index(l, job->level, brick);
-    gather_brick(job->slab, l, job->level, origin, extent, s->samples);
-    ip__summarise_brick(s->samples, l->type, extent, l->brick_edge, l->subblock_edge,
-                        &b->brick_ranges[2 * g], &b->subblock_ranges[2 * g * b->subblocks]);
-    ip_brick_entry *e = &b->entries[g];
-    if (ip__codec_encode(s->samples, extent, l->type, b->options->lz4_level, s->out, s->work, e) !=
-        IP_OK)
-        return -1;
-    job->payloads[i] = NULL;
-    if (e->stored_size > 0) {
-        job->payloads[i] = malloc(e->stored_size);
-        if (!job->payloads[i])
-            return -1;
-        memcpy(job->payloads[i], s->out, e->stored_size);
-    }
-    return 0;
+    e->offset = atomic_fetch_add(&b->spill_end, e->stored_size);
+    return ip__pwrite_all(b->spill_fd, payload, e->stored_size, e->offset, b->out_path, err);
 }
 
-/* One job of a layer (on the pool): takes bricks from the shared counter until none is left,
- * with scratch buffers of its own. */
-static void layer_worker(void *user, unsigned index)
+static ip_status process_brick(bricker *b, const layer_ref *ref, uint64_t i, brick_scratch *s)
 {
-    layer_job *job = user;
+    const ip_layout *l = &b->layout;
+    const level_slab *slab = &b->slabs[ref->level];
+    uint32_t brick[3] = {(uint32_t)(i % l->levels[ref->level].bricks[0]),
+                         (uint32_t)(i / l->levels[ref->level].bricks[0]), ref->bz};
+    uint32_t origin[3], extent[3];
+    ip_brick_extent(l, ref->level, brick, origin, extent);
+    uint64_t g = ip_brick_global_index(l, ref->level, brick);
+    const unsigned char *planes[IP_MAX_BRICK_EDGE + 1];
+    brick_planes(slab, l, ref->level, origin, extent, planes);
+    size_t level_row = (size_t)l->levels[ref->level].dims[0] * b->sample_size;
+    float *range = &b->brick_ranges[2 * g], *ranges = &slab->layer_ranges[2 * i * b->subblocks];
+    ip_brick_entry *e = &b->entries[g];
+    if (l->type == IP_FLOAT32) {
+        /* -0 and +0 compare equal but are different bytes: the codec decides what is constant */
+        gather_brick(planes, level_row, extent, b->sample_size, s->samples);
+        ip__summarise_brick(s->samples, l->type, extent, l->brick_edge, l->subblock_edge, range,
+                            ranges);
+    } else {
+        /* an integer brick is constant when its range is a single value: no copy is made */
+        ip__summarise_planes(planes, level_row, l->type, extent, l->brick_edge, l->subblock_edge,
+                             range, ranges);
+        if (range[0] == range[1]) {
+            ip__codec_encode_constant(e);
+            return IP_OK;
+        }
+        gather_brick(planes, level_row, extent, b->sample_size, s->samples);
+    }
+    if (ip__codec_encode(s->samples, extent, l->type, b->options->lz4_level, s->out, s->work, e) !=
+        IP_OK)
+        return ip__fail(&s->error, IP_ERR_ARGUMENT, "%s: brick %llu does not encode", b->out_path,
+                        (unsigned long long)g);
+    return e->stored_size > 0 ? spill_payload(b, e, s->out, &s->error) : IP_OK;
+}
+
+/* One job of an encoding run (on the pool): takes bricks from the shared counter until none is
+ * left, with scratch buffers of its own. */
+static void encode_worker(void *user, unsigned index)
+{
+    chunk_job *job = user;
     brick_scratch *scratch = &job->b->scratch[index];
     for (;;) {
         uint64_t i = atomic_fetch_add(&job->next, 1);
-        if (i >= job->brick_total || atomic_load(&job->failed))
+        if (i >= job->total || atomic_load(&job->failed))
             break;
-        if (process_brick(job, i, scratch) != 0)
-            atomic_store(&job->failed, 1);
+        uint32_t r = 0;
+        while (i >= job->layers[r].first + job->layers[r].count)
+            r++;
+        ip_status st = process_brick(job->b, &job->layers[r], i - job->layers[r].first, scratch);
+        if (st != IP_OK)
+            worker_failed(job, scratch, st);
     }
 }
 
-/* ---- one layer ---- */
+/* ---- the pool's runs ---- */
 
-static ip_status append_spill(bricker *b, const unsigned char *data, uint32_t size, ip_error *err)
+/* Runs `fn` on the pool with one job per thread (fewer when there is less work) and returns
+ * the first error a job recorded. */
+static ip_status run_jobs(bricker *b, chunk_job *job, ip__pool_job fn, ip_error *err)
 {
-    ip_status st = ip__pwrite_all(b->spill_fd, data, size, b->spill_size, b->out_path, err);
-    b->spill_size += size;
-    return st;
+    atomic_init(&job->next, 0);
+    atomic_init(&job->failed, 0);
+    unsigned jobs = b->threads;
+    if (jobs > job->total)
+        jobs = (unsigned)(job->total > 0 ? job->total : 1);
+    for (unsigned t = 0; t < jobs; t++)
+        b->scratch[t].status = IP_OK;
+    ip__pool_run(b->pool, jobs, fn, job);
+    for (unsigned t = 0; t < jobs; t++)
+        if (b->scratch[t].status != IP_OK) {
+            if (err)
+                *err = b->scratch[t].error;
+            return b->scratch[t].status;
+        }
+    return IP_OK;
 }
 
-static ip_status emit_layer(bricker *b, uint32_t level, ip_error *err)
+/* The last level plane of brick layer bz of level k. */
+static uint32_t layer_last_plane(const ip_layout *l, uint32_t k, uint32_t bz)
+{
+    uint64_t last = (uint64_t)l->brick_edge * (bz + 1);
+    uint32_t top = l->levels[k].dims[2] - 1;
+    return last < top ? (uint32_t)last : top;
+}
+
+/* Encodes every layer whose planes have all arrived, on every thread, then sends each layer's
+ * sub-block ranges to the spill file. A chunk completes at most one layer per level: a level-k
+ * layer ends at a level-0 plane that is a multiple of B, or at the last plane. */
+static ip_status encode_ready_layers(bricker *b, ip_error *err)
 {
     const ip_layout *l = &b->layout;
-    level_slab *slab = &b->slabs[level];
-    layer_job job;
+    chunk_job job;
     memset(&job, 0, sizeof job);
     job.b = b;
-    job.level = level;
-    job.bz = slab->layer;
-    job.slab = slab;
-    job.brick_total = (uint64_t)l->levels[level].bricks[0] * l->levels[level].bricks[1];
-    atomic_init(&job.next, 0);
-    atomic_init(&job.failed, 0);
-    job.payloads = calloc(job.brick_total, sizeof *job.payloads);
-    if (!job.payloads)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", b->out_path);
-    unsigned jobs = b->threads;
-    if (jobs > job.brick_total)
-        jobs = (unsigned)(job.brick_total > 0 ? job.brick_total : 1);
-    ip__pool_run(b->pool, jobs, layer_worker, &job);
-    ip_status st =
-        atomic_load(&job.failed)
-            ? ip__fail(err, IP_ERR_NOMEM, "%s: out of memory while compressing", b->out_path)
-            : IP_OK;
-    for (uint64_t i = 0; i < job.brick_total; i++) {
-        uint32_t brick[3] = {(uint32_t)(i % l->levels[level].bricks[0]),
-                             (uint32_t)(i / l->levels[level].bricks[0]), job.bz};
-        ip_brick_entry *e = &b->entries[ip_brick_global_index(l, level, brick)];
-        if (st == IP_OK && job.payloads[i]) {
-            e->offset = b->spill_size;
-            st = append_spill(b, job.payloads[i], e->stored_size, err);
-        }
-        free(job.payloads[i]);
-    }
-    free(job.payloads);
-    slab->layer++;
-    return st;
-}
-
-/* A level plane has been placed at slot `filled`; emit a layer when the slab is complete. */
-static ip_status plane_arrived(bricker *b, uint32_t level, ip_error *err)
-{
-    level_slab *slab = &b->slabs[level];
-    uint32_t last_plane = b->layout.levels[level].dims[2] - 1;
-    uint32_t plane = slab->next_plane++;
-    slab->filled++;
-    if (slab->filled < b->layout.brick_edge + 1 && plane < last_plane)
-        return IP_OK;
-    ip_status st = emit_layer(b, level, err);
-    if (st == IP_OK && plane < last_plane) {
-        /* the + face of this layer is the - face of the next */
-        memmove(slab->planes, slab->planes + (size_t)(slab->filled - 1) * slab->plane_bytes,
-                slab->plane_bytes);
-        slab->filled = 1;
-    }
-    return st;
-}
-
-static void subsample_plane(const bricker *b, uint32_t level, const unsigned char *src)
-{
-    const level_slab *slab = &b->slabs[level];
-    size_t ss = b->sample_size;
-    size_t row0 = (size_t)b->layout.dims[0] * ss;
-    unsigned char *dst = slab->planes + (size_t)slab->filled * slab->plane_bytes;
-    const ip_level_layout *lv = &b->layout.levels[level];
-    for (uint32_t y = 0; y < lv->dims[1]; y++) {
-        const unsigned char *row = src + (size_t)slab->y_index[y] * row0;
-        for (uint32_t x = 0; x < lv->dims[0]; x++, dst += ss)
-            memcpy(dst, row + (size_t)slab->x_index[x] * ss, ss);
-    }
-}
-
-/* Level-0 plane z has just been read into its slab; feed it to every level that samples it. */
-static ip_status feed_plane(bricker *b, uint32_t z, ip_error *err)
-{
-    const unsigned char *plane =
-        b->slabs[0].planes + (size_t)b->slabs[0].filled * b->slabs[0].plane_bytes;
-    for (uint32_t k = 1; k < b->layout.level_count; k++) {
+    for (uint32_t k = 0; k < l->level_count; k++) {
         level_slab *slab = &b->slabs[k];
-        if (ip_level_sample_index(b->layout.dims[2], k, slab->next_plane) != z)
+        if (slab->layer >= l->levels[k].bricks[2] ||
+            slab->arrived <= layer_last_plane(l, k, slab->layer))
             continue;
-        subsample_plane(b, k, plane);
-        ip_status st = plane_arrived(b, k, err);
-        if (st != IP_OK)
-            return st;
+        layer_ref *ref = &job.layers[job.layer_count++];
+        ref->level = k;
+        ref->bz = slab->layer;
+        ref->first = job.total;
+        ref->count = (uint64_t)l->levels[k].bricks[0] * l->levels[k].bricks[1];
+        job.total += ref->count;
     }
-    return plane_arrived(b, 0, err);
+    ip_status st = job.total ? run_jobs(b, &job, encode_worker, err) : IP_OK;
+    for (uint32_t r = 0; st == IP_OK && r < job.layer_count; r++) {
+        const layer_ref *ref = &job.layers[r];
+        level_slab *slab = &b->slabs[ref->level];
+        uint32_t brick[3] = {0, 0, ref->bz};
+        uint64_t g = ip_brick_global_index(l, ref->level, brick);
+        st = ip__pwrite_all(b->spill_fd, slab->layer_ranges, layer_ranges_bytes(l, ref->level),
+                            g * b->subblocks * 2 * sizeof(float), b->out_path, err);
+        slab->layer++;
+    }
+    return st;
+}
+
+/* ---- reading a chunk of planes and the pyramid ---- */
+
+/* Whether level k samples level-0 plane z, and as which level plane (*plane). */
+static int level_samples_plane(const ip_layout *l, uint32_t k, uint32_t z, uint32_t *plane)
+{
+    if (z == l->dims[2] - 1) {
+        *plane = l->levels[k].dims[2] - 1;
+        return 1;
+    }
+    *plane = z >> k;
+    return (z & ((1u << k) - 1)) == 0;
+}
+
+/* Subsamples level-0 plane `src` into level plane `plane` of level k: a copy per sample, by
+ * sample width, so that the compiler turns it into plain loads and stores. */
+#define DEFINE_SUBSAMPLE(T, NAME)                                                                  \
+    static void NAME(const level_slab *slab, const ip_level_layout *lv, const T *src, size_t row0, \
+                     T *dst)                                                                       \
+    {                                                                                              \
+        for (uint32_t y = 0; y < lv->dims[1]; y++) {                                               \
+            const T *row = src + (size_t)slab->y_index[y] * row0;                                  \
+            for (uint32_t x = 0; x < lv->dims[0]; x++)                                             \
+                *dst++ = row[slab->x_index[x]];                                                    \
+        }                                                                                          \
+    }
+
+DEFINE_SUBSAMPLE(uint8_t, subsample_8)
+DEFINE_SUBSAMPLE(uint16_t, subsample_16)
+DEFINE_SUBSAMPLE(uint32_t, subsample_32)
+
+static void subsample_plane(const bricker *b, uint32_t k, uint32_t plane, const unsigned char *src)
+{
+    const level_slab *slab = &b->slabs[k];
+    const ip_level_layout *lv = &b->layout.levels[k];
+    unsigned char *dst = (unsigned char *)slab_plane(slab, b->layout.brick_edge, plane);
+    size_t row0 = b->layout.dims[0];
+    if (b->sample_size == 1)
+        subsample_8(slab, lv, src, row0, (uint8_t *)dst);
+    else if (b->sample_size == 2)
+        subsample_16(slab, lv, (const uint16_t *)src, row0, (uint16_t *)dst);
+    else
+        subsample_32(slab, lv, (const uint32_t *)src, row0, (uint32_t *)dst);
+}
+
+/* Level-0 plane z is in its slot: places it in every coarser level that samples it. */
+static void feed_levels(const bricker *b, uint32_t z)
+{
+    const unsigned char *src = slab_plane(&b->slabs[0], b->layout.brick_edge, z);
+    for (uint32_t k = 1; k < b->layout.level_count; k++) {
+        uint32_t plane;
+        if (level_samples_plane(&b->layout, k, z, &plane))
+            subsample_plane(b, k, plane, src);
+    }
+}
+
+/* One job of a reading run (on the pool): reads planes into their slots and feeds the
+ * pyramid. Distinct planes land in distinct slots of every level, so the threads never share
+ * a byte. */
+static void read_worker(void *user, unsigned index)
+{
+    chunk_job *job = user;
+    bricker *b = job->b;
+    brick_scratch *scratch = &b->scratch[index];
+    for (;;) {
+        uint64_t i = atomic_fetch_add(&job->next, 1);
+        if (i >= job->total || atomic_load(&job->failed))
+            break;
+        uint32_t z = job->z0 + (uint32_t)i;
+        unsigned char *dst = (unsigned char *)slab_plane(&b->slabs[0], b->layout.brick_edge, z);
+        ip_status st = ip__input_read_planes_at(job->reader, z, 1, dst, &scratch->error);
+        if (st != IP_OK) {
+            worker_failed(job, scratch, st);
+            break;
+        }
+        feed_levels(b, z);
+    }
+}
+
+/* Reads level-0 planes [z0, z1] into the slabs, on every thread when the input can be read
+ * at any plane, else in order on this one (gzip). */
+static ip_status read_chunk(bricker *b, ip_input_reader *reader, uint32_t z0, uint32_t z1,
+                            ip_error *err)
+{
+    ip_status st = IP_OK;
+    if (ip__input_positioned(reader)) {
+        chunk_job job;
+        memset(&job, 0, sizeof job);
+        job.b = b;
+        job.reader = reader;
+        job.z0 = z0;
+        job.total = z1 - z0 + 1;
+        st = run_jobs(b, &job, read_worker, err);
+    } else {
+        for (uint32_t z = z0; st == IP_OK && z <= z1; z++) {
+            unsigned char *dst = (unsigned char *)slab_plane(&b->slabs[0], b->layout.brick_edge, z);
+            st = ip_input_read_planes(reader, dst, 1, err);
+            if (st == IP_OK)
+                feed_levels(b, z);
+        }
+    }
+    for (uint32_t k = 0; st == IP_OK && k < b->layout.level_count; k++) {
+        b->slabs[k].arrived =
+            z1 == b->layout.dims[2] - 1 ? b->layout.levels[k].dims[2] : (z1 >> k) + 1;
+    }
+    return st;
 }
 
 /* ---- setup and teardown ---- */
+
+/* Slab memory in transparent huge pages where the system grants them on request: the first
+ * touch of a slab then takes one page fault per 2 MiB instead of one per 4 KiB, which in a
+ * virtual machine cost more than the copying. Rounded up to whole huge pages. */
+static void *alloc_slab(uint64_t bytes)
+{
+    void *p = NULL;
+    if (bytes > SIZE_MAX - SLAB_ALIGN || posix_memalign(&p, SLAB_ALIGN, slab_rounded(bytes)) != 0)
+        return NULL;
+#ifdef MADV_HUGEPAGE
+    (void)madvise(p, slab_rounded(bytes), MADV_HUGEPAGE);
+#endif
+    return p;
+}
 
 static ip_status alloc_level(bricker *b, uint32_t k, ip_error *err)
 {
     level_slab *slab = &b->slabs[k];
     const ip_level_layout *lv = &b->layout.levels[k];
     slab->plane_bytes = (size_t)lv->dims[0] * lv->dims[1] * b->sample_size;
-    slab->planes = malloc(slab_bytes(&b->layout, k));
+    slab->planes = alloc_slab(slab_bytes(&b->layout, k));
+    slab->layer_ranges = malloc(layer_ranges_bytes(&b->layout, k));
     if (k > 0) {
         slab->x_index = malloc(lv->dims[0] * sizeof *slab->x_index);
         slab->y_index = malloc(lv->dims[1] * sizeof *slab->y_index);
     }
-    if (!slab->planes || (k > 0 && (!slab->x_index || !slab->y_index)))
+    if (!slab->planes || !slab->layer_ranges || (k > 0 && (!slab->x_index || !slab->y_index)))
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for level %u", b->out_path, k);
     for (uint32_t i = 0; k > 0 && i < lv->dims[0]; i++)
         slab->x_index[i] = ip_level_sample_index(b->layout.dims[0], k, i);
@@ -318,6 +494,19 @@ static ip_status open_spill(bricker *b, ip_error *err)
     return IP_OK;
 }
 
+static ip_status alloc_scratch(bricker *b, ip_error *err)
+{
+    size_t bs = brick_samples_max(&b->layout);
+    for (unsigned t = 0; t < b->threads; t++) {
+        b->scratch[t].samples = malloc(bs * b->sample_size);
+        b->scratch[t].out = malloc(ip__codec_bound(bs, b->layout.type));
+        b->scratch[t].work = malloc(ip__codec_work_size(bs, b->layout.type));
+        if (!b->scratch[t].samples || !b->scratch[t].out || !b->scratch[t].work)
+            return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", b->out_path);
+    }
+    return IP_OK;
+}
+
 static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *out_path,
                               const ip_bricker_options *o, ip_error *err)
 {
@@ -341,20 +530,15 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
                         in->path, (unsigned long long)((need + (1 << 20) - 1) >> 20), o->brick_edge,
                         b->threads, (unsigned long long)(o->memory_limit >> 20));
     b->subblocks = ip_layout_subblocks_per_brick(&b->layout);
+    b->ranges_bytes = b->layout.brick_count * b->subblocks * 2 * sizeof(float);
+    atomic_init(&b->spill_end, b->ranges_bytes);
     b->entries = calloc(b->layout.brick_count, sizeof *b->entries);
     b->brick_ranges = calloc(2 * b->layout.brick_count, sizeof(float));
-    b->subblock_ranges = calloc(2 * b->layout.brick_count * b->subblocks, sizeof(float));
     b->scratch = calloc(b->threads, sizeof *b->scratch);
-    if (!b->entries || !b->brick_ranges || !b->subblock_ranges || !b->scratch)
+    if (!b->entries || !b->brick_ranges || !b->scratch)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", out_path);
-    size_t bs = brick_samples_max(&b->layout);
-    for (unsigned t = 0; t < b->threads; t++) {
-        b->scratch[t].samples = malloc(bs * b->sample_size);
-        b->scratch[t].out = malloc(ip__codec_bound(bs, in->type));
-        b->scratch[t].work = malloc(ip__codec_work_size(bs, in->type));
-        if (!b->scratch[t].samples || !b->scratch[t].out || !b->scratch[t].work)
-            return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", out_path);
-    }
+    if ((st = alloc_scratch(b, err)) != IP_OK)
+        return st;
     for (uint32_t k = 0; k < b->layout.level_count; k++)
         if ((st = alloc_level(b, k, err)) != IP_OK)
             return st;
@@ -368,6 +552,7 @@ static void bricker_free(bricker *b)
     ip__pool_destroy(b->pool);
     for (uint32_t k = 0; k < IP_MAX_LEVELS; k++) {
         free(b->slabs[k].planes);
+        free(b->slabs[k].layer_ranges);
         free(b->slabs[k].x_index);
         free(b->slabs[k].y_index);
     }
@@ -379,27 +564,36 @@ static void bricker_free(bricker *b)
     free(b->scratch);
     free(b->entries);
     free(b->brick_ranges);
-    free(b->subblock_ranges);
     if (b->spill_fd >= 0)
         close(b->spill_fd);
 }
 
 /* ---- streaming pass ---- */
 
+/* The input is read in chunks that each complete one layer of level-0 bricks: planes up to
+ * B * (layer + 1). While a chunk is encoded the kernel reads the next one ahead into its page
+ * cache (no memory of the process), so that a cold read overlaps with the encoding. */
 static ip_status stream_input(bricker *b, const ip_input_desc *in, ip_error *err)
 {
     ip_input_reader *reader = NULL;
     ip_status st = ip_input_open(in, &reader, err);
     uint64_t plane_bytes = b->slabs[0].plane_bytes;
     uint64_t total = plane_bytes * in->dims[2];
-    for (uint32_t z = 0; st == IP_OK && z < in->dims[2]; z++) {
-        level_slab *slab = &b->slabs[0];
-        st =
-            ip_input_read_planes(reader, slab->planes + (size_t)slab->filled * plane_bytes, 1, err);
-        if (st == IP_OK)
-            st = feed_plane(b, z, err);
+    uint32_t edge = b->layout.brick_edge;
+    for (uint32_t z0 = 0; st == IP_OK && z0 < in->dims[2];) {
+        uint32_t z1 = layer_last_plane(&b->layout, 0, b->slabs[0].layer);
+        double t0 = ip_now_seconds();
+        st = read_chunk(b, reader, z0, z1, err);
+        double t1 = ip_now_seconds();
+        if (st == IP_OK) {
+            ip__input_prefetch(reader, z1 + 1, edge);
+            st = encode_ready_layers(b, err);
+        }
+        b->report.seconds_read += t1 - t0;
+        b->report.seconds_encode += ip_now_seconds() - t1;
+        z0 = z1 + 1;
         if (st == IP_OK && b->options->progress &&
-            b->options->progress(b->options->progress_user, (z + 1) * plane_bytes, total))
+            b->options->progress(b->options->progress_user, z0 * plane_bytes, total))
             st = ip__fail(err, IP_ERR_CANCELLED, "%s: cancelled; no output written", b->out_path);
     }
     ip_input_close(reader);
@@ -497,37 +691,157 @@ static void level_ranges(bricker *b)
     l->value_max = l->levels[0].value_max;
 }
 
+/* The summary section is streamed to the file through one buffer, hashed on the way, so that
+ * it never exists whole in memory (its sub-block ranges alone are 1/140 of a uint16 input). */
+typedef struct summary_writer {
+    bricker *b;
+    int fd;
+    uint64_t written; /* summary bytes flushed */
+    unsigned char *buf;
+    size_t used;
+    XXH64_state_t *hash;
+} summary_writer;
+
+static ip_status summary_flush(summary_writer *w, ip_error *err)
+{
+    XXH64_update(w->hash, w->buf, w->used);
+    ip_status st = ip__pwrite_all(w->fd, w->buf, w->used, w->b->layout.summary_offset + w->written,
+                                  w->b->out_path, err);
+    w->written += w->used;
+    w->used = 0;
+    return st;
+}
+
+/* Room for `bytes` (at most SUMMARY_CHUNK) at the end of the buffer, flushing it first when
+ * it lacks them; NULL on a write error. */
+static unsigned char *summary_room(summary_writer *w, size_t bytes, ip_error *err)
+{
+    if (w->used + bytes > SUMMARY_CHUNK && summary_flush(w, err) != IP_OK)
+        return NULL;
+    unsigned char *p = w->buf + w->used;
+    w->used += bytes;
+    return p;
+}
+
+/* Zeros up to section offset `at` (the sections are aligned). */
+static ip_status summary_pad(summary_writer *w, uint64_t at, ip_error *err)
+{
+    while (w->written + w->used < at) {
+        uint64_t gap = at - (w->written + w->used);
+        size_t n = gap < SUMMARY_CHUNK ? (size_t)gap : SUMMARY_CHUNK;
+        unsigned char *p = summary_room(w, n, err);
+        if (!p)
+            return IP_ERR_IO;
+        memset(p, 0, n);
+    }
+    return IP_OK;
+}
+
+/* `count` ranges (2 floats each) from memory, in little-endian order. */
+static ip_status summary_ranges(summary_writer *w, const float *ranges, uint64_t count,
+                                ip_error *err)
+{
+    uint64_t step = SUMMARY_CHUNK / (2 * sizeof(float));
+    for (uint64_t i = 0; i < count; i += step) {
+        uint64_t n = count - i < step ? count - i : step;
+        unsigned char *p = summary_room(w, (size_t)n * 2 * sizeof(float), err);
+        if (!p)
+            return IP_ERR_IO;
+        store_ranges(p, ranges + 2 * i, n);
+    }
+    return IP_OK;
+}
+
+/* The sub-block ranges, read back from the spill file a buffer at a time. */
+static ip_status summary_spilled_ranges(summary_writer *w, ip_error *err)
+{
+    uint64_t floats = w->b->ranges_bytes / sizeof(float);
+    uint64_t step = SUMMARY_CHUNK / sizeof(float);
+    ip_status st = IP_OK;
+    for (uint64_t i = 0; st == IP_OK && i < floats; i += step) {
+        uint64_t n = floats - i < step ? floats - i : step;
+        unsigned char *p = summary_room(w, (size_t)n * sizeof(float), err);
+        if (!p)
+            return IP_ERR_IO;
+        st = ip__pread_all(w->b->spill_fd, p, (size_t)n * sizeof(float), i * sizeof(float),
+                           w->b->out_path, err);
+        for (uint64_t j = 0; st == IP_OK && j < n; j++) {
+            uint32_t bits;
+            memcpy(&bits, p + 4 * j, 4);
+            ip__store_u32le(p + 4 * j, bits);
+        }
+    }
+    return st;
+}
+
+static ip_status summary_directory(summary_writer *w, ip_error *err)
+{
+    for (uint64_t g = 0; g < w->b->layout.brick_count; g++) {
+        unsigned char *p = summary_room(w, IP_DIRECTORY_ENTRY_SIZE, err);
+        if (!p)
+            return IP_ERR_IO;
+        ip__format_entry_encode(&w->b->entries[g], p);
+    }
+    return IP_OK;
+}
+
+/* Writes the sections in file order, then the header that records the summary's checksum. */
+static ip_status summary_sections(summary_writer *w, const float *nodes, ip_error *err)
+{
+    ip_layout *l = &w->b->layout;
+    ip_summary_offsets o;
+    ip__summary_offsets_of(l, &o);
+    unsigned char *table = summary_room(w, (size_t)l->level_count * IP_LEVEL_ENTRY_SIZE, err);
+    if (!table)
+        return IP_ERR_IO;
+    ip__format_level_table_encode(l, table);
+    ip_status st = summary_pad(w, o.directory, err);
+    if (st == IP_OK)
+        st = summary_directory(w, err);
+    if (st == IP_OK)
+        st = summary_pad(w, o.brick_ranges, err);
+    if (st == IP_OK)
+        st = summary_ranges(w, w->b->brick_ranges, l->brick_count, err);
+    if (st == IP_OK)
+        st = summary_pad(w, o.subblock_ranges, err);
+    if (st == IP_OK)
+        st = summary_spilled_ranges(w, err);
+    if (st == IP_OK)
+        st = summary_pad(w, o.nodes, err);
+    if (st == IP_OK)
+        st = summary_ranges(w, nodes, l->node_count, err);
+    if (st == IP_OK)
+        st = summary_pad(w, o.end, err);
+    if (st == IP_OK)
+        st = summary_flush(w, err);
+    l->summary_size = o.end;
+    return st;
+}
+
 static ip_status write_summary(bricker *b, int out_fd, ip_error *err)
 {
     ip_layout *l = &b->layout;
-    ip_summary_offsets o;
-    ip__summary_offsets_of(l, &o);
-    unsigned char *s = calloc(1, o.end);
+    summary_writer w = {b, out_fd, 0, malloc(SUMMARY_CHUNK), 0, XXH64_createState()};
     float *nodes = calloc(2 * (l->node_count ? l->node_count : 1), sizeof(float));
-    if (!s || !nodes) {
-        free(s);
-        free(nodes);
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the summary", b->out_path);
-    }
-    level_ranges(b);
-    ip__octree_walk(l, b->brick_ranges, nodes, store_node, nodes);
-    ip__format_level_table_encode(l, s + o.level_table);
-    for (uint64_t g = 0; g < l->brick_count; g++)
-        ip__format_entry_encode(&b->entries[g], s + o.directory + g * IP_DIRECTORY_ENTRY_SIZE);
-    store_ranges(s + o.brick_ranges, b->brick_ranges, l->brick_count);
-    store_ranges(s + o.subblock_ranges, b->subblock_ranges, l->brick_count * b->subblocks);
-    store_ranges(s + o.nodes, nodes, l->node_count);
-    l->summary_size = o.end;
-    l->summary_checksum = ip__format_checksum(s, o.end);
-    l->file_size = l->summary_offset + l->summary_size;
-    ip_status st = ip__pwrite_all(out_fd, s, o.end, l->summary_offset, b->out_path, err);
-    free(s);
-    free(nodes);
+    ip_status st = IP_OK;
+    if (!w.buf || !w.hash || !nodes)
+        st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the summary", b->out_path);
     if (st == IP_OK) {
+        level_ranges(b);
+        ip__octree_walk(l, b->brick_ranges, nodes, store_node, nodes);
+        XXH64_reset(w.hash, 0);
+        st = summary_sections(&w, nodes, err);
+    }
+    if (st == IP_OK) {
+        l->summary_checksum = XXH64_digest(w.hash);
+        l->file_size = l->summary_offset + l->summary_size;
         unsigned char header[IP_HEADER_SIZE];
         ip__format_header_encode(l, header);
         st = ip__pwrite_all(out_fd, header, sizeof header, 0, b->out_path, err);
     }
+    free(w.buf);
+    free(nodes);
+    XXH64_freeState(w.hash);
     return st;
 }
 
@@ -582,10 +896,12 @@ ip_status ip_bricker_run(const ip_input_desc *input, const char *out_path,
         st = ip__atomic_create(&out, out_path, options->force, err);
     if (st == IP_OK)
         st = stream_input(&b, input, err);
+    double finish = ip_now_seconds();
     if (st == IP_OK)
         st = write_payloads(&b, out.fd, err);
     if (st == IP_OK)
         st = write_summary(&b, out.fd, err);
+    b.report.seconds_write = ip_now_seconds() - finish;
     if (st == IP_OK)
         st = ip__atomic_commit(&out, err);
     else

@@ -1,10 +1,13 @@
 /* isoprop: encoding and decoding of one brick's payload.
  *
  * A brick is stored as a constant (no payload), raw little-endian samples, or one LZ4 block of
- * the samples after reversible filters (a predictor, then byte shuffle for wide types). The
- * encoder tries no predictor and the delta predictor and keeps the smaller result; at LZ4HC
- * levels it also tries the median edge predictor, which compresses CT data about 2 % better
- * but decodes several times slower. A brick that does not shrink is stored raw. Every function here is pure: thread-safe on distinct buffers.
+ * the samples after reversible filters (a predictor, then byte shuffle for wide types). At the
+ * fast level the encoder chooses between no predictor and the delta predictor by compressing
+ * three z-slices of the brick both ways, then filters and compresses the whole brick once
+ * (bricks thinner than 16 slices are compressed both ways). At LZ4HC levels it compresses the
+ * whole brick with each predictor, the median edge predictor included, which compresses CT
+ * data about 2 % better but decodes several times slower, and keeps the smallest. A brick that
+ * does not shrink is stored raw. Every function here is pure: thread-safe on distinct buffers.
  */
 #ifndef ISOPROP_CODEC_H
 #define ISOPROP_CODEC_H
@@ -38,6 +41,11 @@ size_t ip__codec_work_size(size_t count, ip_type type);
  *  @return IP_OK or IP_ERR_ARGUMENT. */
 ip_status ip__codec_encode(const void *samples, const uint32_t extent[3], ip_type type, int level,
                            void *out, void *work, ip_brick_entry *entry);
+
+/*! ip__codec_encode_constant() : sets `entry` to what ip__codec_encode() writes for a brick
+ *  whose samples are all equal, for a caller that knows it already (the bricker, from the
+ *  brick's range): no payload, its value is the brick's min in the summary. */
+void ip__codec_encode_constant(ip_brick_entry *entry);
 
 /*! ip__codec_decode() : decodes a payload described by `entry` into `dst` (the brick's
  *  extent[0] x extent[1] x extent[2] samples of `type`, host byte order, caller-owned). A constant brick is filled with `constant_value`.

@@ -19,6 +19,13 @@ void ip__summarise_brick(const void *samples, ip_type type, const uint32_t exten
                          uint32_t brick_edge, uint32_t subblock_edge, float brick_range[2],
                          float *ranges);
 
+/* ip__summarise_brick() for an integer brick (not float32) read where it lies: row y of its
+ * slice z starts at planes[z] + y * row_bytes (so a brick inside the bricker's slabs needs no
+ * copy to be summarised, and one found constant none at all). */
+void ip__summarise_planes(const unsigned char *const *planes, size_t row_bytes, ip_type type,
+                          const uint32_t extent[3], uint32_t brick_edge, uint32_t subblock_edge,
+                          float brick_range[2], float *ranges);
+
 /* Called by ip__octree_walk() once per node with the union of its children's ranges, as
  * read at that moment; a nonzero return stops the walk and is returned by it. */
 typedef int (*ip_octree_node_fn)(void *user, uint32_t level, uint32_t depth, const uint32_t node[3],

@@ -11,6 +11,7 @@
 
 #include "atomic_file.h"
 #include "internal.h"
+#include "input_positioned.h"
 #include "isoprop/input.h"
 
 /* Compressed bytes read per refill: small next to a plane, large enough for few system calls. */
@@ -274,9 +275,10 @@ static void to_host_order(const ip_input_reader *r, void *samples, size_t count)
         ip__swap_bytes(samples, count, r->sample_size);
 }
 
-/* NaN and infinity have no place in an isosurface's scalar field; name the first one. */
+/* NaN and infinity have no place in an isosurface's scalar field; name the first one
+ * (`samples` start at plane first_z). */
 static ip_status check_finite(const ip_input_reader *r, const void *samples, size_t count,
-                              ip_error *err)
+                              uint32_t first_z, ip_error *err)
 {
     const unsigned char *p = samples;
     const uint32_t exponent = 0x7f800000u;
@@ -288,7 +290,7 @@ static ip_status check_finite(const ip_input_reader *r, const void *samples, siz
         uint64_t plane = (uint64_t)r->desc.dims[0] * r->desc.dims[1];
         unsigned x = (unsigned)(i % r->desc.dims[0]);
         unsigned y = (unsigned)((i / r->desc.dims[0]) % r->desc.dims[1]);
-        unsigned long long z = r->next_z + i / plane;
+        unsigned long long z = first_z + i / plane;
         return ip__fail(err, IP_ERR_INPUT, "%s: float32 sample at (x,y,z) = (%u,%u,%llu) is %s",
                         r->label, x, y, z, (bits & 0x007fffffu) ? "NaN" : "infinite");
     }
@@ -315,7 +317,7 @@ static ip_status read_samples(ip_input_reader *r, void *dst, uint32_t count, ip_
     size_t samples = (size_t)(bytes / r->sample_size);
     to_host_order(r, dst, samples);
     if (r->desc.type == IP_FLOAT32)
-        return check_finite(r, dst, samples, err);
+        return check_finite(r, dst, samples, r->next_z, err);
     return IP_OK;
 }
 
@@ -339,4 +341,44 @@ ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t coun
     }
     reader->next_z += count;
     return IP_OK;
+}
+
+/* ---- positioned reads (internal, input_positioned.h) ---- */
+
+int ip__input_positioned(const ip_input_reader *reader)
+{
+    return reader->desc.encoding != IP_ENCODING_GZIP;
+}
+
+ip_status ip__input_read_planes_at(const ip_input_reader *reader, uint32_t z, uint32_t count,
+                                   void *dst, ip_error *err)
+{
+    const ip_input_reader *r = reader;
+    if (!ip__input_positioned(r) || z > r->desc.dims[2] || count > r->desc.dims[2] - z)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: cannot read %u planes at z = %u", r->label,
+                        count, z);
+    uint64_t bytes = (uint64_t)count * r->plane_bytes;
+    if (bytes > SIZE_MAX)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: %u planes are too many to read at once",
+                        r->label, count);
+    uint64_t offset = r->desc.data_offset + (uint64_t)z * r->plane_bytes;
+    ip_status status = ip__pread_all(r->fd, dst, (size_t)bytes, offset, r->desc.data_path, err);
+    if (status != IP_OK)
+        return status;
+    size_t samples = (size_t)(bytes / r->sample_size);
+    to_host_order(r, dst, samples);
+    if (r->desc.type == IP_FLOAT32)
+        return check_finite(r, dst, samples, z, err);
+    return IP_OK;
+}
+
+void ip__input_prefetch(const ip_input_reader *reader, uint32_t z, uint32_t count)
+{
+    const ip_input_reader *r = reader;
+    if (!ip__input_positioned(r) || z >= r->desc.dims[2] || count == 0)
+        return;
+    if (count > r->desc.dims[2] - z)
+        count = r->desc.dims[2] - z;
+    uint64_t offset = r->desc.data_offset + (uint64_t)z * r->plane_bytes;
+    (void)posix_fadvise(r->fd, (off_t)offset, (off_t)(count * r->plane_bytes), POSIX_FADV_WILLNEED);
 }
