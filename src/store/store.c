@@ -167,6 +167,10 @@ ip_status ip_store_open(const char *path, ip_store **out, ip_error *err)
         return st;
     }
     find_largest(s);
+    /* From here on the file is read brick by brick, in the order the view needs them: the
+     * kernel's sequential readahead would read megabytes past each small payload. The reads
+     * the engine plans are asked for explicitly (ip_store_prefetch_brick()). */
+    (void)posix_fadvise(s->fd, 0, 0, POSIX_FADV_RANDOM);
     *out = s;
     return IP_OK;
 }

@@ -94,7 +94,10 @@ if [ "$rc" = 137 ]; then
 else
     check "a run that finished is whole" "$bin/isoinfo" --verify killed.ibv
 fi
-timeout -s INT 0.3 "$bin/isobrick" "$big" -o interrupted.ibv --quiet --threads 1 2>"$work/.err"
+"$bin/isobrick" "$big" -o interrupted.ibv --quiet --threads 1 2>"$work/.err" &
+pid=$!
+signal_when_ready INT 0.3 "$pid"
+wait "$pid"
 rc=$?
 if [ "$rc" != 0 ]; then
     check "an interrupted run leaves no output" test ! -e interrupted.ibv

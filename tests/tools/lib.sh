@@ -32,6 +32,24 @@ check() {
     if "$@"; then ok; else bad "$desc"; fi
 }
 
+# signal_when_ready SIGNAL AFTER PID: waits (up to 60 s) until process PID has a handler for
+# SIGNAL (INT or TERM: its SigCgt mask in /proc), then AFTER seconds more, and sends it the
+# signal. A signal sent before the program installs its handlers (a slow start under the
+# sanitizers, on a loaded machine) would end it by the default action, without its message.
+signal_when_ready() {
+    case $1 in INT) swr_bit=2 ;; TERM) swr_bit=16384 ;; *) swr_bit=0 ;; esac
+    swr_i=0
+    while [ "$swr_bit" != 0 ] && [ "$swr_i" -lt 600 ] && kill -0 "$3" 2>/dev/null; do
+        swr_mask=$(sed -n 's/^SigCgt:[[:space:]]*//p' "/proc/$3/status" 2>/dev/null)
+        swr_low=${swr_mask#????????} # the low 32 bits: the standard signals
+        [ -n "$swr_low" ] && [ $((0x$swr_low & swr_bit)) != 0 ] && break
+        sleep 0.1
+        swr_i=$((swr_i + 1))
+    done
+    sleep "$2"
+    kill -s "$1" "$3" 2>/dev/null
+}
+
 # run_capture COMMAND...: runs it, keeps stdout in $out, stderr in $err, status in $rc.
 run_capture() {
     "$@" >"$work/.out" 2>"$work/.err"

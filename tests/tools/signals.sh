@@ -6,12 +6,16 @@
 
 none_of() { for f in "$@"; do [ ! -e "$f" ] || return 1; done; }
 
-# interrupt SIGNAL AFTER COMMAND...: runs COMMAND, sends it SIGNAL after AFTER seconds, and
-# keeps its status (as the shell reports it) in $rc and its stderr in $err.
+# interrupt SIGNAL AFTER COMMAND...: runs COMMAND, sends it SIGNAL AFTER seconds after it has
+# installed its handler, and keeps its status (as the shell reports it) in $rc and its stderr
+# in $err.
 interrupt() {
     sig=$1 after=$2
     shift 2
-    timeout --preserve-status -s "$sig" "$after" "$@" >"$work/.out" 2>"$work/.err"
+    "$@" >"$work/.out" 2>"$work/.err" &
+    pid=$!
+    signal_when_ready "$sig" "$after" "$pid"
+    wait "$pid"
     rc=$?
     err=$(cat "$work/.err")
 }
@@ -34,8 +38,7 @@ check "isorender writes no output" none_of r.png r.json
 # the same from a job in the background, signalled with kill
 $long_render -o r.png --stats r.json 2>"$work/.err" &
 pid=$!
-sleep 1
-kill -INT "$pid"
+signal_when_ready INT 1 "$pid"
 wait "$pid"
 rc=$?
 check "a background isorender killed with SIGINT ends with 130 (got $rc)" test "$rc" = 130
