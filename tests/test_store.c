@@ -13,16 +13,17 @@
 #include "isoprop/generate.h"
 #include "isoprop/store.h"
 
-/* A gyroid bricked with 4-cell bricks: many payloads, several levels. */
-static void make_file(const char *dir, char *ibv, size_t size)
+/* Volume `p` written as STEM's raw file in dir and bricked with 4-cell bricks, 2-cell
+ * sub-blocks, into dir/STEM.ibv (its path in ibv). */
+static void make_volume(const char *dir, const ip_gen_params *p, const char *stem, char *ibv,
+                        size_t size)
 {
-    ip_gen_params p = {IP_FIELD_GYROID, {21, 18, 19}, IP_UINT16, 0.0, 1};
     char name[256], raw[4400];
     ip_error err;
-    REQUIRE(ip_raw_file_name(name, sizeof name, "gyroid", p.dims, p.type) == IP_OK);
+    REQUIRE(ip_raw_file_name(name, sizeof name, stem, p->dims, p->type) == IP_OK);
     snprintf(raw, sizeof raw, "%s/%s", dir, name);
-    REQUIRE(ip_generate_write(&p, raw, 1, &err) == IP_OK);
-    snprintf(ibv, size, "%s/gyroid.ibv", dir);
+    REQUIRE(ip_generate_write(p, raw, 1, &err) == IP_OK);
+    snprintf(ibv, size, "%s/%s.ibv", dir, stem);
     ip_input_desc d;
     ip_bricker_options o;
     REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
@@ -31,6 +32,13 @@ static void make_file(const char *dir, char *ibv, size_t size)
     o.subblock_edge = 2;
     o.force = 1;
     REQUIRE(ip_bricker_run(&d, ibv, &o, NULL, &err) == IP_OK);
+}
+
+/* A gyroid: many payloads, several levels. */
+static void make_file(const char *dir, char *ibv, size_t size)
+{
+    ip_gen_params p = {IP_FIELD_GYROID, {21, 18, 19}, IP_UINT16, 0.0, 1};
+    make_volume(dir, &p, "gyroid", ibv, size);
 }
 
 static unsigned char *read_whole(const char *path, size_t *size)
@@ -322,6 +330,44 @@ static void test_accessors(const char *ibv)
     free(work);
 }
 
+/* The sub-block ranges as the store holds them (those of uniform bricks shared by value) are
+ * the file's, bit for bit, for every brick; the store holds less than the summary section. */
+static void test_compact_summaries(const char *dir)
+{
+    ip_gen_params p = {IP_FIELD_SHEPP_LOGAN, {40, 36, 33}, IP_UINT8, 0.0, 1};
+    char ibv[4400];
+    ip_error err;
+    make_volume(dir, &p, "phantom", ibv, sizeof ibv);
+    size_t size;
+    unsigned char *file = read_whole(ibv, &size);
+    ip_store *s = NULL;
+    REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
+    const ip_layout *l = ip_store_layout(s);
+    ip_summary_offsets off;
+    ip__summary_offsets_of(l, &off);
+    uint32_t sub = ip_layout_subblocks_per_brick(l);
+    uint64_t constant = 0, mismatches = 0;
+    for (uint64_t g = 0; g < l->brick_count; g++) {
+        ip_brick_entry e;
+        ip_store_brick_entry(s, g, &e);
+        constant += e.encoding == IP_BRICK_CONSTANT;
+        const float *held = ip_store_subblock_ranges(s, g);
+        const unsigned char *stored =
+            file + l->summary_offset + off.subblock_ranges + g * sub * IP_RANGE_SIZE;
+        for (uint32_t i = 0; i < 2 * sub; i++) {
+            uint32_t a, b = (uint32_t)stored[4 * i] | (uint32_t)stored[4 * i + 1] << 8 |
+                            (uint32_t)stored[4 * i + 2] << 16 | (uint32_t)stored[4 * i + 3] << 24;
+            memcpy(&a, &held[i], 4);
+            mismatches += a != b;
+        }
+    }
+    CHECK(constant > 0 && constant < l->brick_count); /* both kinds are exercised */
+    CHECK(mismatches == 0);
+    CHECK(ip_store_summary_memory(s) > 0 && ip_store_summary_memory(s) < l->summary_size);
+    ip_store_close(s);
+    free(file);
+}
+
 int main(void)
 {
     const char *dir = test_tmp_dir("test_store");
@@ -333,5 +379,6 @@ int main(void)
     test_not_regular(dir);
     test_truncated_while_open(dir, ibv);
     test_rewritten_while_open(dir, ibv);
+    test_compact_summaries(dir);
     return test_summary("test_store");
 }

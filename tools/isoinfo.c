@@ -193,7 +193,7 @@ int main(int argc, char **argv)
     int rc = check ? verify(store, cache, json) : 0;
     ip_cache_stats stats;
     ip_cache_get_stats(cache, &stats);
-    uint64_t summary_bytes = ip_store_layout(store)->summary_size;
+    uint64_t summary_bytes = ip_store_summary_memory(store);
     if (check && !json)
         tool_print_cache_table(stdout, &stats, summary_bytes);
     if (rc == 0 && tool_signal_caught())

@@ -413,7 +413,7 @@ static int finish(run *r, ip_error *err)
     if (r->o.progress && !r->o.full &&
         tool_write_text_file("isorender", r->o.progress, r->o.common.force, progress_csv, r) != 0)
         return 1;
-    uint64_t summary = ip_store_layout(r->store)->summary_size;
+    uint64_t summary = ip_store_summary_memory(r->store);
     if (!r->o.common.quiet) {
         print_summary(r);
         tool_print_cache_table(stdout, &st, summary);

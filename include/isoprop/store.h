@@ -57,6 +57,11 @@ IP_API const float *ip_store_subblock_ranges(const ip_store *store, uint64_t g);
 IP_API const float *ip_store_node_range(const ip_store *store, uint32_t level, uint32_t depth,
                                         const uint32_t node[3]);
 
+/*! ip_store_summary_memory() : bytes the store holds in memory for the summaries (directory,
+ *  brick, sub-block and node ranges; the sub-block ranges of constant bricks are shared, so
+ *  this is usually well under the file's summary section). */
+IP_API uint64_t ip_store_summary_memory(const ip_store *store);
+
 /*! ip_store_brick_samples() : number of samples of brick `g` (its extent's product). */
 IP_API uint64_t ip_store_brick_samples(const ip_store *store, uint64_t g);
 

@@ -517,9 +517,9 @@ ip_status ip__format_parse_header(const unsigned char header[IP_HEADER_SIZE], ui
     return st == IP_OK ? check_sections(layout, file_size, name, err) : st;
 }
 
-ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
-                                   const unsigned char *summary, const char *name, unsigned flags,
-                                   ip_error *err)
+ip_status ip__format_check_summary(ip_layout *layout, const unsigned char *gap,
+                                   const unsigned char *head, uint64_t checksum, const char *name,
+                                   unsigned flags, ip_error *err)
 {
     uint64_t gap_size = layout->summary_offset - (layout->data_offset + layout->data_size);
     for (uint64_t i = 0; i < gap_size; i++)
@@ -529,17 +529,16 @@ ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
                             "summary section, is not zero",
                             name,
                             (unsigned long long)(layout->data_offset + layout->data_size + i));
-    if (!(flags & IP_PARSE_SKIP_CHECKSUMS) &&
-        ip__format_checksum(summary, layout->summary_size) != layout->summary_checksum)
+    if (!(flags & IP_PARSE_SKIP_CHECKSUMS) && checksum != layout->summary_checksum)
         return ip__fail(err, IP_ERR_CHECKSUM, "%s: summary section checksum mismatch", name);
-    ip_status st = check_level_table(layout, summary, name, layout, err);
+    ip_status st = check_level_table(layout, head, name, layout, err);
     if (st != IP_OK)
         return st;
     ip_summary_offsets o;
     ip__summary_offsets_of(layout, &o);
     for (uint64_t g = 0; g < layout->brick_count; g++) {
-        const unsigned char *d = summary + o.directory + g * IP_DIRECTORY_ENTRY_SIZE;
-        const unsigned char *r = summary + o.brick_ranges + g * IP_RANGE_SIZE;
+        const unsigned char *d = head + o.directory + g * IP_DIRECTORY_ENTRY_SIZE;
+        const unsigned char *r = head + o.brick_ranges + g * IP_RANGE_SIZE;
         ip_brick_entry e;
         ip__format_entry_decode(d, &e);
         st = check_entry(layout, g, &e, d[IP_DIR_RESERVED] | d[IP_DIR_RESERVED + 1],
@@ -548,6 +547,16 @@ ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
             return st;
     }
     return IP_OK;
+}
+
+ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
+                                   const unsigned char *summary, const char *name, unsigned flags,
+                                   ip_error *err)
+{
+    uint64_t checksum = flags & IP_PARSE_SKIP_CHECKSUMS
+                            ? layout->summary_checksum
+                            : ip__format_checksum(summary, layout->summary_size);
+    return ip__format_check_summary(layout, gap, summary, checksum, name, flags, err);
 }
 
 ip_status ip__format_parse(const unsigned char *file, uint64_t size, const char *name,

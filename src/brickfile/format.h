@@ -87,6 +87,14 @@ ip_status ip__format_parse_summary(ip_layout *layout, const unsigned char *gap,
                                    const unsigned char *summary, const char *name, unsigned flags,
                                    ip_error *err);
 
+/*! ip__format_check_summary() : ip__format_parse_summary() for a reader that holds only the
+ *  start of the summary section, `head` (its bytes up to the sub-block ranges: level table,
+ *  directory and brick ranges), and computed the whole section's checksum itself
+ *  (ip__format_checksum() of the summary_size bytes, in `checksum`). */
+ip_status ip__format_check_summary(ip_layout *layout, const unsigned char *gap,
+                                   const unsigned char *head, uint64_t checksum, const char *name,
+                                   unsigned flags, ip_error *err);
+
 /*! ip__format_parse() : ip__format_parse_header() then ip__format_parse_summary() on a whole
  *  brick file image (`file`, `size` bytes) held in memory.
  *  @return IP_OK and *layout filled, or IP_ERR_FORMAT / IP_ERR_CHECKSUM / IP_ERR_UNSUPPORTED. */

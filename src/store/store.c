@@ -7,7 +7,9 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <xxhash.h>
 
+#include "array.h"
 #include "internal.h"
 #include "codec.h"
 #include "isoprop/store.h"
@@ -19,9 +21,17 @@ struct ip_store {
     uint64_t size; /* the file's size when opened */
     ip_layout layout;
     ip_summary_offsets offsets;
-    unsigned char *summary; /* the summary section, read and verified once at open; owned */
-    const float *ranges;    /* brick, sub-block and node ranges, host floats */
-    float *ranges_copy;     /* owned copy on big-endian hosts, else NULL */
+    unsigned char *summary; /* the summary section up to its sub-block ranges (level table,
+                               directory, brick ranges), read and verified once at open; owned */
+    float *ranges;          /* the brick ranges, host floats; owned */
+    float *nodes;           /* the octree's node ranges, host floats; owned */
+    /* Sub-block ranges, 2 * subblocks floats per block: the blocks of the bricks that are not
+     * uniform, and one block per value shared by the uniform bricks of that value (those whose
+     * every sub-block range is (v, v): constant bricks). block_of[g] is brick g's block. */
+    float *blocks;
+    uint64_t block_count, block_capacity;
+    uint32_t *block_of;
+    uint64_t memory; /* bytes of the above */
     uint32_t subblocks;
     size_t largest_payload; /* bytes of the largest stored payload */
     size_t largest_samples; /* samples of the largest brick */
@@ -89,7 +99,152 @@ static ip_status read_at(const ip_store *s, void *dst, size_t size, uint64_t off
     return failure == 0 ? IP_OK : read_failed(s, failure, what, err);
 }
 
-/* The header, then the padding and the summary section, each read once and validated. */
+/* Host floats from `count` little-endian ones. */
+static void load_floats(const unsigned char *src, float *dst, uint64_t count)
+{
+    for (uint64_t i = 0; i < count; i++) {
+        uint32_t bits = ip__load_u32le(src + 4 * i);
+        memcpy(&dst[i], &bits, 4);
+    }
+}
+
+/* Reads `size` bytes of the summary section from `offset` (relative to it) into dst and adds
+ * them to the checksum. */
+static ip_status read_summary_part(ip_store *s, void *dst, uint64_t size, uint64_t offset,
+                                   XXH64_state_t *hash, ip_error *err)
+{
+    ip_status st = read_at(s, dst, (size_t)size, s->layout.summary_offset + offset,
+                           "the summary section", err);
+    if (st == IP_OK)
+        XXH64_update(hash, dst, (size_t)size);
+    return st;
+}
+
+/* Appends one block of sub-block ranges (host floats); returns its index, or UINT32_MAX when
+ * out of memory. */
+static uint32_t add_block(ip_store *s, const float *ranges)
+{
+    size_t floats = 2 * (size_t)s->subblocks;
+    if (s->block_count >= UINT32_MAX - 1 ||
+        ip__array_reserve(&s->blocks, &s->block_capacity, (s->block_count + 1) * floats,
+                          sizeof(float), 64 * floats) != IP_OK)
+        return UINT32_MAX;
+    memcpy(s->blocks + s->block_count * floats, ranges, floats * sizeof(float));
+    return (uint32_t)s->block_count++;
+}
+
+/* The shared blocks of uniform bricks by value: an open-addressing table of `slots` (a power
+ * of two; block UINT32_MAX marks an empty slot). */
+typedef struct uniform_table {
+    uint32_t *keys, *block, slots, used;
+} uniform_table;
+
+/* Rehashes the table into twice the slots (64 at first). Returns 0 when out of memory. */
+static int grow_table(uniform_table *t)
+{
+    uint32_t slots = t->slots ? 2 * t->slots : 64;
+    uint32_t *keys = malloc(slots * sizeof *keys), *block = malloc(slots * sizeof *block);
+    if (!keys || !block) {
+        free(keys);
+        free(block);
+        return 0;
+    }
+    memset(block, 0xff, slots * sizeof *block);
+    for (uint32_t i = 0; i < t->slots; i++)
+        if (t->block[i] != UINT32_MAX) {
+            uint32_t j = (t->keys[i] * 2654435761u) & (slots - 1);
+            while (block[j] != UINT32_MAX)
+                j = (j + 1) & (slots - 1);
+            keys[j] = t->keys[i];
+            block[j] = t->block[i];
+        }
+    free(t->keys);
+    free(t->block);
+    t->keys = keys;
+    t->block = block;
+    t->slots = slots;
+    return 1;
+}
+
+/* The block shared by the uniform bricks of value `bits` (a float's bits), added when new.
+ * Returns UINT32_MAX when out of memory. */
+static uint32_t uniform_block(ip_store *s, uniform_table *t, uint32_t bits)
+{
+    if (2 * (t->used + 1) > t->slots && !grow_table(t))
+        return UINT32_MAX;
+    uint32_t j = (bits * 2654435761u) & (t->slots - 1);
+    while (t->block[j] != UINT32_MAX && t->keys[j] != bits)
+        j = (j + 1) & (t->slots - 1);
+    if (t->block[j] == UINT32_MAX) {
+        float v, *uniform = malloc(2 * (size_t)s->subblocks * sizeof(float));
+        if (!uniform)
+            return UINT32_MAX;
+        memcpy(&v, &bits, 4);
+        for (uint32_t i = 0; i < 2 * s->subblocks; i++)
+            uniform[i] = v;
+        uint32_t b = add_block(s, uniform);
+        free(uniform);
+        if (b == UINT32_MAX)
+            return b;
+        t->keys[j] = bits;
+        t->block[j] = b;
+        t->used++;
+    }
+    return t->block[j];
+}
+
+/* A brick's block for its sub-block ranges `r` (host floats): the shared one when every
+ * range is (v, v) for one v (bit for bit), else a block of its own. */
+static uint32_t block_for(ip_store *s, uniform_table *t, const float *r)
+{
+    uint32_t bits, other;
+    memcpy(&bits, &r[0], 4);
+    int uniform = 1;
+    for (uint32_t i = 1; uniform && i < 2 * s->subblocks; i++) {
+        memcpy(&other, &r[i], 4);
+        uniform = other == bits;
+    }
+    return uniform ? uniform_block(s, t, bits) : add_block(s, r);
+}
+
+/* The sub-block ranges, read in pieces of whole bricks and compacted (see struct ip_store). */
+static ip_status read_subblock_ranges(ip_store *s, XXH64_state_t *hash, ip_error *err)
+{
+    enum {
+        PIECE_BYTES = 1 << 20
+    };
+    uint64_t brick_bytes = (uint64_t)s->subblocks * IP_RANGE_SIZE;
+    uint64_t per_piece = PIECE_BYTES / brick_bytes ? PIECE_BYTES / brick_bytes : 1;
+    uint64_t bricks = s->layout.brick_count;
+    unsigned char *piece = malloc((size_t)(per_piece * brick_bytes));
+    float *host = malloc(2 * (size_t)s->subblocks * sizeof(float));
+    uniform_table t = {NULL, NULL, 0, 0};
+    s->block_of = malloc((bricks ? bricks : 1) * sizeof *s->block_of);
+    ip_status st = piece && host && s->block_of ? IP_OK : IP_ERR_NOMEM;
+    for (uint64_t g = 0; st == IP_OK && g < bricks; g += per_piece) {
+        uint64_t n = bricks - g < per_piece ? bricks - g : per_piece;
+        st = read_summary_part(s, piece, n * brick_bytes,
+                               s->offsets.subblock_ranges + g * brick_bytes, hash, err);
+        for (uint64_t i = 0; st == IP_OK && i < n; i++) {
+            load_floats(piece + i * brick_bytes, host, 2 * (uint64_t)s->subblocks);
+            s->block_of[g + i] = block_for(s, &t, host);
+            if (s->block_of[g + i] == UINT32_MAX)
+                st = IP_ERR_NOMEM;
+        }
+    }
+    free(piece);
+    free(host);
+    free(t.keys);
+    free(t.block);
+    if (st == IP_ERR_NOMEM)
+        return ip__fail(err, st, "%s: out of memory for the summaries", s->path);
+    return st;
+}
+
+/* The header, then the padding and the summary section, read once and validated. The summary
+ * is read in parts (level table, directory and brick ranges; the sub-block ranges in pieces;
+ * the node ranges) with its checksum computed along, so that its largest array, the sub-block
+ * ranges, is never held whole. */
 static ip_status read_metadata(ip_store *s, ip_error *err)
 {
     unsigned char header[IP_HEADER_SIZE], gap[IP_SUMMARY_ALIGN];
@@ -102,36 +257,42 @@ static ip_status read_metadata(ip_store *s, ip_error *err)
     if (st != IP_OK)
         return st;
     const ip_layout *l = &s->layout;
-    uint64_t data_end = l->data_offset + l->data_size;
-    s->summary = malloc(l->summary_size ? l->summary_size : 1);
-    if (!s->summary)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the %llu-byte summary section",
-                        s->path, (unsigned long long)l->summary_size);
+    ip__summary_offsets_of(l, &s->offsets);
+    s->subblocks = ip_layout_subblocks_per_brick(l);
+    const ip_summary_offsets *o = &s->offsets;
+    uint64_t data_end = l->data_offset + l->data_size, node_bytes = l->summary_size - o->nodes;
+    uint64_t node_floats = node_bytes / 4;
+    s->summary = malloc(o->subblock_ranges ? o->subblock_ranges : 1);
+    s->ranges = malloc((2 * l->brick_count + 1) * sizeof(float));
+    s->nodes = malloc((node_floats + 1) * sizeof(float));
+    unsigned char *stored_nodes = malloc(node_bytes ? node_bytes : 1);
+    XXH64_state_t *hash = XXH64_createState();
+    if (!s->summary || !s->ranges || !s->nodes || !stored_nodes || !hash) {
+        free(stored_nodes);
+        XXH64_freeState(hash);
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the summaries", s->path);
+    }
+    XXH64_reset(hash, 0);
     st = read_at(s, gap, l->summary_offset - data_end, data_end, "the data section", err);
     if (st == IP_OK)
-        st = read_at(s, s->summary, l->summary_size, l->summary_offset, "the summary section", err);
+        st = read_summary_part(s, s->summary, o->subblock_ranges, 0, hash, err);
     if (st == IP_OK)
-        st = ip__format_parse_summary(&s->layout, gap, s->summary, s->path, 0, err);
+        st = read_subblock_ranges(s, hash, err);
+    if (st == IP_OK)
+        st = read_summary_part(s, stored_nodes, node_bytes, o->nodes, hash, err);
+    if (st == IP_OK)
+        st = ip__format_check_summary(&s->layout, gap, s->summary, XXH64_digest(hash), s->path, 0,
+                                      err);
+    if (st == IP_OK) {
+        load_floats(s->summary + o->brick_ranges, s->ranges, 2 * l->brick_count);
+        load_floats(stored_nodes, s->nodes, node_floats);
+        s->memory = o->subblock_ranges + (2 * l->brick_count + node_floats) * sizeof(float) +
+                    s->block_count * 2 * s->subblocks * sizeof(float) +
+                    l->brick_count * sizeof *s->block_of;
+    }
+    free(stored_nodes);
+    XXH64_freeState(hash);
     return st;
-}
-
-static ip_status host_ranges(ip_store *s, ip_error *err)
-{
-    const unsigned char *first = s->summary + s->offsets.brick_ranges;
-    uint64_t floats = (s->offsets.end - s->offsets.brick_ranges) / 4;
-    if (ip__host_little_endian()) {
-        s->ranges = (const float *)(const void *)first; /* 8-aligned: see docs/format.md */
-        return IP_OK;
-    }
-    s->ranges_copy = malloc(floats * sizeof(float));
-    if (!s->ranges_copy)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", s->path);
-    for (uint64_t i = 0; i < floats; i++) {
-        uint32_t bits = ip__load_u32le(first + 4 * i);
-        memcpy(&s->ranges_copy[i], &bits, 4);
-    }
-    s->ranges = s->ranges_copy;
-    return IP_OK;
 }
 
 /* The largest payload and brick, which size the scratch of ip_store_read_brick(). */
@@ -157,11 +318,6 @@ ip_status ip_store_open(const char *path, ip_store **out, ip_error *err)
     ip_status st = open_file(s, err);
     if (st == IP_OK)
         st = read_metadata(s, err);
-    if (st == IP_OK) {
-        ip__summary_offsets_of(&s->layout, &s->offsets);
-        s->subblocks = ip_layout_subblocks_per_brick(&s->layout);
-        st = host_ranges(s, err);
-    }
     if (st != IP_OK) {
         ip_store_close(s);
         return st;
@@ -182,7 +338,10 @@ void ip_store_close(ip_store *s)
     if (s->fd >= 0)
         close(s->fd);
     free(s->summary);
-    free(s->ranges_copy);
+    free(s->ranges);
+    free(s->nodes);
+    free(s->blocks);
+    free(s->block_of);
     free(s);
 }
 
@@ -210,13 +369,19 @@ void ip_store_brick_range(const ip_store *s, uint64_t g, float range[2])
 
 const float *ip_store_subblock_ranges(const ip_store *s, uint64_t g)
 {
-    return s->ranges + 2 * s->layout.brick_count + 2 * g * s->subblocks;
+    IP_ASSERT(g < s->layout.brick_count);
+    return s->blocks + 2 * (uint64_t)s->subblocks * s->block_of[g];
 }
 
-/* The octree's node ranges: after the brick and sub-block ranges. */
+uint64_t ip_store_summary_memory(const ip_store *s)
+{
+    return s->memory;
+}
+
+/* The octree's node ranges. */
 static const float *stored_nodes(const ip_store *s)
 {
-    return s->ranges + 2 * s->layout.brick_count * (1 + (uint64_t)s->subblocks);
+    return s->nodes;
 }
 
 const float *ip_store_node_range(const ip_store *s, uint32_t level, uint32_t depth,

@@ -376,7 +376,7 @@ static int finish(viewer *v)
 {
     ip_cache_stats s;
     ip_cache_get_stats(v->cache, &s);
-    uint64_t summary = ip_store_layout(v->store)->summary_size;
+    uint64_t summary = ip_store_summary_memory(v->store);
     if (!v->o.common.quiet) {
         print_summary(v);
         tool_print_cache_table(stdout, &s, summary);
