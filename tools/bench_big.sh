@@ -28,7 +28,7 @@
 # reads that went to the device, which includes the program's own libraries). Not a test.
 set -eu
 if [ $# -lt 1 ]; then
-    sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
 root=$(cd "$(dirname "$0")/.." && pwd)
