@@ -89,6 +89,13 @@ uint64_t ip_cache_default_budget(void)
     return budget;
 }
 
+/* Bytes of scratch fill_group_ranges() needs for a brick of extent[0] x extent[1] samples in
+ * x and y (two slices and two rows). */
+static size_t group_scratch_bytes(size_t row, size_t slice, ip_type type)
+{
+    return 2 * (slice + row) * ip_type_size(type);
+}
+
 ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache **out,
                           ip_error *err)
 {
@@ -105,7 +112,12 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
     c->slots = calloc(n, sizeof *c->slots);
     c->touched = calloc(n, sizeof *c->touched);
     c->loading = calloc(n, 1);
+    /* decode scratch, reused for the cell-group ranges once a brick is decoded: one allocation
+     * per decoding thread, none per brick */
+    size_t edge = (size_t)c->layout->brick_edge + 1,
+           ranges = group_scratch_bytes(edge, edge * edge, c->layout->type);
     c->work_size = ip_store_read_work_size(store);
+    c->work_size = c->work_size > ranges ? c->work_size : ranges;
     if (!c->slots || !c->touched || !c->loading) {
         ip_cache_destroy(c);
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for a cache of %llu bricks",
@@ -453,23 +465,18 @@ static size_t entry_bytes(const uint32_t extent[3], ip_type type, size_t *group_
     return *group_offset + 2 * groups * size;
 }
 
-/* Fills the cell-group ranges of e from its samples. */
-static ip_status fill_group_ranges(ip_cache *c, entry *e)
+/* Fills the cell-group ranges of e from its samples, with `scratch` (a decode work buffer,
+ * which is at least group_scratch_bytes() for the largest brick). */
+static void fill_group_ranges(ip_cache *c, entry *e, void *scratch)
 {
     ip_type type = c->layout->type;
-    size_t row = e->extent[0], slice = row * e->extent[1];
-    void *scratch = malloc(2 * (slice + row) * ip_type_size(type)), *out;
-    if (!scratch)
-        return IP_ERR_NOMEM;
-    out = (char *)e->samples + e->group_offset;
+    void *out = (char *)e->samples + e->group_offset;
     switch (type) {
     case IP_UINT8: group_ranges_uint8(e->samples, e->extent, out, scratch); break;
     case IP_UINT16: group_ranges_uint16(e->samples, e->extent, out, scratch); break;
     case IP_INT16: group_ranges_int16(e->samples, e->extent, out, scratch); break;
     case IP_FLOAT32: group_ranges_float32(e->samples, e->extent, out, scratch); break;
     }
-    free(scratch);
-    return IP_OK;
 }
 
 /* Decodes brick g into e (not yet published), and computes its cell-group ranges. */
@@ -481,10 +488,9 @@ static ip_status decode_into(ip_cache *c, uint64_t g, entry *e, ip_error *err)
                         ip_store_path(c->store), (unsigned long long)g);
     double t0 = ip_now_seconds();
     ip_status st = ip_store_read_brick(c->store, g, e->samples, work, err);
+    if (st == IP_OK) /* the work buffer is free again: its scratch for the ranges */
+        fill_group_ranges(c, e, work);
     give_work(c, work);
-    if (st == IP_OK && fill_group_ranges(c, e) != IP_OK)
-        st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for brick %llu",
-                      ip_store_path(c->store), (unsigned long long)g);
     double t1 = ip_now_seconds();
     atomic_fetch_add(&c->decode_ns, (uint64_t)((t1 - t0) * 1e9));
     ip_brick_entry be;
