@@ -104,18 +104,25 @@ static float get_f32(const unsigned char *b)
     return f;
 }
 
+/* A mesh of the two triangles fill() makes (their corners in p). */
+static void two_triangles(ip_mesh *m, float p[18])
+{
+    float n[18];
+    uint64_t cells[2];
+    fill(p, n, cells, 2, 0);
+    ip_mesh_init(m);
+    REQUIRE(ip_mesh_append_float_normals(m, p, n, NULL, 2) == IP_OK);
+}
+
 static void test_ply(void)
 {
     const char *dir = test_tmp_dir("test_mesh");
     char path[4200];
     snprintf(path, sizeof path, "%s/two.ply", dir);
     remove(path);
-    float p[18], n[18];
-    uint64_t cells[2];
-    fill(p, n, cells, 2, 0);
+    float p[18];
     ip_mesh m;
-    ip_mesh_init(&m);
-    REQUIRE(ip_mesh_append_float_normals(&m, p, n, NULL, 2) == IP_OK);
+    two_triangles(&m, p);
     ip_error err;
     REQUIRE(ip_mesh_write_ply(&m, path, 0, &err) == IP_OK);
     CHECK(ip_mesh_write_ply(&m, path, 0, &err) == IP_ERR_EXISTS);
@@ -138,6 +145,84 @@ static void test_ply(void)
     CHECK(get_f32(v + 4 * 24 + 12) == 0.0f && get_f32(v + 4 * 24 + 16) == -1.0f);
     const unsigned char *face = v + 6 * 24 + 13;
     CHECK(face[0] == 3 && face[1] == 3 && face[5] == 4 && face[9] == 5);
+    ip_mesh_free(&m);
+}
+
+/* The bytes of file `path` (at most `capacity`); their count in *size. */
+static size_t read_file(const char *path, unsigned char *buf, size_t capacity)
+{
+    FILE *f = fopen(path, "rb");
+    REQUIRE(f);
+    size_t size = fread(buf, 1, capacity, f);
+    fclose(f);
+    return size;
+}
+
+/* Binary STL and OBJ of two triangles, by extension through ip_mesh_write(): sizes, corners,
+ * face normals, indices; an unknown extension is refused and writes nothing. */
+static void test_stl_obj(void)
+{
+    const char *dir = test_tmp_dir("test_mesh");
+    char stl[4200], obj[4200], bad[4200];
+    snprintf(stl, sizeof stl, "%s/two.STL", dir);
+    snprintf(obj, sizeof obj, "%s/two.obj", dir);
+    snprintf(bad, sizeof bad, "%s/two.off", dir);
+    remove(stl);
+    remove(obj);
+    remove(bad);
+    float p[18];
+    ip_mesh m;
+    two_triangles(&m, p);
+    ip_error err;
+    CHECK(strcmp(ip_mesh_format_of(stl), "STL") == 0 && strcmp(ip_mesh_format_of(obj), "OBJ") == 0);
+    CHECK(ip_mesh_format_of(bad) == NULL && ip_mesh_format_of(".stl") == NULL);
+    REQUIRE(ip_mesh_write(&m, stl, 0, &err) == IP_OK);
+    REQUIRE(ip_mesh_write(&m, obj, 0, &err) == IP_OK);
+    CHECK(ip_mesh_write(&m, bad, 0, &err) == IP_ERR_ARGUMENT && strstr(err.message, "two.off"));
+    FILE *f = fopen(bad, "rb");
+    CHECK(f == NULL);
+    if (f)
+        fclose(f);
+
+    static unsigned char buf[4096];
+    size_t size = read_file(stl, buf, sizeof buf);
+    CHECK(size == 84 + 2 * 50);
+    CHECK(memcmp(buf, "solid", 5) != 0);
+    CHECK(buf[80] == 2 && buf[81] == 0 && buf[82] == 0 && buf[83] == 0);
+    for (int t = 0; t < 2; t++) {
+        const unsigned char *r = buf + 84 + 50 * t;
+        float a[3], b[3], c[3], nx = get_f32(r), ny = get_f32(r + 4), nz = get_f32(r + 8);
+        for (int k = 0; k < 9; k++)
+            CHECK(get_f32(r + 12 + 4 * k) == p[9 * t + k]);
+        for (int k = 0; k < 3; k++) {
+            a[k] = p[9 * t + k];
+            b[k] = p[9 * t + 3 + k] - a[k];
+            c[k] = p[9 * t + 6 + k] - a[k];
+        }
+        /* the face normal is unit length and at right angles to both edges */
+        CHECK(fabsf(nx * nx + ny * ny + nz * nz - 1.0f) < 1e-5f);
+        CHECK(fabsf(nx * b[0] + ny * b[1] + nz * b[2]) < 1e-4f);
+        CHECK(fabsf(nx * c[0] + ny * c[1] + nz * c[2]) < 1e-4f);
+    }
+
+    size = read_file(obj, buf, sizeof buf - 1);
+    buf[size] = 0;
+    int v = 0, vn = 0, faces = 0;
+    for (char *line = strtok((char *)buf, "\n"); line; line = strtok(NULL, "\n")) {
+        float x, y, z;
+        if (sscanf(line, "v %f %f %f", &x, &y, &z) == 3) {
+            CHECK(x == p[3 * v] && y == p[3 * v + 1] && z == p[3 * v + 2]);
+            v++;
+        } else if (strncmp(line, "vn ", 3) == 0) {
+            vn++;
+        } else if (line[0] == 'f') {
+            unsigned a, b, c, a2, b2, c2;
+            CHECK(sscanf(line, "f %u//%u %u//%u %u//%u", &a, &a2, &b, &b2, &c, &c2) == 6);
+            CHECK(a == 3u * (unsigned)faces + 1 && b == a + 1 && c == a + 2 && a2 == a);
+            faces++;
+        }
+    }
+    CHECK(v == 6 && vn == 6 && faces == 2);
     ip_mesh_free(&m);
 }
 
@@ -196,5 +281,6 @@ int main(void)
     test_populated_growth();
     test_appends();
     test_ply();
+    test_stl_obj();
     return test_summary("test_mesh");
 }

@@ -37,7 +37,8 @@ static const char usage[] =
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
     "  --threads N         threads for seeding, propagation and --full (default: all cores)\n"
     "  -o OUT.png          the image (default isorender.png)\n"
-    "  --mesh OUT.ply      also write the triangles as binary PLY\n"
+    "  --mesh OUT          also write the triangles: binary PLY (.ply), binary STL (.stl)\n"
+    "                      or Wavefront OBJ (.obj), by the name's extension\n"
     "  --stats OUT.json    counts, times, warnings, the cache statistics and the overdraw\n"
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
@@ -405,8 +406,7 @@ static int finish(run *r, ip_error *err)
         IP_OK)
         rc = -1;
     free(rgba);
-    if (rc == 0 && r->o.mesh &&
-        ip_mesh_write_ply(r->mesh, r->o.mesh, r->o.common.force, err) != IP_OK)
+    if (rc == 0 && r->o.mesh && ip_mesh_write(r->mesh, r->o.mesh, r->o.common.force, err) != IP_OK)
         rc = -1;
     if (rc != 0)
         return tool_fail("isorender", err);
@@ -436,6 +436,9 @@ int main(int argc, char **argv)
     const char *outputs[] = {r.o.out, r.o.mesh, r.o.common.stats, r.o.full ? NULL : r.o.progress};
     if (tool_check_paths("isorender", inputs, 1, outputs, 4, r.o.common.force) != 0)
         return 1;
+    if (r.o.mesh && !ip_mesh_format_of(r.o.mesh)) /* before any work, after the paths' checks */
+        return tool_usage_error("isorender", "--mesh %s: the name must end in .ply, .stl or .obj",
+                                r.o.mesh);
     tool_signals_catch();
     ip_error err;
     ip_error_clear(&err);

@@ -95,6 +95,27 @@ IP_API ip_status ip_mesh_append_mesh(ip_mesh *mesh, const ip_mesh *from, uint64_
  *  exists and is not a regular file), IP_ERR_NOMEM or IP_ERR_IO. */
 IP_API ip_status ip_mesh_write_ply(const ip_mesh *mesh, const char *path, int force, ip_error *err);
 
+/*! ip_mesh_write_stl() : writes the mesh as binary STL (an 80-byte header that does not start
+ *  with "solid", the triangle count, then per triangle its unit face normal from its corners
+ *  and its 3 corners, float32 little-endian), atomically, like ip_mesh_write_ply(). STL keeps
+ *  no per-vertex normals. @return as ip_mesh_write_ply(), and IP_ERR_ARGUMENT for more than
+ *  2^32 - 1 triangles. */
+IP_API ip_status ip_mesh_write_stl(const ip_mesh *mesh, const char *path, int force, ip_error *err);
+
+/*! ip_mesh_write_obj() : writes the mesh as Wavefront OBJ text ("v x y z" and "vn nx ny nz"
+ *  per corner, 3 per triangle, then "f a//a b//b c//c", counting from 1), atomically, like
+ *  ip_mesh_write_ply(). @return as ip_mesh_write_ply(). */
+IP_API ip_status ip_mesh_write_obj(const ip_mesh *mesh, const char *path, int force, ip_error *err);
+
+/*! ip_mesh_format_of() : "PLY", "STL" or "OBJ" for a name ending in .ply, .stl or .obj
+ *  (ignoring case), NULL for any other (a static string: not to be freed). */
+IP_API const char *ip_mesh_format_of(const char *path);
+
+/*! ip_mesh_write() : writes the mesh in the format its name ends in, ignoring case: .ply,
+ *  .stl or .obj. @return as those, or IP_ERR_ARGUMENT with a message naming the file for any
+ *  other name. */
+IP_API ip_status ip_mesh_write(const ip_mesh *mesh, const char *path, int force, ip_error *err);
+
 #ifdef __cplusplus
 }
 #endif

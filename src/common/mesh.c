@@ -1,10 +1,9 @@
-/* Triangle soups: growth, append, binary PLY output. */
+/* Triangle soups: growth and append (the file formats: mesh_write.c). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "array.h"
-#include "atomic_file.h"
 #include "internal.h"
 #include "isoprop/mesh.h"
 
@@ -122,61 +121,4 @@ ip_status ip_mesh_append_mesh(ip_mesh *m, const ip_mesh *from, uint64_t first, u
         return IP_OK;
     return ip_mesh_append(m, from->positions + 9 * first, from->normals + 9 * first,
                           m->with_cells ? from->cells + first : NULL, count);
-}
-
-static void put_f32(unsigned char *p, float v)
-{
-    uint32_t bits;
-    memcpy(&bits, &v, 4);
-    ip__store_u32le(p, bits);
-}
-
-ip_status ip_mesh_write_ply(const ip_mesh *m, const char *path, int force, ip_error *err)
-{
-    ip_atomic_file out;
-    ip_status st = ip__atomic_create(&out, path, force, err);
-    if (st != IP_OK)
-        return st;
-    char header[512];
-    int n = snprintf(header, sizeof header,
-                     "ply\nformat binary_little_endian 1.0\ncomment isoprop isosurface\n"
-                     "element vertex %llu\nproperty float x\nproperty float y\nproperty float z\n"
-                     "property float nx\nproperty float ny\nproperty float nz\n"
-                     "element face %llu\nproperty list uchar int vertex_indices\nend_header\n",
-                     (unsigned long long)(3 * m->triangle_count),
-                     (unsigned long long)m->triangle_count);
-    uint64_t offset = 0;
-    st = ip__pwrite_all(out.fd, header, (size_t)n, 0, path, err);
-    offset += (uint64_t)n;
-    enum {
-        CHUNK = 4096
-    };
-    unsigned char *buf = malloc((size_t)CHUNK * 3 * 24);
-    if (!buf && st == IP_OK)
-        st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path);
-    for (uint64_t t = 0; st == IP_OK && t < m->triangle_count; t += CHUNK) {
-        uint64_t count = m->triangle_count - t < CHUNK ? m->triangle_count - t : CHUNK;
-        for (uint64_t i = 0; i < count * 3; i++)
-            for (int k = 0; k < 3; k++) {
-                put_f32(buf + 24 * i + 4 * k, m->positions[9 * t + 3 * i + k]);
-                put_f32(buf + 24 * i + 12 + 4 * k, ip_normal_unpack(m->normals[9 * t + 3 * i + k]));
-            }
-        st = ip__pwrite_all(out.fd, buf, count * 72, offset, path, err);
-        offset += count * 72;
-    }
-    for (uint64_t t = 0; st == IP_OK && t < m->triangle_count; t += CHUNK) {
-        uint64_t count = m->triangle_count - t < CHUNK ? m->triangle_count - t : CHUNK;
-        for (uint64_t i = 0; i < count; i++) {
-            buf[13 * i] = 3;
-            for (int k = 0; k < 3; k++)
-                ip__store_u32le(buf + 13 * i + 1 + 4 * k, (uint32_t)(3 * (t + i) + (uint64_t)k));
-        }
-        st = ip__pwrite_all(out.fd, buf, count * 13, offset, path, err);
-        offset += count * 13;
-    }
-    free(buf);
-    if (st == IP_OK)
-        return ip__atomic_commit(&out, err);
-    ip__atomic_abort(&out);
-    return st;
 }
