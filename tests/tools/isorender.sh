@@ -12,12 +12,12 @@ check "the summary is printed" grep -q "triangles" "$work/.out"
 check "the cache table is printed" grep -q "cache statistics" "$work/.out"
 check "the cache table shows reading ahead" grep -q "read ahead" "$work/.out"
 check "the PLY header" sh -c 'head -c 200 p.ply | grep -q "format binary_little_endian 1.0"'
-# the same mesh as binary STL (84 + 50 bytes per triangle) by the name's extension
-triangles=$(sed -n 's/^element face \([0-9]*\)$/\1/p' p.ply | head -1)
+# the mesh as binary STL by the name's extension: 84 bytes, then 50 per triangle of the run
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o p2.png --lod off \
-    --mesh p.stl --software --quiet
+    --mesh p.stl --stats p2.json --software --quiet
 check "--mesh .stl succeeds" test "$rc" = 0
-check "the STL holds the PLY's $triangles triangles" test "$(stat -c %s p.stl)" = $((84 + 50 * triangles))
+triangles=$(sed -n 's/.*"triangles": *\([0-9]*\).*/\1/p' p2.json | head -1)
+check "the STL holds the run's $triangles triangles" test "$(stat -c %s p.stl)" = $((84 + 50 * triangles))
 expect_error 2 "p.off" "$bin/isorender" s.ibv --iso 100.5 --mesh p.off -o x.png
 check "an unknown mesh format writes nothing" sh -c '! test -e p.off && ! test -e x.png'
 json=$(cat p.json)
