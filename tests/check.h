@@ -2,6 +2,7 @@
 #ifndef ISOPROP_TEST_CHECK_H
 #define ISOPROP_TEST_CHECK_H
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -45,6 +46,16 @@ static int test_checks_failed;
 
 /* The scratch folders test_tmp_dir() made, removed by test_summary() when every check
  * passed and kept, for diagnosis, otherwise (and after a REQUIRE or a crash). */
+/* The next value of a xorshift64 generator (*state nonzero, updated): reproducible test data. */
+static inline uint64_t test_xorshift(uint64_t *state)
+{
+    uint64_t x = *state;
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    return *state = x;
+}
+
 #define TEST_TMP_DIRS_MAX 16
 static char test_tmp_dirs[TEST_TMP_DIRS_MAX][4096];
 static int test_tmp_dir_count;

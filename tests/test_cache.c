@@ -331,7 +331,7 @@ static void test_group_ranges(const char *dir)
     REQUIRE(f);
     uint64_t x = 88172645463325252ull;
     for (int i = 0; i < 27 * 22 * 19; i++) {
-        x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+        test_xorshift(&x);
         int16_t v = (int16_t)((int)(x % 4001) - 2000);
         REQUIRE(fwrite(&v, sizeof v, 1, f) == 1);
     }

@@ -20,10 +20,7 @@ static uint64_t rng_state = 0x2545F4914F6CDD1Dull;
 
 static uint32_t next_random(void)
 {
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (uint32_t)(rng_state >> 16);
+    return (uint32_t)(test_xorshift(&rng_state) >> 16);
 }
 
 static const unsigned filter_sets[] = {0,

@@ -209,28 +209,6 @@ static void reseal(image *m)
     ip__store_u64le(h + IP_HDR_CHECKSUM, ip__format_checksum(h, IP_HDR_CHECKSUM));
 }
 
-static void put_f32(unsigned char *p, float v)
-{
-    uint32_t bits;
-    memcpy(&bits, &v, 4);
-    ip__store_u32le(p, bits);
-}
-
-static float get_f32(const unsigned char *p)
-{
-    uint32_t bits = ip__load_u32le(p);
-    float v;
-    memcpy(&v, &bits, 4);
-    return v;
-}
-
-static void put_f64(unsigned char *p, double v)
-{
-    uint64_t bits;
-    memcpy(&bits, &v, 8);
-    ip__store_u64le(p, bits);
-}
-
 static void make_image(image *m)
 {
     const uint32_t dims[3] = {13, 9, 6};
@@ -271,17 +249,17 @@ static void make_image(image *m)
                                  ip__format_checksum(payload, raw)};
         ip__format_entry_encode(&e, summary + m->o.directory + g * IP_DIRECTORY_ENTRY_SIZE);
         unsigned char *r = summary + m->o.brick_ranges + g * IP_RANGE_SIZE;
-        put_f32(r + IP_RANGE_MIN, 5);
-        put_f32(r + IP_RANGE_MAX, g == 0 ? 9 : 5);
+        ip__store_f32le(r + IP_RANGE_MIN, 5);
+        ip__store_f32le(r + IP_RANGE_MAX, g == 0 ? 9 : 5);
         for (uint32_t i = 0; i < P3; i++) {
             unsigned char *sr = summary + m->o.subblock_ranges + (g * P3 + i) * IP_RANGE_SIZE;
-            put_f32(sr + IP_RANGE_MIN, 5);
-            put_f32(sr + IP_RANGE_MAX, 5);
+            ip__store_f32le(sr + IP_RANGE_MIN, 5);
+            ip__store_f32le(sr + IP_RANGE_MAX, 5);
         }
     }
     for (uint64_t n = 0; n < l->node_count; n++) {
-        put_f32(summary + m->o.nodes + n * IP_RANGE_SIZE + IP_RANGE_MIN, 5);
-        put_f32(summary + m->o.nodes + n * IP_RANGE_SIZE + IP_RANGE_MAX, 9);
+        ip__store_f32le(summary + m->o.nodes + n * IP_RANGE_SIZE + IP_RANGE_MIN, 5);
+        ip__store_f32le(summary + m->o.nodes + n * IP_RANGE_SIZE + IP_RANGE_MAX, 9);
     }
     ip__format_header_encode(l, m->bytes);
     reseal(m);
@@ -313,7 +291,7 @@ static void test_header_round_trip(void)
           ip__load_u32le(h + IP_HDR_SUBBLOCK_EDGE) == 2);
     CHECK(ip__load_u32le(h + IP_HDR_LEVEL_COUNT) == l->level_count);
     CHECK(ip__load_u32le(h + IP_HDR_FLAGS) == 0);
-    CHECK(get_f32(h + IP_HDR_VALUE_MIN) == 5 && get_f32(h + IP_HDR_VALUE_MAX) == 9);
+    CHECK(ip__load_f32le(h + IP_HDR_VALUE_MIN) == 5 && ip__load_f32le(h + IP_HDR_VALUE_MAX) == 9);
     CHECK(ip__load_u64le(h + IP_HDR_BRICK_COUNT) == l->brick_count);
     CHECK(ip__load_u64le(h + IP_HDR_NODE_COUNT) == l->node_count);
     CHECK(ip__load_u64le(h + IP_HDR_DATA_OFFSET) == 256);
@@ -419,7 +397,7 @@ static void set_spacing_y(image *m, uint64_t bits)
 {
     double v;
     memcpy(&v, &bits, 8);
-    put_f64(m->bytes + IP_HDR_SPACING + 8, v);
+    ip__store_f64le(m->bytes + IP_HDR_SPACING + 8, v);
 }
 
 static uint64_t double_bits(double v)
@@ -464,7 +442,7 @@ static void set_value_max(image *m, uint64_t bits)
     float v;
     uint32_t b = (uint32_t)bits;
     memcpy(&v, &b, 4);
-    put_f32(m->bytes + IP_HDR_VALUE_MAX, v);
+    ip__store_f32le(m->bytes + IP_HDR_VALUE_MAX, v);
 }
 
 static void shorten(image *m, uint64_t n)
@@ -550,7 +528,7 @@ static void set_level_u64(image *m, uint64_t offset)
 
 static void set_level_nan(image *m, uint64_t offset)
 {
-    put_f32(summary_of(m) + m->o.level_table + offset, NAN);
+    ip__store_f32le(summary_of(m) + m->o.level_table + offset, NAN);
 }
 
 /* arg: brick g << 8 | field offset in the directory entry; the byte is or'ed with 0x10 */
@@ -588,7 +566,8 @@ static void set_brick_max(image *m, uint64_t arg)
     float v;
     uint32_t bits = (uint32_t)arg;
     memcpy(&v, &bits, 4);
-    put_f32(summary_of(m) + m->o.brick_ranges + (arg >> 32) * IP_RANGE_SIZE + IP_RANGE_MAX, v);
+    ip__store_f32le(summary_of(m) + m->o.brick_ranges + (arg >> 32) * IP_RANGE_SIZE + IP_RANGE_MAX,
+                    v);
 }
 
 static void gap_byte(image *m, uint64_t i)

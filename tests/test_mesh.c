@@ -96,14 +96,6 @@ static void test_appends(void)
     free(cells);
 }
 
-static float get_f32(const unsigned char *b)
-{
-    uint32_t u = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
-    float f;
-    memcpy(&f, &u, 4);
-    return f;
-}
-
 /* A mesh of the two triangles fill() makes (their corners in p). */
 static void two_triangles(ip_mesh *m, float p[18])
 {
@@ -141,8 +133,8 @@ static void test_ply(void)
     CHECK(size == body + 6 * 24 + 2 * 13); /* 6 vertices of 6 floats, 2 faces of 1 + 3 ints */
     const unsigned char *v = buf + body;
     /* vertex 4 (triangle 1, vertex 1): position p[12..14], normal (0, -1, 0) */
-    CHECK(get_f32(v + 4 * 24) == p[12] && get_f32(v + 4 * 24 + 8) == p[14]);
-    CHECK(get_f32(v + 4 * 24 + 12) == 0.0f && get_f32(v + 4 * 24 + 16) == -1.0f);
+    CHECK(ip__load_f32le(v + 4 * 24) == p[12] && ip__load_f32le(v + 4 * 24 + 8) == p[14]);
+    CHECK(ip__load_f32le(v + 4 * 24 + 12) == 0.0f && ip__load_f32le(v + 4 * 24 + 16) == -1.0f);
     const unsigned char *face = v + 6 * 24 + 13;
     CHECK(face[0] == 3 && face[1] == 3 && face[5] == 4 && face[9] == 5);
     ip_mesh_free(&m);
@@ -191,9 +183,10 @@ static void test_stl_obj(void)
     CHECK(buf[80] == 2 && buf[81] == 0 && buf[82] == 0 && buf[83] == 0);
     for (int t = 0; t < 2; t++) {
         const unsigned char *r = buf + 84 + 50 * t;
-        float a[3], b[3], c[3], nx = get_f32(r), ny = get_f32(r + 4), nz = get_f32(r + 8);
+        float a[3], b[3], c[3], nx = ip__load_f32le(r), ny = ip__load_f32le(r + 4),
+                                nz = ip__load_f32le(r + 8);
         for (int k = 0; k < 9; k++)
-            CHECK(get_f32(r + 12 + 4 * k) == p[9 * t + k]);
+            CHECK(ip__load_f32le(r + 12 + 4 * k) == p[9 * t + k]);
         for (int k = 0; k < 3; k++) {
             a[k] = p[9 * t + k];
             b[k] = p[9 * t + 3 + k] - a[k];

@@ -9,6 +9,7 @@
 
 #include "check.h"
 #include "format.h"
+#include "internal.h"
 #include "isoprop/bricker.h"
 #include "isoprop/generate.h"
 #include "isoprop/store.h"
@@ -355,8 +356,7 @@ static void test_compact_summaries(const char *dir)
         const unsigned char *stored =
             file + l->summary_offset + off.subblock_ranges + g * sub * IP_RANGE_SIZE;
         for (uint32_t i = 0; i < 2 * sub; i++) {
-            uint32_t a, b = (uint32_t)stored[4 * i] | (uint32_t)stored[4 * i + 1] << 8 |
-                            (uint32_t)stored[4 * i + 2] << 16 | (uint32_t)stored[4 * i + 3] << 24;
+            uint32_t a, b = ip__load_u32le(stored + 4 * i);
             memcpy(&a, &held[i], 4);
             mismatches += a != b;
         }

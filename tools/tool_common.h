@@ -89,6 +89,17 @@ typedef struct tool_view_options {
     int force, quiet;
 } tool_view_options;
 
+/* The --help lines of the shared options that steer the engine (the usage texts of isorender
+ * and isoview include them). */
+#define TOOL_ENGINE_OPTIONS_HELP                                                                   \
+    "  --cutoff DEGREES    propagation cut-off angle (default 1.81)\n"                             \
+    "  --foldback DEGREES  fold-back tolerance (default 0.25)\n"                                   \
+    "  --lod on|off        adaptive resolution: far regions from coarser levels (default on)\n"    \
+    "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n" \
+    "  --occlusion on|off  propagation skips cells that extracted surface hides (default on)\n"    \
+    "  --prefetch on|off   a background thread reads and decodes the bricks the next rays need\n"  \
+    "                      (default on)\n"
+
 /* The defaults: view -y, the paper's angles, lod on with a 1-pixel error, occlusion on, reading
  * ahead on, every core, the
  * default cache budget, an image of width x height. */

@@ -23,14 +23,6 @@ static uint32_t ceil_div(uint64_t a, uint64_t b)
     return (uint32_t)((a + b - 1) / b);
 }
 
-static uint32_t ceil_log2(uint32_t v)
-{
-    uint32_t r = 0;
-    while ((1ull << r) < v)
-        r++;
-    return r;
-}
-
 uint32_t ip_level_sample_index(uint32_t dim, uint32_t level, uint32_t i)
 {
     uint64_t s = (uint64_t)i << level;
@@ -45,7 +37,7 @@ static void level_shape(const ip_layout *layout, uint32_t k, ip_level_layout *lv
         uint32_t level_cells = (uint32_t)((cells + (1ull << k) - 1) >> k);
         lv->dims[a] = level_cells + 1;
         lv->bricks[a] = ceil_div(level_cells, layout->brick_edge);
-        uint32_t depth = ceil_log2(lv->bricks[a]);
+        uint32_t depth = ip__ceil_log2(lv->bricks[a]);
         if (depth > deepest)
             deepest = depth;
     }
@@ -257,36 +249,6 @@ ip_status ip__morton_order(const ip_layout *layout, uint32_t level, uint64_t *or
 
 /* ---- encoding ---- */
 
-static void store_f32(unsigned char *p, float v)
-{
-    uint32_t bits;
-    memcpy(&bits, &v, 4);
-    ip__store_u32le(p, bits);
-}
-
-static float load_f32(const unsigned char *p)
-{
-    uint32_t bits = ip__load_u32le(p);
-    float v;
-    memcpy(&v, &bits, 4);
-    return v;
-}
-
-static void store_f64(unsigned char *p, double v)
-{
-    uint64_t bits;
-    memcpy(&bits, &v, 8);
-    ip__store_u64le(p, bits);
-}
-
-static double load_f64(const unsigned char *p)
-{
-    uint64_t bits = ip__load_u64le(p);
-    double v;
-    memcpy(&v, &bits, 8);
-    return v;
-}
-
 void ip__format_header_encode(const ip_layout *layout, unsigned char out[IP_HEADER_SIZE])
 {
     memset(out, 0, IP_HEADER_SIZE);
@@ -295,15 +257,15 @@ void ip__format_header_encode(const ip_layout *layout, unsigned char out[IP_HEAD
     ip__store_u32le(out + IP_HDR_HEADER_SIZE, IP_HEADER_SIZE);
     for (int a = 0; a < 3; a++) {
         ip__store_u32le(out + IP_HDR_DIMS + 4 * a, layout->dims[a]);
-        store_f64(out + IP_HDR_SPACING + 8 * a, layout->spacing[a]);
+        ip__store_f64le(out + IP_HDR_SPACING + 8 * a, layout->spacing[a]);
     }
     ip__store_u32le(out + IP_HDR_TYPE, (uint32_t)layout->type);
     ip__store_u32le(out + IP_HDR_BRICK_EDGE, layout->brick_edge);
     ip__store_u32le(out + IP_HDR_SUBBLOCK_EDGE, layout->subblock_edge);
     ip__store_u32le(out + IP_HDR_LEVEL_COUNT, layout->level_count);
     ip__store_u32le(out + IP_HDR_FLAGS, 0);
-    store_f32(out + IP_HDR_VALUE_MIN, layout->value_min);
-    store_f32(out + IP_HDR_VALUE_MAX, layout->value_max);
+    ip__store_f32le(out + IP_HDR_VALUE_MIN, layout->value_min);
+    ip__store_f32le(out + IP_HDR_VALUE_MAX, layout->value_max);
     ip__store_u64le(out + IP_HDR_BRICK_COUNT, layout->brick_count);
     ip__store_u64le(out + IP_HDR_NODE_COUNT, layout->node_count);
     ip__store_u64le(out + IP_HDR_DATA_OFFSET, layout->data_offset);
@@ -329,8 +291,8 @@ void ip__format_level_table_encode(const ip_layout *layout, unsigned char *out)
         ip__store_u64le(e + IP_LVL_FIRST_BRICK, lv->first_brick);
         ip__store_u32le(e + IP_LVL_OCTREE_DEPTH, lv->octree_depth);
         ip__store_u64le(e + IP_LVL_FIRST_NODE, lv->first_node);
-        store_f32(e + IP_LVL_VALUE_MIN, lv->value_min);
-        store_f32(e + IP_LVL_VALUE_MAX, lv->value_max);
+        ip__store_f32le(e + IP_LVL_VALUE_MIN, lv->value_min);
+        ip__store_f32le(e + IP_LVL_VALUE_MAX, lv->value_max);
     }
 }
 
@@ -379,7 +341,7 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
     double spacing[3];
     for (int a = 0; a < 3; a++) {
         dims[a] = ip__load_u32le(h + IP_HDR_DIMS + 4 * a);
-        spacing[a] = load_f64(h + IP_HDR_SPACING + 8 * a);
+        spacing[a] = ip__load_f64le(h + IP_HDR_SPACING + 8 * a);
     }
     uint32_t type = ip__load_u32le(h + IP_HDR_TYPE);
     if (type >= IP_TYPE_COUNT)
@@ -404,8 +366,8 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
         ip__load_u64le(h + IP_HDR_NODE_COUNT) != layout->node_count)
         return ip__fail(err, IP_ERR_FORMAT,
                         "%s: level, brick or node counts disagree with the dimensions", name);
-    layout->value_min = load_f32(h + IP_HDR_VALUE_MIN);
-    layout->value_max = load_f32(h + IP_HDR_VALUE_MAX);
+    layout->value_min = ip__load_f32le(h + IP_HDR_VALUE_MIN);
+    layout->value_max = ip__load_f32le(h + IP_HDR_VALUE_MAX);
     layout->data_offset = ip__load_u64le(h + IP_HDR_DATA_OFFSET);
     layout->data_size = ip__load_u64le(h + IP_HDR_DATA_SIZE);
     layout->summary_offset = ip__load_u64le(h + IP_HDR_SUMMARY_OFFSET);
@@ -458,8 +420,8 @@ static ip_status check_level_table(const ip_layout *l, const unsigned char *tabl
                             "%s: level %u of the level table disagrees with "
                             "the header",
                             name, k);
-        out->levels[k].value_min = load_f32(e + IP_LVL_VALUE_MIN);
-        out->levels[k].value_max = load_f32(e + IP_LVL_VALUE_MAX);
+        out->levels[k].value_min = ip__load_f32le(e + IP_LVL_VALUE_MIN);
+        out->levels[k].value_max = ip__load_f32le(e + IP_LVL_VALUE_MAX);
         if (!range_ok(out->levels[k].value_min, out->levels[k].value_max))
             return ip__fail(err, IP_ERR_FORMAT, "%s: level %u has an invalid value range", name, k);
     }
@@ -542,7 +504,8 @@ ip_status ip__format_check_summary(ip_layout *layout, const unsigned char *gap,
         ip_brick_entry e;
         ip__format_entry_decode(d, &e);
         st = check_entry(layout, g, &e, d[IP_DIR_RESERVED] | d[IP_DIR_RESERVED + 1],
-                         load_f32(r + IP_RANGE_MIN), load_f32(r + IP_RANGE_MAX), name, err);
+                         ip__load_f32le(r + IP_RANGE_MIN), ip__load_f32le(r + IP_RANGE_MAX), name,
+                         err);
         if (st != IP_OK)
             return st;
     }

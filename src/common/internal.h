@@ -4,6 +4,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "isoprop/status.h"
 #include "isoprop/system.h"
@@ -59,6 +60,42 @@ static inline void ip__store_u64le(unsigned char *p, uint64_t v)
 {
     ip__store_u32le(p, (uint32_t)v);
     ip__store_u32le(p + 4, (uint32_t)(v >> 32));
+}
+
+static inline float ip__load_f32le(const unsigned char *p)
+{
+    uint32_t bits = ip__load_u32le(p);
+    float v;
+    memcpy(&v, &bits, 4);
+    return v;
+}
+static inline double ip__load_f64le(const unsigned char *p)
+{
+    uint64_t bits = ip__load_u64le(p);
+    double v;
+    memcpy(&v, &bits, 8);
+    return v;
+}
+static inline void ip__store_f32le(unsigned char *p, float v)
+{
+    uint32_t bits;
+    memcpy(&bits, &v, 4);
+    ip__store_u32le(p, bits);
+}
+static inline void ip__store_f64le(unsigned char *p, double v)
+{
+    uint64_t bits;
+    memcpy(&bits, &v, 8);
+    ip__store_u64le(p, bits);
+}
+
+/* The smallest r with 2^r >= v (0 for v <= 1): the exponent of a power of two. */
+static inline uint32_t ip__ceil_log2(uint64_t v)
+{
+    uint32_t r = 0;
+    while ((UINT64_C(1) << r) < v)
+        r++;
+    return r;
 }
 
 /* 1 on a little-endian host. */

@@ -67,13 +67,6 @@ static ip_status writer_close(writer *w)
     return w->st;
 }
 
-static void put_f32(unsigned char *p, float v)
-{
-    uint32_t bits;
-    memcpy(&bits, &v, 4);
-    ip__store_u32le(p, bits);
-}
-
 /* Appends printf-formatted text (a line of at most 255 bytes). */
 static void put_text(writer *w, const char *format, ...) __attribute__((format(printf, 2, 3)));
 static void put_text(writer *w, const char *format, ...)
@@ -107,8 +100,8 @@ ip_status ip_mesh_write_ply(const ip_mesh *m, const char *path, int force, ip_er
         if (!p)
             break;
         for (int k = 0; k < 3; k++) {
-            put_f32(p + 4 * k, m->positions[3 * i + k]);
-            put_f32(p + 12 + 4 * k, ip_normal_unpack(m->normals[3 * i + k]));
+            ip__store_f32le(p + 4 * k, m->positions[3 * i + k]);
+            ip__store_f32le(p + 12 + 4 * k, ip_normal_unpack(m->normals[3 * i + k]));
         }
         w.used += 24;
     }
@@ -159,9 +152,9 @@ ip_status ip_mesh_write_stl(const ip_mesh *m, const char *path, int force, ip_er
         float n[3];
         face_normal(m, t, n);
         for (int k = 0; k < 3; k++)
-            put_f32(p + 4 * k, n[k]);
+            ip__store_f32le(p + 4 * k, n[k]);
         for (int k = 0; k < 9; k++)
-            put_f32(p + 12 + 4 * k, m->positions[9 * t + k]);
+            ip__store_f32le(p + 12 + 4 * k, m->positions[9 * t + k]);
         p[48] = p[49] = 0; /* attribute byte count */
         w.used += 50;
     }
@@ -211,9 +204,9 @@ ip_status ip_mesh_write(const ip_mesh *m, const char *path, int force, ip_error 
     if (!format)
         return ip__fail(err, IP_ERR_ARGUMENT,
                         "%s: unknown mesh format (the name must end in .ply, .stl or .obj)", path);
-    if (format[0] == 'S')
+    if (strcmp(format, "STL") == 0)
         return ip_mesh_write_stl(m, path, force, err);
-    if (format[0] == 'O')
+    if (strcmp(format, "OBJ") == 0)
         return ip_mesh_write_obj(m, path, force, err);
     return ip_mesh_write_ply(m, path, force, err);
 }

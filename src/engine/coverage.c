@@ -178,24 +178,14 @@ static void add_projected(ip_coverage *c, const double *x, const double *y, cons
 
 void ip__coverage_add(ip_coverage *c, const float *positions, uint64_t count)
 {
-    /* The corners are projected a chunk at a time, in one loop without branches. */
-    enum {
-        CHUNK = 16
-    };
-    double x[3 * CHUNK], y[3 * CHUNK], z[3 * CHUNK];
-    for (uint64_t first = 0; first < count; first += CHUNK) {
-        unsigned n = count - first < CHUNK ? (unsigned)(count - first) : CHUNK;
-        const float *p = positions + 9 * first;
-        for (unsigned k = 0; k < 3 * n; k++) {
-            double v[3] = {p[3 * k] - c->camera.eye[0], p[3 * k + 1] - c->camera.eye[1],
-                           p[3 * k + 2] - c->camera.eye[2]};
-            z[k] = ip__vec3_dot(v, c->basis.forward);
-            double r = 1.0 / z[k];
-            x[k] = ip__vec3_dot(v, c->to_x) * r + c->centre_x;
-            y[k] = ip__vec3_dot(v, c->to_y) * r + c->centre_y;
+    for (uint64_t t = 0; t < count; t++) {
+        double x[3], y[3], z[3];
+        for (int k = 0; k < 3; k++) {
+            const float *f = positions + 9 * t + 3 * k;
+            double p[3] = {f[0], f[1], f[2]};
+            project(c, p, &x[k], &y[k], &z[k]);
         }
-        for (unsigned t = 0; t < n; t++)
-            add_projected(c, x + 3 * t, y + 3 * t, z + 3 * t);
+        add_projected(c, x, y, z);
     }
 }
 

@@ -12,8 +12,7 @@ ip_status ip__sampler_init(ip_sampler *s, ip_cache *cache, uint32_t level)
     s->cache = cache;
     s->layout = ip_store_layout(ip_cache_store(cache));
     s->level = level;
-    while ((1u << s->edge_shift) < s->layout->brick_edge) /* a power of two */
-        s->edge_shift++;
+    s->edge_shift = ip__ceil_log2(s->layout->brick_edge); /* a power of two */
     for (int a = 0; a < 3; a++) {
         s->dims[a] = s->layout->levels[level].dims[a];
         s->world[a] = malloc(s->dims[a] * sizeof(double));

@@ -11,8 +11,7 @@ ip_status ip__visited_init(ip_visited *v, const ip_layout *layout)
     v->layout = layout;
     uint64_t b = layout->brick_edge;
     v->words_per_brick = (b * b * b + 63) / 64;
-    while ((UINT64_C(1) << v->edge_shift) < b)
-        v->edge_shift++;
+    v->edge_shift = ip__ceil_log2(b);
     v->bitmaps = calloc(layout->brick_count, sizeof *v->bitmaps);
     atomic_init(&v->bytes, 0);
     return v->bitmaps ? IP_OK : IP_ERR_NOMEM;

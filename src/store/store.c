@@ -102,10 +102,8 @@ static ip_status read_at(const ip_store *s, void *dst, size_t size, uint64_t off
 /* Host floats from `count` little-endian ones. */
 static void load_floats(const unsigned char *src, float *dst, uint64_t count)
 {
-    for (uint64_t i = 0; i < count; i++) {
-        uint32_t bits = ip__load_u32le(src + 4 * i);
-        memcpy(&dst[i], &bits, 4);
-    }
+    for (uint64_t i = 0; i < count; i++)
+        dst[i] = ip__load_f32le(src + 4 * i);
 }
 
 /* Reads `size` bytes of the summary section from `offset` (relative to it) into dst and adds
@@ -120,17 +118,17 @@ static ip_status read_summary_part(ip_store *s, void *dst, uint64_t size, uint64
     return st;
 }
 
-/* Appends one block of sub-block ranges (host floats); returns its index, or UINT32_MAX when
- * out of memory. */
-static uint32_t add_block(ip_store *s, const float *ranges)
+/* A new block of sub-block ranges (2 * subblocks floats, to be filled) and its index in
+ * *index; NULL when out of memory. */
+static float *new_block(ip_store *s, uint32_t *index)
 {
     size_t floats = 2 * (size_t)s->subblocks;
     if (s->block_count >= UINT32_MAX - 1 ||
         ip__array_reserve(&s->blocks, &s->block_capacity, (s->block_count + 1) * floats,
                           sizeof(float), 64 * floats) != IP_OK)
-        return UINT32_MAX;
-    memcpy(s->blocks + s->block_count * floats, ranges, floats * sizeof(float));
-    return (uint32_t)s->block_count++;
+        return NULL;
+    *index = (uint32_t)s->block_count;
+    return s->blocks + s->block_count++ * floats;
 }
 
 /* The shared blocks of uniform bricks by value: an open-addressing table of `slots` (a power
@@ -176,16 +174,13 @@ static uint32_t uniform_block(ip_store *s, uniform_table *t, uint32_t bits)
     while (t->block[j] != UINT32_MAX && t->keys[j] != bits)
         j = (j + 1) & (t->slots - 1);
     if (t->block[j] == UINT32_MAX) {
-        float v, *uniform = malloc(2 * (size_t)s->subblocks * sizeof(float));
+        uint32_t b;
+        float v, *uniform = new_block(s, &b);
         if (!uniform)
             return UINT32_MAX;
         memcpy(&v, &bits, 4);
         for (uint32_t i = 0; i < 2 * s->subblocks; i++)
             uniform[i] = v;
-        uint32_t b = add_block(s, uniform);
-        free(uniform);
-        if (b == UINT32_MAX)
-            return b;
         t->keys[j] = bits;
         t->block[j] = b;
         t->used++;
@@ -204,7 +199,14 @@ static uint32_t block_for(ip_store *s, uniform_table *t, const float *r)
         memcpy(&other, &r[i], 4);
         uniform = other == bits;
     }
-    return uniform ? uniform_block(s, t, bits) : add_block(s, r);
+    if (uniform)
+        return uniform_block(s, t, bits);
+    uint32_t b;
+    float *own = new_block(s, &b);
+    if (!own)
+        return UINT32_MAX;
+    memcpy(own, r, 2 * (size_t)s->subblocks * sizeof(float));
+    return b;
 }
 
 /* The sub-block ranges, read in pieces of whole bricks and compacted (see struct ip_store). */
