@@ -29,8 +29,7 @@ fi
 # view ARGS...: runs isoview in its own virtual screen; sets $rc, $out, $err and $elapsed (s).
 view() {
     started=$(date +%s%N)
-    run_capture timeout 300 xvfb-run -a -s "-screen 0 1280x1024x24" \
-        env ${preload:+LD_PRELOAD=$preload} "$bin/isoview" "$@"
+    in_xvfb 99 1280x1024x24 "$bin/isoview" "$@"
     elapsed=$(( ($(date +%s%N) - started) / 1000000000 ))
 }
 

@@ -32,6 +32,24 @@ check() {
     if "$@"; then ok; else bad "$desc"; fi
 }
 
+# in_xvfb FIRST_DISPLAY SCREEN COMMAND...: runs COMMAND in a virtual X server (xvfb-run,
+# display numbers from FIRST_DISPLAY, screen WxHxD) with $preload (Mesa's driver kept loaded
+# under AddressSanitizer), under `timeout 300`; stdout in $out, stderr in $err, and in $rc the
+# status of COMMAND itself, kept in a file: xvfb-run's own status also reflects its clean-up,
+# which can fail when another test's server starts or stops at the same time.
+in_xvfb() {
+    ix_first=$1 ix_screen=$2
+    shift 2
+    rm -f "$work/.xvfb-status"
+    timeout 300 xvfb-run -a -n "$ix_first" -s "-screen 0 $ix_screen" \
+        env ${preload:+LD_PRELOAD=$preload} sh -c '"$@"; echo $? >"$0"' "$work/.xvfb-status" \
+        "$@" >"$work/.out" 2>"$work/.err"
+    ix_status=$?
+    rc=$(cat "$work/.xvfb-status" 2>/dev/null || echo "none (xvfb-run status $ix_status)")
+    out=$(cat "$work/.out")
+    err=$(grep -v '^xvfb-run: error: problem while cleaning up' "$work/.err")
+}
+
 # signal_when_ready SIGNAL AFTER PID: waits (up to 60 s) until process PID has a handler for
 # SIGNAL (INT or TERM: its SigCgt mask in /proc), then AFTER seconds more, and sends it the
 # signal. A signal sent before the program installs its handlers (a slow start under the

@@ -79,16 +79,9 @@ check "isoinfo --verify writes no --stats" none_of v.json
 if command -v xvfb-run >/dev/null 2>&1; then
     # ($preload, from lib.sh, keeps Mesa's driver loaded under AddressSanitizer)
     printf 'wait 60\nscreenshot late.png\nquit\n' >late.txt
-    # isoview's own status, kept in a file: xvfb-run's status also reflects its own clean-up,
-    # which can fail when another test's virtual server starts or stops at the same time (its
-    # display numbers start at 150, away from isoview.sh's, which start at xvfb-run's 99)
-    rm -f view.status
-    timeout 120 xvfb-run -a -n 150 -s "-screen 0 640x480x24" env ${preload:+LD_PRELOAD=$preload} \
-        sh -c 'timeout --preserve-status -s INT 3 "$@"; echo $? >view.status' isoview \
-        "$bin/isoview" g.ibv --iso 128.5 --size 320x240 --stats view.json --script late.txt \
-        --quiet >"$work/.out" 2>"$work/.err"
-    rc=$(cat view.status 2>/dev/null || echo "none (xvfb-run status $?)")
-    err=$(cat "$work/.err")
+    # (display numbers from 150, away from isoview.sh's, which start at 99)
+    in_xvfb 150 640x480x24 timeout --preserve-status -s INT 3 \
+        "$bin/isoview" g.ibv --iso 128.5 --size 320x240 --stats view.json --script late.txt --quiet
     check "isoview ends as killed by SIGINT (status $rc, want 130: $err)" test "$rc" = 130
     check "isoview writes no --stats and no screenshot" none_of view.json late.png
 else
