@@ -70,8 +70,7 @@ typedef struct options {
     tool_view_options common;
     const char *file, *out, *mesh, *progress, *strip;
     int full, software, warm; /* --stats, --force and --quiet are in common */
-    strip_plan strip_at;
-    int strip_at_given;
+    strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
 } options;
 
 /* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
@@ -165,16 +164,15 @@ static int parse_strip_at(const char *program, const tool_option *option, const 
  * error. */
 static int check_strip_options(options *o)
 {
-    o->strip_at_given = o->strip_at.count > 0;
     if (!o->strip) {
-        if (o->strip_at_given)
+        if (o->strip_at.count)
             return tool_usage_error("isorender", "--strip-at needs --strip");
         return 0;
     }
     if (o->full || o->common.rays || o->common.time_limit > 0)
         return tool_usage_error("isorender", "--strip shows a progressive run to its last ray: "
                                              "no --full, --rays or --time");
-    if (!o->strip_at_given)
+    if (!o->strip_at.count)
         o->strip_at = (strip_plan){{0.01, 0.1, 1, 100}, 4};
     uint64_t width = (uint64_t)o->common.width * o->strip_at.count +
                      (uint64_t)STRIP_GAP * (o->strip_at.count - 1);
