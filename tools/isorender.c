@@ -15,6 +15,8 @@
 #include "isoprop/store.h"
 #include "tool_common.h"
 
+#include <stb_easy_font.h>
+
 static const char usage[] =
     "usage: isorender FILE.ibv --iso V [options]\n"
     "Extracts the isosurface V progressively (rays in the paper's order) and renders it to PNG\n"
@@ -36,6 +38,10 @@ static const char usage[] =
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
     "                      overdraw at checkpoints\n"
+    "  --strip OUT.png     also write the progress strip: the image as extracted by a few\n"
+    "                      points of the run, side by side and labelled\n"
+    "  --strip-at P,...    the strip's points, in percent of the view's rays, increasing\n"
+    "                      (default 0.01%,0.1%,1%,100%; at most 8)\n"
     "  --software          render with the software rasterizer instead of OpenGL\n"
     "  --force             replace existing outputs (regular files only; never an input)\n"
     "  --quiet             print nothing but errors and warnings\n"
@@ -45,11 +51,34 @@ static const char usage[] =
     "summed over the threads, which can add up to more than the wall time. Ctrl-C cancels:\n"
     "no output is written, and isorender ends as killed by the signal.\n";
 
+/* The progress strip (--strip): frames side by side, STRIP_GAP pixels apart, over a band of
+ * STRIP_BAND pixels with each frame's label; the text is stb_easy_font's, STRIP_TEXT_SCALE
+ * times larger. */
+#define STRIP_MAX_FRAMES 8
+#define STRIP_GAP 4
+#define STRIP_BAND 24
+#define STRIP_TEXT_SCALE 2
+#define STRIP_MAX_WIDTH 65536
+
+/* --strip-at: the strip's frames, in percent of the view's rays, increasing, in (0, 100] */
+typedef struct strip_plan {
+    double pct[STRIP_MAX_FRAMES];
+    size_t count;
+} strip_plan;
+
 typedef struct options {
     tool_view_options common;
-    const char *file, *out, *mesh, *progress;
+    const char *file, *out, *mesh, *progress, *strip;
     int full, software, warm; /* --stats, --force and --quiet are in common */
+    strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
 } options;
+
+/* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
+ * of the mesh, which only grows by appending) extracted by then. */
+typedef struct strip_frames {
+    uint64_t rays[STRIP_MAX_FRAMES], triangles[STRIP_MAX_FRAMES];
+    size_t recorded; /* frames whose triangles are known */
+} strip_frames;
 
 typedef struct checkpoint {
     double time;
@@ -76,7 +105,11 @@ typedef struct run {
     const char *renderer_name;
     char warning[600]; /* the --iso warning, "" when none */
     int writing;       /* 1 once the outputs are being written */
+    strip_frames strip;
 } run;
+
+static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
+                          void *base);
 
 static const tool_option isorender_options[] = {
     {"-o", NULL, 1, offsetof(options, out), NULL, NULL, NULL},
@@ -85,7 +118,229 @@ static const tool_option isorender_options[] = {
     {"--full", NULL, 0, offsetof(options, full), NULL, NULL, NULL},
     {"--warm", NULL, 0, offsetof(options, warm), NULL, NULL, NULL},
     {"--software", NULL, 0, offsetof(options, software), NULL, NULL, NULL},
+    {"--strip", NULL, 1, offsetof(options, strip), NULL, NULL, NULL},
+    {"--strip-at", NULL, 1, offsetof(options, strip_at), parse_strip_at, NULL, NULL},
 };
+
+/* ---- the progress strip ---- */
+
+/* Parses --strip-at's "P,P,..." (each a number with an optional '%'). Returns 0, or 2 after a
+ * usage error. */
+static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
+                          void *base)
+{
+    strip_plan *plan = (strip_plan *)((char *)base + option->offset);
+    const char *text = values[0];
+    plan->count = 0;
+    for (const char *at = text;; at++) {
+        size_t len = strcspn(at, ",");
+        char item[64];
+        double pct;
+        if (len >= sizeof item)
+            len = sizeof item - 1;
+        memcpy(item, at, len);
+        item[len] = 0;
+        if (len > 1 && item[len - 1] == '%')
+            item[len - 1] = 0;
+        if (tool_parse_double(item, &pct) != 0 || !(pct > 0 && pct <= 100))
+            return tool_usage_error(program,
+                                    "--strip-at '%s': '%.*s' is not a percentage in "
+                                    "(0, 100]",
+                                    text, (int)len, at);
+        if (plan->count == STRIP_MAX_FRAMES)
+            return tool_usage_error(program, "--strip-at '%s': more than %d frames", text,
+                                    STRIP_MAX_FRAMES);
+        if (plan->count && pct <= plan->pct[plan->count - 1])
+            return tool_usage_error(program, "--strip-at '%s': the percentages must increase",
+                                    text);
+        plan->pct[plan->count++] = pct;
+        at += strcspn(at, ",");
+        if (!*at)
+            return 0;
+    }
+}
+
+/* The strip's checks after parsing, and its default frames. Returns 0, or 2 after a usage
+ * error. */
+static int check_strip_options(options *o)
+{
+    if (!o->strip) {
+        if (o->strip_at.count)
+            return tool_usage_error("isorender", "--strip-at needs --strip");
+        return 0;
+    }
+    if (o->full || o->common.rays || o->common.time_limit > 0)
+        return tool_usage_error("isorender", "--strip shows a progressive run to its last ray: "
+                                             "no --full, --rays or --time");
+    if (!o->strip_at.count)
+        o->strip_at = (strip_plan){{0.01, 0.1, 1, 100}, 4};
+    uint64_t width = (uint64_t)o->common.width * o->strip_at.count +
+                     (uint64_t)STRIP_GAP * (o->strip_at.count - 1);
+    if (width > STRIP_MAX_WIDTH)
+        return tool_usage_error("isorender",
+                                "--strip: %zu frames %u pixels wide make a strip "
+                                "of %llu pixels, over %d",
+                                o->strip_at.count, o->common.width, (unsigned long long)width,
+                                STRIP_MAX_WIDTH);
+    return 0;
+}
+
+/* Each frame's ray count, from its percentage of the view's rays (at least 1). */
+static void strip_plan_rays(run *r)
+{
+    uint64_t total = (uint64_t)r->camera.width * r->camera.height;
+    for (size_t f = 0; f < r->o.strip_at.count; f++) {
+        uint64_t rays = (uint64_t)ceil(r->o.strip_at.pct[f] / 100.0 * (double)total);
+        r->strip.rays[f] = rays < 1 ? 1 : rays > total ? total : rays;
+    }
+    r->strip.recorded = 0;
+}
+
+/* Where the next step must stop: `next`, or the ray count of an earlier frame not yet
+ * reached. */
+static uint64_t strip_stop(const run *r, uint64_t rays, uint64_t next)
+{
+    if (!r->o.strip)
+        return next;
+    for (size_t f = r->strip.recorded; f < r->o.strip_at.count; f++)
+        if (r->strip.rays[f] > rays)
+            return r->strip.rays[f] < next ? r->strip.rays[f] : next;
+    return next;
+}
+
+/* After a step: the frames whose ray count is reached show the mesh as it is now. */
+static void strip_record(run *r)
+{
+    if (!r->o.strip)
+        return;
+    ip_engine_counts t;
+    ip_engine_totals(r->engine, &t);
+    uint64_t triangles = ip_engine_mesh(r->engine)->triangle_count;
+    while (r->strip.recorded < r->o.strip_at.count &&
+           (r->strip.rays[r->strip.recorded] <= t.rays || ip_engine_done(r->engine)))
+        r->strip.triangles[r->strip.recorded++] = triangles;
+}
+
+/* Frame f's label, "12 rays, 3456 triangles", or its short form when that is too wide for
+ * the frame ("12 rays"; "" when even that is). */
+static void strip_label(const run *r, size_t f, char *text, size_t size)
+{
+    snprintf(text, size, "%llu rays, %llu triangles", (unsigned long long)r->strip.rays[f],
+             (unsigned long long)r->strip.triangles[f]);
+    if ((uint32_t)stb_easy_font_width(text) * STRIP_TEXT_SCALE + 8 > r->camera.width)
+        snprintf(text, size, "%llu rays", (unsigned long long)r->strip.rays[f]);
+    if ((uint32_t)stb_easy_font_width(text) * STRIP_TEXT_SCALE + 8 > r->camera.width)
+        text[0] = 0;
+}
+
+/* Draws `text` into the strip's band, centred under the frame that starts at column x0:
+ * stb_easy_font's quads are axis-aligned rectangles, filled here scaled up. */
+static void strip_draw_label(uint8_t *rgba, uint32_t strip_width, uint32_t strip_height,
+                             uint32_t x0, uint32_t frame_width, char *text)
+{
+    static const uint8_t ink[4] = {226, 222, 206, 255};
+    char quads[64 * 270]; /* stb_easy_font's estimate: about 270 bytes a character */
+    int count = stb_easy_font_print(0, 0, text, NULL, quads, (int)sizeof quads);
+    int left = (int)x0 + ((int)frame_width - stb_easy_font_width(text) * STRIP_TEXT_SCALE) / 2;
+    int top = (int)strip_height - STRIP_BAND + 4;
+    for (int q = 0; q < count; q++) {
+        float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
+        for (int k = 0; k < 4; k++) { /* a vertex: x, y, z floats, then 4 bytes of colour */
+            float v[2];
+            memcpy(v, quads + (q * 4 + k) * 16, sizeof v);
+            for (int a = 0; a < 2; a++) {
+                lo[a] = v[a] < lo[a] ? v[a] : lo[a];
+                hi[a] = v[a] > hi[a] ? v[a] : hi[a];
+            }
+        }
+        for (int y = (int)(lo[1] * STRIP_TEXT_SCALE); y < (int)(hi[1] * STRIP_TEXT_SCALE); y++)
+            for (int x = (int)(lo[0] * STRIP_TEXT_SCALE); x < (int)(hi[0] * STRIP_TEXT_SCALE);
+                 x++) {
+                int px = left + x, py = top + y;
+                if (px >= 0 && px < (int)strip_width && py >= 0 && py < (int)strip_height)
+                    memcpy(rgba + ((size_t)py * strip_width + (size_t)px) * 4, ink, 4);
+            }
+    }
+}
+
+/* Fills err for a failed allocation of the strip. Returns -1. */
+static int strip_out_of_memory(const run *r, ip_error *err)
+{
+    err->code = IP_ERR_NOMEM;
+    snprintf(err->message, sizeof err->message, "%s: out of memory for the progress strip",
+             r->o.strip);
+    return -1;
+}
+
+/* Renders frame after frame (the mesh's first `triangles` of each) with the renderer of the
+ * image, and copies each into its place in the strip. */
+static int strip_render_frames(run *r, uint8_t *strip, uint32_t strip_width, ip_error *err)
+{
+    uint32_t w = r->camera.width, h = r->camera.height;
+    uint8_t *frame = malloc((size_t)w * h * 4);
+    ip_renderer *gl = NULL;
+    if (!frame)
+        return strip_out_of_memory(r, err);
+    int rc = 0;
+    if (!strcmp(r->renderer_name, "opengl") && ip_renderer_create_headless(w, h, &gl, err) != IP_OK)
+        rc = -1;
+    for (size_t f = 0; rc == 0 && f < r->o.strip_at.count; f++) {
+        ip_mesh prefix = *r->mesh; /* a view of the first triangles, not a copy */
+        prefix.triangle_count = r->strip.triangles[f];
+        ip_status st = gl ? ip_renderer_draw_mesh(gl, &prefix, &r->camera, r->lo, r->hi, err)
+                          : ip_raster_mesh(&prefix, &r->camera, r->lo, r->hi, NULL, frame, err);
+        if (st == IP_OK && gl)
+            st = ip_renderer_read_rgba(gl, frame, err);
+        if (st != IP_OK) {
+            rc = -1;
+            break;
+        }
+        size_t x0 = f * (w + STRIP_GAP);
+        for (uint32_t y = 0; y < h; y++)
+            memcpy(strip + ((size_t)y * strip_width + x0) * 4, frame + (size_t)y * w * 4,
+                   (size_t)w * 4);
+    }
+    ip_renderer_destroy(gl);
+    free(frame);
+    return rc;
+}
+
+/* The strip's image: the frames over a dark band with their labels; *out is the caller's
+ * (free()). Returns 0 or -1 with err set. */
+static int strip_compose(run *r, uint8_t **out, uint32_t *width, uint32_t *height, ip_error *err)
+{
+    static const uint8_t band[4] = {14, 16, 22, 255};
+    size_t n = r->o.strip_at.count;
+    *width = (uint32_t)(n * r->camera.width + (n - 1) * STRIP_GAP);
+    *height = r->camera.height + STRIP_BAND;
+    uint8_t *rgba = malloc((size_t)*width * *height * 4);
+    if (!rgba)
+        return strip_out_of_memory(r, err);
+    for (size_t p = 0; p < (size_t)*width * *height; p++)
+        memcpy(rgba + p * 4, band, 4);
+    if (strip_render_frames(r, rgba, *width, err) != 0) {
+        free(rgba);
+        return -1;
+    }
+    for (size_t f = 0; f < n; f++) {
+        char text[64];
+        strip_label(r, f, text, sizeof text);
+        strip_draw_label(rgba, *width, *height, (uint32_t)(f * (r->camera.width + STRIP_GAP)),
+                         r->camera.width, text);
+    }
+    *out = rgba;
+    return 0;
+}
+
+/* The summary's strip line. */
+static void strip_print(const run *r)
+{
+    printf("  strip         %s:", r->o.strip);
+    for (size_t f = 0; f < r->o.strip_at.count; f++)
+        printf(" %g%% (%llu triangles)", r->o.strip_at.pct[f],
+               (unsigned long long)r->strip.triangles[f]);
+    printf("\n");
+}
 
 static int parse_args(int argc, char **argv, options *o)
 {
@@ -99,7 +354,7 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     if (o->full && (o->common.rays || o->common.time_limit > 0))
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
-    return 0;
+    return check_strip_options(o);
 }
 
 static int setup_camera(run *r, ip_error *err)
@@ -147,6 +402,7 @@ static int extract_progressive(run *r, ip_error *err)
     }
     if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK)
         return -1;
+    strip_plan_rays(r);
     double start = ip_now_seconds();
     uint64_t target = 1, limit = r->o.common.rays ? r->o.common.rays : UINT64_MAX;
     /* ip_engine_begin() clears a cancel: a signal before it is seen through the flag */
@@ -159,9 +415,12 @@ static int extract_progressive(run *r, ip_error *err)
             r->o.common.time_limit > 0 ? r->o.common.time_limit - (ip_now_seconds() - start) : 0;
         if (r->o.common.time_limit > 0 && left <= 0)
             break;
-        uint64_t batch = (target < limit ? target : limit) - t.rays;
-        if (ip_engine_step(r->engine, batch, left, NULL, err) != IP_OK)
+        uint64_t next = target < limit ? target : limit, stop = strip_stop(r, t.rays, next);
+        if (ip_engine_step(r->engine, stop - t.rays, left, NULL, err) != IP_OK)
             return -1;
+        strip_record(r);
+        if (stop < next && !ip_engine_done(r->engine))
+            continue; /* a frame of the strip, between two checkpoints */
         if (add_checkpoint(r, start) != 0)
             return -1;
         target *= 2;
@@ -387,11 +646,16 @@ static int finish(run *r, ip_error *err)
         return 1;
     }
     int rc = render_image(r, rgba, err);
+    uint8_t *strip = NULL;
+    uint32_t strip_width = 0, strip_height = 0;
+    if (rc == 0 && r->o.strip && strip_compose(r, &strip, &strip_width, &strip_height, err) != 0)
+        rc = -1;
     if (rc == 0 && ((r->o.progress && !r->o.full) || r->o.common.stats) &&
         final_pixels(r, err) != 0)
         rc = -1;
     if (rc != 0 || tool_signal_caught()) {
         free(rgba);
+        free(strip);
         return rc != 0 ? tool_fail("isorender", err) : 1;
     }
     r->writing = 1;
@@ -399,6 +663,10 @@ static int finish(run *r, ip_error *err)
         IP_OK)
         rc = -1;
     free(rgba);
+    if (rc == 0 && strip &&
+        ip_png_write(r->o.strip, strip, strip_width, strip_height, r->o.common.force, err) != IP_OK)
+        rc = -1;
+    free(strip);
     if (rc == 0 && r->o.mesh && ip_mesh_write(r->mesh, r->o.mesh, r->o.common.force, err) != IP_OK)
         rc = -1;
     if (rc != 0)
@@ -409,6 +677,8 @@ static int finish(run *r, ip_error *err)
     uint64_t summary = ip_store_summary_memory(r->store);
     if (!r->o.common.quiet) {
         print_summary(r);
+        if (r->o.strip)
+            strip_print(r);
         tool_print_cache_table(stdout, &st, summary);
     }
     if (r->o.common.stats &&
@@ -426,8 +696,9 @@ int main(int argc, char **argv)
     if (rc)
         return rc;
     const char *inputs[] = {r.o.file};
-    const char *outputs[] = {r.o.out, r.o.mesh, r.o.common.stats, r.o.full ? NULL : r.o.progress};
-    if (tool_check_paths("isorender", inputs, 1, outputs, 4, r.o.common.force) != 0)
+    const char *outputs[] = {r.o.out, r.o.mesh, r.o.common.stats, r.o.full ? NULL : r.o.progress,
+                             r.o.strip};
+    if (tool_check_paths("isorender", inputs, 1, outputs, 5, r.o.common.force) != 0)
         return 1;
     if (r.o.mesh && !ip_mesh_format_of(r.o.mesh)) /* before any work, after the paths' checks */
         return tool_usage_error("isorender", "--mesh %s: the name must end in .ply, .stl or .obj",

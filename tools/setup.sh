@@ -3,6 +3,7 @@
 # configures and builds, then runs one job.
 #
 #   tools/setup.sh demo    build, then generate, brick, describe and render the default volume
+#                          (a gyroid): its image, its progress strip and the full extraction
 #   tools/setup.sh test    build, then run the whole test suite: a -Werror build, a Debug build
 #                          (internal assertions on) under AddressSanitizer +
 #                          UndefinedBehaviorSanitizer (with the fuzzers), and
@@ -56,15 +57,37 @@ configure_and_build() {
     cmake --build "$dir" -j "$jobs" -- --no-print-directory >/dev/null
 }
 
+# The demo's volume: a gyroid, one connected surface with many handles (four periods across
+# 128^3 samples), most of it hidden behind its front; seen from above the front right corner
+# (world units are voxels, 0 .. 127).
+demo_view="--iso 2047.5 --camera 283,-221,232,63.5,63.5,57,0,0,1,30"
+
+# json_count FILE KEY: the first "KEY": N of a statistics file
+json_count() {
+    sed -n "s/.*\"$2\": *\([0-9]*\).*/\1/p" "$1" | head -1
+}
+
 demo() {
     configure_and_build build
-    volume=bricks/shepp-logan_128x128x128_uint16.raw
-    build/isogen shepp-logan --dims 128x128x128 --type uint16 -o bricks/ --force --quiet
-    build/isobrick "$volume" -o bricks/shepp-logan.ibv --force
-    build/isoinfo bricks/shepp-logan.ibv
-    build/isorender bricks/shepp-logan.ibv --iso 1000.5 --view -y --size 800x600 \
-        -o bricks/shepp-logan.png --stats bricks/shepp-logan.json --force
-    echo "image: bricks/shepp-logan.png, statistics: bricks/shepp-logan.json"
+    build/isogen gyroid --dims 128x128x128 --type uint16 -o bricks/ --force --quiet
+    build/isobrick bricks/gyroid_128x128x128_uint16.raw -o bricks/gyroid.ibv --force
+    build/isoinfo bricks/gyroid.ibv
+    # shellcheck disable=SC2086 # $demo_view is a list of options
+    build/isorender bricks/gyroid.ibv $demo_view --size 800x600 -o bricks/gyroid.png \
+        --stats bricks/gyroid.json --force
+    # the progress strip: the image as the first rays had extracted it, then with every ray
+    # shellcheck disable=SC2086
+    build/isorender bricks/gyroid.ibv $demo_view --size 360x270 -o bricks/gyroid-360.png \
+        --strip bricks/gyroid-strip.png --progress bricks/gyroid-progress.csv --force --quiet
+    # the whole isosurface, for comparison: the same picture, more triangles
+    # shellcheck disable=SC2086
+    build/isorender bricks/gyroid.ibv $demo_view --size 800x600 --full \
+        -o bricks/gyroid-full.png --stats bricks/gyroid-full.json --force --quiet
+    echo "view-dependent: $(json_count bricks/gyroid.json triangles) triangles for the view;" \
+        "the whole isosurface has $(json_count bricks/gyroid-full.json triangles)" \
+        "(its picture: bricks/gyroid-full.png)"
+    echo "image: bricks/gyroid.png, progress strip: bricks/gyroid-strip.png," \
+        "statistics: bricks/gyroid.json, progress: bricks/gyroid-progress.csv"
 }
 
 # run_ctest DIR ENV [ctest arguments...]: runs ctest in DIR with the environment assignments

@@ -1,8 +1,9 @@
 /* png_compare: compares two PNG images pixel by pixel, for the end-to-end tests.
  *
- *   png_compare A.png B.png [--level L] [--max-pct P]
+ *   png_compare A.png B.png [--level L] [--max-pct P] [--crop X,Y,W,H]
  *
- * Both images are read as 8-bit RGBA. A pixel differs when one of its channels differs by more
+ * Both images are read as 8-bit RGBA. With --crop, A's rectangle of W x H pixels whose top-left
+ * pixel is (X, Y) stands for A (a frame of a strip, say). A pixel differs when one of its channels differs by more
  * than L (default 0). Prints one line: the size, how many pixels differ and the largest channel
  * difference. Exit status: 0 when the sizes agree and at most P % of the pixels differ
  * (default 0), 1 otherwise, 2 for a bad command line or an unreadable image.
@@ -34,6 +35,33 @@ static unsigned char *read_rgba(const char *path, png_uint_32 *width, png_uint_3
     return rgba;
 }
 
+/* Replaces the image by its rectangle crop[] = x, y, w, h; -1 when that lies outside it. */
+static int crop_image(unsigned char **rgba, png_uint_32 *width, png_uint_32 *height,
+                      const unsigned long crop[4])
+{
+    if (crop[2] == 0 || crop[3] == 0 || crop[0] + crop[2] > *width || crop[1] + crop[3] > *height)
+        return -1;
+    unsigned char *part = malloc((size_t)crop[2] * crop[3] * 4);
+    if (!part)
+        return -1;
+    for (unsigned long y = 0; y < crop[3]; y++)
+        memcpy(part + (size_t)y * crop[2] * 4,
+               *rgba + ((size_t)(crop[1] + y) * *width + crop[0]) * 4, (size_t)crop[2] * 4);
+    free(*rgba);
+    *rgba = part;
+    *width = (png_uint_32)crop[2];
+    *height = (png_uint_32)crop[3];
+    return 0;
+}
+
+static int parse_crop(const char *text, unsigned long crop[4])
+{
+    char tail;
+    return sscanf(text, "%lu,%lu,%lu,%lu%c", &crop[0], &crop[1], &crop[2], &crop[3], &tail) == 4
+               ? 0
+               : -1;
+}
+
 static int parse_number(const char *text, double *out)
 {
     char *end;
@@ -45,7 +73,8 @@ int main(int argc, char **argv)
 {
     const char *path[2] = {NULL, NULL};
     double level = 0, max_pct = 0;
-    int files = 0;
+    int files = 0, cropped = 0;
+    unsigned long crop[4];
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--level") && i + 1 < argc) {
             if (parse_number(argv[++i], &level) != 0)
@@ -53,6 +82,10 @@ int main(int argc, char **argv)
         } else if (!strcmp(argv[i], "--max-pct") && i + 1 < argc) {
             if (parse_number(argv[++i], &max_pct) != 0)
                 goto usage;
+        } else if (!strcmp(argv[i], "--crop") && i + 1 < argc) {
+            if (parse_crop(argv[++i], crop) != 0)
+                goto usage;
+            cropped = 1;
         } else if (argv[i][0] != '-' && files < 2) {
             path[files++] = argv[i];
         } else {
@@ -66,6 +99,13 @@ int main(int argc, char **argv)
     unsigned char *b = a ? read_rgba(path[1], &w[1], &h[1]) : NULL;
     if (!b) {
         free(a);
+        return 2;
+    }
+    if (cropped && crop_image(&a, &w[0], &h[0], crop) != 0) {
+        fprintf(stderr, "png_compare: %s: --crop %lu,%lu,%lu,%lu is not within its %ux%u pixels\n",
+                path[0], crop[0], crop[1], crop[2], crop[3], (unsigned)w[0], (unsigned)h[0]);
+        free(a);
+        free(b);
         return 2;
     }
     if (w[0] != w[1] || h[0] != h[1]) {
@@ -93,6 +133,6 @@ int main(int argc, char **argv)
     free(b);
     return pct <= max_pct ? 0 : 1;
 usage:
-    fprintf(stderr, "usage: png_compare A.png B.png [--level L] [--max-pct P]\n");
+    fprintf(stderr, "usage: png_compare A.png B.png [--level L] [--max-pct P] [--crop X,Y,W,H]\n");
     return 2;
 }
