@@ -1,6 +1,6 @@
 #!/bin/sh
 # Checks that the C sources follow .clang-format: runs `clang-format --dry-run --Werror` over
-# every *.c and *.h of src/, tools/, tests/ and include/ (tracked or new, not ignored) and
+# every *.c and *.h of src/, tools/, tests/, include/ and docs/ (tracked or new, not ignored) and
 # exits 1 when any would change, listing each difference as clang-format reports it. Changes
 # nothing. clang-format is Debian's package clang-format (tools/setup.sh installs it).
 #
@@ -22,7 +22,7 @@ if [ $# -gt 0 ]; then
     printf '%s\n' "$@" >"$list"
 else
     git ls-files --cached --others --exclude-standard -- 'src/*.[ch]' 'tools/*.[ch]' \
-        'tests/*.[ch]' 'include/*.[ch]' | sort -u >"$list"
+        'tests/*.[ch]' 'include/*.[ch]' 'docs/*.[ch]' | sort -u >"$list"
 fi
 failed=0 files=0 lines=0
 while IFS= read -r f; do

@@ -1,10 +1,12 @@
 #!/bin/bash
-# The shared library exports exactly the public API: every function declared with IP_API in
-# include/isoprop/*.h, and nothing else (no internal ip__ symbol, nothing without the ip_ prefix).
-#   exports.sh LIBISOPROP.so INCLUDE_DIR
+# A shared library exports exactly its public API: every function declared with IP_API in its
+# public headers, and nothing else (no internal ip__ symbol, nothing without the ip_ prefix, no
+# function of another library's headers).
+#   exports.sh LIBRARY.so HEADER...   (libisoprop.so: include/isoprop/*.h but render.h;
+#                                      libisoprop_render.so: render.h)
 set -u
 lib=$1
-include=$2
+shift
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 # (less the __start_SECTION / __stop_SECTION bounds the linker defines for the coverage sections
@@ -12,7 +14,7 @@ trap 'rm -rf "$dir"' EXIT
 nm -D --defined-only "$lib" | awk 'NF == 3 && $3 !~ /^__(start|stop)___sancov_/ { print $3 }' |
     sort -u >"$dir/exported"
 # the name of each IP_API declaration: the identifier before the first '('
-grep -h '^IP_API ' "$include"/isoprop/*.h | sed 's/(.*//; s/.*[ *]//' | sort -u >"$dir/declared"
+grep -h '^IP_API ' "$@" | sed 's/(.*//; s/.*[ *]//' | sort -u >"$dir/declared"
 failed=0
 while read -r s; do
     echo "exports: $lib exports $s, which no public header declares with IP_API"

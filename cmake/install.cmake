@@ -1,0 +1,90 @@
+# Installation (cmake --install BUILD [--prefix P]): the libraries, their public headers, the
+# CMake package (find_package(isoprop [COMPONENTS render])) and the pkg-config files isoprop.pc
+# and isoprop-render.pc. The package and the .pc files find the prefix from where they lie, so
+# an installed tree may be moved. Components: core (libisoprop and every header but the
+# renderer's), render (libisoprop_render and render.h), programs.
+include(CMakePackageConfigHelpers)
+set(IP_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/isoprop)
+set(IP_PKGCONFIG_DIR ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# ip_dependencies(OUT LIBRARIES...): for the external libraries of an installed library,
+# OUT_FIND (the lines of isopropConfig.cmake that find them for the static targets),
+# OUT_MODULES (pkg-config modules for Requires.private) and OUT_FLAGS (for Libs.private).
+function(ip_dependencies out)
+  set(find "")
+  set(modules "")
+  set(flags "")
+  foreach(lib ${ARGN})
+    if(lib STREQUAL "Threads::Threads")
+      string(APPEND find "find_dependency(Threads)\n")
+      list(APPEND flags ${CMAKE_THREAD_LIBS_INIT})
+    elseif(lib STREQUAL "m")
+      list(APPEND flags -lm)
+    elseif(lib STREQUAL "ZLIB::ZLIB")
+      string(APPEND find "find_dependency(ZLIB)\n")
+      list(APPEND modules zlib)
+    elseif(lib MATCHES "^PkgConfig::(.+)$")
+      # pkg_check_modules(PREFIX ... MODULE) made the target and PREFIX_MODULE_NAME
+      set(prefix ${CMAKE_MATCH_1})
+      set(module ${${prefix}_MODULE_NAME})
+      if(NOT module)
+        message(FATAL_ERROR "cmake/install.cmake: ${lib} names no single pkg-config module")
+      endif()
+      string(APPEND find "if(NOT TARGET ${lib})\n"
+             "  find_dependency(PkgConfig)\n"
+             "  pkg_check_modules(${prefix} REQUIRED QUIET IMPORTED_TARGET ${module})\n"
+             "endif()\n")
+      list(APPEND modules ${module})
+    else()
+      message(FATAL_ERROR "cmake/install.cmake: no rule to find ${lib} for the installed "
+                          "package; add one to ip_dependencies()")
+    endif()
+  endforeach()
+  string(REPLACE ";" " " modules "${modules}")
+  string(REPLACE ";" " " flags "${flags}")
+  set(${out}_FIND "${find}" PARENT_SCOPE)
+  set(${out}_MODULES "${modules}" PARENT_SCOPE)
+  set(${out}_FLAGS "${flags}" PARENT_SCOPE)
+endfunction()
+ip_dependencies(IP_CORE_DEPENDS ${IP_CORE_LIBRARIES})
+ip_dependencies(IP_RENDER_DEPENDS ${IP_RENDER_LIBRARIES})
+
+# libraries and headers
+install(TARGETS isoprop_shared isoprop EXPORT isopropTargets COMPONENT core
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+install(TARGETS isoprop_render_shared isoprop_render EXPORT isopropRenderTargets COMPONENT render
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+set(IP_CORE_HEADER_EXCLUDES "")
+set(IP_RENDER_HEADER_FILES "")
+foreach(header ${IP_RENDER_HEADERS})
+  list(APPEND IP_CORE_HEADER_EXCLUDES PATTERN ${header} EXCLUDE)
+  list(APPEND IP_RENDER_HEADER_FILES ${CMAKE_SOURCE_DIR}/include/isoprop/${header})
+endforeach()
+install(DIRECTORY ${CMAKE_SOURCE_DIR}/include/isoprop DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+        COMPONENT core ${IP_CORE_HEADER_EXCLUDES})
+install(FILES ${IP_RENDER_HEADER_FILES} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/isoprop
+        COMPONENT render)
+
+# the CMake package
+install(EXPORT isopropTargets NAMESPACE isoprop:: DESTINATION ${IP_CMAKE_DIR} COMPONENT core)
+install(EXPORT isopropRenderTargets NAMESPACE isoprop:: DESTINATION ${IP_CMAKE_DIR}
+        COMPONENT render)
+configure_package_config_file(${CMAKE_SOURCE_DIR}/cmake/isopropConfig.cmake.in
+                              ${CMAKE_BINARY_DIR}/package/isopropConfig.cmake
+                              INSTALL_DESTINATION ${IP_CMAKE_DIR})
+write_basic_package_version_file(${CMAKE_BINARY_DIR}/package/isopropConfigVersion.cmake
+                                 VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
+install(FILES ${CMAKE_BINARY_DIR}/package/isopropConfig.cmake
+              ${CMAKE_BINARY_DIR}/package/isopropConfigVersion.cmake
+        DESTINATION ${IP_CMAKE_DIR} COMPONENT core)
+
+# the pkg-config files
+file(RELATIVE_PATH IP_PC_TO_PREFIX ${CMAKE_INSTALL_FULL_LIBDIR}/pkgconfig ${CMAKE_INSTALL_PREFIX})
+string(REGEX REPLACE "/$" "" IP_PC_TO_PREFIX "${IP_PC_TO_PREFIX}")
+foreach(pc isoprop isoprop-render)
+  configure_file(${CMAKE_SOURCE_DIR}/cmake/${pc}.pc.in ${CMAKE_BINARY_DIR}/package/${pc}.pc @ONLY)
+endforeach()
+install(FILES ${CMAKE_BINARY_DIR}/package/isoprop.pc DESTINATION ${IP_PKGCONFIG_DIR}
+        COMPONENT core)
+install(FILES ${CMAKE_BINARY_DIR}/package/isoprop-render.pc DESTINATION ${IP_PKGCONFIG_DIR}
+        COMPONENT render)
