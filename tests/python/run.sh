@@ -15,7 +15,7 @@ if [ -n "${IP_TSAN:-}" ]; then
 fi
 if [ -n "${IP_ASAN_RUNTIME:-}" ]; then
     LD_PRELOAD=$IP_ASAN_RUNTIME
-    ASAN_OPTIONS=detect_leaks=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}
+    ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0
     export LD_PRELOAD ASAN_OPTIONS
 fi
 exec "$py" "$test"
