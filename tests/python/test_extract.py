@@ -170,5 +170,30 @@ class Extract(unittest.TestCase):
             self.assertFalse(g._runs)
 
 
+class SampleVolume(unittest.TestCase):
+    """A real volume of ../shared/data, bricked from a numpy array in Python, against
+    isorender --full on the brick file isobrick makes of the raw file."""
+
+    def test_tooth_full_from_an_array_equals_isorender(self):
+        raw = os.path.join(os.environ.get("IP_SHARED_DATA", ""),
+                           "tooth_103x94x161_uint8.raw")
+        if not os.path.isfile(raw):
+            print("skipped in part: %s is absent (the real volumes of ../shared/data)" % raw)
+            return
+        ibv, ply = support.work("tooth.ibv"), support.work("tooth.ply")
+        support.tool("isobrick", raw, "-o", ibv, "--quiet")
+        support.tool("isorender", ibv, "--iso", "120.5", "--full", "--software", "--size",
+                     "64x48", "-o", support.work("tooth.png"), "--mesh", ply, "--quiet")
+        vertices, normals, faces = support.read_ply(ply)
+        array = np.fromfile(raw, dtype=np.uint8).reshape(161, 94, 103)
+        isoprop.brick(array, support.work("tooth-array.ibv"))
+        with isoprop.open(support.work("tooth-array.ibv")) as f:
+            mesh = f.extract(120.5, full=True)
+        self.assertGreater(len(mesh), 100000)
+        np.testing.assert_array_equal(mesh.vertices, vertices)
+        np.testing.assert_array_equal(mesh.normals, normals)
+        np.testing.assert_array_equal(mesh.faces, faces)
+
+
 if __name__ == "__main__":
     support.main()
