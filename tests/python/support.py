@@ -18,6 +18,9 @@ except ImportError:
 
 import isoprop  # noqa: E402 (after the numpy check)
 
+# run.sh preloads the sanitizer's runtime for this interpreter in the AddressSanitizer build;
+# the programs run below carry their own (python_env() gives it back to child interpreters).
+PRELOAD = os.environ.pop("LD_PRELOAD", None)
 BIN = os.environ.get("IP_BIN", os.path.join(os.path.dirname(__file__), "../../build"))
 NAME = os.path.splitext(os.path.basename(sys.argv[0]))[0]
 WORK = os.path.join(os.environ.get("IP_TEST_TMP", "/tmp/isoprop-test"), "python_" + NAME)
@@ -31,6 +34,14 @@ def tool(program, *args):
         raise AssertionError("%s %s: exit %d: %s" % (program, " ".join(map(str, args)),
                                                      p.returncode, p.stderr.strip()))
     return p.stdout
+
+
+def python_env(**extra):
+    """The environment for a child python3 that imports isoprop: this one's, plus `extra`."""
+    env = dict(os.environ, **extra)
+    if PRELOAD:
+        env["LD_PRELOAD"] = PRELOAD
+    return env
 
 
 def work(name):

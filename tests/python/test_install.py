@@ -15,7 +15,7 @@ def python(code, **env):
     (ctest runs the tests in build/python, where `import` would find the build's package)."""
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           cwd=support.WORK,
-                          env=dict(os.environ, **env))
+                          env=support.python_env(**env))
 
 
 class Install(unittest.TestCase):
