@@ -6,10 +6,12 @@ import numpy as np
 NORMAL_SCALE = 32767.0  # ip_normal_unpack(), include/isoprop/mesh.h
 
 
-def _floats(pointer, ctype, first, count):
-    """`count` values of type `ctype` from index `first` of a C array, as a new numpy array."""
-    address = ctypes.addressof(pointer.contents) + first * ctypes.sizeof(ctype)
-    return np.ctypeslib.as_array((ctype * count).from_address(address)).copy()
+def _view(pointer, dtype, first, count):
+    """`count` values of numpy type `dtype` from index `first` of the C array at `pointer`,
+    as a numpy array over the C memory (no copy: valid only while that memory is)."""
+    size = np.dtype(dtype).itemsize
+    address = ctypes.addressof(pointer.contents) + first * size
+    return np.frombuffer((ctypes.c_char * (count * size)).from_address(address), dtype)
 
 
 def soup_faces(triangles):
@@ -69,7 +71,8 @@ def copy_triangles(mesh, first, count):
     if count == 0:
         empty = np.empty((0, 3), dtype=np.float32)
         return empty, empty.copy()
-    positions = _floats(mesh.positions, ctypes.c_float, 9 * first, 9 * count)
-    packed = _floats(mesh.normals, ctypes.c_int16, 9 * first, 9 * count)
-    normals = (packed.astype(np.float32) / np.float32(NORMAL_SCALE)).astype(np.float32)
+    positions = _view(mesh.positions, np.float32, 9 * first, 9 * count).copy()
+    packed = _view(mesh.normals, np.int16, 9 * first, 9 * count)
+    # as ip_normal_unpack(): the integer as a float, divided by 32767 in float arithmetic
+    normals = np.divide(packed, np.float32(NORMAL_SCALE), dtype=np.float32)
     return positions.reshape(-1, 3), normals.reshape(-1, 3)
