@@ -16,7 +16,6 @@ except ImportError:
     print("skipped: numpy is not installed (Debian: apt-get install python3-numpy)")
     sys.exit(77)
 
-import isoprop  # noqa: E402 (after the numpy check)
 
 # run.sh preloads the sanitizer's runtime for this interpreter in the AddressSanitizer build;
 # the programs run below carry their own (python_env() gives it back to child interpreters).

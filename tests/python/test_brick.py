@@ -4,10 +4,10 @@ scratch file; progress and cancelling."""
 import os
 import unittest
 
+import support  # first: it skips (status 77) when numpy is absent
 import numpy as np
-
-import support
 import isoprop
+
 
 DIMS = (23, 18, 13)  # x, y, z: all different, so that a transposed axis shows
 

@@ -6,7 +6,7 @@ import subprocess
 import sys
 import unittest
 
-import support
+import support  # first: it skips (status 77) when numpy is absent
 import isoprop
 
 

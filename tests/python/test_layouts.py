@@ -5,7 +5,7 @@ import os
 import subprocess
 import unittest
 
-import support
+import support  # first: it skips (status 77) when numpy is absent
 from isoprop import _structs
 
 

@@ -3,9 +3,8 @@ files; closing."""
 import gc
 import unittest
 
+import support  # first: it skips (status 77) when numpy is absent
 import numpy as np
-
-import support
 import isoprop
 
 
