@@ -1,0 +1,22 @@
+"""isoprop: isosurfaces of volumes far larger than memory, from Python.
+
+    import isoprop
+    isoprop.brick(array_zyx, "head.ibv", spacing=(0.3, 0.3, 0.5))   # or a raw/NRRD/MHD path
+    with isoprop.open("head.ibv") as f:
+        mesh = f.extract(600.5, view="-y", size=(800, 600))          # progressive
+        mesh = f.extract(600.5, full=True)                            # every active cell
+        for step in f.extract_steps(600.5, rays_per_step=4096):       # step by step
+            ...
+
+A thin layer (ctypes) over the shared library libisoprop; docs/python.md describes it.
+"""
+from ._library import lib as _lib
+from ._library import path as library_path
+from .bricking import brick
+from .errors import Error
+from .mesh import Mesh, Step
+from .volume import File, Level, open
+
+__version__ = _lib.ip_version().decode()
+__all__ = ["brick", "open", "File", "Level", "Mesh", "Step", "Error", "library_path",
+           "__version__"]

@@ -1,0 +1,99 @@
+"""Finding and loading libisoprop.so, and the prototypes of the functions the module calls.
+
+Where the library is, first found wins:
+1. the environment variable ISOPROP_LIBRARY (a path to libisoprop.so*);
+2. the path in _config.py, which CMake writes: absolute in the build tree
+   (build/python/isoprop), relative to this folder when installed (cmake --install);
+3. the system's loader path (libisoprop.so.MAJOR, then libisoprop.so).
+Only libisoprop is loaded: nothing here renders.
+"""
+import ctypes
+import os
+from ctypes import (POINTER, c_char_p, c_double, c_float, c_int, c_uint, c_uint32, c_uint64,
+                    c_void_p)
+
+from . import _structs as S
+
+try:
+    from . import _config
+except ImportError:  # the source tree, not configured by CMake
+    _config = None
+
+ERR = POINTER(S.Error)
+HANDLE = c_void_p
+
+# name: (restype, argtypes); an ip_status return is an int
+_PROTOTYPES = {
+    "ip_version": (c_char_p, []),
+    "ip_status_message": (c_char_p, [c_int]),
+    "ip_type_name": (c_char_p, [c_int]),
+    "ip_type_parse": (c_int, [c_char_p, POINTER(c_int)]),
+    "ip_thread_count": (c_uint, [c_uint]),
+    "ip_peak_rss_bytes": (c_uint64, []),
+    "ip_now_seconds": (c_double, []),
+    "ip_input_describe": (c_int, [c_char_p, POINTER(S.InputOverrides), POINTER(S.InputDesc), ERR]),
+    "ip_bricker_options_default": (None, [POINTER(S.BrickerOptions)]),
+    "ip_bricker_run": (c_int, [POINTER(S.InputDesc), c_char_p, POINTER(S.BrickerOptions),
+                               POINTER(S.BrickerReport), ERR]),
+    "ip_store_open": (c_int, [c_char_p, POINTER(HANDLE), ERR]),
+    "ip_store_close": (None, [HANDLE]),
+    "ip_store_layout": (POINTER(S.Layout), [HANDLE]),
+    "ip_store_path": (c_char_p, [HANDLE]),
+    "ip_store_summary_memory": (c_uint64, [HANDLE]),
+    "ip_layout_world_box": (None, [POINTER(S.Layout), c_double * 3, c_double * 3]),
+    "ip_cache_default_budget": (c_uint64, []),
+    "ip_cache_create": (c_int, [HANDLE, c_uint64, POINTER(HANDLE), ERR]),
+    "ip_cache_destroy": (None, [HANDLE]),
+    "ip_cache_get_stats": (None, [HANDLE, POINTER(S.CacheStats)]),
+    "ip_camera_check": (c_int, [POINTER(S.Camera), ERR]),
+    "ip_camera_fit_axis": (c_int, [c_double * 3, c_double * 3, c_char_p, c_double, c_uint32,
+                                   c_uint32, POINTER(S.Camera), ERR]),
+    "ip_camera_parse": (c_int, [c_char_p, POINTER(S.Camera), ERR]),
+    "ip_engine_options_default": (None, [POINTER(S.EngineOptions)]),
+    "ip_engine_create": (c_int, [HANDLE, POINTER(S.EngineOptions), POINTER(HANDLE), ERR]),
+    "ip_engine_destroy": (None, [HANDLE]),
+    "ip_engine_begin": (c_int, [HANDLE, POINTER(S.Camera), c_float, ERR]),
+    "ip_engine_step": (c_int, [HANDLE, c_uint64, c_double, POINTER(S.EngineCounts), ERR]),
+    "ip_engine_done": (c_int, [HANDLE]),
+    "ip_engine_mesh": (POINTER(S.Mesh), [HANDLE]),
+    "ip_engine_totals": (None, [HANDLE, POINTER(S.EngineCounts)]),
+    "ip_extract_full": (c_int, [HANDLE, c_float, c_uint32, c_uint, POINTER(S.Mesh),
+                                POINTER(S.EngineCounts), ERR]),
+    "ip_mesh_init": (None, [POINTER(S.Mesh)]),
+    "ip_mesh_free": (None, [POINTER(S.Mesh)]),
+}
+
+
+def _candidates():
+    env = os.environ.get("ISOPROP_LIBRARY")
+    if env:
+        return [env]
+    found = []
+    if _config is not None:
+        path = _config.LIBRARY
+        if not os.path.isabs(path):
+            path = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), path))
+        found.append(path)
+    if _config is not None and getattr(_config, "SONAME", None):
+        found.append(_config.SONAME)
+    return found + ["libisoprop.so.0", "libisoprop.so"]
+
+
+def _load():
+    tried = []
+    for path in _candidates():
+        try:
+            lib = ctypes.CDLL(path)
+        except OSError as e:
+            tried.append(str(e))
+            continue
+        for name, (restype, argtypes) in _PROTOTYPES.items():
+            fn = getattr(lib, name)
+            fn.restype = restype
+            fn.argtypes = argtypes
+        return lib, path
+    raise ImportError("isoprop: cannot load libisoprop (set ISOPROP_LIBRARY to its path): " +
+                      "; ".join(tried))
+
+
+lib, path = _load()

@@ -1,0 +1,174 @@
+/* Prints the size and every field's offset of the public structs that the Python module
+ * mirrors with ctypes (python/isoprop/_structs.py), one "STRUCT SIZE" line per struct and one
+ * "STRUCT.FIELD OFFSET" line per field; tests/python/test_layouts.py compares them. Built
+ * against the public headers alone. */
+#include <stddef.h>
+#include <stdio.h>
+
+#include "isoprop/isoprop.h"
+
+#define SIZE(type) printf("%s %zu\n", #type, sizeof(type))
+#define FIELD(type, field) printf("%s.%s %zu\n", #type, #field, offsetof(type, field))
+
+static void error_and_input(void)
+{
+    SIZE(ip_error);
+    FIELD(ip_error, code);
+    FIELD(ip_error, message);
+    SIZE(ip_input_desc);
+    FIELD(ip_input_desc, path);
+    FIELD(ip_input_desc, data_path);
+    FIELD(ip_input_desc, data_offset);
+    FIELD(ip_input_desc, dims);
+    FIELD(ip_input_desc, type);
+    FIELD(ip_input_desc, big_endian);
+    FIELD(ip_input_desc, spacing);
+    FIELD(ip_input_desc, encoding);
+    SIZE(ip_input_overrides);
+    FIELD(ip_input_overrides, has_dims);
+    FIELD(ip_input_overrides, dims);
+    FIELD(ip_input_overrides, has_type);
+    FIELD(ip_input_overrides, type);
+    FIELD(ip_input_overrides, has_endian);
+    FIELD(ip_input_overrides, big_endian);
+    FIELD(ip_input_overrides, has_spacing);
+    FIELD(ip_input_overrides, spacing);
+}
+
+static void bricker(void)
+{
+    SIZE(ip_bricker_options);
+    FIELD(ip_bricker_options, brick_edge);
+    FIELD(ip_bricker_options, subblock_edge);
+    FIELD(ip_bricker_options, lz4_level);
+    FIELD(ip_bricker_options, threads);
+    FIELD(ip_bricker_options, memory_limit);
+    FIELD(ip_bricker_options, force);
+    FIELD(ip_bricker_options, progress);
+    FIELD(ip_bricker_options, progress_user);
+    SIZE(ip_bricker_report);
+    FIELD(ip_bricker_report, input_bytes);
+    FIELD(ip_bricker_report, file_bytes);
+    FIELD(ip_bricker_report, bricks);
+    FIELD(ip_bricker_report, bricks_constant);
+    FIELD(ip_bricker_report, bricks_compressed);
+    FIELD(ip_bricker_report, bricks_raw);
+    FIELD(ip_bricker_report, levels);
+    FIELD(ip_bricker_report, threads);
+    FIELD(ip_bricker_report, seconds);
+    FIELD(ip_bricker_report, memory_planned);
+    FIELD(ip_bricker_report, peak_rss);
+    FIELD(ip_bricker_report, seconds_read);
+    FIELD(ip_bricker_report, seconds_encode);
+    FIELD(ip_bricker_report, seconds_write);
+}
+
+static void layout(void)
+{
+    SIZE(ip_level_layout);
+    FIELD(ip_level_layout, dims);
+    FIELD(ip_level_layout, bricks);
+    FIELD(ip_level_layout, first_brick);
+    FIELD(ip_level_layout, brick_count);
+    FIELD(ip_level_layout, octree_depth);
+    FIELD(ip_level_layout, first_node);
+    FIELD(ip_level_layout, node_count);
+    FIELD(ip_level_layout, value_min);
+    FIELD(ip_level_layout, value_max);
+    SIZE(ip_layout);
+    FIELD(ip_layout, dims);
+    FIELD(ip_layout, type);
+    FIELD(ip_layout, spacing);
+    FIELD(ip_layout, brick_edge);
+    FIELD(ip_layout, subblock_edge);
+    FIELD(ip_layout, level_count);
+    FIELD(ip_layout, value_min);
+    FIELD(ip_layout, value_max);
+    FIELD(ip_layout, brick_count);
+    FIELD(ip_layout, node_count);
+    FIELD(ip_layout, data_offset);
+    FIELD(ip_layout, data_size);
+    FIELD(ip_layout, summary_offset);
+    FIELD(ip_layout, summary_size);
+    FIELD(ip_layout, summary_checksum);
+    FIELD(ip_layout, file_size);
+    FIELD(ip_layout, levels);
+}
+
+static void cache(void)
+{
+    SIZE(ip_cache_level_stats);
+    FIELD(ip_cache_level_stats, bricks_total);
+    FIELD(ip_cache_level_stats, bricks_touched);
+    FIELD(ip_cache_level_stats, misses);
+    SIZE(ip_cache_stats);
+    FIELD(ip_cache_stats, budget_bytes);
+    FIELD(ip_cache_stats, resident_bytes);
+    FIELD(ip_cache_stats, resident_peak_bytes);
+    FIELD(ip_cache_stats, resident_bricks);
+    FIELD(ip_cache_stats, hits);
+    FIELD(ip_cache_stats, misses);
+    FIELD(ip_cache_stats, evictions);
+    FIELD(ip_cache_stats, waits);
+    FIELD(ip_cache_stats, bytes_decompressed);
+    FIELD(ip_cache_stats, bytes_read);
+    FIELD(ip_cache_stats, decode_seconds);
+    FIELD(ip_cache_stats, over_budget_pins);
+    FIELD(ip_cache_stats, pinned_bytes);
+    FIELD(ip_cache_stats, errors);
+    FIELD(ip_cache_stats, prefetched);
+    FIELD(ip_cache_stats, prefetch_hits);
+    FIELD(ip_cache_stats, bytes_read_disk);
+    FIELD(ip_cache_stats, wait_seconds);
+    FIELD(ip_cache_stats, bricks_touched);
+    FIELD(ip_cache_stats, bricks_total);
+    FIELD(ip_cache_stats, levels);
+    FIELD(ip_cache_stats, level);
+}
+
+static void engine(void)
+{
+    SIZE(ip_camera);
+    FIELD(ip_camera, eye);
+    FIELD(ip_camera, target);
+    FIELD(ip_camera, up);
+    FIELD(ip_camera, fov_y);
+    FIELD(ip_camera, width);
+    FIELD(ip_camera, height);
+    SIZE(ip_engine_options);
+    FIELD(ip_engine_options, cutoff_degrees);
+    FIELD(ip_engine_options, foldback_degrees);
+    FIELD(ip_engine_options, threads);
+    FIELD(ip_engine_options, lod);
+    FIELD(ip_engine_options, pixel_error);
+    FIELD(ip_engine_options, cell_ids);
+    FIELD(ip_engine_options, occlusion);
+    FIELD(ip_engine_options, prefetch);
+    SIZE(ip_engine_counts);
+    FIELD(ip_engine_counts, rays);
+    FIELD(ip_engine_counts, seeds);
+    FIELD(ip_engine_counts, cells);
+    FIELD(ip_engine_counts, triangles);
+    FIELD(ip_engine_counts, intersection_seconds);
+    FIELD(ip_engine_counts, propagation_seconds);
+    FIELD(ip_engine_counts, extraction_seconds);
+    FIELD(ip_engine_counts, rendering_seconds);
+    FIELD(ip_engine_counts, deferred);
+    SIZE(ip_mesh);
+    FIELD(ip_mesh, positions);
+    FIELD(ip_mesh, normals);
+    FIELD(ip_mesh, cells);
+    FIELD(ip_mesh, triangle_count);
+    FIELD(ip_mesh, capacity);
+    FIELD(ip_mesh, with_cells);
+}
+
+int main(void)
+{
+    error_and_input();
+    bricker();
+    layout();
+    cache();
+    engine();
+    return 0;
+}

@@ -1,0 +1,137 @@
+"""isoprop.brick(): from a numpy array (z, y, x) the same brick file as from the raw file of the
+same samples; every sample type; overrides for a plain raw file; errors leave no output and no
+scratch file; progress and cancelling."""
+import os
+import unittest
+
+import support  # first: it skips (status 77) when numpy is absent
+import numpy as np
+import isoprop
+
+
+DIMS = (23, 18, 13)  # x, y, z: all different, so that a transposed axis shows
+
+
+def listing():
+    return sorted(os.listdir(support.WORK))
+
+
+class Brick(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.raw = support.generate("shepp-logan", DIMS, "uint16")
+        cls.array = np.fromfile(cls.raw, dtype="<u2").reshape(DIMS[::-1])
+
+    def brick_both(self, name, **kw):
+        """Bricks the raw file and the array with the same options; returns both paths."""
+        from_file, from_array = support.work(name + "-file.ibv"), support.work(name + "-array.ibv")
+        isoprop.brick(self.raw, from_file, force=True, **kw)
+        report = isoprop.brick(self.array, from_array, force=True, **kw)
+        self.assertEqual(report["input_bytes"], self.array.nbytes)
+        self.assertEqual(report["file_bytes"], os.path.getsize(from_array))
+        return from_file, from_array
+
+    def test_array_equals_raw_file(self):
+        a, b = self.brick_both("same", brick_size=8, spacing=(0.5, 1.0, 2.0))
+        with open(a, "rb") as fa, open(b, "rb") as fb:
+            self.assertEqual(fa.read(), fb.read(), "the two brick files differ")
+        with isoprop.open(a) as f, isoprop.open(b) as g:
+            self.assertEqual(f.dims, DIMS)
+            self.assertEqual(g.shape, self.array.shape)
+            self.assertEqual(g.spacing, (0.5, 1.0, 2.0))
+            self.assertEqual(g.value_range, (self.array.min(), self.array.max()))
+            mf, mg = f.extract(1000.5, full=True), g.extract(1000.5, full=True)
+            self.assertGreater(len(mf), 0)
+            np.testing.assert_array_equal(mf.vertices, mg.vertices)
+            np.testing.assert_array_equal(mf.normals, mg.normals)
+
+    def test_views_and_byte_orders(self):
+        """A big-endian or non-contiguous array gives the same samples."""
+        ref = support.work("ref.ibv")
+        isoprop.brick(self.array, ref, brick_size=8)
+        big = support.work("big.ibv")
+        isoprop.brick(self.array.astype(">u2"), big, brick_size=8)
+        strided = support.work("strided.ibv")
+        isoprop.brick(np.asfortranarray(self.array), strided, brick_size=8)
+        for other in (big, strided):
+            with open(ref, "rb") as fa, open(other, "rb") as fb:
+                self.assertEqual(fa.read(), fb.read(), other)
+
+    def test_every_sample_type(self):
+        rng = np.random.default_rng(1)
+        for dtype in (np.uint8, np.uint16, np.int16, np.float32):
+            a = (rng.random((9, 11, 10)) * 100 - (50 if dtype in (np.int16, np.float32) else 0))
+            a = a.astype(dtype)
+            out = support.work("type-%s.ibv" % np.dtype(dtype).name)
+            isoprop.brick(a, out, brick_size=4, subblock_size=4)
+            with isoprop.open(out) as f:
+                self.assertEqual(f.dtype, np.dtype(dtype))
+                self.assertEqual(f.dims, (10, 11, 9))
+                self.assertEqual(f.value_range, (float(a.min()), float(a.max())))
+
+    def test_plain_raw_with_overrides(self):
+        plain = support.work("samples.bin")
+        self.array.astype(">u2").tofile(plain)
+        out = support.work("plain.ibv")
+        isoprop.brick(plain, out, dims=DIMS, dtype="uint16", endian="big", brick_size=8)
+        ref = support.work("plain-ref.ibv")
+        isoprop.brick(self.raw, ref, brick_size=8)
+        with open(out, "rb") as fa, open(ref, "rb") as fb:
+            self.assertEqual(fa.read(), fb.read())
+        with self.assertRaises(isoprop.Error) as caught:  # no dims: the name does not say them
+            isoprop.brick(plain, support.work("plain2.ibv"))
+        self.assertIn(plain, str(caught.exception))
+
+    def test_bad_arrays(self):
+        before = listing()
+        with self.assertRaises(TypeError):
+            isoprop.brick(np.zeros((4, 4, 4)), support.work("f64.ibv"))  # float64
+        with self.assertRaises(ValueError):
+            isoprop.brick(np.zeros((4, 4), np.uint8), support.work("2d.ibv"))
+        with self.assertRaises(ValueError):
+            isoprop.brick(np.zeros((4, 1, 4), np.uint8), support.work("thin.ibv"))
+        with self.assertRaises(ValueError):
+            isoprop.brick(np.zeros((4, 4, 4), np.uint8), support.work("x.ibv"), dims=(4, 4, 4))
+        nan = np.zeros((4, 4, 4), np.float32)
+        nan[1, 2, 3] = np.nan
+        with self.assertRaises(isoprop.Error) as caught:
+            isoprop.brick(nan, support.work("nan.ibv"))
+        self.assertIn("array", str(caught.exception))
+        self.assertNotIn(".raw", str(caught.exception))  # names the array, not the scratch file
+        self.assertEqual(listing(), before, "an error left a file behind")
+
+    def test_existing_output_and_force(self):
+        out = support.work("exists.ibv")
+        isoprop.brick(self.array, out, brick_size=8)
+        before = listing()
+        with self.assertRaises(isoprop.Error) as caught:
+            isoprop.brick(self.array, out, brick_size=8)
+        self.assertEqual(caught.exception.status, -8)  # IP_ERR_EXISTS
+        self.assertIn(out, str(caught.exception))
+        self.assertEqual(listing(), before)
+        isoprop.brick(self.array, out, brick_size=8, force=True)
+        self.assertEqual(listing(), before)
+
+    def test_progress_and_cancel(self):
+        seen = []
+        isoprop.brick(self.array, support.work("progress.ibv"),
+                      progress=lambda done, total: seen.append((done, total)))
+        self.assertTrue(seen)
+        self.assertEqual(seen[-1][1], self.array.nbytes)
+        before = listing()
+        out = support.work("cancelled.ibv")
+        with self.assertRaises(isoprop.Error) as caught:
+            isoprop.brick(self.array, out, progress=lambda done, total: True)
+        self.assertEqual(caught.exception.status, -11)  # IP_ERR_CANCELLED
+        self.assertEqual(listing(), before)
+
+        def interrupt(done, total):
+            raise KeyboardInterrupt
+
+        with self.assertRaises(KeyboardInterrupt):  # Ctrl-C cancels cleanly too
+            isoprop.brick(self.array, out, progress=interrupt)
+        self.assertEqual(listing(), before)
+
+
+if __name__ == "__main__":
+    support.main()
