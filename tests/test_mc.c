@@ -414,6 +414,7 @@ typedef struct mesh_report {
     long bad_vertices;   /* off their edge, NaN, or a normal that is not unit length */
     long open_edges;     /* a directed edge without its reverse */
     long repeated_edges; /* a directed edge used twice */
+    long split_vertices; /* a grid edge's vertex with other bits in another cell */
     long ambiguous_faces;
     long inward;  /* sphere only: triangles or normals facing the centre */
     long slivers; /* sphere only: too thin to orient numerically */
@@ -471,18 +472,17 @@ static uint64_t grid_edge_id(int x, int y, int z, unsigned edge)
     return ((uint64_t)((z * GRID + y) * GRID + x)) * 3 + edge / 4;
 }
 
-static int vertex_on_edge(const ip_mc_vertex *v, unsigned edge, const float origin[3],
-                          const float size[3])
+static int vertex_on_edge(const ip_mc_vertex *v, unsigned edge, const float lo[3],
+                          const float hi[3])
 {
     unsigned low = ip__mc_edge_corners[edge][0];
     for (unsigned a = 0; a < 3; a++) {
         if (!isfinite(v->position[a]) || !isfinite(v->normal[a]))
             return 0;
-        float lo = origin[a], hi = origin[a] + size[a];
         if (a == edge / 4) {
-            if (v->position[a] < lo || v->position[a] > hi)
+            if (v->position[a] < lo[a] || v->position[a] > hi[a])
                 return 0;
-        } else if (v->position[a] != ((low >> a & 1u) ? hi : lo)) {
+        } else if (v->position[a] != ((low >> a & 1u) ? hi[a] : lo[a])) {
             return 0;
         }
     }
@@ -528,11 +528,26 @@ static void check_sphere_triangle(const ip_mc_vertex *t, const double centre[3],
     }
 }
 
-/* Triangulates every cell, welds vertices by grid edge and checks the mesh is closed and
- * consistently oriented: every directed edge once, and its reverse once. */
-static mesh_report mesh_grid(const grid *gr, float iso, int use_gradients, const float size[3],
-                             const double *sphere_centre)
+/* Counts a vertex on grid edge `id` whose position differs in its bits from the one another
+ * cell put there (at[id], set[id] once one did). */
+static void check_same_bits(float (*at)[3], unsigned char *set, uint64_t id, const float p[3],
+                            mesh_report *r)
 {
+    if (set[id])
+        r->split_vertices += memcmp(at[id], p, sizeof at[id]) != 0;
+    memcpy(at[id], p, sizeof at[id]);
+    set[id] = 1;
+}
+
+/* Triangulates every cell, welds vertices by grid edge and checks the mesh is closed and
+ * consistently oriented: every directed edge once, and its reverse once; and that the cells
+ * sharing a grid edge put its vertex at the same bits (what welding by position relies on). */
+static mesh_report mesh_grid_at(const grid *gr, float iso, int use_gradients, const float size[3],
+                                float shift, const double *sphere_centre)
+{
+    float(*at)[3] = malloc((size_t)GRID * GRID * GRID * 3 * sizeof *at);
+    unsigned char *set = calloc((size_t)GRID * GRID * GRID * 3, 1);
+    REQUIRE(at && set);
     mesh_report r;
     memset(&r, 0, sizeof r);
     size_t capacity = 1 << 16, used = 0;
@@ -548,10 +563,13 @@ static mesh_report mesh_grid(const grid *gr, float iso, int use_gradients, const
                     memcpy(grads[c], gr->g[cz][cy][cx], sizeof grads[c]);
                 }
                 count_ambiguous_faces(values, iso, &r);
-                float origin[3] = {(float)x * size[0], (float)y * size[1], (float)z * size[2]};
+                float lo[3] = {((float)x - shift) * size[0], ((float)y - shift) * size[1],
+                               ((float)z - shift) * size[2]};
+                float hi[3] = {((float)x + 1 - shift) * size[0], ((float)y + 1 - shift) * size[1],
+                               ((float)z + 1 - shift) * size[2]};
                 ip_mc_vertex out[IP_MC_MAX_VERTICES];
-                int n = ip__mc_triangulate_cell(values, use_gradients ? grads : NULL, iso, origin,
-                                                size, out);
+                int n =
+                    ip__mc_triangulate_cell(values, use_gradients ? grads : NULL, iso, lo, hi, out);
                 unsigned c = ip__mc_case(values, iso);
                 REQUIRE(n == ip__mc_triangle_count[c]);
                 if (used + 3 * (size_t)n > capacity) {
@@ -564,7 +582,8 @@ static mesh_report mesh_grid(const grid *gr, float iso, int use_gradients, const
                     for (int k = 0; k < 3; k++) {
                         unsigned e = (unsigned)ip__mc_triangle_table[c][3 * t + k];
                         id[k] = grid_edge_id(x, y, z, e);
-                        r.bad_vertices += !vertex_on_edge(&out[3 * t + k], e, origin, size);
+                        r.bad_vertices += !vertex_on_edge(&out[3 * t + k], e, lo, hi);
+                        check_same_bits(at, set, id[k], out[3 * t + k].position, &r);
                     }
                     for (int k = 0; k < 3; k++)
                         edges[used++] = id[k] << 32 | id[(k + 1) % 3];
@@ -582,18 +601,30 @@ static mesh_report mesh_grid(const grid *gr, float iso, int use_gradients, const
             r.open_edges++;
     }
     free(edges);
+    free(at);
+    free(set);
     return r;
+}
+
+/* mesh_grid_at() with sample (0, 0, 0) at the origin. */
+static mesh_report mesh_grid(const grid *gr, float iso, int use_gradients, const float size[3],
+                             const double *sphere_centre)
+{
+    return mesh_grid_at(gr, iso, use_gradients, size, 0.0f, sphere_centre);
 }
 
 static void check_closed(const char *name, const mesh_report *r, long min_triangles)
 {
-    printf("%-22s %7ld triangles, %6ld ambiguous faces, %ld open, %ld repeated, %ld bad vertices\n",
+    printf("%-22s %7ld triangles, %6ld ambiguous faces, %ld open, %ld repeated, %ld bad vertices, "
+           "%ld split\n",
            name, r->triangles, r->ambiguous_faces, r->open_edges, r->repeated_edges,
-           r->bad_vertices);
+           r->bad_vertices, r->split_vertices);
     CHECK_MSG(r->triangles >= min_triangles, "%s: only %ld triangles", name, r->triangles);
     CHECK_MSG(r->open_edges == 0, "%s: %ld open edges", name, r->open_edges);
     CHECK_MSG(r->repeated_edges == 0, "%s: %ld repeated edges", name, r->repeated_edges);
     CHECK_MSG(r->bad_vertices == 0, "%s: %ld bad vertices", name, r->bad_vertices);
+    CHECK_MSG(r->split_vertices == 0, "%s: %ld vertices at other bits in a neighbour", name,
+              r->split_vertices);
 }
 
 static double sphere_value(double x, double y, double z, const double c[3], double radius)
@@ -622,6 +653,12 @@ static void test_sphere(grid *gr)
     const float stretched[3] = {0.5f, 1.75f, 1.25f};
     mesh_report r = mesh_grid(gr, 0.0f, 0, stretched, NULL);
     check_closed("sphere (anisotropic)", &r, 2000);
+    /* Spacings with no exact float, and the world's zero inside the sphere: near zero,
+     * lo + (hi - lo) need not round to hi, which the neighbour uses as its lo; shared vertices
+     * must still come out at the same bits. */
+    const float inexact[3] = {0.1f, 0.3f, 0.7f};
+    r = mesh_grid_at(gr, 0.0f, 1, inexact, 15.45f, NULL);
+    check_closed("sphere (inexact spacing)", &r, 2000);
 }
 
 static void test_touching_spheres(grid *gr)
@@ -723,7 +760,7 @@ static void test_values_equal_to_iso(grid *gr)
 static void test_non_finite_values(void)
 {
     const float specials[4] = {NAN, INFINITY, -INFINITY, 0.5f};
-    const float origin[3] = {1, 2, 3}, size[3] = {1, 1, 1};
+    const float origin[3] = {1, 2, 3}, far[3] = {2, 3, 4};
     uint64_t state = 5;
     long bad = 0;
     for (int trial = 0; trial < 20000; trial++) {
@@ -733,10 +770,10 @@ static void test_non_finite_values(void)
             values[c] = (r & 3) == 0 ? specials[(r >> 2) % 4] : (float)random_unit(&state);
         }
         ip_mc_vertex out[IP_MC_MAX_VERTICES];
-        int n = ip__mc_triangulate_cell(values, NULL, 0.5f, origin, size, out);
+        int n = ip__mc_triangulate_cell(values, NULL, 0.5f, origin, far, out);
         for (int i = 0; i < 3 * n; i++) {
             unsigned e = (unsigned)ip__mc_triangle_table[ip__mc_case(values, 0.5f)][i];
-            bad += !vertex_on_edge(&out[i], e, origin, size);
+            bad += !vertex_on_edge(&out[i], e, origin, far);
         }
     }
     CHECK_MSG(bad == 0, "%ld non-finite or misplaced vertices", bad);
@@ -751,6 +788,7 @@ static void test_ray_plane(void)
 {
     uint64_t state = 17;
     const float origin[3] = {4.0f, -2.0f, 1.0f}, size[3] = {2.0f, 1.0f, 1.5f};
+    const float far[3] = {origin[0] + size[0], origin[1] + size[1], origin[2] + size[2]};
     int hits = 0, misses = 0, wrong = 0;
     for (int trial = 0; trial < 20000; trial++) {
         double n[3], p[3], dir[3], start[3];
@@ -789,7 +827,7 @@ static void test_ray_plane(void)
         float ro[3] = {(float)start[0], (float)start[1], (float)start[2]};
         float rd[3] = {(float)dir[0], (float)dir[1], (float)dir[2]};
         float t_hit = -1.0f;
-        int got = ip__mc_ray_hits_cell(values, 0.0f, origin, size, ro, rd, &t_hit);
+        int got = ip__mc_ray_hits_cell(values, 0.0f, origin, far, ro, rd, &t_hit);
         if (inside) {
             hits++;
             wrong += !got || fabs(t_hit - t) > 1e-3 * (1.0 + fabs(t));
@@ -816,26 +854,26 @@ static void test_ray_first_active_cell_missed(void)
             sample[z][y][2] = 1.0f;
         }
     sample[0][0][0] = 1.0f; /* only corner 0 of cell A is inside */
-    const float size[3] = {2.0f, 2.0f, 2.0f};
     float cell[2][8];
     for (int k = 0; k < 2; k++)
         for (unsigned c = 0; c < 8; c++)
             cell[k][c] = sample[c >> 2][c >> 1 & 1u][k + (int)(c & 1u)];
     const float origin_a[3] = {0, 0, 0}, origin_b[3] = {2, 0, 0};
+    const float far_a[3] = {2, 2, 2}, far_b[3] = {4, 2, 2};
     const float ray_origin[3] = {-1.0f, 1.6f, 1.6f}, ray_dir[3] = {1.0f, 0.0f, 0.0f};
     float t = -1.0f;
     CHECK(ip__mc_case(cell[0], 0.5f) == 0x01 && ip__mc_edge_table[0x01] != 0); /* A is active */
-    CHECK(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, size, ray_origin, ray_dir, &t) == 0);
+    CHECK(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, far_a, ray_origin, ray_dir, &t) == 0);
     CHECK(t == -1.0f);
-    CHECK(ip__mc_ray_hits_cell(cell[1], 0.5f, origin_b, size, ray_origin, ray_dir, &t) == 1);
+    CHECK(ip__mc_ray_hits_cell(cell[1], 0.5f, origin_b, far_b, ray_origin, ray_dir, &t) == 1);
     CHECK(fabsf(t - 4.0f) < 1e-6f); /* the plane x = 3 */
-    CHECK(ip__mc_ray_hits_cell(cell[1], 0.5f, origin_b, size, ray_origin, ray_dir, NULL) == 1);
+    CHECK(ip__mc_ray_hits_cell(cell[1], 0.5f, origin_b, far_b, ray_origin, ray_dir, NULL) == 1);
     /* Aimed at the cap instead, the same cell is hit; from behind the ray misses (t < 0). */
     const float at_cap[3] = {-1.0f, 0.2f, 0.2f};
-    CHECK(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, size, at_cap, ray_dir, &t) == 1);
+    CHECK(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, far_a, at_cap, ray_dir, &t) == 1);
     CHECK(fabsf(t - 1.6f) < 1e-5f); /* the cap lies on x + y + z = 1 */
     const float behind[3] = {5.0f, 0.2f, 0.2f};
-    CHECK(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, size, behind, ray_dir, &t) == 0);
+    CHECK(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, far_a, behind, ray_dir, &t) == 0);
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -849,7 +887,7 @@ static int bench(int n)
     size_t count = (size_t)n * n * n, cells = (size_t)(n - 1) * (n - 1) * (n - 1);
     float *v = malloc(count * sizeof *v);
     float(*active)[8] = malloc(cells * sizeof *active);
-    float(*origins)[3] = malloc(cells * sizeof *origins);
+    float(*origins)[6] = malloc(cells * sizeof *origins); /* low and high corners */
     REQUIRE(v && active && origins);
     double c = (n - 1) / 2.0, radius = 0.4 * (n - 1);
     for (int z = 0; z < n; z++)
@@ -873,11 +911,13 @@ static int bench(int n)
                     values[k] = v[row * n + (size_t)x + (k & 1u)];
                 }
                 float origin[3] = {(float)x, (float)y, (float)z};
-                int t = ip__mc_triangulate_cell(values, NULL, 0.0f, origin, size, out);
+                float far[3] = {origin[0] + size[0], origin[1] + size[1], origin[2] + size[2]};
+                int t = ip__mc_triangulate_cell(values, NULL, 0.0f, origin, far, out);
                 triangles += t;
                 if (t > 0) {
                     memcpy(active[active_count], values, sizeof values);
-                    memcpy(origins[active_count++], origin, sizeof origin);
+                    memcpy(origins[active_count], origin, sizeof origin);
+                    memcpy(origins[active_count++] + 3, far, sizeof far);
                 }
             }
     double all_seconds = ip_now_seconds() - start;
@@ -887,7 +927,7 @@ static int bench(int n)
     for (int r = 0; r < repeats; r++)
         for (size_t i = 0; i < active_count; i++)
             active_triangles +=
-                ip__mc_triangulate_cell(active[i], NULL, 0.0f, origins[i], size, out);
+                ip__mc_triangulate_cell(active[i], NULL, 0.0f, origins[i], origins[i] + 3, out);
     double active_seconds = ip_now_seconds() - start;
     printf("%d^3 sphere: all %zu cells in %.4f s = %.1f M cells/s (%zu active, %ld triangles); "
            "active cells only: %.1f M cells/s, %.1f M triangles/s\n",

@@ -1,4 +1,5 @@
-/* Meshes: packed normals, cell ids on request, appends, and the PLY writer. */
+/* Meshes: packed normals, cell ids on request, appends, and the writers (PLY, STL, OBJ, binary
+ * glTF) of soups and of welded meshes. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -150,18 +151,30 @@ static size_t read_file(const char *path, unsigned char *buf, size_t capacity)
     return size;
 }
 
+/* path[4200]: `name` in the test's scratch folder, removed if it is there. */
+static void scratch_path(char *path, const char *name)
+{
+    snprintf(path, 4200, "%s/%s", test_tmp_dir("test_mesh"), name);
+    remove(path);
+}
+
+/* Whether no file is at `path`. */
+static int no_file(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (f)
+        fclose(f);
+    return f == NULL;
+}
+
 /* Binary STL and OBJ of two triangles, by extension through ip_mesh_write(): sizes, corners,
  * face normals, indices; an unknown extension is refused and writes nothing. */
 static void test_stl_obj(void)
 {
-    const char *dir = test_tmp_dir("test_mesh");
     char stl[4200], obj[4200], bad[4200];
-    snprintf(stl, sizeof stl, "%s/two.STL", dir);
-    snprintf(obj, sizeof obj, "%s/two.obj", dir);
-    snprintf(bad, sizeof bad, "%s/two.off", dir);
-    remove(stl);
-    remove(obj);
-    remove(bad);
+    scratch_path(stl, "two.STL");
+    scratch_path(obj, "two.obj");
+    scratch_path(bad, "two.off");
     float p[18];
     ip_mesh m;
     two_triangles(&m, p);
@@ -171,10 +184,7 @@ static void test_stl_obj(void)
     REQUIRE(ip_mesh_write(&m, stl, 0, &err) == IP_OK);
     REQUIRE(ip_mesh_write(&m, obj, 0, &err) == IP_OK);
     CHECK(ip_mesh_write(&m, bad, 0, &err) == IP_ERR_ARGUMENT && strstr(err.message, "two.off"));
-    FILE *f = fopen(bad, "rb");
-    CHECK(f == NULL);
-    if (f)
-        fclose(f);
+    CHECK(no_file(bad));
 
     static unsigned char buf[4096];
     size_t size = read_file(stl, buf, sizeof buf);
@@ -216,6 +226,214 @@ static void test_stl_obj(void)
         }
     }
     CHECK(v == 6 && vn == 6 && faces == 2);
+    ip_mesh_free(&m);
+}
+
+/* The number after `key` ("\"count\":") at or after `from` in json; -1 when absent. */
+static long long json_number(const char *from, const char *key)
+{
+    const char *p = strstr(from, key);
+    return p ? strtoll(p + strlen(key), NULL, 10) : -1;
+}
+
+/* A .glb read back: header, chunks, and the JSON's buffer, views and accessors. */
+typedef struct glb_file {
+    const char *json;         /* the JSON chunk, terminated */
+    const unsigned char *bin; /* the binary chunk's data, NULL when none */
+    uint32_t bin_length;
+    long long count[3]; /* the accessors' counts: positions, normals, indices (-1: none) */
+    float min[3], max[3];
+} glb_file;
+
+/* Checks the container of the file in buf[size] and reads it into g. */
+static void read_glb(unsigned char *buf, size_t size, glb_file *g)
+{
+    memset(g, 0, sizeof *g);
+    REQUIRE(size >= 20);
+    CHECK(memcmp(buf, "glTF", 4) == 0 && ip__load_u32le(buf + 4) == 2);
+    CHECK_MSG(ip__load_u32le(buf + 8) == size, "header length %u, file %zu",
+              (unsigned)ip__load_u32le(buf + 8), size);
+    uint32_t json_length = ip__load_u32le(buf + 12);
+    CHECK(json_length % 4 == 0 && memcmp(buf + 16, "JSON", 4) == 0);
+    REQUIRE(20 + (size_t)json_length <= size);
+    size_t end = 20 + json_length;
+    if (end < size) {
+        REQUIRE(end + 8 <= size);
+        g->bin_length = ip__load_u32le(buf + end);
+        CHECK(memcmp(buf + end + 4, "BIN\0", 4) == 0 && g->bin_length % 4 == 0);
+        CHECK(end + 8 + g->bin_length == size);
+        g->bin = buf + end + 8;
+    }
+    char *json = (char *)buf + 16; /* over the chunk header, now read: room for a terminator */
+    memmove(json, buf + 20, json_length);
+    json[json_length] = 0;
+    g->json = json;
+    CHECK(strstr(json, "\"version\":\"2.0\"") && strstr(json, "\"generator\":\"isoprop "));
+    const char *accessors = strstr(json, "\"accessors\":");
+    for (int i = 0; i < 3; i++)
+        g->count[i] = -1;
+    if (!accessors)
+        return;
+    const char *a = accessors;
+    for (int i = 0; i < 3 && (a = strstr(a, "{\"bufferView\":")); i++, a++)
+        g->count[i] = json_number(a, "\"count\":");
+    const char *min = strstr(accessors, "\"min\":["), *max = strstr(accessors, "\"max\":[");
+    REQUIRE(min && max);
+    CHECK(sscanf(min, "\"min\":[%f,%f,%f]", &g->min[0], &g->min[1], &g->min[2]) == 3);
+    CHECK(sscanf(max, "\"max\":[%f,%f,%f]", &g->max[0], &g->max[1], &g->max[2]) == 3);
+    CHECK(json_number(json, "\"buffers\":[{\"byteLength\":") == g->bin_length);
+}
+
+/* Compares a .glb's vertices (and indices, if any) with those expected: positions exactly,
+ * normals within packing, unit length; min and max those of the positions. */
+static void check_glb_arrays(const glb_file *g, const float *positions, const int16_t *normals,
+                             uint64_t vertices, const uint32_t *indices, uint64_t triangles)
+{
+    CHECK(g->count[0] == (long long)vertices && g->count[1] == (long long)vertices);
+    CHECK(g->count[2] == (indices ? (long long)(3 * triangles) : -1));
+    CHECK(g->bin_length == 24 * vertices + (indices ? 12 * triangles : 0));
+    CHECK(json_number(g->json, "\"mode\":") == 4);
+    CHECK((strstr(g->json, "\"indices\":2") != NULL) == (indices != NULL));
+    int same = 1;
+    for (uint64_t i = 0; i < vertices; i++) {
+        float length = 0;
+        for (int k = 0; k < 3; k++) {
+            float p = ip__load_f32le(g->bin + 12 * i + 4 * (uint64_t)k);
+            float n = ip__load_f32le(g->bin + 12 * (vertices + i) + 4 * (uint64_t)k);
+            same &= p == positions[3 * i + (uint64_t)k] && p >= g->min[k] && p <= g->max[k];
+            same &= fabsf(n - ip_normal_unpack(normals[3 * i + (uint64_t)k])) < 1e-4f;
+            length += n * n;
+        }
+        same &= fabsf(length - 1.0f) < 1e-6f;
+    }
+    for (int k = 0; k < 3; k++) { /* the bounds are reached */
+        int low = 0, high = 0;
+        for (uint64_t i = 0; i < vertices; i++) {
+            low |= positions[3 * i + (uint64_t)k] == g->min[k];
+            high |= positions[3 * i + (uint64_t)k] == g->max[k];
+        }
+        same &= low && high;
+    }
+    for (uint64_t i = 0; indices && i < 3 * triangles; i++)
+        same &= ip__load_u32le(g->bin + 24 * vertices + 4 * i) == indices[i];
+    CHECK_MSG(same, "the .glb's arrays differ from the mesh");
+}
+
+/* Binary glTF of a soup and of its welded mesh, and of an empty mesh, read back. */
+static void test_glb(void)
+{
+    char soup_path[4200], welded_path[4200], empty_path[4200];
+    scratch_path(soup_path, "soup.glb");
+    scratch_path(welded_path, "welded.GLB");
+    scratch_path(empty_path, "empty.glb");
+    /* a fan of 5 triangles around a centre: 15 corners, 7 vertices */
+    ip_mesh m;
+    ip_mesh_init(&m);
+    for (int t = 0; t < 5; t++) {
+        float p[9] = {0.5f, -1.25f, 3};
+        float n[9];
+        for (int k = 1; k < 3; k++) {
+            double angle = (t + k - 1) * 0.7;
+            p[3 * k] = 0.5f + (float)cos(angle);
+            p[3 * k + 1] = -1.25f + (float)sin(angle);
+            p[3 * k + 2] = 3 + 0.1f * (float)(t + k);
+        }
+        for (int k = 0; k < 9; k++)
+            n[k] = k % 3 == 2 ? 0.8f : k % 3 == 0 ? 0.6f : 0.0f;
+        REQUIRE(ip_mesh_append_float_normals(&m, p, n, NULL, 1) == IP_OK);
+    }
+    ip_error err;
+    CHECK(strcmp(ip_mesh_format_of(welded_path), "GLB") == 0);
+    REQUIRE(ip_mesh_write(&m, soup_path, 0, &err) == IP_OK);
+    CHECK(ip_mesh_write_glb(&m, soup_path, 0, &err) == IP_ERR_EXISTS);
+    static unsigned char buf[1 << 16];
+    glb_file g;
+    read_glb(buf, read_file(soup_path, buf, sizeof buf), &g);
+    check_glb_arrays(&g, m.positions, m.normals, 15, NULL, 5);
+
+    ip_indexed_mesh w;
+    REQUIRE(ip_mesh_weld(&m, &w) == IP_OK);
+    CHECK(w.vertex_count == 7 && w.triangle_count == 5);
+    REQUIRE(ip_indexed_mesh_write(&w, welded_path, 0, &err) == IP_OK);
+    read_glb(buf, read_file(welded_path, buf, sizeof buf), &g);
+    check_glb_arrays(&g, w.positions, w.normals, 7, w.indices, 5);
+
+    ip_mesh empty;
+    ip_mesh_init(&empty);
+    REQUIRE(ip_mesh_write_glb(&empty, empty_path, 0, &err) == IP_OK);
+    size_t size = read_file(empty_path, buf, sizeof buf);
+    read_glb(buf, size, &g);
+    CHECK(g.bin == NULL && g.count[0] == -1 && strstr(g.json, "\"meshes\"") == NULL);
+
+    /* a position that is not finite has no place in glTF's bounds: refused, nothing written */
+    m.positions[4] = INFINITY;
+    remove(soup_path);
+    CHECK(ip_mesh_write(&m, soup_path, 0, &err) == IP_ERR_ARGUMENT &&
+          strstr(err.message, "soup.glb"));
+    CHECK(no_file(soup_path));
+    ip_indexed_mesh_free(&w);
+    ip_mesh_free(&m);
+}
+
+/* A welded mesh as PLY and OBJ: shared vertices, faces of indices; STL still a soup. */
+static void test_indexed_files(void)
+{
+    char ply[4200], obj[4200], stl[4200];
+    scratch_path(ply, "welded.ply");
+    scratch_path(obj, "welded.obj");
+    scratch_path(stl, "welded.stl");
+    ip_mesh m;
+    ip_mesh_init(&m);
+    /* a square of two triangles: 4 vertices */
+    const float p[18] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 0, 0, 1, 1, 0, 0, 1, 0};
+    float n[18];
+    for (int k = 0; k < 18; k++)
+        n[k] = k % 3 == 2;
+    REQUIRE(ip_mesh_append_float_normals(&m, p, n, NULL, 2) == IP_OK);
+    ip_indexed_mesh w;
+    REQUIRE(ip_mesh_weld(&m, &w) == IP_OK);
+    REQUIRE(w.vertex_count == 4);
+    ip_error err;
+    REQUIRE(ip_indexed_mesh_write(&w, ply, 1, &err) == IP_OK);
+    REQUIRE(ip_indexed_mesh_write(&w, obj, 1, &err) == IP_OK);
+    REQUIRE(ip_indexed_mesh_write(&w, stl, 1, &err) == IP_OK);
+
+    static unsigned char buf[4096];
+    size_t size = read_file(ply, buf, sizeof buf - 1);
+    buf[size] = 0;
+    const char *end = strstr((const char *)buf, "end_header\n");
+    REQUIRE(end);
+    CHECK(strstr((const char *)buf, "element vertex 4\n") &&
+          strstr((const char *)buf, "element face 2\n"));
+    size_t body = (size_t)(end - (const char *)buf) + strlen("end_header\n");
+    CHECK(size == body + 4 * 24 + 2 * 13);
+    const unsigned char *face = buf + body + 4 * 24;
+    CHECK(face[0] == 3 && ip__load_u32le(face + 1) == 0 && ip__load_u32le(face + 5) == 1 &&
+          ip__load_u32le(face + 9) == 2);
+    CHECK(face[13] == 3 && ip__load_u32le(face + 14) == 0 && ip__load_u32le(face + 18) == 2 &&
+          ip__load_u32le(face + 22) == 3);
+    CHECK(ip__load_f32le(buf + body + 3 * 24 + 4) == 1.0f); /* vertex 3 is (0, 1, 0) */
+
+    size = read_file(obj, buf, sizeof buf - 1);
+    buf[size] = 0;
+    int v = 0, vn = 0, faces = 0;
+    for (char *line = strtok((char *)buf, "\n"); line; line = strtok(NULL, "\n")) {
+        v += strncmp(line, "v ", 2) == 0;
+        vn += strncmp(line, "vn ", 3) == 0;
+        if (line[0] == 'f') {
+            unsigned a, b, c, a2, b2, c2;
+            CHECK(sscanf(line, "f %u//%u %u//%u %u//%u", &a, &a2, &b, &b2, &c, &c2) == 6);
+            CHECK(a == 1 && b == (faces ? 3u : 2u) && c == (faces ? 4u : 3u) && a2 == a && c2 == c);
+            faces++;
+        }
+    }
+    CHECK(v == 4 && vn == 4 && faces == 2);
+
+    size = read_file(stl, buf, sizeof buf);
+    CHECK(size == 84 + 2 * 50);
+    for (int k = 0; k < 9; k++)
+        CHECK(ip__load_f32le(buf + 84 + 50 + 12 + 4 * k) == p[9 + k]);
+    ip_indexed_mesh_free(&w);
     ip_mesh_free(&m);
 }
 
@@ -275,5 +493,7 @@ int main(void)
     test_appends();
     test_ply();
     test_stl_obj();
+    test_glb();
+    test_indexed_files();
     return test_summary("test_mesh");
 }

@@ -32,8 +32,13 @@ static const char usage[] =
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
     "  --threads N         threads for seeding, propagation and --full (default: all cores)\n"
     "  -o OUT.png          the image (default isorender.png)\n"
-    "  --mesh OUT          also write the triangles: binary PLY (.ply), binary STL (.stl)\n"
-    "                      or Wavefront OBJ (.obj), by the name's extension\n"
+    "  --mesh OUT          also write the triangles: binary PLY (.ply), binary STL (.stl),\n"
+    "                      Wavefront OBJ (.obj) or binary glTF (.glb, world units as metres),\n"
+    "                      by the name's extension. A progressive run's mesh holds only what\n"
+    "                      the view needed (open behind); with --full it is the whole, closed\n"
+    "                      surface\n"
+    "  --weld, --no-weld   PLY, OBJ and glTF meshes share their vertices (default), or repeat\n"
+    "                      them for every triangle (STL always does)\n"
     "  --stats OUT.json    counts, times, warnings, the cache statistics and the overdraw\n"
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
@@ -71,6 +76,7 @@ typedef struct options {
     const char *file, *out, *mesh, *progress, *strip;
     int full, software, warm; /* --stats, --force and --quiet are in common */
     strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
+    int weld, no_weld;
 } options;
 
 /* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
@@ -106,6 +112,7 @@ typedef struct run {
     char warning[600]; /* the --iso warning, "" when none */
     int writing;       /* 1 once the outputs are being written */
     strip_frames strip;
+    uint64_t mesh_vertices, mesh_dropped; /* of the mesh file: vertices, degenerate triangles */
 } run;
 
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
@@ -120,6 +127,8 @@ static const tool_option isorender_options[] = {
     {"--software", NULL, 0, offsetof(options, software), NULL, NULL, NULL},
     {"--strip", NULL, 1, offsetof(options, strip), NULL, NULL, NULL},
     {"--strip-at", NULL, 1, offsetof(options, strip_at), parse_strip_at, NULL, NULL},
+    {"--weld", NULL, 0, offsetof(options, weld), NULL, NULL, NULL},
+    {"--no-weld", NULL, 0, offsetof(options, no_weld), NULL, NULL, NULL},
 };
 
 /* ---- the progress strip ---- */
@@ -354,6 +363,8 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     if (o->full && (o->common.rays || o->common.time_limit > 0))
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
+    if (o->weld && o->no_weld)
+        return tool_usage_error("isorender", "--weld and --no-weld: one or the other");
     return check_strip_options(o);
 }
 
@@ -619,6 +630,43 @@ static void print_summary(const run *r)
            r->extraction_wall, ip_thread_count(r->o.common.threads), t->intersection_seconds,
            t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
     printf("  image         %s\n", r->o.out);
+    if (r->o.mesh)
+        printf("  mesh          %s: %llu triangles, %llu vertices%s\n", r->o.mesh,
+               (unsigned long long)(r->mesh->triangle_count - r->mesh_dropped),
+               (unsigned long long)r->mesh_vertices,
+               r->mesh_vertices < 3 * r->mesh->triangle_count ? " (shared)" : "");
+}
+
+/* Writes the mesh file: welded (shared vertices) unless --no-weld or STL. A progressive
+ * run's mesh is only what the view needed, which a note says. */
+static int write_mesh(run *r, ip_error *err)
+{
+    const char *format = ip_mesh_format_of(r->o.mesh);
+    ip_status st;
+    if (r->o.no_weld || strcmp(format, "STL") == 0) {
+        st = ip_mesh_write(r->mesh, r->o.mesh, r->o.common.force, err);
+        r->mesh_vertices = 3 * r->mesh->triangle_count;
+    } else {
+        ip_indexed_mesh welded;
+        st = ip_mesh_weld(r->mesh, &welded);
+        if (st != IP_OK) {
+            fprintf(stderr, "isorender: %s: cannot weld %llu triangles (%s)\n", r->o.mesh,
+                    (unsigned long long)r->mesh->triangle_count, ip_status_message(st));
+            return 1;
+        }
+        st = ip_indexed_mesh_write(&welded, r->o.mesh, r->o.common.force, err);
+        r->mesh_vertices = welded.vertex_count;
+        r->mesh_dropped = welded.dropped_triangles;
+        ip_indexed_mesh_free(&welded);
+    }
+    if (st != IP_OK)
+        return tool_fail("isorender", err);
+    if (!r->o.full && !r->o.common.quiet)
+        fprintf(stderr,
+                "isorender: note: %s holds only the surface this view needed (open "
+                "behind); --full --mesh writes the whole, closed surface\n",
+                r->o.mesh);
+    return 0;
 }
 
 /* Frees the decoded bricks once extraction is over: the image needs only the mesh, and
@@ -667,10 +715,10 @@ static int finish(run *r, ip_error *err)
         ip_png_write(r->o.strip, strip, strip_width, strip_height, r->o.common.force, err) != IP_OK)
         rc = -1;
     free(strip);
-    if (rc == 0 && r->o.mesh && ip_mesh_write(r->mesh, r->o.mesh, r->o.common.force, err) != IP_OK)
-        rc = -1;
     if (rc != 0)
         return tool_fail("isorender", err);
+    if (r->o.mesh && write_mesh(r, err) != 0)
+        return 1;
     if (r->o.progress && !r->o.full &&
         tool_write_text_file("isorender", r->o.progress, r->o.common.force, progress_csv, r) != 0)
         return 1;
@@ -701,8 +749,8 @@ int main(int argc, char **argv)
     if (tool_check_paths("isorender", inputs, 1, outputs, 5, r.o.common.force) != 0)
         return 1;
     if (r.o.mesh && !ip_mesh_format_of(r.o.mesh)) /* before any work, after the paths' checks */
-        return tool_usage_error("isorender", "--mesh %s: the name must end in .ply, .stl or .obj",
-                                r.o.mesh);
+        return tool_usage_error(
+            "isorender", "--mesh %s: the name must end in .ply, .stl, .obj or .glb", r.o.mesh);
     tool_signals_catch();
     ip_error err;
     ip_error_clear(&err);

@@ -6,6 +6,18 @@
  * normalisation on). That is 54 bytes a triangle. On request (`with_cells`) it also keeps the
  * id of the cell each triangle came from (8 bytes more), so that two extractions can be
  * compared triangle by triangle.
+ *
+ * Welded, the same surface is an indexed mesh (ip_indexed_mesh): each distinct position once,
+ * and triangles as 3 vertex indices. Marching cubes puts a vertex shared by neighbouring cells
+ * at the same bits in each of them, so welding by exact position joins exactly the corners
+ * that are one point of the surface, and a closed surface comes out closed (every edge shared
+ * by two triangles).
+ *
+ * Files, by the name's extension: binary PLY, binary STL, Wavefront OBJ and binary glTF 2.0
+ * (.glb). PLY, OBJ and glTF keep the vertices as they are given (a soup's 3 per triangle, or
+ * an indexed mesh's shared ones); STL is a triangle soup by definition. glTF has no units of
+ * its own but says that one unit is a metre: world units are written as they are, so a volume
+ * with 1 mm spacing shows 1000 times too large in a viewer that takes glTF at its word.
  */
 #ifndef ISOPROP_MESH_H
 #define ISOPROP_MESH_H
@@ -90,7 +102,8 @@ IP_API ip_status ip_mesh_append_mesh(ip_mesh *mesh, const ip_mesh *from, uint64_
 
 /*! ip_mesh_write_ply() : writes the mesh as binary little-endian PLY (float x,y,z,nx,ny,nz per
  *  vertex, 3 vertices per triangle, faces as uchar-counted int lists), atomically; only a
- *  regular file is ever replaced (isoprop/output.h).
+ *  regular file is ever replaced (isoprop/output.h). An indexed mesh is written with
+ *  ip_indexed_mesh_write().
  *  @return IP_OK, IP_ERR_EXISTS (force == 0 and the file exists), IP_ERR_ARGUMENT (the path
  *  exists and is not a regular file), IP_ERR_NOMEM or IP_ERR_IO. */
 IP_API ip_status ip_mesh_write_ply(const ip_mesh *mesh, const char *path, int force, ip_error *err);
@@ -107,14 +120,61 @@ IP_API ip_status ip_mesh_write_stl(const ip_mesh *mesh, const char *path, int fo
  *  ip_mesh_write_ply(). @return as ip_mesh_write_ply(). */
 IP_API ip_status ip_mesh_write_obj(const ip_mesh *mesh, const char *path, int force, ip_error *err);
 
-/*! ip_mesh_format_of() : "PLY", "STL" or "OBJ" for a name ending in .ply, .stl or .obj
- *  (ignoring case), NULL for any other (a static string: not to be freed). */
+/*! ip_mesh_write_glb() : writes the mesh as binary glTF 2.0 (.glb), atomically, like
+ *  ip_mesh_write_ply(): a 12-byte header, a JSON chunk (padded with spaces to 4 bytes) and a
+ *  binary chunk holding float32 positions (with their min and max in the JSON) and float32
+ *  unit normals, 3 vertices per triangle and no indices; one buffer, mesh, node and scene;
+ *  asset.generator "isoprop VERSION". A mesh without triangles has no buffer, mesh or node.
+ *  @return as ip_mesh_write_ply(), and IP_ERR_ARGUMENT for a file past glTF's 4 GiB limit or
+ *  a position that is not finite. */
+IP_API ip_status ip_mesh_write_glb(const ip_mesh *mesh, const char *path, int force, ip_error *err);
+
+/*! ip_mesh_format_of() : "PLY", "STL", "OBJ" or "GLB" for a name ending in .ply, .stl, .obj or
+ *  .glb (ignoring case), NULL for any other (a static string: not to be freed). */
 IP_API const char *ip_mesh_format_of(const char *path);
 
 /*! ip_mesh_write() : writes the mesh in the format its name ends in, ignoring case: .ply,
- *  .stl or .obj. @return as those, or IP_ERR_ARGUMENT with a message naming the file for any
- *  other name. */
+ *  .stl, .obj or .glb. @return as those, or IP_ERR_ARGUMENT with a message naming the file for
+ *  any other name. */
 IP_API ip_status ip_mesh_write(const ip_mesh *mesh, const char *path, int force, ip_error *err);
+
+/* A welded mesh: shared vertices and triangles of indices into them. */
+typedef struct ip_indexed_mesh {
+    float *positions;  /* 3 floats per vertex: x, y, z in world units, each position once */
+    int16_t *normals;  /* 3 per vertex: its unit normal, ip_normal_pack() */
+    uint32_t *indices; /* 3 per triangle: its vertices, in the soup's order (counter-clockwise
+                          seen from outside) */
+    uint64_t vertex_count;
+    uint64_t triangle_count;
+    uint64_t dropped_triangles; /* soup triangles with two corners at one position, left out */
+} ip_indexed_mesh;
+
+/*! ip_indexed_mesh_init() : an empty indexed mesh (no allocation). */
+IP_API void ip_indexed_mesh_init(ip_indexed_mesh *mesh);
+
+/*! ip_indexed_mesh_free() : releases the arrays; the mesh is empty afterwards. */
+IP_API void ip_indexed_mesh_free(ip_indexed_mesh *mesh);
+
+/*! ip_mesh_weld() : the soup `mesh` as an indexed mesh in `out`: corners at the same position
+ *  (compared bit for bit, with -0 equal to +0; no tolerance) become one vertex, numbered in the
+ *  order of their first appearance. A vertex's normal is the average of its corners' normals,
+ *  normalised again (the first corner's where they cancel out). A triangle with two corners at
+ *  one position has no area and no edge of its own: it is left out and counted in
+ *  out->dropped_triangles (its vertices too, unless another triangle uses them). Cell ids are
+ *  not kept. Takes O(triangles) time; the memory is `out`'s arrays and, while it runs, a hash
+ *  table of 8 bytes per triangle and 12 bytes per vertex. `out` is overwritten (an earlier
+ *  content is not freed) and owned by the caller, who frees it with ip_indexed_mesh_free();
+ *  after a failure it is empty. `mesh` is not changed.
+ *  @return IP_OK, IP_ERR_NOMEM, or IP_ERR_ARGUMENT for more than 2^32 - 2 distinct vertices. */
+IP_API ip_status ip_mesh_weld(const ip_mesh *mesh, ip_indexed_mesh *out);
+
+/*! ip_indexed_mesh_write() : writes the indexed mesh in the format its name ends in, like
+ *  ip_mesh_write(): PLY with its vertex list and faces of indices into it, OBJ with one "v" and
+ *  "vn" per vertex and faces "f a//a b//b c//c", glTF with a uint32 index accessor; STL repeats
+ *  the corners of each triangle, as STL must.
+ *  @return as ip_mesh_write(). */
+IP_API ip_status ip_indexed_mesh_write(const ip_indexed_mesh *mesh, const char *path, int force,
+                                       ip_error *err);
 
 #ifdef __cplusplus
 }

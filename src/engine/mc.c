@@ -35,17 +35,22 @@ static float edge_fraction(float v0, float v1, float iso)
     return t;
 }
 
-static void edge_position(unsigned edge, float t, const float origin[3], const float size[3],
+/* The point at fraction t along `edge` of the cell whose corners are lo and hi. Each coordinate
+ * comes from the edge's own ends, so every cell sharing the edge computes the same bits (which is
+ * what lets vertices be welded by exact position): across the edge the corner's coordinate
+ * itself, along it lo + t * (hi - lo), and exactly lo or hi at t = 0 or 1 (lo + (hi - lo) need
+ * not round to hi), so that a vertex on a corner equals the neighbours' vertices there. */
+static void edge_position(unsigned edge, float t, const float lo[3], const float hi[3],
                           float out[3])
 {
     unsigned low = ip__mc_edge_corners[edge][0];
     unsigned axis = edge >> 2;
-    for (unsigned a = 0; a < 3; a++) {
-        float offset = (float)((low >> a) & 1u);
-        if (a == axis)
-            offset = t;
-        out[a] = origin[a] + offset * size[a];
-    }
+    for (unsigned a = 0; a < 3; a++)
+        out[a] = (low >> a) & 1u ? hi[a] : lo[a];
+    if (t >= 1.0f)
+        out[axis] = hi[axis];
+    else if (t > 0.0f)
+        out[axis] = lo[axis] + t * (hi[axis] - lo[axis]);
 }
 
 /* Writes -g / |g| to out; returns 0 (out untouched) when g has no usable direction. */
@@ -97,7 +102,7 @@ static void edge_normal(const float values[8], const float gradients[8][3], floa
 }
 
 int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], float iso,
-                            const float origin[3], const float size[3], ip_mc_vertex *out)
+                            const float lo[3], const float hi[3], ip_mc_vertex *out)
 {
     unsigned mc_case = ip__mc_case(values, iso);
     unsigned crossed = ip__mc_edge_table[mc_case];
@@ -105,13 +110,14 @@ int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], 
         return 0;
     /* Each crossing is shared by up to 4 triangles of the cell: compute it once. */
     ip_mc_vertex at_edge[12];
-    const float inverse_size[3] = {1.0f / size[0], 1.0f / size[1], 1.0f / size[2]};
+    const float inverse_size[3] = {1.0f / (hi[0] - lo[0]), 1.0f / (hi[1] - lo[1]),
+                                   1.0f / (hi[2] - lo[2])};
     for (unsigned e = 0; e < 12; e++) {
         if (!(crossed >> e & 1u))
             continue;
         float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
                                 values[ip__mc_edge_corners[e][1]], iso);
-        edge_position(e, t, origin, size, at_edge[e].position);
+        edge_position(e, t, lo, hi, at_edge[e].position);
         edge_normal(values, gradients, iso, e, t, inverse_size, at_edge[e].normal);
     }
     const int8_t *row = ip__mc_triangle_table[mc_case];
@@ -121,15 +127,15 @@ int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], 
     return count;
 }
 
-unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float origin[3],
-                                 const float size[3], float points[12][3])
+unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float lo[3],
+                                 const float hi[3], float points[12][3])
 {
     unsigned crossed = ip__mc_edge_table[ip__mc_case(values, iso)];
     for (unsigned e = 0; e < 12; e++)
         if (crossed >> e & 1u) {
             float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
                                     values[ip__mc_edge_corners[e][1]], iso);
-            edge_position(e, t, origin, size, points[e]);
+            edge_position(e, t, lo, hi, points[e]);
         }
     return crossed;
 }
@@ -162,9 +168,8 @@ static int ray_hits_triangle(const double o[3], const double d[3], const double 
     return 1;
 }
 
-int ip__mc_ray_hits_cell(const float values[8], float iso, const float origin[3],
-                         const float size[3], const float ray_origin[3], const float ray_dir[3],
-                         float *t_hit)
+int ip__mc_ray_hits_cell(const float values[8], float iso, const float lo[3], const float hi[3],
+                         const float ray_origin[3], const float ray_dir[3], float *t_hit)
 {
     unsigned mc_case = ip__mc_case(values, iso);
     unsigned crossed = ip__mc_edge_table[mc_case];
@@ -177,7 +182,7 @@ int ip__mc_ray_hits_cell(const float values[8], float iso, const float origin[3]
         float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
                                 values[ip__mc_edge_corners[e][1]], iso);
         float p[3];
-        edge_position(e, t, origin, size, p);
+        edge_position(e, t, lo, hi, p);
         for (unsigned a = 0; a < 3; a++)
             at_edge[e][a] = p[a];
     }

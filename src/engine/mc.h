@@ -9,7 +9,10 @@
  *     y edges:  4: 0-2   5: 1-3   6: 4-6   7: 5-7
  *     z edges:  8: 0-4   9: 1-5  10: 2-6  11: 3-7
  * A vertex on edge e is therefore also on the same grid edge of the (up to) three other cells that
- * share it, which is what makes welding by edge identity possible.
+ * share it, which is what makes welding by edge identity possible. It is computed from the
+ * edge's two samples and end points alone, in the same order and arithmetic by each of those
+ * cells (given the same corner coordinates), so its position has the same bits in all of them:
+ * welding by exact position (ip_mesh_weld()) needs no tolerance.
  *
  * Faces. Face f is the cell side at axis f / 2, on the low (f even) or high (f odd) side:
  * 0 = -x, 1 = +x, 2 = -y, 3 = +y, 4 = -z, 5 = +z.
@@ -95,39 +98,40 @@ unsigned ip__mc_crossed_faces(unsigned mc_case);
  *                NULL to use the gradient of the cell's own trilinear interpolant. For anisotropic
  *                cells the gradients must be in world coordinates.
  *  iso         : the isovalue.
- *  origin      : world position of corner 0.
- *  size        : world extent of the cell along x, y, z; each must be > 0 (a negative extent
- *                mirrors the cell and flips the winding).
+ *  lo, hi      : world positions of corners 0 and 7, hi > lo along each axis (a reversed axis
+ *                mirrors the cell and flips the winding). Neighbouring cells must be given the
+ *                same coordinates for their shared corners (not lo + size), so that they put
+ *                shared vertices at the same bits.
  *  out         : room for IP_MC_MAX_VERTICES vertices, owned by the caller; triangle t is
  *                out[3t], out[3t+1], out[3t+2], in the order of ip__mc_triangle_table.
  *  Each vertex lies on its edge at t = (iso - v0) / (v1 - v0) from the edge's low corner, clamped
- *  to [0, 1], so a value equal to iso puts the vertex on that corner. The normal is the negated,
+ *  to [0, 1], at lo + t * (hi - lo) along the edge's axis (exactly lo or hi at t = 0 or 1), so a
+ *  value equal to iso puts the vertex on that corner. The normal is the negated,
  *  normalised interpolated gradient; where that is zero or not finite it falls back to the
  *  trilinear gradient, then to the edge direction from its inside corner to its outside corner,
  *  so no output is ever NaN for finite inputs.
  *  @return the number of triangles written, 0 to IP_MC_MAX_TRIANGLES. No allocation. */
 int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], float iso,
-                            const float origin[3], const float size[3], ip_mc_vertex *out);
+                            const float lo[3], const float hi[3], ip_mc_vertex *out);
 
 /*! ip__mc_cell_edge_points() : the points where the surface crosses the cell's edges, exactly
- *  where ip__mc_triangulate_cell() (same values, iso, origin, size) puts its vertices, without
+ *  where ip__mc_triangulate_cell() (same values, iso, lo, hi) puts its vertices, without
  *  the normals: points[e] is set for every edge e whose bit is set in the returned mask
  *  (ip__mc_edge_table of the cell's case); the others are left alone. A cell's triangles are
  *  then the rows of ip__mc_triangle_table. No allocation. */
-unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float origin[3],
-                                 const float size[3], float points[12][3]);
+unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float lo[3],
+                                 const float hi[3], float points[12][3]);
 
 /*! ip__mc_ray_hits_cell() : whether the ray ray_origin + t * ray_dir, t >= 0, hits a triangle of
  *  the cell's triangulation (either side), as produced by ip__mc_triangulate_cell with the same
- *  values, iso, origin and size. A ray can cross an active cell without touching its triangles;
+ *  values, iso, lo and hi. A ray can cross an active cell without touching its triangles;
  *  this is the test that tells the two apart when seeding.
  *  t_hit : if not NULL and the ray hits, receives the smallest t of a hit, in units of the length
  *          of ray_dir (the distance when ray_dir is a unit vector); untouched otherwise.
  *  Triangle edges count as hits, so a ray through an edge shared by two triangles is not lost.
  *  @return 1 on a hit, 0 otherwise. No allocation. */
-int ip__mc_ray_hits_cell(const float values[8], float iso, const float origin[3],
-                         const float size[3], const float ray_origin[3], const float ray_dir[3],
-                         float *t_hit);
+int ip__mc_ray_hits_cell(const float values[8], float iso, const float lo[3], const float hi[3],
+                         const float ray_origin[3], const float ray_dir[3], float *t_hit);
 
 #ifdef __cplusplus
 }

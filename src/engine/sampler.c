@@ -99,12 +99,11 @@ int ip__sampler_cell_values(ip_sampler *s, const uint32_t cell[3], float values[
     return 1;
 }
 
-void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float origin[3],
-                          float size[3])
+void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float lo[3], float hi[3])
 {
     for (int a = 0; a < 3; a++) {
-        origin[a] = (float)s->world[a][cell[a]];
-        size[a] = (float)(s->world[a][cell[a] + 1] - s->world[a][cell[a]]);
+        lo[a] = (float)s->world[a][cell[a]];
+        hi[a] = (float)s->world[a][cell[a] + 1];
     }
 }
 
@@ -183,7 +182,7 @@ static double span(const ip_sampler *s, int a, int64_t i)
 int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
                             unsigned *mc_case)
 {
-    float values[8], outer[24], gradients[8][3], origin[3], size[3];
+    float values[8], outer[24], gradients[8][3], lo[3], hi[3];
     /* The case first, from the 8 corners alone: most cells of an active sub-block are not
      * active, and need neither the gradient neighbours nor the divisions. */
     const ip_brick *b = ip__sampler_cell_brick(s, cell);
@@ -208,6 +207,6 @@ int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip
             float vh = h ? outer[3 * c + a] : across, vl = h ? across : outer[3 * c + a];
             gradients[c][a] = d[h][a] > 0 ? (float)((vh - vl) / d[h][a]) : 0.0f;
         }
-    ip__sampler_cell_box(s, cell, origin, size);
-    return ip__mc_triangulate_cell(values, (const float(*)[3])gradients, iso, origin, size, out);
+    ip__sampler_cell_box(s, cell, lo, hi);
+    return ip__mc_triangulate_cell(values, (const float(*)[3])gradients, iso, lo, hi, out);
 }

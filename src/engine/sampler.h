@@ -94,9 +94,9 @@ static inline void ip__cell_values(const ip_brick *b, ip_type type, const ptrdif
     ip__samples_gather(b->samples, type, ip__sample_index(b, cell), offsets, 8, values);
 }
 
-/* World origin and size of `cell`. */
-void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float origin[3],
-                          float size[3]);
+/* World positions of `cell`'s low and high corners (0 and 7), each coordinate the grid's own,
+ * so that neighbouring cells get the same bits for their shared corners. */
+void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float lo[3], float hi[3]);
 
 /* Triangulates `cell` with gradient normals: writes up to IP_MC_MAX_VERTICES vertices and the
  * marching-cubes case. Returns the number of triangles, or -1 after a failure. */

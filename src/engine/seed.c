@@ -203,11 +203,13 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
             s->cells_read++;
         }
         if (mc != 0 && mc != 255) {
-            float origin[3], size[3];
+            float origin[3], far[3], size[3];
             double ro[3];
-            ip__sampler_cell_box(s->sampler, c, origin, size);
-            for (int k = 0; k < 3; k++) /* the cell's frame keeps precision in large volumes */
+            ip__sampler_cell_box(s->sampler, c, origin, far);
+            for (int k = 0; k < 3; k++) { /* the cell's frame keeps precision in large volumes */
                 ro[k] = r->world_origin[k] - (double)origin[k];
+                size[k] = far[k] - origin[k];
+            }
             s->cells_tested++;
             int kind = classify_cell(s, r, mc, values, size, ro);
             if (kind >= 2 && s->seed_index < 0)
