@@ -49,7 +49,7 @@ class Extract(unittest.TestCase):
         ply, stats = support.work(name + ".ply"), support.work(name + ".json")
         support.tool("isorender", self.ibv, "--iso", ISO, "--size", "%dx%d" % SIZE,
                      "--threads", "1", "--software", "-o", support.work(name + ".png"),
-                     "--mesh", ply, "--stats", stats, "--quiet", "--force", *args)
+                     "--mesh", ply, "--no-weld", "--stats", stats, "--quiet", "--force", *args)
         with open(stats) as s:
             return support.read_ply(ply), json.load(s)
 
@@ -183,7 +183,7 @@ class SampleVolume(unittest.TestCase):
         ibv, ply = support.work("tooth.ibv"), support.work("tooth.ply")
         support.tool("isobrick", raw, "-o", ibv, "--quiet")
         support.tool("isorender", ibv, "--iso", "120.5", "--full", "--software", "--size",
-                     "64x48", "-o", support.work("tooth.png"), "--mesh", ply, "--quiet")
+                     "64x48", "-o", support.work("tooth.png"), "--mesh", ply, "--no-weld", "--quiet")
         vertices, normals, faces = support.read_ply(ply)
         array = np.fromfile(raw, dtype=np.uint8).reshape(161, 94, 103)
         isoprop.brick(array, support.work("tooth-array.ibv"))

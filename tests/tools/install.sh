@@ -47,13 +47,13 @@ check "the example uses the installed libisoprop" sh -c "ldd extract | grep -q '
 run_capture ./extract s.ibv 128.5 --full --mesh full.ply
 check "the example extracts fully ($err)" test "$rc" = 0
 check "it prints its triangles" grep -Eq '^[1-9][0-9]* triangles \(full\)' "$work/.out"
-"$bin/isorender" s.ibv --iso 128.5 --full --mesh full_isorender.ply -o full.png --quiet
+"$bin/isorender" s.ibv --iso 128.5 --full --no-weld --mesh full_isorender.ply -o full.png --quiet
 check "full extraction: the example's mesh is isorender --full's, byte for byte" \
     cmp full.ply full_isorender.ply
 # progressive: one thread casts the rays in exactly the sequential order
 run_capture ./extract s.ibv 128.5 --threads 1 --size 160x120 --mesh view.ply
 check "the example extracts progressively ($err)" test "$rc" = 0
-"$bin/isorender" s.ibv --iso 128.5 --threads 1 --size 160x120 --mesh view_isorender.ply \
+"$bin/isorender" s.ibv --iso 128.5 --threads 1 --size 160x120 --no-weld --mesh view_isorender.ply \
     -o view.png --quiet
 check "progressive, one thread: the example's mesh is isorender's, byte for byte" \
     cmp view.ply view_isorender.ply
