@@ -181,11 +181,17 @@ static int parse_args(int argc, char **argv, options *o)
     return 0;
 }
 
-/* bricks/NAME.ibv, NAME being the input's file name without its extension. */
+/* bricks/NAME.ibv, NAME being the input's file name (or folder name: a DICOM series, trailing
+ * slashes aside) without its extension. */
 static int default_output(const char *input, char *out, size_t size)
 {
-    const char *base = strrchr(input, '/');
-    base = base ? base + 1 : input;
+    char name[IP_PATH_MAX];
+    size_t end = strlen(input);
+    while (end > 1 && input[end - 1] == '/')
+        end--;
+    snprintf(name, sizeof name, "%.*s", (int)end, input);
+    const char *base = strrchr(name, '/');
+    base = base ? base + 1 : name;
     const char *dot = strrchr(base, '.');
     int len = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
     if (mkdir("bricks", 0777) != 0 && errno != EEXIST)

@@ -14,6 +14,9 @@ run_capture "$bin/isobrick" "$raw" -o raw.ibv --brick-size 8 --threads 2 --spaci
 check "isobrick bricks the raw volume" test "$rc" = 0
 check "no rescale for raw input" sh -c '! grep -q rescale "$0"' "$work/.out"
 
+run_capture "$bin/isobrick" series/ --quiet
+check "a folder's default output is bricks/FOLDER.ibv" test -s bricks/series.ibv
+
 # the same dims, type, spacing and value range; the file name aside, the same description
 "$bin/isoinfo" --json dicom.ibv | sed 's/"file": "[^"]*", //' >dicom.json
 "$bin/isoinfo" --json raw.ibv | sed 's/"file": "[^"]*", //' >raw.json
