@@ -20,6 +20,13 @@ function(ip_dependencies out)
       list(APPEND flags ${CMAKE_THREAD_LIBS_INIT})
     elseif(lib STREQUAL "m")
       list(APPEND flags -lm)
+    elseif(lib STREQUAL "stdc++")
+      list(APPEND flags -lstdc++)
+    elseif(lib STREQUAL "gdcmMSFF")
+      # GDCM has no pkg-config module; its CMake package names the target, and the DICOM
+      # input calls its MSFF, DSED and Common libraries directly.
+      string(APPEND find "find_dependency(GDCM)\n")
+      list(APPEND flags -lgdcmMSFF -lgdcmDSED -lgdcmCommon)
     elseif(lib STREQUAL "ZLIB::ZLIB")
       string(APPEND find "find_dependency(ZLIB)\n")
       list(APPEND modules zlib)

@@ -1,8 +1,9 @@
 #!/bin/sh
 # Checks that the C sources follow .clang-format: runs `clang-format --dry-run --Werror` over
-# every *.c and *.h of src/, tools/, tests/, include/ and docs/ (tracked or new, not ignored) and
-# exits 1 when any would change, listing each difference as clang-format reports it. Changes
-# nothing. clang-format is Debian's package clang-format (tools/setup.sh installs it).
+# every *.c and *.h of src/, tools/, tests/, include/ and docs/ and the *.cpp of src/ (tracked
+# or new, not ignored) and exits 1 when any would change, listing each difference as
+# clang-format reports it. Changes nothing. clang-format is Debian's package clang-format
+# (tools/setup.sh installs it).
 #
 #   tools/check_format.sh            check the whole tree
 #   tools/check_format.sh FILE...    check these files only
@@ -21,7 +22,7 @@ trap 'rm -f "$list"' EXIT
 if [ $# -gt 0 ]; then
     printf '%s\n' "$@" >"$list"
 else
-    git ls-files --cached --others --exclude-standard -- 'src/*.[ch]' 'tools/*.[ch]' \
+    git ls-files --cached --others --exclude-standard -- 'src/*.[ch]' 'src/*.cpp' 'tools/*.[ch]' \
         'tests/*.[ch]' 'include/*.[ch]' 'docs/*.[ch]' | sort -u >"$list"
 fi
 failed=0 files=0 lines=0

@@ -14,8 +14,9 @@
 
 static const char usage[] =
     "usage: isobrick INPUT [-o OUT.ibv] [options]\n"
-    "Bricks INPUT (NAME_XxYxZ_TYPE.raw, any raw file with --dims/--type, .nrrd, .nhdr, .mhd)\n"
-    "into an LZ4-compressed brick file with min/max summaries and a level-of-detail pyramid.\n"
+    "Bricks INPUT (NAME_XxYxZ_TYPE.raw, any raw file with --dims/--type, .nrrd, .nhdr, .mhd,\n"
+    "or a folder holding a DICOM series) into an LZ4-compressed brick file with min/max\n"
+    "summaries and a level-of-detail pyramid.\n"
     "  -o OUT.ibv          output (default: bricks/NAME.ibv)\n"
     "  --dims XxYxZ        samples along x, y, z (raw input)\n"
     "  --type T            uint8, uint16, int16 or float32 (raw input)\n"
@@ -180,11 +181,17 @@ static int parse_args(int argc, char **argv, options *o)
     return 0;
 }
 
-/* bricks/NAME.ibv, NAME being the input's file name without its extension. */
+/* bricks/NAME.ibv, NAME being the input's file name (or folder name: a DICOM series, trailing
+ * slashes aside) without its extension. */
 static int default_output(const char *input, char *out, size_t size)
 {
-    const char *base = strrchr(input, '/');
-    base = base ? base + 1 : input;
+    char name[IP_PATH_MAX];
+    size_t end = strlen(input);
+    while (end > 1 && input[end - 1] == '/')
+        end--;
+    snprintf(name, sizeof name, "%.*s", (int)end, input);
+    const char *base = strrchr(name, '/');
+    base = base ? base + 1 : name;
     const char *dot = strrchr(base, '.');
     int len = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
     if (mkdir("bricks", 0777) != 0 && errno != EEXIST)
@@ -234,9 +241,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "isobrick: cannot create the folder bricks/ for the output\n");
         return 1;
     }
-    /* the input, its detached data file (NRRD, MetaImage) and the output, before any work */
+    /* the input, its detached data file (NRRD, MetaImage) and the output, before any work; a
+     * folder (a DICOM series) is read file by file by the library, which checks each */
     const char *inputs[] = {desc.path, desc.data_path}, *outputs[] = {out};
-    if (tool_check_paths("isobrick", inputs, 2, outputs, 1, o.brick.force) != 0)
+    struct stat input_stat;
+    int folder = stat(desc.path, &input_stat) == 0 && S_ISDIR(input_stat.st_mode);
+    if (tool_check_paths("isobrick", inputs, folder ? 0 : 2, outputs, 1, o.brick.force) != 0)
         return 1;
     tool_signals_catch();
     progress_state progress = {!o.quiet && isatty(STDERR_FILENO), 0, 0};
@@ -253,7 +263,9 @@ int main(int argc, char **argv)
         tool_signals_reraise(); /* cancelled by a signal: end as killed by it */
         return rc;
     }
-    if (!o.quiet)
+    if (!o.quiet) {
         print_summary(&report, out);
+        tool_print_rescale(stdout, &desc);
+    }
     return 0;
 }

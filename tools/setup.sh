@@ -21,10 +21,10 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # builds and clang-format for tools/check_format.sh, and the lz4/zstd programs the benchmark
 # compares against; GLFW and stb_easy_font for the viewer, and a virtual X server (xvfb-run) for
 # its test; python3 and numpy for the Python module (docs/python.md), which every build puts in
-# build/python.
+# build/python; GDCM for DICOM series input.
 packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang clang-format
           lz4 zstd libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri
-          libglfw3-dev libstb-dev xvfb xauth python3 python3-numpy"
+          libglfw3-dev libstb-dev xvfb xauth python3 python3-numpy libgdcm-dev"
 
 install_missing() {
     missing=""
@@ -147,13 +147,13 @@ run_tests() {
     { echo "  build (gcc, -Werror):"; skip_report build; } >>"$skips"
     # a Debug build (-O1, no NDEBUG): the internal assertions (IP_ASSERT) are checked here
     echo "== AddressSanitizer + UndefinedBehaviorSanitizer (clang, Debug), fuzzers included"
-    CC=clang configure_and_build build-asan -DCMAKE_BUILD_TYPE=Debug -DIP_WERROR=ON \
+    CC=clang CXX=clang++ configure_and_build build-asan -DCMAKE_BUILD_TYPE=Debug -DIP_WERROR=ON \
         -DIP_SANITIZE=address,undefined -DIP_FUZZ=ON
     run_ctest build-asan "ASAN_OPTIONS=detect_leaks=1" --output-on-failure -j "$jobs" ||
         status=1
     { echo "  build-asan (clang, ASan + UBSan):"; skip_report build-asan; } >>"$skips"
     echo "== ThreadSanitizer (clang): the threaded tests"
-    CC=clang configure_and_build build-tsan -DIP_WERROR=ON -DIP_SANITIZE=thread
+    CC=clang CXX=clang++ configure_and_build build-tsan -DIP_WERROR=ON -DIP_SANITIZE=thread
     run_ctest build-tsan "IP_SKIP_SHARED_DATA=1" --output-on-failure -L threads -j "$jobs" ||
         status=1
     { echo "  build-tsan (clang, TSan, threaded tests only):"; skip_report build-tsan; } >>"$skips"

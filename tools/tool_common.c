@@ -330,6 +330,17 @@ void tool_json_string(FILE *out, const char *text)
     fputc('"', out);
 }
 
+void tool_print_rescale(FILE *out, const ip_input_desc *desc)
+{
+    if (!desc->has_rescale)
+        return;
+    double intercept = desc->rescale_intercept;
+    fprintf(out,
+            "  rescale     values stand for stored x %g %c %g (for CT: Hounsfield units); "
+            "samples and iso values are in stored units\n",
+            desc->rescale_slope, intercept < 0 ? '-' : '+', fabs(intercept));
+}
+
 const char *tool_format_bytes(char *buf, size_t size, double bytes)
 {
     static const char *units[] = {"B", "KiB", "MiB", "GiB", "TiB"};

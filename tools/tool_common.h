@@ -8,6 +8,7 @@
 
 #include "isoprop/cache.h"
 #include "isoprop/engine.h"
+#include "isoprop/input.h"
 #include "isoprop/status.h"
 #include "isoprop/store.h"
 #include "isoprop/system.h"
@@ -65,6 +66,11 @@ void tool_json_string(FILE *out, const char *text);
 
 /* Formats a byte count as "12.3 MiB" into buf. */
 const char *tool_format_bytes(char *buf, size_t size, double bytes);
+
+/* When the input says its values stand for stored x slope + intercept (DICOM rescale, NIfTI
+ * scl_slope/scl_inter), prints that on `out` as an indented summary line, with the reminder that
+ * samples, and so iso values, stay in stored units. Prints nothing otherwise. */
+void tool_print_rescale(FILE *out, const ip_input_desc *desc);
 
 /* Parses --cache-mb's value into bytes; returns 0 on success. */
 int tool_parse_cache_mb(const char *text, uint64_t *bytes);

@@ -1,9 +1,11 @@
-/* isoprop: reading raw input volumes (headerless raw, NRRD, MetaImage) plane by plane.
+/* isoprop: reading input volumes (headerless raw, NRRD, MetaImage, TIFF, NIfTI, DICOM) plane
+ * by plane.
  *
  * ip_input_describe() works out where the samples are and how they are laid out, from a file
  * name of the form NAME_XxYxZ_TYPE.raw, from a NRRD header (.nrrd attached, .nhdr detached;
- * raw or gzip encoding) or from a MetaImage header (.mhd with its data file), and from explicit
- * overrides. A reader then streams z-planes in order with bounded memory.
+ * raw or gzip encoding), a MetaImage header (.mhd with its data file), a TIFF file or a folder
+ * of TIFF files, a NIfTI-1/2 file (.nii, .nii.gz) or a folder holding a DICOM series, and from
+ * explicit overrides. A reader then streams z-planes in order with bounded memory.
  */
 #ifndef ISOPROP_INPUT_H
 #define ISOPROP_INPUT_H
@@ -17,9 +19,12 @@
 extern "C" {
 #endif
 
+/* How the samples are stored. */
 typedef enum ip_encoding {
-    IP_ENCODING_RAW = 0,
-    IP_ENCODING_GZIP = 1
+    IP_ENCODING_RAW = 0,  /* plain samples from data_offset on */
+    IP_ENCODING_GZIP = 1, /* a gzip (or zlib) stream from data_offset on */
+    IP_ENCODING_TIFF = 2, /* one TIFF page a plane: a multi-page file or a folder of files */
+    IP_ENCODING_DICOM = 3 /* one DICOM file a plane: a folder holding one series */
 } ip_encoding;
 
 /* Where a volume's samples are and how to read them. */
@@ -32,6 +37,13 @@ typedef struct ip_input_desc {
     int big_endian;    /* 1 when the stored samples are big-endian */
     double spacing[3]; /* world units between samples; default 1,1,1 */
     ip_encoding encoding;
+    uint64_t stream_skip; /* gzip: bytes of the inflated stream before the first sample (a
+                             header inside the stream, as in .nii.gz); 0 otherwise */
+    int has_rescale;      /* 1 when the file says its values stand for stored x rescale_slope
+                             + rescale_intercept (NIfTI scl_slope/scl_inter, DICOM rescale);
+                             reported, never applied: samples keep their stored values */
+    double rescale_slope;
+    double rescale_intercept;
 } ip_input_desc;
 
 /* Values given on the command line; each applies only where its has_ flag is set, and wins
@@ -53,8 +65,10 @@ typedef struct ip_input_overrides {
 
 /*! ip_input_describe() : fills *out for the volume at `path`.
  *  `overrides` may be NULL. The extension picks the format: .nrrd/.nhdr NRRD, .mhd/.mha
- *  MetaImage, anything else headerless raw (little-endian, spacing 1,1,1, dims and type from
- *  a base name NAME_XxYxZ_TYPE.raw or from the overrides). Checks everything that can be
+ *  MetaImage, .tif/.tiff TIFF, .nii/.nii.gz NIfTI; a folder holds a DICOM series or numbered
+ *  TIFF files (told apart by the first file's content); anything else is headerless raw
+ *  (little-endian, spacing 1,1,1, dims and type from a base name NAME_XxYxZ_TYPE.raw or from
+ *  the overrides). Checks everything that can be
  *  checked before reading samples: a dimension under 2 (or at or above 2^31), an unknown
  *  type, an unreadable or malformed header, a header or data file that is not a regular file
  *  (a FIFO or a device is refused at once, never waited on), a missing data file, a size past

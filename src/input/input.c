@@ -1,6 +1,7 @@
 /* Describing an input volume: format dispatch, the NAME_XxYxZ_TYPE.raw convention, overrides,
  * the checks made before any sample is read. */
 #include <ctype.h>
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -12,6 +13,7 @@
 #include <unistd.h>
 
 #include "input_headers.h"
+#include "input_source.h"
 #include "internal.h"
 #include "isoprop/input.h"
 
@@ -22,7 +24,9 @@
 typedef enum input_kind {
     INPUT_RAW,
     INPUT_NRRD,
-    INPUT_MHD
+    INPUT_MHD,
+    INPUT_TIFF,
+    INPUT_NIFTI
 } input_kind;
 
 static const char axis_names[3] = {'x', 'y', 'z'};
@@ -46,7 +50,66 @@ static input_kind kind_of(const char *path)
         return INPUT_NRRD;
     if (has_suffix(path, ".mhd") || has_suffix(path, ".mha"))
         return INPUT_MHD;
+    if (has_suffix(path, ".tif") || has_suffix(path, ".tiff"))
+        return INPUT_TIFF;
+    if (has_suffix(path, ".nii") || has_suffix(path, ".nii.gz"))
+        return INPUT_NIFTI;
     return INPUT_RAW;
+}
+
+/* ---- folders: a DICOM series or numbered TIFF files ---- */
+
+/* The alphabetically first visible regular file of the folder `path` into out; IP_ERR_INPUT
+ * when there is none. */
+static ip_status first_file_of(const char *path, char out[IP_PATH_MAX], ip_error *err)
+{
+    DIR *dir = opendir(path);
+    if (!dir)
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open the folder", path);
+    char best[256] = "";
+    struct dirent *entry;
+    while ((entry = readdir(dir)) != NULL) {
+        struct stat st;
+        char full[IP_PATH_MAX];
+        if (entry->d_name[0] == '.' || (best[0] && strcmp(entry->d_name, best) >= 0))
+            continue;
+        if (snprintf(full, sizeof full, "%s/%s", path, entry->d_name) >= (int)sizeof full ||
+            stat(full, &st) != 0 || !S_ISREG(st.st_mode))
+            continue;
+        snprintf(best, sizeof best, "%s", entry->d_name);
+    }
+    closedir(dir);
+    if (!best[0])
+        return ip__fail(err, IP_ERR_INPUT, "%s: the folder holds no files", path);
+    snprintf(out, IP_PATH_MAX, "%s/%s", path, best);
+    return IP_OK;
+}
+
+/* A folder is a DICOM series when its first file has the DICOM preamble's "DICM" at byte
+ * 128, numbered TIFF files when it starts as a TIFF ("II*\0", "MM\0*", or BigTIFF's 43). */
+static ip_status describe_folder(const char *path, const ip_input_overrides *overrides,
+                                 ip_input_desc *desc, ip_text_found *found, ip_error *err)
+{
+    char first[IP_PATH_MAX];
+    unsigned char head[132];
+    ip_status st = first_file_of(path, first, err);
+    if (st != IP_OK)
+        return st;
+    int fd = open(first, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", first);
+    ssize_t got = pread(fd, head, sizeof head, 0);
+    close(fd);
+    if (got == (ssize_t)sizeof head && memcmp(head + 128, "DICM", 4) == 0)
+        return ip__dicom_describe(path, overrides, desc, found, err);
+    if (got >= 4 &&
+        ((head[0] == 'I' && head[1] == 'I' && (head[2] == 42 || head[2] == 43) && head[3] == 0) ||
+         (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && (head[3] == 42 || head[3] == 43))))
+        return ip__tiff_describe(path, overrides, desc, found, err);
+    return ip__fail(err, IP_ERR_INPUT,
+                    "%s: a folder of neither DICOM nor TIFF files (its first file %s is "
+                    "neither)",
+                    path, first);
 }
 
 /* ---- the raw naming convention ---- */
@@ -137,6 +200,7 @@ static void set_defaults(ip_input_desc *desc, const char *path)
     desc->encoding = IP_ENCODING_RAW;
     for (int axis = 0; axis < 3; axis++)
         desc->spacing[axis] = 1.0;
+    desc->rescale_slope = 1.0;
 }
 
 static ip_status apply_overrides(const ip_input_overrides *overrides, ip_input_desc *desc,
@@ -246,6 +310,8 @@ static ip_status check_data_file(ip_input_desc *desc, int data_at_end, uint64_t 
 {
     char label[2 * IP_PATH_MAX + 16];
     struct stat st;
+    if (ip__plane_source_of(desc->encoding))
+        return IP_OK; /* a plane source checks each plane's file as it reads it */
     data_label(desc, label, sizeof label);
     /* O_NONBLOCK: naming a FIFO must fail below, not hang waiting for a writer. */
     int fd = open(desc->data_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
@@ -306,16 +372,23 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
 {
     struct stat st;
     const ip_text_format *format = NULL;
+    ip__describe_fn describe = NULL;
     switch (kind_of(path)) {
     case INPUT_NRRD: format = &ip__nrrd_format; break;
     case INPUT_MHD: format = &ip__mhd_format; break;
+    case INPUT_TIFF: describe = ip__tiff_describe; break;
+    case INPUT_NIFTI: describe = ip__nifti_describe; break;
     case INPUT_RAW: break;
     }
     if (format)
         return ip__text_read_header(format, path, overrides, desc, found, err);
+    if (describe)
+        return describe(path, overrides, desc, found, err);
     /* A mistyped path should say so, not complain about the name. */
     if (stat(path, &st) != 0)
         return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
+    if (S_ISDIR(st.st_mode) && !has_suffix(path, ".raw"))
+        return describe_folder(path, overrides, desc, found, err);
     return describe_from_name(path, overrides, desc, found, err);
 }
 

@@ -12,6 +12,7 @@
 #include "atomic_file.h"
 #include "internal.h"
 #include "input_positioned.h"
+#include "input_source.h"
 #include "isoprop/input.h"
 
 /* Compressed bytes read per refill: small next to a plane, large enough for few system calls. */
@@ -30,6 +31,9 @@ struct ip_input_reader {
     uint64_t plane_bytes;
     uint64_t total_bytes;
     ip_status failed; /* sticky: after an error the position in the data is unknown */
+    /* TIFF and DICOM: a plane source instead of the data file */
+    const ip__plane_source *source;
+    void *source_state;
     /* gzip only */
     z_stream zs;
     int zs_live;
@@ -69,6 +73,8 @@ static ip_status measure(ip_input_reader *r, ip_error *err)
     return IP_OK;
 }
 
+static ip_status gzip_skip(ip_input_reader *r, ip_error *err);
+
 static ip_status start_gzip(ip_input_reader *r, ip_error *err)
 {
     r->in_buf = malloc(GZIP_INPUT_CHUNK);
@@ -101,6 +107,15 @@ ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_err
         ip_input_close(r);
         return status;
     }
+    r->source = ip__plane_source_of(desc->encoding);
+    if (r->source) {
+        if ((status = r->source->open(&r->desc, &r->source_state, err)) != IP_OK) {
+            ip_input_close(r);
+            return status;
+        }
+        *out = r;
+        return IP_OK;
+    }
     /* O_NONBLOCK and the type check: the file may have been replaced by a FIFO or a device
      * since ip_input_describe() looked at it; reading one would hang or never end. */
     r->fd = open(desc->data_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
@@ -117,7 +132,8 @@ ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_err
     }
     /* Planes are read once, front to back: a hint for read-ahead, harmless if ignored. */
     (void)posix_fadvise(r->fd, 0, 0, POSIX_FADV_SEQUENTIAL);
-    if (desc->encoding == IP_ENCODING_GZIP && (status = start_gzip(r, err)) != IP_OK) {
+    if (desc->encoding == IP_ENCODING_GZIP &&
+        ((status = start_gzip(r, err)) != IP_OK || (status = gzip_skip(r, err)) != IP_OK)) {
         ip_input_close(r);
         return status;
     }
@@ -129,6 +145,8 @@ void ip_input_close(ip_input_reader *reader)
 {
     if (!reader)
         return;
+    if (reader->source)
+        reader->source->close(reader->source_state);
     if (reader->zs_live)
         inflateEnd(&reader->zs);
     if (reader->fd >= 0)
@@ -266,6 +284,33 @@ static ip_status gzip_finish(ip_input_reader *r, ip_error *err)
     return IP_OK;
 }
 
+/* Inflates and drops the desc's stream_skip bytes before the first sample (a header inside
+ * the stream); the counts of later messages start after them. */
+static ip_status gzip_skip(ip_input_reader *r, ip_error *err)
+{
+    unsigned char scratch[4096];
+    uint64_t left = r->desc.stream_skip;
+    while (left > 0) {
+        size_t made;
+        int starved;
+        if (r->stream_ended)
+            starved = 1;
+        else {
+            size_t want = left < sizeof scratch ? (size_t)left : sizeof scratch;
+            ip_status status = gzip_step(r, scratch, want, &made, &starved, err);
+            if (status != IP_OK)
+                return status;
+            left -= made;
+        }
+        if (starved)
+            return ip__fail(err, IP_ERR_INPUT,
+                            "%s: gzip data end inside the %llu header bytes before the samples",
+                            r->label, (unsigned long long)r->desc.stream_skip);
+    }
+    r->produced = 0;
+    return IP_OK;
+}
+
 /* ---- samples ---- */
 
 static void to_host_order(const ip_input_reader *r, void *samples, size_t count)
@@ -297,6 +342,19 @@ static ip_status check_finite(const ip_input_reader *r, const void *samples, siz
     return IP_OK;
 }
 
+/* Planes of a plane source, already in the host's byte order. */
+static ip_status read_source_planes(ip_input_reader *r, unsigned char *dst, uint32_t count,
+                                    ip_error *err)
+{
+    for (uint32_t i = 0; i < count; i++) {
+        ip_status status =
+            r->source->read_plane(r->source_state, r->next_z + i, dst + i * r->plane_bytes, err);
+        if (status != IP_OK)
+            return status;
+    }
+    return IP_OK;
+}
+
 static ip_status read_samples(ip_input_reader *r, void *dst, uint32_t count, ip_error *err)
 {
     uint64_t bytes = (uint64_t)count * r->plane_bytes;
@@ -304,6 +362,12 @@ static ip_status read_samples(ip_input_reader *r, void *dst, uint32_t count, ip_
     if (bytes > SIZE_MAX)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: %u planes are too many to read at once",
                         r->label, count);
+    if (r->source) {
+        status = read_source_planes(r, dst, count, err);
+        if (status == IP_OK && r->desc.type == IP_FLOAT32)
+            status = check_finite(r, dst, (size_t)(bytes / r->sample_size), r->next_z, err);
+        return status;
+    }
     if (r->desc.encoding == IP_ENCODING_GZIP) {
         status = gzip_read(r, dst, (size_t)bytes, err);
         if (status == IP_OK && r->next_z + count == r->desc.dims[2])
@@ -343,11 +407,22 @@ ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t coun
     return IP_OK;
 }
 
+const ip__plane_source *ip__plane_source_of(ip_encoding encoding)
+{
+    switch (encoding) {
+    case IP_ENCODING_TIFF: return &ip__tiff_source;
+    case IP_ENCODING_DICOM: return &ip__dicom_source;
+    case IP_ENCODING_RAW:
+    case IP_ENCODING_GZIP: break;
+    }
+    return NULL;
+}
+
 /* ---- positioned reads (internal, input_positioned.h) ---- */
 
 int ip__input_positioned(const ip_input_reader *reader)
 {
-    return reader->desc.encoding != IP_ENCODING_GZIP;
+    return reader->desc.encoding == IP_ENCODING_RAW;
 }
 
 ip_status ip__input_read_planes_at(const ip_input_reader *reader, uint32_t z, uint32_t count,

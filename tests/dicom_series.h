@@ -1,0 +1,260 @@
+/* DICOM series written by the tests, byte by byte: single-frame Part 10 files (128-byte
+ * preamble, "DICM", the group 0002 meta header in explicit VR little endian with its group
+ * length, then the data set), one file a z-plane of a volume, in explicit or implicit VR little
+ * endian or explicit VR big endian, uncompressed or RLE Lossless. */
+#ifndef ISOPROP_TEST_DICOM_SERIES_H
+#define ISOPROP_TEST_DICOM_SERIES_H
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "isoprop/volume.h"
+
+#define TEST_DICOM_EXPLICIT_LE "1.2.840.10008.1.2.1"
+#define TEST_DICOM_IMPLICIT_LE "1.2.840.10008.1.2"
+#define TEST_DICOM_EXPLICIT_BE "1.2.840.10008.1.2.2"
+#define TEST_DICOM_RLE "1.2.840.10008.1.2.5"
+#define TEST_DICOM_CT_STORAGE "1.2.840.10008.5.1.4.1.1.2"
+
+/* What the files of a series say. */
+typedef struct test_dicom_series {
+    uint32_t dims[3];        /* columns (x), rows (y), slices (z) */
+    ip_type type;            /* IP_UINT8, IP_UINT16 or IP_INT16 */
+    unsigned bits_allocated; /* 0: the type's */
+    double pixel_spacing[2]; /* between rows (y), between columns (x) */
+    double origin_z, step_z; /* slice z lies at origin_z + z * step_z along the normal */
+    int rescale;             /* 1: write slope and intercept */
+    double slope, intercept; /* Rescale Slope and Intercept */
+    const char *series_uid;  /* Series Instance UID */
+    const char *syntax;      /* Transfer Syntax UID (NULL: one by slice, see below) */
+    const char *photometric; /* NULL: MONOCHROME2 */
+    int no_position;         /* 1: leave out Image Position (Patient) */
+} test_dicom_series;
+
+/* A series of `dims`, spacing 0.7 (y) x 0.8 (x) x 2.5 mm, rescale 1 x stored - 1024. */
+static inline test_dicom_series test_dicom_default(uint32_t nx, uint32_t ny, uint32_t nz,
+                                                   ip_type type)
+{
+    test_dicom_series s;
+    memset(&s, 0, sizeof s);
+    s.dims[0] = nx, s.dims[1] = ny, s.dims[2] = nz;
+    s.type = type;
+    s.pixel_spacing[0] = 0.7, s.pixel_spacing[1] = 0.8;
+    s.origin_z = -40.0, s.step_z = 2.5;
+    s.rescale = 1, s.slope = 1.0, s.intercept = -1024.0;
+    s.series_uid = "1.2.826.0.1.3680043.2.1125.1.1";
+    return s;
+}
+
+typedef struct test_bytes {
+    unsigned char *data;
+    size_t size, capacity;
+    int big_endian, implicit; /* how the data set is encoded */
+} test_bytes;
+
+static inline void test_bytes_put(test_bytes *b, const void *data, size_t size)
+{
+    if (b->size + size > b->capacity) {
+        b->capacity = 2 * (b->size + size) + 256;
+        b->data = realloc(b->data, b->capacity);
+        REQUIRE(b->data != NULL);
+    }
+    memcpy(b->data + b->size, data, size);
+    b->size += size;
+}
+
+static inline void test_bytes_uint(test_bytes *b, uint32_t value, int bytes)
+{
+    unsigned char out[4];
+    for (int i = 0; i < bytes; i++)
+        out[b->big_endian ? bytes - 1 - i : i] = (unsigned char)(value >> (8 * i));
+    test_bytes_put(b, out, (size_t)bytes);
+}
+
+/* One element: tag, VR (explicit syntaxes), length, value padded to an even length (UI with a
+ * NUL, text with a space, binary data with a zero). */
+static inline void test_dicom_element(test_bytes *b, uint16_t group, uint16_t element,
+                                      const char *vr, const void *value, size_t size)
+{
+    int long_form = strcmp(vr, "OB") == 0 || strcmp(vr, "OW") == 0;
+    size_t padded = size + (size & 1);
+    test_bytes_uint(b, group, 2);
+    test_bytes_uint(b, element, 2);
+    if (b->implicit) {
+        test_bytes_uint(b, (uint32_t)padded, 4);
+    } else {
+        test_bytes_put(b, vr, 2);
+        if (long_form) {
+            test_bytes_uint(b, 0, 2);
+            test_bytes_uint(b, (uint32_t)padded, 4);
+        } else {
+            test_bytes_uint(b, (uint32_t)padded, 2);
+        }
+    }
+    test_bytes_put(b, value, size);
+    if (size & 1)
+        test_bytes_put(b, strcmp(vr, "UI") == 0 || long_form ? "\0" : " ", 1);
+}
+
+static inline void test_dicom_text(test_bytes *b, uint16_t group, uint16_t element, const char *vr,
+                                   const char *text)
+{
+    test_dicom_element(b, group, element, vr, text, strlen(text));
+}
+
+static inline void test_dicom_us(test_bytes *b, uint16_t group, uint16_t element, unsigned value)
+{
+    test_bytes v = {0};
+    v.big_endian = b->big_endian;
+    test_bytes_uint(&v, value, 2);
+    test_dicom_element(b, group, element, "US", v.data, 2);
+    free(v.data);
+}
+
+/* The meta header, always explicit VR little endian, with its group length first. */
+static inline void test_dicom_meta(test_bytes *out, const char *instance, const char *syntax)
+{
+    test_bytes g = {0};
+    test_dicom_element(&g, 0x0002, 0x0001, "OB", "\0\1", 2);
+    test_dicom_text(&g, 0x0002, 0x0002, "UI", TEST_DICOM_CT_STORAGE);
+    test_dicom_text(&g, 0x0002, 0x0003, "UI", instance);
+    test_dicom_text(&g, 0x0002, 0x0010, "UI", syntax);
+    test_dicom_text(&g, 0x0002, 0x0012, "UI", "1.2.826.0.1.3680043.2.1125.9");
+    unsigned char length[4] = {(unsigned char)g.size, (unsigned char)(g.size >> 8),
+                               (unsigned char)(g.size >> 16), (unsigned char)(g.size >> 24)};
+    test_bytes_put(out, "\2\0\0\0UL\4\0", 8);
+    test_bytes_put(out, length, 4);
+    test_bytes_put(out, g.data, g.size);
+    free(g.data);
+}
+
+/* One RLE segment (PackBits, literal runs only) of `count` bytes taken every `stride` bytes. */
+static inline void test_rle_segment(test_bytes *out, const unsigned char *bytes, size_t count,
+                                    size_t stride)
+{
+    for (size_t i = 0; i < count; i += 128) {
+        size_t run = count - i < 128 ? count - i : 128;
+        unsigned char header = (unsigned char)(run - 1);
+        test_bytes_put(out, &header, 1);
+        for (size_t k = 0; k < run; k++)
+            test_bytes_put(out, &bytes[(i + k) * stride], 1);
+    }
+    if (out->size & 1)
+        test_bytes_put(out, "\x80", 1); /* a no-op byte keeps segments even */
+}
+
+/* RLE Lossless pixel data: an encapsulated element with an empty offset table and one fragment:
+ * the 64-byte RLE header, then one segment a byte of the sample, most significant first. */
+static inline void test_dicom_rle_pixels(test_bytes *b, const unsigned char *plane, size_t count,
+                                         size_t sample)
+{
+    test_bytes frag = {0};
+    uint32_t offsets[16] = {0};
+    test_bytes_put(&frag, (unsigned char[64]){0}, 64);
+    for (size_t k = 0; k < sample; k++) {
+        offsets[k + 1] = (uint32_t)frag.size;
+        test_rle_segment(&frag, plane + (sample - 1 - k), count, sample);
+    }
+    offsets[0] = (uint32_t)sample;
+    for (int i = 0; i < 16; i++)
+        for (int k = 0; k < 4; k++)
+            frag.data[4 * i + k] = (unsigned char)(offsets[i] >> (8 * k));
+    static const unsigned char head[] = {0xE0, 0x7F, 0x10, 0x00, 'O',  'B',
+                                         0,    0,    0xFF, 0xFF, 0xFF, 0xFF};
+    test_bytes_put(b, head, sizeof head);
+    test_bytes_put(b, "\xFE\xFF\x00\xE0\0\0\0\0", 8); /* the empty basic offset table */
+    test_bytes_put(b, "\xFE\xFF\x00\xE0", 4);
+    test_bytes_uint(b, (uint32_t)frag.size, 4);
+    test_bytes_put(b, frag.data, frag.size);
+    test_bytes_put(b, "\xFE\xFF\xDD\xE0\0\0\0\0", 8); /* the sequence delimiter */
+    free(frag.data);
+}
+
+/* The transfer syntax of slice z when the series names none: they take turns. */
+static inline const char *test_dicom_syntax_of(const test_dicom_series *s, uint32_t z)
+{
+    static const char *const turns[] = {TEST_DICOM_EXPLICIT_LE, TEST_DICOM_IMPLICIT_LE,
+                                        TEST_DICOM_EXPLICIT_BE, TEST_DICOM_RLE};
+    return s->syntax ? s->syntax : turns[z % 4];
+}
+
+/* Writes plane z of `volume` (dims[0] x dims[1] x dims[2] samples of s->type, x fastest, host
+ * order) as the DICOM file `path`. */
+static inline void test_dicom_write_slice(const test_dicom_series *s, const void *volume,
+                                          uint32_t z, const char *path)
+{
+    const char *syntax = test_dicom_syntax_of(s, z);
+    size_t sample = ip_type_size(s->type), count = (size_t)s->dims[0] * s->dims[1];
+    const unsigned char *plane = (const unsigned char *)volume + (size_t)z * count * sample;
+    unsigned bits = s->bits_allocated ? s->bits_allocated : (unsigned)(8 * sample);
+    char instance[96], text[128];
+    test_bytes b = {0};
+    snprintf(instance, sizeof instance, "%s.%u", s->series_uid, z + 1);
+    test_bytes_put(&b, (unsigned char[128]){0}, 128);
+    test_bytes_put(&b, "DICM", 4);
+    test_dicom_meta(&b, instance, syntax);
+    b.implicit = strcmp(syntax, TEST_DICOM_IMPLICIT_LE) == 0;
+    b.big_endian = strcmp(syntax, TEST_DICOM_EXPLICIT_BE) == 0;
+    test_dicom_text(&b, 0x0008, 0x0016, "UI", TEST_DICOM_CT_STORAGE);
+    test_dicom_text(&b, 0x0008, 0x0018, "UI", instance);
+    test_dicom_text(&b, 0x0008, 0x0060, "CS", "CT");
+    test_dicom_text(&b, 0x0020, 0x000D, "UI", "1.2.826.0.1.3680043.2.1125.7");
+    test_dicom_text(&b, 0x0020, 0x000E, "UI", s->series_uid);
+    snprintf(text, sizeof text, "%u", z + 1);
+    test_dicom_text(&b, 0x0020, 0x0013, "IS", text);
+    snprintf(text, sizeof text, "-12.5\\30\\%g", s->origin_z + z * s->step_z);
+    if (!s->no_position)
+        test_dicom_text(&b, 0x0020, 0x0032, "DS", text);
+    test_dicom_text(&b, 0x0020, 0x0037, "DS", "1\\0\\0\\0\\1\\0");
+    test_dicom_us(&b, 0x0028, 0x0002, 1);
+    test_dicom_text(&b, 0x0028, 0x0004, "CS", s->photometric ? s->photometric : "MONOCHROME2");
+    test_dicom_us(&b, 0x0028, 0x0010, s->dims[1]);
+    test_dicom_us(&b, 0x0028, 0x0011, s->dims[0]);
+    snprintf(text, sizeof text, "%g\\%g", s->pixel_spacing[0], s->pixel_spacing[1]);
+    test_dicom_text(&b, 0x0028, 0x0030, "DS", text);
+    test_dicom_us(&b, 0x0028, 0x0100, bits);
+    test_dicom_us(&b, 0x0028, 0x0101, bits);
+    test_dicom_us(&b, 0x0028, 0x0102, bits - 1);
+    test_dicom_us(&b, 0x0028, 0x0103, s->type == IP_INT16);
+    if (s->rescale) {
+        snprintf(text, sizeof text, "%g", s->intercept);
+        test_dicom_text(&b, 0x0028, 0x1052, "DS", text);
+        snprintf(text, sizeof text, "%g", s->slope);
+        test_dicom_text(&b, 0x0028, 0x1053, "DS", text);
+    }
+    if (strcmp(syntax, TEST_DICOM_RLE) == 0) {
+        test_dicom_rle_pixels(&b, plane, count, sample);
+    } else {
+        /* samples in the data set's byte order */
+        unsigned char *swapped = malloc(count * sample);
+        REQUIRE(swapped != NULL);
+        for (size_t i = 0; i < count * sample; i++)
+            swapped[i] = plane[b.big_endian ? (i ^ (sample - 1)) : i];
+        test_dicom_element(&b, 0x7FE0, 0x0010, sample == 1 ? "OB" : "OW", swapped, count * sample);
+        free(swapped);
+    }
+    FILE *f = fopen(path, "wb");
+    REQUIRE(f != NULL);
+    REQUIRE(fwrite(b.data, 1, b.size, f) == b.size);
+    REQUIRE(fclose(f) == 0);
+    free(b.data);
+}
+
+/* Writes the series into the folder `dir` (which must exist) as IM0001.dcm, IM0002.dcm, ...
+ * in a shuffled order: file i holds plane (i * 7 + 3) mod dims[2] (dims[2] not a multiple of
+ * 7), so that only the positions give the order. */
+static inline void test_dicom_write_series(const test_dicom_series *s, const void *volume,
+                                           const char *dir)
+{
+    char path[4096];
+    REQUIRE(s->dims[2] % 7 != 0);
+    for (uint32_t i = 0; i < s->dims[2]; i++) {
+        snprintf(path, sizeof path, "%.4000s/IM%04u.dcm", dir, i + 1);
+        test_dicom_write_slice(s, volume, (i * 7 + 3) % s->dims[2], path);
+    }
+}
+
+#endif

@@ -1,0 +1,273 @@
+/* DICOM series input: folders of DICOM files the test writes (dicom_series.h) from a synthetic
+ * volume, in shuffled file order and mixed transfer syntaxes, described and read back sample
+ * for sample; and each way a series folder can be wrong, refused in one line naming it. */
+#include <math.h>
+#include <stdint.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "dicom_series.h"
+#include "isoprop/input.h"
+
+static char scratch[4096];
+
+/* A fresh, empty folder scratch/name; its path into out. */
+static const char *fresh_folder(char out[4096], const char *name)
+{
+    char cmd[8300];
+    REQUIRE(snprintf(out, 4096, "%.3000s/%s", scratch, name) < 4096);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", out, out);
+    REQUIRE(system(cmd) == 0);
+    return out;
+}
+
+/* Writes `text` as dir/name. */
+static void write_text_file(const char *dir, const char *name, const char *text)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    REQUIRE(f != NULL && fputs(text, f) >= 0 && fclose(f) == 0);
+}
+
+/* A DICOMDIR: a DICOM file (a meta header alone here), the index of a folder, not a slice. */
+static void write_index(const char *dir)
+{
+    char path[4200];
+    test_bytes b = {0};
+    snprintf(path, sizeof path, "%s/DICOMDIR", dir);
+    test_bytes_put(&b, (unsigned char[128]){0}, 128);
+    test_bytes_put(&b, "DICM", 4);
+    test_dicom_meta(&b, "1.2.826.0.1.3680043.2.1125.8", TEST_DICOM_EXPLICIT_LE);
+    FILE *f = fopen(path, "wb");
+    REQUIRE(f != NULL && fwrite(b.data, 1, b.size, f) == b.size && fclose(f) == 0);
+    free(b.data);
+}
+
+/* A volume of `type` whose every sample differs from its neighbours; signed types go negative. */
+static void *make_volume(const test_dicom_series *s)
+{
+    size_t count = (size_t)s->dims[0] * s->dims[1] * s->dims[2];
+    unsigned char *v = malloc(count * ip_type_size(s->type));
+    REQUIRE(v != NULL);
+    uint64_t state = 0x9E3779B97F4A7C15ull;
+    for (size_t i = 0; i < count; i++) {
+        uint64_t r = test_xorshift(&state);
+        if (s->type == IP_UINT8)
+            v[i] = (unsigned char)r;
+        else if (s->type == IP_UINT16)
+            ((uint16_t *)v)[i] = (uint16_t)r;
+        else
+            ((int16_t *)v)[i] = (int16_t)((int)(r % 4000) - 2000);
+    }
+    return v;
+}
+
+/* Reads the whole volume of `desc` (3 planes, then the rest) and compares it with `volume`. */
+static void check_samples(const ip_input_desc *desc, const void *volume)
+{
+    ip_input_reader *r = NULL;
+    ip_error err;
+    size_t bytes = (size_t)desc->dims[0] * desc->dims[1] * desc->dims[2] * ip_type_size(desc->type);
+    size_t plane = (size_t)desc->dims[0] * desc->dims[1] * ip_type_size(desc->type);
+    unsigned char *got = malloc(bytes);
+    REQUIRE(got != NULL);
+    CHECK_MSG(ip_input_open(desc, &r, &err) == IP_OK, "%s", err.message);
+    if (r) {
+        CHECK_MSG(ip_input_read_planes(r, got, 3, &err) == IP_OK, "%s", err.message);
+        CHECK_MSG(ip_input_read_planes(r, got + 3 * plane, desc->dims[2] - 3, &err) == IP_OK, "%s",
+                  err.message);
+        CHECK(memcmp(got, volume, bytes) == 0);
+        CHECK(ip_input_read_planes(r, got, 1, &err) == IP_ERR_ARGUMENT);
+    }
+    ip_input_close(r);
+    free(got);
+}
+
+/* A series of every type, in explicit and implicit VR little endian, explicit VR big endian
+ * and RLE Lossless by turns, in shuffled file order: described and read back exactly. */
+static void test_series(ip_type type, const char *name)
+{
+    char dir[4096];
+    test_dicom_series s = test_dicom_default(13, 11, 9, type);
+    void *volume = make_volume(&s);
+    ip_input_desc desc;
+    ip_error err;
+    fresh_folder(dir, name);
+    test_dicom_write_series(&s, volume, dir);
+    /* a hidden file and a DICOMDIR are not slices */
+    write_text_file(dir, ".hidden", "not a slice");
+    write_index(dir);
+    CHECK_MSG(ip_input_describe(dir, NULL, &desc, &err) == IP_OK, "%s", err.message);
+    CHECK(desc.encoding == IP_ENCODING_DICOM);
+    CHECK(desc.dims[0] == 13 && desc.dims[1] == 11 && desc.dims[2] == 9);
+    CHECK(desc.type == type);
+    CHECK_MSG(fabs(desc.spacing[0] - 0.8) < 1e-9 && fabs(desc.spacing[1] - 0.7) < 1e-9 &&
+                  fabs(desc.spacing[2] - 2.5) < 1e-9,
+              "spacing %g %g %g", desc.spacing[0], desc.spacing[1], desc.spacing[2]);
+    CHECK(desc.has_rescale && desc.rescale_slope == 1.0 && desc.rescale_intercept == -1024.0);
+    check_samples(&desc, volume);
+    free(volume);
+}
+
+/* The spacing override replaces the headers' spacing; a dims override that is not the series'
+ * is refused when the reader opens. */
+static void test_overrides(void)
+{
+    char dir[4096];
+    test_dicom_series s = test_dicom_default(6, 5, 4, IP_UINT16);
+    void *volume = make_volume(&s);
+    ip_input_overrides o = {0};
+    ip_input_desc desc;
+    ip_input_reader *r = NULL;
+    ip_error err;
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+    s.rescale = 0;
+    fresh_folder(dir, "overrides");
+    test_dicom_write_series(&s, volume, dir);
+    o.has_spacing = 1;
+    o.spacing[0] = 1, o.spacing[1] = 2, o.spacing[2] = 3;
+    CHECK_MSG(ip_input_describe(dir, &o, &desc, &err) == IP_OK, "%s", err.message);
+    CHECK(desc.spacing[0] == 1 && desc.spacing[1] == 2 && desc.spacing[2] == 3);
+    CHECK(!desc.has_rescale);
+    check_samples(&desc, volume);
+    o.has_dims = 1;
+    o.dims[0] = 5, o.dims[1] = 6, o.dims[2] = 4;
+    CHECK_MSG(ip_input_describe(dir, &o, &desc, &err) == IP_OK, "%s", err.message);
+    CHECK(ip_input_open(&desc, &r, &err) == IP_ERR_INPUT);
+    CHECK_CONTAINS(err.message, "not the 5x6x4");
+    ip_input_close(r);
+    free(volume);
+}
+
+/* Describing `dir` fails with `code` and one line that names `names` and contains `text`. */
+static void expect_refused(const char *dir, ip_status code, const char *names, const char *text)
+{
+    ip_input_desc desc;
+    ip_error err;
+    ip_status st = ip_input_describe(dir, NULL, &desc, &err);
+    CHECK_MSG(st == code, "%s: status %d, not %d (%s)", dir, (int)st, (int)code,
+              st == IP_OK ? "" : err.message);
+    if (st == IP_OK)
+        return;
+    CHECK_CONTAINS(err.message, names);
+    CHECK_CONTAINS(err.message, text);
+    CHECK(strchr(err.message, '\n') == NULL);
+}
+
+/* A folder with the series of `s` less the plane `skip` (none when >= dims[2]), then the
+ * plane `odd_plane` again as odd.dcm, written as `odd` says (odd NULL: no such file). */
+static void write_case(const char *dir, const test_dicom_series *s, const void *volume,
+                       uint32_t skip, const test_dicom_series *odd, uint32_t odd_plane)
+{
+    char path[4200];
+    for (uint32_t z = 0; z < s->dims[2]; z++) {
+        if (z == skip)
+            continue;
+        snprintf(path, sizeof path, "%s/IM%04u.dcm", dir, z + 1);
+        test_dicom_write_slice(s, volume, z, path);
+    }
+    if (odd) {
+        snprintf(path, sizeof path, "%s/odd.dcm", dir);
+        test_dicom_write_slice(odd, volume, odd_plane, path);
+    }
+}
+
+static void test_refused(void)
+{
+    char dir[4096];
+    test_dicom_series s = test_dicom_default(8, 7, 6, IP_INT16), odd;
+    void *volume = make_volume(&s);
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+
+    odd = s, odd.series_uid = "1.2.826.0.1.3680043.2.1125.1.2", odd.origin_z = 100;
+    write_case(fresh_folder(dir, "two_series"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_INPUT, "two_series", "mixes 2 series");
+    expect_refused(dir, IP_ERR_INPUT, "two_series", "1.2.826.0.1.3680043.2.1125.1.2");
+
+    write_case(fresh_folder(dir, "missing"), &s, volume, 3, NULL, 0);
+    expect_refused(dir, IP_ERR_INPUT, "missing",
+                   "a slice is missing between IM0003.dcm (at -35 mm)");
+    expect_refused(dir, IP_ERR_INPUT, "missing", "and IM0005.dcm (at -30 mm)");
+
+    odd = s, odd.dims[1] = 6, odd.origin_z += 6 * s.step_z;
+    write_case(fresh_folder(dir, "rows"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_INPUT, "rows/odd.dcm", "mixed series: a different size");
+
+    odd = s, odd.origin_z += 6 * s.step_z, odd.syntax = "1.2.840.10008.1.2.4.999";
+    write_case(fresh_folder(dir, "unknown_syntax"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_UNSUPPORTED, "unknown_syntax/odd.dcm",
+                   "unknown transfer syntax 1.2.840.10008.1.2.4.999");
+
+    odd = s, odd.origin_z += 6 * s.step_z, odd.syntax = "1.2.840.10008.1.2.4.100";
+    write_case(fresh_folder(dir, "mpeg2"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_UNSUPPORTED, "mpeg2/odd.dcm", "no decoder");
+
+    write_case(fresh_folder(dir, "stranger"), &s, volume, 99, NULL, 0);
+    write_text_file(dir, "notes.txt", "scanned on Tuesday\n");
+    expect_refused(dir, IP_ERR_INPUT, "stranger/notes.txt", "not a DICOM file");
+
+    expect_refused(fresh_folder(dir, "empty"), IP_ERR_INPUT, "empty", "holds no files");
+
+    write_case(fresh_folder(dir, "repeated"), &s, volume, 99, &s, 2);
+    expect_refused(dir, IP_ERR_INPUT, "repeated", "at the same position");
+
+    odd = s, odd.origin_z += 0.3;
+    write_case(fresh_folder(dir, "uneven"), &s, volume, 2, &odd, 2);
+    expect_refused(dir, IP_ERR_INPUT, "uneven", "uneven slice spacing");
+
+    odd = s, odd.origin_z += 6 * s.step_z, odd.photometric = "MONOCHROME1";
+    write_case(fresh_folder(dir, "inverted"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_UNSUPPORTED, "inverted/odd.dcm", "MONOCHROME1");
+
+    odd = s, odd.origin_z += 6 * s.step_z, odd.bits_allocated = 32;
+    write_case(fresh_folder(dir, "wide"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_UNSUPPORTED, "wide/odd.dcm", "32-bit signed samples");
+
+    odd = s, odd.origin_z += 6 * s.step_z, odd.no_position = 1;
+    write_case(fresh_folder(dir, "unplaced"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_INPUT, "unplaced/odd.dcm", "lacks Image Position (Patient)");
+
+    odd = s, odd.dims[2] = 1;
+    write_case(fresh_folder(dir, "single"), &odd, volume, 99, NULL, 0);
+    expect_refused(dir, IP_ERR_INPUT, "single", "holds one DICOM slice");
+    free(volume);
+}
+
+/* A file that changes after the description: its plane fails, naming the file. */
+static void test_changed_file(void)
+{
+    char dir[4096], path[4200];
+    test_dicom_series s = test_dicom_default(8, 7, 6, IP_UINT16), wider;
+    void *volume = make_volume(&s);
+    ip_input_desc desc;
+    ip_input_reader *r = NULL;
+    ip_error err;
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+    write_case(fresh_folder(dir, "changed"), &s, volume, 99, NULL, 0);
+    CHECK_MSG(ip_input_describe(dir, NULL, &desc, &err) == IP_OK, "%s", err.message);
+    CHECK_MSG(ip_input_open(&desc, &r, &err) == IP_OK, "%s", err.message);
+    wider = s, wider.bits_allocated = 8, wider.type = IP_UINT8;
+    snprintf(path, sizeof path, "%s/IM0002.dcm", dir);
+    test_dicom_write_slice(&wider, volume, 1, path);
+    uint16_t *planes = malloc(2 * 8 * 7 * sizeof *planes);
+    REQUIRE(planes != NULL);
+    CHECK(ip_input_read_planes(r, planes, 2, &err) == IP_ERR_INPUT);
+    CHECK_CONTAINS(err.message, "changed/IM0002.dcm");
+    ip_input_close(r);
+    free(planes);
+    free(volume);
+}
+
+int main(void)
+{
+    snprintf(scratch, sizeof scratch, "%s", test_tmp_dir("test_input_dicom"));
+    test_series(IP_INT16, "int16");
+    test_series(IP_UINT16, "uint16");
+    test_series(IP_UINT8, "uint8");
+    test_overrides();
+    test_refused();
+    test_changed_file();
+    return test_summary("test_input_dicom");
+}

@@ -1,0 +1,49 @@
+# DICOM series end to end: isobrick bricks a series written by the tests (shuffled file order,
+# transfer syntaxes by turns: explicit and implicit VR little endian, explicit VR big endian,
+# RLE) to the same samples as the raw volume it was made from, reports the rescale, and refuses
+# a broken series in one line naming it.
+. "$(dirname "$0")/lib.sh"
+
+"$bin/tests/make_dicom" "$work" || { bad "make_dicom writes the series"; finish; }
+raw=volume_40x36x13_int16.raw
+
+run_capture "$bin/isobrick" series -o dicom.ibv --brick-size 8 --threads 2
+check "isobrick bricks the series folder ($err)" test "$rc" = 0
+check "the summary reports the rescale" grep -qF "stored x 1 - 1024" "$work/.out"
+run_capture "$bin/isobrick" "$raw" -o raw.ibv --brick-size 8 --threads 2 --spacing 0.8,0.7,2.5
+check "isobrick bricks the raw volume" test "$rc" = 0
+check "no rescale for raw input" sh -c '! grep -q rescale "$0"' "$work/.out"
+
+run_capture "$bin/isobrick" series/ --quiet
+check "a folder's default output is bricks/FOLDER.ibv" test -s bricks/series.ibv
+
+# the same dims, type, spacing and value range; the file name aside, the same description
+"$bin/isoinfo" --json dicom.ibv | sed 's/"file": "[^"]*", //' >dicom.json
+"$bin/isoinfo" --json raw.ibv | sed 's/"file": "[^"]*", //' >raw.json
+check "isoinfo describes both alike" cmp -s dicom.json raw.json
+check "the spacing comes from the headers" grep -q '"spacing": \[0.8000.*, 0.6999.*, 2.5\]' dicom.json
+check "isoinfo --verify passes" "$bin/isoinfo" --verify dicom.ibv
+
+# the same samples: every cell's triangles, extracted in one thread, byte for byte
+for f in dicom raw; do
+    "$bin/isorender" "$f.ibv" --iso 1500.5 --full --threads 1 --software --size 64x48 \
+        --mesh "$f.ply" -o "$f.png" --quiet
+done
+check "a surface was extracted" test -s dicom.ply
+check "the same triangles from the series as from the raw volume" cmp -s dicom.ply raw.ply
+check "the same image" cmp -s dicom.png raw.png
+
+# broken series: exit 1, one line naming the folder or file, no output
+cp -r series gap
+rm gap/IM0005.dcm
+expect_error 1 "a slice is missing between" "$bin/isobrick" gap -o gap.ibv
+check "the gap message names the folder" sh -c 'printf "%s" "$0" | grep -q "gap:"' "$err"
+check "no output after a missing slice" test ! -e gap.ibv
+mkdir empty
+expect_error 1 "empty: the folder holds no files" "$bin/isobrick" empty -o empty.ibv
+cp -r series stranger
+echo "scanned on Tuesday" >stranger/notes.txt
+expect_error 1 "stranger/notes.txt: not a DICOM file" "$bin/isobrick" stranger -o s.ibv
+check "no output after a stranger" test ! -e s.ibv
+
+finish
