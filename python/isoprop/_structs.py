@@ -21,7 +21,9 @@ class InputDesc(ctypes.Structure):
     """ip_input_desc (input.h)"""
     _fields_ = [("path", c_char * PATH_MAX), ("data_path", c_char * PATH_MAX),
                 ("data_offset", c_uint64), ("dims", c_uint32 * 3), ("type", c_int),
-                ("big_endian", c_int), ("spacing", c_double * 3), ("encoding", c_int)]
+                ("big_endian", c_int), ("spacing", c_double * 3), ("encoding", c_int),
+                ("stream_skip", c_uint64), ("has_rescale", c_int), ("rescale_slope", c_double),
+                ("rescale_intercept", c_double)]
 
 
 class InputOverrides(ctypes.Structure):

@@ -24,6 +24,10 @@ static void error_and_input(void)
     FIELD(ip_input_desc, big_endian);
     FIELD(ip_input_desc, spacing);
     FIELD(ip_input_desc, encoding);
+    FIELD(ip_input_desc, stream_skip);
+    FIELD(ip_input_desc, has_rescale);
+    FIELD(ip_input_desc, rescale_slope);
+    FIELD(ip_input_desc, rescale_intercept);
     SIZE(ip_input_overrides);
     FIELD(ip_input_overrides, has_dims);
     FIELD(ip_input_overrides, dims);
