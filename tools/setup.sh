@@ -16,12 +16,12 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 jobs=$(nproc 2>/dev/null || echo 2)
 
-# Debian packages: compiler and build tools, the libraries, clang for the sanitizer and fuzzer
-# builds and clang-format for tools/check_format.sh, and the lz4/zstd programs the benchmark
-# compares against; GLFW and stb_easy_font for the viewer, and a virtual X server (xvfb-run) for
-# its test.
-packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang clang-format
-          lz4 zstd libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri
+# Debian packages: compiler and build tools, the libraries (libtiff for TIFF input), clang for
+# the sanitizer and fuzzer builds and clang-format for tools/check_format.sh, and the lz4/zstd
+# programs the benchmark compares against; GLFW and stb_easy_font for the viewer, and a virtual
+# X server (xvfb-run) for its test.
+packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev libtiff-dev clang
+          clang-format lz4 zstd libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri
           libglfw3-dev libstb-dev xvfb xauth"
 
 install_missing() {
