@@ -221,26 +221,28 @@ static inline int write_nifti(const char *path, ip_type type, const uint32_t dim
     size_t offset = s->vox_offset ? (size_t)s->vox_offset : header + 4;
     size_t sample = ip_type_size(type);
     size_t bytes = (size_t)dims[0] * dims[1] * dims[2] * sample;
-    unsigned char *file = calloc(1, offset + bytes);
+    size_t total = offset + bytes > header ? offset + bytes : header;
+    unsigned char *file = calloc(1, total);
     if (!file)
         return -1;
-    memcpy(file, h, header < offset ? header : offset);
-    memcpy(file + offset, samples, bytes);
+    unsigned char *data = file + offset;
+    memcpy(data, samples, bytes);
     int host_be = *(const unsigned char *)&(const uint16_t){1} == 0;
     for (size_t i = 0; s->big_endian != host_be && sample > 1 && i < bytes; i += sample)
         for (size_t k = 0; k < sample / 2; k++) {
-            unsigned char c = file[offset + i + k];
-            file[offset + i + k] = file[offset + i + sample - 1 - k];
-            file[offset + i + sample - 1 - k] = c;
+            unsigned char c = data[i + k];
+            data[i + k] = data[i + sample - 1 - k];
+            data[i + sample - 1 - k] = c;
         }
+    memcpy(file, h, header); /* over the samples when vox_offset is too small (a bad file) */
     int ok;
     if (s->gzip) {
         gzFile gz = gzopen(path, "wb");
-        ok = gz && gzwrite(gz, file, (unsigned)(offset + bytes)) == (int)(offset + bytes);
+        ok = gz && gzwrite(gz, file, (unsigned)total) == (int)total;
         ok = gz && gzclose(gz) == Z_OK && ok;
     } else {
         FILE *f = fopen(path, "wb");
-        ok = f && fwrite(file, 1, offset + bytes, f) == offset + bytes;
+        ok = f && fwrite(file, 1, total, f) == total;
         ok = f && fclose(f) == 0 && ok;
     }
     free(file);

@@ -128,6 +128,16 @@ void tool_print_version(const char *program)
     printf("%s %s\n", program, ip_version());
 }
 
+void tool_print_rescale(FILE *out, const ip_input_desc *desc)
+{
+    if (!desc->has_rescale)
+        return;
+    double b = desc->rescale_intercept;
+    fprintf(out,
+            "  rescale     values stand for stored x %g %c %g; iso values are in stored units\n",
+            desc->rescale_slope, b < 0 ? '-' : '+', b < 0 ? -b : b);
+}
+
 /* An input must be there and be a regular file: a FIFO would block the open or the reads,
  * a device would never end. stat() does not open, so it never blocks. */
 static int check_input(const char *program, const char *path)

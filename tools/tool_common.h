@@ -8,6 +8,7 @@
 
 #include "isoprop/cache.h"
 #include "isoprop/engine.h"
+#include "isoprop/input.h"
 #include "isoprop/status.h"
 #include "isoprop/store.h"
 #include "isoprop/system.h"
@@ -15,6 +16,11 @@
 /* Prints "PROGRAM: message" on stderr and returns exit code 1 (2 for usage errors). */
 int tool_fail(const char *program, const ip_error *err);
 int tool_usage_error(const char *program, const char *fmt, ...);
+
+/* When the input says its values stand for stored x slope + intercept (desc->has_rescale:
+ * NIfTI scl_slope/scl_inter, DICOM rescale), prints one line saying so to `out`: the samples
+ * and every iso value stay in stored units. Prints nothing otherwise. */
+void tool_print_rescale(FILE *out, const ip_input_desc *desc);
 
 /* Parses a non-negative integer option value; returns 0 on success, -1 on bad text. */
 int tool_parse_u64(const char *text, uint64_t *out);
