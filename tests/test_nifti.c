@@ -25,7 +25,7 @@ static void *make_samples(ip_type type, const uint32_t dims[3])
     for (size_t i = 0; i < count; i++) {
         double v = (double)((i * 2654435761u) % 65536);
         switch (type) {
-        case IP_UINT8: data[i] = (unsigned char)v; break;
+        case IP_UINT8: data[i] = (unsigned char)((unsigned)v & 0xff); break;
         case IP_UINT16: ((uint16_t *)data)[i] = (uint16_t)v; break;
         case IP_INT16: ((int16_t *)data)[i] = (int16_t)(v - 32768); break;
         case IP_FLOAT32: ((float *)data)[i] = (float)(v / 8 - 1000); break;
