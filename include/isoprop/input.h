@@ -90,7 +90,8 @@ typedef struct ip_input_reader ip_input_reader;
 /*! ip_input_open() : opens a reader positioned at plane z = 0. *out is owned by the caller
  *  and released with ip_input_close(). Gzip streams use a fixed 256 KiB input buffer and
  *  inflate straight into the caller's planes. @return IP_OK, IP_ERR_IO or IP_ERR_NOMEM;
- *  IP_ERR_INPUT when the data file is no longer a regular file; IP_ERR_ARGUMENT for NULL
+ *  IP_ERR_INPUT when the data file is no longer a regular file, when gzip data end within
+ *  the stream_skip bytes before the samples, or when a TIFF file no longer reads; IP_ERR_ARGUMENT for NULL
  *  arguments or a desc without type and dims. */
 IP_API ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_error *err);
 
