@@ -199,13 +199,14 @@ static int default_output(const char *input, char *out, size_t size)
     return snprintf(out, size, "bricks/%.*s.ibv", len, base) < (int)size ? 0 : -1;
 }
 
-static void print_summary(const ip_bricker_report *r, const char *out)
+static void print_summary(const ip_bricker_report *r, const ip_input_desc *desc, const char *out)
 {
     char in_b[32], file_b[32], rss_b[32];
     printf("wrote %s\n", out);
     printf("  input       %s (%llu bytes)\n",
            tool_format_bytes(in_b, sizeof in_b, (double)r->input_bytes),
            (unsigned long long)r->input_bytes);
+    tool_print_rescale(stdout, desc);
     printf("  file        %s (%llu bytes)\n",
            tool_format_bytes(file_b, sizeof file_b, (double)r->file_bytes),
            (unsigned long long)r->file_bytes);
@@ -221,6 +222,14 @@ static void print_summary(const ip_bricker_report *r, const char *out)
     printf("  peak RSS    %s (working memory planned: %s)\n",
            tool_format_bytes(rss_b, sizeof rss_b, (double)r->peak_rss),
            tool_format_bytes(in_b, sizeof in_b, (double)r->memory_planned));
+}
+
+/* `path`, or NULL for a folder (of TIFF or DICOM files), which the library has read file by
+ * file: the checks of tool_check_paths() are for input files. */
+static const char *input_file(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? NULL : path;
 }
 
 int main(int argc, char **argv)
@@ -241,12 +250,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "isobrick: cannot create the folder bricks/ for the output\n");
         return 1;
     }
-    /* the input, its detached data file (NRRD, MetaImage) and the output, before any work; a
-     * folder (a DICOM series) is read file by file by the library, which checks each */
-    const char *inputs[] = {desc.path, desc.data_path}, *outputs[] = {out};
-    struct stat input_stat;
-    int folder = stat(desc.path, &input_stat) == 0 && S_ISDIR(input_stat.st_mode);
-    if (tool_check_paths("isobrick", inputs, folder ? 0 : 2, outputs, 1, o.brick.force) != 0)
+    /* the input, its detached data file (NRRD, MetaImage) and the output, before any work */
+    const char *inputs[] = {input_file(desc.path), input_file(desc.data_path)};
+    const char *outputs[] = {out};
+    if (tool_check_paths("isobrick", inputs, 2, outputs, 1, o.brick.force) != 0)
         return 1;
     tool_signals_catch();
     progress_state progress = {!o.quiet && isatty(STDERR_FILENO), 0, 0};
@@ -263,9 +270,7 @@ int main(int argc, char **argv)
         tool_signals_reraise(); /* cancelled by a signal: end as killed by it */
         return rc;
     }
-    if (!o.quiet) {
-        print_summary(&report, out);
-        tool_print_rescale(stdout, &desc);
-    }
+    if (!o.quiet)
+        print_summary(&report, &desc, out);
     return 0;
 }

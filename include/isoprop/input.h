@@ -76,7 +76,9 @@ typedef struct ip_input_overrides {
  *  outside the bounds of ip_spacing_check(); the length of gzip data is checked by the
  *  reader. Reentrant; *out is untouched on failure.
  *  @return IP_OK, or IP_ERR_INPUT / IP_ERR_IO with err->message naming the file and the
- *  problem in one line; IP_ERR_UNSUPPORTED for a spacing outside the renderable range;
+ *  problem in one line; IP_ERR_UNSUPPORTED for a spacing outside the renderable range, or a
+ *  valid TIFF or NIfTI file this library does not read (a sample type, a compression, 4D
+ *  images, .hdr/.img pairs: docs/input.md);
  *  IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an override type that is not
  *  an ip_type; IP_ERR_NOMEM when an allocation fails. */
 IP_API ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
@@ -88,7 +90,8 @@ typedef struct ip_input_reader ip_input_reader;
 /*! ip_input_open() : opens a reader positioned at plane z = 0. *out is owned by the caller
  *  and released with ip_input_close(). Gzip streams use a fixed 256 KiB input buffer and
  *  inflate straight into the caller's planes. @return IP_OK, IP_ERR_IO or IP_ERR_NOMEM;
- *  IP_ERR_INPUT when the data file is no longer a regular file; IP_ERR_ARGUMENT for NULL
+ *  IP_ERR_INPUT when the data file is no longer a regular file, when gzip data end within
+ *  the stream_skip bytes before the samples, or when a TIFF file no longer reads; IP_ERR_ARGUMENT for NULL
  *  arguments or a desc without type and dims. */
 IP_API ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_error *err);
 

@@ -1,0 +1,55 @@
+# TIFF and NIfTI input end to end: a raw volume written again as a multi-page TIFF, a folder of
+# TIFF files, a NIfTI-1 .nii.gz and a big-endian NIfTI-2 .nii (tests/helpers/make_formats.c)
+# bricks to the same file as the raw volume itself: the same samples, and the same spacing,
+# read from ImageJ's calibration and from pixdim. The brick file stores no source name, so
+# equal samples and spacing make equal files. Then the usual breakages, one line each.
+. "$(dirname "$0")/lib.sh"
+
+"$bin/isogen" shepp-logan --dims 45x38x27 --type int16 -o "$work/" --quiet
+raw=shepp-logan_45x38x27_int16.raw
+mkdir formats
+check "make_formats writes the files" "$bin/tests/make_formats" "$raw" formats 0.5,1.25
+
+run_capture "$bin/isobrick" "$raw" -o raw.ibv --brick-size 8 --threads 2 --spacing 0.5,0.5,1.25
+check "the raw volume bricks" test "$rc" = 0
+for input in formats/stack.tif formats/slices formats/volume.nii.gz formats/volume_be.nii; do
+    name=$(basename "$input" | tr . _)
+    run_capture "$bin/isobrick" "$input" -o "$name.ibv" --brick-size 8 --threads 2
+    check "$input bricks ($err)" test "$rc" = 0
+    check "$input bricks to the raw volume's file" cmp -s raw.ibv "$name.ibv"
+    check "$input verifies" "$bin/isoinfo" --verify "$name.ibv"
+    case $input in
+    *.nii*) check "$input: the scaling is reported" \
+        grep -q "rescale     values stand for stored x 2 - 10; iso values are in stored units" \
+        "$work/.out" ;;
+    *) check "$input: no scaling to report" sh -c '! grep -q rescale "$0"' "$work/.out" ;;
+    esac
+done
+run_capture "$bin/isoinfo" --json stack_tif.ibv
+check "spacing from ImageJ" grep -q '"spacing": \[0.5, 0.5, 1.25\]' "$work/.out"
+
+# the same extraction from each: one mesh, byte for byte
+for name in raw stack_tif volume_be_nii; do
+    run_capture "$bin/isorender" "$name.ibv" --iso 0.5 --full --threads 1 --size 64x64 \
+        -o "$name.png" --mesh "$name.ply"
+    check "isorender --full on $name" test "$rc" = 0
+done
+check "the TIFF's mesh is the raw volume's" cmp -s raw.ply stack_tif.ply
+check "the NIfTI's mesh is the raw volume's" cmp -s raw.ply volume_be_nii.ply
+
+# --- breakages: one line naming the file, exit 1, no output ---
+mv formats/slices/slice7.tif formats/slice7.tif
+expect_error 1 "formats/slices: slice 7 is missing" "$bin/isobrick" formats/slices -o gap.ibv
+check "no output after a missing slice" test ! -e gap.ibv
+"$bin/tests/make_formats" sphere_doesnotexist_4x4x4_uint8.raw formats 1,1 2>/dev/null
+check "make_formats fails on a missing input" test $? = 1
+head -c 1000 formats/volume_be.nii >formats/cut.nii
+expect_error 1 "formats/cut.nii: data size" "$bin/isobrick" formats/cut.nii -o cut.ibv
+check "no output after a truncated NIfTI" test ! -e cut.ibv
+printf 'II*\000' >formats/notreally.tif
+expect_error 1 "formats/notreally.tif: not a readable TIFF" "$bin/isobrick" formats/notreally.tif \
+    -o bad.ibv
+expect_error 1 "differ from the TIFF's" "$bin/isobrick" formats/stack.tif --dims 45x38x26 \
+    -o bad.ibv
+check "no output after bad TIFFs" test ! -e bad.ibv
+finish
