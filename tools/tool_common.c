@@ -336,8 +336,8 @@ void tool_print_rescale(FILE *out, const ip_input_desc *desc)
         return;
     double intercept = desc->rescale_intercept;
     fprintf(out,
-            "  rescale     values stand for stored x %g %c %g (for CT: Hounsfield units); "
-            "samples and iso values are in stored units\n",
+            "  rescale     values stand for stored x %g %c %g; samples and iso values are in "
+            "stored units\n",
             desc->rescale_slope, intercept < 0 ? '-' : '+', fabs(intercept));
 }
 

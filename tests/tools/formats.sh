@@ -20,7 +20,7 @@ for input in formats/stack.tif formats/slices formats/volume.nii.gz formats/volu
     check "$input verifies" "$bin/isoinfo" --verify "$name.ibv"
     case $input in
     *.nii*) check "$input: the scaling is reported" \
-        grep -q "rescale     values stand for stored x 2 - 10; iso values are in stored units" \
+        grep -q "rescale     values stand for stored x 2 - 10; samples and iso values are in stored units" \
         "$work/.out" ;;
     *) check "$input: no scaling to report" sh -c '! grep -q rescale "$0"' "$work/.out" ;;
     esac
