@@ -1,21 +1,34 @@
 /* isoinfo: describe a brick file (.ibv), as text or JSON, and verify it. */
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "isoprop/cache.h"
+#include "isoprop/histogram.h"
 #include "isoprop/layout.h"
 #include "isoprop/store.h"
+#include "isoprop/system.h"
 #include "tool_common.h"
 
 static const char usage[] =
-    "usage: isoinfo FILE.ibv [--json] [--verify] [--cache-mb N] [--stats FILE.json] [--force]\n"
+    "usage: isoinfo FILE.ibv [--json] [--verify] [--histogram [--bins N] [--level K]]\n"
+    "               [--cache-mb N] [--stats FILE.json] [--force]\n"
     "Prints the header, levels, brick counts, compression ratio, value range and summary size.\n"
     "  --json     print the same as one JSON object\n"
     "  --verify   check every checksum, decode every brick and compare it with its summaries;\n"
     "             exits 1 and names the first bad brick; reads through the brick cache and\n"
-    "             prints its statistics on exit\n"
+    "             prints its statistics on exit; a progress bar on stderr when it is a\n"
+    "             terminal (not with --json; ISOINFO_PROGRESS=1 forces it, for tests)\n"
+    "  --histogram      print the histogram of the sample values instead, to choose an\n"
+    "                   isovalue: per bin its samples and the sub-blocks an isovalue at its\n"
+    "                   lower edge would cross (docs/isoinfo.md)\n"
+    "  --bins N         bins over the value range, 1 .. 65536 (default 64; whole values per\n"
+    "                   bin for integer types, so there may be fewer)\n"
+    "  --level K        the pyramid level counted (0: every sample; default: the finest level\n"
+    "                   of at most 16 M samples)\n"
     "  --cache-mb N     brick cache budget in MiB (default 512, or a quarter of RAM if less)\n"
     "  --stats FILE     write the cache statistics as JSON (a \"cache\" object), complete or\n"
     "                   not at all\n"
@@ -116,26 +129,77 @@ static void print_json(const ip_store *s, const file_facts *f)
     printf("]}\n");
 }
 
+/* --verify's progress bar on stderr: shown on a terminal, or always with ISOINFO_PROGRESS=1
+ * (for tests, whose stderr is a pipe); drawn at most five times a second and at the end. */
+typedef struct progress_bar {
+    int show, drawn;
+    double start, last; /* seconds */
+    uint64_t bytes;     /* decoded samples so far */
+} progress_bar;
+
+static void progress_start(progress_bar *p, int wanted)
+{
+    const char *force = getenv("ISOINFO_PROGRESS");
+    p->show = wanted && ((force && strcmp(force, "1") == 0) || isatty(STDERR_FILENO));
+    p->drawn = 0;
+    p->start = p->last = ip_now_seconds();
+    p->bytes = 0;
+}
+
+static void progress_draw(progress_bar *p, uint64_t done, uint64_t total)
+{
+    double now = ip_now_seconds();
+    if (!p->show || (done < total && now - p->last < 0.2))
+        return;
+    double elapsed = now - p->start, fraction = total ? (double)done / (double)total : 1;
+    double eta = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0;
+    int width = 30, fill = (int)(fraction * width);
+    fprintf(stderr, "\r[%-*.*s] %5.1f%% %llu/%llu bricks %7.1f MB/s ETA %4.0fs", width, fill,
+            "##############################", 100 * fraction, (unsigned long long)done,
+            (unsigned long long)total, elapsed > 0 ? (double)p->bytes / elapsed / 1e6 : 0, eta);
+    p->drawn = 1;
+    p->last = now;
+}
+
+/* Ends the bar's line, so that what follows starts on a line of its own. */
+static void progress_end(progress_bar *p)
+{
+    if (p->drawn)
+        fputc('\n', stderr);
+    p->drawn = 0;
+}
+
 /* Reads every brick through the cache, checking checksums and summaries, then the octree. */
 static int verify(const ip_store *s, ip_cache *cache, int quiet)
 {
     const ip_layout *l = ip_store_layout(s);
     ip_error err;
     ip_error_clear(&err);
-    for (uint64_t g = 0; g < l->brick_count; g++) {
+    progress_bar bar;
+    progress_start(&bar, !quiet);
+    int rc = 0;
+    for (uint64_t g = 0; rc == 0 && g < l->brick_count; g++) {
+        progress_draw(&bar, g, l->brick_count);
         if (tool_signal_caught()) {
+            progress_end(&bar);
             fprintf(stderr, "isoinfo: %s: verification cancelled after %llu of %llu bricks\n",
                     ip_store_path(s), (unsigned long long)g, (unsigned long long)l->brick_count);
             return 1;
         }
         ip_brick b;
         if (ip_cache_pin_brick(cache, g, &b, &err) != IP_OK)
-            return tool_fail("isoinfo", &err);
-        ip_status st = ip_store_check_summary(s, g, b.samples, &err);
-        ip_cache_unpin_brick(cache, &b);
-        if (st != IP_OK)
-            return tool_fail("isoinfo", &err);
+            rc = -1;
+        else if (ip_store_check_summary(s, g, b.samples, &err) != IP_OK)
+            rc = -2;
+        if (rc != -1)
+            ip_cache_unpin_brick(cache, &b);
+        bar.bytes += ip_store_brick_samples(s, g) * ip_type_size(l->type);
     }
+    if (rc == 0)
+        progress_draw(&bar, l->brick_count, l->brick_count);
+    progress_end(&bar);
+    if (rc != 0)
+        return tool_fail("isoinfo", &err);
     if (ip_store_verify_octree(s, &err) != IP_OK)
         return tool_fail("isoinfo", &err);
     if (!quiet)
@@ -144,17 +208,117 @@ static int verify(const ip_store *s, ip_cache *cache, int quiet)
     return 0;
 }
 
+/* The histogram as a table: each bin's range, count, a bar of # (logarithmic, so that the
+ * small bins of tissue show next to the huge one of air: log(1 + count), the fullest bin 40
+ * wide) and its active sub-blocks. */
+static void print_histogram_text(const ip_store *s, const ip_histogram *h, double seconds)
+{
+    const ip_layout *l = ip_store_layout(s);
+    const uint32_t *d = l->levels[h->level].dims;
+    uint64_t most = 1;
+    for (uint32_t b = 0; b < h->bin_count; b++)
+        most = h->bins[b].count > most ? h->bins[b].count : most;
+    printf("%s: histogram of level %u of %u (%u x %u x %u = %llu samples, %s), %.3f s\n",
+           ip_store_path(s), h->level, l->level_count - 1, d[0], d[1], d[2],
+           (unsigned long long)h->samples, ip_type_name(l->type), seconds);
+    printf("  %u bins over %g .. %g; a bin holds lo <= v < hi; active: sub-blocks (of %llu)\n"
+           "  an isovalue at lo would cross\n",
+           h->bin_count, h->lo, h->hi, (unsigned long long)h->subblocks);
+    printf("  %12s %12s %12s  %-40s %10s\n", "lo", "hi", "count", "", "active");
+    for (uint32_t b = 0; b < h->bin_count; b++) {
+        const ip_histogram_bin *bin = &h->bins[b];
+        int fill = (int)(log1p((double)bin->count) / log1p((double)most) * 40 + 0.5);
+        printf("  %12g %12g %12llu  %-40.*s %10llu\n", bin->lo, bin->hi,
+               (unsigned long long)bin->count, fill, "########################################",
+               (unsigned long long)bin->active_subblocks);
+    }
+    if (h->unbinned)
+        printf("  %llu samples are NaN and in no bin\n", (unsigned long long)h->unbinned);
+}
+
+static void print_histogram_json(const ip_store *s, const ip_histogram *h, double seconds)
+{
+    const ip_layout *l = ip_store_layout(s);
+    const uint32_t *d = l->levels[h->level].dims;
+    printf("{\"file\": ");
+    tool_json_string(stdout, ip_store_path(s));
+    printf(", \"histogram\": {\"level\": %u, \"dims\": [%u, %u, %u], \"type\": \"%s\"", h->level,
+           d[0], d[1], d[2], ip_type_name(l->type));
+    printf(", \"samples\": %llu, \"unbinned\": %llu, \"subblocks\": %llu",
+           (unsigned long long)h->samples, (unsigned long long)h->unbinned,
+           (unsigned long long)h->subblocks);
+    printf(", \"bricks_read\": %llu, \"bricks_constant\": %llu, \"seconds\": %.6f",
+           (unsigned long long)h->bricks_read, (unsigned long long)h->bricks_constant, seconds);
+    printf(", \"value_min\": %.9g, \"value_max\": %.9g, \"bins\": [", (double)l->value_min,
+           (double)l->value_max);
+    for (uint32_t b = 0; b < h->bin_count; b++)
+        printf("%s{\"lo\": %.17g, \"hi\": %.17g, \"count\": %llu, \"active_subblocks\": %llu}",
+               b ? ", " : "", h->bins[b].lo, h->bins[b].hi, (unsigned long long)h->bins[b].count,
+               (unsigned long long)h->bins[b].active_subblocks);
+    printf("]}}\n");
+}
+
+/* --histogram: the level asked for (or the default), counted and printed. */
+static int histogram(const ip_store *s, int64_t level, uint32_t bins, int json)
+{
+    const ip_layout *l = ip_store_layout(s);
+    if (level >= (int64_t)l->level_count)
+        return tool_usage_error("isoinfo",
+                                "--level %lld is past the pyramid of %s (levels 0 .. %u)",
+                                (long long)level, ip_store_path(s), l->level_count - 1);
+    uint32_t k =
+        level >= 0 ? (uint32_t)level : ip_histogram_default_level(l, IP_HISTOGRAM_DEFAULT_SAMPLES);
+    ip_histogram *h;
+    ip_error err;
+    ip_error_clear(&err);
+    double start = ip_now_seconds();
+    if (ip_histogram_compute(s, k, bins, &h, &err) != IP_OK)
+        return tool_fail("isoinfo", &err);
+    double seconds = ip_now_seconds() - start;
+    if (json)
+        print_histogram_json(s, h, seconds);
+    else
+        print_histogram_text(s, h, seconds);
+    ip_histogram_free(h);
+    return 0;
+}
+
 /* The command line of isoinfo (tool_parse_command_line()). */
 typedef struct info_options {
     const char *stats_path;
-    int json, check, force;
+    int json, check, force, histogram;
+    uint32_t bins;
+    int64_t level;   /* -1: the default */
     uint64_t budget; /* bytes */
 } info_options;
+
+static int parse_bins(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    uint64_t n;
+    if (tool_parse_u64(v[0], &n) != 0 || n < 1 || n > IP_HISTOGRAM_MAX_BINS)
+        return tool_usage_error(p, "--bins '%s' is not within 1 .. %u", v[0],
+                                IP_HISTOGRAM_MAX_BINS);
+    *(uint32_t *)((char *)base + opt->offset) = (uint32_t)n;
+    return 0;
+}
+
+static int parse_level(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    uint64_t n;
+    if (tool_parse_u64(v[0], &n) != 0 || n >= IP_MAX_LEVELS)
+        return tool_usage_error(p, "--level '%s' is not a level (0 .. %u)", v[0],
+                                IP_MAX_LEVELS - 1);
+    *(int64_t *)((char *)base + opt->offset) = (int64_t)n;
+    return 0;
+}
 
 #define INFO_FIELD(member) offsetof(info_options, member)
 static const tool_option info_table[] = {
     {"--json", NULL, 0, INFO_FIELD(json), NULL, NULL, NULL},
     {"--verify", NULL, 0, INFO_FIELD(check), NULL, NULL, NULL},
+    {"--histogram", NULL, 0, INFO_FIELD(histogram), NULL, NULL, NULL},
+    {"--bins", NULL, 1, INFO_FIELD(bins), parse_bins, NULL, NULL},
+    {"--level", NULL, 1, INFO_FIELD(level), parse_level, NULL, NULL},
     {"--force", NULL, 0, INFO_FIELD(force), NULL, NULL, NULL},
     {"--stats", NULL, 1, INFO_FIELD(stats_path), NULL, NULL, NULL},
     {"--cache-mb", NULL, 1, INFO_FIELD(budget), tool_option_cache_mb, NULL, NULL},
@@ -163,13 +327,15 @@ static const tool_option info_table[] = {
 int main(int argc, char **argv)
 {
     const char *path = NULL;
-    info_options o = {NULL, 0, 0, 0, ip_cache_default_budget()};
+    info_options o = {NULL, 0, 0, 0, 0, 0, -1, ip_cache_default_budget()};
     tool_option_table table = {info_table, sizeof info_table / sizeof info_table[0], &o};
     tool_command_line c = {"isoinfo", usage, &table, 1, &path, "file"};
     if (tool_parse_command_line(&c, argc, argv) != 0)
         return 2;
     if (!path)
         return tool_usage_error("isoinfo", "no file");
+    if ((o.bins || o.level >= 0) && !o.histogram)
+        return tool_usage_error("isoinfo", "--bins and --level go with --histogram");
     const char *stats_path = o.stats_path;
     int json = o.json, check = o.check, force = o.force;
     uint64_t budget = o.budget;
@@ -201,7 +367,9 @@ int main(int argc, char **argv)
     if (stats_path && !tool_signal_caught() &&
         tool_write_stats_file("isoinfo", stats_path, force, &stats, summary_bytes, NULL, NULL) != 0)
         rc = 1;
-    if (rc == 0) {
+    if (rc == 0 && o.histogram)
+        rc = histogram(store, o.level, o.bins ? o.bins : IP_HISTOGRAM_DEFAULT_BINS, json);
+    else if (rc == 0) {
         if (json)
             print_json(store, &facts);
         else

@@ -1,7 +1,8 @@
 /* isoprop: the public API of libisoprop in one include.
  *
  * Brick a volume once (input.h, bricker.h), open the brick file (store.h, layout.h), keep its
- * bricks in a cache with a byte budget (cache.h), extract the isosurface progressively for a
+ * bricks in a cache with a byte budget (cache.h), count its values to choose an isovalue
+ * (histogram.h), extract the isosurface progressively for a
  * camera (camera.h, engine.h, mesh.h) and write it (mesh.h). status.h has the error
  * convention, output.h the rules every output follows, generate.h the test volumes,
  * system.h the clock, memory and thread-count helpers, version.h the version.
@@ -24,6 +25,7 @@
 #include "isoprop/layout.h"
 #include "isoprop/bricker.h"
 #include "isoprop/store.h"
+#include "isoprop/histogram.h"
 #include "isoprop/cache.h"
 #include "isoprop/camera.h"
 #include "isoprop/mesh.h"
