@@ -24,7 +24,11 @@ static const char usage[] =
     "  --size WxH          image size in pixels (default 1600x1200)\n"
     "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
     "                      (default -y; up is +z, or +y for the z views)\n"
-    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n"
+    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n" TOOL_ORBIT_OPTIONS_HELP
+    "  --color C           the surface colour: R,G,B (each 0 to 1) or #rrggbb (default\n"
+    "                      #ede3c9, an ivory)\n"
+    "  --background C      the background: one colour, or TOP:BOTTOM for a vertical gradient\n"
+    "                      (default #3d4557:#141721)\n"
     "  --rays N            stop after N rays (default: every pixel)\n"
     "  --time SECONDS      stop extracting after this long\n" TOOL_ENGINE_OPTIONS_HELP
     "  --full              triangulate every active cell instead (the baseline)\n"
@@ -77,6 +81,8 @@ typedef struct options {
     int full, software, warm; /* --stats, --force and --quiet are in common */
     strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
     int weld, no_weld;
+    tool_orbit_options orbit; /* --azimuth, --elevation, --zoom */
+    ip_shading shading;       /* ip_shading_default() with --color and --background */
 } options;
 
 /* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
@@ -117,6 +123,7 @@ typedef struct run {
 
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
                           void *base);
+static tool_option_parse parse_color, parse_background;
 
 static const tool_option isorender_options[] = {
     {"-o", NULL, 1, offsetof(options, out), NULL, NULL, NULL},
@@ -129,7 +136,36 @@ static const tool_option isorender_options[] = {
     {"--strip-at", NULL, 1, offsetof(options, strip_at), parse_strip_at, NULL, NULL},
     {"--weld", NULL, 0, offsetof(options, weld), NULL, NULL, NULL},
     {"--no-weld", NULL, 0, offsetof(options, no_weld), NULL, NULL, NULL},
+    TOOL_ORBIT_OPTION_ROWS(options, orbit),
+    {"--color", NULL, 1, 0, parse_color, NULL, NULL},
+    {"--background", NULL, 1, 0, parse_background, NULL, NULL},
 };
+
+/* ---- the figure's colours ---- */
+
+static int parse_color(const char *program, const tool_option *option, const char *const *values,
+                       void *base)
+{
+    (void)option;
+    if (tool_parse_colour(values[0], ((options *)base)->shading.surface) != 0)
+        return tool_usage_error(program, "--color '%s' is not R,G,B (each 0 to 1) or #rrggbb",
+                                values[0]);
+    return 0;
+}
+
+static int parse_background(const char *program, const tool_option *option,
+                            const char *const *values, void *base)
+{
+    options *o = base;
+    (void)option;
+    if (tool_parse_background(values[0], o->shading.background_top, o->shading.background_bottom) !=
+        0)
+        return tool_usage_error(program,
+                                "--background '%s' is not a colour (R,G,B or #rrggbb) or "
+                                "TOP:BOTTOM, two of them",
+                                values[0]);
+    return 0;
+}
 
 /* ---- the progress strip ---- */
 
@@ -291,13 +327,16 @@ static int strip_render_frames(run *r, uint8_t *strip, uint32_t strip_width, ip_
     if (!frame)
         return strip_out_of_memory(r, err);
     int rc = 0;
-    if (!strcmp(r->renderer_name, "opengl") && ip_renderer_create_headless(w, h, &gl, err) != IP_OK)
+    if (!strcmp(r->renderer_name, "opengl") &&
+        (ip_renderer_create_headless(w, h, &gl, err) != IP_OK ||
+         ip_renderer_set_shading(gl, &r->o.shading, err) != IP_OK))
         rc = -1;
     for (size_t f = 0; rc == 0 && f < r->o.strip_at.count; f++) {
         ip_mesh prefix = *r->mesh; /* a view of the first triangles, not a copy */
         prefix.triangle_count = r->strip.triangles[f];
         ip_status st = gl ? ip_renderer_draw_mesh(gl, &prefix, &r->camera, r->lo, r->hi, err)
-                          : ip_raster_mesh(&prefix, &r->camera, r->lo, r->hi, NULL, frame, err);
+                          : ip_raster_mesh_shaded(&prefix, &r->camera, &r->o.shading, r->lo, r->hi,
+                                                  NULL, frame, err);
         if (st == IP_OK && gl)
             st = ip_renderer_read_rgba(gl, frame, err);
         if (st != IP_OK) {
@@ -356,6 +395,8 @@ static int parse_args(int argc, char **argv, options *o)
     memset(o, 0, sizeof *o);
     o->out = "isorender.png";
     tool_view_options_default(&o->common, 1600, 1200);
+    tool_orbit_options_default(&o->orbit);
+    ip_shading_default(&o->shading);
     int rc = tool_parse_view_command_line("isorender", usage, &o->common, isorender_options,
                                           sizeof isorender_options / sizeof isorender_options[0], o,
                                           &o->file, argc, argv);
@@ -375,14 +416,15 @@ static int setup_camera(run *r, ip_error *err)
     if (r->o.common.camera) {
         r->camera.width = r->o.common.width;
         r->camera.height = r->o.common.height;
-        if (ip_camera_parse(r->o.common.camera, &r->camera, err) != IP_OK)
+        if (ip_camera_parse(r->o.common.camera, &r->camera, err) != IP_OK ||
+            ip_camera_check(&r->camera, err) != IP_OK)
             return -1;
-        return ip_camera_check(&r->camera, err) == IP_OK ? 0 : -1;
+    } else if (ip_camera_fit_axis(r->lo, r->hi, r->o.common.view, 30.0, r->o.common.width,
+                                  r->o.common.height, &r->camera, err) != IP_OK) {
+        return -1;
     }
-    return ip_camera_fit_axis(r->lo, r->hi, r->o.common.view, 30.0, r->o.common.width,
-                              r->o.common.height, &r->camera, err) == IP_OK
-               ? 0
-               : -1;
+    tool_apply_orbit(&r->o.orbit, &r->camera);
+    return 0;
 }
 
 static int add_checkpoint(run *r, double start)
@@ -562,7 +604,9 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
         ip_error why;
         if (ip_renderer_create_headless(r->camera.width, r->camera.height, &gl, &why) == IP_OK) {
             /* streamed: the driver never holds a second copy of the whole mesh */
-            ip_status st = ip_renderer_draw_mesh(gl, r->mesh, &r->camera, r->lo, r->hi, err);
+            ip_status st = ip_renderer_set_shading(gl, &r->o.shading, err);
+            if (st == IP_OK)
+                st = ip_renderer_draw_mesh(gl, r->mesh, &r->camera, r->lo, r->hi, err);
             if (st == IP_OK)
                 st = ip_renderer_read_rgba(gl, rgba, err);
             ip_renderer_destroy(gl);
@@ -573,7 +617,10 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
         fprintf(stderr, "isorender: no headless OpenGL (%s); rendering in software\n", why.message);
     }
     r->renderer_name = "software";
-    int rc = ip_raster_mesh(r->mesh, &r->camera, r->lo, r->hi, NULL, rgba, err) == IP_OK ? 0 : -1;
+    int rc = ip_raster_mesh_shaded(r->mesh, &r->camera, &r->o.shading, r->lo, r->hi, NULL, rgba,
+                                   err) == IP_OK
+                 ? 0
+                 : -1;
     r->totals.rendering_seconds += ip_now_seconds() - start;
     return rc;
 }
