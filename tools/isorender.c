@@ -5,6 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <errno.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
@@ -24,7 +29,11 @@ static const char usage[] =
     "  --size WxH          image size in pixels (default 1600x1200)\n"
     "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
     "                      (default -y; up is +z, or +y for the z views)\n"
-    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n"
+    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n" TOOL_ORBIT_OPTIONS_HELP
+    "  --color C           the surface colour: R,G,B (each 0 to 1) or #rrggbb (default\n"
+    "                      #ede3c9, an ivory)\n"
+    "  --background C      the background: one colour, or TOP:BOTTOM for a vertical gradient\n"
+    "                      (default #3d4557:#141721)\n"
     "  --rays N            stop after N rays (default: every pixel)\n"
     "  --time SECONDS      stop extracting after this long\n" TOOL_ENGINE_OPTIONS_HELP
     "  --full              triangulate every active cell instead (the baseline)\n"
@@ -47,6 +56,12 @@ static const char usage[] =
     "                      points of the run, side by side and labelled\n"
     "  --strip-at P,...    the strip's points, in percent of the view's rays, increasing\n"
     "                      (default 0.01%,0.1%,1%,100%; at most 8)\n"
+    "  --turntable N       write N frames instead of one image, into the folder -o names\n"
+    "                      (default turntable/; made when absent): frame_000.png ..., the eye\n"
+    "                      turned 360/N degrees more in azimuth each time, each frame a\n"
+    "                      complete image extracted for its own view (--full: one extraction)\n"
+    "  --mp4 OUT.mp4       with --turntable: also encode the frames with ffmpeg (H.264, 25 fps);\n"
+    "                      without ffmpeg the frames stay and isorender exits 1\n"
     "  --software          render with the software rasterizer instead of OpenGL\n"
     "  --force             replace existing outputs (regular files only; never an input)\n"
     "  --quiet             print nothing but errors and warnings\n"
@@ -77,6 +92,10 @@ typedef struct options {
     int full, software, warm; /* --stats, --force and --quiet are in common */
     strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
     int weld, no_weld;
+    tool_orbit_options orbit; /* --azimuth, --elevation, --zoom */
+    uint64_t turntable;       /* --turntable N: frames (0: one image) */
+    const char *mp4;          /* --mp4 OUT.mp4 (NULL: none) */
+    ip_shading shading;       /* ip_shading_default() with --color and --background */
 } options;
 
 /* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
@@ -99,6 +118,7 @@ typedef struct run {
     ip_cache *cache;
     ip_engine *engine;
     ip_camera camera;
+    ip_camera view_camera; /* --view's or --camera's, before --azimuth, --elevation, --zoom */
     double lo[3], hi[3];
     ip_mesh full_mesh;
     const ip_mesh *mesh;
@@ -117,6 +137,7 @@ typedef struct run {
 
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
                           void *base);
+static tool_option_parse parse_color, parse_background, parse_turntable;
 
 static const tool_option isorender_options[] = {
     {"-o", NULL, 1, offsetof(options, out), NULL, NULL, NULL},
@@ -129,7 +150,38 @@ static const tool_option isorender_options[] = {
     {"--strip-at", NULL, 1, offsetof(options, strip_at), parse_strip_at, NULL, NULL},
     {"--weld", NULL, 0, offsetof(options, weld), NULL, NULL, NULL},
     {"--no-weld", NULL, 0, offsetof(options, no_weld), NULL, NULL, NULL},
+    TOOL_ORBIT_OPTION_ROWS(options, orbit),
+    {"--color", NULL, 1, 0, parse_color, NULL, NULL},
+    {"--background", NULL, 1, 0, parse_background, NULL, NULL},
+    {"--turntable", NULL, 1, 0, parse_turntable, NULL, NULL},
+    {"--mp4", NULL, 1, offsetof(options, mp4), NULL, NULL, NULL},
 };
+
+/* ---- the figure's colours ---- */
+
+static int parse_color(const char *program, const tool_option *option, const char *const *values,
+                       void *base)
+{
+    (void)option;
+    if (tool_parse_colour(values[0], ((options *)base)->shading.surface) != 0)
+        return tool_usage_error(program, "--color '%s' is not R,G,B (each 0 to 1) or #rrggbb",
+                                values[0]);
+    return 0;
+}
+
+static int parse_background(const char *program, const tool_option *option,
+                            const char *const *values, void *base)
+{
+    options *o = base;
+    (void)option;
+    if (tool_parse_background(values[0], o->shading.background_top, o->shading.background_bottom) !=
+        0)
+        return tool_usage_error(program,
+                                "--background '%s' is not a colour (R,G,B or #rrggbb) or "
+                                "TOP:BOTTOM, two of them",
+                                values[0]);
+    return 0;
+}
 
 /* ---- the progress strip ---- */
 
@@ -291,13 +343,16 @@ static int strip_render_frames(run *r, uint8_t *strip, uint32_t strip_width, ip_
     if (!frame)
         return strip_out_of_memory(r, err);
     int rc = 0;
-    if (!strcmp(r->renderer_name, "opengl") && ip_renderer_create_headless(w, h, &gl, err) != IP_OK)
+    if (!strcmp(r->renderer_name, "opengl") &&
+        (ip_renderer_create_headless(w, h, &gl, err) != IP_OK ||
+         ip_renderer_set_shading(gl, &r->o.shading, err) != IP_OK))
         rc = -1;
     for (size_t f = 0; rc == 0 && f < r->o.strip_at.count; f++) {
         ip_mesh prefix = *r->mesh; /* a view of the first triangles, not a copy */
         prefix.triangle_count = r->strip.triangles[f];
         ip_status st = gl ? ip_renderer_draw_mesh(gl, &prefix, &r->camera, r->lo, r->hi, err)
-                          : ip_raster_mesh(&prefix, &r->camera, r->lo, r->hi, NULL, frame, err);
+                          : ip_raster_mesh_shaded(&prefix, &r->camera, &r->o.shading, r->lo, r->hi,
+                                                  NULL, frame, err);
         if (st == IP_OK && gl)
             st = ip_renderer_read_rgba(gl, frame, err);
         if (st != IP_OK) {
@@ -351,11 +406,57 @@ static void strip_print(const run *r)
     printf("\n");
 }
 
+/* ---- the turntable ---- */
+
+#define TURNTABLE_MAX_FRAMES 100000
+#define TURNTABLE_FPS 25
+
+static int parse_turntable(const char *program, const tool_option *option,
+                           const char *const *values, void *base)
+{
+    options *o = base;
+    (void)option;
+    if (tool_parse_u64(values[0], &o->turntable) != 0 || o->turntable < 1 ||
+        o->turntable > TURNTABLE_MAX_FRAMES)
+        return tool_usage_error(program, "--turntable '%s' is not a frame count (1 to %d)",
+                                values[0], TURNTABLE_MAX_FRAMES);
+    return 0;
+}
+
+/* -o's default, and the options a turntable cannot have. Returns 0, or 2 after a usage
+ * error. */
+static int check_turntable_options(options *o)
+{
+    if (!o->turntable) {
+        if (!o->out)
+            o->out = "isorender.png";
+        if (o->mp4)
+            return tool_usage_error("isorender", "--mp4 needs --turntable N");
+        return 0;
+    }
+    if (!o->out)
+        o->out = "turntable";
+    if (o->mesh || o->progress || o->strip || o->common.stats || o->warm)
+        return tool_usage_error("isorender", "--turntable writes frames only: no --mesh, "
+                                             "--progress, --strip, --stats or --warm");
+    return 0;
+}
+
+/* The digits of frame numbers: 3, or more for 1000 frames and over. */
+static int turntable_digits(uint64_t frames)
+{
+    int digits = 3;
+    for (uint64_t n = 1000; n < frames; n *= 10)
+        digits++;
+    return digits;
+}
+
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
-    o->out = "isorender.png";
     tool_view_options_default(&o->common, 1600, 1200);
+    tool_orbit_options_default(&o->orbit);
+    ip_shading_default(&o->shading);
     int rc = tool_parse_view_command_line("isorender", usage, &o->common, isorender_options,
                                           sizeof isorender_options / sizeof isorender_options[0], o,
                                           &o->file, argc, argv);
@@ -365,6 +466,9 @@ static int parse_args(int argc, char **argv, options *o)
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
     if (o->weld && o->no_weld)
         return tool_usage_error("isorender", "--weld and --no-weld: one or the other");
+    rc = check_turntable_options(o);
+    if (rc)
+        return rc;
     return check_strip_options(o);
 }
 
@@ -375,14 +479,16 @@ static int setup_camera(run *r, ip_error *err)
     if (r->o.common.camera) {
         r->camera.width = r->o.common.width;
         r->camera.height = r->o.common.height;
-        if (ip_camera_parse(r->o.common.camera, &r->camera, err) != IP_OK)
+        if (ip_camera_parse(r->o.common.camera, &r->camera, err) != IP_OK ||
+            ip_camera_check(&r->camera, err) != IP_OK)
             return -1;
-        return ip_camera_check(&r->camera, err) == IP_OK ? 0 : -1;
+    } else if (ip_camera_fit_axis(r->lo, r->hi, r->o.common.view, 30.0, r->o.common.width,
+                                  r->o.common.height, &r->camera, err) != IP_OK) {
+        return -1;
     }
-    return ip_camera_fit_axis(r->lo, r->hi, r->o.common.view, 30.0, r->o.common.width,
-                              r->o.common.height, &r->camera, err) == IP_OK
-               ? 0
-               : -1;
+    r->view_camera = r->camera;
+    tool_apply_orbit(&r->o.orbit, &r->camera);
+    return 0;
 }
 
 static int add_checkpoint(run *r, double start)
@@ -562,7 +668,9 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
         ip_error why;
         if (ip_renderer_create_headless(r->camera.width, r->camera.height, &gl, &why) == IP_OK) {
             /* streamed: the driver never holds a second copy of the whole mesh */
-            ip_status st = ip_renderer_draw_mesh(gl, r->mesh, &r->camera, r->lo, r->hi, err);
+            ip_status st = ip_renderer_set_shading(gl, &r->o.shading, err);
+            if (st == IP_OK)
+                st = ip_renderer_draw_mesh(gl, r->mesh, &r->camera, r->lo, r->hi, err);
             if (st == IP_OK)
                 st = ip_renderer_read_rgba(gl, rgba, err);
             ip_renderer_destroy(gl);
@@ -573,7 +681,10 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
         fprintf(stderr, "isorender: no headless OpenGL (%s); rendering in software\n", why.message);
     }
     r->renderer_name = "software";
-    int rc = ip_raster_mesh(r->mesh, &r->camera, r->lo, r->hi, NULL, rgba, err) == IP_OK ? 0 : -1;
+    int rc = ip_raster_mesh_shaded(r->mesh, &r->camera, &r->o.shading, r->lo, r->hi, NULL, rgba,
+                                   err) == IP_OK
+                 ? 0
+                 : -1;
     r->totals.rendering_seconds += ip_now_seconds() - start;
     return rc;
 }
@@ -736,6 +847,145 @@ static int finish(run *r, ip_error *err)
     return 0;
 }
 
+/* ---- the turntable's frames ---- */
+
+/* Frame f's camera: the azimuth turned by f / N of a full turn (about the view's own up axis,
+ * before the elevation, so that the volume turns as on a potter's wheel). */
+static void turntable_camera(const run *r, uint64_t f, ip_camera *camera)
+{
+    tool_orbit_options orbit = r->o.orbit;
+    orbit.azimuth += 360.0 * (double)f / (double)r->o.turntable;
+    *camera = r->view_camera;
+    tool_apply_orbit(&orbit, camera);
+}
+
+/* The mesh of frame f: a progressive run from scratch for its camera (with --rays and --time
+ * per frame), or the one full extraction, made for frame 0. */
+static int turntable_extract(run *r, ip_error *err)
+{
+    if (r->o.full)
+        return r->mesh ? 0 : extract_full(r, err);
+    if (!r->engine) {
+        ip_engine_options eo;
+        tool_engine_options(&r->o.common, &eo);
+        if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
+            return -1;
+        tool_signals_cancel_engine(r->engine);
+    }
+    double start = ip_now_seconds();
+    if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK ||
+        ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
+        return -1;
+    r->extraction_wall = ip_now_seconds() - start;
+    ip_engine_totals(r->engine, &r->totals);
+    r->mesh = ip_engine_mesh(r->engine);
+    return 0;
+}
+
+/* Encodes the frames into r->o.mp4 with ffmpeg (H.264, yuv420p, TURNTABLE_FPS frames a
+ * second), through a temporary file renamed at the end. Returns 0 or 1 after a message. */
+static int turntable_encode(const run *r)
+{
+    char pattern[4096], partial[4096], rate[16];
+    snprintf(pattern, sizeof pattern, "%s/frame_%%0%dd.png", r->o.out,
+             turntable_digits(r->o.turntable));
+    snprintf(partial, sizeof partial, "%s.partial", r->o.mp4);
+    snprintf(rate, sizeof rate, "%d", TURNTABLE_FPS);
+    char *args[] = {"ffmpeg", "-nostdin", "-hide_banner", "-loglevel",
+                    "error",  "-y",       "-framerate",   rate,
+                    "-i",     pattern,    "-vf",          "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                    "-c:v",   "libx264",  "-pix_fmt",     "yuv420p",
+                    "-f",     "mp4",      partial,        NULL};
+    extern char **environ;
+    pid_t pid;
+    int error = posix_spawnp(&pid, "ffmpeg", NULL, NULL, args, environ), status = 0;
+    if (error == ENOENT) {
+        fprintf(stderr,
+                "isorender: ffmpeg not found: frames are in %s; install ffmpeg to get an MP4\n",
+                r->o.out);
+        return 1;
+    }
+    if (error != 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status) ||
+        WEXITSTATUS(status) != 0) {
+        fprintf(stderr, "isorender: %s: ffmpeg failed; frames are in %s\n", r->o.mp4, r->o.out);
+        remove(partial);
+        return 1;
+    }
+    if (!r->o.common.force && access(r->o.mp4, F_OK) == 0) {
+        fprintf(stderr, "isorender: %s: exists (--force replaces it)\n", r->o.mp4);
+        remove(partial);
+        return 1;
+    }
+    if (rename(partial, r->o.mp4) != 0) {
+        fprintf(stderr, "isorender: %s: %s\n", r->o.mp4, strerror(errno));
+        remove(partial);
+        return 1;
+    }
+    return 0;
+}
+
+/* Renders frame f of the turntable and writes it as OUT/frame_NNN.png. Returns 0 or -1. */
+static int turntable_frame(run *r, uint64_t f, uint8_t *rgba, ip_error *err)
+{
+    turntable_camera(r, f, &r->camera);
+    if (turntable_extract(r, err) != 0 || render_image(r, rgba, err) != 0)
+        return -1;
+    if (!strcmp(r->renderer_name, "software"))
+        r->o.software = 1; /* no OpenGL: say it once, not for every frame */
+    char path[4096];
+    int length = snprintf(path, sizeof path, "%s/frame_%0*llu.png", r->o.out,
+                          turntable_digits(r->o.turntable), (unsigned long long)f);
+    if (length < 0 || (size_t)length >= sizeof path) {
+        err->code = IP_ERR_ARGUMENT;
+        snprintf(err->message, sizeof err->message, "%.200s...: the frames' names are too long",
+                 r->o.out);
+        return -1;
+    }
+    r->writing = 1;
+    if (ip_png_write(path, rgba, r->camera.width, r->camera.height, r->o.common.force, err) !=
+        IP_OK)
+        return -1;
+    if (!r->o.common.quiet)
+        printf("  frame %llu of %llu: %s, %llu triangles\n", (unsigned long long)f + 1,
+               (unsigned long long)r->o.turntable, path,
+               (unsigned long long)r->mesh->triangle_count);
+    return 0;
+}
+
+/* --turntable N: N frames, each a complete image, the eye turned 360 / N degrees more in
+ * azimuth each time, in the folder -o names (made when absent); then the MP4 when asked. */
+static int turntable_run(run *r, ip_error *err)
+{
+    if (mkdir(r->o.out, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "isorender: %s: %s\n", r->o.out, strerror(errno));
+        return 1;
+    }
+    struct stat st;
+    if (stat(r->o.out, &st) != 0 || !S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "isorender: %s: not a folder (--turntable writes its frames there)\n",
+                r->o.out);
+        return 1;
+    }
+    uint8_t *rgba = malloc((size_t)r->camera.width * r->camera.height * 4);
+    if (!rgba) {
+        fprintf(stderr, "isorender: out of memory for a %ux%u image\n", r->camera.width,
+                r->camera.height);
+        return 1;
+    }
+    int rc = 0;
+    for (uint64_t f = 0; rc == 0 && f < r->o.turntable && !tool_signal_caught(); f++)
+        rc = turntable_frame(r, f, rgba, err);
+    free(rgba);
+    if (rc != 0)
+        return err->code == IP_ERR_CANCELLED && tool_signal_caught() ? 1
+                                                                     : tool_fail("isorender", err);
+    if (tool_signal_caught())
+        return 1;
+    if (!r->o.common.quiet)
+        printf("%s: %llu frames in %s\n", r->o.file, (unsigned long long)r->o.turntable, r->o.out);
+    return r->o.mp4 ? turntable_encode(r) : 0;
+}
+
 int main(int argc, char **argv)
 {
     run r;
@@ -744,8 +994,8 @@ int main(int argc, char **argv)
     if (rc)
         return rc;
     const char *inputs[] = {r.o.file};
-    const char *outputs[] = {r.o.out, r.o.mesh, r.o.common.stats, r.o.full ? NULL : r.o.progress,
-                             r.o.strip};
+    const char *outputs[] = {r.o.turntable ? r.o.mp4 : r.o.out, r.o.mesh, r.o.common.stats,
+                             r.o.full ? NULL : r.o.progress, r.o.strip};
     if (tool_check_paths("isorender", inputs, 1, outputs, 5, r.o.common.force) != 0)
         return 1;
     if (r.o.mesh && !ip_mesh_format_of(r.o.mesh)) /* before any work, after the paths' checks */
@@ -766,7 +1016,9 @@ int main(int argc, char **argv)
     } else {
         /* the errors above come first: a bad command line is one line, not a warning too */
         tool_warn_iso_range("isorender", r.store, r.o.common.iso, r.warning, sizeof r.warning);
-        if ((r.o.full ? extract_full(&r, &err) : extract_progressive(&r, &err)) == 0)
+        if (r.o.turntable)
+            rc = turntable_run(&r, &err);
+        else if ((r.o.full ? extract_full(&r, &err) : extract_progressive(&r, &err)) == 0)
             rc = finish(&r, &err);
         else if (!(err.code == IP_ERR_CANCELLED && tool_signal_caught()))
             rc = tool_fail("isorender", &err); /* a cancel by a signal is reported below */

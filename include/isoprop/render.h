@@ -42,8 +42,14 @@ typedef struct ip_shading {
     float background_bottom[3]; /* background colour of the bottom image row */
 } ip_shading;
 
-/*! ip_shading_default() : the parameters both renderers use. Thread-safe. */
+/*! ip_shading_default() : the parameters both renderers use unless given others.
+ *  Thread-safe. */
 IP_API void ip_shading_default(ip_shading *shading);
+
+/*! ip_shading_check() : validates shading parameters: every colour channel in [0, 1];
+ *  ambient, diffuse and specular finite and >= 0; shininess finite and > 0.
+ *  @return IP_OK or IP_ERR_ARGUMENT with a message. Thread-safe. */
+IP_API ip_status ip_shading_check(const ip_shading *shading, ip_error *err);
 
 /*! ip_render_check_box() : validates the world box [lo, hi] (world units) that both
  *  renderers take for their near and far planes: finite, lo <= hi on every axis.
@@ -74,6 +80,15 @@ IP_API ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_
 IP_API ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
                                 const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
                                 ip_error *err);
+
+/*! ip_raster_mesh_shaded() : ip_raster_mesh() with the given shading (a surface colour and
+ *  a background of the caller's, say) instead of ip_shading_default()'s; NULL is the default.
+ *  `shading` is read during the call only.
+ *  @return as ip_raster_mesh(), and IP_ERR_ARGUMENT when ip_shading_check() fails. */
+IP_API ip_status ip_raster_mesh_shaded(const ip_mesh *mesh, const ip_camera *camera,
+                                       const ip_shading *shading, const double lo[3],
+                                       const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
+                                       ip_error *err);
 
 /*! ip_png_write() : writes an image given as width * height * 4 bytes (RGBA, top row first)
  *  as an 8-bit PNG: RGB when every alpha is 255, RGBA otherwise. The file appears only once
@@ -185,6 +200,12 @@ IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera
 IP_API ip_status ip_renderer_draw_mesh(ip_renderer *renderer, const ip_mesh *mesh,
                                        const ip_camera *camera, const double lo[3],
                                        const double hi[3], ip_error *err);
+
+/*! ip_renderer_set_shading() : the shading of later draws (NULL: ip_shading_default(),
+ *  which a new renderer starts with); copied. Needs no context.
+ *  @return IP_OK or IP_ERR_ARGUMENT (ip_shading_check() fails; the shading stays). */
+IP_API ip_status ip_renderer_set_shading(ip_renderer *renderer, const ip_shading *shading,
+                                         ip_error *err);
 
 /*! ip_renderer_read_rgba() : copies the image drawn last into `rgba` (width * height * 4
  *  bytes, caller-owned), top row first, waiting for OpenGL to finish.

@@ -34,6 +34,29 @@ void ip_shading_default(ip_shading *s)
     *s = defaults;
 }
 
+/* Whether every channel of the colour is in [0, 1] (NaN is not). */
+static int is_unit_colour(const float c[3])
+{
+    for (int i = 0; i < 3; i++)
+        if (!(c[i] >= 0.0f && c[i] <= 1.0f))
+            return 0;
+    return 1;
+}
+
+ip_status ip_shading_check(const ip_shading *s, ip_error *err)
+{
+    if (!is_unit_colour(s->surface) || !is_unit_colour(s->background_top) ||
+        !is_unit_colour(s->background_bottom))
+        return ip__fail(err, IP_ERR_ARGUMENT, "shading: a colour channel is outside [0, 1]");
+    if (!(s->ambient >= 0.0f && s->diffuse >= 0.0f && s->specular >= 0.0f) ||
+        !isfinite(s->ambient) || !isfinite(s->diffuse) || !isfinite(s->specular) ||
+        !(s->shininess > 0.0f) || !isfinite(s->shininess))
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "shading: ambient, diffuse and specular must be finite and >= 0, "
+                        "shininess finite and > 0");
+    return IP_OK;
+}
+
 static uint8_t to_unorm8(double v)
 {
     v = v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v;
@@ -313,10 +336,14 @@ static void clip_and_raster(raster_target *t, const raster_view *view, const vie
         raster_triangle(t, view, &poly[cur][0], &poly[cur][i], &poly[cur][i + 1], index);
 }
 
-static void shade_image(const raster_target *t, const ip_camera *camera, uint8_t *rgba)
+static void shade_image(const raster_target *t, const ip_camera *camera, const ip_shading *shading,
+                        uint8_t *rgba)
 {
     ip_shading s;
-    ip_shading_default(&s);
+    if (shading)
+        s = *shading;
+    else
+        ip_shading_default(&s);
     ip_camera_basis basis;
     ip_camera_basis_of(camera, &basis);
     for (uint32_t y = 0; y < t->height; y++) {
@@ -393,7 +420,16 @@ static void free_target(raster_target *t, const uint32_t *triangle_index)
 ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
                          const double hi[3], uint32_t *triangle_index, uint8_t *rgba, ip_error *err)
 {
+    return ip_raster_mesh_shaded(mesh, camera, NULL, lo, hi, triangle_index, rgba, err);
+}
+
+ip_status ip_raster_mesh_shaded(const ip_mesh *mesh, const ip_camera *camera,
+                                const ip_shading *shading, const double lo[3], const double hi[3],
+                                uint32_t *triangle_index, uint8_t *rgba, ip_error *err)
+{
     ip_status st = check_arguments(mesh, camera, lo, hi, err);
+    if (st == IP_OK && shading)
+        st = ip_shading_check(shading, err);
     if (st != IP_OK)
         return st;
     raster_target target;
@@ -409,7 +445,7 @@ ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const dou
             clip_and_raster(&target, &view, tri, (uint32_t)i);
         }
         if (rgba)
-            shade_image(&target, camera, rgba);
+            shade_image(&target, camera, shading, rgba);
     }
     free_target(&target, triangle_index);
     return st;

@@ -586,6 +586,18 @@ static void flip_rows(uint8_t *rgba, uint32_t width, uint32_t height)
     }
 }
 
+ip_status ip_renderer_set_shading(ip_renderer *r, const ip_shading *shading, ip_error *err)
+{
+    if (!shading) {
+        ip_shading_default(&r->shading);
+        return IP_OK;
+    }
+    ip_status st = ip_shading_check(shading, err);
+    if (st == IP_OK)
+        r->shading = *shading;
+    return st;
+}
+
 ip_status ip_renderer_read_rgba(ip_renderer *r, uint8_t *rgba, ip_error *err)
 {
     ip_status st = make_current(r, err);
