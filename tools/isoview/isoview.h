@@ -34,6 +34,7 @@ typedef enum command_kind {
     COMMAND_FULL,
     COMMAND_OVERLAY,
     COMMAND_PAUSE,
+    COMMAND_HELP,
     COMMAND_SCREENSHOT,
     COMMAND_QUIT
 } command_kind;
