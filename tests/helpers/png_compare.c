@@ -1,12 +1,14 @@
 /* png_compare: compares two PNG images pixel by pixel, for the end-to-end tests.
  *
- *   png_compare A.png B.png [--level L] [--max-pct P] [--crop X,Y,W,H]
+ *   png_compare A.png B.png [--level L] [--max-pct P] [--crop X,Y,W,H] [--bbox]
  *
  * Both images are read as 8-bit RGBA. With --crop, A's rectangle of W x H pixels whose top-left
  * pixel is (X, Y) stands for A (a frame of a strip, say). A pixel differs when one of its channels differs by more
  * than L (default 0). Prints one line: the size, how many pixels differ and the largest channel
  * difference. Exit status: 0 when the sizes agree and at most P % of the pixels differ
- * (default 0), 1 otherwise, 2 for a bad command line or an unreadable image.
+ * (default 0), 1 otherwise, 2 for a bad command line or an unreadable image. With --bbox, a
+ * second line gives the smallest rectangle holding every pixel that differs: "bbox X Y W H"
+ * (top-left pixel, size), or "bbox none".
  */
 #include <png.h>
 #include <stdio.h>
@@ -73,7 +75,7 @@ int main(int argc, char **argv)
 {
     const char *path[2] = {NULL, NULL};
     double level = 0, max_pct = 0;
-    int files = 0, cropped = 0;
+    int files = 0, cropped = 0, bbox = 0;
     unsigned long crop[4];
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--level") && i + 1 < argc) {
@@ -86,6 +88,8 @@ int main(int argc, char **argv)
             if (parse_crop(argv[++i], crop) != 0)
                 goto usage;
             cropped = 1;
+        } else if (!strcmp(argv[i], "--bbox")) {
+            bbox = 1;
         } else if (argv[i][0] != '-' && files < 2) {
             path[files++] = argv[i];
         } else {
@@ -117,6 +121,7 @@ int main(int argc, char **argv)
     }
     size_t pixels = (size_t)w[0] * h[0], differ = 0;
     int largest = 0;
+    size_t x0 = w[0], y0 = h[0], x1 = 0, y1 = 0; /* the differing pixels' bounds */
     for (size_t p = 0; p < pixels; p++) {
         int worst = 0;
         for (int c = 0; c < 4; c++) {
@@ -125,14 +130,26 @@ int main(int argc, char **argv)
         }
         largest = worst > largest ? worst : largest;
         differ += worst > level;
+        if (worst > level) {
+            size_t x = p % w[0], y = p / w[0];
+            x0 = x < x0 ? x : x0;
+            y0 = y < y0 ? y : y0;
+            x1 = x > x1 ? x : x1;
+            y1 = y > y1 ? y : y1;
+        }
     }
     double pct = pixels ? 100.0 * (double)differ / (double)pixels : 0.0;
     printf("%s %s: %ux%u, %zu pixels (%.3f %%) differ by more than %g, largest difference %d\n",
            path[0], path[1], (unsigned)w[0], (unsigned)h[0], differ, pct, level, largest);
+    if (bbox && differ)
+        printf("bbox %zu %zu %zu %zu\n", x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+    else if (bbox)
+        printf("bbox none\n");
     free(a);
     free(b);
     return pct <= max_pct ? 0 : 1;
 usage:
-    fprintf(stderr, "usage: png_compare A.png B.png [--level L] [--max-pct P] [--crop X,Y,W,H]\n");
+    fprintf(stderr,
+            "usage: png_compare A.png B.png [--level L] [--max-pct P] [--crop X,Y,W,H] [--bbox]\n");
     return 2;
 }

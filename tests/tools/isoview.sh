@@ -94,6 +94,28 @@ hud=$(pct_differ hud.png start.png)
 check "the overlay is drawn (${hud:-?} % of the pixels differ)" \
     awk -v p="${hud:-0}" 'BEGIN { exit !(p >= 1 && p <= 60) }'
 
+# the compact overlay (the default) keeps to the bottom-left corner, clear of the model at the
+# default zoom: the rectangle where the overlay changes the picture and the one where the
+# picture without it differs from the bare background do not meet (so the corner, overlay off,
+# is background)
+"$bin/isorender" s.ibv --iso 99999 --size 320x240 --view -y -o bg.png --quiet 2>/dev/null
+# bbox A B: "X Y W H" of the pixels of A and B that differ by more than 2 levels, or "none"
+bbox() {
+    "$compare" "$1" "$2" --level 2 --max-pct 100 --bbox | sed -n 's/^bbox //p'
+}
+hud_box=$(bbox hud.png start.png)
+model_box=$(bbox start.png bg.png)
+echo "overlay at $hud_box, model at $model_box"
+# apart X Y W H X Y W H: the two rectangles do not intersect
+apart() {
+    [ "$#" = 8 ] && { [ $(($1 + $3)) -le "$5" ] || [ $(($5 + $7)) -le "$1" ] ||
+        [ $(($2 + $4)) -le "$6" ] || [ $(($6 + $8)) -le "$2" ]; }
+}
+check "the compact overlay is in the lower half (at $hud_box)" \
+    sh -c '[ "$#" = 4 ] && [ "$2" -ge 120 ] && [ "$1" -le 8 ]' sh $hud_box
+check "the compact overlay does not cover the model ($hud_box, $model_box)" \
+    apart $hud_box $model_box
+
 json=$(cat walk.json 2>/dev/null)
 field() { printf '%s' "$json" | sed -n "s/.*\"$1\": \([0-9.]*\).*/\1/p" | head -1; }
 for key in cache budget_bytes resident_peak_bytes hits misses evictions hit_rate bricks_touched \
@@ -110,6 +132,31 @@ budget=$(field budget_bytes)
 check "the cache stayed within its budget ($peak <= $budget)" test "$peak" -le "$budget"
 check "the budget was binding (evictions: $(field evictions))" test "$(field evictions)" -gt 0
 check "no load went over budget" test "$(field over_budget_pins)" = 0
+
+# pausing: a change of view keeps the surface shown (no new pass) until refinement resumes;
+# a change of isovalue resumes it, and the new isovalue's surface appears
+cat >pause.txt <<EOF
+overlay off
+wait done
+pause on
+camera $camera
+wait 0.5
+screenshot paused-view.png
+iso 2000.5
+wait done
+screenshot paused-iso.png
+quit
+EOF
+view s.ibv --iso 1000.5 --size 320x240 --lod off --script pause.txt --stats pause.json \
+    --exit-after 90
+check "the paused run exits with 0 (got $rc: $err)" test "$rc" = 0
+surface=$(pct_differ paused-view.png bg.png)
+check "paused, a new view still shows the surface (${surface:-?} % of the pixels)" \
+    awk -v p="${surface:-0}" 'BEGIN { exit !(p >= 5) }'
+same_image "paused, a new isovalue shows its surface" paused-iso.png r-camera.png
+check "two passes: the first view, then the new isovalue" grep -q '"passes": 2,' pause.json
+printf 'pause maybe\n' >badpause.txt
+expect_error 1 "badpause.txt:1" "$bin/isoview" s.ibv --iso 1 --script badpause.txt
 
 # no script: --screenshot-at and --exit-after alone, adaptive resolution on (the default)
 view s.ibv --iso 1500.5 --size 320x240 --cache-mb 1 --screenshot-at 0.5 at.png \

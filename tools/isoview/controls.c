@@ -28,10 +28,16 @@ void change_view(viewer *v)
     v->restart = 1;
 }
 
+/* A paused viewer would otherwise keep showing the old isovalue's surface under the new
+ * value: the new surface is what the change asks to see, so refinement resumes. */
 void change_iso(viewer *v, double iso)
 {
     v->iso = iso;
     v->restart = 1;
+    if (v->paused) {
+        v->paused = 0;
+        show_message(v, "refinement resumed for the new isovalue");
+    }
 }
 
 static void reset_view(viewer *v)
@@ -116,7 +122,7 @@ static void on_key(GLFWwindow *window, int key, int scancode, int action, int mo
             request_screenshot(v, "");
         break;
     case GLFW_KEY_H: v->help_on = !v->help_on; break;
-    case GLFW_KEY_O: v->overlay_on = !v->overlay_on; break;
+    case GLFW_KEY_O: v->overlay_mode = (v->overlay_mode + 1) % (OVERLAY_DETAILED + 1); break;
     default: break;
     }
 }

@@ -33,6 +33,8 @@ typedef enum command_kind {
     COMMAND_WAIT_DONE,
     COMMAND_FULL,
     COMMAND_OVERLAY,
+    COMMAND_PAUSE,
+    COMMAND_HELP,
     COMMAND_SCREENSHOT,
     COMMAND_QUIT
 } command_kind;
@@ -42,6 +44,14 @@ typedef struct command {
     double a, b;
     char *text; /* camera, view, screenshot: owned */
 } command;
+
+/* What the heads-up text shows: nothing, two lines at the bottom-left corner, or everything at
+ * the top-left corner (the key o cycles through them in this order). */
+typedef enum overlay_mode {
+    OVERLAY_OFF,
+    OVERLAY_COMPACT,
+    OVERLAY_DETAILED
+} overlay_mode;
 
 /* The text overlay: stb_easy_font's quads drawn as indexed triangles in pixel coordinates. */
 typedef struct overlay {
@@ -81,7 +91,10 @@ typedef struct viewer {
     uint64_t passes;               /* ip_engine_begin() calls */
     double pass_wall, pass_render; /* this pass: seconds stepping, seconds drawing */
     double draw_seconds;           /* the last frame, from the end of its slice to its swap */
-    int paused, want_full, full_shown, overlay_on, help_on;
+    /* paused: no rays are cast; a change of view waits (restart stays set, the mesh shown stays
+     * on screen) until resumed; a change of isovalue resumes */
+    int paused, want_full, full_shown, help_on;
+    overlay_mode overlay_mode;
     ip_mesh full_mesh;
     ip_engine_counts full_counts;
     double full_wall;
@@ -111,7 +124,7 @@ typedef struct viewer {
 void set_error(ip_error *err, ip_status code, const char *fmt, ...);
 /* 1 once this pass has cast its --rays, 2 once it has extracted for its --time, else 0. */
 int pass_limit_reached(const viewer *v);
-/* 1 once nothing more will be extracted until the next change (pausing aside). */
+/* 1 once nothing more will be extracted until the next change, or while paused. */
 int refinement_complete(const viewer *v);
 /* Saves the next frame to `path` ("" for the next free isoview-NNN.png). */
 void request_screenshot(viewer *v, const char *path);

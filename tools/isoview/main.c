@@ -52,6 +52,8 @@ int pass_limit_reached(const viewer *v)
 
 int refinement_complete(const viewer *v)
 {
+    if (v->paused && !v->want_full)
+        return 1;
     return !v->restart && !v->want_full &&
            (v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v));
 }
@@ -146,6 +148,7 @@ static int refine(viewer *v)
 static int extract_full(viewer *v)
 {
     v->want_full = 0;
+    v->restart = 0; /* the full mesh serves every view, a change made while paused included */
     ip_mesh_clear(&v->full_mesh);
     memset(&v->full_counts, 0, sizeof v->full_counts);
     double start = ip_now_seconds();
@@ -255,7 +258,8 @@ static int frame(viewer *v)
         glfwWaitEventsTimeout(0.1);
         return 0;
     }
-    if (v->restart && begin_pass(v) != 0)
+    /* paused, a change of view keeps the mesh shown until refinement resumes */
+    if (v->restart && !v->paused && begin_pass(v) != 0)
         return -1;
     if (v->want_full) {
         /* show that it is working, then block */
@@ -462,7 +466,7 @@ int main(int argc, char **argv)
     ip_error_clear(&v->err);
     ip_mesh_init(&v->full_mesh);
     v->iso = v->o.common.iso;
-    v->overlay_on = 1;
+    v->overlay_mode = OVERLAY_COMPACT;
     v->drag_button = -1;
     v->restart = 1;
     rc = 1;

@@ -14,21 +14,7 @@
 #pragma GCC diagnostic pop
 
 #include "isoview.h"
-
-static const char help_text[] = "left drag      orbit around the target\n"
-                                "right drag     pan\n"
-                                "wheel          zoom\n"
-                                "Up / Down      isovalue +/- 1 % of the value range\n"
-                                "Shift+Up/Down  isovalue +/- 0.1 %\n"
-                                "PgUp / PgDn    isovalue +/- 10 %\n"
-                                "i              type an isovalue (Enter applies, Esc cancels)\n"
-                                "r              reset the view\n"
-                                "p              pause / resume refinement\n"
-                                "f              full extraction (until the next change)\n"
-                                "s              save a screenshot (isoview-NNN.png)\n"
-                                "o              overlay on / off\n"
-                                "h              this help\n"
-                                "Esc            quit";
+#include "layout.h"
 
 static const char *const overlay_vertex_source =
     "#version 330 core\n"
@@ -121,19 +107,45 @@ static void put_rectangle(char *quads, int q, float x0, float y0, float x1, floa
         memcpy(quads + q * QUAD_BYTES + k * FONT_VERTEX_BYTES, corners[k], 2 * sizeof(float));
 }
 
-/* Draws `text` on a translucent panel whose top-left corner is at (x, y) framebuffer pixels
- * (top-left origin), scaled `scale` times. */
-static void overlay_draw(overlay *t, char *text, float x, float y, float scale, uint32_t width,
-                         uint32_t height)
+/* Fills the quad buffer with the panel (quad 0) and the text of cells[0 .. n), offset by
+ * `pad`; returns the number of quads. */
+static int fill_quads(overlay *t, const text_cell *cells, size_t n, float w, float h, float pad)
+{
+    int quads = 1;
+    put_rectangle(t->quads, 0, 0, 0, w + 2 * pad, h + 2 * pad);
+    for (size_t i = 0; i < n; i++) {
+        char copy[LAYOUT_MAX_CELL + 1];
+        size_t length = cells[i].length < LAYOUT_MAX_CELL ? cells[i].length : LAYOUT_MAX_CELL;
+        memcpy(copy, cells[i].text, length);
+        copy[length] = 0;
+        int room = t->quads_size - quads * QUAD_BYTES;
+        if (room < QUAD_BYTES)
+            break;
+        quads += stb_easy_font_print(cells[i].x + pad, cells[i].y + pad, copy, NULL,
+                                     t->quads + quads * QUAD_BYTES, room);
+    }
+    return (uint32_t)quads > t->index_quads ? (int)t->index_quads : quads;
+}
+
+/* Draws `text` (a table: '\n' between rows, '\t' between columns) on a translucent panel whose
+ * corner `corner` (0: top-left, 1: bottom-left, 2: centred) is `margin` framebuffer pixels from
+ * the window's, scaled `scale` times. */
+static void overlay_draw(overlay *t, const char *text, int corner, float margin, float scale,
+                         uint32_t width, uint32_t height)
 {
     const float pad = 4;
-    /* quad 0 is the panel; the text follows */
-    int quads =
-        stb_easy_font_print(0, 0, text, NULL, t->quads + QUAD_BYTES, t->quads_size - QUAD_BYTES);
-    if ((uint32_t)quads + 1 > t->index_quads)
-        quads = (int)t->index_quads - 1;
-    float w = (float)stb_easy_font_width(text), h = (float)stb_easy_font_height(text);
-    put_rectangle(t->quads, 0, -pad, -pad, w + pad, h + pad);
+    text_cell cells[128];
+    float w, h;
+    size_t n = layout_table(text, 2 * pad, cells, sizeof cells / sizeof cells[0], &w, &h);
+    int quads = fill_quads(t, cells, n < 128 ? n : 128, w, h, pad);
+    float panel_w = (w + 2 * pad) * scale, panel_h = (h + 2 * pad) * scale;
+    float x = margin, y = corner == 1 ? (float)height - margin - panel_h : margin;
+    if (corner == 2) {
+        x = ((float)width - panel_w) / 2;
+        y = ((float)height - panel_h) / 2;
+    }
+    x = x > 0 ? x : 0;
+    y = y > 0 ? y : 0;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, (GLsizei)width, (GLsizei)height);
     glDisable(GL_DEPTH_TEST);
@@ -143,14 +155,15 @@ static void overlay_draw(overlay *t, char *text, float x, float y, float scale, 
     glUseProgram(t->program);
     glUniform2f(t->viewport_at, (float)width, (float)height);
     glUniform1f(t->scale_at, scale);
-    glUniform2f(t->offset_at, x + pad * scale, y + pad * scale);
+    glUniform2f(t->offset_at, x, y);
     glBindVertexArray(t->array);
     glBindBuffer(GL_ARRAY_BUFFER, t->vertices);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(quads + 1) * QUAD_BYTES, t->quads, GL_STREAM_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)quads * QUAD_BYTES, t->quads, GL_STREAM_DRAW);
     glUniform4f(t->colour_at, 0.0f, 0.0f, 0.0f, 0.6f);
     glDrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, NULL);
     glUniform4f(t->colour_at, 1.0f, 1.0f, 0.85f, 1.0f);
-    glDrawElements(GL_TRIANGLES, 6 * quads, GL_UNSIGNED_INT, (const void *)(6 * sizeof(uint32_t)));
+    glDrawElements(GL_TRIANGLES, 6 * (quads - 1), GL_UNSIGNED_INT,
+                   (const void *)(6 * sizeof(uint32_t)));
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     glBindVertexArray(0);
     glUseProgram(0);
@@ -194,23 +207,10 @@ static const char *overdraw_text(viewer *v, char *text, size_t size)
     return text;
 }
 
-/* The heads-up text. "final px" is the share of pixels already showing their final colour: it
- * is known exactly once every ray has been cast (100 %), and shown as "-" before; so is the
- * overdraw (triangles extracted per triangle visible in the finished image). */
-static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
+/* The first line of the heads-up text: the isovalue (or the one being typed) and the state. */
+static void iso_line(viewer *v, char *text, size_t size, int working_on_full, int detailed)
 {
-    ip_engine_counts t;
-    ip_cache_stats s;
-    ip_engine_totals(v->engine, &t);
-    ip_cache_get_stats(v->cache, &s);
-    double pixels = (double)v->camera.width * v->camera.height;
-    uint64_t lookups = s.hits + s.misses;
-    char iso[96], state[48] = "", progress[160], overdraw[32];
-    if (v->typing)
-        snprintf(iso, sizeof iso, "iso> %s_  (Enter applies, Esc cancels)", v->typed);
-    else
-        snprintf(iso, sizeof iso, "iso %.7g  (values %.7g .. %.7g)", v->iso, (double)v->value_min,
-                 (double)v->value_max);
+    char state[48] = "";
     if (working_on_full)
         snprintf(state, sizeof state, "  [extracting all...]");
     else if (v->full_shown)
@@ -220,6 +220,48 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
     else if (!ip_engine_done(v->engine) && pass_limit_reached(v))
         snprintf(state, sizeof state, "  [%s reached]",
                  pass_limit_reached(v) == 1 ? "--rays" : "--time");
+    if (v->typing)
+        snprintf(text, size, "iso> %s_  (Enter applies, Esc cancels)", v->typed);
+    else if (detailed)
+        snprintf(text, size, "iso %.7g  (values %.7g .. %.7g)%s", v->iso, (double)v->value_min,
+                 (double)v->value_max, state);
+    else
+        snprintf(text, size, "iso %.7g%s", v->iso, state);
+}
+
+/* The compact heads-up text: two lines, the isovalue and the state, then the pass's progress,
+ * triangles, overdraw and frame rate. */
+static int compact_text(viewer *v, char *text, size_t size, int working_on_full)
+{
+    ip_engine_counts t;
+    ip_engine_totals(v->engine, &t);
+    double pixels = (double)v->camera.width * v->camera.height;
+    char iso[96], overdraw[32], rays[32];
+    iso_line(v, iso, sizeof iso, working_on_full, 0);
+    if (v->full_shown)
+        snprintf(rays, sizeof rays, "full");
+    else
+        snprintf(rays, sizeof rays, "rays %.1f %%",
+                 pixels > 0 ? 100.0 * (double)t.rays / pixels : 0.0);
+    return snprintf(text, size, "%s   %.1f fps%s\n%s   %llu triangles   overdraw %s", iso,
+                    v->clock.shown, v->help_on || v->typing ? "" : "   h: help", rays,
+                    (unsigned long long)(v->full_shown ? v->full_counts.triangles : t.triangles),
+                    overdraw_text(v, overdraw, sizeof overdraw));
+}
+
+/* The detailed heads-up text. "final px" is the share of pixels already showing their final
+ * colour: it is known exactly once every ray has been cast (100 %), and shown as "-" before; so
+ * is the overdraw (triangles extracted per triangle visible in the finished image). */
+static int detailed_text(viewer *v, char *text, size_t size, int working_on_full)
+{
+    ip_engine_counts t;
+    ip_cache_stats s;
+    ip_engine_totals(v->engine, &t);
+    ip_cache_get_stats(v->cache, &s);
+    double pixels = (double)v->camera.width * v->camera.height;
+    uint64_t lookups = s.hits + s.misses;
+    char iso[96], progress[160], overdraw[32];
+    iso_line(v, iso, sizeof iso, working_on_full, 1);
     if (v->full_shown)
         snprintf(progress, sizeof progress,
                  "full: %llu cells in %.2f s   final px 100 %%\n"
@@ -234,17 +276,25 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
                  pixels > 0 ? 100.0 * (double)t.rays / pixels : 0.0, pixels,
                  ip_engine_done(v->engine) ? "100 %" : "-", (unsigned long long)t.triangles,
                  overdraw_text(v, overdraw, sizeof overdraw));
-    int n = snprintf(text, size,
-                     "%s%s\n%s\nfps %.1f\ncache %.1f / %.1f MiB   hit rate %.1f %%\n"
-                     "misses %llu   bricks %llu / %llu",
-                     iso, state, progress, v->clock.shown, (double)s.resident_bytes / 1048576.0,
-                     (double)s.budget_bytes / 1048576.0,
-                     lookups ? 100.0 * (double)s.hits / (double)lookups : 0.0,
-                     (unsigned long long)s.misses, (unsigned long long)s.bricks_touched,
-                     (unsigned long long)s.bricks_total);
+    return snprintf(text, size,
+                    "%s\n%s\nfps %.1f\ncache %.1f / %.1f MiB   hit rate %.1f %%\n"
+                    "misses %llu   bricks %llu / %llu",
+                    iso, progress, v->clock.shown, (double)s.resident_bytes / 1048576.0,
+                    (double)s.budget_bytes / 1048576.0,
+                    lookups ? 100.0 * (double)s.hits / (double)lookups : 0.0,
+                    (unsigned long long)s.misses, (unsigned long long)s.bricks_touched,
+                    (unsigned long long)s.bricks_total);
+}
+
+/* The heads-up text of the overlay's mode, then a message while one is shown, else the hint
+ * for the help. */
+static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
+{
+    int n = v->overlay_mode == OVERLAY_DETAILED ? detailed_text(v, text, size, working_on_full)
+                                                : compact_text(v, text, size, working_on_full);
     if (n > 0 && (size_t)n < size && v->message[0] && ip_now_seconds() < v->message_until)
         snprintf(text + n, size - (size_t)n, "\n%s", v->message);
-    else if (n > 0 && (size_t)n < size && !v->help_on)
+    else if (n > 0 && (size_t)n < size && !v->help_on && v->overlay_mode == OVERLAY_DETAILED)
         snprintf(text + n, size - (size_t)n, "\nh: help");
 }
 
@@ -252,17 +302,13 @@ void overlay_draw_frame(viewer *v, int working_on_full)
 {
     uint32_t width = v->camera.width, height = v->camera.height;
     float scale = height >= 720 ? 2.0f : 1.0f;
-    if (v->overlay_on || working_on_full) {
+    if (v->overlay_mode != OVERLAY_OFF || working_on_full) {
         char text[1024];
         hud_text(v, text, sizeof text, working_on_full);
-        overlay_draw(&v->text, text, 8 * scale, 8 * scale, scale, width, height);
+        /* compact: the bottom-left corner, below the volume framed by --view */
+        overlay_draw(&v->text, text, v->overlay_mode == OVERLAY_DETAILED ? 0 : 1, 4 * scale, scale,
+                     width, height);
     }
-    if (v->help_on) {
-        char text[sizeof help_text];
-        memcpy(text, help_text, sizeof help_text);
-        float w = (float)stb_easy_font_width(text) * scale;
-        float h = (float)stb_easy_font_height(text) * scale;
-        float x = ((float)width - w) / 2, y = ((float)height - h) / 2;
-        overlay_draw(&v->text, text, x > 0 ? x : 0, y > 0 ? y : 0, scale, width, height);
-    }
+    if (v->help_on)
+        overlay_draw(&v->text, isoview_help_table, 2, 0, scale, width, height);
 }

@@ -11,7 +11,9 @@
  *     wait done                               until every ray has been cast (or the full
  *                                             extraction is shown)
  *     full                                    full extraction, as the key f
- *     overlay on|off                          show or hide the heads-up text
+ *     overlay compact|detailed|off|on         the heads-up text (on: compact)
+ *     pause on|off                            pause or resume refinement, as the key p
+ *     help on|off                             show or hide the help, as the key h
  *     screenshot PATH                         save the next frame as PNG
  *     quit                                    exit (status 0)
  *
@@ -97,9 +99,21 @@ static int parse_command(viewer *v, char *line, command *c, ip_error *err)
             goto too_many;
         c->kind = COMMAND_FULL;
     } else if (!strcmp(word, "overlay")) {
-        if (args != 1 || (strcmp(arg1, "on") && strcmp(arg1, "off")))
+        if (args != 1)
             goto arguments;
         c->kind = COMMAND_OVERLAY;
+        if (!strcmp(arg1, "off"))
+            c->a = OVERLAY_OFF;
+        else if (!strcmp(arg1, "on") || !strcmp(arg1, "compact"))
+            c->a = OVERLAY_COMPACT;
+        else if (!strcmp(arg1, "detailed"))
+            c->a = OVERLAY_DETAILED;
+        else
+            goto arguments;
+    } else if (!strcmp(word, "pause") || !strcmp(word, "help")) {
+        if (args != 1 || (strcmp(arg1, "on") && strcmp(arg1, "off")))
+            goto arguments;
+        c->kind = word[0] == 'p' ? COMMAND_PAUSE : COMMAND_HELP;
         c->a = !strcmp(arg1, "on");
     } else if (!strcmp(word, "screenshot")) {
         if (args != 1)
@@ -231,7 +245,9 @@ void run_script(viewer *v, double t)
         case COMMAND_WAIT: v->wait_until = t + c->a; break;
         case COMMAND_WAIT_DONE: v->waiting_done = 1; break;
         case COMMAND_FULL: v->want_full = 1; break;
-        case COMMAND_OVERLAY: v->overlay_on = c->a != 0; break;
+        case COMMAND_OVERLAY: v->overlay_mode = (overlay_mode)c->a; break;
+        case COMMAND_PAUSE: v->paused = c->a != 0; break;
+        case COMMAND_HELP: v->help_on = c->a != 0; break;
         case COMMAND_SCREENSHOT: request_screenshot(v, c->text); return;
         case COMMAND_QUIT: v->quit = 1; return;
         }

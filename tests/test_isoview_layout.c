@@ -1,0 +1,83 @@
+/* isoview's text layout (tools/isoview/layout.c): the help's second column starts at one x
+ * for every row, past the widest key; rows stack by the font's line height; a text without
+ * tabs is one cell a row at x = 0; a table too large for the cells given says so. */
+#include <string.h>
+
+#include "check.h"
+#include "layout.h"
+
+/* The index of the first cell of each row, or -1; returns the number of rows. */
+static size_t rows_of(const text_cell *cells, size_t n, size_t first[], size_t max_rows)
+{
+    size_t rows = 0;
+    for (size_t i = 0; i < n && rows < max_rows; i++)
+        if (i == 0 || cells[i].y != cells[i - 1].y)
+            first[rows++] = i;
+    return rows;
+}
+
+static void test_help_columns(void)
+{
+    text_cell cells[64];
+    float width, height;
+    size_t n = layout_table(isoview_help_table, 8, cells, 64, &width, &height);
+    REQUIRE(n <= 64);
+    size_t first[32], rows = rows_of(cells, n, first, 32);
+    CHECK_MSG(rows >= 10 && n == 2 * rows, "%zu rows, %zu cells", rows, n);
+    float widest_key = 0;
+    for (size_t r = 0; r < rows; r++)
+        if (cells[first[r]].width > widest_key)
+            widest_key = cells[first[r]].width;
+    float action_x = cells[first[0] + 1].x;
+    CHECK(action_x == widest_key + 8);
+    for (size_t r = 0; r < rows; r++) {
+        const text_cell *key = &cells[first[r]], *action = key + 1;
+        CHECK_MSG(key->x == 0 && action->x == action_x, "row %zu: key at %g, action at %g", r,
+                  (double)key->x, (double)action->x);
+        CHECK(action->y == key->y && key->y == (float)r * LAYOUT_LINE_HEIGHT);
+        CHECK(memchr(key->text, '\t', key->length) == NULL && key->length > 0);
+        CHECK(memchr(action->text, '\n', action->length) == NULL);
+        CHECK(action->x + action->width <= width);
+    }
+    CHECK(height == (float)rows * LAYOUT_LINE_HEIGHT);
+    /* the key o and its modes are in the help */
+    CHECK(strstr(isoview_help_table, "o\toverlay: compact, detailed, off") != NULL);
+}
+
+static void test_plain_lines(void)
+{
+    text_cell cells[4];
+    float width, height;
+    const char *text = "iso 1000.5\nrays 12.5 %   87 triangles";
+    size_t n = layout_table(text, 8, cells, 4, &width, &height);
+    CHECK(n == 2);
+    CHECK(cells[0].x == 0 && cells[1].x == 0 && cells[1].y == LAYOUT_LINE_HEIGHT);
+    CHECK(cells[0].length == 10 && !strncmp(cells[0].text, "iso 1000.5", 10));
+    CHECK(width == cells[1].width && width > cells[0].width);
+    CHECK(width == layout_text_width("rays 12.5 %   87 triangles", 26));
+    CHECK(height == 2 * LAYOUT_LINE_HEIGHT);
+}
+
+static void test_ragged_rows(void)
+{
+    text_cell cells[8];
+    float width, height;
+    /* a row with one cell, one with three: each column still starts at one x */
+    size_t n = layout_table("a\tbb\tc\nwide key\nk\tv", 4, cells, 8, &width, &height);
+    CHECK(n == 6);
+    float key_w = layout_text_width("wide key", 8), mid_w = layout_text_width("bb", 2);
+    CHECK(cells[1].x == key_w + 4 && cells[5].x == key_w + 4);
+    CHECK(cells[2].x == key_w + 4 + mid_w + 4);
+    CHECK(cells[3].x == 0 && cells[3].length == 8);
+    /* too small a buffer: the count says how many there were */
+    CHECK(layout_table("a\tb\nc\td", 4, cells, 3, &width, &height) == 4);
+    CHECK(layout_table("", 4, cells, 8, &width, &height) == 0 && width == 0 && height == 0);
+}
+
+int main(void)
+{
+    test_help_columns();
+    test_plain_lines();
+    test_ragged_rows();
+    return test_summary("test_isoview_layout");
+}
