@@ -313,6 +313,35 @@ static void test_resize_and_errors(ip_renderer *r, const ip_mesh *m)
     free(gl);
 }
 
+/* Multisampling: bad counts are refused and change nothing; 4 samples keep every pixel whose
+ * samples see one surface (up to rounding) and give the others colours between. */
+static void test_samples(ip_renderer *r, const uint8_t *image)
+{
+    ip_error err;
+    ip_camera c = scene_camera(320, 240);
+    CHECK(ip_renderer_set_samples(r, 0, &err) == IP_ERR_ARGUMENT);
+    CHECK_CONTAINS(err.message, "samples a pixel");
+    CHECK(ip_renderer_set_samples(r, 100000, &err) == IP_ERR_ARGUMENT);
+    uint8_t *aa = malloc(320 * 240 * 4);
+    REQUIRE(aa);
+    draw_and_read(r, &c, aa);
+    CHECK(memcmp(aa, image, 320 * 240 * 4) == 0);
+    REQUIRE(ip_renderer_set_samples(r, 4, &err) == IP_OK);
+    draw_and_read(r, &c, aa);
+    size_t changed = 0, far = 0;
+    for (size_t i = 0; i < 320 * 240 * 4; i++) {
+        int d = abs((int)aa[i] - (int)image[i]);
+        changed += d > 0;
+        far += d > 4;
+    }
+    CHECK(changed > 0);
+    CHECK(far < 320 * 240 * 4 / 20); /* the silhouettes and the edges between surfaces */
+    REQUIRE(ip_renderer_set_samples(r, 1, &err) == IP_OK);
+    draw_and_read(r, &c, aa);
+    CHECK(memcmp(aa, image, 320 * 240 * 4) == 0);
+    free(aa);
+}
+
 typedef struct thread_job {
     ip_renderer *renderer;
     uint8_t *rgba;
@@ -409,6 +438,7 @@ int main(void)
     ip_camera c = scene_camera(320, 240);
     draw_and_read(r, &c, image);
     test_threads(r, image);
+    test_samples(r, image);
     test_resize_and_errors(r, &m);
     ip_renderer_destroy(r);
     test_on_current_context(&m, image);

@@ -63,6 +63,8 @@ static const char usage[] =
     "  --mp4 OUT.mp4       with --turntable: also encode the frames with ffmpeg (H.264, 25 fps);\n"
     "                      without ffmpeg the frames stay and isorender exits 1\n"
     "  --software          render with the software rasterizer instead of OpenGL\n"
+    "  --aa N              OpenGL anti-aliasing: N samples a pixel (1 to 16; default 1, off,\n"
+    "                      the image the software rasterizer draws; 4 or 8 for figures)\n"
     "  --force             replace existing outputs (regular files only; never an input)\n"
     "  --quiet             print nothing but errors and warnings\n"
     "  --version           print the version and exit\n"
@@ -96,6 +98,7 @@ typedef struct options {
     uint64_t turntable;       /* --turntable N: frames (0: one image) */
     const char *mp4;          /* --mp4 OUT.mp4 (NULL: none) */
     ip_shading shading;       /* ip_shading_default() with --color and --background */
+    uint32_t aa;              /* --aa N: OpenGL samples a pixel (1: none) */
 } options;
 
 /* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
@@ -137,7 +140,7 @@ typedef struct run {
 
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
                           void *base);
-static tool_option_parse parse_color, parse_background, parse_turntable;
+static tool_option_parse parse_color, parse_background, parse_turntable, parse_aa;
 
 static const tool_option isorender_options[] = {
     {"-o", NULL, 1, offsetof(options, out), NULL, NULL, NULL},
@@ -155,6 +158,7 @@ static const tool_option isorender_options[] = {
     {"--background", NULL, 1, 0, parse_background, NULL, NULL},
     {"--turntable", NULL, 1, 0, parse_turntable, NULL, NULL},
     {"--mp4", NULL, 1, offsetof(options, mp4), NULL, NULL, NULL},
+    {"--aa", NULL, 1, 0, parse_aa, NULL, NULL},
 };
 
 /* ---- the figure's colours ---- */
@@ -181,6 +185,37 @@ static int parse_background(const char *program, const tool_option *option,
                                 "TOP:BOTTOM, two of them",
                                 values[0]);
     return 0;
+}
+
+#define AA_MAX_SAMPLES 16
+
+static int parse_aa(const char *program, const tool_option *option, const char *const *values,
+                    void *base)
+{
+    uint64_t samples;
+    (void)option;
+    if (tool_parse_u64(values[0], &samples) != 0 || samples < 1 || samples > AA_MAX_SAMPLES)
+        return tool_usage_error(program, "--aa '%s' is not a sample count (1 to %d)", values[0],
+                                AA_MAX_SAMPLES);
+    ((options *)base)->aa = (uint32_t)samples;
+    return 0;
+}
+
+/* A headless renderer of w x h pixels with the figure's shading and anti-aliasing. Returns
+ * 0; 1 when there is no headless OpenGL (`why` says why); -1 when it refuses a setting. */
+static int figure_renderer(const run *r, uint32_t w, uint32_t h, ip_renderer **gl, ip_error *why,
+                           ip_error *err)
+{
+    if (ip_renderer_create_headless(w, h, gl, why) != IP_OK)
+        return 1;
+    ip_status st = ip_renderer_set_shading(*gl, &r->o.shading, err);
+    if (st == IP_OK && r->o.aa > 1)
+        st = ip_renderer_set_samples(*gl, r->o.aa, err);
+    if (st == IP_OK)
+        return 0;
+    ip_renderer_destroy(*gl);
+    *gl = NULL;
+    return -1;
 }
 
 /* ---- the progress strip ---- */
@@ -343,9 +378,7 @@ static int strip_render_frames(run *r, uint8_t *strip, uint32_t strip_width, ip_
     if (!frame)
         return strip_out_of_memory(r, err);
     int rc = 0;
-    if (!strcmp(r->renderer_name, "opengl") &&
-        (ip_renderer_create_headless(w, h, &gl, err) != IP_OK ||
-         ip_renderer_set_shading(gl, &r->o.shading, err) != IP_OK))
+    if (!strcmp(r->renderer_name, "opengl") && figure_renderer(r, w, h, &gl, err, err) != 0)
         rc = -1;
     for (size_t f = 0; rc == 0 && f < r->o.strip_at.count; f++) {
         ip_mesh prefix = *r->mesh; /* a view of the first triangles, not a copy */
@@ -457,6 +490,7 @@ static int parse_args(int argc, char **argv, options *o)
     tool_view_options_default(&o->common, 1600, 1200);
     tool_orbit_options_default(&o->orbit);
     ip_shading_default(&o->shading);
+    o->aa = 1;
     int rc = tool_parse_view_command_line("isorender", usage, &o->common, isorender_options,
                                           sizeof isorender_options / sizeof isorender_options[0], o,
                                           &o->file, argc, argv);
@@ -464,6 +498,8 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     if (o->full && (o->common.rays || o->common.time_limit > 0))
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
+    if (o->software && o->aa > 1)
+        return tool_usage_error("isorender", "--aa is OpenGL's: --software draws without it");
     if (o->weld && o->no_weld)
         return tool_usage_error("isorender", "--weld and --no-weld: one or the other");
     rc = check_turntable_options(o);
@@ -666,11 +702,12 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
     if (!r->o.software) {
         ip_renderer *gl;
         ip_error why;
-        if (ip_renderer_create_headless(r->camera.width, r->camera.height, &gl, &why) == IP_OK) {
+        int made = figure_renderer(r, r->camera.width, r->camera.height, &gl, &why, err);
+        if (made < 0)
+            return -1; /* a setting OpenGL refuses: not a reason to draw something else */
+        if (made == 0) {
             /* streamed: the driver never holds a second copy of the whole mesh */
-            ip_status st = ip_renderer_set_shading(gl, &r->o.shading, err);
-            if (st == IP_OK)
-                st = ip_renderer_draw_mesh(gl, r->mesh, &r->camera, r->lo, r->hi, err);
+            ip_status st = ip_renderer_draw_mesh(gl, r->mesh, &r->camera, r->lo, r->hi, err);
             if (st == IP_OK)
                 st = ip_renderer_read_rgba(gl, rgba, err);
             ip_renderer_destroy(gl);

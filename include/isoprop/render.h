@@ -139,8 +139,8 @@ IP_API ip_status ip_gl_program(const char *vertex_source, const char *fragment_s
  * context must set again for its own drawing: the bound framebuffers, renderbuffer, vertex
  * array, program and buffers (array, copy, pixel pack: 0 afterwards); the viewport; depth
  * test (on, GL_LESS, writes on); face culling, blending, scissor test, depth clamp and sRGB
- * conversion (off); polygon mode (fill); colour mask (all on); pack alignment and row layout
- * (1, tight). */
+ * conversion (off); multisampling (on); polygon mode (fill); colour mask (all on); pack
+ * alignment and row layout (1, tight). */
 typedef struct ip_renderer ip_renderer;
 
 /*! ip_renderer_create_headless() : a renderer with its own headless context and an
@@ -206,6 +206,16 @@ IP_API ip_status ip_renderer_draw_mesh(ip_renderer *renderer, const ip_mesh *mes
  *  @return IP_OK or IP_ERR_ARGUMENT (ip_shading_check() fails; the shading stays). */
 IP_API ip_status ip_renderer_set_shading(ip_renderer *renderer, const ip_shading *shading,
                                          ip_error *err);
+
+/*! ip_renderer_set_samples() : anti-aliasing of a headless renderer: each pixel of later
+ *  draws keeps `samples` coverage and depth samples (OpenGL multisampling; 1: none, the
+ *  default), averaged when the image is read, so silhouettes get intermediate colours while
+ *  a pixel inside a surface keeps the colour shaded at its centre. Reallocates the
+ *  off-screen framebuffer, discarding the image drawn last. For a renderer on the caller's
+ *  context, the caller's framebuffer decides and only 1 is accepted.
+ *  @return IP_OK, IP_ERR_ARGUMENT (0, or more than OpenGL's GL_MAX_SAMPLES: the message says
+ *  the limit; the setting stays), IP_ERR_UNSUPPORTED or IP_ERR_NOMEM. */
+IP_API ip_status ip_renderer_set_samples(ip_renderer *renderer, uint32_t samples, ip_error *err);
 
 /*! ip_renderer_read_rgba() : copies the image drawn last into `rgba` (width * height * 4
  *  bytes, caller-owned), top row first, waiting for OpenGL to finish.

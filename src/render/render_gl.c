@@ -22,6 +22,8 @@ struct ip_renderer {
     uint32_t width, height;            /* pixels */
     GLuint framebuffer;                /* drawn into and read from */
     GLuint color_buffer, depth_buffer; /* the headless renderer's own framebuffer */
+    uint32_t samples;                  /* per pixel of that framebuffer; 1: no multisampling */
+    GLuint resolve_framebuffer, resolve_color; /* samples > 1: the averaged image, read back */
     GLuint mesh_program, background_program;
     GLint view_at, projection_at, eye_at, surface_at, terms_at; /* mesh uniforms */
     GLint top_at, bottom_at, height_at;                         /* background uniforms */
@@ -230,6 +232,33 @@ static void bind_mesh_array(ip_renderer *r)
     bind_array(r->mesh_array, r->positions, r->normals);
 }
 
+/* Whether the bound framebuffer is complete, after no OpenGL error. */
+static ip_status check_framebuffer(const char *what, ip_error *err)
+{
+    GLenum complete = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    ip_status st = check_gl(what, err);
+    if (st == IP_OK && complete != GL_FRAMEBUFFER_COMPLETE)
+        st = ip__fail(err, IP_ERR_UNSUPPORTED, "renderer: framebuffer incomplete (0x%04x)",
+                      (unsigned)complete);
+    return st;
+}
+
+/* The single-sample framebuffer a multisampled image is averaged into before it is read. */
+static ip_status allocate_resolve(ip_renderer *r, GLsizei width, GLsizei height, ip_error *err)
+{
+    if (!r->resolve_framebuffer) {
+        glGenFramebuffers(1, &r->resolve_framebuffer);
+        glGenRenderbuffers(1, &r->resolve_color);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, r->resolve_color);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->resolve_framebuffer);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                              r->resolve_color);
+    return check_framebuffer("allocating the resolve framebuffer", err);
+}
+
 /* (Re)allocates the headless renderer's colour and depth buffers. */
 static ip_status allocate_framebuffer(ip_renderer *r, uint32_t width, uint32_t height,
                                       ip_error *err)
@@ -244,21 +273,21 @@ static ip_status allocate_framebuffer(ip_renderer *r, uint32_t width, uint32_t h
         glGenRenderbuffers(1, &r->color_buffer);
         glGenRenderbuffers(1, &r->depth_buffer);
     }
+    GLsizei samples = r->samples > 1 ? (GLsizei)r->samples : 0, w = (GLsizei)width,
+            h = (GLsizei)height;
     glBindRenderbuffer(GL_RENDERBUFFER, r->color_buffer);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, (GLsizei)width, (GLsizei)height);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
     glBindRenderbuffer(GL_RENDERBUFFER, r->depth_buffer);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, (GLsizei)width, (GLsizei)height);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, w, h);
     glBindRenderbuffer(GL_RENDERBUFFER, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, r->framebuffer);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
                               r->color_buffer);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
                               r->depth_buffer);
-    GLenum complete = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    ip_status st = check_gl("allocating the framebuffer", err);
-    if (st == IP_OK && complete != GL_FRAMEBUFFER_COMPLETE)
-        st = ip__fail(err, IP_ERR_UNSUPPORTED, "renderer: framebuffer incomplete (0x%04x)",
-                      (unsigned)complete);
+    ip_status st = check_framebuffer("allocating the framebuffer", err);
+    if (st == IP_OK && samples)
+        st = allocate_resolve(r, w, h, err);
     if (st == IP_OK) {
         r->width = width;
         r->height = height;
@@ -301,6 +330,7 @@ ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip_render
     ip_renderer *r = calloc(1, sizeof *r);
     if (!r)
         return ip__fail(err, IP_ERR_NOMEM, "renderer: out of memory");
+    r->samples = 1;
     st = ip_gl_context_create_headless(&r->context, err);
     if (st == IP_OK)
         st = setup_objects(r, err);
@@ -335,6 +365,7 @@ ip_status ip_renderer_create_current(uint32_t width, uint32_t height, uint32_t f
         return st;
     }
     r->framebuffer = framebuffer;
+    r->samples = 1;
     r->width = width;
     r->height = height;
     *out = r;
@@ -445,6 +476,7 @@ static void set_draw_state(const ip_renderer *r)
     glDisable(GL_CULL_FACE);
     glDisable(GL_DEPTH_CLAMP);
     glDisable(GL_FRAMEBUFFER_SRGB);
+    glEnable(GL_MULTISAMPLE); /* a no-op on a single-sample framebuffer */
     glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
@@ -598,12 +630,43 @@ ip_status ip_renderer_set_shading(ip_renderer *r, const ip_shading *shading, ip_
     return st;
 }
 
+ip_status ip_renderer_set_samples(ip_renderer *r, uint32_t samples, ip_error *err)
+{
+    if (!r->context)
+        return samples == 1 ? IP_OK
+                            : ip__fail(err, IP_ERR_ARGUMENT,
+                                       "renderer: the caller's framebuffer sets its samples");
+    ip_status st = make_current(r, err);
+    if (st != IP_OK)
+        return st;
+    GLint max_samples = 1;
+    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    if (samples == 0 || samples > (uint32_t)(max_samples > 1 ? max_samples : 1))
+        return ip__fail(err, IP_ERR_ARGUMENT, "renderer: %u samples a pixel (1 to %d here)",
+                        samples, max_samples > 1 ? (int)max_samples : 1);
+    uint32_t old_samples = r->samples;
+    r->samples = samples;
+    st = allocate_framebuffer(r, r->width, r->height, err);
+    if (st != IP_OK) {
+        r->samples = old_samples;
+        (void)allocate_framebuffer(r, r->width, r->height, NULL);
+    }
+    return st;
+}
+
 ip_status ip_renderer_read_rgba(ip_renderer *r, uint8_t *rgba, ip_error *err)
 {
     ip_status st = make_current(r, err);
     if (st != IP_OK)
         return st;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, r->framebuffer);
+    if (r->samples > 1) { /* average each pixel's samples, then read that */
+        GLint w = (GLint)r->width, h = (GLint)r->height;
+        glDisable(GL_SCISSOR_TEST);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, r->resolve_framebuffer);
+        glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        glBindFramebuffer(GL_FRAMEBUFFER, r->resolve_framebuffer);
+    }
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glPixelStorei(GL_PACK_ROW_LENGTH, 0);
@@ -634,9 +697,10 @@ void ip_renderer_destroy(ip_renderer *r)
         glDeleteProgram(r->mesh_program);
         glDeleteProgram(r->background_program);
         if (r->context) {
-            GLuint renderbuffers[2] = {r->color_buffer, r->depth_buffer};
-            glDeleteRenderbuffers(2, renderbuffers);
-            glDeleteFramebuffers(1, &r->framebuffer);
+            GLuint renderbuffers[3] = {r->color_buffer, r->depth_buffer, r->resolve_color};
+            GLuint framebuffers[2] = {r->framebuffer, r->resolve_framebuffer};
+            glDeleteRenderbuffers(3, renderbuffers);
+            glDeleteFramebuffers(2, framebuffers);
         }
     }
     ip_gl_context_destroy(r->context);

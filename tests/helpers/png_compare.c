@@ -9,6 +9,13 @@
  * (default 0), 1 otherwise, 2 for a bad command line or an unreadable image. With --bbox, a
  * second line gives the smallest rectangle holding every pixel that differs: "bbox X Y W H"
  * (top-left pixel, size), or "bbox none".
+ *
+ *   png_compare A.png BIG.png --box K
+ *
+ * for anti-aliasing: BIG, K times A's size on both axes, is shrunk by averaging each K x K
+ * block (per channel, as real numbers), and the mean absolute difference between that and A,
+ * over every pixel and the R, G and B channels, is printed with 4 decimals. Exit status 0, or
+ * 2 when the sizes do not fit.
  */
 #include <png.h>
 #include <stdio.h>
@@ -56,6 +63,37 @@ static int crop_image(unsigned char **rgba, png_uint_32 *width, png_uint_32 *hei
     return 0;
 }
 
+/* The block of BIG (k x k pixels, big_width wide) at (x, y) of the small image, averaged. */
+static double block_mean(const unsigned char *big, png_uint_32 big_width, unsigned long k,
+                         png_uint_32 x, png_uint_32 y, int channel)
+{
+    double sum = 0;
+    for (unsigned long j = 0; j < k; j++)
+        for (unsigned long i = 0; i < k; i++)
+            sum += big[(((size_t)y * k + j) * big_width + (size_t)x * k + i) * 4 + channel];
+    return sum / (double)(k * k);
+}
+
+/* --box K: prints the mean absolute difference between A and BIG box-filtered by K. */
+static int box_difference(const unsigned char *a, png_uint_32 w, png_uint_32 h,
+                          const unsigned char *big, png_uint_32 bw, png_uint_32 bh, unsigned long k)
+{
+    if (bw != w * k || bh != h * k) {
+        fprintf(stderr, "png_compare: %ux%u is not %lu times %ux%u\n", (unsigned)bw, (unsigned)bh,
+                k, (unsigned)w, (unsigned)h);
+        return 2;
+    }
+    double total = 0;
+    for (png_uint_32 y = 0; y < h; y++)
+        for (png_uint_32 x = 0; x < w; x++)
+            for (int c = 0; c < 3; c++) {
+                double d = block_mean(big, bw, k, x, y, c) - a[((size_t)y * w + x) * 4 + c];
+                total += d < 0 ? -d : d;
+            }
+    printf("%.4f\n", total / (3.0 * w * h));
+    return 0;
+}
+
 static int parse_crop(const char *text, unsigned long crop[4])
 {
     char tail;
@@ -76,6 +114,7 @@ int main(int argc, char **argv)
     const char *path[2] = {NULL, NULL};
     double level = 0, max_pct = 0;
     int files = 0, cropped = 0, bbox = 0;
+    double box = 0;
     unsigned long crop[4];
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--level") && i + 1 < argc) {
@@ -88,6 +127,9 @@ int main(int argc, char **argv)
             if (parse_crop(argv[++i], crop) != 0)
                 goto usage;
             cropped = 1;
+        } else if (!strcmp(argv[i], "--box") && i + 1 < argc) {
+            if (parse_number(argv[++i], &box) != 0 || box < 1 || box > 64 || box != (int)box)
+                goto usage;
         } else if (!strcmp(argv[i], "--bbox")) {
             bbox = 1;
         } else if (argv[i][0] != '-' && files < 2) {
@@ -104,6 +146,12 @@ int main(int argc, char **argv)
     if (!b) {
         free(a);
         return 2;
+    }
+    if (box >= 1) {
+        int rc = box_difference(a, w[0], h[0], b, w[1], h[1], (unsigned long)box);
+        free(a);
+        free(b);
+        return rc;
     }
     if (cropped && crop_image(&a, &w[0], &h[0], crop) != 0) {
         fprintf(stderr, "png_compare: %s: --crop %lu,%lu,%lu,%lu is not within its %ux%u pixels\n",
@@ -150,6 +198,7 @@ int main(int argc, char **argv)
     return pct <= max_pct ? 0 : 1;
 usage:
     fprintf(stderr,
-            "usage: png_compare A.png B.png [--level L] [--max-pct P] [--crop X,Y,W,H] [--bbox]\n");
+            "usage: png_compare A.png B.png [--level L] [--max-pct P] [--crop X,Y,W,H] [--bbox]\n"
+            "       png_compare A.png BIG.png --box K\n");
     return 2;
 }

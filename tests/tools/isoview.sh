@@ -12,6 +12,8 @@ compare=$bin/tests/png_compare
 expect_error 2 "--iso" "$bin/isoview" s.ibv
 expect_error 2 "--size" "$bin/isoview" s.ibv --iso 1 --size 12
 expect_error 2 "--lod" "$bin/isoview" s.ibv --iso 1 --lod maybe
+expect_error 2 "--aa '0'" "$bin/isoview" s.ibv --iso 1 --aa 0
+expect_error 2 "--aa '32'" "$bin/isoview" s.ibv --iso 1 --aa 32
 expect_error 1 "nothere.ibv" "$bin/isoview" nothere.ibv --iso 1
 expect_error 1 "view" "$bin/isoview" s.ibv --iso 1 --view +w
 printf 'iso 1\norbit 10\n' >bad.txt
@@ -168,6 +170,14 @@ check "--quiet prints nothing" test -z "$out"
 check "stats show rays" grep -q '"rays": [1-9]' at.json
 check "stats say lod" grep -q '"lod": true' at.json
 expect_error 1 "exists" "$bin/isoview" s.ibv --iso 1 --screenshot-at 1 at.png
+# --aa 4: a multisampled window (its screenshot differs from the one without at the edges)
+printf 'overlay off\nfull\nwait done\nscreenshot %s\nquit\n' aa1.png >aa1.txt
+printf 'overlay off\nfull\nwait done\nscreenshot %s\nquit\n' aa4.png >aa4.txt
+view s.ibv --iso 1500.5 --size 320x240 --lod off --script aa1.txt --quiet
+view s.ibv --iso 1500.5 --size 320x240 --lod off --aa 4 --script aa4.txt --quiet
+check "--aa 4 opens a window and saves its image (got $rc: $err)" test -s aa4.png
+check "--aa 4 changes the edges only" "$bin/tests/png_compare" aa1.png aa4.png --level 3 --max-pct 10
+check "--aa 4 changes the edges" sh -c "! '$bin/tests/png_compare' aa1.png aa4.png"
 
 # a corrupted brick file (4 KiB pages of payloads zeroed): the window closes with one line
 # naming the file and the brick, exit 1, and neither the screenshot nor the statistics appear

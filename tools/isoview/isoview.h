@@ -21,6 +21,7 @@ typedef struct options {
     tool_view_options common; /* with --stats, --force and --quiet */
     const char *file, *script, *screenshot_path;
     double screenshot_at, exit_after;
+    int aa; /* --aa N: samples a pixel of the window (1: no multisampling) */
 } options;
 
 typedef enum command_kind {

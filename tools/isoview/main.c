@@ -298,7 +298,8 @@ static int open_window(viewer *v)
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     glfwWindowHint(GLFW_DEPTH_BITS, 24);
-    glfwWindowHint(GLFW_SAMPLES, 0); /* the image must match isorender's */
+    /* without --aa, the image matches isorender's; the renderer enables GL_MULTISAMPLE */
+    glfwWindowHint(GLFW_SAMPLES, v->o.aa > 1 ? v->o.aa : 0);
     char title[256];
     snprintf(title, sizeof title, "isoview: %s", v->o.file);
     v->window =

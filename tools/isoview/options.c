@@ -18,6 +18,8 @@ static const char usage[] =
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
     "  --threads N         threads for seeding, propagation and full extraction\n"
     "                      (default: all cores)\n"
+    "  --aa N              anti-aliasing: N samples a pixel of the window (1 to 16; default\n"
+    "                      1, off: the image isorender draws)\n"
     "  --stats OUT.json    on exit: counts, times, fps and the cache statistics as JSON\n"
     "  --script FILE       run the commands of FILE (see docs/isoview.md)\n"
     "  --screenshot-at SECONDS OUT.png\n"
@@ -56,10 +58,21 @@ static int parse_exit_after(const char *p, const tool_option *opt, const char *c
     return 0;
 }
 
+static int parse_aa(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    uint64_t samples;
+    (void)opt;
+    if (tool_parse_u64(v[0], &samples) != 0 || samples < 1 || samples > 16)
+        return tool_usage_error(p, "--aa '%s' is not a sample count (1 to 16)", v[0]);
+    ((options *)base)->aa = (int)samples;
+    return 0;
+}
+
 static const tool_option isoview_options[] = {
     {"--script", NULL, 1, offsetof(options, script), NULL, NULL, NULL},
     {"--screenshot-at", NULL, 2, 0, parse_screenshot_at, NULL, NULL},
     {"--exit-after", NULL, 1, 0, parse_exit_after, NULL, NULL},
+    {"--aa", NULL, 1, 0, parse_aa, NULL, NULL},
 };
 
 int parse_args(int argc, char **argv, options *o)
@@ -68,6 +81,7 @@ int parse_args(int argc, char **argv, options *o)
     tool_view_options_default(&o->common, 1280, 960);
     o->screenshot_at = -1;
     o->exit_after = -1;
+    o->aa = 1;
     return tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
                                         sizeof isoview_options / sizeof isoview_options[0], o,
                                         &o->file, argc, argv);
