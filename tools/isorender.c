@@ -48,6 +48,11 @@ static const char usage[] =
     "                      surface\n"
     "  --weld, --no-weld   PLY, OBJ and glTF meshes share their vertices (default), or repeat\n"
     "                      them for every triangle (STL always does)\n"
+    "  --smooth N          smooth the mesh file by N iterations of Taubin's method (lambda 0.5,\n"
+    "                      mu -0.53), which softens the terraces of nearly binary data without\n"
+    "                      shrinking the surface; needs shared vertices (not --no-weld); the\n"
+    "                      rim of an open mesh stays. Only the file changes: the image and\n"
+    "                      what the summary says of it are those of the extracted triangles\n"
     "  --stats OUT.json    counts, times, warnings, the cache statistics and the overdraw\n"
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
@@ -94,6 +99,7 @@ typedef struct options {
     int full, software, warm; /* --stats, --force and --quiet are in common */
     strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
     int weld, no_weld;
+    uint64_t smooth;          /* --smooth N: Taubin iterations for the mesh file (0: none) */
     tool_orbit_options orbit; /* --azimuth, --elevation, --zoom */
     uint64_t turntable;       /* --turntable N: frames (0: one image) */
     const char *mp4;          /* --mp4 OUT.mp4 (NULL: none) */
@@ -140,7 +146,7 @@ typedef struct run {
 
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
                           void *base);
-static tool_option_parse parse_color, parse_background, parse_turntable, parse_aa;
+static tool_option_parse parse_color, parse_background, parse_turntable, parse_aa, parse_smooth;
 
 static const tool_option isorender_options[] = {
     {"-o", NULL, 1, offsetof(options, out), NULL, NULL, NULL},
@@ -153,6 +159,7 @@ static const tool_option isorender_options[] = {
     {"--strip-at", NULL, 1, offsetof(options, strip_at), parse_strip_at, NULL, NULL},
     {"--weld", NULL, 0, offsetof(options, weld), NULL, NULL, NULL},
     {"--no-weld", NULL, 0, offsetof(options, no_weld), NULL, NULL, NULL},
+    {"--smooth", NULL, 1, 0, parse_smooth, NULL, NULL},
     TOOL_ORBIT_OPTION_ROWS(options, orbit),
     {"--color", NULL, 1, 0, parse_color, NULL, NULL},
     {"--background", NULL, 1, 0, parse_background, NULL, NULL},
@@ -439,6 +446,45 @@ static void strip_print(const run *r)
     printf("\n");
 }
 
+/* ---- smoothing the mesh file ---- */
+
+#define SMOOTH_MAX_ITERATIONS 100000
+
+static int parse_smooth(const char *program, const tool_option *option, const char *const *values,
+                        void *base)
+{
+    options *o = base;
+    (void)option;
+    if (tool_parse_u64(values[0], &o->smooth) != 0 || o->smooth > SMOOTH_MAX_ITERATIONS)
+        return tool_usage_error(program, "--smooth '%s' is not an iteration count (0 to %d)",
+                                values[0], SMOOTH_MAX_ITERATIONS);
+    return 0;
+}
+
+/* --smooth smooths a welded mesh file. Returns 0, or 2 after a usage error. */
+static int check_smooth_options(const options *o)
+{
+    if (!o->smooth)
+        return 0;
+    if (!o->mesh)
+        return tool_usage_error("isorender", "--smooth smooths the mesh file: it needs --mesh");
+    if (o->no_weld)
+        return tool_usage_error("isorender", "--smooth needs shared vertices: no --no-weld");
+    return 0;
+}
+
+/* Smooths the welded mesh of the file by --smooth's iterations. Returns 0, or 1 after the
+ * error. */
+static int smooth_mesh(const run *r, ip_indexed_mesh *welded, ip_error *err)
+{
+    if (!r->o.smooth)
+        return 0;
+    if (ip_indexed_mesh_smooth_taubin(welded, (unsigned)r->o.smooth, IP_TAUBIN_LAMBDA, IP_TAUBIN_MU,
+                                      err) != IP_OK)
+        return tool_fail("isorender", err);
+    return 0;
+}
+
 /* ---- the turntable ---- */
 
 #define TURNTABLE_MAX_FRAMES 100000
@@ -502,6 +548,9 @@ static int parse_args(int argc, char **argv, options *o)
         return tool_usage_error("isorender", "--aa is OpenGL's: --software draws without it");
     if (o->weld && o->no_weld)
         return tool_usage_error("isorender", "--weld and --no-weld: one or the other");
+    rc = check_smooth_options(o);
+    if (rc)
+        return rc;
     rc = check_turntable_options(o);
     if (rc)
         return rc;
@@ -779,19 +828,22 @@ static void print_summary(const run *r)
            t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
     printf("  image         %s\n", r->o.out);
     if (r->o.mesh)
-        printf("  mesh          %s: %llu triangles, %llu vertices%s\n", r->o.mesh,
+        printf("  mesh          %s: %llu triangles, %llu vertices%s%s\n", r->o.mesh,
                (unsigned long long)(r->mesh->triangle_count - r->mesh_dropped),
                (unsigned long long)r->mesh_vertices,
-               r->mesh_vertices < 3 * r->mesh->triangle_count ? " (shared)" : "");
+               r->mesh_vertices < 3 * r->mesh->triangle_count ? " (shared)" : "",
+               r->o.smooth ? ", smoothed" : "");
 }
 
-/* Writes the mesh file: welded (shared vertices) unless --no-weld or STL. A progressive
- * run's mesh is only what the view needed, which a note says. */
+/* Writes the mesh file: welded (shared vertices) unless --no-weld or STL (which is welded for
+ * --smooth, then written with its corners repeated). A progressive run's mesh is only what
+ * the view needed, which a note says. */
 static int write_mesh(run *r, ip_error *err)
 {
     const char *format = ip_mesh_format_of(r->o.mesh);
     ip_status st;
-    if (r->o.no_weld || strcmp(format, "STL") == 0) {
+    int stl = strcmp(format, "STL") == 0;
+    if (r->o.no_weld || (stl && !r->o.smooth)) {
         st = ip_mesh_write(r->mesh, r->o.mesh, r->o.common.force, err);
         r->mesh_vertices = 3 * r->mesh->triangle_count;
     } else {
@@ -802,8 +854,12 @@ static int write_mesh(run *r, ip_error *err)
                     (unsigned long long)r->mesh->triangle_count, ip_status_message(st));
             return 1;
         }
+        if (smooth_mesh(r, &welded, err) != 0) {
+            ip_indexed_mesh_free(&welded);
+            return 1;
+        }
         st = ip_indexed_mesh_write(&welded, r->o.mesh, r->o.common.force, err);
-        r->mesh_vertices = welded.vertex_count;
+        r->mesh_vertices = stl ? 3 * welded.triangle_count : welded.vertex_count;
         r->mesh_dropped = welded.dropped_triangles;
         ip_indexed_mesh_free(&welded);
     }

@@ -168,6 +168,29 @@ IP_API void ip_indexed_mesh_free(ip_indexed_mesh *mesh);
  *  @return IP_OK, IP_ERR_NOMEM, or IP_ERR_ARGUMENT for more than 2^32 - 2 distinct vertices. */
 IP_API ip_status ip_mesh_weld(const ip_mesh *mesh, ip_indexed_mesh *out);
 
+/* Taubin's factors for ip_indexed_mesh_smooth_taubin(): lambda 0.5 and mu -0.53 pass
+ * frequencies below about 0.11 (1/lambda + 1/mu) and damp those above, the terraces of
+ * nearly binary data among them. */
+#define IP_TAUBIN_LAMBDA 0.5
+#define IP_TAUBIN_MU (-0.53)
+
+/*! ip_indexed_mesh_smooth_taubin() : smooths the welded mesh in place by Taubin's method:
+ *  `iterations` times, every vertex p moves to p + lambda * (a - p), a being the average of
+ *  its neighbours' positions (the uniform, or umbrella, Laplacian over the triangles' edges),
+ *  then likewise with mu; a negative mu (mu < -lambda, e.g. IP_TAUBIN_LAMBDA, IP_TAUBIN_MU)
+ *  undoes the shrinking that lambda alone (mu = 0: Laplacian smoothing) causes. Vertices on
+ *  an edge that is not in exactly two triangles (a boundary, where the surface meets the
+ *  volume's faces, or a non-manifold edge) stay where they are, so an open surface keeps its
+ *  rim. Afterwards each vertex's normal is the area-weighted average of its triangles' normals
+ *  (from their corners' order, counter-clockwise seen from outside), normalised. Vertex and
+ *  triangle counts and indices do not change. Memory while it runs: 24 bytes per triangle and
+ *  21 bytes per vertex (a table of each vertex's neighbours, new positions); time O(iterations
+ *  * (vertices + edges)). Not thread-safe on one mesh.
+ *  @return IP_OK (also for 0 iterations, which change nothing), IP_ERR_ARGUMENT (lambda not in
+ *  (0, 1] or mu not in [-1, 0]; the mesh unchanged) or IP_ERR_NOMEM (the mesh unchanged). */
+IP_API ip_status ip_indexed_mesh_smooth_taubin(ip_indexed_mesh *mesh, unsigned iterations,
+                                               double lambda, double mu, ip_error *err);
+
 /*! ip_indexed_mesh_write() : writes the indexed mesh in the format its name ends in, like
  *  ip_mesh_write(): PLY with its vertex list and faces of indices into it, OBJ with one "v" and
  *  "vn" per vertex and faces "f a//a b//b c//c", glTF with a uint32 index accessor; STL repeats

@@ -1,5 +1,5 @@
 /* ply_triangles: the triangles of a binary PLY that isorender wrote (vertices of float
- * x,y,z,nx,ny,nz; faces of 3 int indices), for the end-to-end tests of welding.
+ * x,y,z,nx,ny,nz; faces of 3 int indices), for the end-to-end tests of welding and smoothing.
  *
  *   ply_triangles FILE.ply             one line per triangle: its 3 corners' positions as exact
  *                                      hexadecimal floats, in file order, leaving out triangles
@@ -7,9 +7,15 @@
  *   ply_triangles --topology FILE.ply  "vertices V edges E faces F open O repeated R": the
  *                                      undirected edges, the directed edges whose reverse is
  *                                      missing, and those used twice, by vertex index
+ *   ply_triangles --shape FILE.ply     "volume V area A normal_angle D": the enclosed volume
+ *                                      (signed, by the divergence theorem: a closed surface's),
+ *                                      the area, and the mean angle in degrees between the
+ *                                      normals of two triangles sharing an edge (terraces make
+ *                                      it large; smoothing makes it smaller)
  *
  * Exit status: 0 done, 1 a file it cannot read, 2 a bad command line.
  */
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -100,17 +106,82 @@ static void print_topology(const ply *p)
     free(undirected);
 }
 
+/* Face t's normal (the cross product of two edges, counter-clockwise) in n; returns its
+ * length, twice the area. */
+static double face_normal(const ply *p, uint64_t t, double n[3])
+{
+    const float *c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = p->positions + 3 * (uint64_t)p->indices[3 * t + (uint64_t)k];
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = (double)c[1][k] - c[0][k];
+        e2[k] = (double)c[2][k] - c[0][k];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    return sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+/* The angle in degrees between the normals of faces a and b (0 where one has no area). */
+static double normal_angle(const ply *p, uint64_t a, uint64_t b)
+{
+    double na[3], nb[3];
+    double la = face_normal(p, a, na), lb = face_normal(p, b, nb);
+    if (la == 0 || lb == 0)
+        return 0;
+    double c = (na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2]) / (la * lb);
+    return acos(c > 1 ? 1 : c < -1 ? -1 : c) * 180.0 / 3.14159265358979323846;
+}
+
+static void print_shape(const ply *p)
+{
+    double volume = 0, area = 0, angles = 0;
+    unsigned long long pairs = 0, n = 3 * p->faces;
+    /* (undirected edge, face) pairs, sorted by edge: a shared edge's two faces are adjacent */
+    uint64_t(*edge_faces)[2] = malloc(n * sizeof *edge_faces + 1);
+    if (!edge_faces)
+        exit(1);
+    for (uint64_t t = 0; t < p->faces; t++) {
+        double nt[3];
+        area += face_normal(p, t, nt) / 2;
+        const float *c0 = p->positions + 3 * (uint64_t)p->indices[3 * t];
+        volume += (c0[0] * nt[0] + c0[1] * nt[1] + c0[2] * nt[2]) / 6;
+        for (int k = 0; k < 3; k++) {
+            uint64_t a = p->indices[3 * t + (uint64_t)k],
+                     b = p->indices[3 * t + (uint64_t)(k + 1) % 3];
+            edge_faces[3 * t + (uint64_t)k][0] = a < b ? a << 32 | b : b << 32 | a;
+            edge_faces[3 * t + (uint64_t)k][1] = t;
+        }
+    }
+    qsort(edge_faces, n, sizeof *edge_faces, compare_u64); /* by the first of the two */
+    for (unsigned long long i = 0; i + 1 < n; i++)
+        if (edge_faces[i][0] == edge_faces[i + 1][0] &&
+            (i + 2 == n || edge_faces[i + 2][0] != edge_faces[i][0]) &&
+            (i == 0 || edge_faces[i - 1][0] != edge_faces[i][0])) {
+            angles += normal_angle(p, edge_faces[i][1], edge_faces[i + 1][1]);
+            pairs++;
+        }
+    printf("volume %.6g area %.6g normal_angle %.4f\n", volume, area,
+           pairs ? angles / (double)pairs : 0.0);
+    free(edge_faces);
+}
+
 int main(int argc, char **argv)
 {
     int topology = argc == 3 && strcmp(argv[1], "--topology") == 0;
-    if (argc != 2 + topology) {
-        fputs("usage: ply_triangles [--topology] FILE.ply\n", stderr);
+    int shape = argc == 3 && strcmp(argv[1], "--shape") == 0;
+    if (argc != 2 + topology + shape) {
+        fputs("usage: ply_triangles [--topology | --shape] FILE.ply\n", stderr);
         return 2;
     }
     ply p;
-    int ok = read_ply(argv[1 + topology], &p);
+    int ok = read_ply(argv[1 + topology + shape], &p);
     if (ok && topology)
         print_topology(&p);
+    else if (ok && shape)
+        print_shape(&p);
     else if (ok)
         print_triangles(&p);
     free(p.positions);
