@@ -37,18 +37,16 @@ kept_side() { # kept_side OBJ A B C D: the least A*x + B*y + C*z + D over the ve
         $1 == "v" { s = a * $2 + b * $3 + c * $4 + d; if (n++ == 0 || s < m) m = s }
         END { if (n == 0) print "none"; else printf "%.4f\n", m }' "$1"
 }
-least=$(kept_side p1.obj 1 0 0 -24)
-check "x=24: progressive vertices have x >= 24 - 1.733 (least $least)" \
-    awk -v m="$least" 'BEGIN { exit !(m != "none" && m >= -1.733) }'
-least=$(kept_side f1.obj 1 0 0 -24)
-check "x=24: full vertices have x >= 24 - 1.733 (least $least)" \
-    awk -v m="$least" 'BEGIN { exit !(m != "none" && m >= -1.733) }'
+at_least() { # at_least DESC OBJ A B C D LIMIT: the least is at least LIMIT
+    least=$(kept_side "$2" "$3" "$4" "$5" "$6")
+    check "$1 (least $least)" awk -v m="$least" -v l="$7" 'BEGIN { exit !(m != "none" && m >= l) }'
+}
+at_least "x=24: progressive vertices have x >= 24 - 1.733" p1.obj 1 0 0 -24 -1.733
+at_least "x=24: full vertices have x >= 24 - 1.733" f1.obj 1 0 0 -24 -1.733
+at_least "1,1,1,-60: vertices within a cell (1.733 * |n|) of the kept side" p5.obj 1 1 1 -60 -3.0
 least=$(kept_side whole.obj 1 0 0 -24)
 check "without the plane the surface reaches far beyond it (least $least)" \
     awk -v m="$least" 'BEGIN { exit !(m < -10) }'
-least=$(kept_side p5.obj 1 1 1 -60)
-check "1,1,1,-60: vertices within a cell of the plane's kept side (least $least)" \
-    awk -v m="$least" 'BEGIN { exit !(m != "none" && m >= -3.0) }'
 
 # --- a plane that keeps nothing: an empty image, exit 0 ---
 render none --iso 1e9 2>/dev/null
