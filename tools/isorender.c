@@ -637,14 +637,16 @@ static int extract_full(run *r, ip_error *err)
 {
     ip_mesh_init(&r->full_mesh);
     if (r->o.warm) {
-        if (ip_extract_full(r->cache, (float)r->o.common.iso, 0, r->o.common.threads, &r->full_mesh,
-                            NULL, err) != IP_OK)
+        if (ip_extract_full_clipped(r->cache, (float)r->o.common.iso, 0, r->o.common.threads,
+                                    r->o.common.clip, r->o.common.clip_count, &r->full_mesh, NULL,
+                                    err) != IP_OK)
             return -1;
         ip_mesh_clear(&r->full_mesh);
     }
     double start = ip_now_seconds();
-    if (ip_extract_full(r->cache, (float)r->o.common.iso, 0, r->o.common.threads, &r->full_mesh,
-                        &r->totals, err) != IP_OK)
+    if (ip_extract_full_clipped(r->cache, (float)r->o.common.iso, 0, r->o.common.threads,
+                                r->o.common.clip, r->o.common.clip_count, &r->full_mesh, &r->totals,
+                                err) != IP_OK)
         return -1;
     r->extraction_wall = ip_now_seconds() - start;
     r->mesh = &r->full_mesh;

@@ -493,6 +493,49 @@ void tool_engine_options(const tool_view_options *o, ip_engine_options *eo)
     eo->pixel_error = o->pixel_error;
     eo->occlusion = o->occlusion;
     eo->prefetch = o->prefetch;
+    eo->clip_count = o->clip_count;
+    memcpy(eo->clip, o->clip, sizeof eo->clip);
+}
+
+/* An axis shortcut: "x=40", "-z=2.5". Returns 0, or -1 when `text` is not one. */
+static int parse_clip_axis(const char *text, ip_clip_plane *plane)
+{
+    double sign = 1.0;
+    if (text[0] == '-') {
+        sign = -1.0;
+        text++;
+    }
+    const char *axes = "xyz", *at = text[0] ? strchr(axes, tolower((unsigned char)text[0])) : NULL;
+    double value;
+    if (!at || text[1] != '=' || tool_parse_double(text + 2, &value) != 0)
+        return -1;
+    memset(plane, 0, sizeof *plane);
+    plane->normal[at - axes] = sign; /* sign * (x - value) >= 0 */
+    plane->offset = -sign * value;
+    return 0;
+}
+
+int tool_parse_clip(const char *text, ip_clip_plane *plane)
+{
+    if (strchr(text, '='))
+        return parse_clip_axis(text, plane);
+    double v[4];
+    char rest[256];
+    if (strlen(text) >= sizeof rest)
+        return -1;
+    strcpy(rest, text);
+    char *save = NULL, *item = strtok_r(rest, ",", &save);
+    int n = 0;
+    for (; item && n < 4; item = strtok_r(NULL, ",", &save))
+        if (tool_parse_double(item, &v[n++]) != 0)
+            return -1;
+    if (n != 4 || item || strchr(text, ',') == text || strstr(text, ",,") ||
+        text[strlen(text) - 1] == ',')
+        return -1;
+    if (v[0] == 0 && v[1] == 0 && v[2] == 0)
+        return -1;
+    *plane = (ip_clip_plane){{v[0], v[1], v[2]}, v[3]};
+    return 0;
 }
 
 #define MAX_IMAGE_SIDE 16384 /* pixels; OpenGL's common maximum renderbuffer size */
@@ -627,6 +670,19 @@ int tool_option_cache_mb(const char *p, const tool_option *opt, const char *cons
     return 0;
 }
 
+static int parse_clip_option(const char *p, const tool_option *opt, const char *const *v,
+                             void *base)
+{
+    (void)opt;
+    tool_view_options *o = base;
+    if (o->clip_count == IP_MAX_CLIP_PLANES)
+        return tool_usage_error(p, "at most %d --clip planes", IP_MAX_CLIP_PLANES);
+    if (tool_parse_clip(v[0], &o->clip[o->clip_count]) != 0)
+        return tool_usage_error(p, "bad --clip '%s' (x=V, -x=V, y=V, ... or A,B,C,D)", v[0]);
+    o->clip_count++;
+    return 0;
+}
+
 #define VIEW_FIELD(member) offsetof(tool_view_options, member)
 
 static const tool_option view_options[] = {
@@ -645,6 +701,7 @@ static const tool_option view_options[] = {
      NULL},
     {"--occlusion", NULL, 1, 0, parse_occlusion, NULL, NULL},
     {"--prefetch", NULL, 1, 0, parse_prefetch, NULL, NULL},
+    {"--clip", NULL, 1, 0, parse_clip_option, NULL, NULL},
     {"--cache-mb", NULL, 1, VIEW_FIELD(cache_bytes), tool_option_cache_mb, NULL, NULL},
     {"--stats", NULL, 1, VIEW_FIELD(stats), NULL, NULL, NULL},
     {"--force", NULL, 0, VIEW_FIELD(force), NULL, NULL, NULL},
@@ -813,6 +870,18 @@ int tool_parse_view_command_line(const char *program, const char *usage, tool_vi
     return 0;
 }
 
+/* "clip": [[A, B, C, D], ...]: each plane keeps A*x + B*y + C*z + D >= 0 (world units). */
+static void write_clip_json(FILE *f, const tool_view_options *o)
+{
+    fprintf(f, ", \"clip\": [");
+    for (unsigned i = 0; i < o->clip_count; i++) {
+        const ip_clip_plane *c = &o->clip[i];
+        fprintf(f, "%s[%.9g, %.9g, %.9g, %.9g]", i ? ", " : "", c->normal[0], c->normal[1],
+                c->normal[2], c->offset);
+    }
+    fprintf(f, "]");
+}
+
 void tool_write_run_json(FILE *f, const tool_run_json *j)
 {
     const ip_camera *c = j->camera;
@@ -833,6 +902,7 @@ void tool_write_run_json(FILE *f, const tool_run_json *j)
     fprintf(f, ", \"warm\": %s, \"threads\": %u", j->warm ? "true" : "false",
             ip_thread_count(o->threads));
     fprintf(f, ", \"cutoff_degrees\": %.9g, \"foldback_degrees\": %.9g", o->cutoff, o->foldback);
+    write_clip_json(f, o);
     fprintf(f,
             ", \"rays\": %llu, \"rays_total\": %llu, \"done\": %s, \"seeds\": %llu, "
             "\"cells\": %llu, \"triangles\": %llu",

@@ -89,8 +89,10 @@ typedef struct tool_view_options {
     unsigned threads;          /* 0: every core */
     int lod;
     double pixel_error;
-    int occlusion; /* --occlusion on|off */
-    int prefetch;  /* --prefetch on|off */
+    int occlusion;                          /* --occlusion on|off */
+    int prefetch;                           /* --prefetch on|off */
+    unsigned clip_count;                    /* --clip SPEC, repeatable */
+    ip_clip_plane clip[IP_MAX_CLIP_PLANES]; /* world units (tool_parse_clip()) */
     uint64_t cache_bytes;
     const char *stats; /* --stats OUT.json (NULL: none) */
     int force, quiet;
@@ -105,14 +107,21 @@ typedef struct tool_view_options {
     "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n" \
     "  --occlusion on|off  propagation skips cells that extracted surface hides (default on)\n"    \
     "  --prefetch on|off   a background thread reads and decodes the bricks the next rays need\n"  \
-    "                      (default on)\n"
+    "                      (default on)\n"                                                         \
+    "  --clip SPEC         keep one side of a plane, world units (repeatable, up to 6):\n"         \
+    "                      x=40 keeps x >= 40, -x=40 keeps x <= 40 (y, z alike),\n"                \
+    "                      A,B,C,D keeps A*x + B*y + C*z + D >= 0\n"
 
 /* The defaults: view -y, the paper's angles, lod on with a 1-pixel error, occlusion on, reading
  * ahead on, every core, the
  * default cache budget, an image of width x height. */
 void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t height);
 
-/* The engine options the shared options ask for. */
+/* Parses a --clip SPEC (see TOOL_ENGINE_OPTIONS_HELP) into *plane; returns 0, or -1 when it
+ * is not one (an unknown axis, a bad number, a zero normal). */
+int tool_parse_clip(const char *text, ip_clip_plane *plane);
+
+/* The engine options the shared options ask for (the clipping planes too). */
 void tool_engine_options(const tool_view_options *o, ip_engine_options *eo);
 
 /* ---- the command line, parsed from tables ----
@@ -182,7 +191,7 @@ int tool_parse_command_line(const tool_command_line *c, int argc, char **argv);
 
 /* The shared options of tool_view_options as a table over `o`: --iso, --size, --view,
  * --camera, --rays, --time, --cutoff, --foldback, --threads, --lod, --pixel-error, --occlusion, --prefetch,
- * --cache-mb, --stats, --force and --quiet (-q). */
+ * --clip, --cache-mb, --stats, --force and --quiet (-q). */
 tool_option_table tool_view_option_table(tool_view_options *o);
 
 /* The command line of isorender and isoview: the shared view options and the program's

@@ -72,6 +72,17 @@ extern "C" {
 
 #define IP_DEFAULT_CUTOFF_DEGREES 1.81   /* the paper's cut-off angle */
 #define IP_DEFAULT_FOLDBACK_DEGREES 0.25 /* fold-back tolerance */
+#define IP_MAX_CLIP_PLANES 6
+
+/* A clipping plane: keeps the half-space normal . x + offset >= 0 (x in world units; the normal
+ * need not be of unit length). Cells are kept or dropped whole: a cell is kept unless its box
+ * lies wholly beyond one of the planes (normal . x + offset < 0 at all 8 corners), so the cut
+ * is ragged at cell resolution. A dropped cell is neither seeded nor propagated into, nor
+ * extracted by ip_extract_full_clipped(), nor read ahead. */
+typedef struct ip_clip_plane {
+    double normal[3];
+    double offset;
+} ip_clip_plane;
 
 typedef struct ip_engine_options {
     double cutoff_degrees;   /* propagation cut-off angle around the seed's ray */
@@ -85,6 +96,10 @@ typedef struct ip_engine_options {
     int occlusion;           /* occlusion-aware propagation (see Occlusion above; default on) */
     int prefetch;            /* a background reader loads the bricks the next rays need (see
                                 Reading ahead above; default on) */
+    unsigned clip_count;     /* planes in use in clip (0: none, the default) */
+    ip_clip_plane clip[IP_MAX_CLIP_PLANES]; /* the surface is kept where every plane keeps it:
+                                               the exact-image guarantee holds for the kept
+                                               cells (ip_extract_full_clipped()) */
 } ip_engine_options;
 
 /* Counters and times, per step or in total. Times are wall seconds, split as the paper does.
@@ -114,7 +129,8 @@ IP_API void ip_engine_options_default(ip_engine_options *options);
 /*! ip_engine_create() : an engine reading through `cache` (which must outlive it), with its
  *  worker threads started: ip_thread_count(options.threads) - 1 of them, idle until a step
  *  (see Threads above). *out is the caller's, released with ip_engine_destroy().
- *  @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM. */
+ *  @return IP_OK, IP_ERR_ARGUMENT (also for more than IP_MAX_CLIP_PLANES planes, a zero or
+ *  non-finite normal or a non-finite offset) or IP_ERR_NOMEM. */
 IP_API ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options,
                                   ip_engine **out, ip_error *err);
 
@@ -165,6 +181,17 @@ IP_API void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
  *  @return IP_OK or a brick read error. */
 IP_API ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,
                                  ip_mesh *mesh, ip_engine_counts *counts, ip_error *err);
+
+/*! ip_extract_full_clipped() : ip_extract_full() of the cells the `clip_count` planes `clip`
+ *  keep (the rule of ip_clip_plane; the engine with the same planes extracts among the same
+ *  cells), also skipping bricks and sub-blocks that lie wholly beyond a plane. `clip` is the
+ *  caller's, read during the call; NULL with a count of 0 is ip_extract_full().
+ *  @return IP_OK, IP_ERR_ARGUMENT for bad planes (as ip_engine_create()) or a brick read
+ *  error. */
+IP_API ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t level,
+                                         unsigned threads, const ip_clip_plane *clip,
+                                         unsigned clip_count, ip_mesh *mesh,
+                                         ip_engine_counts *counts, ip_error *err);
 
 #ifdef __cplusplus
 }

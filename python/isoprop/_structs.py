@@ -97,11 +97,20 @@ class Camera(ctypes.Structure):
                 ("fov_y", c_double), ("width", c_uint32), ("height", c_uint32)]
 
 
+IP_MAX_CLIP_PLANES = 6  # engine.h
+
+
+class ClipPlane(ctypes.Structure):
+    """ip_clip_plane (engine.h)"""
+    _fields_ = [("normal", c_double * 3), ("offset", c_double)]
+
+
 class EngineOptions(ctypes.Structure):
     """ip_engine_options (engine.h)"""
     _fields_ = [("cutoff_degrees", c_double), ("foldback_degrees", c_double),
                 ("threads", c_uint), ("lod", c_int), ("pixel_error", c_double),
-                ("cell_ids", c_int), ("occlusion", c_int), ("prefetch", c_int)]
+                ("cell_ids", c_int), ("occlusion", c_int), ("prefetch", c_int),
+                ("clip_count", c_uint), ("clip", ClipPlane * IP_MAX_CLIP_PLANES)]
 
 
 class EngineCounts(ctypes.Structure):
@@ -131,6 +140,7 @@ MIRRORS = {
     "ip_cache_level_stats": CacheLevelStats,
     "ip_cache_stats": CacheStats,
     "ip_camera": Camera,
+    "ip_clip_plane": ClipPlane,
     "ip_engine_options": EngineOptions,
     "ip_engine_counts": EngineCounts,
     "ip_mesh": Mesh,

@@ -43,6 +43,8 @@ def run_stats(run, counts, cache):
            "threads": lib.ip_thread_count(run.options.threads),
            "cutoff_degrees": run.options.cutoff_degrees,
            "foldback_degrees": run.options.foldback_degrees,
+           "clip": [list(p.normal) + [p.offset]
+                    for p in run.options.clip[:run.options.clip_count]],
            "rays": counts.rays, "rays_total": c.width * c.height, "done": run.done(),
            "seeds": counts.seeds, "cells": counts.cells, "triangles": counts.triangles,
            "time": {"intersection_s": counts.intersection_seconds,

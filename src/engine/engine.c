@@ -98,6 +98,7 @@ void ip_engine_options_default(ip_engine_options *o)
     o->cell_ids = 0;
     o->occlusion = 1;
     o->prefetch = 1;
+    o->clip_count = 0;
 }
 
 /* The brick file an engine extracts from, which its messages name. */
@@ -118,6 +119,11 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     if (options->lod && !(options->pixel_error > 0 && isfinite(options->pixel_error)))
         return ip__fail(err, IP_ERR_ARGUMENT, "the pixel error %g must be positive",
                         options->pixel_error);
+    if (!ip__clip_valid(options->clip, options->clip_count))
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "clipping planes: %u given (at most %d), each with a finite, non-zero "
+                        "normal and a finite offset",
+                        options->clip_count, IP_MAX_CLIP_PLANES);
     ip_engine *e = calloc(1, sizeof *e);
     if (!e)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for an engine", path_of(cache));
@@ -265,6 +271,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
             ip__sampler_release(&lt->sampler);
             lt->sampler.status = IP_OK;
             ip__seeder_init(&lt->seeder, &lt->sampler, iso, pixel_angle);
+            lt->seeder.clip = (ip_clip){e->options.clip, e->options.clip_count};
             ip__propagator_free(&lt->propagator);
             if (ip__propagator_init(&lt->propagator, &lt->sampler, &e->visited, &w->mesh,
                                     &e->camera, iso, &e->options, e->lod_distance[k],
@@ -276,9 +283,11 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     atomic_store(&e->cancel, 0);
     e->begun = 1;
     if (e->prefetcher) {
-        ip__prefetch_view view = {e->camera,      e->basis,          e->iso,
-                                  e->levels_used, e->lod_distance,   e->order,
-                                  e->order_cells, &e->next_position, &e->cancel};
+        ip__prefetch_view view = {e->camera,       e->basis,
+                                  e->iso,          e->levels_used,
+                                  e->lod_distance, e->order,
+                                  e->order_cells,  &e->next_position,
+                                  &e->cancel,      {e->options.clip, e->options.clip_count}};
         ip__prefetcher_begin(e->prefetcher, &view);
     }
     return IP_OK;

@@ -4,14 +4,15 @@
 #include <string.h>
 
 #include "array.h"
+#include "clip.h"
 #include "internal.h"
 #include "isoprop/engine.h"
 #include "pool.h"
 #include "propagate.h"
 
-/* Triangulates the active cells of one brick, sub-block by sub-block. */
-static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, uint64_t g,
-                               ip_engine_counts *c)
+/* Triangulates the active cells of one brick that `clip` keeps, sub-block by sub-block. */
+static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip_clip *clip,
+                               uint64_t g, ip_engine_counts *c)
 {
     const ip_layout *l = s->layout;
     const float *ranges = ip_store_subblock_ranges(ip_cache_store(s->cache), g);
@@ -28,10 +29,14 @@ static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, uint64_t
             lo[a] = origin[a] + se * sb[a];
             hi[a] = lo[a] + se < origin[a] + extent[a] - 1 ? lo[a] + se : origin[a] + extent[a] - 1;
         }
+        if (!ip__clip_keeps_samples(clip, l, level, lo, hi))
+            continue;
         for (uint32_t z = lo[2]; z < hi[2] && st == IP_OK; z++)
             for (uint32_t y = lo[1]; y < hi[1] && st == IP_OK; y++)
                 for (uint32_t x = lo[0]; x < hi[0]; x++) {
-                    uint32_t cell[3] = {x, y, z};
+                    uint32_t cell[3] = {x, y, z}, far[3] = {x + 1, y + 1, z + 1};
+                    if (clip->count && !ip__clip_keeps_samples(clip, l, level, cell, far))
+                        continue;
                     unsigned mc;
                     int n = ip__extract_cell(s, mesh, cell, iso, &mc, &st);
                     if (n < 0)
@@ -50,6 +55,7 @@ typedef struct full_worker {
     ip_cache *cache;
     float iso;
     uint32_t level;
+    ip_clip clip;
     atomic_uint_fast64_t *next; /* next level-local brick to take */
     ip_sampler sampler;
     ip_mesh mesh;
@@ -72,7 +78,8 @@ static void full_work(void *user, unsigned index)
             break;
         float range[2];
         ip_store_brick_range(store, lv->first_brick + i, range);
-        if (!ip__range_active(range[0], range[1], w->iso))
+        if (!ip__range_active(range[0], range[1], w->iso) ||
+            !ip__clip_keeps_brick(&w->clip, ip_store_layout(store), lv->first_brick + i))
             continue;
         if (w->chunks == w->capacity) {
             uint64_t cap = ip__array_capacity(w->capacity, w->chunks + 1, 256, sizeof(uint64_t),
@@ -86,7 +93,8 @@ static void full_work(void *user, unsigned index)
         }
         w->brick_of[w->chunks] = i;
         w->start_of[w->chunks++] = w->mesh.triangle_count;
-        w->status = extract_brick(&w->sampler, &w->mesh, w->iso, lv->first_brick + i, &w->counts);
+        w->status =
+            extract_brick(&w->sampler, &w->mesh, w->iso, &w->clip, lv->first_brick + i, &w->counts);
         ip__sampler_release(&w->sampler); /* a brick at a time */
     }
     w->counts.extraction_seconds = ip_now_seconds() - start;
@@ -121,10 +129,22 @@ static ip_status merge_in_brick_order(full_worker *w, unsigned threads, ip_mesh 
 ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,
                           ip_mesh *mesh, ip_engine_counts *counts, ip_error *err)
 {
+    return ip_extract_full_clipped(cache, iso, level, threads, NULL, 0, mesh, counts, err);
+}
+
+ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t level, unsigned threads,
+                                  const ip_clip_plane *clip, unsigned clip_count, ip_mesh *mesh,
+                                  ip_engine_counts *counts, ip_error *err)
+{
     const ip_layout *l = ip_store_layout(ip_cache_store(cache));
     const char *path = ip_store_path(ip_cache_store(cache));
     if (level >= l->level_count)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: level %u does not exist", path, level);
+    if (!ip__clip_valid(clip, clip_count))
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "clipping planes: %u given (at most %d), each with a finite, non-zero "
+                        "normal and a finite offset",
+                        clip_count, IP_MAX_CLIP_PLANES);
     threads = ip_thread_count(threads);
     full_worker *w = calloc(threads, sizeof *w);
     if (!w)
@@ -133,7 +153,8 @@ ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned t
     atomic_init(&next, 0);
     ip_status st = IP_OK;
     for (unsigned t = 0; t < threads; t++) {
-        w[t] = (full_worker){.cache = cache, .iso = iso, .level = level, .next = &next};
+        w[t] = (full_worker){
+            .cache = cache, .iso = iso, .level = level, .clip = {clip, clip_count}, .next = &next};
         ip_mesh_init(&w[t].mesh);
         w[t].mesh.with_cells = mesh->with_cells;
         if (ip__sampler_init(&w[t].sampler, cache, level) != IP_OK && st == IP_OK)

@@ -88,7 +88,8 @@ static void enqueue_neighbours(ip__prefetcher *p, uint64_t g)
     for (unsigned i = 0; i < count; i++) {
         float range[2];
         ip_store_brick_range(p->store, neighbours[i], range);
-        if (ip__range_active(range[0], range[1], p->view.iso))
+        if (ip__range_active(range[0], range[1], p->view.iso) &&
+            ip__clip_keeps_brick(&p->view.clip, p->layout, neighbours[i]))
             enqueue(p, neighbours[i]);
     }
 }
@@ -101,8 +102,8 @@ static unsigned ray_bricks(ip__prefetcher *p, uint32_t x, uint32_t y, uint64_t *
     unsigned n = 0;
     ip_camera_pixel_ray(&v->basis, &v->camera, x + 0.5, y + 0.5, dir);
     for (uint32_t k = 0; k < v->levels_used && n < IP__PREFETCH_RAY_BRICKS; k++)
-        n += ip__seed_ray_bricks(p->store, k, v->iso, v->camera.eye, dir, p->lod[k], p->lod[k + 1],
-                                 out + n, IP__PREFETCH_RAY_BRICKS - n);
+        n += ip__seed_ray_bricks(p->store, k, v->iso, &v->clip, v->camera.eye, dir, p->lod[k],
+                                 p->lod[k + 1], out + n, IP__PREFETCH_RAY_BRICKS - n);
     return n;
 }
 

@@ -34,6 +34,7 @@
 #include "isoprop/cache.h"
 #include "isoprop/camera.h"
 #include "isoprop/layout.h"
+#include "clip.h"
 #include "ray_order.h"
 
 #define IP__PREFETCH_AHEAD 4096                /* ray order positions ahead of the workers */
@@ -54,6 +55,7 @@ typedef struct ip__prefetch_view {
     uint64_t order_cells;
     const atomic_uint_fast64_t *claimed; /* the first position no worker has claimed */
     const atomic_int *cancel;            /* the engine's cancel flag */
+    ip_clip clip; /* the engine's planes: bricks wholly beyond one are not read ahead */
 } ip__prefetch_view;
 
 /* Starts the reader thread (signals blocked), idle until ip__prefetcher_resume(). *out is the

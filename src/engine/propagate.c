@@ -29,6 +29,7 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     p->cutoff_versine = 1.0 - cos(options->cutoff_degrees * DEG);
     p->cos_foldback = cos(options->foldback_degrees * DEG);
     p->sin_foldback = sin(options->foldback_degrees * DEG);
+    p->clip = (ip_clip){options->clip, options->clip_count};
     p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
     p->near_distance = near_distance;
     p->far_distance = far_distance;
@@ -145,6 +146,19 @@ static int hidden(const ip_propagator *p, const uint32_t cell[3], double pixels)
     return ip__coverage_hides(p->coverage, lo, hi);
 }
 
+/* 1 unless the clipping planes drop `cell`. */
+static int cell_kept(const ip_propagator *p, const uint32_t cell[3])
+{
+    if (p->clip.count == 0)
+        return 1;
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = p->sampler->world[a][cell[a]];
+        hi[a] = p->sampler->world[a][cell[a] + 1];
+    }
+    return ip__clip_keeps_box(&p->clip, lo, hi);
+}
+
 static ip_status grow_queue(ip_propagator *p, uint64_t head, uint64_t tail)
 {
     /* keep the live part [head, tail) and move it to the front */
@@ -205,7 +219,7 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
             if (!inside)
                 continue;
             uint32_t n3[3] = {(uint32_t)c[0], (uint32_t)c[1], (uint32_t)c[2]};
-            if (ip__visited_test(p->visited, p->sampler->level, n3))
+            if (ip__visited_test(p->visited, p->sampler->level, n3) || !cell_kept(p, n3))
                 continue;
             cell_centre(p->sampler, n3, centre, &diagonal);
             double a = versine_to(eye, dir, centre);

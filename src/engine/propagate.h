@@ -6,6 +6,7 @@
 #include "isoprop/camera.h"
 #include "isoprop/engine.h"
 #include "isoprop/mesh.h"
+#include "clip.h"
 #include "coverage.h"
 #include "sampler.h"
 #include "visited.h"
@@ -28,11 +29,12 @@ typedef struct ip_propagator {
     double pixel_scale;                 /* pixels per unit of (size / depth) */
     double near_distance, far_distance; /* the level's distance band from the eye */
     ip_coverage *coverage;              /* occlusion: shared by the workers; NULL when off */
+    ip_clip clip;                       /* the options' planes: dropped cells are not entered */
     ip_queued_cell *queue;
     uint64_t queue_capacity;
 } ip_propagator;
 
-/* Propagation within one level: cells whose centre lies outside the distance band
+/* Propagation within one level, into the cells the options' clipping planes keep: cells whose centre lies outside the distance band
  * [near_distance, far_distance) from the eye belong to another level and stop it (the paper's
  * resolution boundary). With `coverage` (NULL: off), the triangles it extracts are recorded
  * there, and a neighbour that recorded surface already hides is deferred: neither queued nor

@@ -197,7 +197,9 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
         }
         float values[8];
         unsigned mc = 0;
-        if (group_active) {
+        uint32_t c1[3] = {c[0] + 1, c[1] + 1, c[2] + 1};
+        if (group_active &&
+            (s->clip.count == 0 || ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))) {
             ip__cell_values(brick, s->layout->type, corners, c, values);
             mc = ip__mc_case(values, s->iso);
             s->cells_read++;
@@ -253,7 +255,9 @@ static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], dou
                 last[k] = origin[k] + extent[k] - 1; /* one past the brick's last cell */
                 hi[k] = lo[k] + se < last[k] ? lo[k] + se : last[k];
             }
-            int found = walk_cells(s, r, lo, hi, enter_t, exit_t);
+            int found = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi)
+                            ? walk_cells(s, r, lo, hi, enter_t, exit_t)
+                            : 0;
             if (found)
                 return found;
         }
@@ -278,6 +282,21 @@ static void node_box(const ip_seeder *s, uint32_t depth, const uint32_t node[3],
         lo[k] = (double)a;
         hi[k] = (double)(b < cells ? b : cells);
     }
+}
+
+/* 1 unless the clipping planes drop every cell of node `node` at `depth`. */
+static int node_kept(const ip_seeder *s, uint32_t depth, const uint32_t node[3])
+{
+    if (s->clip.count == 0)
+        return 1;
+    double lo[3], hi[3];
+    node_box(s, depth, node, lo, hi);
+    uint32_t first[3], last[3];
+    for (int k = 0; k < 3; k++) {
+        first[k] = (uint32_t)lo[k];
+        last[k] = (uint32_t)hi[k];
+    }
+    return ip__clip_keeps_samples(&s->clip, s->layout, s->level, first, last);
 }
 
 static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uint32_t node[3],
@@ -314,7 +333,7 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
         if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
             continue;
         uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
-        if (!active(&ranges[2 * i], s->iso))
+        if (!active(&ranges[2 * i], s->iso) || !node_kept(s, depth - 1, ch))
             continue;
         double a = t0, b = t1;
         int missed = 0;
@@ -408,9 +427,9 @@ static int brick_crossed_active(const ip_store *store, uint32_t level, float iso
     }
 }
 
-unsigned ip__seed_ray_bricks(const ip_store *store, uint32_t level, float iso, const double eye[3],
-                             const double dir[3], double t_min, double t_max, uint64_t *bricks,
-                             unsigned max)
+unsigned ip__seed_ray_bricks(const ip_store *store, uint32_t level, float iso,
+                             const ip_clip *planes, const double eye[3], const double dir[3],
+                             double t_min, double t_max, uint64_t *bricks, unsigned max)
 {
     const ip_layout *l = ip_store_layout(store);
     const ip_level_layout *lv = &l->levels[level];
@@ -433,7 +452,7 @@ unsigned ip__seed_ray_bricks(const ip_store *store, uint32_t level, float iso, c
         uint64_t g = ip_brick_global_index(l, level, b);
         float range[2];
         ip_store_brick_range(store, g, range);
-        if (active(range, iso) &&
+        if (active(range, iso) && ip__clip_keeps_brick(planes, l, g) &&
             brick_crossed_active(store, level, iso, &r, g, b, enter_t, exit_t)) {
             bricks[count++] = g;
             if (count == max)

@@ -3,6 +3,7 @@
 #define ISOPROP_SEED_H
 
 #include "isoprop/store.h"
+#include "clip.h"
 #include "sampler.h"
 
 /* Octree depths above the bricks: at most 30, as a level has fewer than 2^31 / 2 bricks along
@@ -28,6 +29,7 @@ typedef struct ip_seeder {
     uint32_t grid[IP_SEED_MAX_DEPTH + 1][3];
     const float *ranges[IP_SEED_MAX_DEPTH + 1];
     uint64_t first_brick; /* global index of the level's brick (0, 0, 0) */
+    ip_clip clip; /* nodes and cells wholly beyond a plane are passed over (none after init) */
 } ip_seeder;
 
 /* A ray whose pixel centre lies within this distance of a triangle's projected edge extracts
@@ -52,11 +54,12 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
                   double t_max, uint32_t cells[][3], unsigned *count, int *seed_index);
 
 /* The bricks of pyramid level `level` that the ray eye + t * dir (world units, t_min <= t <=
- * t_max) would seed in, front to back, up to `max` of them: those whose range holds `iso` and
- * where the ray crosses a sub-block whose range holds it. From the summaries alone (no brick
- * is read); for reading bricks ahead of the rays. @return how many were written to bricks. */
-unsigned ip__seed_ray_bricks(const ip_store *store, uint32_t level, float iso, const double eye[3],
-                             const double dir[3], double t_min, double t_max, uint64_t *bricks,
-                             unsigned max);
+ * t_max) would seed in, front to back, up to `max` of them: those whose range holds `iso`, that
+ * `planes` keep, and where the ray crosses a sub-block whose range holds it. From the summaries
+ * alone (no brick is read); for reading bricks ahead of the rays. @return how many were
+ * written to bricks. */
+unsigned ip__seed_ray_bricks(const ip_store *store, uint32_t level, float iso,
+                             const ip_clip *planes, const double eye[3], const double dir[3],
+                             double t_min, double t_max, uint64_t *bricks, unsigned max);
 
 #endif

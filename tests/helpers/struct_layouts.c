@@ -148,6 +148,11 @@ static void engine(void)
     FIELD(ip_engine_options, cell_ids);
     FIELD(ip_engine_options, occlusion);
     FIELD(ip_engine_options, prefetch);
+    FIELD(ip_engine_options, clip_count);
+    FIELD(ip_engine_options, clip);
+    SIZE(ip_clip_plane);
+    FIELD(ip_clip_plane, normal);
+    FIELD(ip_clip_plane, offset);
     SIZE(ip_engine_counts);
     FIELD(ip_engine_counts, rays);
     FIELD(ip_engine_counts, seeds);

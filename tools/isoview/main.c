@@ -152,8 +152,9 @@ static int extract_full(viewer *v)
     ip_mesh_clear(&v->full_mesh);
     memset(&v->full_counts, 0, sizeof v->full_counts);
     double start = ip_now_seconds();
-    if (ip_extract_full(v->cache, (float)v->iso, 0, v->o.common.threads, &v->full_mesh,
-                        &v->full_counts, &v->err) != IP_OK)
+    if (ip_extract_full_clipped(v->cache, (float)v->iso, 0, v->o.common.threads, v->o.common.clip,
+                                v->o.common.clip_count, &v->full_mesh, &v->full_counts,
+                                &v->err) != IP_OK)
         return -1;
     v->full_wall = ip_now_seconds() - start;
     v->pass_render = 0;
