@@ -42,6 +42,30 @@ check "no space: identity" \
     grep -qF '"origin": [0, 0, 0], "directions": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "space": null' \
     "$work/.out"
 
+# the mesh in physical space: the plain file's vertices moved by origin + D * p
+for name in turned plain; do
+    run_capture "$bin/isorender" "$name.ibv" --iso 128 --full --threads 1 --size 64x48 \
+        -o "$name.png" --mesh "$name.ply" --no-weld
+    check "isorender --full --mesh on $name ($err)" test "$rc" = 0
+    "$bin/tests/ply_triangles" "$name.ply" >"$name.txt"
+done
+check "a surface was extracted" test -s plain.txt
+check "the same image either way" cmp -s turned.png plain.png
+check "turned vertices = (10 - y, -20 + x, 30.5 + z) of the plain ones" python3 -c '
+import sys
+a = [l.split() for l in open("plain.txt")]
+b = [l.split() for l in open("turned.txt")]
+assert len(a) == len(b) > 0, (len(a), len(b))
+worst = 0.0
+for ta, tb in zip(a, b):
+    for i in range(0, 9, 3):
+        x, y, z = (float.fromhex(v) for v in ta[i:i + 3])
+        want = (10 - y, -20 + x, 30.5 + z)
+        got = [float.fromhex(v) for v in tb[i:i + 3]]
+        worst = max(worst, max(abs(g - w) for g, w in zip(got, want)))
+assert worst < 1e-4, worst
+'
+
 # a sheared grid has no orthonormal frame: the identity, and the vectors' lengths as spacing
 sed 's/^space directions:.*/space directions: (0.5,0.5,0) (0,0.5,0) (0,0,2)/' turned.nhdr >sheared.nhdr
 run_capture "$bin/isobrick" sheared.nhdr -o sheared.ibv --brick-size 8 --threads 2
