@@ -216,6 +216,12 @@ static void make_image(image *m)
     ip_error err;
     REQUIRE(ip__layout_init(&m->layout, dims, IP_UINT16, spacing, 4, 2, &err) == IP_OK);
     ip_layout *l = &m->layout;
+    /* x and y turned 30 degrees about z, z reversed: a frame of the other handedness */
+    const ip_orientation turned = {
+        {10, -20, 5.5},
+        {{0.8660254037844387, 0.5, 0}, {-0.5, 0.8660254037844387, 0}, {0, 0, -1}},
+        IP_SPACE_LPS};
+    l->orientation = turned;
     /* brick 0 is raw (its samples all 5 but for one 9), every other brick constant 5 */
     uint32_t b0[3] = {0, 0, 0}, origin[3], extent[3];
     ip_brick_extent(l, 0, b0, origin, extent);
@@ -278,7 +284,7 @@ static void test_header_round_trip(void)
     const unsigned char *h = m.bytes;
     /* the named offsets hold the fields of docs/format.md */
     CHECK(memcmp(h + IP_HDR_MAGIC, "\x89IBV\r\n\x1a\n", 8) == 0);
-    CHECK(ip__load_u32le(h + IP_HDR_VERSION) == 1);
+    CHECK(ip__load_u32le(h + IP_HDR_VERSION) == 2);
     CHECK(ip__load_u32le(h + IP_HDR_HEADER_SIZE) == 256);
     CHECK(ip__load_u32le(h + IP_HDR_DIMS) == 13 && ip__load_u32le(h + IP_HDR_DIMS + 4) == 9 &&
           ip__load_u32le(h + IP_HDR_DIMS + 8) == 6);
@@ -299,6 +305,12 @@ static void test_header_round_trip(void)
     CHECK(ip__load_u64le(h + IP_HDR_SUMMARY_OFFSET) == l->summary_offset);
     CHECK(ip__load_u64le(h + IP_HDR_SUMMARY_SIZE) == l->summary_size);
     CHECK(ip__load_u64le(h + IP_HDR_FILE_SIZE) == m.size);
+    CHECK(ip__load_f64le(h + IP_HDR_ORIGIN) == 10 && ip__load_f64le(h + IP_HDR_ORIGIN + 8) == -20 &&
+          ip__load_f64le(h + IP_HDR_ORIGIN + 16) == 5.5);
+    CHECK(ip__load_f64le(h + IP_HDR_DIRECTIONS + 8) == 0.5);      /* x direction, y component */
+    CHECK(ip__load_f64le(h + IP_HDR_DIRECTIONS + 3 * 8) == -0.5); /* y direction, x component */
+    CHECK(ip__load_f64le(h + IP_HDR_DIRECTIONS + 8 * 8) == -1);   /* z direction, z component */
+    CHECK(ip__load_u32le(h + IP_HDR_SPACE) == IP_SPACE_LPS);
     for (int i = IP_HDR_RESERVED; i < IP_HDR_CHECKSUM; i++)
         CHECK(h[i] == 0);
     CHECK(ip__load_u64le(h + IP_HDR_CHECKSUM) == ip__format_checksum(h, 248));
@@ -308,6 +320,7 @@ static void test_header_round_trip(void)
     REQUIRE(parse(&m, &parsed, &err) == IP_OK);
     CHECK(memcmp(parsed.dims, l->dims, sizeof l->dims) == 0);
     CHECK(memcmp(parsed.spacing, l->spacing, sizeof l->spacing) == 0);
+    CHECK(memcmp(&parsed.orientation, &l->orientation, sizeof l->orientation) == 0);
     CHECK(parsed.type == l->type && parsed.brick_edge == 4 && parsed.subblock_edge == 2);
     CHECK(parsed.level_count == l->level_count && parsed.brick_count == l->brick_count &&
           parsed.node_count == l->node_count);
@@ -393,6 +406,48 @@ static void flip_byte(image *m, uint64_t offset)
     m->bytes[offset] ^= 0x40;
 }
 
+/* Writes v as the header f64 at `offset`. */
+static void set_f64_at(image *m, uint64_t offset, double v)
+{
+    ip__store_f64le(m->bytes + offset, v);
+}
+
+static void set_origin_y(image *m, uint64_t bits)
+{
+    double v;
+    memcpy(&v, &bits, 8);
+    set_f64_at(m, IP_HDR_ORIGIN + 8, v);
+}
+
+/* the z direction's z component (-1 in make_image) */
+static void set_direction_zz(image *m, uint64_t bits)
+{
+    double v;
+    memcpy(&v, &bits, 8);
+    set_f64_at(m, IP_HDR_DIRECTIONS + 8 * 8, v);
+}
+
+/* the y direction made the x direction: unit length, not perpendicular */
+static void copy_x_direction_to_y(image *m, uint64_t unused)
+{
+    (void)unused;
+    memcpy(m->bytes + IP_HDR_DIRECTIONS + 24, m->bytes + IP_HDR_DIRECTIONS, 24);
+}
+
+/* The header as format version 1 wrote it: version 1, bytes 144-247 zero. */
+static void make_version_1(image *m, uint64_t unused)
+{
+    (void)unused;
+    ip__store_u32le(m->bytes + IP_HDR_VERSION, 1);
+    memset(m->bytes + IP_HDR_RESERVED_V1, 0, IP_HDR_CHECKSUM - IP_HDR_RESERVED_V1);
+}
+
+static void make_version_1_poke(image *m, uint64_t offset)
+{
+    make_version_1(m, 0);
+    m->bytes[offset] = 1;
+}
+
 static void set_spacing_y(image *m, uint64_t bits)
 {
     double v;
@@ -460,7 +515,7 @@ static void test_header_refusals(void)
 
     for (uint64_t i = 0; i < IP_HDR_MAGIC_SIZE; i++)
         refused(&m, flip_byte, IP_HDR_MAGIC + i, 1, IP_ERR_FORMAT, "bad magic");
-    refused(&m, set_u32, at(IP_HDR_VERSION, 2), 1, IP_ERR_UNSUPPORTED, "format version 2");
+    refused(&m, set_u32, at(IP_HDR_VERSION, 3), 1, IP_ERR_UNSUPPORTED, "format version 3");
     refused(&m, set_u32, at(IP_HDR_VERSION, 0), 1, IP_ERR_UNSUPPORTED, "format version 0");
     refused(&m, set_u32, at(IP_HDR_HEADER_SIZE, 255), 1, IP_ERR_FORMAT, "header size 255");
     /* any header byte changed without resealing: the header checksum */
@@ -483,6 +538,22 @@ static void test_header_refusals(void)
         char text[64];
         snprintf(text, sizeof text, "reserved header byte %llu is not zero", (unsigned long long)i);
         refused(&m, flip_byte, i, 1, IP_ERR_FORMAT, text);
+    }
+    /* version 2's orientation: finite, orthonormal, a known space */
+    refused(&m, set_origin_y, double_bits(NAN), 1, IP_ERR_FORMAT, "origin nan along y");
+    refused(&m, set_origin_y, double_bits(INFINITY), 1, IP_ERR_FORMAT, "along y is not finite");
+    refused(&m, set_direction_zz, double_bits(NAN), 1, IP_ERR_FORMAT, "z direction is not finite");
+    refused(&m, set_direction_zz, double_bits(-1.01), 1, IP_ERR_FORMAT,
+            "z direction is not a unit vector");
+    refused(&m, set_direction_zz, double_bits(0), 1, IP_ERR_FORMAT, "not a unit vector");
+    refused(&m, copy_x_direction_to_y, 0, 1, IP_ERR_FORMAT,
+            "x and y directions are not perpendicular");
+    refused(&m, set_u32, at(IP_HDR_SPACE, IP_SPACE_LPS + 1), 1, IP_ERR_FORMAT, "unknown space 4");
+    /* version 1: the same bytes are reserved, and must be zero */
+    for (uint64_t i = IP_HDR_RESERVED_V1; i < IP_HDR_CHECKSUM; i++) {
+        char text[64];
+        snprintf(text, sizeof text, "reserved header byte %llu is not zero", (unsigned long long)i);
+        refused(&m, make_version_1_poke, i, 1, IP_ERR_FORMAT, text);
     }
     refused(&m, set_u32, at(IP_HDR_LEVEL_COUNT, m.layout.level_count + 1), 1, IP_ERR_FORMAT,
             "counts disagree with the dimensions");
@@ -587,6 +658,23 @@ static uint64_t f32_bits(float v)
     return bits;
 }
 
+/* A version 1 header (no orientation) still opens, as the identity with zero origin. */
+static void test_version_1(void)
+{
+    image m;
+    make_image(&m);
+    make_version_1(&m, 0);
+    reseal(&m);
+    ip_layout l, identity;
+    ip_error err;
+    REQUIRE(parse(&m, &l, &err) == IP_OK);
+    ip_orientation_identity(&identity.orientation);
+    CHECK(memcmp(&l.orientation, &identity.orientation, sizeof l.orientation) == 0);
+    CHECK(ip_orientation_is_identity(&l.orientation) && l.orientation.space == IP_SPACE_UNKNOWN);
+    CHECK(l.dims[0] == 13 && l.spacing[1] == 0.25);
+    free(m.bytes);
+}
+
 static void test_summary_refusals(void)
 {
     image m;
@@ -689,6 +777,7 @@ int main(void)
     test_header_round_trip();
     test_entry_round_trip();
     test_header_refusals();
+    test_version_1();
     test_summary_refusals();
     test_truncations();
     return test_summary("test_format");

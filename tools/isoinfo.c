@@ -63,6 +63,33 @@ static void gather_facts(const ip_store *s, file_facts *f)
     f->raw_bytes = (uint64_t)l->dims[0] * l->dims[1] * l->dims[2] * ip_type_size(l->type);
 }
 
+/* Origin, directions and space, as three lines of the text report. */
+static void print_orientation_text(const ip_orientation *o)
+{
+    const char *space = ip_space_name(o->space);
+    printf("  origin        %g, %g, %g (%s space)\n", o->origin[0], o->origin[1], o->origin[2],
+           space[0] ? space : "unnamed");
+    printf("  directions    x (%g, %g, %g), y (%g, %g, %g), z (%g, %g, %g)\n", o->directions[0][0],
+           o->directions[0][1], o->directions[0][2], o->directions[1][0], o->directions[1][1],
+           o->directions[1][2], o->directions[2][0], o->directions[2][1], o->directions[2][2]);
+}
+
+/* "origin": [x, y, z], "directions": [[x axis], [y axis], [z axis]], "space": "LPS" or null */
+static void print_orientation_json(const ip_orientation *o)
+{
+    const char *space = ip_space_name(o->space);
+    printf(", \"origin\": [%.17g, %.17g, %.17g]", o->origin[0], o->origin[1], o->origin[2]);
+    printf(", \"directions\": [");
+    for (int a = 0; a < 3; a++)
+        printf("%s[%.17g, %.17g, %.17g]", a ? ", " : "", o->directions[a][0], o->directions[a][1],
+               o->directions[a][2]);
+    printf("]");
+    if (space[0])
+        printf(", \"space\": \"%s\"", space);
+    else
+        printf(", \"space\": null");
+}
+
 static void print_text(const ip_store *s, const file_facts *f)
 {
     const ip_layout *l = ip_store_layout(s);
@@ -72,6 +99,7 @@ static void print_text(const ip_store *s, const file_facts *f)
     printf("  dims          %u x %u x %u samples, %s\n", l->dims[0], l->dims[1], l->dims[2],
            ip_type_name(l->type));
     printf("  spacing       %g, %g, %g\n", l->spacing[0], l->spacing[1], l->spacing[2]);
+    print_orientation_text(&l->orientation);
     printf("  value range   %g .. %g\n", (double)l->value_min, (double)l->value_max);
     printf("  bricks        %u^3 cells, sub-blocks %u^3 cells\n", l->brick_edge, l->subblock_edge);
     printf("  brick count   %llu: %llu constant, %llu compressed, %llu raw\n",
@@ -104,6 +132,7 @@ static void print_json(const ip_store *s, const file_facts *f)
     printf(", \"dims\": [%u, %u, %u]", l->dims[0], l->dims[1], l->dims[2]);
     printf(", \"type\": \"%s\"", ip_type_name(l->type));
     printf(", \"spacing\": [%.17g, %.17g, %.17g]", l->spacing[0], l->spacing[1], l->spacing[2]);
+    print_orientation_json(&l->orientation);
     printf(", \"brick_size\": %u, \"subblock_size\": %u", l->brick_edge, l->subblock_edge);
     printf(", \"levels\": %u", l->level_count);
     printf(", \"bricks\": %llu, \"bricks_constant\": %llu, \"bricks_compressed\": %llu, "

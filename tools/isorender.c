@@ -837,23 +837,23 @@ static void print_summary(const run *r)
                r->o.smooth ? ", smoothed" : "");
 }
 
-/* Writes the mesh file: welded (shared vertices) unless --no-weld or STL (which is welded for
- * --smooth, then written with its corners repeated). A progressive run's mesh is only what
- * the view needed, which a note says. */
-static int write_mesh(run *r, ip_error *err)
+/* Writes `mesh` to the mesh file: welded (shared vertices) unless --no-weld or STL (which is
+ * welded for --smooth, then written with its corners repeated). A progressive run's mesh is
+ * only what the view needed, which a note says. */
+static int write_mesh_as(run *r, const ip_mesh *mesh, ip_error *err)
 {
     const char *format = ip_mesh_format_of(r->o.mesh);
     ip_status st;
     int stl = strcmp(format, "STL") == 0;
     if (r->o.no_weld || (stl && !r->o.smooth)) {
-        st = ip_mesh_write(r->mesh, r->o.mesh, r->o.common.force, err);
-        r->mesh_vertices = 3 * r->mesh->triangle_count;
+        st = ip_mesh_write(mesh, r->o.mesh, r->o.common.force, err);
+        r->mesh_vertices = 3 * mesh->triangle_count;
     } else {
         ip_indexed_mesh welded;
-        st = ip_mesh_weld(r->mesh, &welded);
+        st = ip_mesh_weld(mesh, &welded);
         if (st != IP_OK) {
             fprintf(stderr, "isorender: %s: cannot weld %llu triangles (%s)\n", r->o.mesh,
-                    (unsigned long long)r->mesh->triangle_count, ip_status_message(st));
+                    (unsigned long long)mesh->triangle_count, ip_status_message(st));
             return 1;
         }
         if (smooth_mesh(r, &welded, err) != 0) {
@@ -873,6 +873,26 @@ static int write_mesh(run *r, ip_error *err)
                 "behind); --full --mesh writes the whole, closed surface\n",
                 r->o.mesh);
     return 0;
+}
+
+/* The mesh goes out in the volume's physical space (origin, directions: docs/format.md); a
+ * copy is moved there, unless the file's space is the engine's own. */
+static int write_mesh(run *r, ip_error *err)
+{
+    const ip_orientation *space = &ip_store_layout(r->store)->orientation;
+    if (ip_orientation_is_identity(space))
+        return write_mesh_as(r, r->mesh, err);
+    ip_mesh physical;
+    ip_mesh_init(&physical);
+    if (ip_mesh_append_mesh(&physical, r->mesh, 0, r->mesh->triangle_count) != IP_OK) {
+        fprintf(stderr, "isorender: %s: out of memory\n", r->o.mesh);
+        ip_mesh_free(&physical);
+        return 1;
+    }
+    ip_mesh_to_physical(&physical, space);
+    int rc = write_mesh_as(r, &physical, err);
+    ip_mesh_free(&physical);
+    return rc;
 }
 
 /* Frees the decoded bricks once extraction is over: the image needs only the mesh, and

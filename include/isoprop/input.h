@@ -12,6 +12,7 @@
 
 #include <stdint.h>
 
+#include "isoprop/orientation.h"
 #include "isoprop/status.h"
 #include "isoprop/volume.h"
 
@@ -44,6 +45,11 @@ typedef struct ip_input_desc {
                              reported, never applied: samples keep their stored values */
     double rescale_slope;
     double rescale_intercept;
+    ip_orientation orientation; /* origin, axis directions and space in the file's physical
+                                   space (NRRD space origin/directions/space, MetaImage
+                                   Offset/TransformMatrix/AnatomicalOrientation, NIfTI sform or
+                                   qform, DICOM image position/orientation); identity when the
+                                   file says nothing or its axes are not orthonormal */
 } ip_input_desc;
 
 /* Values given on the command line; each applies only where its has_ flag is set, and wins

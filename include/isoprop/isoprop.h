@@ -20,6 +20,7 @@
 #include "isoprop/version.h"
 #include "isoprop/system.h"
 #include "isoprop/volume.h"
+#include "isoprop/orientation.h"
 #include "isoprop/input.h"
 #include "isoprop/output.h"
 #include "isoprop/layout.h"

@@ -12,6 +12,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "isoprop/orientation.h"
 #include "isoprop/status.h"
 #include "isoprop/volume.h"
 
@@ -19,7 +20,7 @@
 extern "C" {
 #endif
 
-#define IP_FORMAT_VERSION 1u
+#define IP_FORMAT_VERSION 2u
 #define IP_HEADER_SIZE 256u
 #define IP_MAGIC "\x89IBV\r\n\x1a\n" /* 8 bytes */
 #define IP_MAX_LEVELS 32
@@ -65,8 +66,10 @@ typedef struct ip_layout {
     uint32_t dims[3];
     ip_type type;
     double spacing[3];
-    uint32_t brick_edge;    /* B: cells per brick edge, a power of two in [2, 256] */
-    uint32_t subblock_edge; /* s: cells per sub-block edge, a power of two dividing B */
+    ip_orientation orientation; /* origin, directions and space of the volume in its source
+                                   file's physical space (format version 2; identity for 1) */
+    uint32_t brick_edge;        /* B: cells per brick edge, a power of two in [2, 256] */
+    uint32_t subblock_edge;     /* s: cells per sub-block edge, a power of two dividing B */
     uint32_t level_count;
     float value_min, value_max;
     uint64_t brick_count; /* all levels */

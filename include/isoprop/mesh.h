@@ -24,6 +24,7 @@
 
 #include <stdint.h>
 
+#include "isoprop/orientation.h"
 #include "isoprop/status.h"
 
 #ifdef __cplusplus
@@ -99,6 +100,12 @@ IP_API ip_status ip_mesh_append_float_normals(ip_mesh *mesh, const float *positi
  *  IP_ERR_NOMEM. */
 IP_API ip_status ip_mesh_append_mesh(ip_mesh *mesh, const ip_mesh *from, uint64_t first,
                                      uint64_t count);
+
+/*! ip_mesh_to_physical() : moves the mesh from world coordinates (sample index x spacing, as
+ *  the engine makes it) into its volume's physical space: each position p becomes
+ *  origin + D * p and each normal D * n (D: the directions as columns; docs/format.md). Done
+ *  in double precision, stored back as float32 and packed normals. Changes `mesh` in place. */
+IP_API void ip_mesh_to_physical(ip_mesh *mesh, const ip_orientation *orientation);
 
 /*! ip_mesh_write_ply() : writes the mesh as binary little-endian PLY (float x,y,z,nx,ny,nz per
  *  vertex, 3 vertices per triangle, faces as uchar-counted int lists), atomically; only a

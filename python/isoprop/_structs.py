@@ -17,13 +17,18 @@ class Error(ctypes.Structure):
     _fields_ = [("code", c_int), ("message", c_char * 1024)]
 
 
+class Orientation(ctypes.Structure):
+    """ip_orientation (orientation.h)"""
+    _fields_ = [("origin", c_double * 3), ("directions", (c_double * 3) * 3), ("space", c_int)]
+
+
 class InputDesc(ctypes.Structure):
     """ip_input_desc (input.h)"""
     _fields_ = [("path", c_char * PATH_MAX), ("data_path", c_char * PATH_MAX),
                 ("data_offset", c_uint64), ("dims", c_uint32 * 3), ("type", c_int),
                 ("big_endian", c_int), ("spacing", c_double * 3), ("encoding", c_int),
                 ("stream_skip", c_uint64), ("has_rescale", c_int), ("rescale_slope", c_double),
-                ("rescale_intercept", c_double)]
+                ("rescale_intercept", c_double), ("orientation", Orientation)]
 
 
 class InputOverrides(ctypes.Structure):
@@ -64,7 +69,7 @@ class LevelLayout(ctypes.Structure):
 class Layout(ctypes.Structure):
     """ip_layout (layout.h)"""
     _fields_ = [("dims", c_uint32 * 3), ("type", c_int), ("spacing", c_double * 3),
-                ("brick_edge", c_uint32), ("subblock_edge", c_uint32), ("level_count", c_uint32),
+                ("orientation", Orientation), ("brick_edge", c_uint32), ("subblock_edge", c_uint32), ("level_count", c_uint32),
                 ("value_min", c_float), ("value_max", c_float), ("brick_count", c_uint64),
                 ("node_count", c_uint64), ("data_offset", c_uint64), ("data_size", c_uint64),
                 ("summary_offset", c_uint64), ("summary_size", c_uint64),
@@ -131,6 +136,7 @@ class Mesh(ctypes.Structure):
 # Every mirror, by its C name: what the layout test checks.
 MIRRORS = {
     "ip_error": Error,
+    "ip_orientation": Orientation,
     "ip_input_desc": InputDesc,
     "ip_input_overrides": InputOverrides,
     "ip_bricker_options": BrickerOptions,

@@ -507,6 +507,17 @@ static ip_status alloc_scratch(bricker *b, ip_error *err)
     return IP_OK;
 }
 
+/* All-zero directions: a description filled by hand without an orientation, taken as the
+ * identity (as in the files of format version 1). */
+static int orientation_unset(const ip_orientation *o)
+{
+    for (int a = 0; a < 3; a++)
+        for (int c = 0; c < 3; c++)
+            if (o->directions[a][c] != 0.0)
+                return 0;
+    return 1;
+}
+
 static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *out_path,
                               const ip_bricker_options *o, ip_error *err)
 {
@@ -519,6 +530,8 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
                                    o->subblock_edge, &why);
     if (st != IP_OK)
         return ip__fail(err, st, "%s: %s", in->path, why.message);
+    if (!orientation_unset(&in->orientation))
+        b->layout.orientation = in->orientation;
     b->sample_size = ip_type_size(in->type);
     b->threads = thread_count(o);
     uint64_t need = memory_for(&b->layout, b->threads);
@@ -868,6 +881,8 @@ static void count_bricks(bricker *b)
 static ip_status check_request(const ip_input_desc *in, const char *out_path, ip_error *err)
 {
     ip_status st = ip_spacing_check(in->spacing, in->path, err);
+    if (st == IP_OK && !orientation_unset(&in->orientation))
+        st = ip_orientation_check(&in->orientation, in->path, err);
     if (st == IP_OK)
         st = ip_output_not_input(out_path, in->path, err);
     if (st == IP_OK && strcmp(in->data_path, in->path) != 0)

@@ -76,6 +76,7 @@ ip_status ip__layout_init(ip_layout *layout, const uint32_t dims[3], ip_type typ
                         subblock_edge, brick_edge);
     memcpy(layout->dims, dims, sizeof layout->dims);
     memcpy(layout->spacing, spacing, sizeof layout->spacing);
+    ip_orientation_identity(&layout->orientation);
     layout->type = type;
     layout->brick_edge = brick_edge;
     layout->subblock_edge = subblock_edge;
@@ -274,6 +275,13 @@ void ip__format_header_encode(const ip_layout *layout, unsigned char out[IP_HEAD
     ip__store_u64le(out + IP_HDR_SUMMARY_SIZE, layout->summary_size);
     ip__store_u64le(out + IP_HDR_SUMMARY_CHECKSUM, layout->summary_checksum);
     ip__store_u64le(out + IP_HDR_FILE_SIZE, layout->file_size);
+    const ip_orientation *o = &layout->orientation;
+    for (int a = 0; a < 3; a++) {
+        ip__store_f64le(out + IP_HDR_ORIGIN + 8 * a, o->origin[a]);
+        for (int c = 0; c < 3; c++)
+            ip__store_f64le(out + IP_HDR_DIRECTIONS + 8 * (3 * a + c), o->directions[a][c]);
+    }
+    ip__store_u32le(out + IP_HDR_SPACE, (uint32_t)o->space);
     ip__store_u64le(out + IP_HDR_CHECKSUM, ip__format_checksum(out, IP_HDR_CHECKSUM));
 }
 
@@ -320,16 +328,44 @@ void ip__format_entry_decode(const unsigned char in[IP_DIRECTORY_ENTRY_SIZE], ip
 
 /* ---- parsing ---- */
 
+/* Version 2's origin, directions and space; version 1 has none (identity) and its bytes are
+ * reserved. The reserved bytes that remain are zero either way. */
+static ip_status parse_orientation(const unsigned char *h, uint32_t version, const char *name,
+                                   ip_layout *layout, ip_error *err)
+{
+    int reserved_from = version == 1 ? IP_HDR_RESERVED_V1 : IP_HDR_RESERVED;
+    for (int i = reserved_from; i < IP_HDR_CHECKSUM; i++)
+        if (h[i] != 0)
+            return ip__fail(err, IP_ERR_FORMAT, "%s: reserved header byte %d is not zero", name, i);
+    ip_orientation *o = &layout->orientation;
+    ip_orientation_identity(o);
+    if (version == 1)
+        return IP_OK;
+    for (int a = 0; a < 3; a++) {
+        o->origin[a] = ip__load_f64le(h + IP_HDR_ORIGIN + 8 * a);
+        for (int c = 0; c < 3; c++)
+            o->directions[a][c] = ip__load_f64le(h + IP_HDR_DIRECTIONS + 8 * (3 * a + c));
+    }
+    uint32_t space = ip__load_u32le(h + IP_HDR_SPACE);
+    if (space > IP_SPACE_LPS)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: unknown space %u", name, space);
+    o->space = (ip_space)space;
+    ip_error why;
+    if (ip_orientation_check(o, NULL, &why) != IP_OK)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: %s", name, why.message);
+    return IP_OK;
+}
+
 static ip_status parse_header(const unsigned char *h, const char *name, unsigned flags,
                               ip_layout *layout, ip_error *err)
 {
     if (memcmp(h + IP_HDR_MAGIC, IP_MAGIC, IP_HDR_MAGIC_SIZE) != 0)
         return ip__fail(err, IP_ERR_FORMAT, "%s: not a brick file (bad magic)", name);
     uint32_t version = ip__load_u32le(h + IP_HDR_VERSION);
-    if (version != IP_FORMAT_VERSION)
+    if (version < 1 || version > IP_FORMAT_VERSION)
         return ip__fail(err, IP_ERR_UNSUPPORTED,
                         "%s: format version %u is not supported (this "
-                        "build reads version %u)",
+                        "build reads versions 1 to %u)",
                         name, version, IP_FORMAT_VERSION);
     if (ip__load_u32le(h + IP_HDR_HEADER_SIZE) != IP_HEADER_SIZE)
         return ip__fail(err, IP_ERR_FORMAT, "%s: header size %u is not %u", name,
@@ -358,9 +394,8 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
     ip_status st = ip_spacing_check(spacing, name, err);
     if (st != IP_OK)
         return st;
-    for (int i = IP_HDR_RESERVED; i < IP_HDR_CHECKSUM; i++)
-        if (h[i] != 0)
-            return ip__fail(err, IP_ERR_FORMAT, "%s: reserved header byte %d is not zero", name, i);
+    if ((st = parse_orientation(h, version, name, layout, err)) != IP_OK)
+        return st;
     if (ip__load_u32le(h + IP_HDR_LEVEL_COUNT) != layout->level_count ||
         ip__load_u64le(h + IP_HDR_BRICK_COUNT) != layout->brick_count ||
         ip__load_u64le(h + IP_HDR_NODE_COUNT) != layout->node_count)

@@ -35,7 +35,11 @@ enum {
     IP_HDR_SUMMARY_SIZE = 120,     /* u64 */
     IP_HDR_SUMMARY_CHECKSUM = 128, /* u64 */
     IP_HDR_FILE_SIZE = 136,        /* u64 */
-    IP_HDR_RESERVED = 144,         /* zero bytes up to IP_HDR_CHECKSUM */
+    IP_HDR_ORIGIN = 144,           /* f64 x 3 (version 2) */
+    IP_HDR_DIRECTIONS = 168,       /* f64 x 9: x axis direction, then y, then z (version 2) */
+    IP_HDR_SPACE = 240,            /* u32, ip_space (version 2) */
+    IP_HDR_RESERVED = 244,         /* zero bytes up to IP_HDR_CHECKSUM */
+    IP_HDR_RESERVED_V1 = 144,      /* version 1: zero bytes from here up to IP_HDR_CHECKSUM */
     IP_HDR_CHECKSUM = 248          /* u64, XXH64 of bytes [0, IP_HDR_CHECKSUM) */
 };
 
@@ -96,8 +100,12 @@ _Static_assert(IP_HDR_DATA_SIZE + 8 == IP_HDR_SUMMARY_OFFSET, "header: data, sum
 _Static_assert(IP_HDR_SUMMARY_OFFSET + 8 == IP_HDR_SUMMARY_SIZE, "header: summary offset, size");
 _Static_assert(IP_HDR_SUMMARY_SIZE + 8 == IP_HDR_SUMMARY_CHECKSUM, "header: summary checksum");
 _Static_assert(IP_HDR_SUMMARY_CHECKSUM + 8 == IP_HDR_FILE_SIZE, "header: file size");
-_Static_assert(IP_HDR_FILE_SIZE + 8 == IP_HDR_RESERVED, "header: file size, reserved");
-_Static_assert(IP_HDR_RESERVED + 104 == IP_HDR_CHECKSUM, "header: 104 reserved bytes");
+_Static_assert(IP_HDR_FILE_SIZE + 8 == IP_HDR_ORIGIN, "header: file size, origin");
+_Static_assert(IP_HDR_ORIGIN + 3 * 8 == IP_HDR_DIRECTIONS, "header: origin, directions");
+_Static_assert(IP_HDR_DIRECTIONS + 9 * 8 == IP_HDR_SPACE, "header: directions, space");
+_Static_assert(IP_HDR_SPACE + 4 == IP_HDR_RESERVED, "header: space, reserved");
+_Static_assert(IP_HDR_RESERVED + 4 == IP_HDR_CHECKSUM, "header: 4 reserved bytes");
+_Static_assert(IP_HDR_RESERVED_V1 == IP_HDR_ORIGIN, "header: version 1 reserves from 144");
 _Static_assert(IP_HDR_CHECKSUM + 8 == IP_HEADER_SIZE, "header: the checksum ends it");
 
 _Static_assert(IP_LVL_DIMS + 3 * 4 == IP_LVL_BRICKS, "level entry: dims, bricks");

@@ -201,6 +201,7 @@ static void set_defaults(ip_input_desc *desc, const char *path)
     for (int axis = 0; axis < 3; axis++)
         desc->spacing[axis] = 1.0;
     desc->rescale_slope = 1.0;
+    ip_orientation_identity(&desc->orientation);
 }
 
 static ip_status apply_overrides(const ip_input_overrides *overrides, ip_input_desc *desc,

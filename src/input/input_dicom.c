@@ -485,6 +485,31 @@ static ip_status scan_series(const char *folder, dicom_series *s, double *spacin
 
 /* ---- describing ---- */
 
+/* x along the rows (ImageOrientationPatient's first vector), y along the columns (made
+ * perpendicular to x: the files agree only to ORIENTATION_TOLERANCE), z their cross product,
+ * the way the slices were sorted; the origin is the first slice's ImagePositionPatient. */
+static void fill_orientation(const dicom_slice *first, ip_orientation *o)
+{
+    double *x = o->directions[0], *y = o->directions[1], *z = o->directions[2];
+    ip_orientation_identity(o);
+    memcpy(o->origin, first->position, sizeof o->origin);
+    o->space = IP_SPACE_LPS;
+    memcpy(x, first->orientation, 3 * sizeof *x);
+    memcpy(y, first->orientation + 3, 3 * sizeof *y);
+    double n = sqrt(dot(x, x));
+    for (int c = 0; c < 3; c++)
+        x[c] /= n;
+    double along = dot(x, y);
+    for (int c = 0; c < 3; c++)
+        y[c] -= along * x[c];
+    n = sqrt(dot(y, y)); /* check_orientation keeps it near 1 */
+    for (int c = 0; c < 3; c++)
+        y[c] /= n;
+    z[0] = x[1] * y[2] - x[2] * y[1];
+    z[1] = x[2] * y[0] - x[0] * y[2];
+    z[2] = x[0] * y[1] - x[1] * y[0];
+}
+
 static void fill_desc(const dicom_series *s, double spacing_z, const ip_input_overrides *overrides,
                       ip_input_desc *desc, ip_text_found *found)
 {
@@ -502,6 +527,7 @@ static void fill_desc(const dicom_series *s, double spacing_z, const ip_input_ov
         desc->spacing[1] = first->pixel_spacing[0];
         desc->spacing[2] = spacing_z;
     }
+    fill_orientation(first, &desc->orientation);
     /* the identity says nothing worth reporting */
     desc->has_rescale = first->slope != 1.0 || first->intercept != 0.0;
     desc->rescale_slope = first->slope;

@@ -1,5 +1,6 @@
 /* MetaImage headers (.mhd with a separate data file, .mha or ElementDataFile = LOCAL with the
  * data right after the header): "Key = Value" lines ending with ElementDataFile. */
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,6 +22,10 @@ typedef struct mhd_header {
     double spacing[3];
     int size_count; /* ElementSize: the spacing when ElementSpacing is absent */
     double size[3];
+    int offset_count; /* Offset (or Position, Origin): -1 until the key is seen */
+    double offset[3];
+    int has_matrix;      /* TransformMatrix (or Rotation, Orientation) with 9 numbers */
+    double matrix[3][3]; /* x axis direction, then y, then z */
     int has_msb;
     int msb;
     int compressed;
@@ -98,6 +103,27 @@ static ip_status parse_data_file(void *header, const ip_text_key *key, char *val
     return ip__text_data_path(h->at.path, value, h->data_path, err);
 }
 
+/* Nine numbers: the directions of the x, y and z axes, three each (as ITK writes them). */
+static ip_status parse_matrix(void *header, const ip_text_key *key, char *value, ip_error *err)
+{
+    mhd_header *h = header;
+    const char *p = value;
+    for (int i = 0; i < 9; i++) {
+        char *end;
+        double v = strtod(p, &end);
+        if (end == p || !isfinite(v))
+            return ip__text_bad_value(h, key->name, value, "not 9 numbers", err);
+        h->matrix[i / 3][i % 3] = v;
+        p = end;
+    }
+    while (*p == ' ' || *p == '\t')
+        p++;
+    if (*p != '\0')
+        return ip__text_bad_value(h, key->name, value, "not 9 numbers", err);
+    h->has_matrix = 1;
+    return IP_OK;
+}
+
 /* MetaImage keys are words: KEY(ElementType, ...) names the key "ElementType". */
 #define KEY(name, by, parse)   \
     {                          \
@@ -115,6 +141,12 @@ static const ip_text_key mhd_key_list[] = {
     VALUE(ElementType, BY_TYPE, ip__text_key_type, type, offsetof(mhd_header, has_type)),
     LIST(ElementSpacing, BY_SPACING, ip__text_key_doubles, spacing),
     LIST(ElementSize, BY_SPACING, ip__text_key_doubles, size),
+    VALUE(Offset, BY_NOTHING, ip__text_key_doubles, offset, offsetof(mhd_header, offset_count)),
+    VALUE(Position, BY_NOTHING, ip__text_key_doubles, offset, offsetof(mhd_header, offset_count)),
+    VALUE(Origin, BY_NOTHING, ip__text_key_doubles, offset, offsetof(mhd_header, offset_count)),
+    KEY(TransformMatrix, BY_NOTHING, parse_matrix),
+    KEY(Rotation, BY_NOTHING, parse_matrix),
+    KEY(Orientation, BY_NOTHING, parse_matrix),
     KEY(BinaryDataByteOrderMSB, BY_ENDIAN, parse_msb),
     KEY(ElementByteOrderMSB, BY_ENDIAN, parse_msb),
     KEY(CompressedData, BY_NOTHING, parse_compressed),
@@ -133,8 +165,8 @@ static const ip_text_keys mhd_keys = {mhd_key_list,
                                       "MetaImage",
                                       IP_TYPE_SPELLING_METAIMAGE};
 
-/* One "Key = Value" line; keys the reader does not need (ObjectType, Offset,
- * TransformMatrix, ...) are skipped. */
+/* One "Key = Value" line; keys the reader does not need (ObjectType,
+ * AnatomicalOrientation, ...) are skipped. */
 static ip_status parse_line(mhd_header *h, char *line, const ip_input_overrides *overrides,
                             ip_error *err)
 {
@@ -185,9 +217,28 @@ static ip_status check_keys(const mhd_header *h, const ip_input_overrides *overr
     if (h->spacing_count < 0 && h->size_count >= 0 && h->size_count != 3)
         return ip__fail(err, IP_ERR_INPUT, "%s: ElementSize has %d values, NDims is 3", h->at.path,
                         h->size_count);
+    if (h->offset_count >= 0 && h->offset_count != 3)
+        return ip__fail(err, IP_ERR_INPUT, "%s: Offset has %d values, NDims is 3", h->at.path,
+                        h->offset_count);
     if (h->compressed && h->header_size == -1)
         return ip__fail(err, IP_ERR_INPUT, "%s: HeaderSize -1 needs uncompressed data", h->at.path);
     return IP_OK;
+}
+
+/* The matrix only where it is orthonormal (within the tolerance); ITK writes one so. */
+static void fill_orientation(const mhd_header *h, ip_orientation *o)
+{
+    ip_orientation_identity(o);
+    if (h->offset_count == 3)
+        memcpy(o->origin, h->offset, sizeof o->origin);
+    if (h->has_matrix) {
+        ip_orientation framed = *o;
+        double lengths[3];
+        memcpy(framed.directions, h->matrix, sizeof framed.directions);
+        if (ip_orientation_normalize(framed.directions, lengths) == 0 &&
+            ip_orientation_check(&framed, NULL, NULL) == IP_OK)
+            *o = framed;
+    }
 }
 
 /* The data start HeaderSize bytes into the data file or, for LOCAL, into what follows the
@@ -204,6 +255,7 @@ static void fill_desc(const mhd_header *h, uint64_t header_end, ip_input_desc *d
         else if (h->size_count == 3)
             desc->spacing[axis] = h->size[axis];
     }
+    fill_orientation(h, &desc->orientation);
     if (!h->local)
         snprintf(desc->data_path, sizeof desc->data_path, "%s", h->data_path);
     uint64_t base = h->local ? header_end : 0;
@@ -216,7 +268,7 @@ static void fill_desc(const mhd_header *h, uint64_t header_end, ip_input_desc *d
 static void init(void *header)
 {
     mhd_header *h = header;
-    h->dims_count = h->spacing_count = h->size_count = -1; /* not seen yet */
+    h->dims_count = h->spacing_count = h->size_count = h->offset_count = -1; /* not seen yet */
 }
 
 static ip_status finish(void *header, uint64_t header_end, const ip_input_overrides *overrides,

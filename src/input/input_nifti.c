@@ -4,7 +4,8 @@
  * (|pixdim[1..3]|, in the file's unit, xyzt_units), where the samples start (vox_offset) and a
  * scaling (scl_slope, scl_inter) that is reported, never applied. The samples are then read as
  * raw data from vox_offset, or as a gzip stream whose first vox_offset bytes are skipped.
- * Orientation (qform, sform) is not read: the volume is taken in its storage order. */
+ * The orientation comes from the sform when sform_code > 0, else from the qform when
+ * qform_code > 0 (RAS space); the samples keep their storage order either way. */
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -30,6 +31,10 @@ typedef struct nifti_header {
     double pixdim[8];
     double vox_offset;
     double slope, intercept;
+    int qform_code, sform_code;
+    double quatern[3]; /* b, c, d */
+    double qoffset[3];
+    double srow[3][4]; /* srow_x, srow_y, srow_z */
 } nifti_header;
 
 /* ---- loads in the file's byte order ---- */
@@ -81,6 +86,14 @@ static void parse_nifti1(const unsigned char *h, nifti_header *n)
     n->vox_offset = load_f32(h + 108, be);
     n->slope = load_f32(h + 112, be);
     n->intercept = load_f32(h + 116, be);
+    n->qform_code = (int)load_i16(h + 252, be);
+    n->sform_code = (int)load_i16(h + 254, be);
+    for (int i = 0; i < 3; i++) {
+        n->quatern[i] = load_f32(h + 256 + 4 * i, be);
+        n->qoffset[i] = load_f32(h + 268 + 4 * i, be);
+        for (int j = 0; j < 4; j++)
+            n->srow[i][j] = load_f32(h + 280 + 16 * i + 4 * j, be);
+    }
 }
 
 static void parse_nifti2(const unsigned char *h, nifti_header *n)
@@ -94,6 +107,14 @@ static void parse_nifti2(const unsigned char *h, nifti_header *n)
     n->vox_offset = (double)load_i64(h + 168, be);
     n->slope = load_f64(h + 176, be);
     n->intercept = load_f64(h + 184, be);
+    n->qform_code = (int)(int32_t)load_uint(h + 344, 4, be);
+    n->sform_code = (int)(int32_t)load_uint(h + 348, 4, be);
+    for (int i = 0; i < 3; i++) {
+        n->quatern[i] = load_f64(h + 352 + 8 * i, be);
+        n->qoffset[i] = load_f64(h + 376 + 8 * i, be);
+        for (int j = 0; j < 4; j++)
+            n->srow[i][j] = load_f64(h + 400 + 32 * i + 8 * j, be);
+    }
 }
 
 /* The version and byte order from sizeof_hdr, the first 4 bytes: 348 or 540 in one order. */
@@ -251,6 +272,52 @@ static void report_rescale(const nifti_header *n, ip_input_desc *desc)
     desc->rescale_intercept = n->intercept;
 }
 
+/* The sform's columns, over their lengths; 0 when they are not an orthonormal frame. */
+static int sform_orientation(const nifti_header *n, ip_orientation *o)
+{
+    double lengths[3];
+    for (int a = 0; a < 3; a++) {
+        o->origin[a] = n->srow[a][3];
+        for (int c = 0; c < 3; c++)
+            o->directions[a][c] = n->srow[c][a];
+    }
+    return ip_orientation_normalize(o->directions, lengths) == 0 &&
+           ip_orientation_check(o, NULL, NULL) == IP_OK;
+}
+
+/* The rotation of the quaternion (b, c, d; a = sqrt(1 - b^2 - c^2 - d^2)), its third column
+ * times qfac = pixdim[0] (-1 or, for any other value, 1). */
+static int qform_orientation(const nifti_header *n, ip_orientation *o)
+{
+    double b = n->quatern[0], c = n->quatern[1], d = n->quatern[2];
+    double aa = 1.0 - (b * b + c * c + d * d);
+    double a = aa > 0.0 ? sqrt(aa) : 0.0;
+    double qfac = n->pixdim[0] == -1.0 ? -1.0 : 1.0;
+    double r[3][3] = {{a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)},
+                      {2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b)},
+                      {2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b}};
+    double lengths[3];
+    for (int axis = 0; axis < 3; axis++) {
+        o->origin[axis] = n->qoffset[axis];
+        for (int row = 0; row < 3; row++)
+            o->directions[axis][row] = r[row][axis] * (axis == 2 ? qfac : 1.0);
+    }
+    return ip_orientation_normalize(o->directions, lengths) == 0 &&
+           ip_orientation_check(o, NULL, NULL) == IP_OK;
+}
+
+/* sform first, then qform, as the format's codes rank them; identity when neither is set. */
+static void fill_orientation(const nifti_header *n, ip_orientation *o)
+{
+    ip_orientation framed;
+    ip_orientation_identity(o);
+    ip_orientation_identity(&framed);
+    framed.space = IP_SPACE_RAS;
+    if ((n->sform_code > 0 && sform_orientation(n, &framed)) ||
+        (n->qform_code > 0 && qform_orientation(n, &framed)))
+        *o = framed;
+}
+
 ip_status ip__nifti_describe(const char *path, const ip_input_overrides *overrides,
                              ip_input_desc *desc, ip_text_found *found, ip_error *err)
 {
@@ -277,5 +344,6 @@ ip_status ip__nifti_describe(const char *path, const ip_input_overrides *overrid
     desc->data_offset = compressed ? 0 : (uint64_t)n.vox_offset;
     desc->stream_skip = compressed ? (uint64_t)n.vox_offset : 0;
     report_rescale(&n, desc);
+    fill_orientation(&n, &desc->orientation);
     return IP_OK;
 }

@@ -30,7 +30,11 @@ typedef struct nrrd_header {
     int spacings_count; /* -1 until the field is seen */
     double spacings[3];
     int directions_count;
-    double directions[3];
+    double directions[3]; /* lengths of the space directions: the spacing */
+    int has_vectors;      /* every space direction a 3-vector */
+    double vectors[3][3]; /* the space directions as written */
+    double origin[3];     /* space origin; 0 when absent */
+    ip_space space;       /* from the space field */
     int64_t byte_skip;
     int64_t line_skip;
     int has_data_file;
@@ -82,19 +86,24 @@ static ip_status parse_spacings(void *header, const ip_text_key *key, char *valu
     return st;
 }
 
-/* Parses one "(a,b,...)" vector at *p into its length. */
-static int parse_vector_norm(const char **p, double *norm)
+/* Parses one "(a,b,...)" vector at *p: its length, and its first three components into v
+ * (*count: how many it has). */
+static int parse_vector(const char **p, double *norm, double v[3], int *count)
 {
     const char *s = *p;
     double sum = 0.0;
+    *count = 0;
     if (*s++ != '(')
         return -1;
     for (;;) {
         char *end;
-        double v = strtod(s, &end);
+        double c = strtod(s, &end);
         if (end == s)
             return -1;
-        sum += v * v;
+        if (*count < 3)
+            v[*count] = c;
+        (*count)++;
+        sum += c * c;
         s = end;
         while (*s == ' ' || *s == '\t')
             s++;
@@ -108,29 +117,70 @@ static int parse_vector_norm(const char **p, double *norm)
     return 0;
 }
 
-/* Each axis's spacing is the length of its direction vector; "none" marks an axis outside
- * world space, which gets the default spacing. */
+/* Each axis's spacing is the length of its direction vector, and its direction the vector
+ * over that length; "none" marks an axis outside world space, which gets the default
+ * spacing. */
 static ip_status parse_directions(void *header, const ip_text_key *key, char *value, ip_error *err)
 {
     nrrd_header *h = header;
     const char *p = value;
     h->directions_count = 0;
+    h->has_vectors = 1;
     for (;;) {
-        double norm = NAN;
+        double norm = NAN, v[3] = {0, 0, 0};
+        int count = 0;
         while (*p == ' ' || *p == '\t')
             p++;
         if (*p == '\0')
             return IP_OK;
         if (strncmp(p, "none", 4) == 0)
             p += 4;
-        else if (parse_vector_norm(&p, &norm) != 0)
+        else if (parse_vector(&p, &norm, v, &count) != 0)
             return ip__text_bad_value(h, key->name, value, "not '(x,y,z)' vectors or 'none'", err);
         if (*p != '\0' && *p != ' ' && *p != '\t')
             return ip__text_bad_value(h, key->name, value, "not '(x,y,z)' vectors or 'none'", err);
-        if (h->directions_count < 3)
+        if (count != 3)
+            h->has_vectors = 0;
+        if (h->directions_count < 3) {
             h->directions[h->directions_count] = spacing_of(norm);
+            memcpy(h->vectors[h->directions_count], v, sizeof v);
+        }
         h->directions_count++;
     }
+}
+
+static ip_status parse_origin(void *header, const ip_text_key *key, char *value, ip_error *err)
+{
+    nrrd_header *h = header;
+    const char *p = value;
+    double norm, v[3] = {0, 0, 0};
+    int count = 0;
+    int bad = parse_vector(&p, &norm, v, &count) != 0 || count != 3 || !isfinite(norm);
+    while (!bad && (*p == ' ' || *p == '\t'))
+        p++;
+    if (bad || *p != '\0')
+        return ip__text_bad_value(h, key->name, value, "not an '(x,y,z)' vector", err);
+    memcpy(h->origin, v, sizeof v);
+    return IP_OK;
+}
+
+/* The anatomical spaces that ip_space names; any other space is kept as unknown. */
+static ip_status parse_space(void *header, const ip_text_key *key, char *value, ip_error *err)
+{
+    static const struct {
+        const char *name;
+        ip_space space;
+    } spaces[] = {{"right-anterior-superior", IP_SPACE_RAS}, {"RAS", IP_SPACE_RAS},
+                  {"left-anterior-superior", IP_SPACE_LAS},  {"LAS", IP_SPACE_LAS},
+                  {"left-posterior-superior", IP_SPACE_LPS}, {"LPS", IP_SPACE_LPS}};
+    nrrd_header *h = header;
+    (void)key;
+    (void)err;
+    h->space = IP_SPACE_UNKNOWN;
+    for (size_t i = 0; i < sizeof spaces / sizeof spaces[0]; i++)
+        if (strcasecmp(value, spaces[i].name) == 0)
+            h->space = spaces[i].space;
+    return IP_OK;
 }
 
 static ip_status parse_byte_skip(void *header, const ip_text_key *key, char *value, ip_error *err)
@@ -175,6 +225,8 @@ static const ip_text_key nrrd_field_list[] = {
     {"spacings", BY_SPACING, parse_spacings, offsetof(nrrd_header, spacings),
      offsetof(nrrd_header, spacings_count)},
     {"space directions", BY_SPACING, parse_directions, 0, 0},
+    {"space origin", BY_NOTHING, parse_origin, 0, 0},
+    {"space", BY_NOTHING, parse_space, 0, 0},
     {"byte skip", BY_NOTHING, parse_byte_skip, 0, 0},
     {"byteskip", BY_NOTHING, parse_byte_skip, 0, 0},
     {"line skip", BY_NOTHING, parse_line_skip, 0, 0},
@@ -187,7 +239,7 @@ static const ip_text_keys nrrd_fields = {
     IP_TYPE_SPELLING_NRRD};
 
 /* One "field: value" line. Key/value pairs ("key:=value") and fields that describe anything
- * else (content, kinds, space origin, ...) are not needed to read the samples. */
+ * else (content, kinds, ...) are not needed to read the samples. */
 static ip_status parse_line(nrrd_header *h, char *line, const ip_input_overrides *overrides,
                             ip_error *err)
 {
@@ -319,6 +371,23 @@ static ip_status check_endian(const nrrd_header *h, const ip_input_overrides *ov
                     h->at.path, ip_type_name(type));
 }
 
+/* Directions only where every axis has a vector and together they are orthonormal (a sheared
+ * grid has no such frame); the origin and space always. */
+static void fill_orientation(const nrrd_header *h, ip_orientation *o)
+{
+    ip_orientation_identity(o);
+    memcpy(o->origin, h->origin, sizeof o->origin);
+    o->space = h->space;
+    if (h->directions_count == 3 && h->has_vectors) {
+        ip_orientation framed = *o;
+        double lengths[3];
+        memcpy(framed.directions, h->vectors, sizeof framed.directions);
+        if (ip_orientation_normalize(framed.directions, lengths) == 0 &&
+            ip_orientation_check(&framed, NULL, NULL) == IP_OK)
+            *o = framed;
+    }
+}
+
 static void fill_desc(const nrrd_header *h, ip_input_desc *desc, ip_text_found *found)
 {
     ip__text_found_layout(h->has_type, h->type, h->sizes_count, h->sizes, desc, found);
@@ -330,6 +399,7 @@ static void fill_desc(const nrrd_header *h, ip_input_desc *desc, ip_text_found *
         else if (h->directions_count == 3)
             desc->spacing[axis] = h->directions[axis];
     }
+    fill_orientation(h, &desc->orientation);
 }
 
 /* Works out where the samples start: after the header (attached) or at the start of the data

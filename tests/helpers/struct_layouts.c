@@ -28,6 +28,11 @@ static void error_and_input(void)
     FIELD(ip_input_desc, has_rescale);
     FIELD(ip_input_desc, rescale_slope);
     FIELD(ip_input_desc, rescale_intercept);
+    FIELD(ip_input_desc, orientation);
+    SIZE(ip_orientation);
+    FIELD(ip_orientation, origin);
+    FIELD(ip_orientation, directions);
+    FIELD(ip_orientation, space);
     SIZE(ip_input_overrides);
     FIELD(ip_input_overrides, has_dims);
     FIELD(ip_input_overrides, dims);
@@ -83,6 +88,7 @@ static void layout(void)
     FIELD(ip_layout, dims);
     FIELD(ip_layout, type);
     FIELD(ip_layout, spacing);
+    FIELD(ip_layout, orientation);
     FIELD(ip_layout, brick_edge);
     FIELD(ip_layout, subblock_edge);
     FIELD(ip_layout, level_count);

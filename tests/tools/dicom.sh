@@ -17,20 +17,42 @@ check "no rescale for raw input" sh -c '! grep -q rescale "$0"' "$work/.out"
 run_capture "$bin/isobrick" series/ --quiet
 check "a folder's default output is bricks/FOLDER.ibv" test -s bricks/series.ibv
 
-# the same dims, type, spacing and value range; the file name aside, the same description
-"$bin/isoinfo" --json dicom.ibv | sed 's/"file": "[^"]*", //' >dicom.json
-"$bin/isoinfo" --json raw.ibv | sed 's/"file": "[^"]*", //' >raw.json
+# the same dims, type, spacing and value range; the file name and the physical space aside,
+# the same description
+"$bin/isoinfo" --json dicom.ibv >dicom_space.json
+strip_space() { sed 's/"file": "[^"]*", //; s/"origin": .*"space": [^,]*, //' "$1"; }
+"$bin/isoinfo" --json raw.ibv >raw_space.json
+strip_space dicom_space.json >dicom.json
+strip_space raw_space.json >raw.json
 check "isoinfo describes both alike" cmp -s dicom.json raw.json
+# the first slice by position is at (-12.5, 30, -40), rows along x, columns along y: LPS
+check "the origin is the first slice's position" \
+    grep -qF '"origin": [-12.5, 30, -40], "directions": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "space": "LPS"' \
+    dicom_space.json
+check "raw input has no physical space" \
+    grep -qF '"origin": [0, 0, 0], "directions": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "space": null' \
+    raw_space.json
 check "the spacing comes from the headers" grep -q '"spacing": \[0.8000.*, 0.6999.*, 2.5\]' dicom.json
 check "isoinfo --verify passes" "$bin/isoinfo" --verify dicom.ibv
 
 # the same samples: every cell's triangles, extracted in one thread, byte for byte
+# (the series' mesh lies in its LPS space: the raw volume's moved by the origin)
 for f in dicom raw; do
     "$bin/isorender" "$f.ibv" --iso 1500.5 --full --threads 1 --software --size 64x48 \
-        --mesh "$f.ply" -o "$f.png" --quiet
+        --mesh "$f.ply" -o "$f.png" --quiet --no-weld
+    "$bin/tests/ply_triangles" "$f.ply" >"$f.txt"
 done
-check "a surface was extracted" test -s dicom.ply
-check "the same triangles from the series as from the raw volume" cmp -s dicom.ply raw.ply
+check "a surface was extracted" test -s dicom.txt
+check "the same triangles from the series as from the raw volume, moved" python3 -c '
+a = [l.split() for l in open("raw.txt")]
+b = [l.split() for l in open("dicom.txt")]
+assert len(a) == len(b) > 0, (len(a), len(b))
+origin = (-12.5, 30, -40)
+for ta, tb in zip(a, b):
+    for i in range(9):
+        want = float.fromhex(ta[i]) + origin[i % 3]
+        assert abs(float.fromhex(tb[i]) - want) < 1e-4, (ta, tb)
+'
 check "the same image" cmp -s dicom.png raw.png
 
 # broken series: exit 1, one line naming the folder or file, no output
