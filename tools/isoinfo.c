@@ -319,7 +319,7 @@ static const tool_option info_table[] = {
     {"--histogram", NULL, 0, INFO_FIELD(histogram), NULL, NULL, NULL},
     {"--bins", NULL, 1, INFO_FIELD(bins), parse_bins, NULL, NULL},
     {"--level", NULL, 1, INFO_FIELD(level), parse_level, NULL, NULL},
-    {"--force", NULL, 0, INFO_FIELD(force), NULL, NULL, NULL},
+    {"--force", "-f", 0, INFO_FIELD(force), NULL, NULL, NULL},
     {"--stats", NULL, 1, INFO_FIELD(stats_path), NULL, NULL, NULL},
     {"--cache-mb", NULL, 1, INFO_FIELD(budget), tool_option_cache_mb, NULL, NULL},
 };

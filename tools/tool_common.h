@@ -94,6 +94,7 @@ typedef struct tool_view_options {
     uint64_t cache_bytes;
     const char *stats; /* --stats OUT.json (NULL: none) */
     int force, quiet;
+    int verbose; /* --verbose (-v): what each step did, on stderr */
 } tool_view_options;
 
 /* The --help lines of the shared options that steer the engine (the usage texts of isorender

@@ -13,7 +13,7 @@ expect_error 2 "--iso" "$bin/isoview" s.ibv
 expect_error 2 "--size" "$bin/isoview" s.ibv --iso 1 --size 12
 expect_error 2 "--lod" "$bin/isoview" s.ibv --iso 1 --lod maybe
 expect_error 1 "nothere.ibv" "$bin/isoview" nothere.ibv --iso 1
-expect_error 1 "view" "$bin/isoview" s.ibv --iso 1 --view +w
+expect_error 2 "view" "$bin/isoview" s.ibv --iso 1 --view +w
 printf 'iso 1\norbit 10\n' >bad.txt
 expect_error 1 "bad.txt:2" "$bin/isoview" s.ibv --iso 1 --script bad.txt
 expect_error 1 "cannot open a window" env -u DISPLAY -u WAYLAND_DISPLAY "$bin/isoview" s.ibv --iso 1
