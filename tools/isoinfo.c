@@ -360,16 +360,19 @@ int main(int argc, char **argv)
     ip_cache_stats stats;
     ip_cache_get_stats(cache, &stats);
     uint64_t summary_bytes = ip_store_summary_memory(store);
-    if (check && !json)
+    int report = !tool_is_stdout(stats_path); /* --stats -: stdout holds the statistics alone */
+    if (check && !json && report)
         tool_print_cache_table(stdout, &stats, summary_bytes);
     if (rc == 0 && tool_signal_caught())
         rc = 1; /* the last brick was checked, but the run was interrupted: no output */
     if (stats_path && !tool_signal_caught() &&
         tool_write_stats_file("isoinfo", stats_path, force, &stats, summary_bytes, NULL, NULL) != 0)
         rc = 1;
-    if (rc == 0 && o.histogram)
+    if (rc != 0 || !report)
+        ; /* nothing more on stdout */
+    else if (o.histogram)
         rc = histogram(store, o.level, o.bins ? o.bins : IP_HISTOGRAM_DEFAULT_BINS, json);
-    else if (rc == 0) {
+    else {
         if (json)
             print_json(store, &facts);
         else

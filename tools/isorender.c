@@ -397,13 +397,13 @@ static int strip_compose(run *r, uint8_t **out, uint32_t *width, uint32_t *heigh
 }
 
 /* The summary's strip line. */
-static void strip_print(const run *r)
+static void strip_print(FILE *out, const run *r)
 {
-    printf("  strip         %s:", r->o.strip);
+    fprintf(out, "  strip         %s:", r->o.strip);
     for (size_t f = 0; f < r->o.strip_at.count; f++)
-        printf(" %g%% (%llu triangles)", r->o.strip_at.pct[f],
-               (unsigned long long)r->strip.triangles[f]);
-    printf("\n");
+        fprintf(out, " %g%% (%llu triangles)", r->o.strip_at.pct[f],
+                (unsigned long long)r->strip.triangles[f]);
+    fprintf(out, "\n");
 }
 
 /* ---- the turntable ---- */
@@ -722,30 +722,31 @@ static void json_counts(FILE *f, void *user)
     fprintf(f, "]");
 }
 
-static void print_summary(const run *r)
+static void print_summary(FILE *out, const run *r)
 {
     const ip_engine_counts *t = &r->totals;
-    printf("%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso,
-           r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
-    printf("  rays          %llu of %llu\n", (unsigned long long)t->rays,
-           (unsigned long long)r->camera.width * r->camera.height);
-    printf("  seeds         %llu\n", (unsigned long long)t->seeds);
-    printf("  cells         %llu\n", (unsigned long long)t->cells);
-    printf("  triangles     %llu\n", (unsigned long long)t->triangles);
+    fprintf(out, "%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso,
+            r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
+    fprintf(out, "  rays          %llu of %llu\n", (unsigned long long)t->rays,
+            (unsigned long long)r->camera.width * r->camera.height);
+    fprintf(out, "  seeds         %llu\n", (unsigned long long)t->seeds);
+    fprintf(out, "  cells         %llu\n", (unsigned long long)t->cells);
+    fprintf(out, "  triangles     %llu\n", (unsigned long long)t->triangles);
     if (r->owners_known)
-        printf("  visible       %llu triangles own a pixel: overdraw %.2f\n",
-               (unsigned long long)r->visible_triangles,
-               overdraw(r->mesh->triangle_count, r->visible_triangles));
-    printf("  time          %.3f s extraction (wall); CPU s summed over %u threads: "
-           "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
-           r->extraction_wall, ip_thread_count(r->o.common.threads), t->intersection_seconds,
-           t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
-    printf("  image         %s\n", r->o.out);
+        fprintf(out, "  visible       %llu triangles own a pixel: overdraw %.2f\n",
+                (unsigned long long)r->visible_triangles,
+                overdraw(r->mesh->triangle_count, r->visible_triangles));
+    fprintf(out,
+            "  time          %.3f s extraction (wall); CPU s summed over %u threads: "
+            "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
+            r->extraction_wall, ip_thread_count(r->o.common.threads), t->intersection_seconds,
+            t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
+    fprintf(out, "  image         %s\n", r->o.out);
     if (r->o.mesh)
-        printf("  mesh          %s: %llu triangles, %llu vertices%s\n", r->o.mesh,
-               (unsigned long long)(r->mesh->triangle_count - r->mesh_dropped),
-               (unsigned long long)r->mesh_vertices,
-               r->mesh_vertices < 3 * r->mesh->triangle_count ? " (shared)" : "");
+        fprintf(out, "  mesh          %s: %llu triangles, %llu vertices%s\n", r->o.mesh,
+                (unsigned long long)(r->mesh->triangle_count - r->mesh_dropped),
+                (unsigned long long)r->mesh_vertices,
+                r->mesh_vertices < 3 * r->mesh->triangle_count ? " (shared)" : "");
 }
 
 /* Writes the mesh file: welded (shared vertices) unless --no-weld or STL. A progressive
@@ -834,11 +835,15 @@ static int finish(run *r, ip_error *err)
         tool_write_text_file("isorender", r->o.progress, r->o.common.force, progress_csv, r) != 0)
         return 1;
     uint64_t summary = ip_store_summary_memory(r->store);
+    /* with --stats - or --progress -, stdout holds that output alone: the summary goes to
+     * stderr */
+    FILE *report =
+        tool_is_stdout(r->o.common.stats) || tool_is_stdout(r->o.progress) ? stderr : stdout;
     if (!r->o.common.quiet) {
-        print_summary(r);
+        print_summary(report, r);
         if (r->o.strip)
-            strip_print(r);
-        tool_print_cache_table(stdout, &st, summary);
+            strip_print(report, r);
+        tool_print_cache_table(report, &st, summary);
     }
     if (r->o.common.stats &&
         tool_write_stats_file("isorender", r->o.common.stats, r->o.common.force, &st, summary,

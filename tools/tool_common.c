@@ -176,6 +176,25 @@ static int check_output_folder(const char *program, const char *path)
     return 0;
 }
 
+int tool_is_stdout(const char *path)
+{
+    return path && strcmp(path, "-") == 0;
+}
+
+/* At most one output may be standard output ("-"): two would run together there. */
+static int check_stdout_outputs(const char *program, const char *const *outputs, size_t count)
+{
+    size_t named = 0;
+    for (size_t o = 0; o < count; o++)
+        named += tool_is_stdout(outputs[o]);
+    if (named > 1) {
+        fprintf(stderr, "%s: -: standard output named for %zu outputs; at most one may go there\n",
+                program, named);
+        return 1;
+    }
+    return 0;
+}
+
 int tool_check_paths(const char *program, const char *const *inputs, size_t input_count,
                      const char *const *outputs, size_t output_count, int force)
 {
@@ -183,14 +202,17 @@ int tool_check_paths(const char *program, const char *const *inputs, size_t inpu
     for (size_t i = 0; i < input_count; i++)
         if (inputs[i] && check_input(program, inputs[i]) != 0)
             return 1;
+    if (check_stdout_outputs(program, outputs, output_count) != 0)
+        return 1;
     for (size_t o = 0; o < output_count; o++) {
-        if (!outputs[o])
+        if (!outputs[o] || tool_is_stdout(outputs[o]))
             continue;
         for (size_t i = 0; i < input_count; i++)
             if (inputs[i] && ip_output_not_input(outputs[o], inputs[i], &err) != IP_OK)
                 return tool_fail(program, &err);
         for (size_t k = 0; k < o; k++)
-            if (outputs[k] && ip_path_same_file(outputs[o], outputs[k])) {
+            if (outputs[k] && !tool_is_stdout(outputs[k]) &&
+                ip_path_same_file(outputs[o], outputs[k])) {
                 if (strcmp(outputs[o], outputs[k]) == 0)
                     fprintf(stderr,
                             "%s: %s: named for two outputs; each output needs a file "
@@ -228,6 +250,13 @@ int tool_write_text_file(const char *program, const char *path, int force,
         fprintf(stderr, "%s: %s: out of memory\n", program, path);
         free(text);
         return -1;
+    }
+    if (tool_is_stdout(path)) {
+        failed = fwrite(text, 1, size, stdout) != size || fflush(stdout) != 0;
+        free(text);
+        if (failed)
+            fprintf(stderr, "%s: standard output: %s\n", program, strerror(errno));
+        return failed ? -1 : 0;
     }
     ip_error err;
     ip_status st = ip_output_write(path, text, size, force, &err);

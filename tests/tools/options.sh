@@ -90,6 +90,22 @@ for bad in "--type x" "--noise -1" "--seed x" "--upsample 0" "--dims 3"; do
 done
 expect_error 2 "unknown field" "$bin/isogen" bogus
 
+# "-" is standard output for --stats and --progress: stdout then holds that output alone
+keys='import json, sys; d = json.load(sys.stdin); missing = [k for k in sys.argv[1:] if k not in d]; sys.exit(1 if missing else 0)'
+"$bin/isorender" s.ibv --iso 100.5 --size 32x24 --software -f -o d.png --stats - >stats.out 2>summary.err
+check "isorender --stats - writes its JSON to stdout" \
+    sh -c 'python3 -c "$0" cache rays triangles time camera <stats.out' "$keys"
+check "isorender's summary then goes to stderr" grep -q "^  triangles" summary.err
+"$bin/isorender" s.ibv --iso 100.5 --size 32x24 --software -f -q -o d.png --progress - >progress.out
+check "isorender --progress - writes the CSV to stdout" \
+    sh -c 'head -1 progress.out | grep -q "^time_s,rays,seeds,cells,triangles" && [ $(wc -l <progress.out) -gt 1 ]'
+"$bin/isoinfo" s.ibv --verify --stats - >info.out 2>/dev/null
+check "isoinfo --verify --stats - writes only the JSON to stdout" \
+    sh -c 'python3 -c "$0" cache <info.out' "$keys"
+check "no file named - was written" test ! -e ./-
+expect_error 1 "standard output named for 2 outputs" "$bin/isorender" s.ibv --iso 100.5 \
+    --stats - --progress - -o d.png -f
+
 # the time line: parts in CPU seconds summed over the threads, numbers kept
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 64x48 --software --threads 2 -o t.png
 check "isorender succeeds (got $rc: $err)" test "$rc" = 0
