@@ -52,6 +52,7 @@ static const char usage[] =
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
     "                      overdraw at checkpoints\n"
+    "                      (--stats - or --progress -: standard output, the summary on stderr)\n"
     "  --strip OUT.png     also write the progress strip: the image as extracted by a few\n"
     "                      points of the run, side by side and labelled\n"
     "  --strip-at P,...    the strip's points, in percent of the view's rays, increasing\n"
@@ -63,9 +64,14 @@ static const char usage[] =
     "  --mp4 OUT.mp4       with --turntable: also encode the frames with ffmpeg (H.264, 25 fps);\n"
     "                      without ffmpeg the frames stay and isorender exits 1\n"
     "  --software          render with the software rasterizer instead of OpenGL\n"
-    "  --force             replace existing outputs (regular files only; never an input)\n"
-    "  --quiet             print nothing but errors and warnings\n"
+    "  -f, --force         replace existing outputs (regular files only; never an input)\n"
+    "  -q, --quiet         print nothing but errors and warnings (and no progress bar)\n"
+    "  -v, --verbose       each extraction step's counts on stderr\n"
     "  --version           print the version and exit\n"
+    "A progress bar (rays done, triangles) is drawn on stderr when it is a terminal\n"
+    "(ISORENDER_PROGRESS=1 forces it). Options take their value as --iso V or --iso=V; short\n"
+    "ones cluster (-qf); -- ends the options; a long name may be shortened while unambiguous.\n"
+    "Exit status: 0 success, 1 failure, 2 bad command line.\n"
     "Every output appears only when complete. The summary's time line gives the extraction's\n"
     "wall time, then its parts (intersection, propagation, marching cubes) in CPU seconds\n"
     "summed over the threads, which can add up to more than the wall time. Ctrl-C cancels:\n"
@@ -155,6 +161,7 @@ static const tool_option isorender_options[] = {
     {"--background", NULL, 1, 0, parse_background, NULL, NULL},
     {"--turntable", NULL, 1, 0, parse_turntable, NULL, NULL},
     {"--mp4", NULL, 1, offsetof(options, mp4), NULL, NULL, NULL},
+    {"--verbose", "-v", 0, offsetof(options, common.verbose), NULL, NULL, NULL},
 };
 
 /* ---- the figure's colours ---- */
@@ -505,6 +512,26 @@ static int add_checkpoint(run *r, double start)
 }
 
 /* Casts rays until done, the ray count or the time limit, checkpointing as the count doubles. */
+/* After each step: the bar (rays done of those asked for, triangles so far) and, with
+ * --verbose, the step's counts on a line of their own. */
+static void step_report(const run *r, tool_progress *bar, uint64_t limit)
+{
+    ip_engine_counts t;
+    ip_engine_totals(r->engine, &t);
+    uint64_t pixels = (uint64_t)r->camera.width * r->camera.height;
+    uint64_t total = limit < pixels ? limit : pixels;
+    char detail[48];
+    snprintf(detail, sizeof detail, "%llu triangles", (unsigned long long)t.triangles);
+    tool_progress_draw(bar, ip_engine_done(r->engine) ? total : t.rays, total, "rays", detail);
+    if (r->o.common.verbose) {
+        tool_progress_end(bar);
+        fprintf(
+            stderr, "isorender: step: %llu rays, %llu seeds, %llu cells, %llu triangles, %.3f s\n",
+            (unsigned long long)t.rays, (unsigned long long)t.seeds, (unsigned long long)t.cells,
+            (unsigned long long)t.triangles, tool_progress_elapsed(bar));
+    }
+}
+
 static int extract_progressive(run *r, ip_error *err)
 {
     ip_engine_options eo;
@@ -522,6 +549,8 @@ static int extract_progressive(run *r, ip_error *err)
     strip_plan_rays(r);
     double start = ip_now_seconds();
     uint64_t target = 1, limit = r->o.common.rays ? r->o.common.rays : UINT64_MAX;
+    tool_progress bar;
+    tool_progress_start(&bar, !r->o.common.quiet, "ISORENDER_PROGRESS");
     /* ip_engine_begin() clears a cancel: a signal before it is seen through the flag */
     while (!ip_engine_done(r->engine) && !tool_signal_caught()) {
         ip_engine_counts t;
@@ -533,15 +562,21 @@ static int extract_progressive(run *r, ip_error *err)
         if (r->o.common.time_limit > 0 && left <= 0)
             break;
         uint64_t next = target < limit ? target : limit, stop = strip_stop(r, t.rays, next);
-        if (ip_engine_step(r->engine, stop - t.rays, left, NULL, err) != IP_OK)
+        if (ip_engine_step(r->engine, stop - t.rays, left, NULL, err) != IP_OK) {
+            tool_progress_end(&bar);
             return -1;
+        }
+        step_report(r, &bar, limit);
         strip_record(r);
         if (stop < next && !ip_engine_done(r->engine))
             continue; /* a frame of the strip, between two checkpoints */
-        if (add_checkpoint(r, start) != 0)
+        if (add_checkpoint(r, start) != 0) {
+            tool_progress_end(&bar);
             return -1;
+        }
         target *= 2;
     }
+    tool_progress_end(&bar);
     r->extraction_wall = ip_now_seconds() - start;
     ip_engine_totals(r->engine, &r->totals);
     r->mesh = ip_engine_mesh(r->engine);

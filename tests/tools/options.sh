@@ -106,6 +106,19 @@ check "no file named - was written" test ! -e ./-
 expect_error 1 "standard output named for 2 outputs" "$bin/isorender" s.ibv --iso 100.5 \
     --stats - --progress - -o d.png -f
 
+# isorender's progress bar: none on a pipe, forced with ISORENDER_PROGRESS=1, none with -q;
+# --verbose prints each step's counts
+run_capture "$bin/isorender" s.ibv --iso 100.5 --size 32x24 --software -f -o d.png
+check "no bar on a pipe" test "$(printf '%s' "$err" | grep -c 'rays.*triangles ETA')" = 0
+run_capture env ISORENDER_PROGRESS=1 "$bin/isorender" s.ibv --iso 100.5 --size 32x24 --software -f -o d.png
+check "ISORENDER_PROGRESS=1 draws the bar to 768/768 rays" \
+    sh -c 'printf "%s" "$0" | tr "\r" "\n" | grep -qE "100.0% 768/768 rays [0-9]+ triangles ETA"' "$err"
+run_capture env ISORENDER_PROGRESS=1 "$bin/isorender" s.ibv --iso 100.5 --size 32x24 --software -qf -o d.png
+check "no bar with --quiet" test -z "$err"
+run_capture "$bin/isorender" s.ibv --iso 100.5 --size 32x24 --software -qvf -o d.png
+check "--verbose prints each step's counts" \
+    sh -c 'printf "%s\n" "$0" | grep -qE "^isorender: step: 768 rays, [0-9]+ seeds, [0-9]+ cells, [0-9]+ triangles"' "$err"
+
 # the time line: parts in CPU seconds summed over the threads, numbers kept
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 64x48 --software --threads 2 -o t.png
 check "isorender succeeds (got $rc: $err)" test "$rc" = 0
