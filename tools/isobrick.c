@@ -82,7 +82,7 @@ static int parse_type(const char *p, const tool_option *opt, const char *const *
     options *o = base;
     (void)opt;
     if (ip_type_parse(v[0], &o->overrides.type) != IP_OK)
-        return tool_usage_error(p, "unknown type '%s'", v[0]);
+        return tool_usage_error(p, "--type: unknown type '%s'", v[0]);
     o->overrides.has_type = 1;
     return 0;
 }
@@ -109,13 +109,16 @@ static int parse_spacing(const char *p, const tool_option *opt, const char *cons
     return 0;
 }
 
-/* --brick-size and --subblock-size, into the uint32_t at the option's offset: at most 256
- * here; the bricker checks the rest */
+/* --brick-size and --subblock-size, into the uint32_t at the option's offset: a power of two
+ * up to IP_MAX_BRICK_EDGE (a brick edge at least 2); that the sub-block fits the brick is
+ * checked once both are known */
 static int parse_edge(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     uint64_t n;
-    if (tool_parse_u64(v[0], &n) != 0 || n > 256)
-        return tool_usage_error(p, "bad %s '%s'", opt->name, v[0]);
+    uint64_t least = strcmp(opt->name, "--brick-size") == 0 ? 2 : 1;
+    if (tool_parse_u64(v[0], &n) != 0 || n < least || n > IP_MAX_BRICK_EDGE || (n & (n - 1)))
+        return tool_usage_error(p, "%s '%s' is not a power of two in [%llu, %u]", opt->name, v[0],
+                                (unsigned long long)least, IP_MAX_BRICK_EDGE);
     *(uint32_t *)(void *)((char *)base + opt->offset) = (uint32_t)n;
     return 0;
 }
@@ -162,7 +165,7 @@ static const tool_option isobrick_options[] = {
     {"--hc", NULL, TOOL_OPTIONAL_VALUE, 0, parse_hc, NULL, tool_is_u64},
     {"--threads", NULL, 1, 0, parse_threads, NULL, NULL},
     {"--mem-mb", NULL, 1, 0, parse_mem_mb, NULL, NULL},
-    {"--force", NULL, 0, offsetof(options, brick.force), NULL, NULL, NULL},
+    {"--force", "-f", 0, offsetof(options, brick.force), NULL, NULL, NULL},
     {"--quiet", "-q", 0, offsetof(options, quiet), NULL, NULL, NULL},
 };
 
@@ -178,6 +181,10 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     if (!o->input)
         return tool_usage_error("isobrick", "no input file");
+    if (o->brick.subblock_edge > o->brick.brick_edge)
+        return tool_usage_error("isobrick",
+                                "the sub-block edge %u is larger than the brick edge %u",
+                                o->brick.subblock_edge, o->brick.brick_edge);
     return 0;
 }
 

@@ -1,5 +1,6 @@
 /* isogen: writes a synthetic test volume, or an upsampled copy of a volume, as a raw file. */
 #include <inttypes.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,26 +58,6 @@ typedef struct options {
     int quiet;
 } options;
 
-/* Matches `name` at argv[*i] as "NAME VALUE" or "NAME=VALUE": 1 with *value set, 0 when it is
- * another argument, -1 when the value is missing. */
-static int option_value(int argc, char **argv, int *i, const char *name, const char **value)
-{
-    const char *arg = argv[*i];
-    size_t n = strlen(name);
-    if (strncmp(arg, name, n) != 0)
-        return 0;
-    if (arg[n] == '=') {
-        *value = arg + n + 1;
-        return 1;
-    }
-    if (arg[n] != '\0')
-        return 0;
-    if (*i + 1 >= argc)
-        return -1;
-    *value = argv[++*i];
-    return 1;
-}
-
 /* Applies the value of a recognised option; returns 0, or 2 after a usage error. */
 static int apply_value(options *o, const char *name, const char *value)
 {
@@ -112,40 +93,23 @@ static int apply_value(options *o, const char *name, const char *value)
     return 0;
 }
 
-/* Handles argv[*i]; returns 0 to go on, 2 after a usage error, -1 after --help, -2 after
- * --version. */
-static int parse_argument(options *o, int argc, char **argv, int *i)
+static int parse_value(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
-    static const char *const valued[] = {"--dims", "--type",     "--endian", "--noise",
-                                         "--seed", "--upsample", "-o"};
-    const char *arg = argv[*i];
-    if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0)
-        return -1;
-    if (strcmp(arg, "--version") == 0)
-        return -2;
-    if (strcmp(arg, "--force") == 0) {
-        o->force = 1;
-        return 0;
-    }
-    if (strcmp(arg, "--quiet") == 0) {
-        o->quiet = 1;
-        return 0;
-    }
-    for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++) {
-        const char *value;
-        int m = option_value(argc, argv, i, valued[k], &value);
-        if (m < 0)
-            return tool_usage_error(PROGRAM, "%s needs a value", valued[k]);
-        if (m > 0)
-            return apply_value(o, valued[k], value);
-    }
-    if (arg[0] == '-')
-        return tool_usage_error(PROGRAM, "unknown option '%s'", arg);
-    if (o->positional)
-        return tool_usage_error(PROGRAM, "unexpected argument '%s'", arg);
-    o->positional = arg;
-    return 0;
+    (void)p;
+    return apply_value(base, opt->name, v[0]);
 }
+
+static const tool_option isogen_options[] = {
+    {"--dims", NULL, 1, 0, parse_value, NULL, NULL},
+    {"--type", NULL, 1, 0, parse_value, NULL, NULL},
+    {"--endian", NULL, 1, 0, parse_value, NULL, NULL},
+    {"--noise", NULL, 1, 0, parse_value, NULL, NULL},
+    {"--seed", NULL, 1, 0, parse_value, NULL, NULL},
+    {"--upsample", NULL, 1, 0, parse_value, NULL, NULL},
+    {"-o", NULL, 1, 0, parse_value, NULL, NULL},
+    {"--force", "-f", 0, offsetof(options, force), NULL, NULL, NULL},
+    {"--quiet", "-q", 0, offsetof(options, quiet), NULL, NULL, NULL},
+};
 
 /* Checks that the options fit the mode; returns 0 or 2 after a usage error. */
 static int check_mode(const options *o, ip_field *field)
@@ -320,19 +284,11 @@ int main(int argc, char **argv)
     options o;
     ip_field field = IP_FIELD_SHEPP_LOGAN;
     memset(&o, 0, sizeof o);
-    for (int i = 1; i < argc; i++) {
-        int rc = parse_argument(&o, argc, argv, &i);
-        if (rc == -2) {
-            tool_print_version(PROGRAM);
-            return 0;
-        }
-        if (rc < 0) {
-            fputs(usage_text, stdout);
-            return 0;
-        }
-        if (rc != 0)
-            return rc;
-    }
+    tool_option_table table = {isogen_options, sizeof isogen_options / sizeof isogen_options[0],
+                               &o};
+    tool_command_line c = {PROGRAM, usage_text, &table, 1, &o.positional, "argument"};
+    if (tool_parse_command_line(&c, argc, argv) != 0)
+        return 2;
     int rc = check_mode(&o, &field);
     if (rc != 0)
         return rc;

@@ -158,44 +158,13 @@ static void print_json(const ip_store *s, const file_facts *f)
     printf("]}\n");
 }
 
-/* --verify's progress bar on stderr: shown on a terminal, or always with ISOINFO_PROGRESS=1
- * (for tests, whose stderr is a pipe); drawn at most five times a second and at the end. */
-typedef struct progress_bar {
-    int show, drawn;
-    double start, last; /* seconds */
-    uint64_t bytes;     /* decoded samples so far */
-} progress_bar;
-
-static void progress_start(progress_bar *p, int wanted)
+/* --verify's bar: bricks, and the decoded bytes' rate */
+static void progress_draw(tool_progress *bar, uint64_t done, uint64_t total, uint64_t bytes)
 {
-    const char *force = getenv("ISOINFO_PROGRESS");
-    p->show = wanted && ((force && strcmp(force, "1") == 0) || isatty(STDERR_FILENO));
-    p->drawn = 0;
-    p->start = p->last = ip_now_seconds();
-    p->bytes = 0;
-}
-
-static void progress_draw(progress_bar *p, uint64_t done, uint64_t total)
-{
-    double now = ip_now_seconds();
-    if (!p->show || (done < total && now - p->last < 0.2))
-        return;
-    double elapsed = now - p->start, fraction = total ? (double)done / (double)total : 1;
-    double eta = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0;
-    int width = 30, fill = (int)(fraction * width);
-    fprintf(stderr, "\r[%-*.*s] %5.1f%% %llu/%llu bricks %7.1f MB/s ETA %4.0fs", width, fill,
-            "##############################", 100 * fraction, (unsigned long long)done,
-            (unsigned long long)total, elapsed > 0 ? (double)p->bytes / elapsed / 1e6 : 0, eta);
-    p->drawn = 1;
-    p->last = now;
-}
-
-/* Ends the bar's line, so that what follows starts on a line of its own. */
-static void progress_end(progress_bar *p)
-{
-    if (p->drawn)
-        fputc('\n', stderr);
-    p->drawn = 0;
+    char rate[32];
+    double elapsed = tool_progress_elapsed(bar);
+    snprintf(rate, sizeof rate, "%7.1f MB/s", elapsed > 0 ? (double)bytes / elapsed / 1e6 : 0);
+    tool_progress_draw(bar, done, total, "bricks", rate);
 }
 
 /* Reads every brick through the cache, checking checksums and summaries, then the octree. */
@@ -204,13 +173,14 @@ static int verify(const ip_store *s, ip_cache *cache, int quiet)
     const ip_layout *l = ip_store_layout(s);
     ip_error err;
     ip_error_clear(&err);
-    progress_bar bar;
-    progress_start(&bar, !quiet);
+    tool_progress bar;
+    uint64_t bytes = 0; /* decoded samples so far */
+    tool_progress_start(&bar, !quiet, "ISOINFO_PROGRESS");
     int rc = 0;
     for (uint64_t g = 0; rc == 0 && g < l->brick_count; g++) {
-        progress_draw(&bar, g, l->brick_count);
+        progress_draw(&bar, g, l->brick_count, bytes);
         if (tool_signal_caught()) {
-            progress_end(&bar);
+            tool_progress_end(&bar);
             fprintf(stderr, "isoinfo: %s: verification cancelled after %llu of %llu bricks\n",
                     ip_store_path(s), (unsigned long long)g, (unsigned long long)l->brick_count);
             return 1;
@@ -222,11 +192,11 @@ static int verify(const ip_store *s, ip_cache *cache, int quiet)
             rc = -2;
         if (rc != -1)
             ip_cache_unpin_brick(cache, &b);
-        bar.bytes += ip_store_brick_samples(s, g) * ip_type_size(l->type);
+        bytes += ip_store_brick_samples(s, g) * ip_type_size(l->type);
     }
     if (rc == 0)
-        progress_draw(&bar, l->brick_count, l->brick_count);
-    progress_end(&bar);
+        progress_draw(&bar, l->brick_count, l->brick_count, bytes);
+    tool_progress_end(&bar);
     if (rc != 0)
         return tool_fail("isoinfo", &err);
     if (ip_store_verify_octree(s, &err) != IP_OK)
@@ -348,7 +318,7 @@ static const tool_option info_table[] = {
     {"--histogram", NULL, 0, INFO_FIELD(histogram), NULL, NULL, NULL},
     {"--bins", NULL, 1, INFO_FIELD(bins), parse_bins, NULL, NULL},
     {"--level", NULL, 1, INFO_FIELD(level), parse_level, NULL, NULL},
-    {"--force", NULL, 0, INFO_FIELD(force), NULL, NULL, NULL},
+    {"--force", "-f", 0, INFO_FIELD(force), NULL, NULL, NULL},
     {"--stats", NULL, 1, INFO_FIELD(stats_path), NULL, NULL, NULL},
     {"--cache-mb", NULL, 1, INFO_FIELD(budget), tool_option_cache_mb, NULL, NULL},
 };
@@ -389,16 +359,19 @@ int main(int argc, char **argv)
     ip_cache_stats stats;
     ip_cache_get_stats(cache, &stats);
     uint64_t summary_bytes = ip_store_summary_memory(store);
-    if (check && !json)
+    int report = !tool_is_stdout(stats_path); /* --stats -: stdout holds the statistics alone */
+    if (check && !json && report)
         tool_print_cache_table(stdout, &stats, summary_bytes);
     if (rc == 0 && tool_signal_caught())
         rc = 1; /* the last brick was checked, but the run was interrupted: no output */
     if (stats_path && !tool_signal_caught() &&
         tool_write_stats_file("isoinfo", stats_path, force, &stats, summary_bytes, NULL, NULL) != 0)
         rc = 1;
-    if (rc == 0 && o.histogram)
+    if (rc != 0 || !report)
+        ; /* nothing more on stdout */
+    else if (o.histogram)
         rc = histogram(store, o.level, o.bins ? o.bins : IP_HISTOGRAM_DEFAULT_BINS, json);
-    else if (rc == 0) {
+    else {
         if (json)
             print_json(store, &facts);
         else

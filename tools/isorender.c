@@ -57,6 +57,7 @@ static const char usage[] =
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
     "                      overdraw at checkpoints\n"
+    "                      (--stats - or --progress -: standard output, the summary on stderr)\n"
     "  --strip OUT.png     also write the progress strip: the image as extracted by a few\n"
     "                      points of the run, side by side and labelled\n"
     "  --strip-at P,...    the strip's points, in percent of the view's rays, increasing\n"
@@ -70,9 +71,14 @@ static const char usage[] =
     "  --software          render with the software rasterizer instead of OpenGL\n"
     "  --aa N              OpenGL anti-aliasing: N samples a pixel (1 to 16; default 1, off,\n"
     "                      the image the software rasterizer draws; 4 or 8 for figures)\n"
-    "  --force             replace existing outputs (regular files only; never an input)\n"
-    "  --quiet             print nothing but errors and warnings\n"
+    "  -f, --force         replace existing outputs (regular files only; never an input)\n"
+    "  -q, --quiet         print nothing but errors and warnings (and no progress bar)\n"
+    "  -v, --verbose       each extraction step's counts on stderr\n"
     "  --version           print the version and exit\n"
+    "A progress bar (rays done, triangles) is drawn on stderr when it is a terminal\n"
+    "(ISORENDER_PROGRESS=1 forces it). Options take their value as --iso V or --iso=V; short\n"
+    "ones cluster (-qf); -- ends the options; a long name may be shortened while unambiguous.\n"
+    "Exit status: 0 success, 1 failure, 2 bad command line.\n"
     "Every output appears only when complete. The summary's time line gives the extraction's\n"
     "wall time, then its parts (intersection, propagation, marching cubes) in CPU seconds\n"
     "summed over the threads, which can add up to more than the wall time. Ctrl-C cancels:\n"
@@ -166,6 +172,7 @@ static const tool_option isorender_options[] = {
     {"--turntable", NULL, 1, 0, parse_turntable, NULL, NULL},
     {"--mp4", NULL, 1, offsetof(options, mp4), NULL, NULL, NULL},
     {"--aa", NULL, 1, 0, parse_aa, NULL, NULL},
+    {"--verbose", "-v", 0, offsetof(options, common.verbose), NULL, NULL, NULL},
 };
 
 /* ---- the figure's colours ---- */
@@ -437,13 +444,13 @@ static int strip_compose(run *r, uint8_t **out, uint32_t *width, uint32_t *heigh
 }
 
 /* The summary's strip line. */
-static void strip_print(const run *r)
+static void strip_print(FILE *out, const run *r)
 {
-    printf("  strip         %s:", r->o.strip);
+    fprintf(out, "  strip         %s:", r->o.strip);
     for (size_t f = 0; f < r->o.strip_at.count; f++)
-        printf(" %g%% (%llu triangles)", r->o.strip_at.pct[f],
-               (unsigned long long)r->strip.triangles[f]);
-    printf("\n");
+        fprintf(out, " %g%% (%llu triangles)", r->o.strip_at.pct[f],
+                (unsigned long long)r->strip.triangles[f]);
+    fprintf(out, "\n");
 }
 
 /* ---- smoothing the mesh file ---- */
@@ -590,6 +597,26 @@ static int add_checkpoint(run *r, double start)
 }
 
 /* Casts rays until done, the ray count or the time limit, checkpointing as the count doubles. */
+/* After each step: the bar (rays done of those asked for, triangles so far) and, with
+ * --verbose, the step's counts on a line of their own. */
+static void step_report(const run *r, tool_progress *bar, uint64_t limit)
+{
+    ip_engine_counts t;
+    ip_engine_totals(r->engine, &t);
+    uint64_t pixels = (uint64_t)r->camera.width * r->camera.height;
+    uint64_t total = limit < pixels ? limit : pixels;
+    char detail[48];
+    snprintf(detail, sizeof detail, "%llu triangles", (unsigned long long)t.triangles);
+    tool_progress_draw(bar, ip_engine_done(r->engine) ? total : t.rays, total, "rays", detail);
+    if (r->o.common.verbose) {
+        tool_progress_end(bar);
+        fprintf(
+            stderr, "isorender: step: %llu rays, %llu seeds, %llu cells, %llu triangles, %.3f s\n",
+            (unsigned long long)t.rays, (unsigned long long)t.seeds, (unsigned long long)t.cells,
+            (unsigned long long)t.triangles, tool_progress_elapsed(bar));
+    }
+}
+
 static int extract_progressive(run *r, ip_error *err)
 {
     ip_engine_options eo;
@@ -607,6 +634,8 @@ static int extract_progressive(run *r, ip_error *err)
     strip_plan_rays(r);
     double start = ip_now_seconds();
     uint64_t target = 1, limit = r->o.common.rays ? r->o.common.rays : UINT64_MAX;
+    tool_progress bar;
+    tool_progress_start(&bar, !r->o.common.quiet, "ISORENDER_PROGRESS");
     /* ip_engine_begin() clears a cancel: a signal before it is seen through the flag */
     while (!ip_engine_done(r->engine) && !tool_signal_caught()) {
         ip_engine_counts t;
@@ -618,15 +647,21 @@ static int extract_progressive(run *r, ip_error *err)
         if (r->o.common.time_limit > 0 && left <= 0)
             break;
         uint64_t next = target < limit ? target : limit, stop = strip_stop(r, t.rays, next);
-        if (ip_engine_step(r->engine, stop - t.rays, left, NULL, err) != IP_OK)
+        if (ip_engine_step(r->engine, stop - t.rays, left, NULL, err) != IP_OK) {
+            tool_progress_end(&bar);
             return -1;
+        }
+        step_report(r, &bar, limit);
         strip_record(r);
         if (stop < next && !ip_engine_done(r->engine))
             continue; /* a frame of the strip, between two checkpoints */
-        if (add_checkpoint(r, start) != 0)
+        if (add_checkpoint(r, start) != 0) {
+            tool_progress_end(&bar);
             return -1;
+        }
         target *= 2;
     }
+    tool_progress_end(&bar);
     r->extraction_wall = ip_now_seconds() - start;
     ip_engine_totals(r->engine, &r->totals);
     r->mesh = ip_engine_mesh(r->engine);
@@ -810,31 +845,32 @@ static void json_counts(FILE *f, void *user)
     fprintf(f, "]");
 }
 
-static void print_summary(const run *r)
+static void print_summary(FILE *out, const run *r)
 {
     const ip_engine_counts *t = &r->totals;
-    printf("%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso,
-           r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
-    printf("  rays          %llu of %llu\n", (unsigned long long)t->rays,
-           (unsigned long long)r->camera.width * r->camera.height);
-    printf("  seeds         %llu\n", (unsigned long long)t->seeds);
-    printf("  cells         %llu\n", (unsigned long long)t->cells);
-    printf("  triangles     %llu\n", (unsigned long long)t->triangles);
+    fprintf(out, "%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso,
+            r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
+    fprintf(out, "  rays          %llu of %llu\n", (unsigned long long)t->rays,
+            (unsigned long long)r->camera.width * r->camera.height);
+    fprintf(out, "  seeds         %llu\n", (unsigned long long)t->seeds);
+    fprintf(out, "  cells         %llu\n", (unsigned long long)t->cells);
+    fprintf(out, "  triangles     %llu\n", (unsigned long long)t->triangles);
     if (r->owners_known)
-        printf("  visible       %llu triangles own a pixel: overdraw %.2f\n",
-               (unsigned long long)r->visible_triangles,
-               overdraw(r->mesh->triangle_count, r->visible_triangles));
-    printf("  time          %.3f s extraction (wall); CPU s summed over %u threads: "
-           "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
-           r->extraction_wall, ip_thread_count(r->o.common.threads), t->intersection_seconds,
-           t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
-    printf("  image         %s\n", r->o.out);
+        fprintf(out, "  visible       %llu triangles own a pixel: overdraw %.2f\n",
+                (unsigned long long)r->visible_triangles,
+                overdraw(r->mesh->triangle_count, r->visible_triangles));
+    fprintf(out,
+            "  time          %.3f s extraction (wall); CPU s summed over %u threads: "
+            "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
+            r->extraction_wall, ip_thread_count(r->o.common.threads), t->intersection_seconds,
+            t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
+    fprintf(out, "  image         %s\n", r->o.out);
     if (r->o.mesh)
-        printf("  mesh          %s: %llu triangles, %llu vertices%s%s\n", r->o.mesh,
-               (unsigned long long)(r->mesh->triangle_count - r->mesh_dropped),
-               (unsigned long long)r->mesh_vertices,
-               r->mesh_vertices < 3 * r->mesh->triangle_count ? " (shared)" : "",
-               r->o.smooth ? ", smoothed" : "");
+        fprintf(out, "  mesh          %s: %llu triangles, %llu vertices%s%s\n", r->o.mesh,
+                (unsigned long long)(r->mesh->triangle_count - r->mesh_dropped),
+                (unsigned long long)r->mesh_vertices,
+                r->mesh_vertices < 3 * r->mesh->triangle_count ? " (shared)" : "",
+                r->o.smooth ? ", smoothed" : "");
 }
 
 /* Writes `mesh` to the mesh file: welded (shared vertices) unless --no-weld or STL (which is
@@ -949,11 +985,15 @@ static int finish(run *r, ip_error *err)
         tool_write_text_file("isorender", r->o.progress, r->o.common.force, progress_csv, r) != 0)
         return 1;
     uint64_t summary = ip_store_summary_memory(r->store);
+    /* with --stats - or --progress -, stdout holds that output alone: the summary goes to
+     * stderr */
+    FILE *report =
+        tool_is_stdout(r->o.common.stats) || tool_is_stdout(r->o.progress) ? stderr : stdout;
     if (!r->o.common.quiet) {
-        print_summary(r);
+        print_summary(report, r);
         if (r->o.strip)
-            strip_print(r);
-        tool_print_cache_table(stdout, &st, summary);
+            strip_print(report, r);
+        tool_print_cache_table(report, &st, summary);
     }
     if (r->o.common.stats &&
         tool_write_stats_file("isorender", r->o.common.stats, r->o.common.force, &st, summary,

@@ -1,6 +1,7 @@
 /* Helpers shared by the programs. */
 #include <ctype.h>
 #include <errno.h>
+#include <getopt.h>
 #include <limits.h>
 #include <math.h>
 #include <pthread.h>
@@ -175,6 +176,25 @@ static int check_output_folder(const char *program, const char *path)
     return 0;
 }
 
+int tool_is_stdout(const char *path)
+{
+    return path && strcmp(path, "-") == 0;
+}
+
+/* At most one output may be standard output ("-"): two would run together there. */
+static int check_stdout_outputs(const char *program, const char *const *outputs, size_t count)
+{
+    size_t named = 0;
+    for (size_t o = 0; o < count; o++)
+        named += tool_is_stdout(outputs[o]);
+    if (named > 1) {
+        fprintf(stderr, "%s: -: standard output named for %zu outputs; at most one may go there\n",
+                program, named);
+        return 1;
+    }
+    return 0;
+}
+
 int tool_check_paths(const char *program, const char *const *inputs, size_t input_count,
                      const char *const *outputs, size_t output_count, int force)
 {
@@ -182,14 +202,17 @@ int tool_check_paths(const char *program, const char *const *inputs, size_t inpu
     for (size_t i = 0; i < input_count; i++)
         if (inputs[i] && check_input(program, inputs[i]) != 0)
             return 1;
+    if (check_stdout_outputs(program, outputs, output_count) != 0)
+        return 1;
     for (size_t o = 0; o < output_count; o++) {
-        if (!outputs[o])
+        if (!outputs[o] || tool_is_stdout(outputs[o]))
             continue;
         for (size_t i = 0; i < input_count; i++)
             if (inputs[i] && ip_output_not_input(outputs[o], inputs[i], &err) != IP_OK)
                 return tool_fail(program, &err);
         for (size_t k = 0; k < o; k++)
-            if (outputs[k] && ip_path_same_file(outputs[o], outputs[k])) {
+            if (outputs[k] && !tool_is_stdout(outputs[k]) &&
+                ip_path_same_file(outputs[o], outputs[k])) {
                 if (strcmp(outputs[o], outputs[k]) == 0)
                     fprintf(stderr,
                             "%s: %s: named for two outputs; each output needs a file "
@@ -227,6 +250,13 @@ int tool_write_text_file(const char *program, const char *path, int force,
         fprintf(stderr, "%s: %s: out of memory\n", program, path);
         free(text);
         return -1;
+    }
+    if (tool_is_stdout(path)) {
+        failed = fwrite(text, 1, size, stdout) != size || fflush(stdout) != 0;
+        free(text);
+        if (failed)
+            fprintf(stderr, "%s: standard output: %s\n", program, strerror(errno));
+        return failed ? -1 : 0;
     }
     ip_error err;
     ip_status st = ip_output_write(path, text, size, force, &err);
@@ -314,6 +344,44 @@ int tool_warn_iso_range(const char *program, const ip_store *store, double iso, 
     if (warning && warning_size)
         snprintf(warning, warning_size, "%s", text);
     return 1;
+}
+
+void tool_progress_start(tool_progress *p, int wanted, const char *force_variable)
+{
+    const char *force = getenv(force_variable);
+    p->show = wanted && ((force && strcmp(force, "1") == 0) || isatty(STDERR_FILENO));
+    p->drawn = 0;
+    p->start = p->last = ip_now_seconds();
+}
+
+double tool_progress_elapsed(const tool_progress *p)
+{
+    return ip_now_seconds() - p->start;
+}
+
+void tool_progress_draw(tool_progress *p, uint64_t done, uint64_t total, const char *unit,
+                        const char *detail)
+{
+    double now = ip_now_seconds();
+    if (!p->show || (done < total && now - p->last < 0.2))
+        return;
+    double elapsed = now - p->start, fraction = total ? (double)done / (double)total : 1;
+    if (fraction > 1)
+        fraction = 1;
+    double eta = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0;
+    int width = 30, fill = (int)(fraction * width);
+    fprintf(stderr, "\r[%-*.*s] %5.1f%% %llu/%llu %s %s ETA %4.0fs", width, fill,
+            "##############################", 100 * fraction, (unsigned long long)done,
+            (unsigned long long)total, unit, detail, eta);
+    p->drawn = 1;
+    p->last = now;
+}
+
+void tool_progress_end(tool_progress *p)
+{
+    if (p->drawn)
+        fputc('\n', stderr);
+    p->drawn = 0;
 }
 
 void tool_json_string(FILE *out, const char *text)
@@ -683,13 +751,40 @@ static int parse_clip_option(const char *p, const tool_option *opt, const char *
     return 0;
 }
 
+/* --view and --camera are checked as they are parsed, so that a bad one is a usage error
+ * (exit 2) before any file is opened; the library's own check says what is wrong. */
+static int parse_view(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    static const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    ip_camera probe;
+    ip_error err;
+    (void)opt;
+    if (ip_camera_fit_axis(lo, hi, v[0], 30.0, 1, 1, &probe, &err) != IP_OK)
+        return tool_usage_error(p, "--view '%s' is not an axis (+x -x +y -y +z -z)", v[0]);
+    ((tool_view_options *)base)->view = v[0];
+    return 0;
+}
+
+static int parse_camera(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    ip_camera probe;
+    ip_error err;
+    (void)opt;
+    memset(&probe, 0, sizeof probe);
+    probe.width = probe.height = 1;
+    if (ip_camera_parse(v[0], &probe, &err) != IP_OK || ip_camera_check(&probe, &err) != IP_OK)
+        return tool_usage_error(p, "--camera '%s': %s", v[0], err.message);
+    ((tool_view_options *)base)->camera = v[0];
+    return 0;
+}
+
 #define VIEW_FIELD(member) offsetof(tool_view_options, member)
 
 static const tool_option view_options[] = {
     {"--iso", NULL, 1, VIEW_FIELD(iso), parse_iso, "is not a number", NULL},
     {"--size", NULL, 1, 0, parse_size_option, NULL, NULL},
-    {"--view", NULL, 1, VIEW_FIELD(view), NULL, NULL, NULL},
-    {"--camera", NULL, 1, VIEW_FIELD(camera), NULL, NULL, NULL},
+    {"--view", NULL, 1, VIEW_FIELD(view), parse_view, NULL, NULL},
+    {"--camera", NULL, 1, VIEW_FIELD(camera), parse_camera, NULL, NULL},
     {"--rays", NULL, 1, 0, parse_rays, NULL, NULL},
     {"--time", NULL, 1, VIEW_FIELD(time_limit), tool_option_positive, "is not positive seconds",
      NULL},
@@ -704,7 +799,7 @@ static const tool_option view_options[] = {
     {"--clip", NULL, 1, 0, parse_clip_option, NULL, NULL},
     {"--cache-mb", NULL, 1, VIEW_FIELD(cache_bytes), tool_option_cache_mb, NULL, NULL},
     {"--stats", NULL, 1, VIEW_FIELD(stats), NULL, NULL, NULL},
-    {"--force", NULL, 0, VIEW_FIELD(force), NULL, NULL, NULL},
+    {"--force", "-f", 0, VIEW_FIELD(force), NULL, NULL, NULL},
     {"--quiet", "-q", 0, VIEW_FIELD(quiet), NULL, NULL, NULL},
 };
 
@@ -786,39 +881,109 @@ int tool_parse_background(const char *text, float top[3], float bottom[3])
     return tool_parse_colour(first, top) != 0 || tool_parse_colour(colon + 1, bottom) != 0 ? -1 : 0;
 }
 
-/* ---- the command-line engine ---- */
+/* ---- the command-line engine: getopt_long over the tables ----
+ *
+ * Every row becomes a struct option (its long name without the dashes) and, when its name or
+ * alias is a single letter ("-o", "-q"), a letter of the short-option string, so that
+ * "--iso=V", "--iso V", "-oFILE", "-o FILE", clustered letters ("-qf"), "--" and unambiguous
+ * prefixes of long names ("--mes" for --mesh) all work as getopt_long makes them. A row's
+ * getopt_long value is ROW_VALUE + its index in the flattened list of rows. */
 
-static const tool_option *find_option(const tool_command_line *c, const char *name, void **base)
+#define ROW_VALUE 0x1000
+#define HELP_VALUE 0x0fff
+#define VERSION_VALUE 0x0ffe
+
+typedef struct option_row {
+    const tool_option *option;
+    void *base;
+} option_row;
+
+typedef struct getopt_tables {
+    option_row *rows;
+    struct option *longs;
+    char shorts[128];
+    size_t count;
+} getopt_tables;
+
+static int is_short_name(const char *name)
 {
+    return name && name[0] == '-' && name[1] && name[1] != '-' && !name[2];
+}
+
+static void add_short(getopt_tables *g, const char *name, int has_value)
+{
+    size_t n = strlen(g->shorts);
+    if (n + 3 >= sizeof g->shorts)
+        return;
+    g->shorts[n++] = name[1];
+    if (has_value)
+        g->shorts[n++] = ':';
+    g->shorts[n] = '\0';
+}
+
+/* Builds the getopt_long tables; returns 0, or -1 when out of memory. */
+static int build_getopt_tables(const tool_command_line *c, getopt_tables *g)
+{
+    size_t count = 0;
+    for (size_t t = 0; t < c->table_count; t++)
+        count += c->tables[t].count;
+    g->rows = calloc(count ? count : 1, sizeof *g->rows);
+    g->longs = calloc(count + 3, sizeof *g->longs);
+    if (!g->rows || !g->longs)
+        return -1;
+    strcpy(g->shorts, ":h"); /* ':': a missing value is reported as such, not as unknown */
+    size_t l = 0;
     for (size_t t = 0; t < c->table_count; t++)
         for (size_t k = 0; k < c->tables[t].count; k++) {
             const tool_option *opt = &c->tables[t].options[k];
-            if (!strcmp(name, opt->name) || (opt->alias && !strcmp(name, opt->alias))) {
-                *base = c->tables[t].base;
-                return opt;
+            int has_value = opt->values >= 1; /* an optional value is taken by hand */
+            g->rows[g->count] = (option_row){opt, c->tables[t].base};
+            const char *names[2] = {opt->name, opt->alias};
+            for (int n = 0; n < 2; n++) {
+                if (is_short_name(names[n]))
+                    add_short(g, names[n], has_value);
+                else if (names[n] && names[n][0] == '-' && names[n][1] == '-')
+                    g->longs[l++] =
+                        (struct option){names[n] + 2, has_value ? required_argument : no_argument,
+                                        NULL, ROW_VALUE + (int)g->count};
             }
+            g->count++;
         }
-    return NULL;
+    g->longs[l++] = (struct option){"help", no_argument, NULL, HELP_VALUE};
+    g->longs[l++] = (struct option){"version", no_argument, NULL, VERSION_VALUE};
+    return 0;
 }
 
-/* Takes the option at argv[*i] and its values, advancing *i past them. Returns 0, 1 when
- * its values are missing, or 2 after a usage error. */
-static int take_option(const tool_command_line *c, const tool_option *opt, void *base, int argc,
-                       char **argv, int *i)
+/* The row whose short name or alias is `letter`, or -1. */
+static int short_row(const getopt_tables *g, int letter)
 {
-    int available = argc - 1 - *i;
-    int count = opt->values;
-    if (count == TOOL_OPTIONAL_VALUE)
-        count = available > 0 && opt->accepts(argv[*i + 1]) ? 1 : 0;
-    else if (available < count)
-        return 1;
+    for (size_t r = 0; r < g->count; r++) {
+        const tool_option *opt = g->rows[r].option;
+        if ((is_short_name(opt->name) && opt->name[1] == letter) ||
+            (is_short_name(opt->alias) && opt->alias[1] == letter))
+            return (int)r;
+    }
+    return -1;
+}
+
+/* Takes a row's values (getopt_long's optarg, then what follows in argv for a second or an
+ * optional value) and applies them. Returns 0, or 2 after a usage error. */
+static int take_row(const tool_command_line *c, const option_row *row, int argc, char **argv)
+{
+    const tool_option *opt = row->option;
     const char *values[2] = {NULL, NULL};
-    for (int k = 0; k < count && k < 2; k++)
-        values[k] = argv[*i + 1 + k];
-    *i += count;
-    char *field = (char *)base + opt->offset;
+    if (opt->values >= 1)
+        values[0] = optarg;
+    if (opt->values == 2) {
+        if (optind >= argc)
+            return tool_usage_error(c->program, "%s needs %d values", opt->name, opt->values);
+        values[1] = argv[optind++];
+    }
+    if (opt->values == TOOL_OPTIONAL_VALUE && optind < argc && opt->accepts(argv[optind]))
+        values[0] = argv[optind++];
+    char *field = (char *)row->base + opt->offset;
     if (opt->parse)
-        return opt->parse(c->program, opt, values, base);
+        return opt->parse(c->program, opt, values, row->base);
     if (opt->values == 0)
         *(int *)(void *)field = 1;
     else
@@ -826,32 +991,63 @@ static int take_option(const tool_command_line *c, const tool_option *opt, void 
     return 0;
 }
 
-int tool_parse_command_line(const tool_command_line *c, int argc, char **argv)
+/* The usage error for getopt_long's '?' or ':' on argv[optind - 1]. */
+static int getopt_error(const tool_command_line *c, int result, char **argv)
 {
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        void *base = NULL;
-        const tool_option *opt = find_option(c, a, &base);
-        int rc = opt ? take_option(c, opt, base, argc, argv, &i) : 1;
-        if (rc == 2)
-            return 2;
-        if (rc == 0)
-            continue;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+    const char *arg = argv[optind - 1];
+    if (result == ':')
+        return tool_usage_error(c->program, "option '%s' needs a value", arg);
+    if (optopt && arg[0] == '-' && arg[1] != '-')
+        return tool_usage_error(c->program, "unknown option '-%c' (in '%s')", optopt, arg);
+    return tool_usage_error(c->program, "unknown or ambiguous option '%s'", arg);
+}
+
+static int parse_getopt(const tool_command_line *c, const getopt_tables *g, int argc, char **argv)
+{
+    opterr = 0;
+    optind = 0; /* start afresh, even when called twice */
+    for (;;) {
+        int result = getopt_long(argc, argv, g->shorts, g->longs, NULL);
+        if (result == -1)
+            break;
+        if (result == HELP_VALUE || result == 'h') {
             fputs(c->usage, stdout);
             exit(0);
-        } else if (!strcmp(a, "--version")) {
+        }
+        if (result == VERSION_VALUE) {
             tool_print_version(c->program);
             exit(0);
-        } else if (a[0] == '-' && a[1]) {
-            return tool_usage_error(c->program, "unknown or incomplete option '%s'", a);
-        } else if (c->positional && !*c->positional) {
-            *c->positional = a;
-        } else {
-            return tool_usage_error(c->program, "more than one %s ('%s')", c->positional_name, a);
         }
+        if (result == '?' || result == ':')
+            return getopt_error(c, result, argv);
+        int r = result >= ROW_VALUE ? result - ROW_VALUE : short_row(g, result);
+        if (r < 0)
+            return tool_usage_error(c->program, "unknown option '%s'", argv[optind - 1]);
+        if (take_row(c, &g->rows[r], argc, argv) != 0)
+            return 2;
+    }
+    for (int i = optind; i < argc; i++) {
+        if (c->positional && !*c->positional)
+            *c->positional = argv[i];
+        else
+            return tool_usage_error(c->program, "more than one %s ('%s')", c->positional_name,
+                                    argv[i]);
     }
     return 0;
+}
+
+int tool_parse_command_line(const tool_command_line *c, int argc, char **argv)
+{
+    getopt_tables g;
+    memset(&g, 0, sizeof g);
+    int rc = build_getopt_tables(c, &g) == 0 ? parse_getopt(c, &g, argc, argv) : -1;
+    free(g.rows);
+    free(g.longs);
+    if (rc < 0) {
+        fprintf(stderr, "%s: out of memory\n", c->program);
+        return 2;
+    }
+    return rc;
 }
 
 int tool_parse_view_command_line(const char *program, const char *usage, tool_view_options *o,

@@ -38,13 +38,18 @@ void tool_print_version(const char *program);
  * refused, never opened); no output is an input (the same file by device and inode, however
  * spelled); no two outputs are the same file; each output may be written (absent, or a
  * regular file and `force`; a directory, device or FIFO is refused even with force; see
- * isoprop/output.h). Returns 0, or 1 after printing one line "PROGRAM: path: problem". */
+ * isoprop/output.h). An output "-" is standard output, which at most one output may be. Returns 0, or 1 after printing one line "PROGRAM: path: problem". */
 int tool_check_paths(const char *program, const char *const *inputs, size_t input_count,
                      const char *const *outputs, size_t output_count, int force);
 
+/* Whether an output's path is "-", standard output (--stats -, --progress -). */
+int tool_is_stdout(const char *path);
+
 /* Writes what fill(out, user) prints as the whole file at `path`, all-or-nothing (nothing is
  * left at path on failure; an existing file is replaced only with `force`, and only when it
- * is a regular file). Returns 0, or -1 after printing "PROGRAM: path: reason" on stderr. */
+ * is a regular file). A path of "-" is standard output: the text is written there whole, at
+ * once, but what has been written to stdout cannot be taken back when a later output fails.
+ * Returns 0, or -1 after printing "PROGRAM: path: reason" on stderr. */
 int tool_write_text_file(const char *program, const char *path, int force,
                          void (*fill)(FILE *out, void *user), void *user);
 
@@ -61,6 +66,25 @@ void tool_signals_cancel_engine(ip_engine *engine);
 /* When a signal was caught: flushes stdout and stderr, restores the default action and
  * raises the signal again (the process ends there). Returns when none was caught. */
 void tool_signals_reraise(void);
+
+/* A progress bar on stderr (isoinfo --verify, isorender): shown when stderr is a terminal, or
+ * always when the environment variable `force_variable` is "1" (for tests, whose stderr is a
+ * pipe); drawn at most five times a second and at the end, as
+ * "[####      ]  40.0% DONE/TOTAL UNIT DETAIL ETA Ns" on one line that it redraws. */
+typedef struct tool_progress {
+    int show, drawn;
+    double start, last; /* seconds */
+} tool_progress;
+
+/* Starts the clock; the bar shows only when `wanted` (not --quiet, not --json). */
+void tool_progress_start(tool_progress *p, int wanted, const char *force_variable);
+/* Draws done of total UNIT (e.g. "bricks"), then `detail` (may be ""). */
+void tool_progress_draw(tool_progress *p, uint64_t done, uint64_t total, const char *unit,
+                        const char *detail);
+/* Seconds since tool_progress_start(). */
+double tool_progress_elapsed(const tool_progress *p);
+/* Ends the bar's line, so that what follows starts on a line of its own. */
+void tool_progress_end(tool_progress *p);
 
 /* Writes `text` as a JSON string literal (with quotes and escapes). */
 void tool_json_string(FILE *out, const char *text);
@@ -96,6 +120,7 @@ typedef struct tool_view_options {
     uint64_t cache_bytes;
     const char *stats; /* --stats OUT.json (NULL: none) */
     int force, quiet;
+    int verbose; /* --verbose (-v): what each step did, on stderr */
 } tool_view_options;
 
 /* The --help lines of the shared options that steer the engine (the usage texts of isorender

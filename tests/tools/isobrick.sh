@@ -46,7 +46,7 @@ check "no output after an unreadable header" test ! -e badnrrd.ibv
 expect_error 1 "nothere.raw" "$bin/isobrick" nothere.raw -o nothere.ibv
 expect_error 2 "--dims" "$bin/isobrick" "$raw" --dims 40x30 -o x.ibv
 expect_error 2 "unknown" "$bin/isobrick" "$raw" --frobnicate
-expect_error 1 "brick edge" "$bin/isobrick" "$raw" --brick-size 12 -o b12.ibv
+expect_error 2 "--brick-size '12' is not a power of two" "$bin/isobrick" "$raw" --brick-size 12 -o b12.ibv
 check "no output after a bad brick size" test ! -e b12.ibv
 
 # --- existing output: kept without --force, replaced with it ---

@@ -80,8 +80,8 @@ expect_error 2 "--iso" "$bin/isorender" s.ibv -o x.png
 check "no image without --iso" test ! -e x.png
 expect_error 1 "nothere.ibv" "$bin/isorender" nothere.ibv --iso 1 -o x.png
 expect_error 2 "--size" "$bin/isorender" s.ibv --iso 1 --size 12 -o x.png
-expect_error 1 "view" "$bin/isorender" s.ibv --iso 1 --view +w -o x.png
-expect_error 1 "camera" "$bin/isorender" s.ibv --iso 1 --camera 0,0,0,0,0,0,0,0,1,30 -o x.png
+expect_error 2 "view" "$bin/isorender" s.ibv --iso 1 --view +w -o x.png
+expect_error 2 "camera" "$bin/isorender" s.ibv --iso 1 --camera 0,0,0,0,0,0,0,0,1,30 -o x.png
 expect_error 1 "exists" "$bin/isorender" s.ibv --iso 100.5 --size 16x12 -o p.png --software
 head -c 1000 s.ibv >cut.ibv
 expect_error 1 "cut.ibv" "$bin/isorender" cut.ibv --iso 1 -o x.png

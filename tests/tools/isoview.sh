@@ -15,7 +15,7 @@ expect_error 2 "--lod" "$bin/isoview" s.ibv --iso 1 --lod maybe
 expect_error 2 "--aa '0'" "$bin/isoview" s.ibv --iso 1 --aa 0
 expect_error 2 "--aa '32'" "$bin/isoview" s.ibv --iso 1 --aa 32
 expect_error 1 "nothere.ibv" "$bin/isoview" nothere.ibv --iso 1
-expect_error 1 "view" "$bin/isoview" s.ibv --iso 1 --view +w
+expect_error 2 "view" "$bin/isoview" s.ibv --iso 1 --view +w
 printf 'iso 1\norbit 10\n' >bad.txt
 expect_error 1 "bad.txt:2" "$bin/isoview" s.ibv --iso 1 --script bad.txt
 expect_error 1 "cannot open a window" env -u DISPLAY -u WAYLAND_DISPLAY "$bin/isoview" s.ibv --iso 1

@@ -383,7 +383,7 @@ static int finish(viewer *v)
     ip_cache_stats s;
     ip_cache_get_stats(v->cache, &s);
     uint64_t summary = ip_store_summary_memory(v->store);
-    if (!v->o.common.quiet) {
+    if (!v->o.common.quiet && !tool_is_stdout(v->o.common.stats)) {
         print_summary(v);
         tool_print_cache_table(stdout, &s, summary);
     }
