@@ -57,6 +57,20 @@ static input_kind kind_of(const char *path)
     return INPUT_RAW;
 }
 
+ip_status ip__input_open_regular(const char *path, int *fd, ip_error *err)
+{
+    struct stat st;
+    *fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (*fd < 0)
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
+    if (fstat(*fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(*fd);
+        *fd = -1;
+        return ip__fail(err, IP_ERR_INPUT, "%s: not a regular file", path);
+    }
+    return IP_OK;
+}
+
 /* ---- folders: a DICOM series or numbered TIFF files ---- */
 
 /* The alphabetically first visible regular file of the folder `path` into out; IP_ERR_INPUT

@@ -157,14 +157,10 @@ static ip_status check_magic(const char *path, const unsigned char *h, const nif
 static ip_status read_header(const char *path, nifti_header *n, int *compressed, ip_error *err)
 {
     unsigned char h[NIFTI2_HEADER_BYTES];
-    struct stat st;
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0)
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        close(fd);
-        return ip__fail(err, IP_ERR_INPUT, "%s: not a regular file", path);
-    }
+    int fd;
+    ip_status st = ip__input_open_regular(path, &fd, err);
+    if (st != IP_OK)
+        return st;
     *compressed = pread(fd, h, 2, 0) == 2 && h[0] == 0x1f && h[1] == 0x8b;
     gzFile gz = gzdopen(fd, "rb");
     if (!gz) {

@@ -42,6 +42,11 @@ typedef struct ip__plane_source {
 extern const ip__plane_source ip__tiff_source;
 extern const ip__plane_source ip__dicom_source;
 
+/*! ip__input_open_regular() : opens `path` read-only without waiting (O_NONBLOCK: a FIFO is
+ *  refused, never waited on) and checks that it is a regular file; *fd is the caller's to
+ *  close. IP_ERR_IO when it cannot be opened, IP_ERR_INPUT when it is not a regular file. */
+ip_status ip__input_open_regular(const char *path, int *fd, ip_error *err);
+
 /*! ip__plane_source_of() : the plane source of an encoding; NULL for raw and gzip data. */
 const ip__plane_source *ip__plane_source_of(ip_encoding encoding);
 

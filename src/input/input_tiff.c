@@ -59,16 +59,12 @@ static const char *tiff_reason(const tiff_file *f, const char *otherwise)
  * address libtiff keeps until tiff_close(). */
 static ip_status tiff_open_file(tiff_file *f, const char *path, ip_error *err)
 {
-    struct stat st;
     memset(f, 0, sizeof *f);
     snprintf(f->path, sizeof f->path, "%s", path);
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0)
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        close(fd);
-        return ip__fail(err, IP_ERR_INPUT, "%s: not a regular file", path);
-    }
+    int fd;
+    ip_status st = ip__input_open_regular(path, &fd, err);
+    if (st != IP_OK)
+        return st;
     TIFFOpenOptions *options = TIFFOpenOptionsAlloc();
     if (!options) {
         close(fd);
