@@ -7,6 +7,11 @@ if [ -d "$bin/man" ]; then
     for program in isobrick isoinfo isogen isorender isoview; do
         check "$bin/man/$program.1 exists" test -s "$bin/man/$program.1"
         check "$program.1 mentions --version" grep -q -- 'version' "$bin/man/$program.1"
+        # the NAME line says what the program does, not just its name again
+        check "$program.1 has a NAME line with a description" \
+            sh -c 'sed -n "/^\.SH NAME/{n;p;}" "$0" | grep -Eq "^$1 \\\\- [a-z]" && \
+                   ! sed -n "/^\.SH NAME/{n;p;}" "$0" | grep -Eq "^$1 \\\\- $1\$"' \
+            "$bin/man/$program.1" "$program"
     done
     check "isorender.1 mentions --iso and --stats" \
         sh -c 'grep -q -- "-iso" "$0" && grep -q -- "-stats" "$0"' "$bin/man/isorender.1"
