@@ -663,11 +663,14 @@ static void test_version_1(void)
 {
     image m;
     make_image(&m);
-    make_version_1(&m, 0);
-    reseal(&m);
     ip_layout l, identity;
     ip_error err;
     REQUIRE(parse(&m, &l, &err) == IP_OK);
+    CHECK(l.format_version == IP_FORMAT_VERSION); /* the file's own version is kept */
+    make_version_1(&m, 0);
+    reseal(&m);
+    REQUIRE(parse(&m, &l, &err) == IP_OK);
+    CHECK(l.format_version == 1);
     ip_orientation_identity(&identity.orientation);
     CHECK(memcmp(&l.orientation, &identity.orientation, sizeof l.orientation) == 0);
     CHECK(ip_orientation_is_identity(&l.orientation) && l.orientation.space == IP_SPACE_UNKNOWN);

@@ -95,7 +95,7 @@ static void print_text(const ip_store *s, const file_facts *f)
     const ip_layout *l = ip_store_layout(s);
     char a[32], b[32], c[32];
     printf("%s\n", ip_store_path(s));
-    printf("  format        version %u\n", IP_FORMAT_VERSION);
+    printf("  format        version %u\n", l->format_version);
     printf("  dims          %u x %u x %u samples, %s\n", l->dims[0], l->dims[1], l->dims[2],
            ip_type_name(l->type));
     printf("  spacing       %g, %g, %g\n", l->spacing[0], l->spacing[1], l->spacing[2]);
@@ -128,7 +128,7 @@ static void print_json(const ip_store *s, const file_facts *f)
     const ip_layout *l = ip_store_layout(s);
     printf("{\"file\": ");
     tool_json_string(stdout, ip_store_path(s));
-    printf(", \"format_version\": %u", IP_FORMAT_VERSION);
+    printf(", \"format_version\": %u", l->format_version);
     printf(", \"dims\": [%u, %u, %u]", l->dims[0], l->dims[1], l->dims[2]);
     printf(", \"type\": \"%s\"", ip_type_name(l->type));
     printf(", \"spacing\": [%.17g, %.17g, %.17g]", l->spacing[0], l->spacing[1], l->spacing[2]);

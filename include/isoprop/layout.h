@@ -79,6 +79,8 @@ typedef struct ip_layout {
     uint64_t summary_checksum;
     uint64_t file_size;
     ip_level_layout levels[IP_MAX_LEVELS];
+    uint32_t format_version; /* the file's format version (an opened file's own: 1 or 2); the
+                                version this build writes for a layout made to write */
 } ip_layout;
 
 /* A brick directory entry (24 bytes on disk). */

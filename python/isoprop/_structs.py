@@ -74,7 +74,7 @@ class Layout(ctypes.Structure):
                 ("node_count", c_uint64), ("data_offset", c_uint64), ("data_size", c_uint64),
                 ("summary_offset", c_uint64), ("summary_size", c_uint64),
                 ("summary_checksum", c_uint64), ("file_size", c_uint64),
-                ("levels", LevelLayout * MAX_LEVELS)]
+                ("levels", LevelLayout * MAX_LEVELS), ("format_version", c_uint32)]
 
 
 class CacheLevelStats(ctypes.Structure):

@@ -57,6 +57,7 @@ ip_status ip__layout_init(ip_layout *layout, const uint32_t dims[3], ip_type typ
                           ip_error *err)
 {
     memset(layout, 0, sizeof *layout);
+    layout->format_version = IP_FORMAT_VERSION;
     for (int a = 0; a < 3; a++) {
         if (dims[a] < 2 || dims[a] >= (1u << 31))
             return ip__fail(err, IP_ERR_ARGUMENT, "dimension %u along %c is outside [2, 2^31)",
@@ -394,6 +395,7 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
     ip_status st = ip_spacing_check(spacing, name, err);
     if (st != IP_OK)
         return st;
+    layout->format_version = version;
     if ((st = parse_orientation(h, version, name, layout, err)) != IP_OK)
         return st;
     if (ip__load_u32le(h + IP_HDR_LEVEL_COUNT) != layout->level_count ||

@@ -103,6 +103,7 @@ static void layout(void)
     FIELD(ip_layout, summary_checksum);
     FIELD(ip_layout, file_size);
     FIELD(ip_layout, levels);
+    FIELD(ip_layout, format_version);
 }
 
 static void cache(void)
