@@ -132,6 +132,7 @@ static void test_header_fields(void)
     CHECK(d.type == IP_UINT16 && d.dims[0] == 2 && d.dims[2] == 4 && d.spacing[1] == 0.1);
     free(samples);
 }
+
 static void patch(const char *path, long offset, const void *bytes, size_t size)
 {
     FILE *f = fopen(path, "r+b");

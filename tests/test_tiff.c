@@ -59,6 +59,7 @@ static void check_reads_as(const char *path, ip_type type, const uint32_t dims[3
                   "%s: samples differ", path);
     free(got);
 }
+
 static void make_folder(const char *path)
 {
     REQUIRE(mkdir(path, 0777) == 0);
