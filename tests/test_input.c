@@ -10,6 +10,7 @@
 #include <zlib.h>
 
 #include "check.h"
+#include "input_check.h"
 #include "isoprop/input.h"
 
 static char scratch[4096];
@@ -181,20 +182,6 @@ static int describe_ok(const char *path, const ip_input_overrides *overrides, ip
     ip_status status = ip_input_describe(path, overrides, d, &err);
     CHECK_MSG(status == IP_OK, "%s: %s", path, err.message);
     return status == IP_OK;
-}
-
-/* Describes `path`, expecting `code` and a message that names `name` and holds `needle`. */
-static void describe_fails(const char *path, const ip_input_overrides *overrides, ip_status code,
-                           const char *name, const char *needle)
-{
-    ip_input_desc d;
-    ip_error err;
-    ip_error_clear(&err);
-    ip_status status = ip_input_describe(path, overrides, &d, &err);
-    CHECK_MSG(status == code, "%s: got %d (%s), expected %d", path, status, err.message, code);
-    CHECK_CONTAINS(err.message, name);
-    CHECK_CONTAINS(err.message, needle);
-    CHECK(strchr(err.message, '\n') == NULL);
 }
 
 /* Reads every plane of `desc` one at a time, expecting the reads to fail with `code` and a

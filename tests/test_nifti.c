@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "input_check.h"
 #include "volume_files.h"
 
 static char scratch[4096];
@@ -132,18 +133,6 @@ static void test_header_fields(void)
     free(samples);
 }
 
-static void describe_fails(const char *path, ip_status code, const char *needle)
-{
-    ip_input_desc d;
-    ip_error err;
-    ip_error_clear(&err);
-    ip_status st = ip_input_describe(path, NULL, &d, &err);
-    CHECK_MSG(st == code, "%s: got %d (%s), expected %d", path, st, err.message, code);
-    CHECK_CONTAINS(err.message, path);
-    CHECK_CONTAINS(err.message, needle);
-    CHECK(strchr(err.message, '\n') == NULL);
-}
-
 static void patch(const char *path, long offset, const void *bytes, size_t size)
 {
     FILE *f = fopen(path, "r+b");
@@ -163,9 +152,9 @@ static void test_bad_files(void)
     /* truncated: inside the samples, inside the header, and a gzip stream cut short */
     REQUIRE(write_nifti(in_scratch(path, "short.nii"), IP_UINT16, dims, samples, &s) == 0);
     REQUIRE(truncate(path, 352 + 6 * 5 * 4 * 2 - 10) == 0);
-    describe_fails(path, IP_ERR_INPUT, "does not equal 6x5x4 x 2 bytes");
+    describe_fails(path, NULL, IP_ERR_INPUT, path, "does not equal 6x5x4 x 2 bytes");
     REQUIRE(truncate(path, 200) == 0);
-    describe_fails(path, IP_ERR_INPUT, "truncated: 200 bytes, under the 348");
+    describe_fails(path, NULL, IP_ERR_INPUT, path, "truncated: 200 bytes, under the 348");
     s.gzip = 1;
     REQUIRE(write_nifti(in_scratch(path, "short.nii.gz"), IP_UINT16, dims, samples, &s) == 0);
     FILE *f = fopen(path, "rb");
@@ -184,30 +173,31 @@ static void test_bad_files(void)
     /* 4D, 2D, bad magic, a .hdr/.img header, another datatype, not NIfTI at all */
     s.dim[0] = 4, s.dim[1] = 6, s.dim[2] = 5, s.dim[3] = 2, s.dim[4] = 2;
     REQUIRE(write_nifti(in_scratch(path, "4d.nii"), IP_UINT16, dims, samples, &s) == 0);
-    describe_fails(path, IP_ERR_UNSUPPORTED, "a 4D image (dim[4] = 2)");
+    describe_fails(path, NULL, IP_ERR_UNSUPPORTED, path, "a 4D image (dim[4] = 2)");
     s.dim[0] = 2;
     REQUIRE(write_nifti(in_scratch(path, "2d.nii"), IP_UINT16, dims, samples, &s) == 0);
-    describe_fails(path, IP_ERR_UNSUPPORTED, "dim[0] = 2: only 3D");
+    describe_fails(path, NULL, IP_ERR_UNSUPPORTED, path, "dim[0] = 2: only 3D");
     s.dim[0] = 0;
     REQUIRE(write_nifti(in_scratch(path, "magic.nii"), IP_UINT16, dims, samples, &s) == 0);
     patch(path, 344, "n+9", 4);
-    describe_fails(path, IP_ERR_INPUT, "bad NIfTI-1 magic");
+    describe_fails(path, NULL, IP_ERR_INPUT, path, "bad NIfTI-1 magic");
     patch(path, 344, "ni1", 4);
-    describe_fails(path, IP_ERR_UNSUPPORTED, ".hdr/.img pair");
+    describe_fails(path, NULL, IP_ERR_UNSUPPORTED, path, ".hdr/.img pair");
     s.version = 2;
     REQUIRE(write_nifti(in_scratch(path, "magic2.nii"), IP_UINT16, dims, samples, &s) == 0);
     patch(path, 4, "n+1", 4);
-    describe_fails(path, IP_ERR_INPUT, "bad NIfTI-2 magic");
+    describe_fails(path, NULL, IP_ERR_INPUT, path, "bad NIfTI-2 magic");
     s.datatype = 64;
     REQUIRE(write_nifti(in_scratch(path, "double.nii"), IP_UINT16, dims, samples, &s) == 0);
-    describe_fails(path, IP_ERR_UNSUPPORTED, "datatype 64 (float64) is not supported");
+    describe_fails(path, NULL, IP_ERR_UNSUPPORTED, path, "datatype 64 (float64) is not supported");
     s.datatype = 0;
     s.vox_offset = 100;
     REQUIRE(write_nifti(in_scratch(path, "offset.nii"), IP_UINT16, dims, samples, &s) == 0);
-    describe_fails(path, IP_ERR_INPUT, "vox_offset 100 is not a byte offset past the 540");
+    describe_fails(path, NULL, IP_ERR_INPUT, path,
+                   "vox_offset 100 is not a byte offset past the 540");
     REQUIRE(write_nifti(in_scratch(path, "zeros.nii"), IP_UINT16, dims, samples, &s) == 0);
     patch(path, 0, "\0\0\0\0", 4);
-    describe_fails(path, IP_ERR_INPUT, "not a NIfTI file");
+    describe_fails(path, NULL, IP_ERR_INPUT, path, "not a NIfTI file");
     free(samples);
 }
 

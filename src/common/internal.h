@@ -40,6 +40,12 @@ ip_status ip__fail(ip_error *err, ip_status code, const char *fmt, ...) IP_PRINT
 ip_status ip__fail_errno(ip_error *err, ip_status code, int errnum, const char *fmt, ...)
     IP_PRINTF(4, 5);
 
+struct ip_orientation;
+/* Sets o's directions to `directions` (one vector an axis) over their lengths and returns 1
+ * when they form an orthonormal frame that passes ip_orientation_check with o's origin and
+ * space; else returns 0 and leaves o as it was. */
+int ip__orientation_frame(struct ip_orientation *o, const double directions[3][3]);
+
 /* Little-endian loads and stores, independent of the host's byte order. */
 static inline uint32_t ip__load_u32le(const unsigned char *p)
 {

@@ -96,3 +96,15 @@ int ip_orientation_normalize(double columns[3][3], double lengths[3])
     }
     return 0;
 }
+
+int ip__orientation_frame(ip_orientation *o, const double directions[3][3])
+{
+    ip_orientation framed = *o;
+    double lengths[3];
+    memcpy(framed.directions, directions, sizeof framed.directions);
+    if (ip_orientation_normalize(framed.directions, lengths) != 0 ||
+        ip_orientation_check(&framed, NULL, NULL) != IP_OK)
+        return 0;
+    *o = framed;
+    return 1;
+}

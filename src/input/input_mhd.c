@@ -231,14 +231,8 @@ static void fill_orientation(const mhd_header *h, ip_orientation *o)
     ip_orientation_identity(o);
     if (h->offset_count == 3)
         memcpy(o->origin, h->offset, sizeof o->origin);
-    if (h->has_matrix) {
-        ip_orientation framed = *o;
-        double lengths[3];
-        memcpy(framed.directions, h->matrix, sizeof framed.directions);
-        if (ip_orientation_normalize(framed.directions, lengths) == 0 &&
-            ip_orientation_check(&framed, NULL, NULL) == IP_OK)
-            *o = framed;
-    }
+    if (h->has_matrix)
+        ip__orientation_frame(o, h->matrix);
 }
 
 /* The data start HeaderSize bytes into the data file or, for LOCAL, into what follows the

@@ -271,14 +271,13 @@ static void report_rescale(const nifti_header *n, ip_input_desc *desc)
 /* The sform's columns, over their lengths; 0 when they are not an orthonormal frame. */
 static int sform_orientation(const nifti_header *n, ip_orientation *o)
 {
-    double lengths[3];
+    double directions[3][3];
     for (int a = 0; a < 3; a++) {
         o->origin[a] = n->srow[a][3];
         for (int c = 0; c < 3; c++)
-            o->directions[a][c] = n->srow[c][a];
+            directions[a][c] = n->srow[c][a];
     }
-    return ip_orientation_normalize(o->directions, lengths) == 0 &&
-           ip_orientation_check(o, NULL, NULL) == IP_OK;
+    return ip__orientation_frame(o, directions);
 }
 
 /* The rotation of the quaternion (b, c, d; a = sqrt(1 - b^2 - c^2 - d^2)), its third column
@@ -292,14 +291,13 @@ static int qform_orientation(const nifti_header *n, ip_orientation *o)
     double r[3][3] = {{a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)},
                       {2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b)},
                       {2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b}};
-    double lengths[3];
+    double directions[3][3];
     for (int axis = 0; axis < 3; axis++) {
         o->origin[axis] = n->qoffset[axis];
         for (int row = 0; row < 3; row++)
-            o->directions[axis][row] = r[row][axis] * (axis == 2 ? qfac : 1.0);
+            directions[axis][row] = r[row][axis] * (axis == 2 ? qfac : 1.0);
     }
-    return ip_orientation_normalize(o->directions, lengths) == 0 &&
-           ip_orientation_check(o, NULL, NULL) == IP_OK;
+    return ip__orientation_frame(o, directions);
 }
 
 /* sform first, then qform, as the format's codes rank them; identity when neither is set. */

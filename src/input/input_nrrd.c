@@ -378,14 +378,8 @@ static void fill_orientation(const nrrd_header *h, ip_orientation *o)
     ip_orientation_identity(o);
     memcpy(o->origin, h->origin, sizeof o->origin);
     o->space = h->space;
-    if (h->directions_count == 3 && h->has_vectors) {
-        ip_orientation framed = *o;
-        double lengths[3];
-        memcpy(framed.directions, h->vectors, sizeof framed.directions);
-        if (ip_orientation_normalize(framed.directions, lengths) == 0 &&
-            ip_orientation_check(&framed, NULL, NULL) == IP_OK)
-            *o = framed;
-    }
+    if (h->directions_count == 3 && h->has_vectors)
+        ip__orientation_frame(o, h->vectors);
 }
 
 static void fill_desc(const nrrd_header *h, ip_input_desc *desc, ip_text_found *found)
