@@ -18,22 +18,28 @@ int ip__clip_valid(const ip_clip_plane *planes, unsigned count)
 
 int ip__clip_keeps_box(const ip_clip *c, const double lo[3], const double hi[3])
 {
+    int side = IP__CLIP_KEEPS_ALL;
     for (unsigned i = 0; i < c->count; i++) {
         const ip_clip_plane *p = &c->planes[i];
-        double most = p->offset; /* the plane's largest value over the box: at one corner */
-        for (int k = 0; k < 3; k++)
+        /* the plane's largest and smallest values over the box: each at one corner */
+        double most = p->offset, least = p->offset;
+        for (int k = 0; k < 3; k++) {
             most += p->normal[k] * (p->normal[k] > 0 ? hi[k] : lo[k]);
+            least += p->normal[k] * (p->normal[k] > 0 ? lo[k] : hi[k]);
+        }
         if (most < 0)
-            return 0;
+            return IP__CLIP_DROPS;
+        if (least < 0)
+            side = IP__CLIP_STRADDLES;
     }
-    return 1;
+    return side;
 }
 
 int ip__clip_keeps_samples(const ip_clip *c, const ip_layout *l, uint32_t level,
                            const uint32_t first[3], const uint32_t last[3])
 {
     if (c->count == 0)
-        return 1;
+        return IP__CLIP_KEEPS_ALL;
     double lo[3], hi[3];
     for (int k = 0; k < 3; k++) {
         lo[k] = ip_level_sample_index(l->dims[k], level, first[k]) * l->spacing[k];
@@ -45,7 +51,7 @@ int ip__clip_keeps_samples(const ip_clip *c, const ip_layout *l, uint32_t level,
 int ip__clip_keeps_brick(const ip_clip *c, const ip_layout *l, uint64_t g)
 {
     if (c->count == 0)
-        return 1;
+        return IP__CLIP_KEEPS_ALL;
     uint32_t level, b[3], origin[3], extent[3], last[3];
     ip_brick_coords(l, g, &level, b);
     ip_brick_extent(l, level, b, origin, extent);

@@ -18,7 +18,15 @@ typedef struct ip_clip {
 /* 1 when the planes are usable: at most IP_MAX_CLIP_PLANES, finite, normals not zero. */
 int ip__clip_valid(const ip_clip_plane *planes, unsigned count);
 
-/* 1 unless the world box [lo, hi] lies wholly beyond one of the planes. */
+/* Where the world box [lo, hi] lies: IP__CLIP_DROPS when wholly beyond one of the planes,
+ * IP__CLIP_KEEPS_ALL when wholly on the kept side of every plane (always, with no planes), else
+ * IP__CLIP_STRADDLES. Nonzero means kept; callers test the cells of a straddling box one by one
+ * and skip that test inside a box kept whole. */
+enum {
+    IP__CLIP_DROPS = 0,
+    IP__CLIP_STRADDLES = 1,
+    IP__CLIP_KEEPS_ALL = 2
+};
 int ip__clip_keeps_box(const ip_clip *c, const double lo[3], const double hi[3]);
 
 /* ip__clip_keeps_box() of the box between samples `first` and `last` of pyramid level `level`

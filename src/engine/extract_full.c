@@ -29,13 +29,15 @@ static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip
             lo[a] = origin[a] + se * sb[a];
             hi[a] = lo[a] + se < origin[a] + extent[a] - 1 ? lo[a] + se : origin[a] + extent[a] - 1;
         }
-        if (!ip__clip_keeps_samples(clip, l, level, lo, hi))
+        int side = ip__clip_keeps_samples(clip, l, level, lo, hi);
+        if (side == IP__CLIP_DROPS)
             continue;
         for (uint32_t z = lo[2]; z < hi[2] && st == IP_OK; z++)
             for (uint32_t y = lo[1]; y < hi[1] && st == IP_OK; y++)
                 for (uint32_t x = lo[0]; x < hi[0]; x++) {
                     uint32_t cell[3] = {x, y, z}, far[3] = {x + 1, y + 1, z + 1};
-                    if (clip->count && !ip__clip_keeps_samples(clip, l, level, cell, far))
+                    if (side == IP__CLIP_STRADDLES &&
+                        !ip__clip_keeps_samples(clip, l, level, cell, far))
                         continue;
                     unsigned mc;
                     int n = ip__extract_cell(s, mesh, cell, iso, &mc, &st);

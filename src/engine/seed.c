@@ -162,9 +162,11 @@ static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc, co
     return best;
 }
 
-/* Tests the cells of one sub-block (cells [lo, hi) in level coordinates) along the ray. */
+/* Tests the cells of one sub-block (cells [lo, hi) in level coordinates) along the ray; `side`
+ * is where the sub-block lies against the clipping planes (ip__clip_keeps_box()), its cells
+ * tested against them only when it straddles one. */
 static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], const uint32_t hi[3],
-                      double t0, double t1)
+                      int side, double t0, double t1)
 {
     double base[3] = {lo[0], lo[1], lo[2]};
     uint32_t n[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
@@ -198,8 +200,8 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
         float values[8];
         unsigned mc = 0;
         uint32_t c1[3] = {c[0] + 1, c[1] + 1, c[2] + 1};
-        if (group_active &&
-            (s->clip.count == 0 || ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))) {
+        if (group_active && (side == IP__CLIP_KEEPS_ALL ||
+                             ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))) {
             ip__cell_values(brick, s->layout->type, corners, c, values);
             mc = ip__mc_case(values, s->iso);
             s->cells_read++;
@@ -255,9 +257,8 @@ static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], dou
                 last[k] = origin[k] + extent[k] - 1; /* one past the brick's last cell */
                 hi[k] = lo[k] + se < last[k] ? lo[k] + se : last[k];
             }
-            int found = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi)
-                            ? walk_cells(s, r, lo, hi, enter_t, exit_t)
-                            : 0;
+            int side = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi);
+            int found = side ? walk_cells(s, r, lo, hi, side, enter_t, exit_t) : 0;
             if (found)
                 return found;
         }
