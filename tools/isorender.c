@@ -140,7 +140,7 @@ typedef struct run {
     ip_engine_counts totals;
     checkpoint *checkpoints;
     size_t checkpoint_count;
-    double extraction_wall, progress_render_seconds, final_pct;
+    double extraction_wall, progress_render_seconds;
     uint64_t visible_triangles; /* triangles of the mesh that own a pixel of its image */
     int owners_known;           /* visible_triangles and the checkpoints' `visible` are set */
     const char *renderer_name;
@@ -607,7 +607,6 @@ static int add_checkpoint(run *r, double start)
     return 0;
 }
 
-/* Casts rays until done, the ray count or the time limit, checkpointing as the count doubles. */
 /* After each step: the bar (rays done of those asked for, triangles so far) and, with
  * --verbose, the step's counts on a line of their own. */
 static void step_report(const run *r, tool_progress *bar, uint64_t limit)
@@ -628,13 +627,24 @@ static void step_report(const run *r, tool_progress *bar, uint64_t limit)
     }
 }
 
-static int extract_progressive(run *r, ip_error *err)
+/* The engine with the command line's options, cancelled by a signal; made once. */
+static int create_engine(run *r, ip_error *err)
 {
+    if (r->engine)
+        return 0;
     ip_engine_options eo;
     tool_engine_options(&r->o.common, &eo);
     if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
         return -1;
     tool_signals_cancel_engine(r->engine);
+    return 0;
+}
+
+/* Casts rays until done, the ray count or the time limit, checkpointing as the count doubles. */
+static int extract_progressive(run *r, ip_error *err)
+{
+    if (create_engine(r, err) != 0)
+        return -1;
     if (r->o.warm) { /* the same work once, untimed: the bricks it needs stay in the cache */
         if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK ||
             ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
@@ -1021,13 +1031,8 @@ static int turntable_extract(run *r, ip_error *err)
 {
     if (r->o.full)
         return r->mesh ? 0 : extract_full(r, err);
-    if (!r->engine) {
-        ip_engine_options eo;
-        tool_engine_options(&r->o.common, &eo);
-        if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
-            return -1;
-        tool_signals_cancel_engine(r->engine);
-    }
+    if (create_engine(r, err) != 0)
+        return -1;
     double start = ip_now_seconds();
     if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK ||
         ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
