@@ -140,7 +140,7 @@ typedef struct run {
     ip_engine_counts totals;
     checkpoint *checkpoints;
     size_t checkpoint_count;
-    double extraction_wall, progress_render_seconds, final_pct;
+    double extraction_wall, progress_render_seconds;
     uint64_t visible_triangles; /* triangles of the mesh that own a pixel of its image */
     int owners_known;           /* visible_triangles and the checkpoints' `visible` are set */
     const char *renderer_name;
@@ -220,8 +220,11 @@ static int parse_aa(const char *program, const tool_option *option, const char *
 static int figure_renderer(const run *r, uint32_t w, uint32_t h, ip_renderer **gl, ip_error *why,
                            ip_error *err)
 {
-    if (ip_renderer_create_headless(w, h, gl, why) != IP_OK)
+    *gl = NULL;
+    if (ip_renderer_create_headless(w, h, gl, why) != IP_OK) {
+        *gl = NULL;
         return 1;
+    }
     ip_status st = ip_renderer_set_shading(*gl, &r->o.shading, err);
     if (st == IP_OK && r->o.aa > 1)
         st = ip_renderer_set_samples(*gl, r->o.aa, err);
@@ -230,6 +233,19 @@ static int figure_renderer(const run *r, uint32_t w, uint32_t h, ip_renderer **g
     ip_renderer_destroy(*gl);
     *gl = NULL;
     return -1;
+}
+
+/* Draws `mesh` into rgba with `gl`, or in software when gl is NULL: the image, the strip's
+ * frames and the turntable's all go through here. */
+static ip_status draw_mesh(const run *r, ip_renderer *gl, const ip_mesh *mesh, uint8_t *rgba,
+                           ip_error *err)
+{
+    if (!gl)
+        return ip_raster_mesh_shaded(mesh, &r->camera, &r->o.shading, r->lo, r->hi, NULL, rgba,
+                                     err);
+    /* streamed: the driver never holds a second copy of the whole mesh */
+    ip_status st = ip_renderer_draw_mesh(gl, mesh, &r->camera, r->lo, r->hi, err);
+    return st == IP_OK ? ip_renderer_read_rgba(gl, rgba, err) : st;
 }
 
 /* ---- the progress strip ---- */
@@ -397,12 +413,7 @@ static int strip_render_frames(run *r, uint8_t *strip, uint32_t strip_width, ip_
     for (size_t f = 0; rc == 0 && f < r->o.strip_at.count; f++) {
         ip_mesh prefix = *r->mesh; /* a view of the first triangles, not a copy */
         prefix.triangle_count = r->strip.triangles[f];
-        ip_status st = gl ? ip_renderer_draw_mesh(gl, &prefix, &r->camera, r->lo, r->hi, err)
-                          : ip_raster_mesh_shaded(&prefix, &r->camera, &r->o.shading, r->lo, r->hi,
-                                                  NULL, frame, err);
-        if (st == IP_OK && gl)
-            st = ip_renderer_read_rgba(gl, frame, err);
-        if (st != IP_OK) {
+        if (draw_mesh(r, gl, &prefix, frame, err) != IP_OK) {
             rc = -1;
             break;
         }
@@ -596,7 +607,6 @@ static int add_checkpoint(run *r, double start)
     return 0;
 }
 
-/* Casts rays until done, the ray count or the time limit, checkpointing as the count doubles. */
 /* After each step: the bar (rays done of those asked for, triangles so far) and, with
  * --verbose, the step's counts on a line of their own. */
 static void step_report(const run *r, tool_progress *bar, uint64_t limit)
@@ -617,13 +627,24 @@ static void step_report(const run *r, tool_progress *bar, uint64_t limit)
     }
 }
 
-static int extract_progressive(run *r, ip_error *err)
+/* The engine with the command line's options, cancelled by a signal; made once. */
+static int create_engine(run *r, ip_error *err)
 {
+    if (r->engine)
+        return 0;
     ip_engine_options eo;
     tool_engine_options(&r->o.common, &eo);
     if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
         return -1;
     tool_signals_cancel_engine(r->engine);
+    return 0;
+}
+
+/* Casts rays until done, the ray count or the time limit, checkpointing as the count doubles. */
+static int extract_progressive(run *r, ip_error *err)
+{
+    if (create_engine(r, err) != 0)
+        return -1;
     if (r->o.warm) { /* the same work once, untimed: the bricks it needs stay in the cache */
         if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK ||
             ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
@@ -785,31 +806,21 @@ static void progress_csv(FILE *f, void *user)
 static int render_image(run *r, uint8_t *rgba, ip_error *err)
 {
     double start = ip_now_seconds();
+    ip_renderer *gl = NULL;
     if (!r->o.software) {
-        ip_renderer *gl;
         ip_error why;
         int made = figure_renderer(r, r->camera.width, r->camera.height, &gl, &why, err);
         if (made < 0)
             return -1; /* a setting OpenGL refuses: not a reason to draw something else */
-        if (made == 0) {
-            /* streamed: the driver never holds a second copy of the whole mesh */
-            ip_status st = ip_renderer_draw_mesh(gl, r->mesh, &r->camera, r->lo, r->hi, err);
-            if (st == IP_OK)
-                st = ip_renderer_read_rgba(gl, rgba, err);
-            ip_renderer_destroy(gl);
-            r->totals.rendering_seconds += ip_now_seconds() - start;
-            r->renderer_name = "opengl";
-            return st == IP_OK ? 0 : -1;
-        }
-        fprintf(stderr, "isorender: no headless OpenGL (%s); rendering in software\n", why.message);
+        if (made > 0)
+            fprintf(stderr, "isorender: no headless OpenGL (%s); rendering in software\n",
+                    why.message);
     }
-    r->renderer_name = "software";
-    int rc = ip_raster_mesh_shaded(r->mesh, &r->camera, &r->o.shading, r->lo, r->hi, NULL, rgba,
-                                   err) == IP_OK
-                 ? 0
-                 : -1;
+    r->renderer_name = gl ? "opengl" : "software";
+    ip_status st = draw_mesh(r, gl, r->mesh, rgba, err);
+    ip_renderer_destroy(gl);
     r->totals.rendering_seconds += ip_now_seconds() - start;
-    return rc;
+    return st == IP_OK ? 0 : -1;
 }
 
 static void json_counts(FILE *f, void *user)
@@ -1020,13 +1031,8 @@ static int turntable_extract(run *r, ip_error *err)
 {
     if (r->o.full)
         return r->mesh ? 0 : extract_full(r, err);
-    if (!r->engine) {
-        ip_engine_options eo;
-        tool_engine_options(&r->o.common, &eo);
-        if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
-            return -1;
-        tool_signals_cancel_engine(r->engine);
-    }
+    if (create_engine(r, err) != 0)
+        return -1;
     double start = ip_now_seconds();
     if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK ||
         ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
