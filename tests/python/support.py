@@ -54,6 +54,15 @@ def generate(field, dims, dtype):
                 WORK + "/", "--force").strip()
 
 
+def phantom(dims, dtype, spacing, name="phantom.ibv"):
+    """The Shepp-Logan phantom of `dims` and `dtype`, bricked (8^3 bricks, `spacing`) into the
+    scratch folder; returns the brick file's path."""
+    raw = generate("shepp-logan", dims, dtype)
+    ibv = work(name)
+    tool("isobrick", raw, "-o", ibv, "--brick-size", "8", "--spacing", spacing, "--quiet")
+    return ibv
+
+
 def isoinfo(path):
     return json.loads(tool("isoinfo", path, "--json"))
 

@@ -33,10 +33,7 @@ def key_paths(d, prefix=""):
 class Extract(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        raw = support.generate("shepp-logan", (48, 40, 36), "uint16")
-        cls.ibv = support.work("phantom.ibv")
-        support.tool("isobrick", raw, "-o", cls.ibv, "--brick-size", "8", "--spacing",
-                     "1,1,1.5", "--quiet")
+        cls.ibv = support.phantom((48, 40, 36), "uint16", "1,1,1.5")
         cls.f = isoprop.open(cls.ibv)
 
     @classmethod

@@ -11,10 +11,7 @@ import isoprop
 class Open(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        raw = support.generate("shepp-logan", (40, 33, 27), "int16")
-        cls.ibv = support.work("phantom.ibv")
-        support.tool("isobrick", raw, "-o", cls.ibv, "--brick-size", "8", "--spacing",
-                     "0.5,0.75,1.25", "--quiet")
+        cls.ibv = support.phantom((40, 33, 27), "int16", "0.5,0.75,1.25")
         cls.info = support.isoinfo(cls.ibv)
 
     def test_attributes_equal_isoinfo(self):
