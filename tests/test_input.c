@@ -643,6 +643,93 @@ static void test_mhd(void)
     }
 }
 
+/* The space the NRRD `space` field names, long or short; any other space is unknown. */
+static void test_nrrd_spaces(void)
+{
+    static const struct {
+        const char *field;
+        ip_space space;
+        const char *name;
+    } cases[] = {{"right-anterior-superior", IP_SPACE_RAS, "RAS"},
+                 {"RAS", IP_SPACE_RAS, "RAS"},
+                 {"left-anterior-superior", IP_SPACE_LAS, "LAS"},
+                 {"left-posterior-superior", IP_SPACE_LPS, "LPS"},
+                 {"LPS", IP_SPACE_LPS, "LPS"},
+                 {"scanner-xyz", IP_SPACE_UNKNOWN, ""}};
+    char path[4096], text[512];
+    ip_input_desc d;
+    const uint32_t dims[3] = {3, 3, 3};
+    in_scratch(path, "spaces.nrrd");
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        snprintf(text, sizeof text,
+                 "NRRD0004\ntype: uint8\ndimension: 3\nspace: %s\nsizes: 3 3 3\n"
+                 "space directions: (0,0,-2) (0,1,0) (1,0,0)\nspace origin: (1,2,3)\n"
+                 "encoding: raw\n\n",
+                 cases[i].field);
+        write_text(path, text);
+        write_volume(path, "ab", IP_UINT8, dims, 0);
+        if (!describe_ok(path, NULL, &d))
+            continue;
+        CHECK_MSG(d.orientation.space == cases[i].space &&
+                      strcmp(ip_space_name(d.orientation.space), cases[i].name) == 0,
+                  "space: %s", cases[i].field);
+        /* the file's own space, not converted: the origin and directions as written */
+        CHECK(d.orientation.origin[0] == 1 && d.orientation.origin[1] == 2 &&
+              d.orientation.origin[2] == 3);
+        CHECK(d.orientation.directions[0][2] == -1 && d.orientation.directions[1][1] == 1 &&
+              d.orientation.directions[2][0] == 1 && d.spacing[0] == 2);
+    }
+}
+
+/* MetaImage: Offset (or Position, Origin) is the origin; TransformMatrix (or Rotation,
+ * Orientation) lists the x axis direction, then y, then z; the spacing stays ElementSpacing;
+ * AnatomicalOrientation is not read and no space is named; a matrix without an orthonormal
+ * frame gives the identity directions and keeps the origin. */
+static void test_mhd_orientation(void)
+{
+    /* the rotation of the unit quaternion (0.8, 0.2, 0.4, 0.4): axis a's direction */
+    static const double axes[3][3] = {{0.36, 0.8, -0.48}, {-0.48, 0.6, 0.64}, {0.8, 0.0, 0.6}};
+    static const struct {
+        const char *origin_key, *matrix_key, *matrix;
+        int framed;
+    } cases[] = {{"Offset", "TransformMatrix", "0.36 0.8 -0.48 -0.48 0.6 0.64 0.8 0 0.6", 1},
+                 {"Position", "Rotation", "0.36 0.8 -0.48 -0.48 0.6 0.64 0.8 0 0.6", 1},
+                 {"Origin", "Orientation", "0.36 0.8 -0.48 -0.48 0.6 0.64 0.8 0 0.6", 1},
+                 {"Offset", "TransformMatrix", "1 0.5 0 0 1 0 0 0 1", 0}};
+    char header[4096], data[4096], text[1024];
+    ip_input_desc d;
+    const uint32_t dims[3] = {7, 5, 3};
+    in_scratch(data, "turned.raw");
+    write_volume(data, "wb", IP_UINT8, dims, 0);
+    in_scratch(header, "turned.mhd");
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        snprintf(text, sizeof text,
+                 "ObjectType = Image\nNDims = 3\n%s = 10 -20 30.5\n%s = %s\n"
+                 "AnatomicalOrientation = LPI\nDimSize = 7 5 3\nElementSpacing = 0.5 0.75 2\n"
+                 "ElementType = MET_UCHAR\nElementDataFile = turned.raw\n",
+                 cases[i].origin_key, cases[i].matrix_key, cases[i].matrix);
+        write_text(header, text);
+        if (!describe_ok(header, NULL, &d))
+            continue;
+        double worst = 0.0;
+        for (int a = 0; a < 3; a++)
+            for (int c = 0; c < 3; c++)
+                worst = fmax(worst, fabs(d.orientation.directions[a][c] -
+                                         (cases[i].framed ? axes[a][c] : a == c)));
+        CHECK_MSG(worst < 1e-12, "%s: directions off by %g", cases[i].matrix_key, worst);
+        CHECK(d.orientation.origin[0] == 10 && d.orientation.origin[1] == -20 &&
+              d.orientation.origin[2] == 30.5);
+        CHECK(d.spacing[0] == 0.5 && d.spacing[1] == 0.75 && d.spacing[2] == 2);
+        CHECK(d.orientation.space == IP_SPACE_UNKNOWN);
+        CHECK(read_and_compare(&d, 3) == 0);
+    }
+    /* neither key: the identity */
+    write_text(header, "NDims = 3\nDimSize = 7 5 3\nElementType = MET_UCHAR\n"
+                       "ElementDataFile = turned.raw\n");
+    if (describe_ok(header, NULL, &d))
+        CHECK(ip_orientation_is_identity(&d.orientation));
+}
+
 static void test_mhd_compressed(void)
 {
     char header[4096], data[4096];
@@ -1192,8 +1279,10 @@ int main(void)
     test_nrrd_space_directions();
     test_nrrd_byte_skip();
     test_nrrd_overrides();
+    test_nrrd_spaces();
     test_mhd();
     test_mhd_compressed();
+    test_mhd_orientation();
     test_wrong_size();
     test_unknown_type();
     test_dimension_under_2();

@@ -2,6 +2,7 @@
  * spacing from pixdim, the scaling reported, overrides, and the usual breakages (truncated,
  * 4D, bad magic, unsupported datatype, .hdr/.img pairs), each one line naming the file. The
  * files are written here by hand. */
+#include <math.h>
 #include <unistd.h>
 
 #include "check.h"
@@ -133,6 +134,141 @@ static void test_header_fields(void)
     free(samples);
 }
 
+/* ---- orientation: sform, qform, both, neither ---- */
+
+/* The rotation of the unit quaternion (0.8, 0.2, 0.4, 0.4), worked out by hand from the
+ * NIfTI-1 formula: R[row][column], column a the direction of sample axis a. */
+static const double turn[3][3] = {{0.36, -0.48, 0.8}, {0.8, 0.6, 0.0}, {-0.48, 0.64, 0.6}};
+
+static void expect_orientation(const char *name, const ip_input_desc *d, const double origin[3],
+                               const double columns[3][3], const double spacing[3], ip_space space)
+{
+    double worst = 0.0;
+    for (int a = 0; a < 3; a++) {
+        worst = fmax(worst, fabs(d->orientation.origin[a] - origin[a]));
+        worst = fmax(worst, fabs(d->spacing[a] - spacing[a]));
+        for (int c = 0; c < 3; c++)
+            worst = fmax(worst, fabs(d->orientation.directions[a][c] - columns[c][a]));
+    }
+    CHECK_MSG(worst < 1e-6, "%s: off by %g", name, worst);
+    CHECK_MSG(d->orientation.space == space, "%s: space %s", name,
+              ip_space_name(d->orientation.space));
+}
+
+/* Sample index (i, j, k) lies at origin + D * (index x spacing): for an sform that is the
+ * sform's own affine map, srow . (i, j, k, 1). */
+static void expect_sform_map(const char *name, const ip_input_desc *d, const double srow[3][4])
+{
+    const double index[3] = {3, 4, 5};
+    double world[3], physical[3], worst = 0.0;
+    for (int a = 0; a < 3; a++)
+        world[a] = index[a] * d->spacing[a];
+    ip_orientation_apply(&d->orientation, world, physical);
+    for (int r = 0; r < 3; r++) {
+        double want =
+            srow[r][0] * index[0] + srow[r][1] * index[1] + srow[r][2] * index[2] + srow[r][3];
+        worst = fmax(worst, fabs(physical[r] - want));
+    }
+    CHECK_MSG(worst < 1e-5, "%s: index (3,4,5) off its sform position by %g", name, worst);
+}
+
+static void describe_ok(const char *path, ip_input_desc *d)
+{
+    ip_error err;
+    ip_status st = ip_input_describe(path, NULL, d, &err);
+    CHECK_MSG(st == IP_OK, "%s: %s", path, err.message);
+    if (st != IP_OK)
+        memset(d, 0, sizeof *d);
+}
+
+static void test_orientation(void)
+{
+    char path[4096], name[64];
+    const uint32_t dims[3] = {6, 5, 4};
+    void *samples = make_samples(IP_UINT8, dims);
+    const double sform_origin[3] = {10, -20, 30.5}, spacing[3] = {0.5, 0.75, 2};
+    const double qoffset[3] = {-5, 7.5, 12}, pixdim[3] = {1.25, 1.5, 3};
+    const double identity[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, zero[3] = {0, 0, 0};
+    double flipped[3][3]; /* turn with its third column times qfac = -1 */
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            flipped[r][c] = c == 2 ? -turn[r][c] : turn[r][c];
+    ip_input_desc d;
+    for (int version = 1; version <= 2; version++) {
+        nifti_style s = style_of(version, version == 2, 0);
+        memcpy(s.pixdim, pixdim, sizeof pixdim);
+        for (int r = 0; r < 3; r++) {
+            for (int c = 0; c < 3; c++)
+                s.srow[r][c] = turn[r][c] * spacing[c];
+            s.srow[r][3] = sform_origin[r];
+        }
+        s.quatern[0] = 0.2, s.quatern[1] = 0.4, s.quatern[2] = 0.4;
+        memcpy(s.qoffset, qoffset, sizeof qoffset);
+
+        /* only an sform: its columns' lengths are the spacing, pixdim unused */
+        s.sform_code = 2;
+        snprintf(name, sizeof name, "sform%d.nii", version);
+        REQUIRE(write_nifti(in_scratch(path, name), IP_UINT8, dims, samples, &s) == 0);
+        describe_ok(path, &d);
+        expect_orientation(name, &d, sform_origin, turn, spacing, IP_SPACE_RAS);
+        expect_sform_map(name, &d, s.srow);
+
+        /* both: the sform wins */
+        s.qform_code = 1;
+        snprintf(name, sizeof name, "both%d.nii", version);
+        REQUIRE(write_nifti(in_scratch(path, name), IP_UINT8, dims, samples, &s) == 0);
+        describe_ok(path, &d);
+        expect_orientation(name, &d, sform_origin, turn, spacing, IP_SPACE_RAS);
+
+        /* only a qform (the srows filled but sform_code 0): pixdim is the spacing */
+        s.sform_code = 0;
+        snprintf(name, sizeof name, "qform%d.nii", version);
+        REQUIRE(write_nifti(in_scratch(path, name), IP_UINT8, dims, samples, &s) == 0);
+        describe_ok(path, &d);
+        expect_orientation(name, &d, qoffset, turn, pixdim, IP_SPACE_RAS);
+
+        /* qfac -1 turns the third axis round */
+        s.qfac = -1;
+        snprintf(name, sizeof name, "qfac%d.nii", version);
+        REQUIRE(write_nifti(in_scratch(path, name), IP_UINT8, dims, samples, &s) == 0);
+        describe_ok(path, &d);
+        expect_orientation(name, &d, qoffset, flipped, pixdim, IP_SPACE_RAS);
+
+        /* a sheared sform has no frame: the qform */
+        s.sform_code = 1;
+        s.srow[0][1] += 0.25;
+        snprintf(name, sizeof name, "sheared%d.nii", version);
+        REQUIRE(write_nifti(in_scratch(path, name), IP_UINT8, dims, samples, &s) == 0);
+        describe_ok(path, &d);
+        expect_orientation(name, &d, qoffset, flipped, pixdim, IP_SPACE_RAS);
+
+        /* neither code: the identity, no space, pixdim */
+        s.sform_code = s.qform_code = 0;
+        snprintf(name, sizeof name, "neither%d.nii", version);
+        REQUIRE(write_nifti(in_scratch(path, name), IP_UINT8, dims, samples, &s) == 0);
+        describe_ok(path, &d);
+        expect_orientation(name, &d, zero, identity, pixdim, IP_SPACE_UNKNOWN);
+        CHECK(ip_orientation_is_identity(&d.orientation));
+    }
+    /* --spacing still replaces an sform's spacing; the directions stay */
+    nifti_style s = style_of(1, 0, 0);
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++)
+            s.srow[r][c] = turn[r][c] * spacing[c];
+        s.srow[r][3] = sform_origin[r];
+    }
+    s.sform_code = 4;
+    REQUIRE(write_nifti(in_scratch(path, "override.nii"), IP_UINT8, dims, samples, &s) == 0);
+    ip_input_overrides o = {0};
+    ip_error err;
+    o.has_spacing = 1;
+    o.spacing[0] = o.spacing[1] = o.spacing[2] = 0.1;
+    REQUIRE(ip_input_describe(path, &o, &d, &err) == IP_OK);
+    const double tenths[3] = {0.1, 0.1, 0.1};
+    expect_orientation("override.nii", &d, sform_origin, turn, tenths, IP_SPACE_RAS);
+    free(samples);
+}
+
 static void patch(const char *path, long offset, const void *bytes, size_t size)
 {
     FILE *f = fopen(path, "r+b");
@@ -206,6 +342,7 @@ int main(void)
     snprintf(scratch, sizeof scratch, "%s", test_tmp_dir("test_nifti"));
     test_round_trips();
     test_header_fields();
+    test_orientation();
     test_bad_files();
     return test_summary("test_nifti");
 }

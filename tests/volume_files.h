@@ -141,6 +141,12 @@ typedef struct nifti_style {
     double pixdim[3];
     double slope, intercept;
     int64_t vox_offset; /* 0: right after the header and its 4 extension bytes */
+    /* where the samples lie; all 0 (the default) writes neither form */
+    double qfac; /* pixdim[0] */
+    int qform_code, sform_code;
+    double quatern[3]; /* quatern_b, _c, _d */
+    double qoffset[3];
+    double srow[3][4]; /* srow_x, srow_y, srow_z */
 } nifti_style;
 
 static inline void nifti_put(unsigned char *p, uint64_t v, int bytes, int big_endian)
@@ -194,6 +200,15 @@ static inline size_t nifti_header(unsigned char *h, ip_type type, const uint32_t
         nifti_put_f32(h + 112, s->slope, be);
         nifti_put_f32(h + 116, s->intercept, be);
         h[123] = 2; /* millimetres */
+        nifti_put_f32(h + 76, s->qfac, be);
+        nifti_put(h + 252, (uint16_t)s->qform_code, 2, be);
+        nifti_put(h + 254, (uint16_t)s->sform_code, 2, be);
+        for (int i = 0; i < 3; i++) {
+            nifti_put_f32(h + 256 + 4 * i, s->quatern[i], be);
+            nifti_put_f32(h + 268 + 4 * i, s->qoffset[i], be);
+            for (int j = 0; j < 4; j++)
+                nifti_put_f32(h + 280 + 16 * i + 4 * j, s->srow[i][j], be);
+        }
         memcpy(h + 344, "n+1", 4);
     } else {
         memcpy(h + 4, "n+2\0\r\n\032\n", 8);
@@ -207,6 +222,15 @@ static inline size_t nifti_header(unsigned char *h, ip_type type, const uint32_t
         nifti_put_f64(h + 176, s->slope, be);
         nifti_put_f64(h + 184, s->intercept, be);
         nifti_put(h + 500, 2, 4, be);
+        nifti_put_f64(h + 104, s->qfac, be);
+        nifti_put(h + 344, (uint32_t)s->qform_code, 4, be);
+        nifti_put(h + 348, (uint32_t)s->sform_code, 4, be);
+        for (int i = 0; i < 3; i++) {
+            nifti_put_f64(h + 352 + 8 * i, s->quatern[i], be);
+            nifti_put_f64(h + 376 + 8 * i, s->qoffset[i], be);
+            for (int j = 0; j < 4; j++)
+                nifti_put_f64(h + 400 + 32 * i + 8 * j, s->srow[i][j], be);
+        }
     }
     return size;
 }

@@ -207,12 +207,11 @@ static int parse_aa(const char *program, const tool_option *option, const char *
                     void *base)
 {
     uint64_t samples;
-    (void)option;
-    if (tool_parse_u64(values[0], &samples) != 0 || samples < 1 || samples > AA_MAX_SAMPLES)
-        return tool_usage_error(program, "--aa '%s' is not a sample count (1 to %d)", values[0],
-                                AA_MAX_SAMPLES);
-    ((options *)base)->aa = (uint32_t)samples;
-    return 0;
+    int rc = tool_parse_bounded(program, option->name, values[0], 1, AA_MAX_SAMPLES,
+                                "a sample count", &samples);
+    if (rc == 0)
+        ((options *)base)->aa = (uint32_t)samples;
+    return rc;
 }
 
 /* A headless renderer of w x h pixels with the figure's shading and anti-aliasing. Returns
@@ -471,12 +470,8 @@ static void strip_print(FILE *out, const run *r)
 static int parse_smooth(const char *program, const tool_option *option, const char *const *values,
                         void *base)
 {
-    options *o = base;
-    (void)option;
-    if (tool_parse_u64(values[0], &o->smooth) != 0 || o->smooth > SMOOTH_MAX_ITERATIONS)
-        return tool_usage_error(program, "--smooth '%s' is not an iteration count (0 to %d)",
-                                values[0], SMOOTH_MAX_ITERATIONS);
-    return 0;
+    return tool_parse_bounded(program, option->name, values[0], 0, SMOOTH_MAX_ITERATIONS,
+                              "an iteration count", &((options *)base)->smooth);
 }
 
 /* --smooth smooths a welded mesh file. Returns 0, or 2 after a usage error. */
@@ -511,13 +506,8 @@ static int smooth_mesh(const run *r, ip_indexed_mesh *welded, ip_error *err)
 static int parse_turntable(const char *program, const tool_option *option,
                            const char *const *values, void *base)
 {
-    options *o = base;
-    (void)option;
-    if (tool_parse_u64(values[0], &o->turntable) != 0 || o->turntable < 1 ||
-        o->turntable > TURNTABLE_MAX_FRAMES)
-        return tool_usage_error(program, "--turntable '%s' is not a frame count (1 to %d)",
-                                values[0], TURNTABLE_MAX_FRAMES);
-    return 0;
+    return tool_parse_bounded(program, option->name, values[0], 1, TURNTABLE_MAX_FRAMES,
+                              "a frame count", &((options *)base)->turntable);
 }
 
 /* -o's default, and the options a turntable cannot have. Returns 0, or 2 after a usage
@@ -802,12 +792,14 @@ static void progress_csv(FILE *f, void *user)
     }
 }
 
-/* Renders with OpenGL through EGL, or in software when asked or when no OpenGL is found. */
-static int render_image(run *r, uint8_t *rgba, ip_error *err)
+/* Renders with OpenGL through EGL, or in software when asked or when no OpenGL is found.
+ * With `keep` (the turntable's frames), the OpenGL renderer the first call makes stays in
+ * *keep for the next calls, and the caller destroys it; without, it goes at the end. */
+static int render_image(run *r, uint8_t *rgba, ip_renderer **keep, ip_error *err)
 {
     double start = ip_now_seconds();
-    ip_renderer *gl = NULL;
-    if (!r->o.software) {
+    ip_renderer *gl = keep ? *keep : NULL;
+    if (!gl && !r->o.software) {
         ip_error why;
         int made = figure_renderer(r, r->camera.width, r->camera.height, &gl, &why, err);
         if (made < 0)
@@ -818,7 +810,10 @@ static int render_image(run *r, uint8_t *rgba, ip_error *err)
     }
     r->renderer_name = gl ? "opengl" : "software";
     ip_status st = draw_mesh(r, gl, r->mesh, rgba, err);
-    ip_renderer_destroy(gl);
+    if (keep)
+        *keep = gl;
+    else
+        ip_renderer_destroy(gl);
     r->totals.rendering_seconds += ip_now_seconds() - start;
     return st == IP_OK ? 0 : -1;
 }
@@ -966,7 +961,7 @@ static int finish(run *r, ip_error *err)
                 r->camera.height);
         return 1;
     }
-    int rc = render_image(r, rgba, err);
+    int rc = render_image(r, rgba, NULL, err);
     uint8_t *strip = NULL;
     uint32_t strip_width = 0, strip_height = 0;
     if (rc == 0 && r->o.strip && strip_compose(r, &strip, &strip_width, &strip_height, err) != 0)
@@ -1085,11 +1080,12 @@ static int turntable_encode(const run *r)
     return 0;
 }
 
-/* Renders frame f of the turntable and writes it as OUT/frame_NNN.png. Returns 0 or -1. */
-static int turntable_frame(run *r, uint64_t f, uint8_t *rgba, ip_error *err)
+/* Renders frame f of the turntable with the renderer in *gl (made by the first frame) and
+ * writes it as OUT/frame_NNN.png. Returns 0 or -1. */
+static int turntable_frame(run *r, uint64_t f, ip_renderer **gl, uint8_t *rgba, ip_error *err)
 {
     turntable_camera(r, f, &r->camera);
-    if (turntable_extract(r, err) != 0 || render_image(r, rgba, err) != 0)
+    if (turntable_extract(r, err) != 0 || render_image(r, rgba, gl, err) != 0)
         return -1;
     if (!strcmp(r->renderer_name, "software"))
         r->o.software = 1; /* no OpenGL: say it once, not for every frame */
@@ -1134,8 +1130,10 @@ static int turntable_run(run *r, ip_error *err)
         return 1;
     }
     int rc = 0;
+    ip_renderer *gl = NULL; /* one for all the frames */
     for (uint64_t f = 0; rc == 0 && f < r->o.turntable && !tool_signal_caught(); f++)
-        rc = turntable_frame(r, f, rgba, err);
+        rc = turntable_frame(r, f, &gl, rgba, err);
+    ip_renderer_destroy(gl);
     free(rgba);
     if (rc != 0)
         return err->code == IP_ERR_CANCELLED && tool_signal_caught() ? 1

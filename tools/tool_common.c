@@ -52,6 +52,17 @@ int tool_parse_u64(const char *text, uint64_t *out)
     return 0;
 }
 
+int tool_parse_bounded(const char *program, const char *option, const char *text, uint64_t least,
+                       uint64_t most, const char *what, uint64_t *out)
+{
+    uint64_t v;
+    if (tool_parse_u64(text, &v) != 0 || v < least || v > most)
+        return tool_usage_error(program, "%s '%s' is not %s (%llu to %llu)", option, text, what,
+                                (unsigned long long)least, (unsigned long long)most);
+    *out = v;
+    return 0;
+}
+
 int tool_parse_double(const char *text, double *out)
 {
     char *end;

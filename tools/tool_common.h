@@ -20,6 +20,10 @@ int tool_usage_error(const char *program, const char *fmt, ...);
 
 /* Parses a non-negative integer option value; returns 0 on success, -1 on bad text. */
 int tool_parse_u64(const char *text, uint64_t *out);
+/* Parses the value of `option` as an integer from `least` to `most`, into *out. Returns 0, or
+ * 2 after the usage error "OPTION 'TEXT' is not WHAT (LEAST to MOST)". */
+int tool_parse_bounded(const char *program, const char *option, const char *text, uint64_t least,
+                       uint64_t most, const char *what, uint64_t *out);
 /* Parses a finite double; returns 0 on success, -1 on bad text. */
 int tool_parse_double(const char *text, double *out);
 /* Parses "a,b,c" into three finite doubles; returns 0 on success. */

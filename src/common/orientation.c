@@ -105,6 +105,9 @@ int ip__orientation_frame(ip_orientation *o, const double directions[3][3])
     if (ip_orientation_normalize(framed.directions, lengths) != 0 ||
         ip_orientation_check(&framed, NULL, NULL) != IP_OK)
         return 0;
+    for (int a = 0; a < 3; a++)
+        for (int c = 0; c < 3; c++)
+            framed.directions[a][c] += 0.0; /* -0 (a zero times -1) becomes 0 */
     *o = framed;
     return 1;
 }

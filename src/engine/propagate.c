@@ -146,11 +146,9 @@ static int hidden(const ip_propagator *p, const uint32_t cell[3], double pixels)
     return ip__coverage_hides(p->coverage, lo, hi);
 }
 
-/* 1 unless the clipping planes drop `cell`. */
+/* 1 unless the clipping planes drop `cell`; only called when there are planes. */
 static int cell_kept(const ip_propagator *p, const uint32_t cell[3])
 {
-    if (p->clip.count == 0)
-        return 1;
     double lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
         lo[a] = p->sampler->world[a][cell[a]];
@@ -179,6 +177,7 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
     double start = ip_now_seconds(), extracting = 0;
     uint64_t extracted = 0;
     double centre[3], diagonal;
+    const int clipping = p->clip.count > 0; /* without planes no cell is tested */
     cell_centre(p->sampler, seed, centre, &diagonal);
     uint64_t head = 0, tail = 0;
     p->queue[tail++] =
@@ -219,7 +218,8 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
             if (!inside)
                 continue;
             uint32_t n3[3] = {(uint32_t)c[0], (uint32_t)c[1], (uint32_t)c[2]};
-            if (ip__visited_test(p->visited, p->sampler->level, n3) || !cell_kept(p, n3))
+            if (ip__visited_test(p->visited, p->sampler->level, n3) ||
+                (clipping && !cell_kept(p, n3)))
                 continue;
             cell_centre(p->sampler, n3, centre, &diagonal);
             double a = versine_to(eye, dir, centre);

@@ -574,6 +574,9 @@ static ip_status check_described(const dicom_source *src, const ip_input_desc *d
     return IP_OK;
 }
 
+/* Reads the headers again: the description (a plain value, ip_input_desc) has no room for the
+ * slices' order, and the second reading checks that the folder still holds the series
+ * described (check_described()). Each header is read up to the pixel data only. */
 static ip_status dicom_open(const ip_input_desc *desc, void **state, ip_error *err)
 {
     double spacing_z;

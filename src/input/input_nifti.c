@@ -5,7 +5,10 @@
  * scaling (scl_slope, scl_inter) that is reported, never applied. The samples are then read as
  * raw data from vox_offset, or as a gzip stream whose first vox_offset bytes are skipped.
  * The orientation comes from the sform when sform_code > 0, else from the qform when
- * qform_code > 0 (RAS space); the samples keep their storage order either way. */
+ * qform_code > 0 (RAS space); the samples keep their storage order either way. The standard
+ * ranks neither form above the other (the qform for scanner coordinates, the sform for a
+ * standard space); this reader prefers the sform. The sform makes no use of pixdim, so when
+ * it gives the orientation its columns' lengths are the spacing. */
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -268,14 +271,18 @@ static void report_rescale(const nifti_header *n, ip_input_desc *desc)
     desc->rescale_intercept = n->intercept;
 }
 
-/* The sform's columns, over their lengths; 0 when they are not an orthonormal frame. */
-static int sform_orientation(const nifti_header *n, ip_orientation *o)
+/* The sform's columns over their lengths, which go to `spacing`; 0 when they are not an
+ * orthonormal frame. */
+static int sform_orientation(const nifti_header *n, ip_orientation *o, double spacing[3])
 {
     double directions[3][3];
     for (int a = 0; a < 3; a++) {
         o->origin[a] = n->srow[a][3];
         for (int c = 0; c < 3; c++)
             directions[a][c] = n->srow[c][a];
+        spacing[a] =
+            sqrt(directions[a][0] * directions[a][0] + directions[a][1] * directions[a][1] +
+                 directions[a][2] * directions[a][2]);
     }
     return ip__orientation_frame(o, directions);
 }
@@ -300,16 +307,23 @@ static int qform_orientation(const nifti_header *n, ip_orientation *o)
     return ip__orientation_frame(o, directions);
 }
 
-/* sform first, then qform, as the format's codes rank them; identity when neither is set. */
-static void fill_orientation(const nifti_header *n, ip_orientation *o)
+/* The sform when it is set and a frame, else the qform when it is set and a frame, else the
+ * identity (no space). The spacing is |pixdim[1..3]|, or the sform's when it is used. */
+static void fill_orientation(const nifti_header *n, ip_orientation *o, double spacing[3])
 {
     ip_orientation framed;
+    double sform_spacing[3];
     ip_orientation_identity(o);
     ip_orientation_identity(&framed);
     framed.space = IP_SPACE_RAS;
-    if ((n->sform_code > 0 && sform_orientation(n, &framed)) ||
-        (n->qform_code > 0 && qform_orientation(n, &framed)))
+    for (int axis = 0; axis < 3; axis++)
+        spacing[axis] = fabs(n->pixdim[axis + 1]);
+    if (n->sform_code > 0 && sform_orientation(n, &framed, sform_spacing)) {
         *o = framed;
+        memcpy(spacing, sform_spacing, sizeof sform_spacing);
+    } else if (n->qform_code > 0 && qform_orientation(n, &framed)) {
+        *o = framed;
+    }
 }
 
 ip_status ip__nifti_describe(const char *path, const ip_input_overrides *overrides,
@@ -328,9 +342,10 @@ ip_status ip__nifti_describe(const char *path, const ip_input_overrides *overrid
             return status;
         found->has_type = 1;
     }
+    double spacing[3];
+    fill_orientation(&n, &desc->orientation, spacing);
     if (!ip__text_overridden(BY_SPACING, overrides))
-        for (int axis = 0; axis < 3; axis++)
-            desc->spacing[axis] = fabs(n.pixdim[axis + 1]);
+        memcpy(desc->spacing, spacing, sizeof spacing);
     if ((status = check_offset(path, &n, err)) != IP_OK)
         return status;
     desc->big_endian = n.big_endian;
@@ -338,6 +353,5 @@ ip_status ip__nifti_describe(const char *path, const ip_input_overrides *overrid
     desc->data_offset = compressed ? 0 : (uint64_t)n.vox_offset;
     desc->stream_skip = compressed ? (uint64_t)n.vox_offset : 0;
     report_rescale(&n, desc);
-    fill_orientation(&n, &desc->orientation);
     return IP_OK;
 }

@@ -45,8 +45,12 @@ int main(int argc, char **argv)
     bad |= mkdir(path, 0777);
     bad |= write_tiff_folder(path, "slice", 1, d.type, d.dims, samples, &tiles);
     for (int version = 1; version <= 2; version++) {
-        nifti_style s = {
-            version, version == 2, version == 1, 0, {0}, {pixel, pixel, slice}, 2.0, -10.0, 0};
+        nifti_style s = {.version = version,
+                         .big_endian = version == 2,
+                         .gzip = version == 1,
+                         .pixdim = {pixel, pixel, slice},
+                         .slope = 2.0,
+                         .intercept = -10.0};
         snprintf(path, sizeof path, "%s/%s", argv[2],
                  version == 1 ? "volume.nii.gz" : "volume_be.nii");
         bad |= write_nifti(path, d.type, d.dims, samples, &s);

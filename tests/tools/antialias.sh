@@ -12,10 +12,10 @@ render() {
         --background '#ffffff' "$@"
 }
 
-expect_error 2 "--aa '0'" render --aa 0 -o x.png
-expect_error 2 "--aa '17'" render --aa 17 -o x.png
-expect_error 2 "--aa 'four'" render --aa four -o x.png
-expect_error 2 "--aa '-4'" render --aa -4 -o x.png
+expect_error 2 "--aa '0' is not a sample count (1 to 16)" render --aa 0 -o x.png
+expect_error 2 "--aa '17' is not a sample count (1 to 16)" render --aa 17 -o x.png
+expect_error 2 "--aa 'four' is not a sample count (1 to 16)" render --aa four -o x.png
+expect_error 2 "--aa '-4' is not a sample count (1 to 16)" render --aa -4 -o x.png
 expect_error 2 "--aa is OpenGL's" render --aa 4 --software -o x.png
 check "a refused run writes nothing" test ! -e x.png
 

@@ -78,6 +78,7 @@ done
 expect_error 2 "at most 6 --clip" "$bin/isorender" s.ibv --iso 100.5 -o bad.png --clip x=1 \
     --clip x=2 --clip x=3 --clip x=4 --clip x=5 --clip x=6 --clip x=7
 expect_error 2 "bad --clip" "$bin/isoview" s.ibv --iso 100.5 --clip y
+expect_error 2 "option '--clip' needs a value" "$bin/isorender" s.ibv --iso 100.5 -o bad.png --clip
 check "no image after a bad plane" test ! -e bad.png
 
 finish

@@ -25,8 +25,9 @@ expect_error 2 "--color '#12345g'" render --color '#12345g'
 expect_error 2 "--color '0.5,0.5'" render --color 0.5,0.5
 expect_error 2 "--background 'red'" render --background red
 expect_error 2 "--background '#000000:'" render --background '#000000:'
-expect_error 2 "--turntable '0'" render --turntable 0
-expect_error 2 "--turntable 'x'" render --turntable x
+expect_error 2 "--turntable '0' is not a frame count (1 to 100000)" render --turntable 0
+expect_error 2 "--turntable 'x' is not a frame count (1 to 100000)" render --turntable x
+expect_error 2 "--turntable '100001' is not a frame count (1 to 100000)" render --turntable 100001
 expect_error 2 "--mp4 needs --turntable" render --mp4 t.mp4
 expect_error 2 "no --mesh" render --turntable 3 --mesh m.ply
 check "a refused run writes nothing" test ! -e isorender.png -a ! -e turntable -a ! -e m.ply
@@ -83,6 +84,16 @@ render --full --color '0.2,0.5,0.9' --background '#ffe0c0:#102030' --azimuth 30 
     -o sw.png
 if grep -q '"renderer": "opengl"' gl.json; then
     same "OpenGL and software agree with colours" gl.png sw.png --level 3 --max-pct 2
+    # the turntable draws all its frames with one renderer: each frame is the image a run
+    # of its own gives
+    gl() { "$bin/isorender" c.ibv --iso 60 --size 120x90 --quiet --full --elevation 20 "$@"; }
+    run_capture gl --turntable 3 --azimuth 30 -o glframes
+    check "an OpenGL --turntable succeeds ($err)" test "$rc" = 0
+    for f in 0 1 2; do
+        gl --azimuth $((30 + 120 * f)) -o gl$f.png
+        same "OpenGL turntable frame $f is its own run's image" glframes/frame_00$f.png gl$f.png \
+            --level 1 --max-pct 0.1
+    done
 else
     echo "figure: no headless OpenGL here; the OpenGL comparison is skipped"
 fi

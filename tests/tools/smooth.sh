@@ -38,7 +38,7 @@ check "the STL holds as many triangles, moved" sh -c \
     'test "$(stat -c %s "$0")" = "$(stat -c %s "$1")" && ! cmp -s "$0" "$1"' smooth.stl plain.stl
 
 for bad in -1 x 1.5 ""; do
-    expect_error 2 "--smooth '$bad'" "$bin/isorender" p.ibv --iso 20.5 --full --smooth "$bad" --mesh x.ply -o x.png
+    expect_error 2 "--smooth '$bad' is not an iteration count (0 to 100000)" "$bin/isorender" p.ibv --iso 20.5 --full --smooth "$bad" --mesh x.ply -o x.png
 done
 expect_error 2 "--no-weld" "$bin/isorender" p.ibv --iso 20.5 --full --smooth 5 --no-weld --mesh x.ply -o x.png
 expect_error 2 "needs --mesh" "$bin/isorender" p.ibv --iso 20.5 --full --smooth 5 -o x.png

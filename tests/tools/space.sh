@@ -1,6 +1,9 @@
 # Physical space end to end: a NRRD header with a space, a space origin and turned space
 # directions bricks to a file whose isoinfo shows them (the spacing being the vectors'
-# lengths), and a header that names nothing bricks to the identity.
+# lengths), and a header that names nothing bricks to the identity. The same turn written as
+# a NIfTI sform (pixdim left at 1: the sform's column lengths are the spacing) and as a
+# MetaImage TransformMatrix and Offset, and a NIfTI qform (a half turn about z, qfac -1),
+# give the origin, directions and space isoinfo shows and the mesh's physical vertices.
 . "$(dirname "$0")/lib.sh"
 
 "$bin/isogen" sphere --dims 24x20x16 -o "$work/" --quiet
@@ -65,6 +68,91 @@ for ta, tb in zip(a, b):
         worst = max(worst, max(abs(g - w) for g, w in zip(got, want)))
 assert worst < 1e-4, worst
 '
+
+# nifti NAME PIXDIM(3) QFAC QFORM_CODE QUATERN(3) QOFFSET(3) SFORM_CODE SROW(12): a NIfTI-1 file
+# of the sphere's samples, written field by field (offsets of the NIfTI-1 header)
+nifti() {
+    python3 - "$raw" "$type" "$@" <<'PY'
+import struct, sys
+raw, kind, name = sys.argv[1:4]
+v = [float(x) for x in sys.argv[4:]]
+pixdim, qfac, qcode = v[0:3], v[3], int(v[4])
+quatern, qoffset, scode, srow = v[5:8], v[8:11], int(v[11]), v[12:24]
+datatype, bits = {"uint8": (2, 8), "uint16": (512, 16)}[kind]
+h = bytearray(352)
+struct.pack_into("<i", h, 0, 348)
+struct.pack_into("<8h", h, 40, 3, 24, 20, 16, 1, 1, 1, 1)
+struct.pack_into("<2h", h, 70, datatype, bits)
+struct.pack_into("<4f", h, 76, qfac, *pixdim)
+struct.pack_into("<f", h, 108, 352)
+h[123] = 2
+struct.pack_into("<2h", h, 252, qcode, scode)
+struct.pack_into("<6f", h, 256, *quatern, *qoffset)
+struct.pack_into("<12f", h, 280, *srow)
+h[344:348] = b"n+1\0"
+with open(name, "wb") as f:
+    f.write(h + open(raw, "rb").read())
+PY
+}
+# the turn: srow_x = (0, -0.5, 0, 10), srow_y = (0.5, 0, 0, -20), srow_z = (0, 0, 2, 30.5)
+nifti sform.nii 1 1 1 1 0 0 0 0 0 0 0 2 0 -0.5 0 10 0.5 0 0 -20 0 0 2 30.5
+# a half turn about z (quaternion b, c, d = 0, 0, 1), the third axis flipped by qfac -1
+nifti qform.nii 0.5 0.5 2 -1 1 0 0 1 1 2 3 0 9 9 9 9 9 9 9 9 9 9 9 9
+cat >turned.mhd <<MHD
+ObjectType = Image
+NDims = 3
+BinaryData = True
+BinaryDataByteOrderMSB = False
+TransformMatrix = 0 1 0 -1 0 0 0 0 1
+Offset = 10 -20 30.5
+AnatomicalOrientation = RAI
+ElementSpacing = 0.5 0.5 2
+DimSize = 24 20 16
+ElementType = MET_$(test "$type" = uint8 && echo UCHAR || echo USHORT)
+ElementDataFile = $raw
+MHD
+for name in sform qform mhd; do
+    input=$name.nii
+    test "$name" = mhd && input=turned.mhd
+    run_capture "$bin/isobrick" "$input" -o "$name.ibv" --brick-size 8 --threads 2
+    check "$input bricks ($err)" test "$rc" = 0
+    run_capture "$bin/isoinfo" --json "$name.ibv"
+    check "isoinfo --json on $name: the spacing" grep -qF '"spacing": [0.5, 0.5, 2]' "$work/.out"
+    case $name in
+    sform) want='"origin": [10, -20, 30.5], "directions": [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], "space": "RAS"' ;;
+    qform) want='"origin": [1, 2, 3], "directions": [[-1, 0, 0], [0, -1, 0], [0, 0, -1]], "space": "RAS"' ;;
+    mhd) want='"origin": [10, -20, 30.5], "directions": [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], "space": null' ;;
+    esac
+    check "isoinfo --json on $name: origin, directions and space" grep -qF "$want" "$work/.out"
+    run_capture "$bin/isorender" "$name.ibv" --iso 128 --full --threads 1 --size 64x48 \
+        -o "$name.png" --mesh "$name.ply" --no-weld
+    check "isorender --full --mesh on $name ($err)" test "$rc" = 0
+    "$bin/tests/ply_triangles" "$name.ply" >"$name.txt"
+done
+run_capture "$bin/isoinfo" sform.ibv
+check "isoinfo: the NIfTI origin line" grep -qF "origin        10, -20, 30.5 (RAS space)" "$work/.out"
+check "isoinfo: the NIfTI directions line" \
+    grep -qF "directions    x (0, 1, 0), y (-1, 0, 0), z (0, 0, 1)" "$work/.out"
+# moved: compares the vertices of plain.txt moved by the expression with those of the file
+moved() {
+    python3 - "$1" "$2" <<'PY'
+import sys
+a = [l.split() for l in open("plain.txt")]
+b = [l.split() for l in open(sys.argv[1])]
+assert len(a) == len(b) > 0, (len(a), len(b))
+worst = 0.0
+for ta, tb in zip(a, b):
+    for i in range(0, 9, 3):
+        x, y, z = (float.fromhex(v) for v in ta[i:i + 3])
+        want = eval(sys.argv[2])
+        got = [float.fromhex(v) for v in tb[i:i + 3]]
+        worst = max(worst, max(abs(g - w) for g, w in zip(got, want)))
+assert worst < 1e-4, worst
+PY
+}
+check "NIfTI sform vertices = (10 - y, -20 + x, 30.5 + z)" moved sform.txt '(10 - y, -20 + x, 30.5 + z)'
+check "NIfTI qform vertices = (1 - x, 2 - y, 3 - z)" moved qform.txt '(1 - x, 2 - y, 3 - z)'
+check "MetaImage vertices = (10 - y, -20 + x, 30.5 + z)" moved mhd.txt '(10 - y, -20 + x, 30.5 + z)'
 
 # a sheared grid has no orthonormal frame: the identity, and the vectors' lengths as spacing
 sed 's/^space directions:.*/space directions: (0.5,0.5,0) (0,0.5,0) (0,0,2)/' turned.nhdr >sheared.nhdr
