@@ -235,12 +235,13 @@ static int parse_opacity(const char *program, const tool_option *option, const c
     return 0;
 }
 
-/* The colours of the surfaces that --color leaves out, by position (the first: the default
- * ivory). */
-static const float surface_palette[TOOL_MAX_ISOS][3] = {{0.929f, 0.890f, 0.788f},
-                                                        {0.561f, 0.702f, 0.851f},
-                                                        {0.878f, 0.639f, 0.439f},
-                                                        {0.612f, 0.812f, 0.561f}};
+/* The colours of the second to last surfaces when --color leaves them out, by position (the
+ * first surface's is the shading's, the default ivory). */
+static const float surface_palette[TOOL_MAX_ISOS - 1][3] = {
+    {0.561f, 0.702f, 0.851f}, /* #8fb3d9 */
+    {0.878f, 0.639f, 0.439f}, /* #e0a370 */
+    {0.612f, 0.812f, 0.561f}, /* #9ccf8f */
+};
 
 /* Several --iso: at most TOOL_MAX_ISOS, no two alike, and no more colours or opacities than
  * surfaces. Returns 0, or 2 after a usage error. */
@@ -289,8 +290,10 @@ static void surface_of(const run *r, size_t i, const uint64_t *prefix, ip_mesh *
     if (prefix)
         views[i].triangle_count = prefix[i];
     out->mesh = &views[i];
-    memcpy(out->colour, i < o->colour_count ? o->colours[i] : surface_palette[i],
-           sizeof out->colour);
+    const float *colour = i < o->colour_count ? o->colours[i]
+                          : i == 0            ? o->shading.surface
+                                              : surface_palette[i - 1];
+    memcpy(out->colour, colour, sizeof out->colour);
     out->opacity = i < o->opacity_count ? o->opacity[i] : 1.0f;
 }
 

@@ -93,6 +93,11 @@ assert d["warnings"] == []
 check "--progress: an iso column, the rows of 60 then of 180" sh -c '
     head -1 glass.csv | grep -q "^time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,overdraw,iso$" &&
     test "$(tail -n +2 glass.csv | cut -d, -f9 | uniq | tr "\n" " ")" = "60 180 "'
+render --iso 60 --iso 120 --iso 180 -o palette.png --stats palette.json
+check "surfaces without --color take the palette" python3 -c '
+import json
+s = json.load(open("palette.json"))["surfaces"]
+assert [x["color"] for x in s] == ["#ede3c9", "#8fb3d9", "#e0a370"], s'
 # one --iso: no "surfaces", no iso column
 render --iso 60 -o one.png --stats one.json --progress one.csv
 check "one --iso: no surfaces in --stats" sh -c '! grep -q surfaces one.json'
