@@ -331,6 +331,130 @@ static void test_head_on_shading(void)
     ip_mesh_free(&m);
 }
 
+/* Renders `m` alone in colour `colour` (the other shading the default's). */
+static void raster_alone(const ip_mesh *m, const ip_camera *c, const float colour[3], uint8_t *rgba)
+{
+    ip_shading s;
+    ip_shading_default(&s);
+    memcpy(s.surface, colour, sizeof s.surface);
+    REQUIRE(ip_raster_mesh_shaded(m, c, &s, box_lo, box_hi, NULL, rgba, NULL) == IP_OK);
+}
+
+/* The largest channel difference between `out` and round(a * top + (1 - a) * under). */
+static int blend_error(const uint8_t *out, const uint8_t *top, const uint8_t *under, double a)
+{
+    int worst = 0;
+    for (int k = 0; k < 3; k++) {
+        int d = abs(out[k] - (int)lround(a * top[k] + (1 - a) * under[k]));
+        worst = d > worst ? d : worst;
+    }
+    return worst;
+}
+
+/* Several surfaces: opaque ones make one depth-tested scene; a translucent one shows its
+ * nearest layer blended over the nearest opaque fragment when at least as near. */
+static void test_surfaces(void)
+{
+    ip_camera c = front_camera(W, H);
+    const double big[6] = {1, 1, 60, 1, 1, 45}, small[6] = {10, 10, 30, 10, 10, 30};
+    const float red[3] = {0.9f, 0.2f, 0.1f}, blue[3] = {0.1f, 0.3f, 0.9f};
+    ip_mesh near_small, far_big, near_big, far_small;
+    ip_mesh_init(&near_small), ip_mesh_init(&far_big), ip_mesh_init(&near_big);
+    ip_mesh_init(&far_small);
+    add_screen_triangle(&near_small, &c, small, 8.0);
+    add_screen_triangle(&far_big, &c, big, 10.0);
+    add_screen_triangle(&near_big, &c, big, 8.0);
+    add_screen_triangle(&far_small, &c, small, 10.0);
+    uint8_t out[W * H * 4], a_img[W * H * 4], b_img[W * H * 4], bg[W * H * 4];
+    const size_t inside = 4 * (15 * W + 15), big_only = 4 * (5 * W + 40), empty = 4 * (40 * W + 40);
+    ip_mesh none;
+    ip_mesh_init(&none);
+    raster_alone(&none, &c, red, bg);
+    /* a translucent red triangle in front of an opaque blue one */
+    ip_surface two[2] = {{&near_small, {0.9f, 0.2f, 0.1f}, 0.4f},
+                         {&far_big, {0.1f, 0.3f, 0.9f}, 1.0f}};
+    raster_alone(&near_small, &c, red, a_img);
+    raster_alone(&far_big, &c, blue, b_img);
+    REQUIRE(ip_raster_surfaces(two, 2, &c, NULL, box_lo, box_hi, out, NULL) == IP_OK);
+    CHECK(blend_error(out + inside, a_img + inside, b_img + inside, 0.4) <= 1);
+    CHECK(memcmp(out + big_only, b_img + big_only, 4) == 0);
+    CHECK(memcmp(out + empty, bg + empty, 4) == 0);
+    CHECK(out[inside + 3] == 255);
+    /* the order of the surfaces does not matter with one translucent surface */
+    ip_surface swapped[2] = {two[1], two[0]};
+    uint8_t other[W * H * 4];
+    REQUIRE(ip_raster_surfaces(swapped, 2, &c, NULL, box_lo, box_hi, other, NULL) == IP_OK);
+    CHECK(memcmp(out, other, sizeof out) == 0);
+    /* behind the opaque surface, a translucent one does not show */
+    ip_surface hidden[2] = {{&far_small, {0.9f, 0.2f, 0.1f}, 0.4f},
+                            {&near_big, {0.1f, 0.3f, 0.9f}, 1.0f}};
+    raster_alone(&near_big, &c, blue, b_img);
+    REQUIRE(ip_raster_surfaces(hidden, 2, &c, NULL, box_lo, box_hi, out, NULL) == IP_OK);
+    CHECK(memcmp(out, b_img, sizeof out) == 0);
+    /* over the background alone */
+    ip_surface alone = {&near_small, {0.9f, 0.2f, 0.1f}, 0.4f};
+    REQUIRE(ip_raster_surfaces(&alone, 1, &c, NULL, box_lo, box_hi, out, NULL) == IP_OK);
+    CHECK(blend_error(out + inside, a_img + inside, bg + inside, 0.4) <= 1);
+    CHECK(memcmp(out + empty, bg + empty, 4) == 0);
+    /* only the nearest layer of a translucent surface shows, whatever its triangles' order:
+     * a second layer behind it changes nothing */
+    ip_mesh layers[2];
+    for (int order = 0; order < 2; order++) {
+        ip_mesh_init(&layers[order]);
+        add_screen_triangle(&layers[order], &c, small, order ? 9.0 : 8.0);
+        add_screen_triangle(&layers[order], &c, small, order ? 8.0 : 9.0);
+    }
+    ip_surface l0 = {&layers[0], {0.9f, 0.2f, 0.1f}, 0.4f}, l1 = l0;
+    l1.mesh = &layers[1];
+    uint8_t first[W * H * 4];
+    REQUIRE(ip_raster_surfaces(&l0, 1, &c, NULL, box_lo, box_hi, first, NULL) == IP_OK);
+    REQUIRE(ip_raster_surfaces(&l1, 1, &c, NULL, box_lo, box_hi, other, NULL) == IP_OK);
+    CHECK(memcmp(first, other, sizeof out) == 0);
+    REQUIRE(ip_raster_surfaces(&alone, 1, &c, NULL, box_lo, box_hi, out, NULL) == IP_OK);
+    CHECK(memcmp(first, out, sizeof out) == 0);
+    /* opaque surfaces only: the concatenated mesh, each pixel in its surface's colour */
+    ip_mesh both;
+    ip_mesh_init(&both);
+    REQUIRE(ip_mesh_append_mesh(&both, &far_big, 0, 1) == IP_OK);
+    REQUIRE(ip_mesh_append_mesh(&both, &near_small, 0, 1) == IP_OK);
+    uint32_t index[W * H];
+    REQUIRE(ip_raster_mesh(&both, &c, box_lo, box_hi, index, NULL, NULL) == IP_OK);
+    raster_alone(&far_big, &c, blue, b_img);
+    ip_surface opaque[2] = {{&far_big, {0.1f, 0.3f, 0.9f}, 1.0f},
+                            {&near_small, {0.9f, 0.2f, 0.1f}, 1.0f}};
+    REQUIRE(ip_raster_surfaces(opaque, 2, &c, NULL, box_lo, box_hi, out, NULL) == IP_OK);
+    size_t wrong = 0, shown[2] = {0, 0};
+    for (size_t i = 0; i < W * H; i++) {
+        const uint8_t *want = index[i] == UINT32_MAX ? bg : index[i] == 0 ? b_img : a_img;
+        wrong += memcmp(out + 4 * i, want + 4 * i, 4) != 0;
+        if (index[i] != UINT32_MAX)
+            shown[index[i]]++;
+    }
+    CHECK(wrong == 0 && shown[0] > 100 && shown[1] > 100);
+    /* bad surfaces */
+    ip_error err;
+    ip_surface bad = alone;
+    CHECK(ip_raster_surfaces(&bad, 0, &c, NULL, box_lo, box_hi, out, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_raster_surfaces(&bad, IP_MAX_SURFACES + 1, &c, NULL, box_lo, box_hi, out, &err) ==
+          IP_ERR_ARGUMENT);
+    const float opacities[3] = {0.0f, 1.5f, NAN};
+    for (int i = 0; i < 3; i++) {
+        bad.opacity = opacities[i];
+        CHECK(ip_raster_surfaces(&bad, 1, &c, NULL, box_lo, box_hi, out, &err) == IP_ERR_ARGUMENT);
+        CHECK_CONTAINS(err.message, "opacity");
+    }
+    bad = alone;
+    bad.colour[1] = -0.1f;
+    CHECK(ip_surfaces_check(&bad, 1, &err) == IP_ERR_ARGUMENT);
+    bad = alone;
+    bad.mesh = NULL;
+    CHECK(ip_surfaces_check(&bad, 1, &err) == IP_ERR_ARGUMENT);
+    ip_mesh *meshes[] = {&near_small, &far_big,   &near_big, &far_small,
+                         &layers[0],  &layers[1], &both};
+    for (size_t i = 0; i < sizeof meshes / sizeof meshes[0]; i++)
+        ip_mesh_free(meshes[i]);
+}
+
 /* A ground plane much larger than the view, reaching behind the eye: near-plane and
  * guard-band clipping must leave exactly the pixels whose rays meet it. */
 static void test_clipping(void)
@@ -490,6 +614,7 @@ int main(void)
     test_depth();
     test_cube();
     test_head_on_shading();
+    test_surfaces();
     test_clipping();
     test_bad_arguments();
     test_png();

@@ -293,6 +293,80 @@ static void test_streamed_draw(ip_renderer *r)
     ip_mesh_free(&big);
 }
 
+/* Draws the surfaces with OpenGL and in software; returns how many pixels differ by more
+ * than SHADE_LEVELS + 1 (blending rounds once more) and prints the statistics. */
+static size_t surfaces_outliers(ip_renderer *r, const ip_surface *f, size_t count,
+                                const ip_camera *c, uint8_t *gl)
+{
+    size_t pixels = (size_t)c->width * c->height, outliers = 0;
+    uint8_t *ref = malloc(pixels * 4);
+    REQUIRE(ref);
+    ip_error err;
+    ip_status st = ip_renderer_draw_surfaces(r, f, count, c, scene_lo, scene_hi, &err);
+    CHECK_MSG(st == IP_OK, "%s", err.message);
+    CHECK(ip_renderer_read_rgba(r, gl, &err) == IP_OK);
+    REQUIRE(ip_raster_surfaces(f, count, c, NULL, scene_lo, scene_hi, ref, NULL) == IP_OK);
+    int worst = 0;
+    for (size_t i = 0; i < pixels; i++) {
+        int diff = 0;
+        for (int k = 0; k < 4; k++) {
+            int d = abs(gl[4 * i + k] - ref[4 * i + k]);
+            diff = d > diff ? d : diff;
+        }
+        outliers += diff > SHADE_LEVELS + 1;
+        worst = diff > worst ? diff : worst;
+    }
+    printf("%zu surfaces: %zu pixels differ by more than %d levels, worst %d\n", count, outliers,
+           SHADE_LEVELS + 1, worst);
+    free(ref);
+    return outliers;
+}
+
+/* Several surfaces, one translucent or two, agree with the software rasterizer; one opaque
+ * surface is ip_renderer_draw_mesh()'s image. */
+static void test_surfaces(ip_renderer *r)
+{
+    ip_mesh sphere, box;
+    ip_mesh_init(&sphere);
+    ip_mesh_init(&box);
+    add_sphere(&sphere, 4);
+    const float lo[3] = {0.3f, -1.15f, -0.95f}, hi[3] = {1.2f, -0.4f, -0.15f};
+    add_box(&box, lo, hi);
+    ip_camera c = scene_camera(320, 240);
+    size_t pixels = 320 * 240;
+    uint8_t *gl = malloc(pixels * 4), *plain = malloc(pixels * 4);
+    REQUIRE(gl && plain);
+    ip_surface f[2] = {{&sphere, {0.93f, 0.6f, 0.5f}, 0.4f}, {&box, {0.3f, 0.5f, 0.9f}, 1.0f}};
+    CHECK(surfaces_outliers(r, f, 2, &c, gl) <= SHADE_OUTLIER_FRACTION * pixels);
+    f[1].opacity = 0.7f; /* two translucent surfaces: the depth is redrawn for the second */
+    CHECK(surfaces_outliers(r, f, 2, &c, gl) <= SHADE_OUTLIER_FRACTION * pixels);
+    f[0].opacity = 1.0f;
+    CHECK(surfaces_outliers(r, f, 2, &c, gl) <= SHADE_OUTLIER_FRACTION * pixels);
+    /* one opaque surface: draw_mesh's image in its colour */
+    ip_error err;
+    ip_shading s;
+    ip_shading_default(&s);
+    memcpy(s.surface, f[0].colour, sizeof s.surface);
+    REQUIRE(ip_renderer_set_shading(r, &s, NULL) == IP_OK);
+    CHECK(ip_renderer_draw_mesh(r, &sphere, &c, scene_lo, scene_hi, &err) == IP_OK);
+    CHECK(ip_renderer_read_rgba(r, plain, &err) == IP_OK);
+    REQUIRE(ip_renderer_set_shading(r, NULL, NULL) == IP_OK);
+    CHECK(ip_renderer_draw_surfaces(r, f, 1, &c, scene_lo, scene_hi, &err) == IP_OK);
+    CHECK(ip_renderer_read_rgba(r, gl, &err) == IP_OK);
+    CHECK(memcmp(gl, plain, pixels * 4) == 0);
+    /* the translucent sphere changes the picture */
+    f[0].opacity = 0.4f;
+    CHECK(ip_renderer_draw_surfaces(r, f, 1, &c, scene_lo, scene_hi, &err) == IP_OK);
+    CHECK(ip_renderer_read_rgba(r, gl, &err) == IP_OK);
+    CHECK(memcmp(gl, plain, pixels * 4) != 0);
+    f[0].opacity = 0.0f;
+    CHECK(ip_renderer_draw_surfaces(r, f, 1, &c, scene_lo, scene_hi, &err) == IP_ERR_ARGUMENT);
+    free(gl);
+    free(plain);
+    ip_mesh_free(&sphere);
+    ip_mesh_free(&box);
+}
+
 static void test_resize_and_errors(ip_renderer *r, const ip_mesh *m)
 {
     ip_error err;
@@ -430,6 +504,7 @@ int main(void)
     test_against_raster(r, &m);
     test_incremental_upload(r, &m);
     test_streamed_draw(r);
+    test_surfaces(r);
     ip_renderer_clear_mesh(r);
     REQUIRE(ip_renderer_upload(r, &m, 0, NULL) == IP_OK);
 

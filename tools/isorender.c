@@ -23,15 +23,22 @@
 #include <stb_easy_font.h>
 
 static const char usage[] =
-    "usage: isorender FILE.ibv --iso V [options]\n"
+    "usage: isorender FILE.ibv --iso V [--iso V2 ...] [options]\n"
     "Extracts the isosurface V progressively (rays in the paper's order) and renders it to PNG\n"
-    "with OpenGL 3.3 core through EGL (no display needed).\n"
+    "with OpenGL 3.3 core through EGL (no display needed). --iso given up to 4 times draws as\n"
+    "many surfaces together, each extracted by its own progressive run with the same view\n"
+    "and options (see --color and --opacity).\n"
     "  --size WxH          image size in pixels (default 1600x1200)\n"
     "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
     "                      (default -y; up is +z, or +y for the z views)\n"
     "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n" TOOL_ORBIT_OPTIONS_HELP
     "  --color C           the surface colour: R,G,B (each 0 to 1) or #rrggbb (default\n"
-    "                      #ede3c9, an ivory)\n"
+    "                      #ede3c9, an ivory); repeated, the colours of the surfaces in the\n"
+    "                      order of --iso (those without one: #ede3c9, #8fb3d9, #e0a370,\n"
+    "                      #9ccf8f by position)\n"
+    "  --opacity A         the surface's opacity, 0 < A <= 1 (default 1, opaque); repeated, in\n"
+    "                      the order of --iso. A translucent surface shows its nearest layer,\n"
+    "                      blended over the nearest opaque surface where in front of it\n"
     "  --background C      the background: one colour, or TOP:BOTTOM for a vertical gradient\n"
     "                      (default #3d4557:#141721)\n"
     "  --rays N            stop after N rays (default: every pixel)\n"
@@ -45,7 +52,8 @@ static const char usage[] =
     "                      Wavefront OBJ (.obj) or binary glTF (.glb, world units as metres),\n"
     "                      by the name's extension. A progressive run's mesh holds only what\n"
     "                      the view needed (open behind); with --full it is the whole, closed\n"
-    "                      surface\n"
+    "                      surface. With several --iso, one file a surface, the isovalue before\n"
+    "                      the extension (head.ply: head_iso600.5.ply, head_iso1224.5.ply)\n"
     "  --weld, --no-weld   PLY, OBJ and glTF meshes share their vertices (default), or repeat\n"
     "                      them for every triangle (STL always does)\n"
     "  --smooth N          smooth the mesh file by N iterations of Taubin's method (lambda 0.5,\n"
@@ -57,7 +65,10 @@ static const char usage[] =
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
     "                      overdraw at checkpoints\n"
-    "                      (--stats - or --progress -: standard output, the summary on stderr)\n"
+    "                      (--stats - or --progress -: standard output, the summary on stderr).\n"
+    "                      With several --iso, --stats adds \"surfaces\", an entry a surface\n"
+    "                      (the rest is the first surface's), and --progress an iso column,\n"
+    "                      each surface's rows after the previous one's\n"
     "  --strip OUT.png     also write the progress strip: the image as extracted by a few\n"
     "                      points of the run, side by side and labelled\n"
     "  --strip-at P,...    the strip's points, in percent of the view's rays, increasing\n"
@@ -111,6 +122,11 @@ typedef struct options {
     const char *mp4;          /* --mp4 OUT.mp4 (NULL: none) */
     ip_shading shading;       /* ip_shading_default() with --color and --background */
     uint32_t aa;              /* --aa N: OpenGL samples a pixel (1: none) */
+    /* --color and --opacity, repeatable: the surfaces' in the order of --iso */
+    float colours[TOOL_MAX_ISOS][3];
+    size_t colour_count;
+    float opacity[TOOL_MAX_ISOS];
+    size_t opacity_count;
 } options;
 
 /* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
@@ -148,11 +164,17 @@ typedef struct run {
     int writing;       /* 1 once the outputs are being written */
     strip_frames strip;
     uint64_t mesh_vertices, mesh_dropped; /* of the mesh file: vertices, degenerate triangles */
+    /* several --iso: this run is the first surface's; others[] the later ones', each a run of
+     * its own (engine, mesh, counts) sharing the store, the cache and the camera */
+    struct run *others;
+    size_t other_count;
+    char mesh_name[4096]; /* the surface's mesh file (o.mesh points here), several --iso */
 } run;
 
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
                           void *base);
-static tool_option_parse parse_color, parse_background, parse_turntable, parse_aa, parse_smooth;
+static tool_option_parse parse_color, parse_background, parse_turntable, parse_aa, parse_smooth,
+    parse_opacity;
 
 static const tool_option isorender_options[] = {
     {"-o", NULL, 1, offsetof(options, out), NULL, NULL, NULL},
@@ -168,6 +190,7 @@ static const tool_option isorender_options[] = {
     {"--smooth", NULL, 1, 0, parse_smooth, NULL, NULL},
     TOOL_ORBIT_OPTION_ROWS(options, orbit),
     {"--color", NULL, 1, 0, parse_color, NULL, NULL},
+    {"--opacity", NULL, 1, 0, parse_opacity, NULL, NULL},
     {"--background", NULL, 1, 0, parse_background, NULL, NULL},
     {"--turntable", NULL, 1, 0, parse_turntable, NULL, NULL},
     {"--mp4", NULL, 1, offsetof(options, mp4), NULL, NULL, NULL},
@@ -177,14 +200,101 @@ static const tool_option isorender_options[] = {
 
 /* ---- the figure's colours ---- */
 
+/* --color, repeatable: the first is the shading's surface colour (one surface's image is
+ * drawn with it), each one the next surface's. */
 static int parse_color(const char *program, const tool_option *option, const char *const *values,
                        void *base)
 {
+    options *o = base;
+    float rgb[3];
     (void)option;
-    if (tool_parse_colour(values[0], ((options *)base)->shading.surface) != 0)
+    if (tool_parse_colour(values[0], rgb) != 0)
         return tool_usage_error(program, "--color '%s' is not R,G,B (each 0 to 1) or #rrggbb",
                                 values[0]);
+    if (o->colour_count == TOOL_MAX_ISOS)
+        return tool_usage_error(program, "--color '%s': more than %d colours", values[0],
+                                TOOL_MAX_ISOS);
+    if (o->colour_count == 0)
+        memcpy(o->shading.surface, rgb, sizeof rgb);
+    memcpy(o->colours[o->colour_count++], rgb, sizeof rgb);
     return 0;
+}
+
+static int parse_opacity(const char *program, const tool_option *option, const char *const *values,
+                         void *base)
+{
+    options *o = base;
+    double a;
+    (void)option;
+    if (tool_parse_double(values[0], &a) != 0 || !(a > 0 && a <= 1))
+        return tool_usage_error(program, "--opacity '%s' is not a number in (0, 1]", values[0]);
+    if (o->opacity_count == TOOL_MAX_ISOS)
+        return tool_usage_error(program, "--opacity '%s': more than %d opacities", values[0],
+                                TOOL_MAX_ISOS);
+    o->opacity[o->opacity_count++] = (float)a;
+    return 0;
+}
+
+/* The colours of the second to last surfaces when --color leaves them out, by position (the
+ * first surface's is the shading's, the default ivory). */
+static const float surface_palette[TOOL_MAX_ISOS - 1][3] = {
+    {0.561f, 0.702f, 0.851f}, /* #8fb3d9 */
+    {0.878f, 0.639f, 0.439f}, /* #e0a370 */
+    {0.612f, 0.812f, 0.561f}, /* #9ccf8f */
+};
+
+/* Several --iso: at most TOOL_MAX_ISOS, no two alike, and no more colours or opacities than
+ * surfaces. Returns 0, or 2 after a usage error. */
+static int check_surface_options(const options *o)
+{
+    unsigned n = o->common.iso_count;
+    if (n > TOOL_MAX_ISOS)
+        return tool_usage_error("isorender", "--iso given %u times: at most %d surfaces", n,
+                                TOOL_MAX_ISOS);
+    for (unsigned i = 0; i < n; i++)
+        for (unsigned j = 0; j < i; j++)
+            if ((float)o->common.isos[i] == (float)o->common.isos[j])
+                return tool_usage_error("isorender", "--iso %g is given twice", o->common.isos[i]);
+    if (o->colour_count > n || o->opacity_count > n)
+        return tool_usage_error("isorender",
+                                "%zu --color and %zu --opacity for %u --iso: at most one of each "
+                                "a surface",
+                                o->colour_count, o->opacity_count, n);
+    return 0;
+}
+
+/* Whether the image needs the several-surface drawing: several --iso, or a translucent one. */
+static int several_surfaces(const run *r)
+{
+    return r->other_count > 0 || (r->o.opacity_count && r->o.opacity[0] < 1.0f);
+}
+
+/* Surface i's run: r itself for the first. */
+static run *surface_run(run *r, size_t i)
+{
+    return i ? &r->others[i - 1] : r;
+}
+
+static const run *surface_run_c(const run *r, size_t i)
+{
+    return i ? &r->others[i - 1] : r;
+}
+
+/* Surface i as the renderers take it: its mesh (its first prefix[i] triangles when prefix is
+ * not NULL; `views` holds them), colour and opacity. */
+static void surface_of(const run *r, size_t i, const uint64_t *prefix, ip_mesh *views,
+                       ip_surface *out)
+{
+    const options *o = &r->o;
+    views[i] = *surface_run_c(r, i)->mesh; /* a view of the triangles, not a copy */
+    if (prefix)
+        views[i].triangle_count = prefix[i];
+    out->mesh = &views[i];
+    const float *colour = i < o->colour_count ? o->colours[i]
+                          : i == 0            ? o->shading.surface
+                                              : surface_palette[i - 1];
+    memcpy(out->colour, colour, sizeof out->colour);
+    out->opacity = i < o->opacity_count ? o->opacity[i] : 1.0f;
 }
 
 static int parse_background(const char *program, const tool_option *option,
@@ -245,6 +355,36 @@ static ip_status draw_mesh(const run *r, ip_renderer *gl, const ip_mesh *mesh, u
     /* streamed: the driver never holds a second copy of the whole mesh */
     ip_status st = ip_renderer_draw_mesh(gl, mesh, &r->camera, r->lo, r->hi, err);
     return st == IP_OK ? ip_renderer_read_rgba(gl, rgba, err) : st;
+}
+
+/* Draws every surface (their first prefix[i] triangles when prefix is not NULL) into rgba
+ * with `gl`, or in software when gl is NULL. */
+static ip_status draw_surfaces(const run *r, ip_renderer *gl, const uint64_t *prefix, uint8_t *rgba,
+                               ip_error *err)
+{
+    ip_mesh views[TOOL_MAX_ISOS];
+    ip_surface surfaces[TOOL_MAX_ISOS];
+    size_t count = 1 + r->other_count;
+    for (size_t i = 0; i < count; i++)
+        surface_of(r, i, prefix, views, &surfaces[i]);
+    if (!gl)
+        return ip_raster_surfaces(surfaces, count, &r->camera, &r->o.shading, r->lo, r->hi, rgba,
+                                  err);
+    ip_status st = ip_renderer_draw_surfaces(gl, surfaces, count, &r->camera, r->lo, r->hi, err);
+    return st == IP_OK ? ip_renderer_read_rgba(gl, rgba, err) : st;
+}
+
+/* The image of the run's surfaces (prefix: as draw_surfaces()); one opaque surface is drawn
+ * as it always was. */
+static ip_status draw_image(const run *r, ip_renderer *gl, const uint64_t *prefix, uint8_t *rgba,
+                            ip_error *err)
+{
+    if (several_surfaces(r))
+        return draw_surfaces(r, gl, prefix, rgba, err);
+    ip_mesh view = *r->mesh; /* a view of the first triangles, not a copy */
+    if (prefix)
+        view.triangle_count = prefix[0];
+    return draw_mesh(r, gl, &view, rgba, err);
 }
 
 /* ---- the progress strip ---- */
@@ -346,12 +486,21 @@ static void strip_record(run *r)
         r->strip.triangles[r->strip.recorded++] = triangles;
 }
 
+/* The triangles frame f of the strip shows, of every surface. */
+static uint64_t strip_triangles(const run *r, size_t f)
+{
+    uint64_t sum = 0;
+    for (size_t i = 0; i <= r->other_count; i++)
+        sum += surface_run_c(r, i)->strip.triangles[f];
+    return sum;
+}
+
 /* Frame f's label, "12 rays, 3456 triangles", or its short form when that is too wide for
  * the frame ("12 rays"; "" when even that is). */
 static void strip_label(const run *r, size_t f, char *text, size_t size)
 {
     snprintf(text, size, "%llu rays, %llu triangles", (unsigned long long)r->strip.rays[f],
-             (unsigned long long)r->strip.triangles[f]);
+             (unsigned long long)strip_triangles(r, f));
     if ((uint32_t)stb_easy_font_width(text) * STRIP_TEXT_SCALE + 8 > r->camera.width)
         snprintf(text, size, "%llu rays", (unsigned long long)r->strip.rays[f]);
     if ((uint32_t)stb_easy_font_width(text) * STRIP_TEXT_SCALE + 8 > r->camera.width)
@@ -410,9 +559,10 @@ static int strip_render_frames(run *r, uint8_t *strip, uint32_t strip_width, ip_
     if (!strcmp(r->renderer_name, "opengl") && figure_renderer(r, w, h, &gl, err, err) != 0)
         rc = -1;
     for (size_t f = 0; rc == 0 && f < r->o.strip_at.count; f++) {
-        ip_mesh prefix = *r->mesh; /* a view of the first triangles, not a copy */
-        prefix.triangle_count = r->strip.triangles[f];
-        if (draw_mesh(r, gl, &prefix, frame, err) != IP_OK) {
+        uint64_t prefix[TOOL_MAX_ISOS];
+        for (size_t i = 0; i <= r->other_count; i++)
+            prefix[i] = surface_run_c(r, i)->strip.triangles[f];
+        if (draw_image(r, gl, prefix, frame, err) != IP_OK) {
             rc = -1;
             break;
         }
@@ -459,7 +609,7 @@ static void strip_print(FILE *out, const run *r)
     fprintf(out, "  strip         %s:", r->o.strip);
     for (size_t f = 0; f < r->o.strip_at.count; f++)
         fprintf(out, " %g%% (%llu triangles)", r->o.strip_at.pct[f],
-                (unsigned long long)r->strip.triangles[f]);
+                (unsigned long long)strip_triangles(r, f));
     fprintf(out, "\n");
 }
 
@@ -556,6 +706,9 @@ static int parse_args(int argc, char **argv, options *o)
         return tool_usage_error("isorender", "--aa is OpenGL's: --software draws without it");
     if (o->weld && o->no_weld)
         return tool_usage_error("isorender", "--weld and --no-weld: one or the other");
+    rc = check_surface_options(o);
+    if (rc)
+        return rc;
     rc = check_smooth_options(o);
     if (rc)
         return rc;
@@ -699,6 +852,45 @@ static int extract_full(run *r, ip_error *err)
     return 0;
 }
 
+/* What the surfaces' runs share with the first: the store, the cache and the view. */
+static void share_view(const run *r, run *s)
+{
+    if (s == r)
+        return;
+    s->store = r->store;
+    s->cache = r->cache;
+    s->camera = r->camera;
+    s->view_camera = r->view_camera;
+    memcpy(s->lo, r->lo, sizeof s->lo);
+    memcpy(s->hi, r->hi, sizeof s->hi);
+}
+
+/* Extracts every surface, one run after the other, each with the same view and options. */
+static int extract_surfaces(run *r, ip_error *err)
+{
+    for (size_t i = 0; i <= r->other_count; i++) {
+        run *s = surface_run(r, i);
+        if (i && tool_signal_caught()) { /* the later surfaces have no mesh: stop here */
+            err->code = IP_ERR_CANCELLED;
+            snprintf(err->message, sizeof err->message, "cancelled");
+            return -1;
+        }
+        share_view(r, s);
+        if ((s->o.full ? extract_full(s, err) : extract_progressive(s, err)) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* The triangles of every surface. */
+static uint64_t all_triangles(const run *r)
+{
+    uint64_t sum = 0;
+    for (size_t i = 0; i <= r->other_count; i++)
+        sum += surface_run_c(r, i)->mesh->triangle_count;
+    return sum;
+}
+
 /* The first checkpoint whose mesh holds triangle i (checkpoint_count when none). */
 static size_t checkpoint_of(const run *r, uint64_t i)
 {
@@ -781,14 +973,22 @@ static double overdraw(uint64_t triangles, uint64_t visible)
 static void progress_csv(FILE *f, void *user)
 {
     const run *r = user;
-    /* the columns scripts read come first, unchanged; later ones are appended */
-    fprintf(f, "time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,overdraw\n");
-    for (size_t c = 0; c < r->checkpoint_count; c++) {
-        const checkpoint *k = &r->checkpoints[c];
-        fprintf(f, "%.6f,%llu,%llu,%llu,%llu,%.4f,%llu,%.4f\n", k->time,
-                (unsigned long long)k->rays, (unsigned long long)k->seeds,
-                (unsigned long long)k->cells, (unsigned long long)k->triangles, k->final_pct,
-                (unsigned long long)k->visible, overdraw(k->triangles, k->visible));
+    /* the columns scripts read come first, unchanged; later ones are appended: with several
+     * surfaces, the isovalue, each surface's rows after the previous one's */
+    fprintf(f, "time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,overdraw%s\n",
+            r->other_count ? ",iso" : "");
+    for (size_t i = 0; i <= r->other_count; i++) {
+        const run *s = surface_run_c(r, i);
+        for (size_t c = 0; c < s->checkpoint_count; c++) {
+            const checkpoint *k = &s->checkpoints[c];
+            fprintf(f, "%.6f,%llu,%llu,%llu,%llu,%.4f,%llu,%.4f", k->time,
+                    (unsigned long long)k->rays, (unsigned long long)k->seeds,
+                    (unsigned long long)k->cells, (unsigned long long)k->triangles, k->final_pct,
+                    (unsigned long long)k->visible, overdraw(k->triangles, k->visible));
+            if (r->other_count)
+                fprintf(f, ",%.9g", s->o.common.iso);
+            fprintf(f, "\n");
+        }
     }
 }
 
@@ -809,13 +1009,51 @@ static int render_image(run *r, uint8_t *rgba, ip_renderer **keep, ip_error *err
                     why.message);
     }
     r->renderer_name = gl ? "opengl" : "software";
-    ip_status st = draw_mesh(r, gl, r->mesh, rgba, err);
+    ip_status st = draw_image(r, gl, NULL, rgba, err);
     if (keep)
         *keep = gl;
     else
         ip_renderer_destroy(gl);
     r->totals.rendering_seconds += ip_now_seconds() - start;
     return st == IP_OK ? 0 : -1;
+}
+
+/* "surfaces": each surface's isovalue, colour, opacity, counts and mesh file. */
+static void json_surfaces(FILE *f, const run *r)
+{
+    ip_mesh views[TOOL_MAX_ISOS];
+    fprintf(f, ", \"surfaces\": [");
+    for (size_t i = 0; i <= r->other_count; i++) {
+        const run *s = surface_run_c(r, i);
+        const ip_engine_counts *t = &s->totals;
+        ip_surface look;
+        surface_of(r, i, NULL, views, &look);
+        fprintf(f,
+                "%s{\"iso\": %.9g, \"color\": \"#%02x%02x%02x\", \"opacity\": %g, "
+                "\"rays\": %llu, \"done\": %s, \"seeds\": %llu, \"cells\": %llu, "
+                "\"triangles\": %llu, \"extraction_wall_s\": %.6f",
+                i ? ", " : "", s->o.common.iso, (unsigned)lround(255 * look.colour[0]),
+                (unsigned)lround(255 * look.colour[1]), (unsigned)lround(255 * look.colour[2]),
+                (double)look.opacity, (unsigned long long)t->rays,
+                s->o.full || (s->engine && ip_engine_done(s->engine)) ? "true" : "false",
+                (unsigned long long)t->seeds, (unsigned long long)t->cells,
+                (unsigned long long)t->triangles, s->extraction_wall);
+        if (s->checkpoint_count)
+            fprintf(f, ", \"final_pixel_pct\": %.4f",
+                    s->checkpoints[s->checkpoint_count - 1].final_pct);
+        if (s->owners_known)
+            fprintf(f, ", \"visible_triangles\": %llu, \"overdraw\": %.4f",
+                    (unsigned long long)s->visible_triangles,
+                    overdraw(s->mesh->triangle_count, s->visible_triangles));
+        if (!s->o.full)
+            fprintf(f, ", \"deferred_cells\": %llu", (unsigned long long)t->deferred);
+        if (s->o.mesh) {
+            fprintf(f, ", \"mesh\": ");
+            tool_json_string(f, s->o.mesh);
+        }
+        fprintf(f, "}");
+    }
+    fprintf(f, "]");
 }
 
 static void json_counts(FILE *f, void *user)
@@ -846,37 +1084,62 @@ static void json_counts(FILE *f, void *user)
                 r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred,
                 r->o.common.prefetch ? "true" : "false");
     fprintf(f, ", \"warnings\": [");
-    if (r->warning[0])
-        tool_json_string(f, r->warning);
+    for (size_t i = 0, written = 0; i <= r->other_count; i++) {
+        const run *s = surface_run_c(r, i);
+        if (!s->warning[0])
+            continue;
+        fprintf(f, "%s", written++ ? ", " : "");
+        tool_json_string(f, s->warning);
+    }
     fprintf(f, "]");
+    if (r->other_count)
+        json_surfaces(f, r);
 }
 
-static void print_summary(FILE *out, const run *r)
+/* The summary's lines of surface run s (r: the first surface's, which knows the renderer). */
+static void print_counts(FILE *out, const run *s, const run *r)
 {
-    const ip_engine_counts *t = &r->totals;
-    fprintf(out, "%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso,
-            r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
+    const ip_engine_counts *t = &s->totals;
     fprintf(out, "  rays          %llu of %llu\n", (unsigned long long)t->rays,
             (unsigned long long)r->camera.width * r->camera.height);
     fprintf(out, "  seeds         %llu\n", (unsigned long long)t->seeds);
     fprintf(out, "  cells         %llu\n", (unsigned long long)t->cells);
     fprintf(out, "  triangles     %llu\n", (unsigned long long)t->triangles);
-    if (r->owners_known)
+    if (s->owners_known)
         fprintf(out, "  visible       %llu triangles own a pixel: overdraw %.2f\n",
-                (unsigned long long)r->visible_triangles,
-                overdraw(r->mesh->triangle_count, r->visible_triangles));
+                (unsigned long long)s->visible_triangles,
+                overdraw(s->mesh->triangle_count, s->visible_triangles));
     fprintf(out,
             "  time          %.3f s extraction (wall); CPU s summed over %u threads: "
             "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
-            r->extraction_wall, ip_thread_count(r->o.common.threads), t->intersection_seconds,
+            s->extraction_wall, ip_thread_count(s->o.common.threads), t->intersection_seconds,
             t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
+}
+
+static void print_summary(FILE *out, const run *r)
+{
+    if (!r->other_count) {
+        fprintf(out, "%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso,
+                r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
+        print_counts(out, r, r);
+    } else {
+        fprintf(out, "%s: %zu surfaces, %s, %ux%u\n", r->o.file, r->other_count + 1,
+                r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
+        for (size_t i = 0; i <= r->other_count; i++) {
+            fprintf(out, "  surface %zu     iso %g\n", i + 1, surface_run_c(r, i)->o.common.iso);
+            print_counts(out, surface_run_c(r, i), r);
+        }
+    }
     fprintf(out, "  image         %s\n", r->o.out);
-    if (r->o.mesh)
-        fprintf(out, "  mesh          %s: %llu triangles, %llu vertices%s%s\n", r->o.mesh,
-                (unsigned long long)(r->mesh->triangle_count - r->mesh_dropped),
-                (unsigned long long)r->mesh_vertices,
-                r->mesh_vertices < 3 * r->mesh->triangle_count ? " (shared)" : "",
-                r->o.smooth ? ", smoothed" : "");
+    for (size_t i = 0; i <= r->other_count; i++) {
+        const run *s = surface_run_c(r, i);
+        if (s->o.mesh)
+            fprintf(out, "  mesh          %s: %llu triangles, %llu vertices%s%s\n", s->o.mesh,
+                    (unsigned long long)(s->mesh->triangle_count - s->mesh_dropped),
+                    (unsigned long long)s->mesh_vertices,
+                    s->mesh_vertices < 3 * s->mesh->triangle_count ? " (shared)" : "",
+                    s->o.smooth ? ", smoothed" : "");
+    }
 }
 
 /* Writes `mesh` to the mesh file: welded (shared vertices) unless --no-weld or STL (which is
@@ -966,9 +1229,10 @@ static int finish(run *r, ip_error *err)
     uint32_t strip_width = 0, strip_height = 0;
     if (rc == 0 && r->o.strip && strip_compose(r, &strip, &strip_width, &strip_height, err) != 0)
         rc = -1;
-    if (rc == 0 && ((r->o.progress && !r->o.full) || r->o.common.stats) &&
-        final_pixels(r, err) != 0)
-        rc = -1;
+    for (size_t i = 0; i <= r->other_count; i++)
+        if (rc == 0 && ((r->o.progress && !r->o.full) || r->o.common.stats) &&
+            final_pixels(surface_run(r, i), err) != 0)
+            rc = -1;
     if (rc != 0 || tool_signal_caught()) {
         free(rgba);
         free(strip);
@@ -985,8 +1249,9 @@ static int finish(run *r, ip_error *err)
     free(strip);
     if (rc != 0)
         return tool_fail("isorender", err);
-    if (r->o.mesh && write_mesh(r, err) != 0)
-        return 1;
+    for (size_t i = 0; i <= r->other_count; i++)
+        if (r->o.mesh && write_mesh(surface_run(r, i), err) != 0)
+            return 1;
     if (r->o.progress && !r->o.full &&
         tool_write_text_file("isorender", r->o.progress, r->o.common.force, progress_csv, r) != 0)
         return 1;
@@ -1022,7 +1287,7 @@ static void turntable_camera(const run *r, uint64_t f, ip_camera *camera)
 
 /* The mesh of frame f: a progressive run from scratch for its camera (with --rays and --time
  * per frame), or the one full extraction, made for frame 0. */
-static int turntable_extract(run *r, ip_error *err)
+static int turntable_extract_one(run *r, ip_error *err)
 {
     if (r->o.full)
         return r->mesh ? 0 : extract_full(r, err);
@@ -1035,6 +1300,18 @@ static int turntable_extract(run *r, ip_error *err)
     r->extraction_wall = ip_now_seconds() - start;
     ip_engine_totals(r->engine, &r->totals);
     r->mesh = ip_engine_mesh(r->engine);
+    return 0;
+}
+
+/* Frame f's meshes, of every surface. */
+static int turntable_extract(run *r, ip_error *err)
+{
+    for (size_t i = 0; i <= r->other_count; i++) {
+        run *s = surface_run(r, i);
+        share_view(r, s);
+        if (turntable_extract_one(s, err) != 0)
+            return -1;
+    }
     return 0;
 }
 
@@ -1104,8 +1381,7 @@ static int turntable_frame(run *r, uint64_t f, ip_renderer **gl, uint8_t *rgba, 
         return -1;
     if (!r->o.common.quiet)
         printf("  frame %llu of %llu: %s, %llu triangles\n", (unsigned long long)f + 1,
-               (unsigned long long)r->o.turntable, path,
-               (unsigned long long)r->mesh->triangle_count);
+               (unsigned long long)r->o.turntable, path, (unsigned long long)all_triangles(r));
     return 0;
 }
 
@@ -1145,26 +1421,91 @@ static int turntable_run(run *r, ip_error *err)
     return r->o.mp4 ? turntable_encode(r) : 0;
 }
 
+/* The mesh file of the surface of isovalue `iso`: `path` with "_isoV" before its extension
+ * (head.ply: head_iso600.5.ply). Returns 0, or 2 after a usage error. */
+static int surface_mesh_name(const char *path, double iso, char *out, size_t size)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash))
+        dot = path + strlen(path);
+    int length = snprintf(out, size, "%.*s_iso%g%s", (int)(dot - path), path, iso, dot);
+    if (length < 0 || (size_t)length >= size)
+        return tool_usage_error("isorender", "--mesh %s: the name is too long", path);
+    return 0;
+}
+
+/* The surfaces' runs after the first (several --iso), copies of its options with their own
+ * isovalues, and with --mesh each surface's file name. Returns 0, 1 (out of memory) or 2
+ * (a usage error). */
+static int setup_surfaces(run *r)
+{
+    size_t n = r->o.common.iso_count;
+    r->o.common.iso = r->o.common.isos[0]; /* the first --iso is the first surface's */
+    if (n < 2)
+        return 0;
+    r->others = calloc(n - 1, sizeof *r->others);
+    if (!r->others) {
+        fprintf(stderr, "isorender: out of memory\n");
+        return 1;
+    }
+    r->other_count = n - 1;
+    for (size_t i = 1; i < n; i++) {
+        r->others[i - 1].o = r->o;
+        r->others[i - 1].o.common.iso = r->o.common.isos[i];
+    }
+    for (size_t i = 0; r->o.mesh && i < n; i++) {
+        run *s = surface_run(r, n - 1 - i); /* the first last: its name is the template */
+        if (surface_mesh_name(r->o.mesh, s->o.common.iso, s->mesh_name, sizeof s->mesh_name))
+            return 2;
+        s->o.mesh = s->mesh_name;
+    }
+    return 0;
+}
+
+/* Frees what the surfaces' runs after the first hold. */
+static void free_surfaces(run *r)
+{
+    for (size_t i = 0; i < r->other_count; i++) {
+        ip_engine_destroy(r->others[i].engine);
+        ip_mesh_free(&r->others[i].full_mesh);
+        free(r->others[i].checkpoints);
+    }
+    free(r->others);
+}
+
 int main(int argc, char **argv)
 {
     run r;
     memset(&r, 0, sizeof r);
     int rc = parse_args(argc, argv, &r.o);
-    if (rc)
+    if (!rc)
+        rc = setup_surfaces(&r);
+    if (rc) {
+        free_surfaces(&r);
         return rc;
+    }
     const char *inputs[] = {r.o.file};
-    const char *outputs[] = {r.o.turntable ? r.o.mp4 : r.o.out, r.o.mesh, r.o.common.stats,
-                             r.o.full ? NULL : r.o.progress, r.o.strip};
-    if (tool_check_paths("isorender", inputs, 1, outputs, 5, r.o.common.force) != 0)
+    const char *outputs[5 + TOOL_MAX_ISOS - 1] = {r.o.turntable ? r.o.mp4 : r.o.out, r.o.mesh,
+                                                  r.o.common.stats, r.o.full ? NULL : r.o.progress,
+                                                  r.o.strip};
+    for (size_t i = 0; i < r.other_count; i++)
+        outputs[5 + i] = r.others[i].o.mesh;
+    if (tool_check_paths("isorender", inputs, 1, outputs, 5 + r.other_count, r.o.common.force) !=
+        0) {
+        free_surfaces(&r);
         return 1;
-    if (r.o.mesh && !ip_mesh_format_of(r.o.mesh)) /* before any work, after the paths' checks */
+    }
+    if (r.o.mesh && !ip_mesh_format_of(r.o.mesh)) { /* before any work, after the paths' checks */
+        free_surfaces(&r);
         return tool_usage_error(
             "isorender", "--mesh %s: the name must end in .ply, .stl, .obj or .glb", r.o.mesh);
+    }
     tool_signals_catch();
     ip_error err;
     ip_error_clear(&err);
     if (ip_store_open(r.o.file, &r.store, &err) != IP_OK) {
         rc = tool_fail("isorender", &err);
+        free_surfaces(&r);
         tool_signals_reraise();
         return rc;
     }
@@ -1174,10 +1515,14 @@ int main(int argc, char **argv)
         rc = tool_fail("isorender", &err);
     } else {
         /* the errors above come first: a bad command line is one line, not a warning too */
-        tool_warn_iso_range("isorender", r.store, r.o.common.iso, r.warning, sizeof r.warning);
+        for (size_t i = 0; i <= r.other_count; i++) {
+            run *s = surface_run(&r, i);
+            tool_warn_iso_range("isorender", r.store, s->o.common.iso, s->warning,
+                                sizeof s->warning);
+        }
         if (r.o.turntable)
             rc = turntable_run(&r, &err);
-        else if ((r.o.full ? extract_full(&r, &err) : extract_progressive(&r, &err)) == 0)
+        else if (extract_surfaces(&r, &err) == 0)
             rc = finish(&r, &err);
         else if (!(err.code == IP_ERR_CANCELLED && tool_signal_caught()))
             rc = tool_fail("isorender", &err); /* a cancel by a signal is reported below */
@@ -1185,6 +1530,7 @@ int main(int argc, char **argv)
     tool_signals_cancel_engine(NULL);
     if (tool_signal_caught() && !r.writing)
         fprintf(stderr, "isorender: %s: cancelled; no output written\n", r.o.file);
+    free_surfaces(&r);
     ip_engine_destroy(r.engine);
     ip_mesh_free(&r.full_mesh);
     free(r.checkpoints);

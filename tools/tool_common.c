@@ -685,9 +685,13 @@ int tool_parse_threads(const char *program, const char *text, unsigned max, unsi
 
 static int parse_iso(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
+    tool_view_options *o = base;
     if (tool_option_number(p, opt, v, base) != 0)
         return 2;
-    ((tool_view_options *)base)->has_iso = 1;
+    o->has_iso = 1;
+    if (o->iso_count < TOOL_MAX_ISOS)
+        o->isos[o->iso_count] = o->iso;
+    o->iso_count++;
     return 0;
 }
 

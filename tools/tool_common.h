@@ -104,11 +104,18 @@ void tool_print_rescale(FILE *out, const ip_input_desc *desc);
 /* Parses --cache-mb's value into bytes; returns 0 on success. */
 int tool_parse_cache_mb(const char *text, uint64_t *bytes);
 
+/* The isovalues one command line keeps (isorender's surfaces). */
+#define TOOL_MAX_ISOS 4
+
 /* The options isorender and isoview share: what to extract, from where, and how, and the
  * statistics file, --force and --quiet. */
 typedef struct tool_view_options {
     double iso;
     int has_iso;
+    /* every --iso in order (iso is the last), the first TOOL_MAX_ISOS of them; iso_count
+     * counts them all */
+    double isos[TOOL_MAX_ISOS];
+    unsigned iso_count;
     uint32_t width, height;    /* pixels */
     const char *view, *camera; /* --view AXIS, --camera E,T,U,FOV (NULL: none) */
     uint64_t rays;             /* 0: every pixel */

@@ -21,6 +21,7 @@
 #ifndef ISOPROP_RENDER_H
 #define ISOPROP_RENDER_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "isoprop/camera.h"
@@ -89,6 +90,43 @@ IP_API ip_status ip_raster_mesh_shaded(const ip_mesh *mesh, const ip_camera *cam
                                        const ip_shading *shading, const double lo[3],
                                        const double hi[3], uint32_t *triangle_index, uint8_t *rgba,
                                        ip_error *err);
+
+/* One surface of a several-surface image (ip_raster_surfaces(), ip_renderer_draw_surfaces()):
+ * a mesh with its own colour and opacity. The other shading terms are the shading's. */
+typedef struct ip_surface {
+    const ip_mesh *mesh; /* read during the call only */
+    float colour[3];     /* replaces ip_shading.surface for this mesh; 0..1 per channel */
+    float opacity;       /* 1: opaque; (0, 1): translucent, drawn by the front-layer rule */
+} ip_surface;
+
+/* The most surfaces one image takes. */
+#define IP_MAX_SURFACES 16
+
+/*! ip_surfaces_check() : validates surfaces for a several-surface image: 1 to
+ *  IP_MAX_SURFACES of them, each with a mesh, colour channels in [0, 1] and an opacity in
+ *  (0, 1]. @return IP_OK or IP_ERR_ARGUMENT with a message. Thread-safe. */
+IP_API ip_status ip_surfaces_check(const ip_surface *surfaces, size_t count, ip_error *err);
+
+/*! ip_raster_surfaces() : renders several surfaces into one image in software, the reference
+ *  for ip_renderer_draw_surfaces(). The rule ("front layer only"), per pixel: the opaque
+ *  surfaces (opacity 1) are one depth-tested scene, as ip_raster_mesh() draws one mesh (on
+ *  equal depth the lower surface index wins, then the lower triangle index), shaded with
+ *  their own colours over the background; then each translucent surface, in index order, is
+ *  blended over that colour with its opacity a, colour = a * shaded + (1 - a) * colour,
+ *  rounded to 8 bits after each blend, at the pixels where its own nearest fragment is at
+ *  least as near as the nearest opaque fragment (or where no opaque surface is). Only the
+ *  nearest layer of a translucent surface shows, and it hides nothing of the others: the
+ *  image depends on the surfaces' order, never on the order of the triangles. With every
+ *  surface opaque the image is that of the meshes concatenated in index order, each pixel
+ *  shaded with the colour of the surface it shows. `shading` (NULL: ip_shading_default())
+ *  gives the background and the lighting terms; its surface colour is not used. `rgba`:
+ *  width * height * 4 bytes, caller-owned. Single-threaded; reentrant.
+ *  @return IP_OK, IP_ERR_ARGUMENT (as ip_raster_mesh_shaded(), or ip_surfaces_check()
+ *  fails) or IP_ERR_NOMEM (about 24 bytes a pixel per surface). */
+IP_API ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count,
+                                    const ip_camera *camera, const ip_shading *shading,
+                                    const double lo[3], const double hi[3], uint8_t *rgba,
+                                    ip_error *err);
 
 /*! ip_png_write() : writes an image given as width * height * 4 bytes (RGBA, top row first)
  *  as an 8-bit PNG: RGB when every alpha is 255, RGBA otherwise. The file appears only once
@@ -200,6 +238,19 @@ IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera
 IP_API ip_status ip_renderer_draw_mesh(ip_renderer *renderer, const ip_mesh *mesh,
                                        const ip_camera *camera, const double lo[3],
                                        const double hi[3], ip_error *err);
+
+/*! ip_renderer_draw_surfaces() : draws the background and several surfaces by the rule of
+ *  ip_raster_surfaces() (the opaque ones depth-tested together; then each translucent one,
+ *  in index order, by a depth pass of the opaque surfaces and of itself and a blended colour
+ *  pass of its fragments at that depth), streamed as ip_renderer_draw_mesh() streams one
+ *  mesh. The renderer's shading gives the background and the lighting terms; each surface
+ *  its colour and opacity. The uploaded triangles are left alone and not drawn. One opaque
+ *  surface gives ip_renderer_draw_mesh()'s image with that colour. The meshes are read
+ *  during the call only.
+ *  @return as ip_renderer_draw(), and IP_ERR_ARGUMENT when ip_surfaces_check() fails. */
+IP_API ip_status ip_renderer_draw_surfaces(ip_renderer *renderer, const ip_surface *surfaces,
+                                           size_t count, const ip_camera *camera,
+                                           const double lo[3], const double hi[3], ip_error *err);
 
 /*! ip_renderer_set_shading() : the shading of later draws (NULL: ip_shading_default(),
  *  which a new renderer starts with); copied. Needs no context.

@@ -72,8 +72,10 @@ static void shade_background(const ip_shading *s, uint32_t row, uint32_t height,
     out[3] = 255;
 }
 
-/* n: the interpolated normal (any length); v: the unit vector toward the eye. */
-static void shade_surface(const ip_shading *s, const float n[3], const double v[3], uint8_t out[4])
+/* The shaded colour of a surface of colour `colour`, before rounding. n: the interpolated
+ * normal (any length); v: the unit vector toward the eye. */
+static void shade_value(const ip_shading *s, const float colour[3], const float n[3],
+                        const double v[3], double out[3])
 {
     const double normal[3] = {n[0], n[1], n[2]};
     double len = ip__vec3_length(normal);
@@ -82,7 +84,15 @@ static void shade_surface(const ip_shading *s, const float n[3], const double v[
         c = fmin(1.0, fabs(ip__vec3_dot(normal, v)) / len);
     double light = s->ambient + s->diffuse * c, highlight = s->specular * pow(c, s->shininess);
     for (int i = 0; i < 3; i++)
-        out[i] = to_unorm8(s->surface[i] * light + highlight);
+        out[i] = colour[i] * light + highlight;
+}
+
+static void shade_surface(const ip_shading *s, const float n[3], const double v[3], uint8_t out[4])
+{
+    double value[3];
+    shade_value(s, s->surface, n, v, value);
+    for (int i = 0; i < 3; i++)
+        out[i] = to_unorm8(value[i]);
     out[3] = 255;
 }
 
@@ -417,6 +427,18 @@ static void free_target(raster_target *t, const uint32_t *triangle_index)
     free(t->normal);
 }
 
+/* Rasterizes every triangle of `mesh` into t, numbered from `first_index` on. */
+static void raster_triangles(raster_target *t, const raster_view *view, const ip_mesh *mesh,
+                             uint32_t first_index)
+{
+    for (uint64_t i = 0; i < mesh->triangle_count; i++) {
+        view_vertex tri[3];
+        for (int k = 0; k < 3; k++)
+            to_view(view, mesh->positions + 9 * i + 3 * k, mesh->normals + 9 * i + 3 * k, &tri[k]);
+        clip_and_raster(t, view, tri, first_index + (uint32_t)i);
+    }
+}
+
 ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
                          const double hi[3], uint32_t *triangle_index, uint8_t *rgba, ip_error *err)
 {
@@ -437,16 +459,158 @@ ip_status ip_raster_mesh_shaded(const ip_mesh *mesh, const ip_camera *camera,
     if (st == IP_OK) {
         raster_view view;
         setup_view(&view, camera, lo, hi);
-        for (uint64_t i = 0; i < mesh->triangle_count; i++) {
-            view_vertex tri[3];
-            for (int k = 0; k < 3; k++)
-                to_view(&view, mesh->positions + 9 * i + 3 * k, mesh->normals + 9 * i + 3 * k,
-                        &tri[k]);
-            clip_and_raster(&target, &view, tri, (uint32_t)i);
-        }
+        raster_triangles(&target, &view, mesh, 0);
         if (rgba)
             shade_image(&target, camera, shading, rgba);
     }
     free_target(&target, triangle_index);
+    return st;
+}
+
+/* ---- several surfaces ---- */
+
+ip_status ip_surfaces_check(const ip_surface *surfaces, size_t count, ip_error *err)
+{
+    if (count < 1 || count > IP_MAX_SURFACES || !surfaces)
+        return ip__fail(err, IP_ERR_ARGUMENT, "surfaces: %zu of them (1 to %d)", count,
+                        IP_MAX_SURFACES);
+    for (size_t i = 0; i < count; i++) {
+        const ip_surface *f = &surfaces[i];
+        if (!f->mesh)
+            return ip__fail(err, IP_ERR_ARGUMENT, "surface %zu: no mesh", i);
+        if (!is_unit_colour(f->colour))
+            return ip__fail(err, IP_ERR_ARGUMENT, "surface %zu: a colour channel is outside [0, 1]",
+                            i);
+        if (!(f->opacity > 0.0f && f->opacity <= 1.0f))
+            return ip__fail(err, IP_ERR_ARGUMENT, "surface %zu: opacity %g is not in (0, 1]", i,
+                            (double)f->opacity);
+    }
+    return IP_OK;
+}
+
+/* The surfaces' buffers: one target for the opaque ones together (triangles numbered across
+ * them in surface order), one for each translucent one; first[i] is surface i's first
+ * triangle number in its target. */
+typedef struct surface_targets {
+    raster_target opaque;
+    raster_target layer[IP_MAX_SURFACES]; /* of the translucent surfaces */
+    uint32_t first[IP_MAX_SURFACES];
+} surface_targets;
+
+static int is_opaque(const ip_surface *f)
+{
+    return f->opacity >= 1.0f;
+}
+
+/* The surface the opaque target's triangle `index` belongs to. */
+static size_t opaque_surface_of(const surface_targets *st, const ip_surface *surfaces, size_t count,
+                                uint32_t index)
+{
+    size_t found = 0;
+    for (size_t i = 0; i < count; i++)
+        if (is_opaque(&surfaces[i]) && st->first[i] <= index)
+            found = i;
+    return found;
+}
+
+/* The pixel's colour: the nearest opaque surface (or the background), then each translucent
+ * surface whose nearest fragment is at least as near, blended over it in surface order. */
+static void shade_surfaces_pixel(const surface_targets *st, const ip_surface *surfaces,
+                                 size_t count, const ip_shading *s, const double ray[3],
+                                 size_t pixel, uint8_t out[4])
+{
+    const raster_target *o = &st->opaque;
+    double value[3];
+    if (o->index[pixel] != UINT32_MAX) {
+        const ip_surface *f = &surfaces[opaque_surface_of(st, surfaces, count, o->index[pixel])];
+        shade_value(s, f->colour, o->normal + 3 * pixel, ray, value);
+        for (int k = 0; k < 3; k++)
+            out[k] = to_unorm8(value[k]);
+    }
+    for (size_t i = 0; i < count; i++) {
+        const raster_target *t = &st->layer[i];
+        if (is_opaque(&surfaces[i]) || t->index[pixel] == UINT32_MAX ||
+            t->inverse_depth[pixel] < o->inverse_depth[pixel])
+            continue;
+        double a = surfaces[i].opacity;
+        shade_value(s, surfaces[i].colour, t->normal + 3 * pixel, ray, value);
+        for (int k = 0; k < 3; k++)
+            out[k] = to_unorm8(a * fmin(1.0, fmax(0.0, value[k])) + (1.0 - a) * (out[k] / 255.0));
+    }
+}
+
+static void shade_surfaces(const surface_targets *st, const ip_surface *surfaces, size_t count,
+                           const ip_camera *camera, const ip_shading *s, uint8_t *rgba)
+{
+    ip_camera_basis basis;
+    ip_camera_basis_of(camera, &basis);
+    for (uint32_t y = 0; y < camera->height; y++) {
+        uint8_t background[4];
+        shade_background(s, y, camera->height, background);
+        for (uint32_t x = 0; x < camera->width; x++) {
+            size_t pixel = (size_t)y * camera->width + x;
+            double ray[3];
+            ip_camera_pixel_ray(&basis, camera, x + 0.5, y + 0.5, ray);
+            memcpy(rgba + 4 * pixel, background, 4);
+            shade_surfaces_pixel(st, surfaces, count, s, ray, pixel, rgba + 4 * pixel);
+        }
+    }
+}
+
+static ip_status check_surfaces(const ip_surface *surfaces, size_t count, const ip_camera *camera,
+                                const ip_shading *shading, const double lo[3], const double hi[3],
+                                ip_error *err)
+{
+    ip_status st = ip_surfaces_check(surfaces, count, err);
+    if (st == IP_OK && shading)
+        st = ip_shading_check(shading, err);
+    uint64_t opaque = 0;
+    for (size_t i = 0; st == IP_OK && i < count; i++) {
+        st = check_arguments(surfaces[i].mesh, camera, lo, hi, err);
+        opaque += is_opaque(&surfaces[i]) ? surfaces[i].mesh->triangle_count : 0;
+    }
+    if (st == IP_OK && opaque >= UINT32_MAX)
+        return ip__fail(err, IP_ERR_ARGUMENT, "raster: %llu opaque triangles are too many",
+                        (unsigned long long)opaque);
+    return st;
+}
+
+ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count, const ip_camera *camera,
+                             const ip_shading *shading, const double lo[3], const double hi[3],
+                             uint8_t *rgba, ip_error *err)
+{
+    ip_status st = check_surfaces(surfaces, count, camera, shading, lo, hi, err);
+    if (st != IP_OK)
+        return st;
+    ip_shading s;
+    if (shading)
+        s = *shading;
+    else
+        ip_shading_default(&s);
+    surface_targets *targets = calloc(1, sizeof *targets);
+    if (!targets)
+        return ip__fail(err, IP_ERR_NOMEM, "raster: out of memory");
+    raster_view view;
+    setup_view(&view, camera, lo, hi);
+    st = allocate_target(&targets->opaque, camera, NULL, 1, err);
+    uint32_t next = 0;
+    for (size_t i = 0; st == IP_OK && i < count; i++) {
+        const ip_surface *f = &surfaces[i];
+        if (is_opaque(f)) {
+            targets->first[i] = next;
+            raster_triangles(&targets->opaque, &view, f->mesh, next);
+            next += (uint32_t)f->mesh->triangle_count;
+            continue;
+        }
+        st = allocate_target(&targets->layer[i], camera, NULL, 1, err);
+        if (st == IP_OK)
+            raster_triangles(&targets->layer[i], &view, f->mesh, 0);
+    }
+    if (st == IP_OK)
+        shade_surfaces(targets, surfaces, count, camera, &s, rgba);
+    free_target(&targets->opaque, NULL);
+    for (size_t i = 0; i < count; i++)
+        free_target(&targets->layer[i], NULL);
+    free(targets);
     return st;
 }

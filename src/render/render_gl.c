@@ -25,8 +25,8 @@ struct ip_renderer {
     uint32_t samples;                  /* per pixel of that framebuffer; 1: no multisampling */
     GLuint resolve_framebuffer, resolve_color; /* samples > 1: the averaged image, read back */
     GLuint mesh_program, background_program;
-    GLint view_at, projection_at, eye_at, surface_at, terms_at; /* mesh uniforms */
-    GLint top_at, bottom_at, height_at;                         /* background uniforms */
+    GLint view_at, projection_at, eye_at, surface_at, terms_at, opacity_at; /* mesh uniforms */
+    GLint top_at, bottom_at, height_at;  /* background uniforms */
     GLuint mesh_array, background_array; /* vertex arrays; the background has no attributes */
     GLuint positions, normals;           /* POSITION_BYTES and NORMAL_BYTES per triangle */
     uint64_t triangle_count, triangle_capacity;
@@ -58,13 +58,14 @@ static const char *const mesh_fragment_source =
     "uniform vec3 eye;\n"
     "uniform vec3 surface;\n"
     "uniform vec4 terms; /* ambient, diffuse, specular, shininess */\n"
+    "uniform float opacity;\n"
     "out vec4 colour;\n"
     "void main() {\n"
     "    vec3 v = normalize(eye - world);\n"
     "    float len = length(world_normal);\n"
     "    float c = len > 1e-12 ? min(1.0, abs(dot(world_normal, v)) / len) : 1.0;\n"
     "    vec3 lit = surface * (terms.x + terms.y * c) + vec3(terms.z * pow(c, terms.w));\n"
-    "    colour = vec4(clamp(lit, 0.0, 1.0), 1.0);\n"
+    "    colour = vec4(clamp(lit, 0.0, 1.0), opacity);\n"
     "}\n";
 
 static const char *const background_vertex_source =
@@ -205,6 +206,7 @@ static ip_status build_programs(ip_renderer *r, ip_error *err)
     r->eye_at = glGetUniformLocation(r->mesh_program, "eye");
     r->surface_at = glGetUniformLocation(r->mesh_program, "surface");
     r->terms_at = glGetUniformLocation(r->mesh_program, "terms");
+    r->opacity_at = glGetUniformLocation(r->mesh_program, "opacity");
     r->top_at = glGetUniformLocation(r->background_program, "top");
     r->bottom_at = glGetUniformLocation(r->background_program, "bottom");
     r->height_at = glGetUniformLocation(r->background_program, "height");
@@ -512,6 +514,7 @@ static void use_mesh_program(const ip_renderer *r, const ip_camera *camera, doub
     glUniform3fv(r->eye_at, 1, eye);
     glUniform3fv(r->surface_at, 1, s->surface);
     glUniform4fv(r->terms_at, 1, terms);
+    glUniform1f(r->opacity_at, 1.0f);
 }
 
 static void draw_mesh(const ip_renderer *r, const ip_camera *camera, double near_plane,
@@ -573,16 +576,9 @@ static ip_status make_stream_buffers(ip_renderer *r, ip_error *err)
     return check_gl("creating the streaming buffers", err);
 }
 
-ip_status ip_renderer_draw_mesh(ip_renderer *r, const ip_mesh *m, const ip_camera *camera,
-                                const double lo[3], const double hi[3], ip_error *err)
+/* Draws the triangles of `m` with the program in use, through the streaming buffers. */
+static void stream_mesh(const ip_renderer *r, const ip_mesh *m)
 {
-    double near_plane, far_plane;
-    ip_status st = begin_image(r, camera, lo, hi, &near_plane, &far_plane, err);
-    if (st == IP_OK)
-        st = make_stream_buffers(r, err);
-    if (st != IP_OK || m->triangle_count == 0)
-        return st == IP_OK ? check_gl("drawing", err) : st;
-    use_mesh_program(r, camera, near_plane, far_plane);
     glBindVertexArray(r->stream_array);
     /* Each part replaces the buffers' storage (orphaning it), so the driver never waits for
      * the previous draw and frees each part's copy once drawn. Drawing in parts, in order,
@@ -600,6 +596,81 @@ ip_status ip_renderer_draw_mesh(ip_renderer *r, const ip_mesh *m, const ip_camer
     }
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     glBindVertexArray(0);
+}
+
+ip_status ip_renderer_draw_mesh(ip_renderer *r, const ip_mesh *m, const ip_camera *camera,
+                                const double lo[3], const double hi[3], ip_error *err)
+{
+    double near_plane, far_plane;
+    ip_status st = begin_image(r, camera, lo, hi, &near_plane, &far_plane, err);
+    if (st == IP_OK)
+        st = make_stream_buffers(r, err);
+    if (st != IP_OK || m->triangle_count == 0)
+        return st == IP_OK ? check_gl("drawing", err) : st;
+    use_mesh_program(r, camera, near_plane, far_plane);
+    stream_mesh(r, m);
+    glUseProgram(0);
+    return check_gl("drawing", err);
+}
+
+/* Draws the opaque surfaces, each in its colour; with depth writes only when `colour` is 0. */
+static void draw_opaque(const ip_renderer *r, const ip_surface *surfaces, size_t count, int colour)
+{
+    for (size_t i = 0; i < count; i++) {
+        if (surfaces[i].opacity < 1.0f)
+            continue;
+        if (colour)
+            glUniform3fv(r->surface_at, 1, surfaces[i].colour);
+        stream_mesh(r, surfaces[i].mesh);
+    }
+}
+
+/* Translucent surface f by the front-layer rule, over the opaque surfaces drawn: the depth
+ * buffer is made the nearer of the opaque surfaces' (redrawn when `restore`, after an
+ * earlier translucent surface) and f's own; then f's fragments at that depth are blended.
+ * The same program and vertices give the same depths in both passes. */
+static void draw_translucent(const ip_renderer *r, const ip_surface *surfaces, size_t count,
+                             const ip_surface *f, int restore)
+{
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    if (restore) {
+        glClear(GL_DEPTH_BUFFER_BIT);
+        draw_opaque(r, surfaces, count, 0);
+    }
+    stream_mesh(r, f->mesh);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_LEQUAL);
+    glEnable(GL_BLEND);
+    /* colour: a * shaded + (1 - a) * below; the alpha channel stays 1 */
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    glUniform3fv(r->surface_at, 1, f->colour);
+    glUniform1f(r->opacity_at, f->opacity);
+    stream_mesh(r, f->mesh);
+    glUniform1f(r->opacity_at, 1.0f);
+    glDisable(GL_BLEND);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+}
+
+ip_status ip_renderer_draw_surfaces(ip_renderer *r, const ip_surface *surfaces, size_t count,
+                                    const ip_camera *camera, const double lo[3], const double hi[3],
+                                    ip_error *err)
+{
+    ip_status st = ip_surfaces_check(surfaces, count, err);
+    double near_plane, far_plane;
+    if (st == IP_OK)
+        st = begin_image(r, camera, lo, hi, &near_plane, &far_plane, err);
+    if (st == IP_OK)
+        st = make_stream_buffers(r, err);
+    if (st != IP_OK)
+        return st;
+    use_mesh_program(r, camera, near_plane, far_plane);
+    draw_opaque(r, surfaces, count, 1);
+    int translucent = 0;
+    for (size_t i = 0; i < count; i++)
+        if (surfaces[i].opacity < 1.0f)
+            draw_translucent(r, surfaces, count, &surfaces[i], translucent++ > 0);
     glUseProgram(0);
     return check_gl("drawing", err);
 }

@@ -42,8 +42,8 @@ done
     -o ratio-p.png
 "$bin/isorender" ratio.ibv --iso 100.5 --size 160x120 --software --full --view +z --quiet \
     -o ratio-f.png
-"$bin/isorender" ratio.ibv --iso 100.5 --size 160x120 --software --full --view +z --quiet \
-    --iso 1e9 -o ratio-none.png 2>/dev/null
+"$bin/isorender" ratio.ibv --iso 1e9 --size 160x120 --software --full --view +z --quiet \
+    -o ratio-none.png 2>/dev/null
 line=$("$compare" ratio-p.png ratio-f.png --level 2 --max-pct 0)
 check "a ratio of 1000: progressive equals full: $line" test $? = 0
 check "and the surface shows" sh -c '! "$0" "$1" "$2" --level 2 --max-pct 1 >/dev/null' \
