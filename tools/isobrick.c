@@ -304,11 +304,11 @@ static int print_levels(const char *out)
         }
         char b[32];
         fprintf(stderr,
-                "isobrick: level %u: %ux%ux%u samples, %ux%ux%u = %llu bricks: %llu constant, "
+                "isobrick: level %u: %ux%ux%u samples, %ux%ux%u = %llu brick%s: %llu constant, "
                 "%llu LZ4, %llu raw; %s of payload; filters:",
                 k, level->dims[0], level->dims[1], level->dims[2], level->bricks[0],
                 level->bricks[1], level->bricks[2], (unsigned long long)level->brick_count,
-                (unsigned long long)count[IP_BRICK_CONSTANT],
+                level->brick_count == 1 ? "" : "s", (unsigned long long)count[IP_BRICK_CONSTANT],
                 (unsigned long long)count[IP_BRICK_LZ4], (unsigned long long)count[IP_BRICK_RAW],
                 tool_format_bytes(b, sizeof b, (double)stored));
         int any = 0;

@@ -290,8 +290,8 @@ IP_API void ip_renderer_destroy(ip_renderer *renderer);
  * renderer drew it, with or without anti-aliasing. Each draws only inside a box in one corner,
  * which it reports as {x0, y0, x1, y1} (pixels; x0, y0 included, x1, y1 excluded): the triad
  * in the bottom-left corner, the scale bar in the bottom-right. Their sizes follow the
- * image's smaller side s: text (stb_easy_font's, scaled by max(1, min(4, s / 300))), the
- * triad's arms 6 % of s (at least 12 pixels). Lines are anti-aliased, text is not. */
+ * image's smaller side s: text (stb_easy_font's, scaled by round(s / 240), 1 to 4), the
+ * triad's arms 8 % of s (at least 16 pixels). Lines are anti-aliased, text is not. */
 
 /* A scale bar: a round length and what it spans in the image at the target's depth. */
 typedef struct ip_scale_bar {

@@ -36,7 +36,8 @@ static overlay_sizes sizes_of(const ip_camera *camera)
 {
     int side = (int)(camera->width < camera->height ? camera->width : camera->height);
     overlay_sizes s;
-    s.text_scale = side / 250 < 1 ? 1 : side / 250 > 4 ? 4 : side / 250;
+    int scale = (side + 120) / 240; /* the nearest whole multiple of 240 pixels */
+    s.text_scale = scale < 1 ? 1 : scale > 4 ? 4 : scale;
     s.margin = 4 * s.text_scale;
     s.arm = 0.08 * side < 16 ? 16 : 0.08 * side;
     return s;
