@@ -171,6 +171,12 @@ static void test_drawing(uint32_t w, uint32_t h)
     }
     CHECK_MSG(lit == bar_box[2] - bar_box[0], "%u lit", lit);
 
+    /* on a white background the bar is dark */
+    memset(image, 255, bytes);
+    CHECK(ip_overlay_draw_scale_bar(image, &c, &bar, "mm", box, bar_box, &err) == IP_OK);
+    const uint8_t *p = image + ((size_t)(bar_box[3] - 1) * w + bar_box[0]) * 4;
+    CHECK_MSG(p[0] < 60 && p[1] < 60 && p[2] < 60, "%u %u %u on white", p[0], p[1], p[2]);
+
     CHECK(ip_overlay_draw_axes(NULL, &c, &o, box, &err) == IP_ERR_ARGUMENT);
     bar.pixels = -1;
     CHECK(ip_overlay_draw_scale_bar(image, &c, &bar, NULL, NULL, NULL, &err) == IP_ERR_ARGUMENT);

@@ -313,7 +313,8 @@ IP_API ip_status ip_scale_bar_choose(const ip_camera *camera, double max_pixels,
  *  (origin + D * world: isoprop/orientation.h; the world's own axes when D is the identity).
  *  screen[a] receives the unit world direction of physical axis a (row a of D) in the
  *  camera's basis: {right, down (image y), toward the eye}, so that {screen[a][0],
- *  screen[a][1]} is where the axis points in the image. Thread-safe. */
+ *  screen[a][1]} is where the axis points in the image. The camera must pass
+ *  ip_camera_check(), the orientation ip_orientation_check(). Thread-safe. */
 IP_API void ip_overlay_axis_directions(const ip_camera *camera, const ip_orientation *orientation,
                                        double screen[3][3]);
 
@@ -335,7 +336,8 @@ IP_API ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
 /*! ip_overlay_draw_scale_bar() : draws `bar` (ip_scale_bar_choose()) into `rgba` (the
  *  camera's size) in the bottom-right corner: a horizontal bar round(bar->pixels) pixels long
  *  (at least 1), with end ticks inside that length, under the label "LENGTH UNIT" (`unit`
- *  may be NULL or "": the length alone). `box` (may be NULL) receives the corner box drawn
+ *  may be NULL or "": the length alone); light on a dark corner, dark where the corner's
+ *  mean luma is over 140 of 255 (a white background). `box` (may be NULL) receives the corner box drawn
  *  in; `bar_box` (may be NULL) the bar's own pixels, ticks included.
  *  @return IP_OK or IP_ERR_ARGUMENT (a bad camera, a NULL image, a bar that is not finite
  *  and > 0). */

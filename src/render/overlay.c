@@ -22,8 +22,8 @@ typedef struct colour {
 } colour;
 
 static const colour axis_colours[3] = {{235, 80, 70}, {100, 205, 90}, {95, 150, 250}};
-static const colour ink = {240, 238, 230};
-static const colour shadow = {10, 10, 14};
+static const colour light = {240, 238, 230};
+static const colour dark = {10, 10, 14};
 
 /* The overlays' sizes for an image: the text scale (an integer, 1 to 4), the margin from the
  * image's edges and the triad's arm, both in pixels. */
@@ -98,7 +98,8 @@ static void text_size(const char *text, int scale, int *w, int *h)
 /* Draws `text` with its top-left corner at (left, top), `scale` times stb_easy_font's size,
  * over a shadow one text pixel down and right: stb_easy_font's quads are axis-aligned
  * rectangles, filled here scaled up. */
-static void draw_text(const canvas *cv, int left, int top, const char *text, int scale, colour c)
+static void draw_text(const canvas *cv, int left, int top, const char *text, int scale, colour c,
+                      colour shadow)
 {
     char quads[32 * 270]; /* stb_easy_font's estimate: about 270 bytes a character */
     int count = stb_easy_font_print(0, 0, (char *)text, NULL, quads, (int)sizeof quads);
@@ -119,6 +120,21 @@ static void draw_text(const canvas *cv, int left, int top, const char *text, int
                       pass == 0 ? shadow : c);
         }
     }
+}
+
+/* The mean luma (0 to 255) of the image's pixels in [x0, x1) x [y0, y1), clipped; 0 when
+ * none is inside. */
+static double mean_luma(const canvas *cv, int x0, int y0, int x1, int y1)
+{
+    double sum = 0;
+    uint64_t count = 0;
+    for (int y = y0 < 0 ? 0 : y0; y < y1 && y < cv->height; y++)
+        for (int x = x0 < 0 ? 0 : x0; x < x1 && x < cv->width; x++) {
+            const uint8_t *p = cv->rgba + ((size_t)y * (size_t)cv->width + (size_t)x) * 4;
+            sum += 0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2];
+            count++;
+        }
+    return count ? sum / (double)count : 0;
 }
 
 /* Clips {x0, y0, x1, y1} to the image and stores it in box (may be NULL). */
@@ -225,7 +241,7 @@ ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
     for (int i = 0; i < 3; i++) {
         int a = order[i];
         double tx = cx + s.arm * screen[a][0], ty = cy + s.arm * screen[a][1];
-        draw_segment(&cv, cx, cy, tx, ty, stroke + 1.5, shadow);
+        draw_segment(&cv, cx, cy, tx, ty, stroke + 1.5, dark);
         draw_segment(&cv, cx, cy, tx, ty, stroke, axis_colours[a]);
         /* the label beyond the tip, along the arm's direction in the image */
         double len = hypot(screen[a][0], screen[a][1]);
@@ -235,7 +251,7 @@ ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
         text_size(label, s.text_scale, &w, &h);
         double lx = tx + (reach - s.arm) * ux, ly = ty + (reach - s.arm) * uy;
         draw_text(&cv, (int)lround(lx - w / 2.0), (int)lround(ly - h / 2.0), label, s.text_scale,
-                  axis_colours[a]);
+                  axis_colours[a], dark);
     }
     report_box(camera, (int)floor(cx - radius), (int)floor(cy - radius), (int)ceil(cx + radius) + 1,
                (int)ceil(cy + radius) + 1, box);
@@ -259,13 +275,7 @@ ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera, cons
         n = 1;
     int thick = (int)lround(1.5 * s.text_scale) < 2 ? 2 : (int)lround(1.5 * s.text_scale);
     int x1 = cv.width - s.margin, x0 = (int)(x1 - n), y1 = cv.height - s.margin, y0 = y1 - thick;
-    int tick = thick * 2;
-    /* the bar and its end ticks (inside its length), over a shadow one pixel below them */
-    fill_rect(&cv, x0, y1, x1, y1 + 1, shadow);
-    fill_rect(&cv, x0, y0, x1, y1, ink);
-    int tick_w = thick < (int)n ? thick : (int)n;
-    fill_rect(&cv, x0, y1 - tick, x0 + tick_w, y0, ink);
-    fill_rect(&cv, x1 - tick_w, y1 - tick, x1, y0, ink);
+    int tick = thick * 2, tick_w = thick < (int)n ? thick : (int)n;
     char label[96];
     if (unit && unit[0])
         snprintf(label, sizeof label, "%g %.60s", bar->length, unit);
@@ -276,8 +286,16 @@ ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera, cons
     int lx = (x0 + x1) / 2 - w / 2, ly = y1 - tick - s.margin - h;
     if (lx + w + s.text_scale > x1)
         lx = x1 - w - s.text_scale; /* a label wider than the bar ends at its right end */
-    draw_text(&cv, lx, ly, label, s.text_scale, ink);
+    /* light on a dark corner, dark on a light one (a white figure background) */
     int left = x0 < lx ? x0 : lx;
+    int bright = mean_luma(&cv, left, ly, x1 + s.text_scale, y1 + 1) > 140;
+    colour ink = bright ? dark : light, shadow = bright ? light : dark;
+    /* the bar and its end ticks (inside its length), over a shadow one pixel below them */
+    fill_rect(&cv, x0, y1, x1, y1 + 1, shadow);
+    fill_rect(&cv, x0, y0, x1, y1, ink);
+    fill_rect(&cv, x0, y1 - tick, x0 + tick_w, y0, ink);
+    fill_rect(&cv, x1 - tick_w, y1 - tick, x1, y0, ink);
+    draw_text(&cv, lx, ly, label, s.text_scale, ink, shadow);
     report_box(camera, left, ly, x1 + s.text_scale, y1 + 1, box);
     report_box(camera, x0, y1 - tick, x1, y1, bar_box);
     return IP_OK;
