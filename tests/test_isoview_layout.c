@@ -42,6 +42,8 @@ static void test_help_columns(void)
     CHECK(height == (float)rows * LAYOUT_LINE_HEIGHT);
     /* the key o and its modes are in the help */
     CHECK(strstr(isoview_help_table, "o\toverlay: compact, detailed, off") != NULL);
+    /* and the key c, which turns the --clip planes off and on */
+    CHECK(strstr(isoview_help_table, "c\tclipping planes (--clip) on / off") != NULL);
 }
 
 static void test_plain_lines(void)

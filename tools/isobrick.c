@@ -5,8 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
-#include <unistd.h>
 
 #include "isoprop/bricker.h"
 #include "isoprop/input.h"
@@ -28,34 +26,45 @@ static const char usage[] =
     "  --threads N         compression threads (default: all cores)\n"
     "  --mem-mb N          cap on working memory in MiB (default: none)\n"
     "  --force             replace OUT if it exists (a regular file; never the input)\n"
-    "  --quiet             no progress bar and no summary\n"
+    "  -q, --quiet         no progress bar and no summary\n"
+    "  -v, --verbose       details on stderr: the input, the layout and the plan first, a line\n"
+    "                      for each chunk of planes as it is read and encoded, then each\n"
+    "                      level's bricks as written (encodings, bytes, filters) and the\n"
+    "                      filter choices over all levels (not with --quiet)\n"
     "  --version           print the version and exit\n"
+    "A progress bar (planes read and encoded) is drawn on stderr when it is a terminal\n"
+    "(ISOBRICK_PROGRESS=1 forces it).\n"
+    "Exit status: 0 success, 1 failure, 2 bad command line.\n"
     "Ctrl-C cancels cleanly: no output is left, and isobrick ends as killed by the signal.\n";
 
+/* The bar and, with --verbose, a line for each chunk of planes: the library reports the
+ * input bytes read and encoded so far after each chunk. */
 typedef struct progress_state {
-    int show;
-    double start, last;
+    tool_progress bar;
+    int verbose;
+    uint64_t plane_bytes, planes; /* of the input (level 0) */
+    uint64_t planes_done;
 } progress_state;
 
 static int report_progress(void *user, uint64_t done, uint64_t total)
 {
     progress_state *p = user;
-    if (p->show) {
-        struct timespec ts;
-        clock_gettime(CLOCK_MONOTONIC, &ts);
-        double now = (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-        if (now - p->last >= 0.2 || done == total) {
-            double elapsed = now - p->start, rate = elapsed > 0 ? (double)done / elapsed : 0;
-            double eta = rate > 0 ? (double)(total - done) / rate : 0;
-            int width = 30, fill = total ? (int)((double)done / (double)total * width) : width;
-            fprintf(stderr, "\r[%-*.*s] %5.1f%% %7.1f MB/s ETA %4.0fs", width, fill,
-                    "##############################",
-                    total ? 100.0 * (double)done / (double)total : 100.0, rate / 1e6, eta);
-            if (done == total)
-                fputc('\n', stderr);
-            p->last = now;
-        }
+    uint64_t planes = p->plane_bytes ? done / p->plane_bytes : 0;
+    double elapsed = tool_progress_elapsed(&p->bar);
+    char detail[48];
+    snprintf(detail, sizeof detail, "%.1f MB/s", elapsed > 0 ? (double)done / elapsed / 1e6 : 0.0);
+    tool_progress_draw(&p->bar, planes, p->planes, "planes", detail);
+    if (p->verbose) {
+        char done_b[32], total_b[32];
+        tool_progress_end(&p->bar);
+        fprintf(stderr,
+                "isobrick: chunk: planes %llu-%llu of %llu read and encoded (%s of %s), %.2f s\n",
+                (unsigned long long)p->planes_done, (unsigned long long)(planes ? planes - 1 : 0),
+                (unsigned long long)p->planes,
+                tool_format_bytes(done_b, sizeof done_b, (double)done),
+                tool_format_bytes(total_b, sizeof total_b, (double)total), elapsed);
     }
+    p->planes_done = planes;
     return tool_signal_caught() != 0; /* SIGINT/SIGTERM: a clean cancel */
 }
 
@@ -63,7 +72,7 @@ typedef struct options {
     const char *input, *output;
     ip_input_overrides overrides;
     ip_bricker_options brick;
-    int quiet;
+    int quiet, verbose;
 } options;
 
 /* The values of isobrick's options (tool_option_parse: base is the options). */
@@ -167,6 +176,7 @@ static const tool_option isobrick_options[] = {
     {"--mem-mb", NULL, 1, 0, parse_mem_mb, NULL, NULL},
     {"--force", "-f", 0, offsetof(options, brick.force), NULL, NULL, NULL},
     {"--quiet", "-q", 0, offsetof(options, quiet), NULL, NULL, NULL},
+    {"--verbose", "-v", 0, offsetof(options, verbose), NULL, NULL, NULL},
 };
 
 static int parse_args(int argc, char **argv, options *o)
@@ -181,6 +191,8 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     if (!o->input)
         return tool_usage_error("isobrick", "no input file");
+    if (o->quiet && o->verbose)
+        return tool_usage_error("isobrick", "--quiet and --verbose: one or the other");
     if (o->brick.subblock_edge > o->brick.brick_edge)
         return tool_usage_error("isobrick",
                                 "the sub-block edge %u is larger than the brick edge %u",
@@ -231,6 +243,101 @@ static void print_summary(const ip_bricker_report *r, const ip_input_desc *desc,
            tool_format_bytes(in_b, sizeof in_b, (double)r->memory_planned));
 }
 
+/* --verbose, before the run: what is read and how it will be bricked. */
+static void print_plan(const ip_input_desc *desc, const ip_bricker_options *brick, const char *out)
+{
+    const char *space = ip_space_name(desc->orientation.space);
+    fprintf(stderr, "isobrick: input: %s: %ux%ux%u %s, spacing %g,%g,%g%s%s\n", desc->path,
+            desc->dims[0], desc->dims[1], desc->dims[2], ip_type_name(desc->type), desc->spacing[0],
+            desc->spacing[1], desc->spacing[2], space[0] ? ", space " : "", space);
+    uint64_t planned = 0;
+    ip_error err;
+    char b[32];
+    if (ip_bricker_memory_needed(desc, brick, &planned, &err) == IP_OK)
+        fprintf(stderr,
+                "isobrick: plan: %s, brick size %u, sub-block size %u, LZ4 %s, %s of working "
+                "memory\n",
+                out, brick->brick_edge, brick->subblock_edge,
+                brick->lz4_level == IP_LZ4_FAST ? "fast" : "high compression",
+                tool_format_bytes(b, sizeof b, (double)planned));
+}
+
+/* The names of a brick's filter bits: "delta", "med+shuffle", "none". */
+static const char *filter_name(unsigned filters, char *text, size_t size)
+{
+    static const struct {
+        unsigned bit;
+        const char *name;
+    } names[] = {
+        {IP_FILTER_DELTA, "delta"}, {IP_FILTER_MED, "med"}, {IP_FILTER_SHUFFLE, "shuffle"}};
+    text[0] = 0;
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (filters & names[i].bit)
+            snprintf(text + strlen(text), size - strlen(text), "%s%s", text[0] ? "+" : "",
+                     names[i].name);
+    if (!text[0])
+        snprintf(text, size, "none");
+    return text;
+}
+
+/* --verbose, after the run: each level's bricks as the file holds them (from its directory:
+ * encodings, payload bytes, filters of the LZ4 bricks), then the filter choices over all
+ * levels. Returns 0, or 1 when the new file cannot be read back. */
+static int print_levels(const char *out)
+{
+    ip_store *store;
+    ip_error err;
+    if (ip_store_open(out, &store, &err) != IP_OK)
+        return tool_fail("isobrick", &err);
+    const ip_layout *l = ip_store_layout(store);
+    uint64_t all_filters[8] = {0};
+    for (uint32_t k = 0; k < l->level_count; k++) {
+        const ip_level_layout *level = &l->levels[k];
+        uint64_t count[3] = {0}, stored = 0, filters[8] = {0};
+        for (uint64_t i = 0; i < level->brick_count; i++) {
+            ip_brick_entry e;
+            ip_store_brick_entry(store, level->first_brick + i, &e);
+            count[e.encoding < 3 ? e.encoding : 0]++;
+            stored += e.stored_size;
+            if (e.encoding == IP_BRICK_LZ4)
+                filters[e.filters & 7]++;
+        }
+        char b[32];
+        fprintf(stderr,
+                "isobrick: level %u: %ux%ux%u samples, %ux%ux%u = %llu brick%s: %llu constant, "
+                "%llu LZ4, %llu raw; %s of payload; filters:",
+                k, level->dims[0], level->dims[1], level->dims[2], level->bricks[0],
+                level->bricks[1], level->bricks[2], (unsigned long long)level->brick_count,
+                level->brick_count == 1 ? "" : "s", (unsigned long long)count[IP_BRICK_CONSTANT],
+                (unsigned long long)count[IP_BRICK_LZ4], (unsigned long long)count[IP_BRICK_RAW],
+                tool_format_bytes(b, sizeof b, (double)stored));
+        int any = 0;
+        for (unsigned f = 0; f < 8; f++)
+            if (filters[f]) {
+                char name[32];
+                fprintf(stderr, " %s %llu", filter_name(f, name, sizeof name),
+                        (unsigned long long)filters[f]);
+                all_filters[f] += filters[f];
+                any = 1;
+            }
+        fprintf(stderr, "%s\n", any ? "" : " -");
+    }
+    uint64_t lz4 = 0;
+    for (unsigned f = 0; f < 8; f++)
+        lz4 += all_filters[f];
+    fprintf(stderr, "isobrick: filters chosen for %llu LZ4 bricks:", (unsigned long long)lz4);
+    for (unsigned f = 0; f < 8; f++)
+        if (all_filters[f]) {
+            char name[32];
+            fprintf(stderr, " %s %llu (%.1f%%)", filter_name(f, name, sizeof name),
+                    (unsigned long long)all_filters[f],
+                    100.0 * (double)all_filters[f] / (double)lz4);
+        }
+    fprintf(stderr, "\n");
+    ip_store_close(store);
+    return 0;
+}
+
 /* `path`, or NULL for a folder (of TIFF or DICOM files), which the library has read file by
  * file: the checks of tool_check_paths() are for input files. */
 static const char *input_file(const char *path)
@@ -263,19 +370,29 @@ int main(int argc, char **argv)
     if (tool_check_paths("isobrick", inputs, 2, outputs, 1, o.brick.force) != 0)
         return 1;
     tool_signals_catch();
-    progress_state progress = {!o.quiet && isatty(STDERR_FILENO), 0, 0};
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    progress.start = (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+    if (o.verbose)
+        print_plan(&desc, &o.brick, out);
+    progress_state progress;
+    memset(&progress, 0, sizeof progress);
+    tool_progress_start(&progress.bar, !o.quiet, "ISOBRICK_PROGRESS");
+    progress.verbose = o.verbose;
+    progress.plane_bytes = (uint64_t)desc.dims[0] * desc.dims[1] * ip_type_size(desc.type);
+    progress.planes = desc.dims[2];
     o.brick.progress = report_progress;
     o.brick.progress_user = &progress;
     ip_bricker_report report;
     if (ip_bricker_run(&desc, out, &o.brick, &report, &err) != IP_OK) {
-        if (progress.show)
-            fputc('\n', stderr);
+        tool_progress_end(&progress.bar);
         rc = tool_fail("isobrick", &err);
         tool_signals_reraise(); /* cancelled by a signal: end as killed by it */
         return rc;
+    }
+    tool_progress_end(&progress.bar);
+    if (o.verbose) {
+        fprintf(stderr, "isobrick: phases: read %.2f s, encode %.2f s, write %.2f s\n",
+                report.seconds_read, report.seconds_encode, report.seconds_write);
+        if (print_levels(out) != 0)
+            return 1;
     }
     if (!o.quiet)
         print_summary(&report, &desc, out);

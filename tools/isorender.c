@@ -79,6 +79,18 @@ static const char usage[] =
     "                      complete image extracted for its own view (--full: one extraction)\n"
     "  --mp4 OUT.mp4       with --turntable: also encode the frames with ffmpeg (H.264, 25 fps);\n"
     "                      without ffmpeg the frames stay and isorender exits 1\n"
+    "  --axes              draw an axis triad in the bottom-left corner: the directions of the\n"
+    "                      file's physical axes as the camera sees them (x red, y green, z\n"
+    "                      blue), labelled R/L, A/P, S where the file names an anatomical space\n"
+    "                      (RAS, LAS, LPS), else x, y, z\n"
+    "  --scale-bar         draw a scale bar in the bottom-right corner: a round length (1, 2 or 5\n"
+    "                      times a power of ten world units, at most a quarter of the width)\n"
+    "                      as long as it looks at the depth of the view's target (perspective:\n"
+    "                      nearer is larger)\n"
+    "  --scale-unit TEXT   the scale bar's unit (default mm where the file names an anatomical\n"
+    "                      space, else units: world units are the spacing's)\n"
+    "                      (--axes and --scale-bar mark the image and the turntable's frames,\n"
+    "                      not the strip)\n"
     "  --software          render with the software rasterizer instead of OpenGL\n"
     "  --aa N              OpenGL anti-aliasing: N samples a pixel (1 to 16; default 1, off,\n"
     "                      the image the software rasterizer draws; 4 or 8 for figures)\n"
@@ -127,6 +139,8 @@ typedef struct options {
     size_t colour_count;
     float opacity[TOOL_MAX_ISOS];
     size_t opacity_count;
+    int axes, scale_bar;    /* --axes, --scale-bar: the figure overlays */
+    const char *scale_unit; /* --scale-unit TEXT (NULL: from the file's space) */
 } options;
 
 /* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
@@ -169,6 +183,7 @@ typedef struct run {
     struct run *others;
     size_t other_count;
     char mesh_name[4096]; /* the surface's mesh file (o.mesh points here), several --iso */
+    ip_scale_bar bar;     /* --scale-bar: the last image's */
 } run;
 
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
@@ -195,6 +210,9 @@ static const tool_option isorender_options[] = {
     {"--turntable", NULL, 1, 0, parse_turntable, NULL, NULL},
     {"--mp4", NULL, 1, offsetof(options, mp4), NULL, NULL, NULL},
     {"--aa", NULL, 1, 0, parse_aa, NULL, NULL},
+    {"--axes", NULL, 0, offsetof(options, axes), NULL, NULL, NULL},
+    {"--scale-bar", NULL, 0, offsetof(options, scale_bar), NULL, NULL, NULL},
+    {"--scale-unit", NULL, 1, offsetof(options, scale_unit), NULL, NULL, NULL},
     {"--verbose", "-v", 0, offsetof(options, common.verbose), NULL, NULL, NULL},
 };
 
@@ -709,6 +727,8 @@ static int parse_args(int argc, char **argv, options *o)
     rc = check_surface_options(o);
     if (rc)
         return rc;
+    if (o->scale_unit && !o->scale_bar)
+        return tool_usage_error("isorender", "--scale-unit needs --scale-bar");
     rc = check_smooth_options(o);
     if (rc)
         return rc;
@@ -992,6 +1012,54 @@ static void progress_csv(FILE *f, void *user)
     }
 }
 
+/* ---- the figure overlays: --axes and --scale-bar ---- */
+
+/* The scale bar's unit: --scale-unit, else mm in a named anatomical space (DICOM, NIfTI and
+ * NRRD state lengths in millimetres there), else "units". */
+static const char *scale_unit(const run *r)
+{
+    if (r->o.scale_unit)
+        return r->o.scale_unit;
+    return ip_store_layout(r->store)->orientation.space != IP_SPACE_UNKNOWN ? "mm" : "units";
+}
+
+/* Draws the overlays asked for into the rendered image; with --verbose, says what they show
+ * and where. */
+static ip_status draw_overlays(run *r, uint8_t *rgba, ip_error *err)
+{
+    const ip_orientation *space = &ip_store_layout(r->store)->orientation;
+    uint32_t box[4], bar_box[4];
+    if (r->o.axes) {
+        if (ip_overlay_draw_axes(rgba, &r->camera, space, box, err) != IP_OK)
+            return err->code;
+        if (r->o.common.verbose) {
+            double screen[3][3];
+            ip_overlay_axis_directions(&r->camera, space, screen);
+            fprintf(stderr, "isorender: axes: box %u,%u to %u,%u;", box[0], box[1], box[2], box[3]);
+            for (int a = 0; a < 3; a++) {
+                for (int k = 0; k < 3; k++) /* no "-0.0000" */
+                    screen[a][k] = fabs(screen[a][k]) < 5e-5 ? 0.0 : screen[a][k];
+                fprintf(stderr, " %s %+.4f,%+.4f,%+.4f", ip_overlay_axis_label(space->space, a),
+                        screen[a][0], screen[a][1], screen[a][2]);
+            }
+            fprintf(stderr, " (right, down, toward the eye)\n");
+        }
+    }
+    if (r->o.scale_bar) {
+        if (ip_scale_bar_choose(&r->camera, r->camera.width / 4.0, &r->bar, err) != IP_OK ||
+            ip_overlay_draw_scale_bar(rgba, &r->camera, &r->bar, scale_unit(r), box, bar_box,
+                                      err) != IP_OK)
+            return err->code;
+        if (r->o.common.verbose)
+            fprintf(stderr,
+                    "isorender: scale bar: %g %s = %.3f pixels (%.6g %s a pixel at the "
+                    "target's depth); bar %u,%u to %u,%u; box %u,%u to %u,%u\n",
+                    r->bar.length, scale_unit(r), r->bar.pixels, r->bar.pixel_size, scale_unit(r),
+                    bar_box[0], bar_box[1], bar_box[2], bar_box[3], box[0], box[1], box[2], box[3]);
+    }
+    return IP_OK;
+}
+
 /* Renders with OpenGL through EGL, or in software when asked or when no OpenGL is found.
  * With `keep` (the turntable's frames), the OpenGL renderer the first call makes stays in
  * *keep for the next calls, and the caller destroys it; without, it goes at the end. */
@@ -1014,6 +1082,8 @@ static int render_image(run *r, uint8_t *rgba, ip_renderer **keep, ip_error *err
         *keep = gl;
     else
         ip_renderer_destroy(gl);
+    if (st == IP_OK)
+        st = draw_overlays(r, rgba, err);
     r->totals.rendering_seconds += ip_now_seconds() - start;
     return st == IP_OK ? 0 : -1;
 }
@@ -1079,6 +1149,11 @@ static void json_counts(FILE *f, void *user)
         fprintf(f, ", \"visible_triangles\": %llu, \"overdraw\": %.4f",
                 (unsigned long long)r->visible_triangles,
                 overdraw(r->mesh->triangle_count, r->visible_triangles));
+    if (r->o.scale_bar) {
+        fprintf(f, ", \"scale_bar\": {\"length\": %.17g, \"unit\": ", r->bar.length);
+        tool_json_string(f, scale_unit(r));
+        fprintf(f, ", \"pixel_size\": %.17g, \"pixels\": %.17g}", r->bar.pixel_size, r->bar.pixels);
+    }
     if (!r->o.full)
         fprintf(f, ", \"occlusion\": %s, \"deferred_cells\": %llu, \"prefetch\": %s",
                 r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred,

@@ -26,6 +26,7 @@
 
 #include "isoprop/camera.h"
 #include "isoprop/mesh.h"
+#include "isoprop/orientation.h"
 #include "isoprop/status.h"
 
 #ifdef __cplusplus
@@ -281,6 +282,68 @@ IP_API void ip_renderer_release(ip_renderer *renderer);
 /*! ip_renderer_destroy() : frees the GPU objects and, for a headless renderer, its context
  *  (NULL is a no-op). A renderer on the caller's context needs that context current. */
 IP_API void ip_renderer_destroy(ip_renderer *renderer);
+
+/* ---- figure overlays: an axis triad and a scale bar, drawn into a finished image ----
+ *
+ * Both draw into an RGBA image as the renderers give it (width * height * 4 bytes, top row
+ * first; the camera's width and height), after rendering, so they look the same whichever
+ * renderer drew it, with or without anti-aliasing. Each draws only inside a box in one corner,
+ * which it reports as {x0, y0, x1, y1} (pixels; x0, y0 included, x1, y1 excluded): the triad
+ * in the bottom-left corner, the scale bar in the bottom-right. Their sizes follow the
+ * image's smaller side s: text (stb_easy_font's, scaled by round(s / 240), 1 to 4), the
+ * triad's arms 8 % of s (at least 16 pixels). Lines are anti-aliased, text is not. */
+
+/* A scale bar: a round length and what it spans in the image at the target's depth. */
+typedef struct ip_scale_bar {
+    double length;     /* world units (the spacing's): 1, 2 or 5 times a power of ten */
+    double pixel_size; /* world units one pixel spans at the depth of the camera's target */
+    double pixels;     /* length / pixel_size: the bar's length in the image, pixels */
+} ip_scale_bar;
+
+/*! ip_scale_bar_choose() : the longest length of 1, 2 or 5 times a power of ten world units
+ *  whose bar spans at most `max_pixels` (> 0) pixels at the depth of the camera's target,
+ *  where a pixel spans ip_camera_pixel_size(camera, height) world units. The view is a
+ *  perspective one: the bar holds for lengths at that depth, across the view (nearer
+ *  lengths look longer, farther ones shorter).
+ *  @return IP_OK, or IP_ERR_ARGUMENT (a bad camera, max_pixels not finite and > 0). */
+IP_API ip_status ip_scale_bar_choose(const ip_camera *camera, double max_pixels, ip_scale_bar *bar,
+                                     ip_error *err);
+
+/*! ip_overlay_axis_directions() : how the camera sees the axes of the volume's physical space
+ *  (origin + D * world: isoprop/orientation.h; the world's own axes when D is the identity).
+ *  screen[a] receives the unit world direction of physical axis a (row a of D) in the
+ *  camera's basis: {right, down (image y), toward the eye}, so that {screen[a][0],
+ *  screen[a][1]} is where the axis points in the image. The camera must pass
+ *  ip_camera_check(), the orientation ip_orientation_check(). Thread-safe. */
+IP_API void ip_overlay_axis_directions(const ip_camera *camera, const ip_orientation *orientation,
+                                       double screen[3][3]);
+
+/*! ip_overlay_axis_label() : the label of physical axis `axis` (0, 1, 2) in `space`: the
+ *  anatomical direction its positive end points to ("R", "A", "S" in RAS; "L", "A", "S" in
+ *  LAS; "L", "P", "S" in LPS), or "x", "y", "z" where the space is unknown. A static string. */
+IP_API const char *ip_overlay_axis_label(ip_space space, int axis);
+
+/*! ip_overlay_draw_axes() : draws the axis triad into `rgba` (the camera's size) in the
+ *  bottom-left corner: an arm for each physical axis (ip_overlay_axis_directions(); x red,
+ *  y green, z blue) from a common centre, the nearer arms over the farther ones, each
+ *  labelled at its tip (ip_overlay_axis_label()). An arm along the view is short, as the
+ *  camera sees it. `box` (may be NULL) receives the corner box drawn in.
+ *  @return IP_OK or IP_ERR_ARGUMENT (a bad camera, a NULL image). */
+IP_API ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
+                                      const ip_orientation *orientation, uint32_t box[4],
+                                      ip_error *err);
+
+/*! ip_overlay_draw_scale_bar() : draws `bar` (ip_scale_bar_choose()) into `rgba` (the
+ *  camera's size) in the bottom-right corner: a horizontal bar round(bar->pixels) pixels long
+ *  (at least 1), with end ticks inside that length, under the label "LENGTH UNIT" (`unit`
+ *  may be NULL or "": the length alone); light on a dark corner, dark where the corner's
+ *  mean luma is over 140 of 255 (a white background). `box` (may be NULL) receives the corner box drawn
+ *  in; `bar_box` (may be NULL) the bar's own pixels, ticks included.
+ *  @return IP_OK or IP_ERR_ARGUMENT (a bad camera, a NULL image, a bar that is not finite
+ *  and > 0). */
+IP_API ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera,
+                                           const ip_scale_bar *bar, const char *unit,
+                                           uint32_t box[4], uint32_t bar_box[4], ip_error *err);
 
 #ifdef __cplusplus
 }

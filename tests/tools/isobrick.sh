@@ -29,6 +29,39 @@ run_capture "$bin/isobrick" "$raw" --quiet
 check "default output bricks/NAME.ibv" test -s bricks/sphere_40x30x20_uint16.ibv
 check "quiet prints nothing" test -z "$out$err"
 
+# --- --verbose: the plan, a line a chunk of planes, a line a level, the filter choices ---
+run_capture "$bin/isobrick" "$raw" -o plain.ibv --brick-size 8 --threads 2
+check "no details (nor a bar, on a pipe) without --verbose" test "$rc" = 0 -a -z "$err"
+run_capture "$bin/isobrick" "$raw" -o verbose.ibv --brick-size 8 --threads 2 -v
+check "-v succeeds" test "$rc" = 0
+check "-v keeps the summary on stdout" grep -q "wrote verbose.ibv" "$work/.out"
+check "-v: the input line" sh -c 'printf "%s" "$0" | grep -q "^isobrick: input: .*40x30x20 uint16"' "$err"
+check "-v: the plan line" sh -c 'printf "%s" "$0" | grep -q "^isobrick: plan: verbose.ibv, brick size 8"' "$err"
+# 20 planes in chunks of B + 1 = 9 planes, then 8: planes 0-8, 9-16, 17-19
+chunks=$(printf '%s\n' "$err" | grep '^isobrick: chunk:' | sed 's/.*planes \([0-9]*-[0-9]*\) of 20.*/\1/' | tr '\n' ' ')
+check "-v: a line a chunk of planes ($chunks)" test "$chunks" = "0-8 9-16 17-19 "
+levels=$(sed -n 's/.* in \([0-9]*\) levels.*/\1/p' "$work/.out")
+check "-v: a line a level ($levels levels)" \
+    test "$(printf '%s\n' "$err" | grep -c '^isobrick: level [0-9]*: ')" = "$levels"
+check "-v: level 0 has 5x4x3 bricks" \
+    sh -c 'printf "%s" "$0" | grep -q "^isobrick: level 0: 40x30x20 samples, 5x4x3 = 60 bricks"' "$err"
+# the levels' LZ4 bricks add up to the filter summary's count
+lz4=$(printf '%s\n' "$err" | sed -n 's/.* constant, \([0-9]*\) LZ4,.*/\1/p' | awk '{ n += $1 } END { print n }')
+check "-v: the filter choices cover the $lz4 LZ4 bricks" \
+    sh -c 'printf "%s" "$0" | grep -q "^isobrick: filters chosen for $1 LZ4 bricks: "' "$err" "$lz4"
+check "-v: the phases" sh -c 'printf "%s" "$0" | grep -q "^isobrick: phases: read "' "$err"
+check "-v writes the same file" cmp good.ibv verbose.ibv
+run_capture "$bin/isobrick" "$raw" -o q.ibv --brick-size 8 -q
+check "-q prints nothing" test "$rc" = 0 -a -z "$out$err"
+expect_error 2 "--quiet and --verbose" "$bin/isobrick" "$raw" -o qv.ibv -q -v
+check "-q -v writes nothing" test ! -e qv.ibv
+# the bar: none on a pipe (above), forced with ISOBRICK_PROGRESS=1, none with -q
+run_capture env ISOBRICK_PROGRESS=1 "$bin/isobrick" "$raw" -o bar.ibv --brick-size 8
+check "ISOBRICK_PROGRESS=1 draws the bar to 20/20 planes" \
+    sh -c 'printf "%s" "$0" | grep -q "100.0% 20/20 planes"' "$err"
+run_capture env ISOBRICK_PROGRESS=1 "$bin/isobrick" "$raw" -o bar.ibv --brick-size 8 -qf
+check "no bar with -q" test -z "$err"
+
 # --- bad input: one line naming the file and the problem, non-zero exit, no output ---
 head -c 47999 "$raw" >short_40x30x20_uint16.raw
 expect_error 1 "short_40x30x20_uint16.raw" "$bin/isobrick" short_40x30x20_uint16.raw -o short.ibv

@@ -19,6 +19,14 @@ expect_error 2 "view" "$bin/isoview" s.ibv --iso 1 --view +w
 printf 'iso 1\norbit 10\n' >bad.txt
 expect_error 1 "bad.txt:2" "$bin/isoview" s.ibv --iso 1 --script bad.txt
 expect_error 1 "cannot open a window" env -u DISPLAY -u WAYLAND_DISPLAY "$bin/isoview" s.ibv --iso 1
+# --clip as isorender takes it, and the script's clip on|off
+expect_error 2 "bad --clip 'w=3'" "$bin/isoview" s.ibv --iso 1 --clip w=3
+expect_error 2 "bad --clip '0,0,0,1'" "$bin/isoview" s.ibv --iso 1 --clip 0,0,0,1
+expect_error 2 "at most 6 --clip planes" "$bin/isoview" s.ibv --iso 1 --clip x=1 --clip x=2 \
+    --clip x=3 --clip x=4 --clip x=5 --clip x=6 --clip x=7
+printf 'clip maybe\n' >badclip.txt
+expect_error 1 "badclip.txt:1: bad arguments to 'clip'" "$bin/isoview" s.ibv --iso 1 --clip x=1 \
+    --script badclip.txt
 
 if ! command -v xvfb-run >/dev/null 2>&1; then
     echo "isoview: window tests skipped: xvfb-run is missing (Debian package xvfb)"
@@ -157,6 +165,36 @@ check "paused, a new view still shows the surface (${surface:-?} % of the pixels
     awk -v p="${surface:-0}" 'BEGIN { exit !(p >= 5) }'
 same_image "paused, a new isovalue shows its surface" paused-iso.png r-camera.png
 check "two passes: the first view, then the new isovalue" grep -q '"passes": 2,' pause.json
+# clipping: the window with --clip shows isorender's clipped image; clip off shows the whole
+# surface (a new pass), clip on the clipped one again; without planes, clip is a message only
+cat >clip.txt <<EOF
+overlay off
+wait done
+screenshot clip-on.png
+clip off
+wait done
+screenshot clip-off.png
+clip on
+wait done
+screenshot clip-again.png
+quit
+EOF
+view s.ibv --iso 1000.5 --size 320x240 --lod off --clip -x=63.5 --clip z=40 --script clip.txt \
+    --stats clip.json --exit-after 90
+check "the clipped run exits with 0 (got $rc: $err)" test "$rc" = 0
+"$bin/isorender" s.ibv --iso 1000.5 --size 320x240 --view -y --lod off --clip -x=63.5 \
+    --clip z=40 -o r-clip.png --quiet
+same_image "the window with --clip shows isorender's clipped image" clip-on.png r-clip.png
+same_image "clip off shows the whole surface" clip-off.png r-start.png
+same_image "clip on shows the clipped one again" clip-again.png r-clip.png
+check "the clipped and whole images differ (the test can fail)" \
+    sh -c '! "$0" r-clip.png r-start.png --level 2 --max-pct 1 >/dev/null' "$compare"
+check "three passes: clipped, whole, clipped" grep -q '"passes": 3,' clip.json
+check "the statistics give the planes that applied at the end" grep -q '"clip": \[\[' clip.json
+view s.ibv --iso 1000.5 --size 320x240 --lod off --script clip.txt --force --exit-after 90
+check "without planes, clip changes nothing (got $rc: $err)" test "$rc" = 0
+same_image "... the image stays the whole surface" clip-again.png r-start.png
+
 printf 'pause maybe\n' >badpause.txt
 expect_error 1 "badpause.txt:1" "$bin/isoview" s.ibv --iso 1 --script badpause.txt
 

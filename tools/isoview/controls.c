@@ -40,6 +40,30 @@ void change_iso(viewer *v, double iso)
     }
 }
 
+void set_clip(viewer *v, int on)
+{
+    unsigned planes = v->o.common.clip_count;
+    if (!planes) {
+        show_message(v, "no clipping planes: start isoview with --clip SPEC");
+        return;
+    }
+    if (on != v->clip_on) {
+        v->clip_on = on;
+        v->clip_changed = 1;
+        v->restart = 1;
+        v->paused = 0;
+    }
+    show_message(v, on ? "clipping on: %u plane%s" : "clipping off (%u plane%s kept for c)", planes,
+                 planes > 1 ? "s" : "");
+}
+
+void clip_options(const viewer *v, tool_view_options *o)
+{
+    *o = v->o.common;
+    if (!v->clip_on)
+        o->clip_count = 0;
+}
+
 static void reset_view(viewer *v)
 {
     ip_error ignored;
@@ -117,6 +141,7 @@ static void on_key(GLFWwindow *window, int key, int scancode, int action, int mo
     case GLFW_KEY_R: reset_view(v); break;
     case GLFW_KEY_P: v->paused = !v->paused; break;
     case GLFW_KEY_F: v->want_full = 1; break;
+    case GLFW_KEY_C: set_clip(v, !v->clip_on); break;
     case GLFW_KEY_S:
         if (!v->screenshot_pending)
             request_screenshot(v, "");

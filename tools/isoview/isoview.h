@@ -36,6 +36,7 @@ typedef enum command_kind {
     COMMAND_OVERLAY,
     COMMAND_PAUSE,
     COMMAND_HELP,
+    COMMAND_CLIP,
     COMMAND_SCREENSHOT,
     COMMAND_QUIT
 } command_kind;
@@ -95,6 +96,9 @@ typedef struct viewer {
     /* paused: no rays are cast; a change of view waits (restart stays set, the mesh shown stays
      * on screen) until resumed; a change of isovalue resumes */
     int paused, want_full, full_shown, help_on;
+    /* the --clip planes apply (the key c toggles them); clip_changed: the engine must be made
+     * again with the planes on or off before the next pass */
+    int clip_on, clip_changed;
     overlay_mode overlay_mode;
     ip_mesh full_mesh;
     ip_engine_counts full_counts;
@@ -155,6 +159,11 @@ void change_view(viewer *v);
 void change_iso(viewer *v, double iso);
 /* Moves the eye toward the target: the distance is divided by `factor`. */
 void zoom_view(viewer *v, double factor);
+/* Turns the --clip planes on or off (a new pass with them or without them; refinement
+ * resumes if paused); says so in the overlay, or that there are none. */
+void set_clip(viewer *v, int on);
+/* The command line's options with the clipping planes as they apply now (none while off). */
+void clip_options(const viewer *v, tool_view_options *o);
 /* Shows a line in the overlay for a few seconds. */
 void show_message(viewer *v, const char *fmt, ...);
 /* Routes the window's keyboard and mouse to the viewer (the window's user pointer). */

@@ -105,6 +105,28 @@ static double frames_per_second(const frame_clock *k)
 
 /* ---- the progressive engine and the mesh on the GPU ---- */
 
+/* The engine with the command line's options and the clipping planes as they apply now
+ * (clip_on), cancelled by a signal. An engine made before (its planes are fixed when it is
+ * made) is replaced, and kept when the new one cannot be made. Returns 0, or -1 with the
+ * error in *err. */
+static int create_engine(viewer *v, ip_error *err)
+{
+    tool_view_options common;
+    clip_options(v, &common);
+    ip_engine_options eo;
+    tool_engine_options(&common, &eo);
+    ip_engine *engine;
+    if (ip_engine_create(v->cache, &eo, &engine, err) != IP_OK)
+        return -1;
+    tool_signals_cancel_engine(NULL); /* no handler uses the old one from here */
+    ip_engine_destroy(v->engine);
+    v->engine = engine;
+    tool_signals_cancel_engine(v->engine);
+    v->clip_changed = 0;
+    v->restart = 1;
+    return 0;
+}
+
 static int begin_pass(viewer *v)
 {
     v->restart = 0;
@@ -153,8 +175,8 @@ static int extract_full(viewer *v)
     memset(&v->full_counts, 0, sizeof v->full_counts);
     double start = ip_now_seconds();
     if (ip_extract_full_clipped(v->cache, (float)v->iso, 0, v->o.common.threads, v->o.common.clip,
-                                v->o.common.clip_count, &v->full_mesh, &v->full_counts,
-                                &v->err) != IP_OK)
+                                v->clip_on ? v->o.common.clip_count : 0, &v->full_mesh,
+                                &v->full_counts, &v->err) != IP_OK)
         return -1;
     v->full_wall = ip_now_seconds() - start;
     v->pass_render = 0;
@@ -259,6 +281,8 @@ static int frame(viewer *v)
         glfwWaitEventsTimeout(0.1);
         return 0;
     }
+    if (v->clip_changed && create_engine(v, &v->err) != 0)
+        return -1;
     /* paused, a change of view keeps the mesh shown until refinement resumes */
     if (v->restart && !v->paused && begin_pass(v) != 0)
         return -1;
@@ -337,12 +361,14 @@ static void json_counts(FILE *f, void *user)
     else
         ip_engine_totals(v->engine, &t);
     int done = full || ip_engine_done(v->engine);
+    tool_view_options common; /* "clip": the planes as they apply at the end */
+    clip_options(v, &common);
     const tool_run_json j = {v->o.file,
                              v->iso,
                              full,
                              &v->camera,
                              "opengl",
-                             &v->o.common,
+                             &common,
                              0,
                              done,
                              &t,
@@ -444,11 +470,9 @@ static int prepare(viewer *v)
         return -1;
     if (check_paths(v) != 0)
         return -2;
-    ip_engine_options eo;
-    tool_engine_options(&v->o.common, &eo);
-    if (ip_engine_create(v->cache, &eo, &v->engine, err) != IP_OK)
+    v->clip_on = v->o.common.clip_count > 0;
+    if (create_engine(v, err) != 0)
         return -1;
-    tool_signals_cancel_engine(v->engine);
     tool_warn_iso_range("isoview", v->store, v->o.common.iso, NULL, 0);
     return 0;
 }

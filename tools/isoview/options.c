@@ -34,8 +34,9 @@ static const char usage[] =
     "isoview then ends as killed by the signal.\n"
     "Controls: left drag orbits, right drag pans, the wheel zooms; Up/Down change V by 1 %\n"
     "of the value range (with Shift 0.1 %), PageUp/PageDown by 10 %; i types V (Enter\n"
-    "applies); r resets the view; p pauses; f extracts everything; s saves a screenshot;\n"
-    "o hides the overlay; h shows help; Esc quits.\n";
+    "applies); r resets the view; p pauses; f extracts everything; c turns the --clip planes\n"
+    "off and on again (each restarts the pass); s saves a screenshot; o hides the overlay;\n"
+    "h shows help; Esc quits.\n";
 
 /* --screenshot-at SECONDS OUT.png */
 static int parse_screenshot_at(const char *p, const tool_option *opt, const char *const *v,

@@ -220,13 +220,15 @@ static void iso_line(viewer *v, char *text, size_t size, int working_on_full, in
     else if (!ip_engine_done(v->engine) && pass_limit_reached(v))
         snprintf(state, sizeof state, "  [%s reached]",
                  pass_limit_reached(v) == 1 ? "--rays" : "--time");
+    /* with --clip: whether the planes apply (the key c) */
+    const char *clip = !v->o.common.clip_count ? "" : v->clip_on ? "  [clip on]" : "  [clip off]";
     if (v->typing)
         snprintf(text, size, "iso> %s_  (Enter applies, Esc cancels)", v->typed);
     else if (detailed)
-        snprintf(text, size, "iso %.7g  (values %.7g .. %.7g)%s", v->iso, (double)v->value_min,
-                 (double)v->value_max, state);
+        snprintf(text, size, "iso %.7g  (values %.7g .. %.7g)%s%s", v->iso, (double)v->value_min,
+                 (double)v->value_max, state, clip);
     else
-        snprintf(text, size, "iso %.7g%s", v->iso, state);
+        snprintf(text, size, "iso %.7g%s%s", v->iso, state, clip);
 }
 
 /* The compact heads-up text: two lines, the isovalue and the state, then the pass's progress,

@@ -110,6 +110,11 @@ static int parse_command(viewer *v, char *line, command *c, ip_error *err)
             c->a = OVERLAY_DETAILED;
         else
             goto arguments;
+    } else if (!strcmp(word, "clip")) {
+        if (args != 1 || (strcmp(arg1, "on") && strcmp(arg1, "off")))
+            goto arguments;
+        c->kind = COMMAND_CLIP;
+        c->a = !strcmp(arg1, "on");
     } else if (!strcmp(word, "pause") || !strcmp(word, "help")) {
         if (args != 1 || (strcmp(arg1, "on") && strcmp(arg1, "off")))
             goto arguments;
@@ -248,6 +253,7 @@ void run_script(viewer *v, double t)
         case COMMAND_OVERLAY: v->overlay_mode = (overlay_mode)c->a; break;
         case COMMAND_PAUSE: v->paused = c->a != 0; break;
         case COMMAND_HELP: v->help_on = c->a != 0; break;
+        case COMMAND_CLIP: set_clip(v, c->a != 0); break;
         case COMMAND_SCREENSHOT: request_screenshot(v, c->text); return;
         case COMMAND_QUIT: v->quit = 1; return;
         }

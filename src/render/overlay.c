@@ -1,0 +1,302 @@
+/* Figure overlays drawn into a finished RGBA image: the axis triad and the scale bar
+ * (isoprop/render.h). They are drawn after rendering, on the CPU, so that the OpenGL and the
+ * software renderers, with or without anti-aliasing, get the same overlay. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "internal.h"
+#include "isoprop/render.h"
+
+#include <stb_easy_font.h>
+
+/* The image being drawn into. */
+typedef struct canvas {
+    uint8_t *rgba;
+    int width, height;
+} canvas;
+
+typedef struct colour {
+    uint8_t r, g, b;
+} colour;
+
+static const colour axis_colours[3] = {{235, 80, 70}, {100, 205, 90}, {95, 150, 250}};
+static const colour light = {240, 238, 230};
+static const colour dark = {10, 10, 14};
+
+/* The overlays' sizes for an image: the text scale (an integer, 1 to 4), the margin from the
+ * image's edges and the triad's arm, both in pixels. */
+typedef struct overlay_sizes {
+    int text_scale, margin;
+    double arm;
+} overlay_sizes;
+
+static overlay_sizes sizes_of(const ip_camera *camera)
+{
+    int side = (int)(camera->width < camera->height ? camera->width : camera->height);
+    overlay_sizes s;
+    int scale = (side + 120) / 240; /* the nearest whole multiple of 240 pixels */
+    s.text_scale = scale < 1 ? 1 : scale > 4 ? 4 : scale;
+    s.margin = 4 * s.text_scale;
+    s.arm = 0.08 * side < 16 ? 16 : 0.08 * side;
+    return s;
+}
+
+/* Blends `c` over pixel (x, y) with coverage a in [0, 1]; outside the image, nothing. */
+static void blend(const canvas *cv, int x, int y, colour c, double a)
+{
+    if (x < 0 || y < 0 || x >= cv->width || y >= cv->height || a <= 0)
+        return;
+    if (a > 1)
+        a = 1;
+    uint8_t *p = cv->rgba + ((size_t)y * (size_t)cv->width + (size_t)x) * 4;
+    const uint8_t rgb[3] = {c.r, c.g, c.b};
+    for (int k = 0; k < 3; k++)
+        p[k] = (uint8_t)lround(p[k] + a * ((double)rgb[k] - p[k]));
+    p[3] = 255;
+}
+
+/* A filled rectangle of pixels [x0, x1) x [y0, y1). */
+static void fill_rect(const canvas *cv, int x0, int y0, int x1, int y1, colour c)
+{
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++)
+            blend(cv, x, y, c, 1);
+}
+
+/* An anti-aliased segment from (ax, ay) to (bx, by) (pixel coordinates, pixel centres at
+ * +0.5), `width` pixels wide with round ends: each pixel is covered by how far its centre
+ * lies inside the stroke, over a one-pixel ramp. */
+static void draw_segment(const canvas *cv, double ax, double ay, double bx, double by, double width,
+                         colour c)
+{
+    double r = width / 2, dx = bx - ax, dy = by - ay, len2 = dx * dx + dy * dy;
+    int x0 = (int)floor(fmin(ax, bx) - r - 1), x1 = (int)ceil(fmax(ax, bx) + r + 1);
+    int y0 = (int)floor(fmin(ay, by) - r - 1), y1 = (int)ceil(fmax(ay, by) + r + 1);
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            double px = x + 0.5 - ax, py = y + 0.5 - ay;
+            double t = len2 > 0 ? (px * dx + py * dy) / len2 : 0;
+            t = t < 0 ? 0 : t > 1 ? 1 : t;
+            double ex = px - t * dx, ey = py - t * dy;
+            blend(cv, x, y, c, r + 0.5 - sqrt(ex * ex + ey * ey));
+        }
+}
+
+/* The height of stb_easy_font's capitals and digits, pixels at scale 1 (its line height,
+ * stb_easy_font_height(), adds the spacing between lines). */
+#define GLYPH_HEIGHT 7
+
+/* The width and height of one line of `text` in pixels at `scale`. */
+static void text_size(const char *text, int scale, int *w, int *h)
+{
+    *w = stb_easy_font_width((char *)text) * scale;
+    *h = GLYPH_HEIGHT * scale;
+}
+
+/* Draws `text` with its top-left corner at (left, top), `scale` times stb_easy_font's size,
+ * over a shadow one text pixel down and right: stb_easy_font's quads are axis-aligned
+ * rectangles, filled here scaled up. */
+static void draw_text(const canvas *cv, int left, int top, const char *text, int scale, colour c,
+                      colour shadow)
+{
+    char quads[32 * 270]; /* stb_easy_font's estimate: about 270 bytes a character */
+    int count = stb_easy_font_print(0, 0, (char *)text, NULL, quads, (int)sizeof quads);
+    for (int pass = 0; pass < 2; pass++) {
+        int offset = pass == 0 ? scale : 0;
+        for (int q = 0; q < count; q++) {
+            float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
+            for (int k = 0; k < 4; k++) { /* a vertex: x, y, z floats, then 4 bytes of colour */
+                float v[2];
+                memcpy(v, quads + (q * 4 + k) * 16, sizeof v);
+                for (int a = 0; a < 2; a++) {
+                    lo[a] = v[a] < lo[a] ? v[a] : lo[a];
+                    hi[a] = v[a] > hi[a] ? v[a] : hi[a];
+                }
+            }
+            fill_rect(cv, left + offset + (int)lo[0] * scale, top + offset + (int)lo[1] * scale,
+                      left + offset + (int)hi[0] * scale, top + offset + (int)hi[1] * scale,
+                      pass == 0 ? shadow : c);
+        }
+    }
+}
+
+/* The mean luma (0 to 255) of the image's pixels in [x0, x1) x [y0, y1), clipped; 0 when
+ * none is inside. */
+static double mean_luma(const canvas *cv, int x0, int y0, int x1, int y1)
+{
+    double sum = 0;
+    uint64_t count = 0;
+    for (int y = y0 < 0 ? 0 : y0; y < y1 && y < cv->height; y++)
+        for (int x = x0 < 0 ? 0 : x0; x < x1 && x < cv->width; x++) {
+            const uint8_t *p = cv->rgba + ((size_t)y * (size_t)cv->width + (size_t)x) * 4;
+            sum += 0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2];
+            count++;
+        }
+    return count ? sum / (double)count : 0;
+}
+
+/* Clips {x0, y0, x1, y1} to the image and stores it in box (may be NULL). */
+static void report_box(const ip_camera *camera, int x0, int y0, int x1, int y1, uint32_t box[4])
+{
+    if (!box)
+        return;
+    int w = (int)camera->width, h = (int)camera->height;
+    int b[4] = {x0 < 0 ? 0 : x0, y0 < 0 ? 0 : y0, x1 > w ? w : x1, y1 > h ? h : y1};
+    for (int k = 0; k < 4; k++)
+        box[k] = (uint32_t)(b[k] < 0 ? 0 : b[k]);
+}
+
+static ip_status check_image(const uint8_t *rgba, const ip_camera *camera, ip_error *err)
+{
+    if (!rgba || !camera)
+        return ip__fail(err, IP_ERR_ARGUMENT, "overlay: no image or no camera");
+    return ip_camera_check(camera, err);
+}
+
+ip_status ip_scale_bar_choose(const ip_camera *camera, double max_pixels, ip_scale_bar *bar,
+                              ip_error *err)
+{
+    ip_status st = ip_camera_check(camera, err);
+    if (st != IP_OK)
+        return st;
+    if (!(max_pixels > 0 && isfinite(max_pixels)))
+        return ip__fail(err, IP_ERR_ARGUMENT, "scale bar: %g pixels is not a length", max_pixels);
+    double pixel_size = ip_camera_pixel_size(camera, camera->height);
+    double longest = max_pixels * pixel_size;
+    if (!(pixel_size > 0 && isfinite(longest)))
+        return ip__fail(err, IP_ERR_ARGUMENT, "scale bar: the camera gives no pixel size");
+    /* the decade at or under `longest`, then the largest of 1, 2, 5 times it that fits */
+    double decade = pow(10.0, floor(log10(longest)));
+    double length = decade;
+    if (5 * decade <= longest * (1 + 1e-12))
+        length = 5 * decade;
+    else if (2 * decade <= longest * (1 + 1e-12))
+        length = 2 * decade;
+    bar->length = length;
+    bar->pixel_size = pixel_size;
+    bar->pixels = length / pixel_size;
+    return IP_OK;
+}
+
+void ip_overlay_axis_directions(const ip_camera *camera, const ip_orientation *orientation,
+                                double screen[3][3])
+{
+    ip_camera_basis basis;
+    ip_camera_basis_of(camera, &basis);
+    for (int a = 0; a < 3; a++) {
+        double w[3]; /* physical axis a in world coordinates: row a of D (D is orthonormal) */
+        for (int k = 0; k < 3; k++)
+            w[k] = orientation->directions[k][a];
+        double right = 0, up = 0, forward = 0;
+        for (int k = 0; k < 3; k++) {
+            right += w[k] * basis.right[k];
+            up += w[k] * basis.up[k];
+            forward += w[k] * basis.forward[k];
+        }
+        screen[a][0] = right;
+        screen[a][1] = -up;
+        screen[a][2] = -forward;
+    }
+}
+
+const char *ip_overlay_axis_label(ip_space space, int axis)
+{
+    static const char *const labels[4][3] = {
+        {"x", "y", "z"}, {"R", "A", "S"}, {"L", "A", "S"}, {"L", "P", "S"}};
+    if (axis < 0 || axis > 2)
+        return "";
+    int s = space == IP_SPACE_RAS ? 1 : space == IP_SPACE_LAS ? 2 : space == IP_SPACE_LPS ? 3 : 0;
+    return labels[s][axis];
+}
+
+ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
+                               const ip_orientation *orientation, uint32_t box[4], ip_error *err)
+{
+    ip_status st = check_image(rgba, camera, err);
+    if (st != IP_OK)
+        return st;
+    if (!orientation)
+        return ip__fail(err, IP_ERR_ARGUMENT, "axes: no orientation");
+    canvas cv = {rgba, (int)camera->width, (int)camera->height};
+    overlay_sizes s = sizes_of(camera);
+    double screen[3][3];
+    ip_overlay_axis_directions(camera, orientation, screen);
+    /* each label is centred beyond its arm's tip, `gap` out: the box holds arm and label */
+    double gap = GLYPH_HEIGHT * s.text_scale * 0.5 + 2 + s.text_scale;
+    double reach = s.arm + gap;
+    int radius = (int)ceil(reach + gap);
+    double cx = s.margin + radius, cy = (double)camera->height - s.margin - radius;
+    /* farthest arm first, so that a nearer one passes over it */
+    int order[3] = {0, 1, 2};
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++)
+            if (screen[order[j]][2] < screen[order[i]][2]) {
+                int t = order[i];
+                order[i] = order[j];
+                order[j] = t;
+            }
+    double stroke = 1.0 + 0.5 * s.text_scale;
+    for (int i = 0; i < 3; i++) {
+        int a = order[i];
+        double tx = cx + s.arm * screen[a][0], ty = cy + s.arm * screen[a][1];
+        draw_segment(&cv, cx, cy, tx, ty, stroke + 1.5, dark);
+        draw_segment(&cv, cx, cy, tx, ty, stroke, axis_colours[a]);
+        /* the label beyond the tip, along the arm's direction in the image */
+        double len = hypot(screen[a][0], screen[a][1]);
+        double ux = len > 1e-6 ? screen[a][0] / len : 0, uy = len > 1e-6 ? screen[a][1] / len : 0;
+        const char *label = ip_overlay_axis_label(orientation->space, a);
+        int w, h;
+        text_size(label, s.text_scale, &w, &h);
+        double lx = tx + (reach - s.arm) * ux, ly = ty + (reach - s.arm) * uy;
+        draw_text(&cv, (int)lround(lx - w / 2.0), (int)lround(ly - h / 2.0), label, s.text_scale,
+                  axis_colours[a], dark);
+    }
+    report_box(camera, (int)floor(cx - radius), (int)floor(cy - radius), (int)ceil(cx + radius) + 1,
+               (int)ceil(cy + radius) + 1, box);
+    return IP_OK;
+}
+
+ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera, const ip_scale_bar *bar,
+                                    const char *unit, uint32_t box[4], uint32_t bar_box[4],
+                                    ip_error *err)
+{
+    ip_status st = check_image(rgba, camera, err);
+    if (st != IP_OK)
+        return st;
+    if (!bar || !(bar->length > 0 && isfinite(bar->length) && bar->pixels > 0 &&
+                  isfinite(bar->pixels) && bar->pixels < 1e9))
+        return ip__fail(err, IP_ERR_ARGUMENT, "scale bar: not a length");
+    canvas cv = {rgba, (int)camera->width, (int)camera->height};
+    overlay_sizes s = sizes_of(camera);
+    long n = lround(bar->pixels);
+    if (n < 1)
+        n = 1;
+    int thick = (int)lround(1.5 * s.text_scale) < 2 ? 2 : (int)lround(1.5 * s.text_scale);
+    int x1 = cv.width - s.margin, x0 = (int)(x1 - n), y1 = cv.height - s.margin, y0 = y1 - thick;
+    int tick = thick * 2, tick_w = thick < (int)n ? thick : (int)n;
+    char label[96];
+    if (unit && unit[0])
+        snprintf(label, sizeof label, "%g %.60s", bar->length, unit);
+    else
+        snprintf(label, sizeof label, "%g", bar->length);
+    int w, h;
+    text_size(label, s.text_scale, &w, &h);
+    int lx = (x0 + x1) / 2 - w / 2, ly = y1 - tick - s.margin - h;
+    if (lx + w + s.text_scale > x1)
+        lx = x1 - w - s.text_scale; /* a label wider than the bar ends at its right end */
+    /* light on a dark corner, dark on a light one (a white figure background) */
+    int left = x0 < lx ? x0 : lx;
+    int bright = mean_luma(&cv, left, ly, x1 + s.text_scale, y1 + 1) > 140;
+    colour ink = bright ? dark : light, shadow = bright ? light : dark;
+    /* the bar and its end ticks (inside its length), over a shadow one pixel below them */
+    fill_rect(&cv, x0, y1, x1, y1 + 1, shadow);
+    fill_rect(&cv, x0, y0, x1, y1, ink);
+    fill_rect(&cv, x0, y1 - tick, x0 + tick_w, y0, ink);
+    fill_rect(&cv, x1 - tick_w, y1 - tick, x1, y0, ink);
+    draw_text(&cv, lx, ly, label, s.text_scale, ink, shadow);
+    report_box(camera, left, ly, x1 + s.text_scale, y1 + 1, box);
+    report_box(camera, x0, y1 - tick, x1, y1, bar_box);
+    return IP_OK;
+}

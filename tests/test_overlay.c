@@ -1,0 +1,195 @@
+/* Tests of the figure overlays (src/render/overlay.c): the scale bar's length against the
+ * camera's projection, the axis triad's directions as the camera turns, and that each draws
+ * only inside the corner box it reports. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "isoprop/render.h"
+
+/* An eye 100 world units from the target on -y, looking along +y, up +z: right is +x. */
+static ip_camera front_camera(uint32_t width, uint32_t height)
+{
+    ip_camera c = {.eye = {0, -100, 0},
+                   .target = {0, 0, 0},
+                   .up = {0, 0, 1},
+                   .fov_y = 30,
+                   .width = width,
+                   .height = height};
+    return c;
+}
+
+static void test_scale_bar_choice(void)
+{
+    ip_camera c = front_camera(400, 300);
+    ip_scale_bar bar;
+    ip_error err;
+    double pixel = 2 * 100 * tan(15 * M_PI / 180) / 300; /* 0.1786 world units */
+    CHECK(ip_scale_bar_choose(&c, 100, &bar, &err) == IP_OK);
+    CHECK(fabs(bar.pixel_size - pixel) < 1e-12);
+    CHECK(bar.length == 10); /* 100 pixels span 17.9 units: 10 is the round length under it */
+    CHECK(fabs(bar.pixels - 10 / pixel) < 1e-9);
+    /* the bar's length is what the projection makes of that length at the target's depth */
+    ip_camera_basis basis;
+    ip_camera_basis_of(&c, &basis);
+    double end[3] = {bar.length, 0, 0}, px, py, depth, cx, cy;
+    double centre[3] = {0, 0, 0};
+    CHECK(ip_camera_project(&basis, &c, end, &px, &py, &depth) == 1);
+    CHECK(ip_camera_project(&basis, &c, centre, &cx, &cy, &depth) == 1);
+    CHECK_MSG(fabs((px - cx) - bar.pixels) < 1e-6, "%g vs %g", px - cx, bar.pixels);
+    /* 1, 2 or 5 times a power of ten, the largest that fits */
+    const double limits[][2] = {{0.3 / pixel, 0.2},
+                                {5.0 / pixel, 5},
+                                {99 / pixel, 50},
+                                {19.99 / pixel, 10},
+                                {2.5e-3 / pixel, 2e-3}};
+    for (size_t i = 0; i < sizeof limits / sizeof limits[0]; i++) {
+        CHECK(ip_scale_bar_choose(&c, limits[i][0], &bar, &err) == IP_OK);
+        CHECK_MSG(fabs(bar.length - limits[i][1]) < 1e-12 * limits[i][1], "%g pixels: %g",
+                  limits[i][0], bar.length);
+        CHECK(bar.pixels <= limits[i][0] * (1 + 1e-9));
+    }
+    /* a zoom (narrower field of view) makes each unit longer */
+    ip_camera narrow = c;
+    narrow.fov_y = 2 * atan(tan(15 * M_PI / 180) / 2) * 180 / M_PI;
+    CHECK(ip_scale_bar_choose(&narrow, 100, &bar, &err) == IP_OK);
+    CHECK(fabs(bar.pixel_size - pixel / 2) < 1e-12);
+    CHECK(ip_scale_bar_choose(&c, 0, &bar, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_scale_bar_choose(&c, NAN, &bar, &err) == IP_ERR_ARGUMENT);
+    c.fov_y = 0;
+    CHECK(ip_scale_bar_choose(&c, 100, &bar, &err) == IP_ERR_ARGUMENT);
+}
+
+static int near(const double a[3], double x, double y, double z)
+{
+    return fabs(a[0] - x) < 1e-9 && fabs(a[1] - y) < 1e-9 && fabs(a[2] - z) < 1e-9;
+}
+
+static void test_axis_directions(void)
+{
+    ip_camera c = front_camera(400, 300);
+    ip_orientation o;
+    ip_orientation_identity(&o);
+    double s[3][3];
+    ip_overlay_axis_directions(&c, &o, s);
+    CHECK(near(s[0], 1, 0, 0));  /* x to the right */
+    CHECK(near(s[1], 0, 0, -1)); /* y away from the eye */
+    CHECK(near(s[2], 0, -1, 0)); /* z up: toward the image's top, y decreasing */
+    /* the eye turned half round: x points left, y toward the eye, z still up */
+    ip_camera turned = c;
+    ip_camera_orbit(&turned, 180, 0);
+    ip_overlay_axis_directions(&turned, &o, s);
+    CHECK(near(s[0], -1, 0, 0));
+    CHECK(near(s[1], 0, 0, 1));
+    CHECK(near(s[2], 0, -1, 0));
+    /* a file whose sample x axis runs along physical -x (LPS, say): physical x, the one the
+     * triad shows, points left in the world's right-pointing view */
+    o.directions[0][0] = -1;
+    o.space = IP_SPACE_LPS;
+    ip_overlay_axis_directions(&c, &o, s);
+    CHECK(near(s[0], -1, 0, 0));
+    /* a file whose sample axes are the physical axes permuted: world x is physical y */
+    ip_orientation_identity(&o);
+    memset(o.directions, 0, sizeof o.directions);
+    o.directions[0][1] = 1; /* sample x -> physical y */
+    o.directions[1][2] = 1; /* sample y -> physical z */
+    o.directions[2][0] = 1; /* sample z -> physical x */
+    ip_overlay_axis_directions(&c, &o, s);
+    CHECK(near(s[0], 0, -1, 0)); /* physical x is world z: up */
+    CHECK(near(s[1], 1, 0, 0));  /* physical y is world x: right */
+    CHECK(near(s[2], 0, 0, -1)); /* physical z is world y: away */
+    CHECK(!strcmp(ip_overlay_axis_label(IP_SPACE_UNKNOWN, 0), "x"));
+    CHECK(!strcmp(ip_overlay_axis_label(IP_SPACE_RAS, 0), "R"));
+    CHECK(!strcmp(ip_overlay_axis_label(IP_SPACE_LAS, 0), "L"));
+    CHECK(!strcmp(ip_overlay_axis_label(IP_SPACE_LPS, 1), "P"));
+    CHECK(!strcmp(ip_overlay_axis_label(IP_SPACE_RAS, 2), "S"));
+    CHECK(!strcmp(ip_overlay_axis_label(IP_SPACE_RAS, 3), ""));
+}
+
+/* The pixels of `a` and `b` that differ: how many, and how many of them lie outside `box`. */
+static void count_changes(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h,
+                          const uint32_t box[4], size_t *changed, size_t *outside)
+{
+    *changed = *outside = 0;
+    for (uint32_t y = 0; y < h; y++)
+        for (uint32_t x = 0; x < w; x++) {
+            size_t p = ((size_t)y * w + x) * 4;
+            if (!memcmp(a + p, b + p, 4))
+                continue;
+            (*changed)++;
+            if (x < box[0] || x >= box[2] || y < box[1] || y >= box[3])
+                (*outside)++;
+        }
+}
+
+static void test_drawing(uint32_t w, uint32_t h)
+{
+    ip_camera c = front_camera(w, h);
+    ip_camera_orbit(&c, 30, -20);
+    size_t bytes = (size_t)w * h * 4;
+    uint8_t *plain = malloc(bytes), *image = malloc(bytes);
+    REQUIRE(plain && image);
+    for (size_t i = 0; i < bytes; i++)
+        plain[i] = (i % 4 == 3) ? 255 : (uint8_t)(40 + i % 7);
+    ip_orientation o;
+    ip_orientation_identity(&o);
+    ip_error err;
+    uint32_t box[4], bar_box[4];
+    size_t changed, outside;
+
+    memcpy(image, plain, bytes);
+    CHECK(ip_overlay_draw_axes(image, &c, &o, box, &err) == IP_OK);
+    count_changes(plain, image, w, h, box, &changed, &outside);
+    CHECK_MSG(changed > 20 && outside == 0, "%ux%u axes: %zu changed, %zu outside", w, h, changed,
+              outside);
+    CHECK(box[0] < box[2] && box[2] <= w && box[3] <= h);
+    if (w >= 200) /* in its corner */
+        CHECK(box[2] <= w / 2 && box[1] >= h / 2);
+
+    ip_scale_bar bar;
+    CHECK(ip_scale_bar_choose(&c, w / 4.0, &bar, &err) == IP_OK);
+    memcpy(image, plain, bytes);
+    CHECK(ip_overlay_draw_scale_bar(image, &c, &bar, "mm", box, bar_box, &err) == IP_OK);
+    count_changes(plain, image, w, h, box, &changed, &outside);
+    CHECK_MSG(changed > 20 && outside == 0, "%ux%u bar: %zu changed, %zu outside", w, h, changed,
+              outside);
+    CHECK(box[2] <= w && box[3] <= h);
+    if (w >= 200)
+        CHECK(box[0] >= w / 2 && box[1] >= h / 2);
+    /* the bar is round(pixels) long, within a pixel of the projection's length */
+    CHECK_MSG(bar_box[2] - bar_box[0] == (uint32_t)lround(bar.pixels), "%u vs %g",
+              bar_box[2] - bar_box[0], bar.pixels);
+    /* its bottom row is the bar's colour over its whole length, and only there */
+    uint32_t row = bar_box[3] - 1, lit = 0;
+    for (uint32_t x = 0; x < w; x++) {
+        const uint8_t *p = image + ((size_t)row * w + x) * 4;
+        if (p[0] > 200 && p[1] > 200 && p[2] > 200)
+            lit++;
+    }
+    CHECK_MSG(lit == bar_box[2] - bar_box[0], "%u lit", lit);
+
+    /* on a white background the bar is dark */
+    memset(image, 255, bytes);
+    CHECK(ip_overlay_draw_scale_bar(image, &c, &bar, "mm", box, bar_box, &err) == IP_OK);
+    const uint8_t *p = image + ((size_t)(bar_box[3] - 1) * w + bar_box[0]) * 4;
+    CHECK_MSG(p[0] < 60 && p[1] < 60 && p[2] < 60, "%u %u %u on white", p[0], p[1], p[2]);
+
+    CHECK(ip_overlay_draw_axes(NULL, &c, &o, box, &err) == IP_ERR_ARGUMENT);
+    bar.pixels = -1;
+    CHECK(ip_overlay_draw_scale_bar(image, &c, &bar, NULL, NULL, NULL, &err) == IP_ERR_ARGUMENT);
+    free(plain);
+    free(image);
+}
+
+int main(void)
+{
+    test_scale_bar_choice();
+    test_axis_directions();
+    test_drawing(400, 300);
+    test_drawing(1600, 1200);
+    test_drawing(40, 30); /* tiny: everything clipped to the image */
+    return test_summary("test_overlay");
+}
