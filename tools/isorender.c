@@ -621,9 +621,12 @@ static void step_report(const run *r, tool_progress *bar, uint64_t limit)
     if (r->o.common.verbose) {
         tool_progress_end(bar);
         fprintf(
-            stderr, "isorender: step: %llu rays, %llu seeds, %llu cells, %llu triangles, %.3f s\n",
-            (unsigned long long)t.rays, (unsigned long long)t.seeds, (unsigned long long)t.cells,
-            (unsigned long long)t.triangles, tool_progress_elapsed(bar));
+            stderr,
+            "isorender: step: %llu rays (%llu retired), %llu seeds, %llu cells, %llu triangles, "
+            "%.3f s\n",
+            (unsigned long long)t.rays, (unsigned long long)t.retired, (unsigned long long)t.seeds,
+            (unsigned long long)t.cells, (unsigned long long)t.triangles,
+            tool_progress_elapsed(bar));
     }
 }
 
@@ -847,8 +850,11 @@ static void json_counts(FILE *f, void *user)
                 (unsigned long long)r->visible_triangles,
                 overdraw(r->mesh->triangle_count, r->visible_triangles));
     if (!r->o.full)
-        fprintf(f, ", \"occlusion\": %s, \"deferred_cells\": %llu, \"prefetch\": %s",
+        fprintf(f,
+                ", \"occlusion\": %s, \"deferred_cells\": %llu, \"retired_rays\": %llu, "
+                "\"ray_nodes\": %llu, \"prefetch\": %s",
                 r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred,
+                (unsigned long long)r->totals.retired, (unsigned long long)r->totals.nodes,
                 r->o.common.prefetch ? "true" : "false");
     fprintf(f, ", \"warnings\": [");
     if (r->warning[0])
@@ -861,8 +867,12 @@ static void print_summary(FILE *out, const run *r)
     const ip_engine_counts *t = &r->totals;
     fprintf(out, "%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso,
             r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
-    fprintf(out, "  rays          %llu of %llu\n", (unsigned long long)t->rays,
+    fprintf(out, "  rays          %llu of %llu", (unsigned long long)t->rays,
             (unsigned long long)r->camera.width * r->camera.height);
+    if (!r->o.full)
+        fprintf(out, " (%llu retired without a walk; %llu nodes walked)",
+                (unsigned long long)t->retired, (unsigned long long)t->nodes);
+    fprintf(out, "\n");
     fprintf(out, "  seeds         %llu\n", (unsigned long long)t->seeds);
     fprintf(out, "  cells         %llu\n", (unsigned long long)t->cells);
     fprintf(out, "  triangles     %llu\n", (unsigned long long)t->triangles);
