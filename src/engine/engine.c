@@ -56,8 +56,8 @@ typedef struct worker {
 
 /* A screen tile of bulk retirement (see retire()). */
 typedef struct tile {
-    atomic_uint depth;   /* a float's bits: the rays of its pixels whose walk would stop no
-                             deeper need none (0: none known) */
+    atomic_uint depth;   /* a float's bits: the rays of its pixels whose solid entry is no
+                            deeper need no walk (0: none known; +infinity: every ray) */
     atomic_uchar tested; /* 1 + the last ray-order level (from tile_from) it was tested in */
 } tile;
 
