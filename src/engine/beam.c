@@ -37,7 +37,7 @@ void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
 }
 
 /* 1 when the index box [lo, hi] may meet the beam. */
-static int meets(const index_beam *w, const double lo[3], const double hi[3])
+static inline int meets(const index_beam *w, const double lo[3], const double hi[3])
 {
     double z = 0;
     for (int a = 0; a < 3; a++)
@@ -89,19 +89,20 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
                 for (uint32_t z = gz; z < g1[2]; z++)
                     for (uint32_t y = gy; y < g1[1]; y++)
                         for (uint32_t x = gx; x < g1[0]; x++) {
+                            /* cheapest first: most cells here are extracted or inactive */
                             uint32_t c[3] = {x, y, z}, c1[3] = {x + 1, y + 1, z + 1};
-                            double clo[3] = {x, y, z}, chi[3] = {x + 1.0, y + 1.0, z + 1.0};
-                            if (!meets(w, clo, chi))
+                            if (ip__visited_test(w->visited, s->level, c))
                                 continue;
                             float values[8];
                             ip__cell_values(brick, s->layout->type, corners, c, values);
                             unsigned mc = ip__mc_case(values, s->iso);
                             if (mc == 0 || mc == 255)
                                 continue;
-                            if (side != IP__CLIP_KEEPS_ALL &&
-                                !ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))
+                            double clo[3] = {x, y, z}, chi[3] = {x + 1.0, y + 1.0, z + 1.0};
+                            if (!meets(w, clo, chi))
                                 continue;
-                            if (!ip__visited_test(w->visited, s->level, c))
+                            if (side == IP__CLIP_KEEPS_ALL ||
+                                ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))
                                 return 0;
                         }
             }
