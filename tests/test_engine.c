@@ -143,7 +143,7 @@ static void check_view(scene *s, const char *what, const char *axis, float iso, 
     ip_mesh_init_with_cells(&full);
     ip_engine_counts fc;
     REQUIRE(ip_extract_full(s->cache, iso, 0, 0, &full, &fc, &err) == IP_OK);
-    CHECK(t.rays == (uint64_t)w * h);
+    CHECK(t.rays == (uint64_t)w * h && t.retired < t.rays && t.nodes > 0);
     CHECK(part->triangle_count == t.triangles && full.triangle_count == fc.triangles);
     CHECK_MSG(part->triangle_count > 0 && part->triangle_count <= full.triangle_count,
               "%s %s: %llu progressive, %llu full triangles", what, axis,
@@ -166,11 +166,11 @@ static void check_view(scene *s, const char *what, const char *axis, float iso, 
         pixel_diff += memcmp(ca + 4 * i, cb + 4 * i, 4) != 0;
     }
     double same = covered ? 100.0 * (double)(n - pixel_diff) / (double)n : 0;
-    printf("test_engine: %s %s iso %g: %llu rays, %llu seeds, %llu of %llu triangles, "
-           "%zu covered pixels, %zu coverage and %zu colour differences\n",
-           what, axis, (double)iso, (unsigned long long)t.rays, (unsigned long long)t.seeds,
-           (unsigned long long)part->triangle_count, (unsigned long long)full.triangle_count,
-           covered, coverage_diff, pixel_diff);
+    printf("test_engine: %s %s iso %g: %llu rays (%llu retired), %llu seeds, %llu of %llu "
+           "triangles, %zu covered pixels, %zu coverage and %zu colour differences\n",
+           what, axis, (double)iso, (unsigned long long)t.rays, (unsigned long long)t.retired,
+           (unsigned long long)t.seeds, (unsigned long long)part->triangle_count,
+           (unsigned long long)full.triangle_count, covered, coverage_diff, pixel_diff);
     CHECK_MSG(covered > n / 50, "%s %s: the surface covers only %zu pixels", what, axis, covered);
     CHECK_MSG(coverage_diff == 0, "%s %s: %zu pixels differ in coverage", what, axis,
               coverage_diff);
@@ -500,6 +500,108 @@ static void check_occlusion(const char *dir)
     close_scene(&s);
 }
 
+/* Rays retired in bulk: a wall across the volume near the eye hides blobs behind it. Once the
+ * wall is extracted, the rays of the tiles it covers solidly stop at it and find nothing new,
+ * so most of them are retired without a walk, as are those of tiles whose beam meets no active
+ * cell at all (outside the volume); the image stays that of the full extraction, with 1 and 2
+ * threads, and the walks enter fewer nodes than without occlusion (no stops, no retirement). */
+static void check_retirement(const char *dir)
+{
+    const uint32_t d[3] = {40, 36, 44};
+    size_t count = (size_t)d[0] * d[1] * d[2];
+    uint8_t *v = malloc(count);
+    REQUIRE(v);
+    for (uint32_t z = 0; z < d[2]; z++)
+        for (uint32_t y = 0; y < d[1]; y++)
+            for (uint32_t x = 0; x < d[0]; x++) {
+                int wall = z >= 3 && z <= 6;
+                /* blobs behind the wall: a lattice of small balls */
+                int bx = (int)x % 9 - 4, by = (int)y % 9 - 4, bz = (int)z % 11 - 5;
+                int blob = z >= 14 && bx * bx + by * by + bz * bz <= 6;
+                v[x + (size_t)d[0] * (y + (size_t)d[1] * z)] = wall || blob ? 200 : 10;
+            }
+    char name[256], raw[4096], ibv[4200];
+    ip_error err;
+    REQUIRE(ip_raw_file_name(name, sizeof name, "wall", d, IP_UINT8) == IP_OK);
+    REQUIRE(snprintf(raw, sizeof raw, "%s/%s", dir, name) < (int)sizeof raw);
+    FILE *f = fopen(raw, "wb");
+    REQUIRE(f && fwrite(v, 1, count, f) == count && fclose(f) == 0);
+    free(v);
+    REQUIRE(snprintf(ibv, sizeof ibv, "%s/wall.ibv", dir) < (int)sizeof ibv);
+    ip_input_desc in;
+    ip_bricker_options bo;
+    REQUIRE(ip_input_describe(raw, NULL, &in, &err) == IP_OK);
+    ip_bricker_options_default(&bo);
+    bo.brick_edge = 16;
+    bo.subblock_edge = 4;
+    bo.force = 1;
+    REQUIRE(ip_bricker_run(&in, ibv, &bo, NULL, &err) == IP_OK);
+    scene s;
+    open_scene(ibv, &s);
+    const uint32_t w = 128, h = 112;
+    const float iso = 100.5f;
+    ip_camera cam;
+    REQUIRE(ip_camera_fit_axis(s.lo, s.hi, "-z", 30.0, w, h, &cam, &err) == IP_OK);
+    size_t n = (size_t)w * h;
+    uint32_t *index = malloc(n * 4), *full_index = malloc(n * 4);
+    uint8_t *rgba = malloc(n * 4), *full_rgba = malloc(n * 4);
+    REQUIRE(index && full_index && rgba && full_rgba);
+    ip_mesh full;
+    ip_mesh_init(&full);
+    REQUIRE(ip_extract_full(s.cache, iso, 0, 1, &full, NULL, &err) == IP_OK);
+    REQUIRE(ip_raster_mesh(&full, &cam, s.lo, s.hi, full_index, full_rgba, &err) == IP_OK);
+    size_t covered = 0;
+    for (size_t i = 0; i < n; i++)
+        covered += full_index[i] != UINT32_MAX;
+    uint64_t nodes[2] = {0, 0};
+    for (int threads = 1; threads <= 2; threads++)
+        for (int occlusion = 0; occlusion <= 1; occlusion++) {
+            ip_engine *e;
+            ip_engine_options o;
+            ip_engine_options_default(&o);
+            o.lod = 0;
+            o.threads = (unsigned)threads;
+            o.occlusion = occlusion;
+            REQUIRE(ip_engine_create(s.cache, &o, &e, &err) == IP_OK);
+            ip_engine_counts t;
+            run_all_rays(e, &cam, iso, &t);
+            REQUIRE(ip_raster_mesh(ip_engine_mesh(e), &cam, s.lo, s.hi, index, rgba, &err) ==
+                    IP_OK);
+            size_t coverage_diff = 0, colour_diff = 0;
+            for (size_t i = 0; i < n; i++) {
+                coverage_diff += (index[i] == UINT32_MAX) != (full_index[i] == UINT32_MAX);
+                colour_diff += memcmp(rgba + 4 * i, full_rgba + 4 * i, 4) != 0;
+            }
+            printf("test_engine: wall, occlusion %s, %d thread%s: %llu rays, %llu retired, %llu "
+                   "nodes walked, %llu cells; %zu covered pixels, %zu coverage, %zu colour "
+                   "differences\n",
+                   occlusion ? "on" : "off", threads, threads > 1 ? "s" : "",
+                   (unsigned long long)t.rays, (unsigned long long)t.retired,
+                   (unsigned long long)t.nodes, (unsigned long long)t.cells, covered, coverage_diff,
+                   colour_diff);
+            CHECK_MSG(coverage_diff == 0 && colour_diff == 0,
+                      "wall, occlusion %d, %d threads: %zu coverage, %zu colour differences",
+                      occlusion, threads, coverage_diff, colour_diff);
+            CHECK(t.rays == n);
+            if (occlusion) /* more than the rays outside the wall: the wall's own retired */
+                CHECK_MSG(t.retired > n - covered + covered / 2,
+                          "%d threads: %llu rays retired, %zu pixels covered of %zu", threads,
+                          (unsigned long long)t.retired, covered, n);
+            else
+                CHECK(t.retired == 0);
+            nodes[occlusion] = t.nodes;
+            ip_engine_destroy(e);
+        }
+    CHECK_MSG(2 * nodes[1] < nodes[0], "%llu nodes walked with occlusion, %llu without",
+              (unsigned long long)nodes[1], (unsigned long long)nodes[0]);
+    free(index);
+    free(full_index);
+    free(rgba);
+    free(full_rgba);
+    ip_mesh_free(&full);
+    close_scene(&s);
+}
+
 /* Step budgets with the ray order handed out in ranges to several workers: each step casts
  * exactly its budget (the rest at the end), a step cut short by its deadline leaves no pixel
  * out, and the rays add up to the pixels once the engine is done. */
@@ -602,6 +704,7 @@ int main(void)
     check_lod(dir);
     check_coverage_box_test();
     check_occlusion(dir);
+    check_retirement(dir);
     check_shared_data();
     return test_summary("test_engine");
 }

@@ -784,9 +784,12 @@ static void step_report(const run *r, tool_progress *bar, uint64_t limit)
     if (r->o.common.verbose) {
         tool_progress_end(bar);
         fprintf(
-            stderr, "isorender: step: %llu rays, %llu seeds, %llu cells, %llu triangles, %.3f s\n",
-            (unsigned long long)t.rays, (unsigned long long)t.seeds, (unsigned long long)t.cells,
-            (unsigned long long)t.triangles, tool_progress_elapsed(bar));
+            stderr,
+            "isorender: step: %llu rays (%llu retired), %llu seeds, %llu cells, %llu triangles, "
+            "%.3f s\n",
+            (unsigned long long)t.rays, (unsigned long long)t.retired, (unsigned long long)t.seeds,
+            (unsigned long long)t.cells, (unsigned long long)t.triangles,
+            tool_progress_elapsed(bar));
     }
 }
 
@@ -1155,8 +1158,11 @@ static void json_counts(FILE *f, void *user)
         fprintf(f, ", \"pixel_size\": %.17g, \"pixels\": %.17g}", r->bar.pixel_size, r->bar.pixels);
     }
     if (!r->o.full)
-        fprintf(f, ", \"occlusion\": %s, \"deferred_cells\": %llu, \"prefetch\": %s",
+        fprintf(f,
+                ", \"occlusion\": %s, \"deferred_cells\": %llu, \"retired_rays\": %llu, "
+                "\"ray_nodes\": %llu, \"prefetch\": %s",
                 r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred,
+                (unsigned long long)r->totals.retired, (unsigned long long)r->totals.nodes,
                 r->o.common.prefetch ? "true" : "false");
     fprintf(f, ", \"warnings\": [");
     for (size_t i = 0, written = 0; i <= r->other_count; i++) {
@@ -1175,8 +1181,12 @@ static void json_counts(FILE *f, void *user)
 static void print_counts(FILE *out, const run *s, const run *r)
 {
     const ip_engine_counts *t = &s->totals;
-    fprintf(out, "  rays          %llu of %llu\n", (unsigned long long)t->rays,
+    fprintf(out, "  rays          %llu of %llu", (unsigned long long)t->rays,
             (unsigned long long)r->camera.width * r->camera.height);
+    if (!s->o.full)
+        fprintf(out, " (%llu retired without a walk; %llu nodes walked)",
+                (unsigned long long)t->retired, (unsigned long long)t->nodes);
+    fprintf(out, "\n");
     fprintf(out, "  seeds         %llu\n", (unsigned long long)t->seeds);
     fprintf(out, "  cells         %llu\n", (unsigned long long)t->cells);
     fprintf(out, "  triangles     %llu\n", (unsigned long long)t->triangles);

@@ -30,7 +30,14 @@
  * propagation does not queue a cell whose box that surface hides at every pixel centre the box
  * may cover (it stays unvisited). Such a cell cannot show in the final image, and since every
  * pixel's ray still extracts its own first-hit cell, the guarantee above is unchanged; what
- * changes is how much hidden surface is extracted (docs/occlusion.md). 4 bytes a pixel.
+ * changes is how much hidden surface is extracted (docs/occlusion.md). The buffer also keeps,
+ * per pixel, the depth of surface that holds the pixel centre by 1/64 pixel or more, which the
+ * rasterizer draws there whatever its rounding: a ray stops its walk where cells lie wholly
+ * behind that depth (nothing there can show at its pixel), and the rays of an 8 x 8 pixel tile
+ * whose pixels are all so covered are retired without a walk once a test of the tile's beam
+ * against the octree finds every active cell those walks could enter extracted already
+ * (`retired`); the guarantee above is unchanged (the arguments are in engine.c). 8 bytes a
+ * pixel.
  *
  * Reading ahead (options.prefetch, on by default): one more thread per engine reads and
  * decodes into the cache, from the first step after ip_engine_begin() on and between steps,
@@ -117,6 +124,10 @@ typedef struct ip_engine_counts {
     double rendering_seconds;    /* reported by the caller, ip_engine_add_rendering_time() */
     uint64_t deferred; /* with occlusion: neighbours propagation left because surface already
                           extracted hid them (a cell may count more than once) */
+    uint64_t retired;  /* with occlusion: rays (counted in rays) retired with their screen tile,
+                          without a walk (see Occlusion above) */
+    uint64_t nodes;    /* octree nodes (bricks included), sub-blocks and cells the rays' walks
+                          entered: the seeding work, independent of the clock */
 } ip_engine_counts;
 
 typedef struct ip_engine ip_engine;

@@ -123,7 +123,8 @@ class EngineCounts(ctypes.Structure):
     _fields_ = [("rays", c_uint64), ("seeds", c_uint64), ("cells", c_uint64),
                 ("triangles", c_uint64), ("intersection_seconds", c_double),
                 ("propagation_seconds", c_double), ("extraction_seconds", c_double),
-                ("rendering_seconds", c_double), ("deferred", c_uint64)]
+                ("rendering_seconds", c_double), ("deferred", c_uint64),
+                ("retired", c_uint64), ("nodes", c_uint64)]
 
 
 class Mesh(ctypes.Structure):

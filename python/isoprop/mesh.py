@@ -53,7 +53,7 @@ class Mesh:
 class Step(Mesh):
     """One step of a progressive extraction: the triangles it added (a Mesh of its own),
     `first_triangle` (how many the steps before added), `counts` (this step's rays, seeds,
-    cells, triangles, deferred), `rays` and `rays_total` (cast so far, and one per pixel),
+    cells, triangles, deferred, retired, nodes), `rays` and `rays_total` (cast so far, and one per pixel),
     `done` (every pixel has had its ray) and `stats` (the run so far)."""
 
     def __init__(self, vertices, normals, stats, first_triangle, counts):

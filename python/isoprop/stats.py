@@ -54,6 +54,7 @@ def run_stats(run, counts, cache):
                     "extraction_wall_s": run.wall_seconds, "progress_render_s": 0.0}}
     if not run.full:
         out.update({"occlusion": bool(run.options.occlusion), "deferred_cells": counts.deferred,
+                    "retired_rays": counts.retired, "ray_nodes": counts.nodes,
                     "prefetch": bool(run.options.prefetch)})
     out["warnings"] = list(run.warnings)
     return out
@@ -62,4 +63,5 @@ def run_stats(run, counts, cache):
 def counts_dict(counts):
     """One step's ip_engine_counts as a dict."""
     return {"rays": counts.rays, "seeds": counts.seeds, "cells": counts.cells,
-            "triangles": counts.triangles, "deferred": counts.deferred}
+            "triangles": counts.triangles, "deferred": counts.deferred,
+            "retired": counts.retired, "nodes": counts.nodes}

@@ -49,10 +49,14 @@ ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const doub
     size_t n = (size_t)camera->width * camera->height;
     if (n > c->capacity) {
         free(c->depth);
+        free(c->solid);
         c->depth = malloc(n * sizeof *c->depth);
-        c->capacity = c->depth ? n : 0;
-        if (!c->depth)
+        c->solid = malloc(n * sizeof *c->solid);
+        c->capacity = c->depth && c->solid ? n : 0;
+        if (!c->capacity) {
+            ip__coverage_free(c);
             return IP_ERR_NOMEM;
+        }
     }
     c->camera = *camera;
     ip_camera_basis_of(camera, &c->basis);
@@ -69,15 +73,19 @@ ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const doub
     float inf = INFINITY;
     unsigned bits;
     memcpy(&bits, &inf, sizeof bits);
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++) {
         atomic_init(&c->depth[i], bits);
+        atomic_init(&c->solid[i], bits);
+    }
     return IP_OK;
 }
 
 void ip__coverage_free(ip_coverage *c)
 {
     free(c->depth);
+    free(c->solid);
     c->depth = NULL;
+    c->solid = NULL;
     c->capacity = 0;
 }
 
@@ -155,12 +163,13 @@ static void add_projected(ip_coverage *c, const double *x, const double *y, cons
         return;
     int o1 = area < 0 ? 2 : 1, o2 = 3 - o1; /* counter-clockwise: inside is left of every edge */
     double vx[3] = {x[0], x[o1], x[o2]}, vy[3] = {y[0], y[o1], y[o2]};
-    double ex[3], ey[3], need[3];
+    double ex[3], ey[3], need[3], inner[3];
     for (int i = 0; i < 3; i++) {
         int j = i == 2 ? 0 : i + 1;
         ex[i] = vx[j] - vx[i];
         ey[i] = vy[j] - vy[i];
         need[i] = -EDGE_TOLERANCE * (fabs(ex[i]) + fabs(ey[i])); /* >= the edge's length */
+        inner[i] = IP_COVERAGE_SOLID_MARGIN * sqrt(ex[i] * ex[i] + ey[i] * ey[i]);
     }
     /* the next float above zmax (a positive finite float: its bits plus one) */
     unsigned bits = float_bits((float)zmax) + 1;
@@ -168,10 +177,15 @@ static void add_projected(ip_coverage *c, const double *x, const double *y, cons
         double cy = py + 0.5;
         for (int64_t px = x0; px <= x1; px++) {
             double cx = px + 0.5;
-            if (ex[0] * (cy - vy[0]) - ey[0] * (cx - vx[0]) >= need[0] &&
-                ex[1] * (cy - vy[1]) - ey[1] * (cx - vx[1]) >= need[1] &&
-                ex[2] * (cy - vy[2]) - ey[2] * (cx - vx[2]) >= need[2])
-                lower(&c->depth[(size_t)py * c->width + (size_t)px], bits);
+            double e0 = ex[0] * (cy - vy[0]) - ey[0] * (cx - vx[0]);
+            double e1 = ex[1] * (cy - vy[1]) - ey[1] * (cx - vx[1]);
+            double e2 = ex[2] * (cy - vy[2]) - ey[2] * (cx - vx[2]);
+            if (e0 >= need[0] && e1 >= need[1] && e2 >= need[2]) {
+                size_t at = (size_t)py * c->width + (size_t)px;
+                lower(&c->depth[at], bits);
+                if (e0 >= inner[0] && e1 >= inner[1] && e2 >= inner[2])
+                    lower(&c->solid[at], bits);
+            }
         }
     }
 }

@@ -1,7 +1,9 @@
 /* The coverage depth buffer of occlusion-aware propagation. Internal.
  *
- * One entry per pixel of the image: an upper bound on the view depth of the nearest extracted
- * triangle whose projection holds the pixel's centre (+infinity where none is known yet).
+ * Two entries per pixel of the image. The first, `depth`: an upper bound on the view depth of the nearest extracted
+ * triangle whose projection holds the pixel's centre (+infinity where none is known yet). The second, `solid`, the same bound from the triangles
+ * whose projection holds the centre by a margin (IP_COVERAGE_SOLID_MARGIN), which the
+ * rasterizer draws there whatever its rounding: rays stop at it (see engine.c, cast_ray()).
  * Workers add the triangles they extract and test, before queueing a cell, whether extracted
  * surface already hides it (docs/occlusion.md; the argument is in coverage.c).
  *
@@ -21,11 +23,18 @@
 
 #include <stdatomic.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "isoprop/camera.h"
 #include "isoprop/status.h"
 
 #define IP_COVERAGE_MAX_PIXELS 1024 /* the largest box or triangle (bounding pixels) used */
+
+/* A triangle records a pixel centre as solidly covered when the centre lies inside its exact
+ * projection by at least this distance (pixels) from every edge: far more than the 1/256-pixel
+ * vertex snapping of the rasterizer can move an edge (at most sqrt(2) / 512 pixel), so the
+ * rasterizer draws the triangle there in any mesh that holds it. */
+#define IP_COVERAGE_SOLID_MARGIN (1.0 / 64)
 
 typedef struct ip_coverage {
     ip_camera camera;
@@ -35,6 +44,7 @@ typedef struct ip_coverage {
     double centre_x, centre_y;
     uint32_t width, height;
     atomic_uint *depth; /* width * height entries: the bits of a float depth, +inf: unknown */
+    atomic_uint *solid; /* the same, from triangles holding the centre by the solid margin */
     size_t capacity;    /* entries allocated */
 } ip_coverage;
 
@@ -48,6 +58,18 @@ void ip__coverage_free(ip_coverage *c);
 
 /* Records `count` triangles (9 floats each, world units). Any thread. */
 void ip__coverage_add(ip_coverage *c, const float *positions, uint64_t count);
+
+/* The solid entry of pixel (x, y) (inside the image): an upper bound on the view depth (world
+ * units) of an extracted triangle whose projection holds the pixel centre by at least
+ * IP_COVERAGE_SOLID_MARGIN pixels from every edge, or +infinity where none is known. Bounds
+ * the depth that the rasterizer shows there once that triangle is drawn. Any thread. */
+static inline double ip__coverage_solid(const ip_coverage *c, uint32_t x, uint32_t y)
+{
+    unsigned bits = atomic_load_explicit(&c->solid[(size_t)y * c->width + x], memory_order_relaxed);
+    float f;
+    memcpy(&f, &bits, sizeof f);
+    return f;
+}
 
 /* 1 when the world box [lo, hi] is certainly hidden: it lies wholly in front of the eye and
  * beyond the near plane, its projection holds at least one pixel centre, and at every pixel

@@ -7,6 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "beam.h"
 #include "coverage.h"
 #include "internal.h"
 #include "isoprop/engine.h"
@@ -22,6 +23,9 @@
 #define RANGE_MAX 1024 /* ...and at most, later: 1/256 of the positions already handed out */
 #define LOCAL_LEVELS 3 /* ray order: the finest levels cast in Z-order (see begin) */
 #define FLUSH_TRIANGLES 16384 /* a worker's buffer moves to the engine's mesh past this size */
+#define DEPTH_MARGIN 1e-5     /* relative: float rounding of vertices (as coverage.c's boxes) */
+#define TILE_SHIFT 3          /* bulk retirement: tiles of 8 x 8 pixels */
+#define TILE_SLACK (1.0 / 64) /* pixels added around a tile's pixel centres for its beam */
 
 /* A worker's tools for one pyramid level: pinned bricks, seeding state, propagation queue. */
 typedef struct level_tools {
@@ -50,6 +54,18 @@ typedef struct worker {
     uint32_t failed_level;
 } worker;
 
+/* A screen tile of bulk retirement (see retire()). */
+typedef struct tile {
+    atomic_uint depth;   /* a float's bits: the rays of its pixels whose solid entry is no
+                            deeper need no walk (0: none known; +infinity: every ray) */
+    atomic_uchar tested; /* 1 + the last ray-order level (from tile_from) it was tested in */
+} tile;
+
+/* A ray of the order: its pixel and the order's level it belongs to. */
+typedef struct order_ray {
+    uint32_t x, y, level;
+} order_ray;
+
 struct ip_engine {
     ip_cache *cache;
     ip_engine_options options;
@@ -67,6 +83,12 @@ struct ip_engine {
     int begun;
     uint32_t levels_used;                   /* levels 0 .. levels_used - 1 have a distance band */
     double lod_distance[IP_MAX_LEVELS + 1]; /* D[k]; D[levels_used] = infinity */
+    double cell_reach[IP_MAX_LEVELS];       /* a level-k cell's extent along the view (world) */
+    /* With occlusion: bulk retirement of the rays of 8 x 8 pixel tiles (see retire()). */
+    tile *tiles;
+    size_t tile_capacity;
+    uint32_t tiles_x, tiles_y;
+    uint32_t tile_from; /* the first ray-order level whose rays test their tile */
     /* The ray order is handed out in ranges of positions: a worker claims the next range
      * with one atomic add (or takes a range another worker left unfinished at the end of a
      * step, the earliest first) and walks it with its own iterator, so no lock is held while
@@ -180,6 +202,7 @@ void ip_engine_destroy(ip_engine *e)
     }
     free(e->workers);
     free(e->leftovers);
+    free(e->tiles);
     ip__visited_free(&e->visited);
     ip__coverage_free(&e->coverage);
     ip_mesh_free(&e->mesh);
@@ -249,11 +272,30 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     e->leftover_count = 0;
     atomic_store(&e->leftovers_waiting, 0);
     set_lod_distances(e);
+    const ip_layout *layout = ip_store_layout(ip_cache_store(e->cache));
+    for (uint32_t k = 0; k < e->levels_used; k++) {
+        e->cell_reach[k] = 0;
+        for (int a = 0; a < 3; a++)
+            e->cell_reach[k] += layout->spacing[a] * (double)(1u << k) * fabs(e->basis.forward[a]);
+    }
+    e->tile_from = last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0;
     if (e->options.occlusion) {
         double lo[3], hi[3];
-        ip_layout_world_box(ip_store_layout(ip_cache_store(e->cache)), lo, hi);
-        if (ip__coverage_reset(&e->coverage, camera, lo, hi) != IP_OK)
+        ip_layout_world_box(layout, lo, hi);
+        e->tiles_x = (camera->width + (1u << TILE_SHIFT) - 1) >> TILE_SHIFT;
+        e->tiles_y = (camera->height + (1u << TILE_SHIFT) - 1) >> TILE_SHIFT;
+        size_t tiles = (size_t)e->tiles_x * e->tiles_y;
+        if (tiles > e->tile_capacity) {
+            free(e->tiles);
+            e->tiles = malloc(tiles * sizeof *e->tiles);
+            e->tile_capacity = e->tiles ? tiles : 0;
+        }
+        if (!e->tiles || ip__coverage_reset(&e->coverage, camera, lo, hi) != IP_OK)
             return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
+        for (size_t t = 0; t < tiles; t++) {
+            atomic_init(&e->tiles[t].depth, 0);
+            atomic_init(&e->tiles[t].tested, 0);
+        }
     }
     double pixel_angle = 2.0 * e->basis.tan_half_y / camera->height;
     for (unsigned t = 0; t < e->threads; t++) {
@@ -314,6 +356,8 @@ static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
     to->extraction_seconds += from->extraction_seconds;
     to->rendering_seconds += from->rendering_seconds;
     to->deferred += from->deferred;
+    to->retired += from->retired;
+    to->nodes += from->nodes;
 }
 
 /* Extracts one cell without propagating from it. */
@@ -331,9 +375,45 @@ static ip_status extract_one(worker *w, level_tools *lt, const uint32_t cell[3])
     return IP_OK;
 }
 
+/* The view depth (world units) beyond which no cell can show at pixel (x, y) any more: the
+ * solid coverage entry (coverage.h) widened by DEPTH_MARGIN; +infinity without occlusion or
+ * where nothing covers the pixel solidly yet. */
+static double stop_depth(const ip_engine *e, uint32_t x, uint32_t y)
+{
+    if (!e->options.occlusion)
+        return INFINITY;
+    return ip__coverage_solid(&e->coverage, x, y) / (1.0 - DEPTH_MARGIN);
+}
+
 /* Casts the ray of pixel (x, y), one distance band (pyramid level) after the other, front to
  * back: extracts its seed, and the cells it nearly hit before it, propagating from each that
- * was not extracted yet. */
+ * was not extracted yet.
+ *
+ * With occlusion the walk stops where the solid coverage entry of the pixel (coverage.h) says
+ * nothing further can show: at t = (z + reach) / cos, z the entry widened by DEPTH_MARGIN,
+ * reach a cell's extent along the view, cos the cosine between the ray and the view. Why the
+ * image stays exact. The entry z means: an extracted triangle T, kept in the mesh, holds the
+ * pixel centre by 1/64 pixel or more from each of its edges and has its vertices no deeper
+ * than z. The rasterizer moves a vertex by at most sqrt(2) / 512 pixel when it snaps it, and
+ * an affine map moving the corners of T that little moves no point of T more, so T still
+ * holds the centre after snapping (the disc of 1/64 pixel around it lies in T, and the
+ * snapped T covers the point of that disc it maps to the centre); the depth it is drawn with
+ * there interpolates 1 / depth between its vertices, so is at most z. A cell the walk enters
+ * at t holds the ray's point at view depth t * cos, so its box reaches no nearer than
+ * t * cos - reach; a cell entered beyond the stop has its box, and so every vertex of its
+ * triangles, deeper than the entry by more than the margin (which covers the rounding of
+ * vertices to floats), and any of its triangles is drawn at the pixel, if at all, deeper than
+ * T, which beats it in either mesh. Nothing there can be the full extraction's triangle at this
+ * pixel, nor change the extracted mesh's image there. The walk is otherwise the same: the
+ * cells of a ray are entered front to back (the boxes of disjoint nodes cut disjoint spans of
+ * the ray), so the shortened walk meets exactly the cells of the full walk up to the stop, in
+ * the same order, and extracts the same ones of them, near misses (the cells it passes within
+ * 1/64 pixel of a triangle edge, extracted alone) and seed alike. Rays may then find nothing
+ * where they would have found a hidden seed; propagation from such a seed only ever saved other
+ * rays work. Entries only decrease and each is backed by a triangle already in a worker's mesh,
+ * so a stale read only stops the walk later. The edge of the solid margin matters: the plain
+ * coverage entry also counts centres on a triangle's edge, where snapping may uncover a
+ * silhouette and show the surface behind, which this ray must then still find. */
 static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
 {
     ip_engine *e = w->engine;
@@ -341,12 +421,19 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
     uint32_t cells[IP_SEED_MAX_CELLS][3];
     ip_camera_pixel_ray(&e->basis, &e->camera, x + 0.5, y + 0.5, dir);
     w->counts.rays++;
+    double z = stop_depth(e, x, y), cos = ip__vec3_dot(dir, e->basis.forward);
     for (uint32_t k = 0; k < e->levels_used; k++) {
         level_tools *lt = &w->level[k];
         unsigned count;
         int seed_index;
-        int found = ip__seed_find(&lt->seeder, e->camera.eye, dir, e->lod_distance[k],
-                                  e->lod_distance[k + 1], cells, &count, &seed_index);
+        double t_max = e->lod_distance[k + 1], stop = (z + e->cell_reach[k]) / cos;
+        t_max = stop < t_max ? stop : t_max;
+        if (t_max < e->lod_distance[k])
+            return IP_OK;
+        uint64_t nodes = lt->seeder.nodes;
+        int found = ip__seed_find(&lt->seeder, e->camera.eye, dir, e->lod_distance[k], t_max, cells,
+                                  &count, &seed_index);
+        w->counts.nodes += lt->seeder.nodes - nodes;
         if (found < 0) {
             w->failed_level = k;
             return lt->sampler.status;
@@ -373,6 +460,95 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
             return IP_OK;
     }
     return IP_OK;
+}
+
+/* 1 when the rays of tile (tx, ty) whose solid coverage entry (coverage.h) is no deeper than
+ * *solid can extract nothing any more: every active cell that such a ray could enter before its
+ * stop (cast_ray()), at any level, is extracted already. *solid is the deepest entry among the
+ * tile's pixels covered solidly, or +infinity when none is (then the test is for every ray of
+ * the tile, which must find nothing new anywhere: a tile outside the surface's image). The beam of the
+ * tile's pixel centres (widened by TILE_SLACK) is tested against the octree down to the cells,
+ * up to that depth plus a cell's reach along the view. The rays it admits would then find only
+ * extracted cells, now or later (entries only decrease and cells stay extracted), and do
+ * nothing: their walks can be left out, and the mesh is the one the walks would leave. */
+static int tile_settled(worker *w, uint32_t tx, uint32_t ty, double *solid)
+{
+    ip_engine *e = w->engine;
+    uint32_t x0 = tx << TILE_SHIFT, y0 = ty << TILE_SHIFT;
+    uint32_t x1 = x0 + (1u << TILE_SHIFT), y1 = y0 + (1u << TILE_SHIFT);
+    x1 = x1 < e->camera.width ? x1 : e->camera.width;
+    y1 = y1 < e->camera.height ? y1 : e->camera.height;
+    double deepest = 0; /* over the pixels covered solidly; +infinity when there is none */
+    for (uint32_t y = y0; y < y1; y++)
+        for (uint32_t x = x0; x < x1; x++) {
+            double z = ip__coverage_solid(&e->coverage, x, y);
+            deepest = z < INFINITY && z > deepest ? z : deepest;
+        }
+    deepest = deepest > 0 ? deepest : INFINITY;
+    *solid = deepest;
+    double stop = deepest / (1.0 - DEPTH_MARGIN); /* as stop_depth() */
+    double corner[4][3];
+    double cx[4] = {x0 + 0.5 - TILE_SLACK, x1 - 0.5 + TILE_SLACK, x1 - 0.5 + TILE_SLACK,
+                    x0 + 0.5 - TILE_SLACK};
+    double cy[4] = {y0 + 0.5 - TILE_SLACK, y0 + 0.5 - TILE_SLACK, y1 - 0.5 + TILE_SLACK,
+                    y1 - 0.5 + TILE_SLACK};
+    for (int i = 0; i < 4; i++)
+        ip_camera_pixel_ray(&e->basis, &e->camera, cx[i], cy[i], corner[i]);
+    for (uint32_t k = 0; k < e->levels_used; k++) {
+        ip_beam beam;
+        ip__beam_init(&beam, e->camera.eye, e->basis.forward, corner, stop + e->cell_reach[k]);
+        if (!ip__beam_settled(&w->level[k].seeder, &e->visited, &beam))
+            return 0;
+    }
+    return 1;
+}
+
+static unsigned float_bits(float f)
+{
+    unsigned bits;
+    memcpy(&bits, &f, sizeof bits);
+    return bits;
+}
+
+static float float_of_bits(unsigned bits)
+{
+    float f;
+    memcpy(&f, &bits, sizeof f);
+    return f;
+}
+
+/* 1 when the ray of pixel (x, y), of the order's level `level`, may be retired without a walk
+ * (counted): its solid coverage entry is no deeper than one its tile was found settled at
+ * (tile_settled()), +infinity included. A tile is tested by the first ray of each of the
+ * Z-order levels (ray_order.h) that it does not retire; an entry found settled stays so.
+ * Without occlusion, never. */
+static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level)
+{
+    ip_engine *e = w->engine;
+    if (!e->options.occlusion || level < e->tile_from)
+        return 0;
+    float z = (float)ip__coverage_solid(&e->coverage, x, y); /* a float's value: exact */
+    tile *t = &e->tiles[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)];
+    unsigned settled = atomic_load_explicit(&t->depth, memory_order_relaxed);
+    if (!(z <= float_of_bits(settled))) {
+        unsigned char pass = (unsigned char)(level - e->tile_from + 1);
+        if (atomic_load_explicit(&t->tested, memory_order_relaxed) >= pass)
+            return 0; /* tested in this level already */
+        atomic_store_explicit(&t->tested, pass, memory_order_relaxed);
+        double solid;
+        if (!tile_settled(w, x >> TILE_SHIFT, y >> TILE_SHIFT, &solid))
+            return 0;
+        unsigned bits = float_bits((float)solid); /* exact; raised, never lowered: both hold */
+        while (bits > settled &&
+               !atomic_compare_exchange_weak_explicit(&t->depth, &settled, bits,
+                                                      memory_order_relaxed, memory_order_relaxed))
+            ;
+        if (!(z <= float_of_bits(bits)))
+            return 0;
+    }
+    w->counts.rays++;
+    w->counts.retired++;
+    return 1;
 }
 
 /* Gives the worker a range of the order to walk: the earliest one left unfinished by a step,
@@ -426,7 +602,7 @@ static void leave_range(ip_engine *e, worker *w)
 
 /* Takes up to RAY_BATCH pixels of the order for this step from the worker's ranges; returns
  * how many. */
-static unsigned take_rays(ip_engine *e, worker *w, uint32_t xy[][2])
+static unsigned take_rays(ip_engine *e, worker *w, order_ray *rays)
 {
     if (atomic_load_explicit(&e->step_stopped, memory_order_relaxed) ||
         (e->step_deadline > 0 && ip_now_seconds() >= e->step_deadline))
@@ -442,9 +618,10 @@ static unsigned take_rays(ip_engine *e, worker *w, uint32_t xy[][2])
     }
     unsigned n = 0;
     while (n < want && (w->holding || claim_range(e, w))) {
-        if (ip__ray_order_next_before(&w->order, w->range_end, &xy[n][0], &xy[n][1]))
+        if (ip__ray_order_next_before(&w->order, w->range_end, &rays[n].x, &rays[n].y)) {
+            rays[n].level = ip__ray_order_level(&w->order);
             n++;
-        else
+        } else
             w->holding = 0;
     }
     if (e->step_limited && n < want) /* the order ran out: give the rest of the share back */
@@ -470,9 +647,9 @@ static void work(void *user, unsigned index)
 {
     ip_engine *e = user;
     worker *w = &e->workers[index];
-    uint32_t xy[RAY_BATCH][2];
+    order_ray rays[RAY_BATCH];
     unsigned n;
-    while (w->status == IP_OK && (n = take_rays(e, w, xy)) > 0) {
+    while (w->status == IP_OK && (n = take_rays(e, w, rays)) > 0) {
         /* The clock is read once per batch: seeding is the batch's time less what
          * propagation and extraction measured of it. */
         double t0 = ip_now_seconds();
@@ -482,7 +659,8 @@ static void work(void *user, unsigned index)
                 w->status = IP_ERR_CANCELLED;
                 break;
             }
-            w->status = cast_ray(w, xy[i][0], xy[i][1]);
+            if (!retire(w, rays[i].x, rays[i].y, rays[i].level))
+                w->status = cast_ray(w, rays[i].x, rays[i].y);
         }
         double seeding = ip_now_seconds() - t0 -
                          (w->counts.propagation_seconds + w->counts.extraction_seconds - inner);

@@ -186,6 +186,7 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
     dda d;
     dda_init(&d, r, base, 1.0, n, t0, t1);
     for (;;) {
+        s->nodes++;
         uint32_t c[3] = {lo[0] + (uint32_t)d.i[0], lo[1] + (uint32_t)d.i[1],
                          lo[2] + (uint32_t)d.i[2]};
         size_t at = ((c[0] - brick->origin[0]) >> 1) + groups_x * ((c[1] - brick->origin[1]) >> 1) +
@@ -246,6 +247,7 @@ static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], dou
     dda d;
     dda_init(&d, r, base, se, n, t0, t1);
     for (;;) {
+        s->nodes++;
         int32_t at[3] = {d.i[0], d.i[1], d.i[2]};
         double enter_t = d.t, exit_t;
         int more = dda_next(&d, &exit_t);
@@ -303,6 +305,7 @@ static int node_kept(const ip_seeder *s, uint32_t depth, const uint32_t node[3])
 static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uint32_t node[3],
                      double t0, double t1)
 {
+    s->nodes++;
     if (depth == 0)
         return walk_brick(s, r, node, t0, t1);
     child_hit hits[8];

@@ -19,8 +19,9 @@ typedef struct ip_seeder {
     double scale[3];       /* world units per level cell along each axis (uniform part) */
     uint64_t cells_tested; /* active cells whose triangles were tested against a ray */
     uint64_t cells_read;   /* cells whose 8 corners were read (to find their case) */
-    int use_group_ranges;  /* 1 (the default): pass over the cells of inactive cell groups */
-    uint32_t (*found)[3];  /* the cells of the current ray (see ip__seed_find) */
+    uint64_t nodes; /* octree nodes (bricks included), sub-blocks and cells that rays entered */
+    int use_group_ranges; /* 1 (the default): pass over the cells of inactive cell groups */
+    uint32_t (*found)[3]; /* the cells of the current ray (see ip__seed_find) */
     unsigned found_count;
     int seed_index; /* position in found of the first cell the ray is inside, or -1 */
     double margin;  /* IP_SEED_MARGIN_PIXELS as an angle, radians */

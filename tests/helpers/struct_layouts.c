@@ -170,6 +170,8 @@ static void engine(void)
     FIELD(ip_engine_counts, extraction_seconds);
     FIELD(ip_engine_counts, rendering_seconds);
     FIELD(ip_engine_counts, deferred);
+    FIELD(ip_engine_counts, retired);
+    FIELD(ip_engine_counts, nodes);
     SIZE(ip_mesh);
     FIELD(ip_mesh, positions);
     FIELD(ip_mesh, normals);

@@ -25,7 +25,7 @@ for key in cache budget_bytes resident_bytes resident_peak_bytes hits misses evi
            bytes_decompressed decode_seconds bricks_touched bricks_total hit_rate \
            peak_rss_bytes rays seeds cells triangles intersection_s propagation_s \
            extraction_s rendering_s visible_triangles overdraw occlusion deferred_cells \
-           prefetch prefetched prefetch_hits bytes_read_disk wait_seconds; do
+           retired_rays ray_nodes prefetch prefetched prefetch_hits bytes_read_disk wait_seconds; do
     check "stats has \"$key\"" sh -c 'printf "%s" "$0" | grep -q "\"$1\":"' "$json" "$key"
 done
 check "every pixel had its ray" sh -c 'printf "%s" "$0" | grep -q "\"rays\": 19200, \"rays_total\": 19200, \"done\": true"' "$json"
@@ -50,7 +50,12 @@ check "visible triangles only grow" awk -F, 'NR > 2 && $7 + 0 < prev { exit 1 } 
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o o.png --lod off \
     --occlusion off --stats o.json --software --quiet
 check "occlusion off succeeds" test "$rc" = 0
-check "occlusion off says so" grep -q '"occlusion": false, "deferred_cells": 0' o.json
+check "occlusion off says so" grep -q '"occlusion": false, "deferred_cells": 0, "retired_rays": 0,' o.json
+retired=$(printf '%s' "$json" | sed 's/.*"retired_rays": \([0-9]*\).*/\1/')
+check "occlusion on retires rays in bulk (0 < $retired < 19200)" test "$retired" -gt 0 -a "$retired" -lt 19200
+walked=$(printf '%s' "$json" | sed 's/.*"ray_nodes": \([0-9]*\).*/\1/')
+walked_off=$(sed 's/.*"ray_nodes": \([0-9]*\).*/\1/' o.json)
+check "the rays walk fewer nodes with occlusion ($walked < $walked_off)" test "$walked" -lt "$walked_off"
 off=$(sed 's/.*"triangles": \([0-9]*\).*/\1/' o.json)
 check "occlusion on extracts no more ($triangles <= $off)" test "$triangles" -le "$off"
 check "occlusion on and off make the same picture" cmp -s p.png o.png

@@ -117,7 +117,7 @@ run_capture env ISORENDER_PROGRESS=1 "$bin/isorender" s.ibv --iso 100.5 --size 3
 check "no bar with --quiet" test -z "$err"
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 32x24 --software -qvf -o d.png
 check "--verbose prints each step's counts" \
-    sh -c 'printf "%s\n" "$0" | grep -qE "^isorender: step: 768 rays, [0-9]+ seeds, [0-9]+ cells, [0-9]+ triangles"' "$err"
+    sh -c 'printf "%s\n" "$0" | grep -qE "^isorender: step: 768 rays \([0-9]+ retired\), [0-9]+ seeds, [0-9]+ cells, [0-9]+ triangles"' "$err"
 
 # the time line: parts in CPU seconds summed over the threads, numbers kept
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 64x48 --software --threads 2 -o t.png

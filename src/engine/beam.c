@@ -1,0 +1,209 @@
+/* Beams against the min/max octree: root -> bricks -> sub-blocks -> cell groups -> cells. */
+#include <math.h>
+
+#include "beam.h"
+#include "format.h"
+#include "vec3.h"
+
+/* The beam in the level's index space (cell (i, j, k) is the box [i, i+1] x ...): a box meets
+ * it unless it lies wholly beyond max_depth or wholly outside one plane. */
+typedef struct index_beam {
+    ip_seeder *s;
+    const ip_visited *visited;
+    double normal[4][3]; /* the planes' normals with index coordinates: n[a] * scale[a] */
+    double offset[4];    /* - n . eye */
+    double forward[3];   /* forward[a] * scale[a] */
+    double limit;        /* max_depth + forward . eye */
+} index_beam;
+
+void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
+                   const double corner[4][3], double max_depth)
+{
+    double middle[3] = {0, 0, 0};
+    for (int i = 0; i < 4; i++)
+        for (int a = 0; a < 3; a++)
+            middle[a] += corner[i][a];
+    for (int i = 0; i < 4; i++) {
+        ip__vec3_cross(corner[i], corner[(i + 1) % 4], b->normal[i]);
+        if (ip__vec3_dot(b->normal[i], middle) < 0)
+            for (int a = 0; a < 3; a++)
+                b->normal[i][a] = -b->normal[i][a];
+    }
+    for (int a = 0; a < 3; a++) {
+        b->eye[a] = eye[a];
+        b->forward[a] = forward[a];
+    }
+    b->max_depth = max_depth;
+}
+
+/* 1 when the index box [lo, hi] may meet the beam. */
+static inline int meets(const index_beam *w, const double lo[3], const double hi[3])
+{
+    double z = 0;
+    for (int a = 0; a < 3; a++)
+        z += w->forward[a] * (w->forward[a] >= 0 ? lo[a] : hi[a]);
+    if (z > w->limit)
+        return 0;
+    for (int p = 0; p < 4; p++) {
+        const double *n = w->normal[p];
+        double v = w->offset[p];
+        for (int a = 0; a < 3; a++)
+            v += n[a] * (n[a] >= 0 ? hi[a] : lo[a]);
+        if (v < 0)
+            return 0;
+    }
+    return 1;
+}
+
+/* The cells [lo, hi) of one sub-block, by cell groups (cache.h): 1 when every active cell the
+ * beam may meet is visited. */
+static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[3], int side)
+{
+    ip_seeder *s = w->s;
+    const ip_brick *brick = ip__sampler_cell_brick(s->sampler, lo);
+    if (!brick)
+        return 0;
+    ptrdiff_t corners[8];
+    ip__corner_offsets(brick, corners);
+    size_t groups_x = brick->extent[0] / 2, groups_xy = groups_x * (brick->extent[1] / 2);
+    /* sub-blocks start on even cells: their groups are whole, bar a brick's odd last cell */
+    for (uint32_t gz = lo[2]; gz < hi[2]; gz += 2)
+        for (uint32_t gy = lo[1]; gy < hi[1]; gy += 2)
+            for (uint32_t gx = lo[0]; gx < hi[0]; gx += 2) {
+                uint32_t g1[3] = {gx + 2 < hi[0] ? gx + 2 : hi[0], gy + 2 < hi[1] ? gy + 2 : hi[1],
+                                  gz + 2 < hi[2] ? gz + 2 : hi[2]};
+                double blo[3] = {gx, gy, gz}, bhi[3] = {g1[0], g1[1], g1[2]};
+                if (!meets(w, blo, bhi))
+                    continue;
+                if (s->use_group_ranges) {
+                    static const ptrdiff_t pair[2] = {0, 1};
+                    float range[2];
+                    size_t at = ((gx - brick->origin[0]) >> 1) +
+                                groups_x * ((gy - brick->origin[1]) >> 1) +
+                                groups_xy * ((gz - brick->origin[2]) >> 1);
+                    ip__samples_gather(brick->group_ranges, s->layout->type, 2 * at, pair, 2,
+                                       range);
+                    if (!ip__range_active(range[0], range[1], s->iso))
+                        continue;
+                }
+                for (uint32_t z = gz; z < g1[2]; z++)
+                    for (uint32_t y = gy; y < g1[1]; y++)
+                        for (uint32_t x = gx; x < g1[0]; x++) {
+                            /* cheapest first: most cells here are extracted or inactive */
+                            uint32_t c[3] = {x, y, z}, c1[3] = {x + 1, y + 1, z + 1};
+                            if (ip__visited_test(w->visited, s->level, c))
+                                continue;
+                            float values[8];
+                            ip__cell_values(brick, s->layout->type, corners, c, values);
+                            unsigned mc = ip__mc_case(values, s->iso);
+                            if (mc == 0 || mc == 255)
+                                continue;
+                            double clo[3] = {x, y, z}, chi[3] = {x + 1.0, y + 1.0, z + 1.0};
+                            if (!meets(w, clo, chi))
+                                continue;
+                            if (side == IP__CLIP_KEEPS_ALL ||
+                                ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))
+                                return 0;
+                        }
+            }
+    return 1;
+}
+
+/* The sub-blocks of brick `b`. */
+static int settled_brick(index_beam *w, const uint32_t b[3])
+{
+    ip_seeder *s = w->s;
+    const ip_layout *l = s->layout;
+    uint32_t origin[3], extent[3];
+    ip_brick_extent(l, s->level, b, origin, extent);
+    const uint32_t *bricks = s->grid[0];
+    uint64_t g = s->first_brick + b[0] + (uint64_t)bricks[0] * (b[1] + (uint64_t)bricks[1] * b[2]);
+    const float *ranges = ip_store_subblock_ranges(s->store, g);
+    uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge, n[3];
+    for (int k = 0; k < 3; k++)
+        n[k] = (extent[k] - 1 + se - 1) / se; /* sub-blocks that hold cells */
+    for (uint32_t i = 0; i < n[2]; i++)
+        for (uint32_t j = 0; j < n[1]; j++)
+            for (uint32_t h = 0; h < n[0]; h++) {
+                uint32_t sb = h + per * (j + per * i), at[3] = {h, j, i};
+                if (!ip__range_active(ranges[2 * sb], ranges[2 * sb + 1], s->iso))
+                    continue;
+                uint32_t lo[3], hi[3];
+                double blo[3], bhi[3];
+                for (int k = 0; k < 3; k++) {
+                    uint32_t last = origin[k] + extent[k] - 1; /* one past the last cell */
+                    lo[k] = origin[k] + se * at[k];
+                    hi[k] = lo[k] + se < last ? lo[k] + se : last;
+                    blo[k] = lo[k];
+                    bhi[k] = hi[k];
+                }
+                if (!meets(w, blo, bhi))
+                    continue;
+                int side = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi);
+                if (side && !settled_cells(w, lo, hi, side))
+                    return 0;
+            }
+    return 1;
+}
+
+/* Node `node` of octree depth `depth` (0: a brick), which meets the beam. */
+static int settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
+{
+    if (depth == 0)
+        return settled_brick(w, node);
+    ip_seeder *s = w->s;
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    const uint32_t *grid = s->grid[depth - 1];
+    const float *ranges = s->ranges[depth - 1];
+    uint64_t span = (uint64_t)s->layout->brick_edge << (depth - 1);
+    for (int c = 0; c < 8; c++) {
+        uint32_t ch[3] = {2 * node[0] + (c & 1), 2 * node[1] + ((c >> 1) & 1),
+                          2 * node[2] + ((c >> 2) & 1)};
+        if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
+            continue;
+        uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
+        if (!ip__range_active(ranges[2 * i], ranges[2 * i + 1], s->iso))
+            continue;
+        double lo[3], hi[3];
+        uint32_t first[3], last[3];
+        for (int k = 0; k < 3; k++) {
+            uint64_t a = ch[k] * span, b = a + span, cells = lv->dims[k] - 1;
+            lo[k] = (double)a;
+            hi[k] = (double)(b < cells ? b : cells);
+            first[k] = (uint32_t)lo[k];
+            last[k] = (uint32_t)hi[k];
+        }
+        if (!meets(w, lo, hi) ||
+            (s->clip.count && !ip__clip_keeps_samples(&s->clip, s->layout, s->level, first, last)))
+            continue;
+        if (!settled_node(w, depth - 1, ch))
+            return 0;
+    }
+    return 1;
+}
+
+int ip__beam_settled(ip_seeder *s, const ip_visited *visited, const ip_beam *b)
+{
+    index_beam w;
+    w.s = s;
+    w.visited = visited;
+    w.limit = b->max_depth + ip__vec3_dot(b->forward, b->eye);
+    for (int a = 0; a < 3; a++)
+        w.forward[a] = b->forward[a] * s->scale[a];
+    for (int p = 0; p < 4; p++) {
+        w.offset[p] = -ip__vec3_dot(b->normal[p], b->eye);
+        for (int a = 0; a < 3; a++)
+            w.normal[p][a] = b->normal[p][a] * s->scale[a];
+    }
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    uint32_t depth = lv->octree_depth;
+    if (!ip__range_active(s->ranges[depth][0], s->ranges[depth][1], s->iso))
+        return 1;
+    double lo[3] = {0, 0, 0}, hi[3];
+    for (int k = 0; k < 3; k++)
+        hi[k] = (double)(lv->dims[k] - 1);
+    if (!meets(&w, lo, hi))
+        return 1;
+    static const uint32_t root[3] = {0, 0, 0};
+    return settled_node(&w, depth, root);
+}

@@ -1,0 +1,32 @@
+/* Beams: whether the rays through a screen tile could still extract anything, tested once for
+ * the whole tile against the min/max octree (bulk retirement of rays; see engine.c). Internal. */
+#ifndef ISOPROP_BEAM_H
+#define ISOPROP_BEAM_H
+
+#include "seed.h"
+#include "visited.h"
+
+/* The rays from `eye` through a convex screen region, as the 4 planes through the eye that
+ * bound them (world units, normals pointing inwards), and a depth beyond which they need not
+ * look: a point lies in the beam when it is on the inner side of every plane. */
+typedef struct ip_beam {
+    double eye[3];
+    double normal[4][3];
+    double forward[3]; /* the view direction (unit) */
+    double max_depth;  /* view depth (world units): cells wholly beyond it are passed over */
+} ip_beam;
+
+/* The beam of the rays from the eye through the four corner directions `corner` (unit, in
+ * order around the region, each ray of the region a positive combination of them). */
+void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
+                   const double corner[4][3], double max_depth);
+
+/* 1 when every active cell of the seeder's level (a marching-cubes case other than 0 and
+ * 255) that the clipping planes keep, that the beam may cross and whose nearest point lies
+ * no deeper than b->max_depth is marked in `visited`; 0 when some may not be (or a brick in
+ * the way could not be read: the sampler's status then says which). Reads the summaries,
+ * and the cells of the bricks where an active sub-block meets the beam. Conservative: boxes
+ * are tested against the beam's planes one at a time, so some that miss it count as met. */
+int ip__beam_settled(ip_seeder *s, const ip_visited *visited, const ip_beam *b);
+
+#endif
