@@ -122,8 +122,8 @@ IP_API ip_status ip_surfaces_check(const ip_surface *surfaces, size_t count, ip_
  *  shaded with the colour of the surface it shows. `shading` (NULL: ip_shading_default())
  *  gives the background and the lighting terms; its surface colour is not used. `rgba`:
  *  width * height * 4 bytes, caller-owned. Single-threaded; reentrant.
- *  @return IP_OK, IP_ERR_ARGUMENT (as ip_raster_mesh_shaded(), or ip_surfaces_check()
- *  fails) or IP_ERR_NOMEM (about 24 bytes a pixel per surface). */
+ *  @return IP_OK, IP_ERR_ARGUMENT (as ip_raster_mesh_shaded(), ip_surfaces_check() fails, or
+ *  `rgba` is NULL) or IP_ERR_NOMEM (about 24 bytes a pixel per surface). */
 IP_API ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count,
                                     const ip_camera *camera, const ip_shading *shading,
                                     const double lo[3], const double hi[3], uint8_t *rgba,
