@@ -88,9 +88,12 @@ static const char usage[] =
     "                      as long as it looks at the depth of the view's target (perspective:\n"
     "                      nearer is larger)\n"
     "  --scale-unit TEXT   the scale bar's unit (default mm where the file names an anatomical\n"
-    "                      space, else units: world units are the spacing's)\n"
+    "                      space, else units: world units are the spacing's; printable ASCII,\n"
+    "                      other bytes are drawn as ?)\n"
     "                      (--axes and --scale-bar mark the image and the turntable's frames,\n"
-    "                      not the strip)\n"
+    "                      not the strip; each is drawn whole or not at all: --axes needs an\n"
+    "                      image of 63x62 pixels or more (exit 2), a scale bar and label wider\n"
+    "                      or taller than the image end the run with nothing written (exit 1))\n"
     "  --software          render with the software rasterizer instead of OpenGL\n"
     "  --aa N              OpenGL anti-aliasing: N samples a pixel (1 to 16; default 1, off,\n"
     "                      the image the software rasterizer draws; 4 or 8 for figures)\n"
@@ -729,6 +732,9 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     if (o->scale_unit && !o->scale_bar)
         return tool_usage_error("isorender", "--scale-unit needs --scale-bar");
+    ip_error why;
+    if (o->axes && ip_overlay_axes_check(o->common.width, o->common.height, &why) != IP_OK)
+        return tool_usage_error("isorender", "--%s", why.message); /* "--axes: the triad..." */
     rc = check_smooth_options(o);
     if (rc)
         return rc;

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
@@ -32,9 +33,9 @@ typedef struct overlay_sizes {
     double arm;
 } overlay_sizes;
 
-static overlay_sizes sizes_of(const ip_camera *camera)
+static overlay_sizes sizes_of(uint32_t width, uint32_t height)
 {
-    int side = (int)(camera->width < camera->height ? camera->width : camera->height);
+    int side = (int)(width < height ? width : height);
     overlay_sizes s;
     int scale = (side + 120) / 240; /* the nearest whole multiple of 240 pixels */
     s.text_scale = scale < 1 ? 1 : scale > 4 ? 4 : scale;
@@ -88,21 +89,42 @@ static void draw_segment(const canvas *cv, double ax, double ay, double bx, doub
  * stb_easy_font_height(), adds the spacing between lines). */
 #define GLYPH_HEIGHT 7
 
-/* The width and height of one line of `text` in pixels at `scale`. */
+/* The most quads stb_easy_font gives one character (printable ASCII: 11, measured over ' '
+ * to '~'), and the bytes of a quad (4 vertices of 3 floats and 4 bytes of colour). */
+#define FONT_MAX_QUADS_PER_CHAR 11
+#define FONT_QUAD_BYTES 64
+
+/* Replaces each byte of `text` that stb_easy_font has no glyph for (outside ' ' to '~': it
+ * would index its tables out of bounds) with '?'. */
+static void make_printable(char *text)
+{
+    for (; *text; text++)
+        if (*text < ' ' || *text > '~')
+            *text = '?';
+}
+
+/* The width and height of one line of `text` (printable) in pixels at `scale`. */
 static void text_size(const char *text, int scale, int *w, int *h)
 {
     *w = stb_easy_font_width((char *)text) * scale;
     *h = GLYPH_HEIGHT * scale;
 }
 
-/* Draws `text` with its top-left corner at (left, top), `scale` times stb_easy_font's size,
- * over a shadow one text pixel down and right: stb_easy_font's quads are axis-aligned
- * rectangles, filled here scaled up. */
-static void draw_text(const canvas *cv, int left, int top, const char *text, int scale, colour c,
-                      colour shadow)
+/* Draws `text` (printable: make_printable()) with its top-left corner at (left, top), `scale`
+ * times stb_easy_font's size, over a shadow one text pixel down and right: stb_easy_font's
+ * quads are axis-aligned rectangles, filled here scaled up. Returns 0, or -1 when out of
+ * memory (nothing drawn). */
+static int draw_text(const canvas *cv, int left, int top, const char *text, int scale, colour c,
+                     colour shadow)
 {
-    char quads[32 * 270]; /* stb_easy_font's estimate: about 270 bytes a character */
-    int count = stb_easy_font_print(0, 0, (char *)text, NULL, quads, (int)sizeof quads);
+    size_t length = strlen(text);
+    if (length > (size_t)INT32_MAX / (FONT_MAX_QUADS_PER_CHAR * FONT_QUAD_BYTES) - 1)
+        return -1;
+    size_t size = (length + 1) * FONT_MAX_QUADS_PER_CHAR * FONT_QUAD_BYTES; /* every glyph */
+    char *quads = malloc(size);
+    if (!quads)
+        return -1;
+    int count = stb_easy_font_print(0, 0, (char *)text, NULL, quads, (int)size);
     for (int pass = 0; pass < 2; pass++) {
         int offset = pass == 0 ? scale : 0;
         for (int q = 0; q < count; q++) {
@@ -120,6 +142,8 @@ static void draw_text(const canvas *cv, int left, int top, const char *text, int
                       pass == 0 ? shadow : c);
         }
     }
+    free(quads);
+    return 0;
 }
 
 /* The mean luma (0 to 255) of the image's pixels in [x0, x1) x [y0, y1), clipped; 0 when
@@ -146,6 +170,43 @@ static void report_box(const ip_camera *camera, int x0, int y0, int x1, int y1, 
     int b[4] = {x0 < 0 ? 0 : x0, y0 < 0 ? 0 : y0, x1 > w ? w : x1, y1 > h ? h : y1};
     for (int k = 0; k < 4; k++)
         box[k] = (uint32_t)(b[k] < 0 ? 0 : b[k]);
+}
+
+/* Where the triad goes in a width x height image: its centre (cx, cy), the labels' distance
+ * from it (reach) and their gap beyond the arms' tips, and the box {x0, y0, x1, y1} that holds
+ * arms and labels, which may reach out of a small image. */
+typedef struct axes_geometry {
+    overlay_sizes s;
+    double gap, reach, cx, cy;
+    int radius, box[4];
+} axes_geometry;
+
+static void axes_geometry_of(uint32_t width, uint32_t height, axes_geometry *g)
+{
+    g->s = sizes_of(width, height);
+    /* each label is centred beyond its arm's tip, `gap` out: the box holds arm and label */
+    g->gap = GLYPH_HEIGHT * g->s.text_scale * 0.5 + 2 + g->s.text_scale;
+    g->reach = g->s.arm + g->gap;
+    g->radius = (int)ceil(g->reach + g->gap);
+    g->cx = g->s.margin + g->radius;
+    g->cy = (double)height - g->s.margin - g->radius;
+    g->box[0] = (int)floor(g->cx - g->radius);
+    g->box[1] = (int)floor(g->cy - g->radius);
+    g->box[2] = (int)ceil(g->cx + g->radius) + 1;
+    g->box[3] = (int)ceil(g->cy + g->radius) + 1;
+}
+
+ip_status ip_overlay_axes_check(uint32_t width, uint32_t height, ip_error *err)
+{
+    axes_geometry g;
+    if (width < 1 || height < 1 || width > INT32_MAX / 2 || height > INT32_MAX / 2)
+        return ip__fail(err, IP_ERR_ARGUMENT, "axes: an image of %ux%u pixels", width, height);
+    axes_geometry_of(width, height, &g);
+    if (g.box[0] < 0 || g.box[1] < 0 || g.box[2] > (int)width || g.box[3] > (int)height)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "axes: the triad needs an image of at least %dx%d pixels, not %ux%u",
+                        g.box[2], g.s.margin + 2 * g.radius, width, height);
+    return IP_OK;
 }
 
 static ip_status check_image(const uint8_t *rgba, const ip_camera *camera, ip_error *err)
@@ -215,19 +276,17 @@ ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
                                const ip_orientation *orientation, uint32_t box[4], ip_error *err)
 {
     ip_status st = check_image(rgba, camera, err);
+    if (st == IP_OK)
+        st = ip_overlay_axes_check(camera->width, camera->height, err);
     if (st != IP_OK)
         return st;
     if (!orientation)
         return ip__fail(err, IP_ERR_ARGUMENT, "axes: no orientation");
     canvas cv = {rgba, (int)camera->width, (int)camera->height};
-    overlay_sizes s = sizes_of(camera);
+    axes_geometry g;
+    axes_geometry_of(camera->width, camera->height, &g);
     double screen[3][3];
     ip_overlay_axis_directions(camera, orientation, screen);
-    /* each label is centred beyond its arm's tip, `gap` out: the box holds arm and label */
-    double gap = GLYPH_HEIGHT * s.text_scale * 0.5 + 2 + s.text_scale;
-    double reach = s.arm + gap;
-    int radius = (int)ceil(reach + gap);
-    double cx = s.margin + radius, cy = (double)camera->height - s.margin - radius;
     /* farthest arm first, so that a nearer one passes over it */
     int order[3] = {0, 1, 2};
     for (int i = 0; i < 3; i++)
@@ -237,24 +296,25 @@ ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
                 order[i] = order[j];
                 order[j] = t;
             }
-    double stroke = 1.0 + 0.5 * s.text_scale;
+    int scale = g.s.text_scale;
+    double stroke = 1.0 + 0.5 * scale, arm = g.s.arm;
     for (int i = 0; i < 3; i++) {
         int a = order[i];
-        double tx = cx + s.arm * screen[a][0], ty = cy + s.arm * screen[a][1];
-        draw_segment(&cv, cx, cy, tx, ty, stroke + 1.5, dark);
-        draw_segment(&cv, cx, cy, tx, ty, stroke, axis_colours[a]);
+        double tx = g.cx + arm * screen[a][0], ty = g.cy + arm * screen[a][1];
+        draw_segment(&cv, g.cx, g.cy, tx, ty, stroke + 1.5, dark);
+        draw_segment(&cv, g.cx, g.cy, tx, ty, stroke, axis_colours[a]);
         /* the label beyond the tip, along the arm's direction in the image */
         double len = hypot(screen[a][0], screen[a][1]);
         double ux = len > 1e-6 ? screen[a][0] / len : 0, uy = len > 1e-6 ? screen[a][1] / len : 0;
         const char *label = ip_overlay_axis_label(orientation->space, a);
         int w, h;
-        text_size(label, s.text_scale, &w, &h);
-        double lx = tx + (reach - s.arm) * ux, ly = ty + (reach - s.arm) * uy;
-        draw_text(&cv, (int)lround(lx - w / 2.0), (int)lround(ly - h / 2.0), label, s.text_scale,
-                  axis_colours[a], dark);
+        text_size(label, scale, &w, &h);
+        double lx = tx + (g.reach - arm) * ux, ly = ty + (g.reach - arm) * uy;
+        if (draw_text(&cv, (int)lround(lx - w / 2.0), (int)lround(ly - h / 2.0), label, scale,
+                      axis_colours[a], dark) != 0)
+            return ip__fail(err, IP_ERR_NOMEM, "axes: out of memory");
     }
-    report_box(camera, (int)floor(cx - radius), (int)floor(cy - radius), (int)ceil(cx + radius) + 1,
-               (int)ceil(cy + radius) + 1, box);
+    report_box(camera, g.box[0], g.box[1], g.box[2], g.box[3], box);
     return IP_OK;
 }
 
@@ -269,25 +329,37 @@ ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera, cons
                   isfinite(bar->pixels) && bar->pixels < 1e9))
         return ip__fail(err, IP_ERR_ARGUMENT, "scale bar: not a length");
     canvas cv = {rgba, (int)camera->width, (int)camera->height};
-    overlay_sizes s = sizes_of(camera);
+    overlay_sizes s = sizes_of(camera->width, camera->height);
     long n = lround(bar->pixels);
     if (n < 1)
         n = 1;
     int thick = (int)lround(1.5 * s.text_scale) < 2 ? 2 : (int)lround(1.5 * s.text_scale);
     int x1 = cv.width - s.margin, x0 = (int)(x1 - n), y1 = cv.height - s.margin, y0 = y1 - thick;
     int tick = thick * 2, tick_w = thick < (int)n ? thick : (int)n;
-    char label[96];
+    size_t size = (unit ? strlen(unit) : 0) + 32; /* "%g " and the unit */
+    char *label = malloc(size);
+    if (!label)
+        return ip__fail(err, IP_ERR_NOMEM, "scale bar: out of memory");
     if (unit && unit[0])
-        snprintf(label, sizeof label, "%g %.60s", bar->length, unit);
+        snprintf(label, size, "%g %s", bar->length, unit);
     else
-        snprintf(label, sizeof label, "%g", bar->length);
+        snprintf(label, size, "%g", bar->length);
+    make_printable(label);
     int w, h;
     text_size(label, s.text_scale, &w, &h);
     int lx = (x0 + x1) / 2 - w / 2, ly = y1 - tick - s.margin - h;
     if (lx + w + s.text_scale > x1)
         lx = x1 - w - s.text_scale; /* a label wider than the bar ends at its right end */
-    /* light on a dark corner, dark on a light one (a white figure background) */
     int left = x0 < lx ? x0 : lx;
+    if (left < 0 || ly < 0) { /* the bar or its label would be cut: draw nothing */
+        st = ip__fail(err, IP_ERR_ARGUMENT,
+                      "scale bar: \"%.60s\" and its bar need %ldx%d pixels in the corner, more "
+                      "than the %ux%u image has",
+                      label, (long)cv.width - left, cv.height - ly, camera->width, camera->height);
+        free(label);
+        return st;
+    }
+    /* light on a dark corner, dark on a light one (a white figure background) */
     int bright = mean_luma(&cv, left, ly, x1 + s.text_scale, y1 + 1) > 140;
     colour ink = bright ? dark : light, shadow = bright ? light : dark;
     /* the bar and its end ticks (inside its length), over a shadow one pixel below them */
@@ -295,7 +367,10 @@ ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera, cons
     fill_rect(&cv, x0, y0, x1, y1, ink);
     fill_rect(&cv, x0, y1 - tick, x0 + tick_w, y0, ink);
     fill_rect(&cv, x1 - tick_w, y1 - tick, x1, y0, ink);
-    draw_text(&cv, lx, ly, label, s.text_scale, ink, shadow);
+    int drawn = draw_text(&cv, lx, ly, label, s.text_scale, ink, shadow);
+    free(label);
+    if (drawn != 0)
+        return ip__fail(err, IP_ERR_NOMEM, "scale bar: out of memory");
     report_box(camera, left, ly, x1 + s.text_scale, y1 + 1, box);
     report_box(camera, x0, y1 - tick, x1, y1, bar_box);
     return IP_OK;
