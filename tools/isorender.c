@@ -1502,14 +1502,31 @@ static int turntable_run(run *r, ip_error *err)
     return r->o.mp4 ? turntable_encode(r) : 0;
 }
 
+/* The shortest "%g" text (6 to 9 significant digits) of the isovalue the engine extracts,
+ * (float)iso, that reads back as that float: isovalues no two alike as floats (as
+ * check_surface_options() wants them) get texts no two alike (100.0001 and 100.0002, not 100
+ * twice), and 600.5 stays 600.5. */
+static void iso_text(double iso, char *out, size_t size)
+{
+    float value = (float)iso;
+    for (int digits = 6; digits <= 9; digits++) {
+        snprintf(out, size, "%.*g", digits, (double)value);
+        if ((float)strtod(out, NULL) == value)
+            return;
+    }
+}
+
 /* The mesh file of the surface of isovalue `iso`: `path` with "_isoV" before its extension
- * (head.ply: head_iso600.5.ply). Returns 0, or 2 after a usage error. */
+ * (head.ply: head_iso600.5.ply; V as iso_text() gives it). Returns 0, or 2 after a usage
+ * error. */
 static int surface_mesh_name(const char *path, double iso, char *out, size_t size)
 {
     const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
     if (!dot || (slash && dot < slash))
         dot = path + strlen(path);
-    int length = snprintf(out, size, "%.*s_iso%g%s", (int)(dot - path), path, iso, dot);
+    char value[32];
+    iso_text(iso, value, sizeof value);
+    int length = snprintf(out, size, "%.*s_iso%s%s", (int)(dot - path), path, value, dot);
     if (length < 0 || (size_t)length >= size)
         return tool_usage_error("isorender", "--mesh %s: the name is too long", path);
     return 0;

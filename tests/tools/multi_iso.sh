@@ -118,6 +118,10 @@ expect_error 1 "m_iso60.ply" render --iso 60 --iso 180 -o m2.png --mesh m.ply
 : >taken_iso180.ply
 expect_error 1 "taken_iso180.ply" render --iso 60 --iso 180 -o t.png --mesh taken.ply
 check "and then nothing is written" test ! -e t.png -a ! -e taken_iso60.ply
+# isovalues that "%g" would both write as 100 keep the digits that tell them apart
+render --iso 100.0001 --iso 100.0002 --iso 0.1 -o n.png --mesh n.ply 2>/dev/null
+check "--mesh names 100.0001, 100.0002 and 0.1 apart" \
+    test -s n_iso100.0001.ply -a -s n_iso100.0002.ply -a -s n_iso0.1.ply
 
 # --full: the whole surfaces, the same picture
 render --iso 60 --iso 180 --color "$outer" --color "$inner" --opacity 0.4 --full -o full.png
