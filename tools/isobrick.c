@@ -155,12 +155,11 @@ static int parse_threads(const char *p, const tool_option *opt, const char *cons
 
 static int parse_mem_mb(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
-    (void)opt;
     uint64_t n;
-    if (tool_parse_u64(v[0], &n) != 0 || n < 1 || n > (1ull << 40))
-        return tool_usage_error(p, "bad --mem-mb '%s'", v[0]);
-    ((options *)base)->brick.memory_limit = n << 20;
-    return 0;
+    int rc = tool_parse_bounded(p, opt->name, v[0], 1, 1ull << 40, "a size in MiB", &n);
+    if (rc == 0)
+        ((options *)base)->brick.memory_limit = n << 20;
+    return rc;
 }
 
 static const tool_option isobrick_options[] = {
