@@ -82,7 +82,13 @@ int parse_args(int argc, char **argv, options *o)
     o->screenshot_at = -1;
     o->exit_after = -1;
     o->aa = 1;
-    return tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
-                                        sizeof isoview_options / sizeof isoview_options[0], o,
-                                        &o->file, argc, argv);
+    int rc = tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
+                                          sizeof isoview_options / sizeof isoview_options[0], o,
+                                          &o->file, argc, argv);
+    if (rc == 0 && o->common.iso_count > 1) /* isorender draws each; here one would be lost */
+        return tool_usage_error("isoview",
+                                "--iso given %u times: isoview shows one surface (isorender "
+                                "draws several)",
+                                o->common.iso_count);
+    return rc;
 }
