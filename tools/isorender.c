@@ -284,6 +284,20 @@ static int check_surface_options(const options *o)
     return 0;
 }
 
+/* The shortest "%g" text (6 to 9 significant digits) of the isovalue the engine extracts,
+ * (float)iso, that reads back as that float: isovalues no two alike as floats (as
+ * check_surface_options() wants them) get texts no two alike (100.0001 and 100.0002, not 100
+ * twice), and 600.5 stays 600.5. */
+static void iso_text(double iso, char *out, size_t size)
+{
+    float value = (float)iso;
+    for (int digits = 6; digits <= 9; digits++) {
+        snprintf(out, size, "%.*g", digits, (double)value);
+        if ((float)strtod(out, NULL) == value)
+            return;
+    }
+}
+
 /* Whether the image needs the several-surface drawing: several --iso, or a translucent one. */
 static int several_surfaces(const run *r)
 {
@@ -1177,7 +1191,8 @@ static void json_counts(FILE *f, void *user)
         json_surfaces(f, r);
 }
 
-/* The summary's lines of surface run s (r: the first surface's, which knows the renderer). */
+/* The summary's lines of surface run s (r: the first surface's, which knows the renderer and
+ * the image's rendering time: with several surfaces, given once after them). */
 static void print_counts(FILE *out, const run *s, const run *r)
 {
     const ip_engine_counts *t = &s->totals;
@@ -1192,9 +1207,12 @@ static void print_counts(FILE *out, const run *s, const run *r)
                 overdraw(s->mesh->triangle_count, s->visible_triangles));
     fprintf(out,
             "  time          %.3f s extraction (wall); CPU s summed over %u threads: "
-            "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
+            "intersection %.3f, propagation %.3f, marching cubes %.3f",
             s->extraction_wall, ip_thread_count(s->o.common.threads), t->intersection_seconds,
-            t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
+            t->propagation_seconds, t->extraction_seconds);
+    if (!r->other_count)
+        fprintf(out, "; rendering %.3f s (%s)", t->rendering_seconds, r->renderer_name);
+    fprintf(out, "\n");
 }
 
 static void print_summary(FILE *out, const run *r)
@@ -1207,9 +1225,13 @@ static void print_summary(FILE *out, const run *r)
         fprintf(out, "%s: %zu surfaces, %s, %ux%u\n", r->o.file, r->other_count + 1,
                 r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
         for (size_t i = 0; i <= r->other_count; i++) {
-            fprintf(out, "  surface %zu     iso %g\n", i + 1, surface_run_c(r, i)->o.common.iso);
+            char iso[32];
+            iso_text(surface_run_c(r, i)->o.common.iso, iso, sizeof iso);
+            fprintf(out, "  surface %zu     iso %s\n", i + 1, iso);
             print_counts(out, surface_run_c(r, i), r);
         }
+        fprintf(out, "  rendering     %.3f s (%s), the surfaces together\n",
+                r->totals.rendering_seconds, r->renderer_name);
     }
     fprintf(out, "  image         %s\n", r->o.out);
     for (size_t i = 0; i <= r->other_count; i++) {
@@ -1500,20 +1522,6 @@ static int turntable_run(run *r, ip_error *err)
     if (!r->o.common.quiet)
         printf("%s: %llu frames in %s\n", r->o.file, (unsigned long long)r->o.turntable, r->o.out);
     return r->o.mp4 ? turntable_encode(r) : 0;
-}
-
-/* The shortest "%g" text (6 to 9 significant digits) of the isovalue the engine extracts,
- * (float)iso, that reads back as that float: isovalues no two alike as floats (as
- * check_surface_options() wants them) get texts no two alike (100.0001 and 100.0002, not 100
- * twice), and 600.5 stays 600.5. */
-static void iso_text(double iso, char *out, size_t size)
-{
-    float value = (float)iso;
-    for (int digits = 6; digits <= 9; digits++) {
-        snprintf(out, size, "%.*g", digits, (double)value);
-        if ((float)strtod(out, NULL) == value)
-            return;
-    }
 }
 
 /* The mesh file of the surface of isovalue `iso`: `path` with "_isoV" before its extension

@@ -118,6 +118,13 @@ expect_error 1 "m_iso60.ply" render --iso 60 --iso 180 -o m2.png --mesh m.ply
 : >taken_iso180.ply
 expect_error 1 "taken_iso180.ply" render --iso 60 --iso 180 -o t.png --mesh taken.ply
 check "and then nothing is written" test ! -e t.png -a ! -e taken_iso60.ply
+# the summary: each surface's counts and extraction times, then the image's one rendering time
+run_capture "$bin/isorender" s.ibv --size 120x90 --software --iso 60 --iso 180 -o sum.png
+check "the summary gives each surface" \
+    test "$(printf '%s\n' "$out" | grep -c '^  surface [12]     iso \(60\|180\)$')" = 2
+check "... and the rendering once, not per surface" \
+    test "$(printf '%s\n' "$out" | grep -c '^  rendering     [0-9.]* s (software), the surfaces together$')" = 1 \
+    -a "$(printf '%s\n' "$out" | grep -c '; rendering')" = 0
 # isovalues that "%g" would both write as 100 keep the digits that tell them apart
 render --iso 100.0001 --iso 100.0002 --iso 0.1 -o n.png --mesh n.ply 2>/dev/null
 check "--mesh names 100.0001, 100.0002 and 0.1 apart" \
