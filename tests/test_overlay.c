@@ -59,6 +59,7 @@ static void test_scale_bar_choice(void)
     CHECK(fabs(bar.pixel_size - pixel / 2) < 1e-12);
     CHECK(ip_scale_bar_choose(&c, 0, &bar, &err) == IP_ERR_ARGUMENT);
     CHECK(ip_scale_bar_choose(&c, NAN, &bar, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_scale_bar_choose(&c, 100, NULL, &err) == IP_ERR_ARGUMENT);
     c.fov_y = 0;
     CHECK(ip_scale_bar_choose(&c, 100, &bar, &err) == IP_ERR_ARGUMENT);
 }

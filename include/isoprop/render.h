@@ -305,8 +305,9 @@ typedef struct ip_scale_bar {
  *  whose bar spans at most `max_pixels` (> 0) pixels at the depth of the camera's target,
  *  where a pixel spans ip_camera_pixel_size(camera, height) world units. The view is a
  *  perspective one: the bar holds for lengths at that depth, across the view (nearer
- *  lengths look longer, farther ones shorter).
- *  @return IP_OK, or IP_ERR_ARGUMENT (a bad camera, max_pixels not finite and > 0). */
+ *  lengths look longer, farther ones shorter). `bar` (caller-owned) receives it. Thread-safe.
+ *  @return IP_OK, or IP_ERR_ARGUMENT (a bad camera, max_pixels not finite and > 0, a NULL
+ *  bar). */
 IP_API ip_status ip_scale_bar_choose(const ip_camera *camera, double max_pixels, ip_scale_bar *bar,
                                      ip_error *err);
 

@@ -222,6 +222,8 @@ ip_status ip_scale_bar_choose(const ip_camera *camera, double max_pixels, ip_sca
     ip_status st = ip_camera_check(camera, err);
     if (st != IP_OK)
         return st;
+    if (!bar)
+        return ip__fail(err, IP_ERR_ARGUMENT, "scale bar: nowhere to put it");
     if (!(max_pixels > 0 && isfinite(max_pixels)))
         return ip__fail(err, IP_ERR_ARGUMENT, "scale bar: %g pixels is not a length", max_pixels);
     double pixel_size = ip_camera_pixel_size(camera, camera->height);
