@@ -1584,6 +1584,7 @@ int main(int argc, char **argv)
     run r;
     memset(&r, 0, sizeof r);
     int rc = parse_args(argc, argv, &r.o);
+    const char *mesh_option = r.o.mesh; /* as given: setup_surfaces() may name it per surface */
     if (!rc)
         rc = setup_surfaces(&r);
     if (rc) {
@@ -1604,7 +1605,7 @@ int main(int argc, char **argv)
     if (r.o.mesh && !ip_mesh_format_of(r.o.mesh)) { /* before any work, after the paths' checks */
         free_surfaces(&r);
         return tool_usage_error(
-            "isorender", "--mesh %s: the name must end in .ply, .stl, .obj or .glb", r.o.mesh);
+            "isorender", "--mesh %s: the name must end in .ply, .stl, .obj or .glb", mesh_option);
     }
     tool_signals_catch();
     ip_error err;

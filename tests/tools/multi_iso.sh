@@ -125,6 +125,7 @@ check "the summary gives each surface" \
 check "... and the rendering once, not per surface" \
     test "$(printf '%s\n' "$out" | grep -c '^  rendering     [0-9.]* s (software), the surfaces together$')" = 1 \
     -a "$(printf '%s\n' "$out" | grep -c '; rendering')" = 0
+expect_error 2 "--mesh m.xyz: the name must end in" render --iso 60 --iso 180 -o x.png --mesh m.xyz
 # isovalues that "%g" would both write as 100 keep the digits that tell them apart
 render --iso 100.0001 --iso 100.0002 --iso 0.1 -o n.png --mesh n.ply 2>/dev/null
 check "--mesh names 100.0001, 100.0002 and 0.1 apart" \
