@@ -1068,8 +1068,16 @@ static ip_status draw_overlays(run *r, uint8_t *rgba, ip_error *err)
     if (r->o.scale_bar) {
         if (ip_scale_bar_choose(&r->camera, r->camera.width / 4.0, &r->bar, err) != IP_OK ||
             ip_overlay_draw_scale_bar(rgba, &r->camera, &r->bar, scale_unit(r), box, bar_box,
-                                      err) != IP_OK)
+                                      err) != IP_OK) {
+            static const char prefix[] = "scale bar: "; /* the library's; the option's instead */
+            char text[sizeof err->message];
+            if (!strncmp(err->message, prefix, strlen(prefix))) {
+                snprintf(text, sizeof text, "%s: --scale-bar: %s", r->o.file,
+                         err->message + strlen(prefix));
+                memcpy(err->message, text, sizeof text);
+            }
             return err->code;
+        }
         if (r->o.common.verbose)
             fprintf(stderr,
                     "isorender: scale bar: %g %s = %.3f pixels (%.6g %s a pixel at the "

@@ -22,7 +22,8 @@ expect_error 2 "not 62x62" render --size 62x62 --axes --software -o x.png
 check "a refused --axes writes nothing" test ! -e x.png
 render --size 63x62 --axes --software -o small.png
 check "63x62 takes the triad" test -s small.png
-expect_error 1 "the 40x40 image has" render --size 40x40 --scale-bar --software -o x.png
+expect_error 1 "c.ibv: --scale-bar: \"10 units\" and its bar need 48x19 pixels in the corner, more than the 40x40 image has" \
+    render --size 40x40 --scale-bar --software -o x.png
 check "a scale bar that does not fit writes nothing" test ! -e x.png
 
 # box WORD TEXT: the "x0,y0 to x1,y1" after WORD in TEXT, as "x0 y0 x1 y1"
