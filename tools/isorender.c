@@ -247,7 +247,8 @@ static int parse_opacity(const char *program, const tool_option *option, const c
     options *o = base;
     double a;
     (void)option;
-    if (tool_parse_double(values[0], &a) != 0 || !(a > 0 && a <= 1))
+    /* checked as the float the renderers take: 1e-50 would be 0 there */
+    if (tool_parse_double(values[0], &a) != 0 || !((float)a > 0 && (float)a <= 1))
         return tool_usage_error(program, "--opacity '%s' is not a number in (0, 1]", values[0]);
     if (o->opacity_count == TOOL_MAX_ISOS)
         return tool_usage_error(program, "--opacity '%s': more than %d opacities", values[0],

@@ -27,6 +27,7 @@ differ() { # differ DESCRIPTION A B: more than 5 % of the pixels differ by more 
 expect_error 2 "--opacity '0'" render --iso 60 --opacity 0
 expect_error 2 "--opacity '1.5'" render --iso 60 --opacity 1.5
 expect_error 2 "--opacity 'abc'" render --iso 60 --opacity abc
+expect_error 2 "--opacity '1e-50' is not a number in (0, 1]" render --iso 60 --opacity 1e-50
 expect_error 2 "--iso given 5 times" render --iso 10 --iso 20 --iso 30 --iso 40 --iso 50
 expect_error 2 "--iso 60 is given twice" render --iso 60 --iso 180 --iso 60.0
 expect_error 2 "3 --color and 0 --opacity for 2 --iso" render --iso 60 --iso 180 \
