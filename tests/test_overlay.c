@@ -270,6 +270,53 @@ static void test_labels(void)
     free(b);
 }
 
+/* The shared text: its width adds up character by character, it draws inside its box, with
+ * a shadow one text pixel down and right, and clips at the image's edges. */
+static void test_text(void)
+{
+    CHECK(ip_overlay_text_width("AB", 1) ==
+          ip_overlay_text_width("A", 1) + ip_overlay_text_width("B", 1));
+    CHECK(ip_overlay_text_width("10 mm", 3) == 3 * ip_overlay_text_width("10 mm", 1));
+    CHECK(ip_overlay_text_width("\xc3\xa9\n", 1) == ip_overlay_text_width("???", 1));
+    CHECK(ip_overlay_text_width(NULL, 1) == 0 && ip_overlay_text_width("A", 0) == 0 &&
+          ip_overlay_text_width("A", 17) == 0);
+    enum {
+        W = 64,
+        H = 32
+    };
+    static uint8_t image[W * H * 4];
+    const uint8_t ink[3] = {250, 250, 250}, shade[3] = {20, 30, 40};
+    ip_error err;
+    memset(image, 0, sizeof image);
+    CHECK(ip_overlay_draw_text(image, W, H, 3, 4, "A7", 2, ink, NULL, &err) == IP_OK);
+    uint32_t w = ip_overlay_text_width("A7", 2), inked = 0, outside = 0;
+    for (uint32_t y = 0; y < H; y++)
+        for (uint32_t x = 0; x < W; x++) {
+            const uint8_t *p = image + ((size_t)y * W + x) * 4;
+            if (!p[0])
+                continue;
+            inked++;
+            outside += x < 3 || x >= 3 + w || y < 4 || y >= 4 + 2 * 7 + 2;
+            CHECK(p[0] == 250 && p[3] == 255);
+        }
+    CHECK_MSG(inked > 20 && outside == 0, "%u inked, %u outside", inked, outside);
+    /* the shadow: the same glyphs one text pixel (2) down and right, under the ink */
+    memset(image, 0, sizeof image);
+    CHECK(ip_overlay_draw_text(image, W, H, 3, 4, "A7", 2, ink, shade, &err) == IP_OK);
+    uint32_t shadowed = 0;
+    for (size_t p = 0; p < (size_t)W * H; p++)
+        shadowed += image[4 * p] == 20 && image[4 * p + 2] == 40;
+    CHECK_MSG(shadowed > 0, "%u shadow pixels", shadowed);
+    /* partly outside: clipped, not written out of bounds (the sanitizer build checks) */
+    CHECK(ip_overlay_draw_text(image, W, H, -5, H - 6, "WIDE TEXT", 3, ink, shade, &err) == IP_OK);
+    CHECK(ip_overlay_draw_text(NULL, W, H, 0, 0, "A", 1, ink, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_overlay_draw_text(image, W, H, 0, 0, NULL, 1, ink, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_overlay_draw_text(image, W, H, 0, 0, "A", 17, ink, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_overlay_draw_text(image, W, H, 1 << 25, 0, "A", 1, ink, NULL, &err) ==
+          IP_ERR_ARGUMENT);
+    CHECK(ip_overlay_draw_text(image, 0, H, 0, 0, "A", 1, ink, NULL, &err) == IP_ERR_ARGUMENT);
+}
+
 int main(void)
 {
     test_scale_bar_choice();
@@ -279,5 +326,6 @@ int main(void)
     test_drawing(64, 64); /* small: each overlay still whole */
     test_small_images();
     test_labels();
+    test_text();
     return test_summary("test_overlay");
 }

@@ -20,8 +20,6 @@
 #include "isoprop/store.h"
 #include "tool_common.h"
 
-#include <stb_easy_font.h>
-
 static const char usage[] =
     "usage: isorender FILE.ibv --iso V [--iso V2 ...] [options]\n"
     "Extracts the isosurface V progressively (rays in the paper's order) and renders it to PNG\n"
@@ -111,8 +109,8 @@ static const char usage[] =
     "no output is written, and isorender ends as killed by the signal.\n";
 
 /* The progress strip (--strip): frames side by side, STRIP_GAP pixels apart, over a band of
- * STRIP_BAND pixels with each frame's label; the text is stb_easy_font's, STRIP_TEXT_SCALE
- * times larger. */
+ * STRIP_BAND pixels with each frame's label, the render stage's text (ip_overlay_draw_text())
+ * at STRIP_TEXT_SCALE. */
 #define STRIP_MAX_FRAMES 8
 #define STRIP_GAP 4
 #define STRIP_BAND 24
@@ -537,40 +535,24 @@ static void strip_label(const run *r, size_t f, char *text, size_t size)
 {
     snprintf(text, size, "%llu rays, %llu triangles", (unsigned long long)r->strip.rays[f],
              (unsigned long long)strip_triangles(r, f));
-    if ((uint32_t)stb_easy_font_width(text) * STRIP_TEXT_SCALE + 8 > r->camera.width)
+    if (ip_overlay_text_width(text, STRIP_TEXT_SCALE) + 8 > r->camera.width)
         snprintf(text, size, "%llu rays", (unsigned long long)r->strip.rays[f]);
-    if ((uint32_t)stb_easy_font_width(text) * STRIP_TEXT_SCALE + 8 > r->camera.width)
+    if (ip_overlay_text_width(text, STRIP_TEXT_SCALE) + 8 > r->camera.width)
         text[0] = 0;
 }
 
-/* Draws `text` into the strip's band, centred under the frame that starts at column x0:
- * stb_easy_font's quads are axis-aligned rectangles, filled here scaled up. */
-static void strip_draw_label(uint8_t *rgba, uint32_t strip_width, uint32_t strip_height,
-                             uint32_t x0, uint32_t frame_width, char *text)
+/* Draws `text` into the strip's band, centred under the frame that starts at column x0 (the
+ * render stage's text, as the figure overlays draw theirs). */
+static ip_status strip_draw_label(uint8_t *rgba, uint32_t strip_width, uint32_t strip_height,
+                                  uint32_t x0, uint32_t frame_width, const char *text,
+                                  ip_error *err)
 {
-    static const uint8_t ink[4] = {226, 222, 206, 255};
-    char quads[64 * 270]; /* stb_easy_font's estimate: about 270 bytes a character */
-    int count = stb_easy_font_print(0, 0, text, NULL, quads, (int)sizeof quads);
-    int left = (int)x0 + ((int)frame_width - stb_easy_font_width(text) * STRIP_TEXT_SCALE) / 2;
+    static const uint8_t ink[3] = {226, 222, 206};
+    int left =
+        (int)x0 + ((int)frame_width - (int)ip_overlay_text_width(text, STRIP_TEXT_SCALE)) / 2;
     int top = (int)strip_height - STRIP_BAND + 4;
-    for (int q = 0; q < count; q++) {
-        float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
-        for (int k = 0; k < 4; k++) { /* a vertex: x, y, z floats, then 4 bytes of colour */
-            float v[2];
-            memcpy(v, quads + (q * 4 + k) * 16, sizeof v);
-            for (int a = 0; a < 2; a++) {
-                lo[a] = v[a] < lo[a] ? v[a] : lo[a];
-                hi[a] = v[a] > hi[a] ? v[a] : hi[a];
-            }
-        }
-        for (int y = (int)(lo[1] * STRIP_TEXT_SCALE); y < (int)(hi[1] * STRIP_TEXT_SCALE); y++)
-            for (int x = (int)(lo[0] * STRIP_TEXT_SCALE); x < (int)(hi[0] * STRIP_TEXT_SCALE);
-                 x++) {
-                int px = left + x, py = top + y;
-                if (px >= 0 && px < (int)strip_width && py >= 0 && py < (int)strip_height)
-                    memcpy(rgba + ((size_t)py * strip_width + (size_t)px) * 4, ink, 4);
-            }
-    }
+    return ip_overlay_draw_text(rgba, strip_width, strip_height, left, top, text, STRIP_TEXT_SCALE,
+                                ink, NULL, err);
 }
 
 /* Fills err for a failed allocation of the strip. Returns -1. */
@@ -632,8 +614,11 @@ static int strip_compose(run *r, uint8_t **out, uint32_t *width, uint32_t *heigh
     for (size_t f = 0; f < n; f++) {
         char text[64];
         strip_label(r, f, text, sizeof text);
-        strip_draw_label(rgba, *width, *height, (uint32_t)(f * (r->camera.width + STRIP_GAP)),
-                         r->camera.width, text);
+        if (strip_draw_label(rgba, *width, *height, (uint32_t)(f * (r->camera.width + STRIP_GAP)),
+                             r->camera.width, text, err) != IP_OK) {
+            free(rgba);
+            return -1;
+        }
     }
     *out = rgba;
     return 0;

@@ -294,6 +294,24 @@ IP_API void ip_renderer_destroy(ip_renderer *renderer);
  * image's smaller side s: text (stb_easy_font's, scaled by round(s / 240), 1 to 4), the
  * triad's arms 8 % of s (at least 16 pixels). Lines are anti-aliased, text is not. */
 
+/*! ip_overlay_text_width() : the width in pixels of one line of `text` as
+ *  ip_overlay_draw_text() draws it at `scale` (1 to 16); 0 for NULL text or another scale.
+ *  Thread-safe. */
+IP_API uint32_t ip_overlay_text_width(const char *text, int scale);
+
+/*! ip_overlay_draw_text() : draws one line of `text` into `rgba` (width * height * 4 bytes,
+ *  RGBA, top row first; caller-owned) with its top-left corner at pixel (left, top) (within
+ *  2^24 of the image; what falls outside it is clipped): stb_easy_font's glyphs, capitals 7
+ *  pixels high at `scale` 1, scaled by `scale` (1 to 16), opaque in `ink` (RGB), not
+ *  anti-aliased; with `shadow` (RGB, may be NULL), the whole text first in that colour one
+ *  text pixel down and right. A byte outside printable ASCII (UTF-8, a control character,
+ *  '\n') is drawn as '?'. Thread-safe on distinct images.
+ *  @return IP_OK or IP_ERR_ARGUMENT (a NULL image, text or ink, an empty image, a scale or a
+ *  corner out of range). */
+IP_API ip_status ip_overlay_draw_text(uint8_t *rgba, uint32_t width, uint32_t height, int left,
+                                      int top, const char *text, int scale, const uint8_t ink[3],
+                                      const uint8_t shadow[3], ip_error *err);
+
 /* A scale bar: a round length and what it spans in the image at the target's depth. */
 typedef struct ip_scale_bar {
     double length;     /* world units (the spacing's): 1, 2 or 5 times a power of ten */
@@ -335,8 +353,8 @@ IP_API ip_status ip_overlay_axes_check(uint32_t width, uint32_t height, ip_error
  *  y green, z blue) from a common centre, the nearer arms over the farther ones, each
  *  labelled at its tip (ip_overlay_axis_label()). An arm along the view is short, as the
  *  camera sees it. `box` (may be NULL) receives the corner box drawn in.
- *  @return IP_OK, IP_ERR_ARGUMENT (a bad camera, a NULL image, an image the triad does not
- *  fit: ip_overlay_axes_check(); nothing is drawn) or IP_ERR_NOMEM. */
+ *  @return IP_OK or IP_ERR_ARGUMENT (a bad camera, a NULL image or orientation, an image the
+ *  triad does not fit: ip_overlay_axes_check(); nothing is drawn). */
 IP_API ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
                                       const ip_orientation *orientation, uint32_t box[4],
                                       ip_error *err);

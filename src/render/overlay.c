@@ -61,6 +61,8 @@ static void blend(const canvas *cv, int x, int y, colour c, double a)
 /* A filled rectangle of pixels [x0, x1) x [y0, y1). */
 static void fill_rect(const canvas *cv, int x0, int y0, int x1, int y1, colour c)
 {
+    x0 = x0 < 0 ? 0 : x0, y0 = y0 < 0 ? 0 : y0; /* the rest is outside the image */
+    x1 = x1 > cv->width ? cv->width : x1, y1 = y1 > cv->height ? cv->height : y1;
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++)
             blend(cv, x, y, c, 1);
@@ -89,44 +91,45 @@ static void draw_segment(const canvas *cv, double ax, double ay, double bx, doub
  * stb_easy_font_height(), adds the spacing between lines). */
 #define GLYPH_HEIGHT 7
 
-/* The most quads stb_easy_font gives one character (printable ASCII: 11, measured over ' '
- * to '~'), and the bytes of a quad (4 vertices of 3 floats and 4 bytes of colour). */
-#define FONT_MAX_QUADS_PER_CHAR 11
-#define FONT_QUAD_BYTES 64
+/* Room for one glyph's quads: stb_easy_font gives a printable ASCII character at most 11
+ * (measured over ' ' to '~'), each 64 bytes (4 vertices of 3 floats and 4 bytes of colour). */
+#define GLYPH_BUFFER_BYTES (16 * 64)
 
-/* Replaces each byte of `text` that stb_easy_font has no glyph for (outside ' ' to '~': it
- * would index its tables out of bounds) with '?'. */
-static void make_printable(char *text)
+/* `c`, or '?' where stb_easy_font has no glyph (outside ' ' to '~': it would index its
+ * tables out of bounds; a '\n' would start a line). */
+static char printable(char c)
 {
-    for (; *text; text++)
-        if (*text < ' ' || *text > '~')
-            *text = '?';
+    return c < ' ' || c > '~' ? '?' : c;
 }
 
-/* The width and height of one line of `text` (printable) in pixels at `scale`. */
+/* The advance of one line of `text` in font units (stb_easy_font_width() of each character:
+ * its widths add up, no spacing being set). */
+static int text_units(const char *text)
+{
+    int units = 0;
+    for (; *text; text++) {
+        char one[2] = {printable(*text), 0};
+        units += stb_easy_font_width(one);
+    }
+    return units;
+}
+
+/* The width and height of one line of `text` in pixels at `scale`. */
 static void text_size(const char *text, int scale, int *w, int *h)
 {
-    *w = stb_easy_font_width((char *)text) * scale;
+    *w = text_units(text) * scale;
     *h = GLYPH_HEIGHT * scale;
 }
 
-/* Draws `text` (printable: make_printable()) with its top-left corner at (left, top), `scale`
- * times stb_easy_font's size, over a shadow one text pixel down and right: stb_easy_font's
- * quads are axis-aligned rectangles, filled here scaled up. Returns 0, or -1 when out of
- * memory (nothing drawn). */
-static int draw_text(const canvas *cv, int left, int top, const char *text, int scale, colour c,
-                     colour shadow)
+/* Fills the glyphs of `text` (each character's quads, axis-aligned rectangles, scaled up),
+ * with the top-left corner at (left, top), in colour c. One character at a time: no buffer
+ * for the whole text. */
+static void fill_glyphs(const canvas *cv, int left, int top, const char *text, int scale, colour c)
 {
-    size_t length = strlen(text);
-    if (length > (size_t)INT32_MAX / (FONT_MAX_QUADS_PER_CHAR * FONT_QUAD_BYTES) - 1)
-        return -1;
-    size_t size = (length + 1) * FONT_MAX_QUADS_PER_CHAR * FONT_QUAD_BYTES; /* every glyph */
-    char *quads = malloc(size);
-    if (!quads)
-        return -1;
-    int count = stb_easy_font_print(0, 0, (char *)text, NULL, quads, (int)size);
-    for (int pass = 0; pass < 2; pass++) {
-        int offset = pass == 0 ? scale : 0;
+    int pen = 0; /* font units */
+    for (; *text; text++) {
+        char one[2] = {printable(*text), 0}, quads[GLYPH_BUFFER_BYTES];
+        int count = stb_easy_font_print(0, 0, one, NULL, quads, (int)sizeof quads);
         for (int q = 0; q < count; q++) {
             float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
             for (int k = 0; k < 4; k++) { /* a vertex: x, y, z floats, then 4 bytes of colour */
@@ -137,13 +140,57 @@ static int draw_text(const canvas *cv, int left, int top, const char *text, int 
                     hi[a] = v[a] > hi[a] ? v[a] : hi[a];
                 }
             }
-            fill_rect(cv, left + offset + (int)lo[0] * scale, top + offset + (int)lo[1] * scale,
-                      left + offset + (int)hi[0] * scale, top + offset + (int)hi[1] * scale,
-                      pass == 0 ? shadow : c);
+            fill_rect(cv, left + (pen + (int)lo[0]) * scale, top + (int)lo[1] * scale,
+                      left + (pen + (int)hi[0]) * scale, top + (int)hi[1] * scale, c);
         }
+        pen += stb_easy_font_width(one);
     }
-    free(quads);
-    return 0;
+}
+
+/* Draws one line of `text` with its top-left corner at (left, top), `scale` times
+ * stb_easy_font's size; with a shadow (may be NULL), first the whole text in it one text
+ * pixel down and right. */
+static void draw_text(const canvas *cv, int left, int top, const char *text, int scale, colour c,
+                      const colour *shadow)
+{
+    if (shadow)
+        fill_glyphs(cv, left + scale, top + scale, text, scale, *shadow);
+    fill_glyphs(cv, left, top, text, scale, c);
+}
+
+/* The text functions' limits: a scale, and how far outside the image a corner may lie (so
+ * that no pixel coordinate overflows). */
+#define TEXT_MAX_SCALE 16
+#define TEXT_MAX_OFFSET (1 << 24)
+
+uint32_t ip_overlay_text_width(const char *text, int scale)
+{
+    if (!text || scale < 1 || scale > TEXT_MAX_SCALE)
+        return 0;
+    return (uint32_t)text_units(text) * (uint32_t)scale;
+}
+
+ip_status ip_overlay_draw_text(uint8_t *rgba, uint32_t width, uint32_t height, int left, int top,
+                               const char *text, int scale, const uint8_t ink[3],
+                               const uint8_t shadow[3], ip_error *err)
+{
+    if (!rgba || !text || !ink || width < 1 || height < 1 || width > INT32_MAX / 4 ||
+        height > INT32_MAX / 4)
+        return ip__fail(err, IP_ERR_ARGUMENT, "text: no image, text or ink, or a %ux%u image",
+                        width, height);
+    if (scale < 1 || scale > TEXT_MAX_SCALE)
+        return ip__fail(err, IP_ERR_ARGUMENT, "text: scale %d is not 1 to %d", scale,
+                        TEXT_MAX_SCALE);
+    if (left < -TEXT_MAX_OFFSET || left > TEXT_MAX_OFFSET || top < -TEXT_MAX_OFFSET ||
+        top > TEXT_MAX_OFFSET)
+        return ip__fail(err, IP_ERR_ARGUMENT, "text: corner %d,%d is too far out", left, top);
+    canvas cv = {rgba, (int)width, (int)height};
+    const colour c = {ink[0], ink[1], ink[2]};
+    colour under = {0, 0, 0};
+    if (shadow)
+        under = (colour){shadow[0], shadow[1], shadow[2]};
+    draw_text(&cv, left, top, text, scale, c, shadow ? &under : NULL);
+    return IP_OK;
 }
 
 /* The mean luma (0 to 255) of the image's pixels in [x0, x1) x [y0, y1), clipped; 0 when
@@ -312,9 +359,8 @@ ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
         int w, h;
         text_size(label, scale, &w, &h);
         double lx = tx + (g.reach - arm) * ux, ly = ty + (g.reach - arm) * uy;
-        if (draw_text(&cv, (int)lround(lx - w / 2.0), (int)lround(ly - h / 2.0), label, scale,
-                      axis_colours[a], dark) != 0)
-            return ip__fail(err, IP_ERR_NOMEM, "axes: out of memory");
+        draw_text(&cv, (int)lround(lx - w / 2.0), (int)lround(ly - h / 2.0), label, scale,
+                  axis_colours[a], &dark);
     }
     report_box(camera, g.box[0], g.box[1], g.box[2], g.box[3], box);
     return IP_OK;
@@ -346,7 +392,8 @@ ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera, cons
         snprintf(label, size, "%g %s", bar->length, unit);
     else
         snprintf(label, size, "%g", bar->length);
-    make_printable(label);
+    for (char *p = label; *p; p++) /* a control character would break the message's line */
+        *p = (unsigned char)*p < ' ' || *p == 127 ? '?' : *p;
     int w, h;
     text_size(label, s.text_scale, &w, &h);
     int lx = (x0 + x1) / 2 - w / 2, ly = y1 - tick - s.margin - h;
@@ -369,10 +416,8 @@ ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera, cons
     fill_rect(&cv, x0, y0, x1, y1, ink);
     fill_rect(&cv, x0, y1 - tick, x0 + tick_w, y0, ink);
     fill_rect(&cv, x1 - tick_w, y1 - tick, x1, y0, ink);
-    int drawn = draw_text(&cv, lx, ly, label, s.text_scale, ink, shadow);
+    draw_text(&cv, lx, ly, label, s.text_scale, ink, &shadow);
     free(label);
-    if (drawn != 0)
-        return ip__fail(err, IP_ERR_NOMEM, "scale bar: out of memory");
     report_box(camera, left, ly, x1 + s.text_scale, y1 + 1, box);
     report_box(camera, x0, y1 - tick, x1, y1, bar_box);
     return IP_OK;
