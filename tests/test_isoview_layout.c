@@ -76,10 +76,22 @@ static void test_ragged_rows(void)
     CHECK(layout_table("", 4, cells, 8, &width, &height) == 0 && width == 0 && height == 0);
 }
 
+/* Bytes without a glyph (a file name's UTF-8, a control character) count and draw as '?',
+ * instead of being looked up out of the font's tables. */
+static void test_unprintable(void)
+{
+    CHECK(layout_text_width("\xc3\xa9t\xc3\xa9.png", 9) == layout_text_width("??t??.png", 9));
+    CHECK(layout_text_width("a\x01\x7f", 3) == layout_text_width("a??", 3));
+    char text[] = "saved \xc3\xa9\x7f~ ok";
+    layout_printable(text);
+    CHECK(!strcmp(text, "saved ???~ ok"));
+}
+
 int main(void)
 {
     test_help_columns();
     test_plain_lines();
     test_ragged_rows();
+    test_unprintable();
     return test_summary("test_isoview_layout");
 }

@@ -59,6 +59,7 @@ static void test_scale_bar_choice(void)
     CHECK(fabs(bar.pixel_size - pixel / 2) < 1e-12);
     CHECK(ip_scale_bar_choose(&c, 0, &bar, &err) == IP_ERR_ARGUMENT);
     CHECK(ip_scale_bar_choose(&c, NAN, &bar, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_scale_bar_choose(&c, 100, NULL, &err) == IP_ERR_ARGUMENT);
     c.fov_y = 0;
     CHECK(ip_scale_bar_choose(&c, 100, &bar, &err) == IP_ERR_ARGUMENT);
 }
@@ -184,12 +185,147 @@ static void test_drawing(uint32_t w, uint32_t h)
     free(image);
 }
 
+/* An overlay that would not fit whole in the image is refused and draws nothing. */
+static void test_small_images(void)
+{
+    ip_orientation o;
+    ip_orientation_identity(&o);
+    ip_error err;
+    uint32_t box[4], bar_box[4];
+    uint8_t image[64 * 64 * 4], plain[64 * 64 * 4];
+    for (size_t i = 0; i < sizeof plain; i++)
+        plain[i] = (i % 4 == 3) ? 255 : (uint8_t)(40 + i % 7);
+    /* the triad's arms (16 pixels) and labels need 63x62 pixels */
+    const uint32_t sizes[][3] = {{16, 16, 0}, {40, 30, 0}, {62, 62, 0},
+                                 {63, 61, 0}, {63, 62, 1}, {64, 64, 1}};
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
+        ip_camera c = front_camera(sizes[i][0], sizes[i][1]);
+        int fits = (int)sizes[i][2];
+        CHECK_MSG((ip_overlay_axes_check(c.width, c.height, &err) == IP_OK) == fits, "%ux%u",
+                  c.width, c.height);
+        memcpy(image, plain, sizeof image);
+        ip_status st = ip_overlay_draw_axes(image, &c, &o, box, &err);
+        CHECK_MSG((st == IP_OK) == fits, "%ux%u: %s", c.width, c.height, err.message);
+        if (!fits) {
+            CHECK_CONTAINS(err.message, "at least 63x62");
+            CHECK(!memcmp(image, plain, sizeof image));
+        } else {
+            CHECK(box[2] <= c.width && box[3] <= c.height);
+        }
+    }
+    /* a 16x16 image has no room for "10 units" */
+    ip_camera c = front_camera(16, 16);
+    ip_scale_bar bar;
+    CHECK(ip_scale_bar_choose(&c, 4, &bar, &err) == IP_OK);
+    memcpy(image, plain, sizeof image);
+    CHECK(ip_overlay_draw_scale_bar(image, &c, &bar, "units", box, bar_box, &err) ==
+          IP_ERR_ARGUMENT);
+    CHECK_CONTAINS(err.message, "units");
+    CHECK(!memcmp(image, plain, sizeof image));
+    /* a bar longer than the image (a caller's own): refused, not drawn off the image */
+    c = front_camera(64, 64);
+    bar.pixels = 5e8;
+    CHECK(ip_overlay_draw_scale_bar(image, &c, &bar, NULL, box, bar_box, &err) == IP_ERR_ARGUMENT);
+    CHECK(!memcmp(image, plain, sizeof image));
+}
+
+/* The whole label is drawn however long, and a byte the font has no glyph for is a '?'. */
+static void test_labels(void)
+{
+    const uint32_t w = 1600, h = 300;
+    ip_camera c = front_camera(w, h);
+    size_t bytes = (size_t)w * h * 4;
+    uint8_t *a = calloc(bytes, 1), *b = calloc(bytes, 1);
+    REQUIRE(a && b);
+    ip_scale_bar bar;
+    ip_error err;
+    uint32_t box[4], short_box[4], bar_box[4];
+    CHECK(ip_scale_bar_choose(&c, w / 4.0, &bar, &err) == IP_OK);
+    const char *unit = "ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+    CHECK(ip_overlay_draw_scale_bar(a, &c, &bar, unit, box, bar_box, &err) == IP_OK);
+    CHECK(ip_overlay_draw_scale_bar(b, &c, &bar, "ABCDEFGHIJKLMNOPQRSTUVWXYZ", short_box, NULL,
+                                    &err) == IP_OK);
+    /* the long label's ink (above the bar) spans its 76 characters, about 6 pixels each */
+    uint32_t first = w, last = 0;
+    for (uint32_t y = box[1]; y < bar_box[1]; y++)
+        for (uint32_t x = box[0]; x < box[2]; x++)
+            if (a[((size_t)y * w + x) * 4]) {
+                first = x < first ? x : first;
+                last = x > last ? x : last;
+            }
+    CHECK_MSG(last > first && last - first > 400, "ink from %u to %u", first, last);
+    CHECK(box[0] < short_box[0]);
+    /* "\xc2\xb5m" (UTF-8 micro sign) and "\tm" draw as "??m" and "?m" */
+    memset(a, 0, bytes);
+    memset(b, 0, bytes);
+    CHECK(ip_overlay_draw_scale_bar(a, &c, &bar, "\xc2\xb5m", NULL, NULL, &err) == IP_OK);
+    CHECK(ip_overlay_draw_scale_bar(b, &c, &bar, "??m", NULL, NULL, &err) == IP_OK);
+    CHECK(!memcmp(a, b, bytes));
+    memset(a, 0, bytes);
+    memset(b, 0, bytes);
+    CHECK(ip_overlay_draw_scale_bar(a, &c, &bar, "\tm\x7f", NULL, NULL, &err) == IP_OK);
+    CHECK(ip_overlay_draw_scale_bar(b, &c, &bar, "?m?", NULL, NULL, &err) == IP_OK);
+    CHECK(!memcmp(a, b, bytes));
+    free(a);
+    free(b);
+}
+
+/* The shared text: its width adds up character by character, it draws inside its box, with
+ * a shadow one text pixel down and right, and clips at the image's edges. */
+static void test_text(void)
+{
+    CHECK(ip_overlay_text_width("AB", 1) ==
+          ip_overlay_text_width("A", 1) + ip_overlay_text_width("B", 1));
+    CHECK(ip_overlay_text_width("10 mm", 3) == 3 * ip_overlay_text_width("10 mm", 1));
+    CHECK(ip_overlay_text_width("\xc3\xa9\n", 1) == ip_overlay_text_width("???", 1));
+    CHECK(ip_overlay_text_width(NULL, 1) == 0 && ip_overlay_text_width("A", 0) == 0 &&
+          ip_overlay_text_width("A", 17) == 0);
+    enum {
+        W = 64,
+        H = 32
+    };
+    static uint8_t image[W * H * 4];
+    const uint8_t ink[3] = {250, 250, 250}, shade[3] = {20, 30, 40};
+    ip_error err;
+    memset(image, 0, sizeof image);
+    CHECK(ip_overlay_draw_text(image, W, H, 3, 4, "A7", 2, ink, NULL, &err) == IP_OK);
+    uint32_t w = ip_overlay_text_width("A7", 2), inked = 0, outside = 0;
+    for (uint32_t y = 0; y < H; y++)
+        for (uint32_t x = 0; x < W; x++) {
+            const uint8_t *p = image + ((size_t)y * W + x) * 4;
+            if (!p[0])
+                continue;
+            inked++;
+            outside += x < 3 || x >= 3 + w || y < 4 || y >= 4 + 2 * 7 + 2;
+            CHECK(p[0] == 250 && p[3] == 255);
+        }
+    CHECK_MSG(inked > 20 && outside == 0, "%u inked, %u outside", inked, outside);
+    /* the shadow: the same glyphs one text pixel (2) down and right, under the ink */
+    memset(image, 0, sizeof image);
+    CHECK(ip_overlay_draw_text(image, W, H, 3, 4, "A7", 2, ink, shade, &err) == IP_OK);
+    uint32_t shadowed = 0;
+    for (size_t p = 0; p < (size_t)W * H; p++)
+        shadowed += image[4 * p] == 20 && image[4 * p + 2] == 40;
+    CHECK_MSG(shadowed > 0, "%u shadow pixels", shadowed);
+    /* partly outside: clipped, not written out of bounds (the sanitizer build checks) */
+    CHECK(ip_overlay_draw_text(image, W, H, -5, H - 6, "WIDE TEXT", 3, ink, shade, &err) == IP_OK);
+    CHECK(ip_overlay_draw_text(NULL, W, H, 0, 0, "A", 1, ink, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_overlay_draw_text(image, W, H, 0, 0, NULL, 1, ink, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_overlay_draw_text(image, W, H, 0, 0, "A", 17, ink, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_overlay_draw_text(image, W, H, 1 << 25, 0, "A", 1, ink, NULL, &err) ==
+          IP_ERR_ARGUMENT);
+    CHECK(ip_overlay_draw_text(image, 0, H, 0, 0, "A", 1, ink, NULL, &err) == IP_ERR_ARGUMENT);
+}
+
 int main(void)
 {
     test_scale_bar_choice();
     test_axis_directions();
     test_drawing(400, 300);
     test_drawing(1600, 1200);
-    test_drawing(40, 30); /* tiny: everything clipped to the image */
+    test_drawing(64, 64); /* small: each overlay still whole */
+    test_small_images();
+    test_labels();
+    test_text();
     return test_summary("test_overlay");
 }

@@ -449,6 +449,9 @@ static void test_surfaces(void)
     bad = alone;
     bad.mesh = NULL;
     CHECK(ip_surfaces_check(&bad, 1, &err) == IP_ERR_ARGUMENT);
+    /* no image: an argument error, not a write through NULL */
+    CHECK(ip_raster_surfaces(&alone, 1, &c, NULL, box_lo, box_hi, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK_CONTAINS(err.message, "no image");
     ip_mesh *meshes[] = {&near_small, &far_big,   &near_big, &far_small,
                          &layers[0],  &layers[1], &both};
     for (size_t i = 0; i < sizeof meshes / sizeof meshes[0]; i++)

@@ -27,9 +27,9 @@ static const char usage[] =
     "  --mem-mb N          cap on working memory in MiB (default: none)\n"
     "  --force             replace OUT if it exists (a regular file; never the input)\n"
     "  -q, --quiet         no progress bar and no summary\n"
-    "  -v, --verbose       details on stderr: the input, the layout and the plan first, a line\n"
-    "                      for each chunk of planes as it is read and encoded, then each\n"
-    "                      level's bricks as written (encodings, bytes, filters) and the\n"
+    "  -v, --verbose       details on stderr: the input and the plan first, a line for each\n"
+    "                      chunk of planes as it is read and encoded, then the phases' times,\n"
+    "                      each level's bricks as written (encodings, bytes, filters) and the\n"
     "                      filter choices over all levels (not with --quiet)\n"
     "  --version           print the version and exit\n"
     "A progress bar (planes read and encoded) is drawn on stderr when it is a terminal\n"
@@ -155,12 +155,11 @@ static int parse_threads(const char *p, const tool_option *opt, const char *cons
 
 static int parse_mem_mb(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
-    (void)opt;
     uint64_t n;
-    if (tool_parse_u64(v[0], &n) != 0 || n < 1 || n > (1ull << 40))
-        return tool_usage_error(p, "bad --mem-mb '%s'", v[0]);
-    ((options *)base)->brick.memory_limit = n << 20;
-    return 0;
+    int rc = tool_parse_bounded(p, opt->name, v[0], 1, 1ull << 40, "a size in MiB", &n);
+    if (rc == 0)
+        ((options *)base)->brick.memory_limit = n << 20;
+    return rc;
 }
 
 static const tool_option isobrick_options[] = {

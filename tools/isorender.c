@@ -20,8 +20,6 @@
 #include "isoprop/store.h"
 #include "tool_common.h"
 
-#include <stb_easy_font.h>
-
 static const char usage[] =
     "usage: isorender FILE.ibv --iso V [--iso V2 ...] [options]\n"
     "Extracts the isosurface V progressively (rays in the paper's order) and renders it to PNG\n"
@@ -88,9 +86,12 @@ static const char usage[] =
     "                      as long as it looks at the depth of the view's target (perspective:\n"
     "                      nearer is larger)\n"
     "  --scale-unit TEXT   the scale bar's unit (default mm where the file names an anatomical\n"
-    "                      space, else units: world units are the spacing's)\n"
+    "                      space, else units: world units are the spacing's; printable ASCII,\n"
+    "                      other bytes are drawn as ?)\n"
     "                      (--axes and --scale-bar mark the image and the turntable's frames,\n"
-    "                      not the strip)\n"
+    "                      not the strip; each is drawn whole or not at all: --axes needs an\n"
+    "                      image of 63x62 pixels or more (exit 2), a scale bar and label wider\n"
+    "                      or taller than the image end the run with nothing written (exit 1))\n"
     "  --software          render with the software rasterizer instead of OpenGL\n"
     "  --aa N              OpenGL anti-aliasing: N samples a pixel (1 to 16; default 1, off,\n"
     "                      the image the software rasterizer draws; 4 or 8 for figures)\n"
@@ -108,8 +109,8 @@ static const char usage[] =
     "no output is written, and isorender ends as killed by the signal.\n";
 
 /* The progress strip (--strip): frames side by side, STRIP_GAP pixels apart, over a band of
- * STRIP_BAND pixels with each frame's label; the text is stb_easy_font's, STRIP_TEXT_SCALE
- * times larger. */
+ * STRIP_BAND pixels with each frame's label, the render stage's text (ip_overlay_draw_text())
+ * at STRIP_TEXT_SCALE. */
 #define STRIP_MAX_FRAMES 8
 #define STRIP_GAP 4
 #define STRIP_BAND 24
@@ -244,7 +245,8 @@ static int parse_opacity(const char *program, const tool_option *option, const c
     options *o = base;
     double a;
     (void)option;
-    if (tool_parse_double(values[0], &a) != 0 || !(a > 0 && a <= 1))
+    /* checked as the float the renderers take: 1e-50 would be 0 there */
+    if (tool_parse_double(values[0], &a) != 0 || !((float)a > 0 && (float)a <= 1))
         return tool_usage_error(program, "--opacity '%s' is not a number in (0, 1]", values[0]);
     if (o->opacity_count == TOOL_MAX_ISOS)
         return tool_usage_error(program, "--opacity '%s': more than %d opacities", values[0],
@@ -279,6 +281,20 @@ static int check_surface_options(const options *o)
                                 "a surface",
                                 o->colour_count, o->opacity_count, n);
     return 0;
+}
+
+/* The shortest "%g" text (6 to 9 significant digits) of the isovalue the engine extracts,
+ * (float)iso, that reads back as that float: isovalues no two alike as floats (as
+ * check_surface_options() wants them) get texts no two alike (100.0001 and 100.0002, not 100
+ * twice), and 600.5 stays 600.5. */
+static void iso_text(double iso, char *out, size_t size)
+{
+    float value = (float)iso;
+    for (int digits = 6; digits <= 9; digits++) {
+        snprintf(out, size, "%.*g", digits, (double)value);
+        if ((float)strtod(out, NULL) == value)
+            return;
+    }
 }
 
 /* Whether the image needs the several-surface drawing: several --iso, or a translucent one. */
@@ -519,40 +535,24 @@ static void strip_label(const run *r, size_t f, char *text, size_t size)
 {
     snprintf(text, size, "%llu rays, %llu triangles", (unsigned long long)r->strip.rays[f],
              (unsigned long long)strip_triangles(r, f));
-    if ((uint32_t)stb_easy_font_width(text) * STRIP_TEXT_SCALE + 8 > r->camera.width)
+    if (ip_overlay_text_width(text, STRIP_TEXT_SCALE) + 8 > r->camera.width)
         snprintf(text, size, "%llu rays", (unsigned long long)r->strip.rays[f]);
-    if ((uint32_t)stb_easy_font_width(text) * STRIP_TEXT_SCALE + 8 > r->camera.width)
+    if (ip_overlay_text_width(text, STRIP_TEXT_SCALE) + 8 > r->camera.width)
         text[0] = 0;
 }
 
-/* Draws `text` into the strip's band, centred under the frame that starts at column x0:
- * stb_easy_font's quads are axis-aligned rectangles, filled here scaled up. */
-static void strip_draw_label(uint8_t *rgba, uint32_t strip_width, uint32_t strip_height,
-                             uint32_t x0, uint32_t frame_width, char *text)
+/* Draws `text` into the strip's band, centred under the frame that starts at column x0 (the
+ * render stage's text, as the figure overlays draw theirs). */
+static ip_status strip_draw_label(uint8_t *rgba, uint32_t strip_width, uint32_t strip_height,
+                                  uint32_t x0, uint32_t frame_width, const char *text,
+                                  ip_error *err)
 {
-    static const uint8_t ink[4] = {226, 222, 206, 255};
-    char quads[64 * 270]; /* stb_easy_font's estimate: about 270 bytes a character */
-    int count = stb_easy_font_print(0, 0, text, NULL, quads, (int)sizeof quads);
-    int left = (int)x0 + ((int)frame_width - stb_easy_font_width(text) * STRIP_TEXT_SCALE) / 2;
+    static const uint8_t ink[3] = {226, 222, 206};
+    int left =
+        (int)x0 + ((int)frame_width - (int)ip_overlay_text_width(text, STRIP_TEXT_SCALE)) / 2;
     int top = (int)strip_height - STRIP_BAND + 4;
-    for (int q = 0; q < count; q++) {
-        float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
-        for (int k = 0; k < 4; k++) { /* a vertex: x, y, z floats, then 4 bytes of colour */
-            float v[2];
-            memcpy(v, quads + (q * 4 + k) * 16, sizeof v);
-            for (int a = 0; a < 2; a++) {
-                lo[a] = v[a] < lo[a] ? v[a] : lo[a];
-                hi[a] = v[a] > hi[a] ? v[a] : hi[a];
-            }
-        }
-        for (int y = (int)(lo[1] * STRIP_TEXT_SCALE); y < (int)(hi[1] * STRIP_TEXT_SCALE); y++)
-            for (int x = (int)(lo[0] * STRIP_TEXT_SCALE); x < (int)(hi[0] * STRIP_TEXT_SCALE);
-                 x++) {
-                int px = left + x, py = top + y;
-                if (px >= 0 && px < (int)strip_width && py >= 0 && py < (int)strip_height)
-                    memcpy(rgba + ((size_t)py * strip_width + (size_t)px) * 4, ink, 4);
-            }
-    }
+    return ip_overlay_draw_text(rgba, strip_width, strip_height, left, top, text, STRIP_TEXT_SCALE,
+                                ink, NULL, err);
 }
 
 /* Fills err for a failed allocation of the strip. Returns -1. */
@@ -614,8 +614,11 @@ static int strip_compose(run *r, uint8_t **out, uint32_t *width, uint32_t *heigh
     for (size_t f = 0; f < n; f++) {
         char text[64];
         strip_label(r, f, text, sizeof text);
-        strip_draw_label(rgba, *width, *height, (uint32_t)(f * (r->camera.width + STRIP_GAP)),
-                         r->camera.width, text);
+        if (strip_draw_label(rgba, *width, *height, (uint32_t)(f * (r->camera.width + STRIP_GAP)),
+                             r->camera.width, text, err) != IP_OK) {
+            free(rgba);
+            return -1;
+        }
     }
     *out = rgba;
     return 0;
@@ -729,6 +732,9 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     if (o->scale_unit && !o->scale_bar)
         return tool_usage_error("isorender", "--scale-unit needs --scale-bar");
+    ip_error why;
+    if (o->axes && ip_overlay_axes_check(o->common.width, o->common.height, &why) != IP_OK)
+        return tool_usage_error("isorender", "--%s", why.message); /* "--axes: the triad..." */
     rc = check_smooth_options(o);
     if (rc)
         return rc;
@@ -1051,8 +1057,16 @@ static ip_status draw_overlays(run *r, uint8_t *rgba, ip_error *err)
     if (r->o.scale_bar) {
         if (ip_scale_bar_choose(&r->camera, r->camera.width / 4.0, &r->bar, err) != IP_OK ||
             ip_overlay_draw_scale_bar(rgba, &r->camera, &r->bar, scale_unit(r), box, bar_box,
-                                      err) != IP_OK)
+                                      err) != IP_OK) {
+            static const char prefix[] = "scale bar: "; /* the library's; the option's instead */
+            char text[sizeof err->message];
+            if (!strncmp(err->message, prefix, strlen(prefix))) {
+                snprintf(text, sizeof text, "%s: --scale-bar: %s", r->o.file,
+                         err->message + strlen(prefix));
+                memcpy(err->message, text, sizeof text);
+            }
             return err->code;
+        }
         if (r->o.common.verbose)
             fprintf(stderr,
                     "isorender: scale bar: %g %s = %.3f pixels (%.6g %s a pixel at the "
@@ -1177,7 +1191,8 @@ static void json_counts(FILE *f, void *user)
         json_surfaces(f, r);
 }
 
-/* The summary's lines of surface run s (r: the first surface's, which knows the renderer). */
+/* The summary's lines of surface run s (r: the first surface's, which knows the renderer and
+ * the image's rendering time: with several surfaces, given once after them). */
 static void print_counts(FILE *out, const run *s, const run *r)
 {
     const ip_engine_counts *t = &s->totals;
@@ -1196,9 +1211,12 @@ static void print_counts(FILE *out, const run *s, const run *r)
                 overdraw(s->mesh->triangle_count, s->visible_triangles));
     fprintf(out,
             "  time          %.3f s extraction (wall); CPU s summed over %u threads: "
-            "intersection %.3f, propagation %.3f, marching cubes %.3f; rendering %.3f s (%s)\n",
+            "intersection %.3f, propagation %.3f, marching cubes %.3f",
             s->extraction_wall, ip_thread_count(s->o.common.threads), t->intersection_seconds,
-            t->propagation_seconds, t->extraction_seconds, t->rendering_seconds, r->renderer_name);
+            t->propagation_seconds, t->extraction_seconds);
+    if (!r->other_count)
+        fprintf(out, "; rendering %.3f s (%s)", t->rendering_seconds, r->renderer_name);
+    fprintf(out, "\n");
 }
 
 static void print_summary(FILE *out, const run *r)
@@ -1211,9 +1229,13 @@ static void print_summary(FILE *out, const run *r)
         fprintf(out, "%s: %zu surfaces, %s, %ux%u\n", r->o.file, r->other_count + 1,
                 r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
         for (size_t i = 0; i <= r->other_count; i++) {
-            fprintf(out, "  surface %zu     iso %g\n", i + 1, surface_run_c(r, i)->o.common.iso);
+            char iso[32];
+            iso_text(surface_run_c(r, i)->o.common.iso, iso, sizeof iso);
+            fprintf(out, "  surface %zu     iso %s\n", i + 1, iso);
             print_counts(out, surface_run_c(r, i), r);
         }
+        fprintf(out, "  rendering     %.3f s (%s), the surfaces together\n",
+                r->totals.rendering_seconds, r->renderer_name);
     }
     fprintf(out, "  image         %s\n", r->o.out);
     for (size_t i = 0; i <= r->other_count; i++) {
@@ -1507,13 +1529,16 @@ static int turntable_run(run *r, ip_error *err)
 }
 
 /* The mesh file of the surface of isovalue `iso`: `path` with "_isoV" before its extension
- * (head.ply: head_iso600.5.ply). Returns 0, or 2 after a usage error. */
+ * (head.ply: head_iso600.5.ply; V as iso_text() gives it). Returns 0, or 2 after a usage
+ * error. */
 static int surface_mesh_name(const char *path, double iso, char *out, size_t size)
 {
     const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
     if (!dot || (slash && dot < slash))
         dot = path + strlen(path);
-    int length = snprintf(out, size, "%.*s_iso%g%s", (int)(dot - path), path, iso, dot);
+    char value[32];
+    iso_text(iso, value, sizeof value);
+    int length = snprintf(out, size, "%.*s_iso%s%s", (int)(dot - path), path, value, dot);
     if (length < 0 || (size_t)length >= size)
         return tool_usage_error("isorender", "--mesh %s: the name is too long", path);
     return 0;
@@ -1563,6 +1588,7 @@ int main(int argc, char **argv)
     run r;
     memset(&r, 0, sizeof r);
     int rc = parse_args(argc, argv, &r.o);
+    const char *mesh_option = r.o.mesh; /* as given: setup_surfaces() may name it per surface */
     if (!rc)
         rc = setup_surfaces(&r);
     if (rc) {
@@ -1583,7 +1609,7 @@ int main(int argc, char **argv)
     if (r.o.mesh && !ip_mesh_format_of(r.o.mesh)) { /* before any work, after the paths' checks */
         free_surfaces(&r);
         return tool_usage_error(
-            "isorender", "--mesh %s: the name must end in .ply, .stl, .obj or .glb", r.o.mesh);
+            "isorender", "--mesh %s: the name must end in .ply, .stl, .obj or .glb", mesh_option);
     }
     tool_signals_catch();
     ip_error err;

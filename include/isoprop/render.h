@@ -122,8 +122,8 @@ IP_API ip_status ip_surfaces_check(const ip_surface *surfaces, size_t count, ip_
  *  shaded with the colour of the surface it shows. `shading` (NULL: ip_shading_default())
  *  gives the background and the lighting terms; its surface colour is not used. `rgba`:
  *  width * height * 4 bytes, caller-owned. Single-threaded; reentrant.
- *  @return IP_OK, IP_ERR_ARGUMENT (as ip_raster_mesh_shaded(), or ip_surfaces_check()
- *  fails) or IP_ERR_NOMEM (about 24 bytes a pixel per surface). */
+ *  @return IP_OK, IP_ERR_ARGUMENT (as ip_raster_mesh_shaded(), ip_surfaces_check() fails, or
+ *  `rgba` is NULL) or IP_ERR_NOMEM (about 24 bytes a pixel per surface). */
 IP_API ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count,
                                     const ip_camera *camera, const ip_shading *shading,
                                     const double lo[3], const double hi[3], uint8_t *rgba,
@@ -289,9 +289,28 @@ IP_API void ip_renderer_destroy(ip_renderer *renderer);
  * first; the camera's width and height), after rendering, so they look the same whichever
  * renderer drew it, with or without anti-aliasing. Each draws only inside a box in one corner,
  * which it reports as {x0, y0, x1, y1} (pixels; x0, y0 included, x1, y1 excluded): the triad
- * in the bottom-left corner, the scale bar in the bottom-right. Their sizes follow the
+ * in the bottom-left corner, the scale bar in the bottom-right; an overlay that would not fit
+ * whole in the image is refused, never cut. Their sizes follow the
  * image's smaller side s: text (stb_easy_font's, scaled by round(s / 240), 1 to 4), the
  * triad's arms 8 % of s (at least 16 pixels). Lines are anti-aliased, text is not. */
+
+/*! ip_overlay_text_width() : the width in pixels of one line of `text` as
+ *  ip_overlay_draw_text() draws it at `scale` (1 to 16); 0 for NULL text or another scale.
+ *  Thread-safe. */
+IP_API uint32_t ip_overlay_text_width(const char *text, int scale);
+
+/*! ip_overlay_draw_text() : draws one line of `text` into `rgba` (width * height * 4 bytes,
+ *  RGBA, top row first; caller-owned) with its top-left corner at pixel (left, top) (within
+ *  2^24 of the image; what falls outside it is clipped): stb_easy_font's glyphs, capitals 7
+ *  pixels high at `scale` 1, scaled by `scale` (1 to 16), opaque in `ink` (RGB), not
+ *  anti-aliased; with `shadow` (RGB, may be NULL), the whole text first in that colour one
+ *  text pixel down and right. A byte outside printable ASCII (UTF-8, a control character,
+ *  '\n') is drawn as '?'. Thread-safe on distinct images.
+ *  @return IP_OK or IP_ERR_ARGUMENT (a NULL image, text or ink, an empty image, a scale or a
+ *  corner out of range). */
+IP_API ip_status ip_overlay_draw_text(uint8_t *rgba, uint32_t width, uint32_t height, int left,
+                                      int top, const char *text, int scale, const uint8_t ink[3],
+                                      const uint8_t shadow[3], ip_error *err);
 
 /* A scale bar: a round length and what it spans in the image at the target's depth. */
 typedef struct ip_scale_bar {
@@ -304,8 +323,9 @@ typedef struct ip_scale_bar {
  *  whose bar spans at most `max_pixels` (> 0) pixels at the depth of the camera's target,
  *  where a pixel spans ip_camera_pixel_size(camera, height) world units. The view is a
  *  perspective one: the bar holds for lengths at that depth, across the view (nearer
- *  lengths look longer, farther ones shorter).
- *  @return IP_OK, or IP_ERR_ARGUMENT (a bad camera, max_pixels not finite and > 0). */
+ *  lengths look longer, farther ones shorter). `bar` (caller-owned) receives it. Thread-safe.
+ *  @return IP_OK, or IP_ERR_ARGUMENT (a bad camera, max_pixels not finite and > 0, a NULL
+ *  bar). */
 IP_API ip_status ip_scale_bar_choose(const ip_camera *camera, double max_pixels, ip_scale_bar *bar,
                                      ip_error *err);
 
@@ -323,12 +343,18 @@ IP_API void ip_overlay_axis_directions(const ip_camera *camera, const ip_orienta
  *  LAS; "L", "P", "S" in LPS), or "x", "y", "z" where the space is unknown. A static string. */
 IP_API const char *ip_overlay_axis_label(ip_space space, int axis);
 
+/*! ip_overlay_axes_check() : whether the axis triad fits whole in an image of width x height
+ *  pixels (the arms' 16-pixel minimum and the labels need 63x62 pixels at least).
+ *  Thread-safe. @return IP_OK or IP_ERR_ARGUMENT, the message giving the size needed. */
+IP_API ip_status ip_overlay_axes_check(uint32_t width, uint32_t height, ip_error *err);
+
 /*! ip_overlay_draw_axes() : draws the axis triad into `rgba` (the camera's size) in the
  *  bottom-left corner: an arm for each physical axis (ip_overlay_axis_directions(); x red,
  *  y green, z blue) from a common centre, the nearer arms over the farther ones, each
  *  labelled at its tip (ip_overlay_axis_label()). An arm along the view is short, as the
  *  camera sees it. `box` (may be NULL) receives the corner box drawn in.
- *  @return IP_OK or IP_ERR_ARGUMENT (a bad camera, a NULL image). */
+ *  @return IP_OK or IP_ERR_ARGUMENT (a bad camera, a NULL image or orientation, an image the
+ *  triad does not fit: ip_overlay_axes_check(); nothing is drawn). */
 IP_API ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
                                       const ip_orientation *orientation, uint32_t box[4],
                                       ip_error *err);
@@ -336,11 +362,14 @@ IP_API ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
 /*! ip_overlay_draw_scale_bar() : draws `bar` (ip_scale_bar_choose()) into `rgba` (the
  *  camera's size) in the bottom-right corner: a horizontal bar round(bar->pixels) pixels long
  *  (at least 1), with end ticks inside that length, under the label "LENGTH UNIT" (`unit`
- *  may be NULL or "": the length alone); light on a dark corner, dark where the corner's
- *  mean luma is over 140 of 255 (a white background). `box` (may be NULL) receives the corner box drawn
- *  in; `bar_box` (may be NULL) the bar's own pixels, ticks included.
- *  @return IP_OK or IP_ERR_ARGUMENT (a bad camera, a NULL image, a bar that is not finite
- *  and > 0). */
+ *  may be NULL or "": the length alone; a byte outside printable ASCII is drawn as '?', the
+ *  font has no other glyphs); light on a dark corner, dark where the corner's mean luma is
+ *  over 140 of 255 (a white background). `box` (may be NULL) receives the corner box drawn
+ *  in; `bar_box` (may be NULL) the bar's own pixels, ticks included. `unit` is read during
+ *  the call only.
+ *  @return IP_OK, IP_ERR_ARGUMENT (a bad camera, a NULL image, a bar that is not finite and
+ *  > 0, or a bar or label that would not fit whole in the image: nothing is drawn) or
+ *  IP_ERR_NOMEM. */
 IP_API ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera,
                                            const ip_scale_bar *bar, const char *unit,
                                            uint32_t box[4], uint32_t bar_box[4], ip_error *err);

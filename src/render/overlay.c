@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
@@ -32,9 +33,9 @@ typedef struct overlay_sizes {
     double arm;
 } overlay_sizes;
 
-static overlay_sizes sizes_of(const ip_camera *camera)
+static overlay_sizes sizes_of(uint32_t width, uint32_t height)
 {
-    int side = (int)(camera->width < camera->height ? camera->width : camera->height);
+    int side = (int)(width < height ? width : height);
     overlay_sizes s;
     int scale = (side + 120) / 240; /* the nearest whole multiple of 240 pixels */
     s.text_scale = scale < 1 ? 1 : scale > 4 ? 4 : scale;
@@ -60,6 +61,8 @@ static void blend(const canvas *cv, int x, int y, colour c, double a)
 /* A filled rectangle of pixels [x0, x1) x [y0, y1). */
 static void fill_rect(const canvas *cv, int x0, int y0, int x1, int y1, colour c)
 {
+    x0 = x0 < 0 ? 0 : x0, y0 = y0 < 0 ? 0 : y0; /* the rest is outside the image */
+    x1 = x1 > cv->width ? cv->width : x1, y1 = y1 > cv->height ? cv->height : y1;
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++)
             blend(cv, x, y, c, 1);
@@ -88,23 +91,45 @@ static void draw_segment(const canvas *cv, double ax, double ay, double bx, doub
  * stb_easy_font_height(), adds the spacing between lines). */
 #define GLYPH_HEIGHT 7
 
+/* Room for one glyph's quads: stb_easy_font gives a printable ASCII character at most 11
+ * (measured over ' ' to '~'), each 64 bytes (4 vertices of 3 floats and 4 bytes of colour). */
+#define GLYPH_BUFFER_BYTES (16 * 64)
+
+/* `c`, or '?' where stb_easy_font has no glyph (outside ' ' to '~': it would index its
+ * tables out of bounds; a '\n' would start a line). */
+static char printable(char c)
+{
+    return c < ' ' || c > '~' ? '?' : c;
+}
+
+/* The advance of one line of `text` in font units (stb_easy_font_width() of each character:
+ * its widths add up, no spacing being set). */
+static int text_units(const char *text)
+{
+    int units = 0;
+    for (; *text; text++) {
+        char one[2] = {printable(*text), 0};
+        units += stb_easy_font_width(one);
+    }
+    return units;
+}
+
 /* The width and height of one line of `text` in pixels at `scale`. */
 static void text_size(const char *text, int scale, int *w, int *h)
 {
-    *w = stb_easy_font_width((char *)text) * scale;
+    *w = text_units(text) * scale;
     *h = GLYPH_HEIGHT * scale;
 }
 
-/* Draws `text` with its top-left corner at (left, top), `scale` times stb_easy_font's size,
- * over a shadow one text pixel down and right: stb_easy_font's quads are axis-aligned
- * rectangles, filled here scaled up. */
-static void draw_text(const canvas *cv, int left, int top, const char *text, int scale, colour c,
-                      colour shadow)
+/* Fills the glyphs of `text` (each character's quads, axis-aligned rectangles, scaled up),
+ * with the top-left corner at (left, top), in colour c. One character at a time: no buffer
+ * for the whole text. */
+static void fill_glyphs(const canvas *cv, int left, int top, const char *text, int scale, colour c)
 {
-    char quads[32 * 270]; /* stb_easy_font's estimate: about 270 bytes a character */
-    int count = stb_easy_font_print(0, 0, (char *)text, NULL, quads, (int)sizeof quads);
-    for (int pass = 0; pass < 2; pass++) {
-        int offset = pass == 0 ? scale : 0;
+    int pen = 0; /* font units */
+    for (; *text; text++) {
+        char one[2] = {printable(*text), 0}, quads[GLYPH_BUFFER_BYTES];
+        int count = stb_easy_font_print(0, 0, one, NULL, quads, (int)sizeof quads);
         for (int q = 0; q < count; q++) {
             float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
             for (int k = 0; k < 4; k++) { /* a vertex: x, y, z floats, then 4 bytes of colour */
@@ -115,11 +140,57 @@ static void draw_text(const canvas *cv, int left, int top, const char *text, int
                     hi[a] = v[a] > hi[a] ? v[a] : hi[a];
                 }
             }
-            fill_rect(cv, left + offset + (int)lo[0] * scale, top + offset + (int)lo[1] * scale,
-                      left + offset + (int)hi[0] * scale, top + offset + (int)hi[1] * scale,
-                      pass == 0 ? shadow : c);
+            fill_rect(cv, left + (pen + (int)lo[0]) * scale, top + (int)lo[1] * scale,
+                      left + (pen + (int)hi[0]) * scale, top + (int)hi[1] * scale, c);
         }
+        pen += stb_easy_font_width(one);
     }
+}
+
+/* Draws one line of `text` with its top-left corner at (left, top), `scale` times
+ * stb_easy_font's size; with a shadow (may be NULL), first the whole text in it one text
+ * pixel down and right. */
+static void draw_text(const canvas *cv, int left, int top, const char *text, int scale, colour c,
+                      const colour *shadow)
+{
+    if (shadow)
+        fill_glyphs(cv, left + scale, top + scale, text, scale, *shadow);
+    fill_glyphs(cv, left, top, text, scale, c);
+}
+
+/* The text functions' limits: a scale, and how far outside the image a corner may lie (so
+ * that no pixel coordinate overflows). */
+#define TEXT_MAX_SCALE 16
+#define TEXT_MAX_OFFSET (1 << 24)
+
+uint32_t ip_overlay_text_width(const char *text, int scale)
+{
+    if (!text || scale < 1 || scale > TEXT_MAX_SCALE)
+        return 0;
+    return (uint32_t)text_units(text) * (uint32_t)scale;
+}
+
+ip_status ip_overlay_draw_text(uint8_t *rgba, uint32_t width, uint32_t height, int left, int top,
+                               const char *text, int scale, const uint8_t ink[3],
+                               const uint8_t shadow[3], ip_error *err)
+{
+    if (!rgba || !text || !ink || width < 1 || height < 1 || width > INT32_MAX / 4 ||
+        height > INT32_MAX / 4)
+        return ip__fail(err, IP_ERR_ARGUMENT, "text: no image, text or ink, or a %ux%u image",
+                        width, height);
+    if (scale < 1 || scale > TEXT_MAX_SCALE)
+        return ip__fail(err, IP_ERR_ARGUMENT, "text: scale %d is not 1 to %d", scale,
+                        TEXT_MAX_SCALE);
+    if (left < -TEXT_MAX_OFFSET || left > TEXT_MAX_OFFSET || top < -TEXT_MAX_OFFSET ||
+        top > TEXT_MAX_OFFSET)
+        return ip__fail(err, IP_ERR_ARGUMENT, "text: corner %d,%d is too far out", left, top);
+    canvas cv = {rgba, (int)width, (int)height};
+    const colour c = {ink[0], ink[1], ink[2]};
+    colour under = {0, 0, 0};
+    if (shadow)
+        under = (colour){shadow[0], shadow[1], shadow[2]};
+    draw_text(&cv, left, top, text, scale, c, shadow ? &under : NULL);
+    return IP_OK;
 }
 
 /* The mean luma (0 to 255) of the image's pixels in [x0, x1) x [y0, y1), clipped; 0 when
@@ -148,6 +219,43 @@ static void report_box(const ip_camera *camera, int x0, int y0, int x1, int y1, 
         box[k] = (uint32_t)(b[k] < 0 ? 0 : b[k]);
 }
 
+/* Where the triad goes in a width x height image: its centre (cx, cy), the labels' distance
+ * from it (reach) and their gap beyond the arms' tips, and the box {x0, y0, x1, y1} that holds
+ * arms and labels, which may reach out of a small image. */
+typedef struct axes_geometry {
+    overlay_sizes s;
+    double gap, reach, cx, cy;
+    int radius, box[4];
+} axes_geometry;
+
+static void axes_geometry_of(uint32_t width, uint32_t height, axes_geometry *g)
+{
+    g->s = sizes_of(width, height);
+    /* each label is centred beyond its arm's tip, `gap` out: the box holds arm and label */
+    g->gap = GLYPH_HEIGHT * g->s.text_scale * 0.5 + 2 + g->s.text_scale;
+    g->reach = g->s.arm + g->gap;
+    g->radius = (int)ceil(g->reach + g->gap);
+    g->cx = g->s.margin + g->radius;
+    g->cy = (double)height - g->s.margin - g->radius;
+    g->box[0] = (int)floor(g->cx - g->radius);
+    g->box[1] = (int)floor(g->cy - g->radius);
+    g->box[2] = (int)ceil(g->cx + g->radius) + 1;
+    g->box[3] = (int)ceil(g->cy + g->radius) + 1;
+}
+
+ip_status ip_overlay_axes_check(uint32_t width, uint32_t height, ip_error *err)
+{
+    axes_geometry g;
+    if (width < 1 || height < 1 || width > INT32_MAX / 2 || height > INT32_MAX / 2)
+        return ip__fail(err, IP_ERR_ARGUMENT, "axes: an image of %ux%u pixels", width, height);
+    axes_geometry_of(width, height, &g);
+    if (g.box[0] < 0 || g.box[1] < 0 || g.box[2] > (int)width || g.box[3] > (int)height)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "axes: the triad needs an image of at least %dx%d pixels, not %ux%u",
+                        g.box[2], g.s.margin + 2 * g.radius, width, height);
+    return IP_OK;
+}
+
 static ip_status check_image(const uint8_t *rgba, const ip_camera *camera, ip_error *err)
 {
     if (!rgba || !camera)
@@ -161,6 +269,8 @@ ip_status ip_scale_bar_choose(const ip_camera *camera, double max_pixels, ip_sca
     ip_status st = ip_camera_check(camera, err);
     if (st != IP_OK)
         return st;
+    if (!bar)
+        return ip__fail(err, IP_ERR_ARGUMENT, "scale bar: nowhere to put it");
     if (!(max_pixels > 0 && isfinite(max_pixels)))
         return ip__fail(err, IP_ERR_ARGUMENT, "scale bar: %g pixels is not a length", max_pixels);
     double pixel_size = ip_camera_pixel_size(camera, camera->height);
@@ -215,19 +325,17 @@ ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
                                const ip_orientation *orientation, uint32_t box[4], ip_error *err)
 {
     ip_status st = check_image(rgba, camera, err);
+    if (st == IP_OK)
+        st = ip_overlay_axes_check(camera->width, camera->height, err);
     if (st != IP_OK)
         return st;
     if (!orientation)
         return ip__fail(err, IP_ERR_ARGUMENT, "axes: no orientation");
     canvas cv = {rgba, (int)camera->width, (int)camera->height};
-    overlay_sizes s = sizes_of(camera);
+    axes_geometry g;
+    axes_geometry_of(camera->width, camera->height, &g);
     double screen[3][3];
     ip_overlay_axis_directions(camera, orientation, screen);
-    /* each label is centred beyond its arm's tip, `gap` out: the box holds arm and label */
-    double gap = GLYPH_HEIGHT * s.text_scale * 0.5 + 2 + s.text_scale;
-    double reach = s.arm + gap;
-    int radius = (int)ceil(reach + gap);
-    double cx = s.margin + radius, cy = (double)camera->height - s.margin - radius;
     /* farthest arm first, so that a nearer one passes over it */
     int order[3] = {0, 1, 2};
     for (int i = 0; i < 3; i++)
@@ -237,24 +345,24 @@ ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
                 order[i] = order[j];
                 order[j] = t;
             }
-    double stroke = 1.0 + 0.5 * s.text_scale;
+    int scale = g.s.text_scale;
+    double stroke = 1.0 + 0.5 * scale, arm = g.s.arm;
     for (int i = 0; i < 3; i++) {
         int a = order[i];
-        double tx = cx + s.arm * screen[a][0], ty = cy + s.arm * screen[a][1];
-        draw_segment(&cv, cx, cy, tx, ty, stroke + 1.5, dark);
-        draw_segment(&cv, cx, cy, tx, ty, stroke, axis_colours[a]);
+        double tx = g.cx + arm * screen[a][0], ty = g.cy + arm * screen[a][1];
+        draw_segment(&cv, g.cx, g.cy, tx, ty, stroke + 1.5, dark);
+        draw_segment(&cv, g.cx, g.cy, tx, ty, stroke, axis_colours[a]);
         /* the label beyond the tip, along the arm's direction in the image */
         double len = hypot(screen[a][0], screen[a][1]);
         double ux = len > 1e-6 ? screen[a][0] / len : 0, uy = len > 1e-6 ? screen[a][1] / len : 0;
         const char *label = ip_overlay_axis_label(orientation->space, a);
         int w, h;
-        text_size(label, s.text_scale, &w, &h);
-        double lx = tx + (reach - s.arm) * ux, ly = ty + (reach - s.arm) * uy;
-        draw_text(&cv, (int)lround(lx - w / 2.0), (int)lround(ly - h / 2.0), label, s.text_scale,
-                  axis_colours[a], dark);
+        text_size(label, scale, &w, &h);
+        double lx = tx + (g.reach - arm) * ux, ly = ty + (g.reach - arm) * uy;
+        draw_text(&cv, (int)lround(lx - w / 2.0), (int)lround(ly - h / 2.0), label, scale,
+                  axis_colours[a], &dark);
     }
-    report_box(camera, (int)floor(cx - radius), (int)floor(cy - radius), (int)ceil(cx + radius) + 1,
-               (int)ceil(cy + radius) + 1, box);
+    report_box(camera, g.box[0], g.box[1], g.box[2], g.box[3], box);
     return IP_OK;
 }
 
@@ -269,25 +377,38 @@ ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera, cons
                   isfinite(bar->pixels) && bar->pixels < 1e9))
         return ip__fail(err, IP_ERR_ARGUMENT, "scale bar: not a length");
     canvas cv = {rgba, (int)camera->width, (int)camera->height};
-    overlay_sizes s = sizes_of(camera);
+    overlay_sizes s = sizes_of(camera->width, camera->height);
     long n = lround(bar->pixels);
     if (n < 1)
         n = 1;
     int thick = (int)lround(1.5 * s.text_scale) < 2 ? 2 : (int)lround(1.5 * s.text_scale);
     int x1 = cv.width - s.margin, x0 = (int)(x1 - n), y1 = cv.height - s.margin, y0 = y1 - thick;
     int tick = thick * 2, tick_w = thick < (int)n ? thick : (int)n;
-    char label[96];
+    size_t size = (unit ? strlen(unit) : 0) + 32; /* "%g " and the unit */
+    char *label = malloc(size);
+    if (!label)
+        return ip__fail(err, IP_ERR_NOMEM, "scale bar: out of memory");
     if (unit && unit[0])
-        snprintf(label, sizeof label, "%g %.60s", bar->length, unit);
+        snprintf(label, size, "%g %s", bar->length, unit);
     else
-        snprintf(label, sizeof label, "%g", bar->length);
+        snprintf(label, size, "%g", bar->length);
+    for (char *p = label; *p; p++) /* a control character would break the message's line */
+        *p = (unsigned char)*p < ' ' || *p == 127 ? '?' : *p;
     int w, h;
     text_size(label, s.text_scale, &w, &h);
     int lx = (x0 + x1) / 2 - w / 2, ly = y1 - tick - s.margin - h;
     if (lx + w + s.text_scale > x1)
         lx = x1 - w - s.text_scale; /* a label wider than the bar ends at its right end */
-    /* light on a dark corner, dark on a light one (a white figure background) */
     int left = x0 < lx ? x0 : lx;
+    if (left < 0 || ly < 0) { /* the bar or its label would be cut: draw nothing */
+        st = ip__fail(err, IP_ERR_ARGUMENT,
+                      "scale bar: \"%.60s\" and its bar need %ldx%d pixels in the corner, more "
+                      "than the %ux%u image has",
+                      label, (long)cv.width - left, cv.height - ly, camera->width, camera->height);
+        free(label);
+        return st;
+    }
+    /* light on a dark corner, dark on a light one (a white figure background) */
     int bright = mean_luma(&cv, left, ly, x1 + s.text_scale, y1 + 1) > 140;
     colour ink = bright ? dark : light, shadow = bright ? light : dark;
     /* the bar and its end ticks (inside its length), over a shadow one pixel below them */
@@ -295,7 +416,8 @@ ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera, cons
     fill_rect(&cv, x0, y0, x1, y1, ink);
     fill_rect(&cv, x0, y1 - tick, x0 + tick_w, y0, ink);
     fill_rect(&cv, x1 - tick_w, y1 - tick, x1, y0, ink);
-    draw_text(&cv, lx, ly, label, s.text_scale, ink, shadow);
+    draw_text(&cv, lx, ly, label, s.text_scale, ink, &shadow);
+    free(label);
     report_box(camera, left, ly, x1 + s.text_scale, y1 + 1, box);
     report_box(camera, x0, y1 - tick, x1, y1, bar_box);
     return IP_OK;

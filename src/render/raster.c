@@ -582,6 +582,8 @@ ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count, const ip_
     ip_status st = check_surfaces(surfaces, count, camera, shading, lo, hi, err);
     if (st != IP_OK)
         return st;
+    if (!rgba)
+        return ip__fail(err, IP_ERR_ARGUMENT, "raster: no image to draw the surfaces into");
     ip_shading s;
     if (shading)
         s = *shading;

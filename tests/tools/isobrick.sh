@@ -80,6 +80,9 @@ expect_error 1 "nothere.raw" "$bin/isobrick" nothere.raw -o nothere.ibv
 expect_error 2 "--dims" "$bin/isobrick" "$raw" --dims 40x30 -o x.ibv
 expect_error 2 "unknown" "$bin/isobrick" "$raw" --frobnicate
 expect_error 2 "--brick-size '12' is not a power of two" "$bin/isobrick" "$raw" --brick-size 12 -o b12.ibv
+expect_error 2 "--mem-mb '0' is not a size in MiB (1 to 1099511627776)" "$bin/isobrick" "$raw" \
+    --mem-mb 0 -o m0.ibv
+expect_error 2 "--mem-mb 'lots' is not a size in MiB" "$bin/isobrick" "$raw" --mem-mb lots -o m0.ibv
 check "no output after a bad brick size" test ! -e b12.ibv
 
 # --- existing output: kept without --force, replaced with it ---

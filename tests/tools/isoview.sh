@@ -12,8 +12,9 @@ compare=$bin/tests/png_compare
 expect_error 2 "--iso" "$bin/isoview" s.ibv
 expect_error 2 "--size" "$bin/isoview" s.ibv --iso 1 --size 12
 expect_error 2 "--lod" "$bin/isoview" s.ibv --iso 1 --lod maybe
-expect_error 2 "--aa '0'" "$bin/isoview" s.ibv --iso 1 --aa 0
-expect_error 2 "--aa '32'" "$bin/isoview" s.ibv --iso 1 --aa 32
+expect_error 2 "--aa '0' is not a sample count (1 to 16)" "$bin/isoview" s.ibv --iso 1 --aa 0
+expect_error 2 "--aa '32' is not a sample count (1 to 16)" "$bin/isoview" s.ibv --iso 1 --aa 32
+expect_error 2 "--iso given 2 times: isoview shows one surface" "$bin/isoview" s.ibv --iso 1 --iso 2
 expect_error 1 "nothere.ibv" "$bin/isoview" nothere.ibv --iso 1
 expect_error 2 "view" "$bin/isoview" s.ibv --iso 1 --view +w
 printf 'iso 1\norbit 10\n' >bad.txt

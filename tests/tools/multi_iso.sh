@@ -27,6 +27,7 @@ differ() { # differ DESCRIPTION A B: more than 5 % of the pixels differ by more 
 expect_error 2 "--opacity '0'" render --iso 60 --opacity 0
 expect_error 2 "--opacity '1.5'" render --iso 60 --opacity 1.5
 expect_error 2 "--opacity 'abc'" render --iso 60 --opacity abc
+expect_error 2 "--opacity '1e-50' is not a number in (0, 1]" render --iso 60 --opacity 1e-50
 expect_error 2 "--iso given 5 times" render --iso 10 --iso 20 --iso 30 --iso 40 --iso 50
 expect_error 2 "--iso 60 is given twice" render --iso 60 --iso 180 --iso 60.0
 expect_error 2 "3 --color and 0 --opacity for 2 --iso" render --iso 60 --iso 180 \
@@ -118,6 +119,18 @@ expect_error 1 "m_iso60.ply" render --iso 60 --iso 180 -o m2.png --mesh m.ply
 : >taken_iso180.ply
 expect_error 1 "taken_iso180.ply" render --iso 60 --iso 180 -o t.png --mesh taken.ply
 check "and then nothing is written" test ! -e t.png -a ! -e taken_iso60.ply
+# the summary: each surface's counts and extraction times, then the image's one rendering time
+run_capture "$bin/isorender" s.ibv --size 120x90 --software --iso 60 --iso 180 -o sum.png
+check "the summary gives each surface" \
+    test "$(printf '%s\n' "$out" | grep -c '^  surface [12]     iso \(60\|180\)$')" = 2
+check "... and the rendering once, not per surface" \
+    test "$(printf '%s\n' "$out" | grep -c '^  rendering     [0-9.]* s (software), the surfaces together$')" = 1 \
+    -a "$(printf '%s\n' "$out" | grep -c '; rendering')" = 0
+expect_error 2 "--mesh m.xyz: the name must end in" render --iso 60 --iso 180 -o x.png --mesh m.xyz
+# isovalues that "%g" would both write as 100 keep the digits that tell them apart
+render --iso 100.0001 --iso 100.0002 --iso 0.1 -o n.png --mesh n.ply 2>/dev/null
+check "--mesh names 100.0001, 100.0002 and 0.1 apart" \
+    test -s n_iso100.0001.ply -a -s n_iso100.0002.ply -a -s n_iso0.1.ply
 
 # --full: the whole surfaces, the same picture
 render --iso 60 --iso 180 --color "$outer" --color "$inner" --opacity 0.4 --full -o full.png

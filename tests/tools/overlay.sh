@@ -13,6 +13,18 @@ render() { "$bin/isorender" c.ibv --iso 60 --size 320x240 --full --quiet --force
 
 expect_error 2 "--scale-unit needs --scale-bar" render --scale-unit mm -o x.png
 check "a refused run writes nothing" test ! -e x.png
+# an overlay is drawn whole or not at all: the triad needs 63x62 pixels (before any work);
+# the scale bar's label is known only once the view is, so a bar that does not fit ends the
+# run with nothing written
+expect_error 2 "--axes: the triad needs an image of at least 63x62 pixels, not 16x16" \
+    render --size 16x16 --axes -o x.png
+expect_error 2 "not 62x62" render --size 62x62 --axes --software -o x.png
+check "a refused --axes writes nothing" test ! -e x.png
+render --size 63x62 --axes --software -o small.png
+check "63x62 takes the triad" test -s small.png
+expect_error 1 "c.ibv: --scale-bar: \"10 units\" and its bar need 48x19 pixels in the corner, more than the 40x40 image has" \
+    render --size 40x40 --scale-bar --software -o x.png
+check "a scale bar that does not fit writes nothing" test ! -e x.png
 
 # box WORD TEXT: the "x0,y0 to x1,y1" after WORD in TEXT, as "x0 y0 x1 y1"
 box() { printf '%s\n' "$2" | sed -n "s/.*$1 \([0-9]*\),\([0-9]*\) to \([0-9]*\),\([0-9]*\).*/\1 \2 \3 \4/p"; }
@@ -81,6 +93,10 @@ check "--zoom 2: 10 units would be twice as long, 5 fit ($err)" \
     sh -c 'printf "%s" "$0" | grep -q "scale bar: 5 units = "' "$err"
 run_capture render --camera $camera --software --scale-bar --scale-unit mm -v -o mm.png
 check "--scale-unit names the unit" sh -c 'printf "%s" "$0" | grep -q "scale bar: 10 mm = "' "$err"
+# a unit the font has no glyphs for (UTF-8 "um" with a micro sign) is drawn with '?'
+render --camera $camera --software --scale-bar --scale-unit "$(printf '\302\265m')" -o micro.png
+render --camera $camera --software --scale-bar --scale-unit '??m' -o qm.png
+check "a non-ASCII unit draws as ?" "$compare" micro.png qm.png
 
 # The triad follows the camera: from -y, x points right; turned by 180 degrees, left
 direction() { printf '%s\n' "$1" | sed -n "s/.* $2 \([-+][0-9.]*\),\([-+][0-9.]*\),.*/\1 \2/p"; }

@@ -27,6 +27,13 @@ const char isoview_help_table[] = "left drag\torbit around the target\n"
                                   "h\tthis help\n"
                                   "Esc\tquit";
 
+void layout_printable(char *text)
+{
+    for (; *text; text++)
+        if (*text < ' ' || *text > '~')
+            *text = '?';
+}
+
 float layout_text_width(const char *text, size_t length)
 {
     char copy[LAYOUT_MAX_CELL + 1];
@@ -34,6 +41,7 @@ float layout_text_width(const char *text, size_t length)
         length = LAYOUT_MAX_CELL;
     memcpy(copy, text, length);
     copy[length] = 0;
+    layout_printable(copy);
     return (float)stb_easy_font_width(copy);
 }
 

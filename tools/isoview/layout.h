@@ -23,6 +23,9 @@ extern const char isoview_help_table[];
 
 /* The width of text[0 .. length) in stb_easy_font units. */
 float layout_text_width(const char *text, size_t length);
+/* Replaces each byte of `text` that the font has no glyph for (outside ' ' to '~', which it
+ * would look up out of its tables' bounds: UTF-8 in a file name, say) with '?'. */
+void layout_printable(char *text);
 
 /* Lays out `text`: column c of every row starts at the same x, the widest cell of column c - 1
  * plus `gap` after column c - 1's x; row r is at y = r * LAYOUT_LINE_HEIGHT. A row with fewer

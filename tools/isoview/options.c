@@ -62,11 +62,10 @@ static int parse_exit_after(const char *p, const tool_option *opt, const char *c
 static int parse_aa(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     uint64_t samples;
-    (void)opt;
-    if (tool_parse_u64(v[0], &samples) != 0 || samples < 1 || samples > 16)
-        return tool_usage_error(p, "--aa '%s' is not a sample count (1 to 16)", v[0]);
-    ((options *)base)->aa = (int)samples;
-    return 0;
+    int rc = tool_parse_bounded(p, opt->name, v[0], 1, 16, "a sample count", &samples);
+    if (rc == 0)
+        ((options *)base)->aa = (int)samples;
+    return rc;
 }
 
 static const tool_option isoview_options[] = {
@@ -83,7 +82,13 @@ int parse_args(int argc, char **argv, options *o)
     o->screenshot_at = -1;
     o->exit_after = -1;
     o->aa = 1;
-    return tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
-                                        sizeof isoview_options / sizeof isoview_options[0], o,
-                                        &o->file, argc, argv);
+    int rc = tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
+                                          sizeof isoview_options / sizeof isoview_options[0], o,
+                                          &o->file, argc, argv);
+    if (rc == 0 && o->common.iso_count > 1) /* isorender draws each; here one would be lost */
+        return tool_usage_error("isoview",
+                                "--iso given %u times: isoview shows one surface (isorender "
+                                "draws several)",
+                                o->common.iso_count);
+    return rc;
 }

@@ -118,6 +118,7 @@ static int fill_quads(overlay *t, const text_cell *cells, size_t n, float w, flo
         size_t length = cells[i].length < LAYOUT_MAX_CELL ? cells[i].length : LAYOUT_MAX_CELL;
         memcpy(copy, cells[i].text, length);
         copy[length] = 0;
+        layout_printable(copy);
         int room = t->quads_size - quads * QUAD_BYTES;
         if (room < QUAD_BYTES)
             break;
