@@ -389,6 +389,13 @@ ip_status ip_engine_set_region(ip_engine *e, uint32_t x, uint32_t y, uint32_t wi
     for (unsigned t = 0; t < e->threads; t++) {
         e->workers[t].order = e->order;
         e->workers[t].holding = 0;
+        for (uint32_t k = 0; k < e->levels_used; k++) { /* propagate within the rectangle */
+            double *window = e->workers[t].level[k].propagator.window;
+            window[0] = x;
+            window[1] = y;
+            window[2] = (double)x + width;
+            window[3] = (double)y + height;
+        }
     }
     begin_prefetch(e);
     return IP_OK;
