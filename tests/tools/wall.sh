@@ -11,13 +11,19 @@ if ! command -v mpirun >/dev/null 2>&1; then
     exit 77
 fi
 compare=$bin/tests/png_compare
-# OpenMPI under LeakSanitizer: what MPI's own libraries keep until exit is not isoprop's
-if [ -n "${IP_SANITIZE:-}" ]; then
-    printf 'leak:libmpi.so\nleak:libopen-pal.so\nleak:libopen-rte.so\nleak:libpmix.so\nleak:mca_\nleak:libhwloc.so\nleak:libevent\n' >lsan.supp
-    export LSAN_OPTIONS="suppressions=$work/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
-fi
+# Under AddressSanitizer, leak checking is off in the MPI processes: OpenMPI unloads its
+# components at MPI_Finalize, so LeakSanitizer cannot name the frames of what they kept (an
+# "unknown module"), and no suppression can match them. Memory errors are still caught, and the
+# library calls isowall makes (ip_engine_set_region(), ip_raster_mesh_part()) are leak-checked
+# by test_engine.
+case "${IP_SANITIZE:-}" in
+*address*)
+    echo "note: leak checking off in the MPI processes (OpenMPI's unloaded components)"
+    export ASAN_OPTIONS="detect_leaks=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
+    ;;
+esac
 wall() { # wall ARGS...: isowall on 4 processes over g.ibv, 3x2 tiles of 160x120
-    timeout 300 mpirun --oversubscribe --allow-run-as-root -np 4 -x LSAN_OPTIONS \
+    timeout 300 mpirun --oversubscribe --allow-run-as-root -np 4 \
         "$bin/isowall" g.ibv --iso 0.5 --wall 3x2 --tile 160x120 --quiet "$@"
 }
 
