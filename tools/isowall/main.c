@@ -35,6 +35,8 @@ typedef struct wall_run {
     ip_cache *cache;
     ip_engine *engine;
     wall_layout layout;
+    double *cost;           /* per region: CPU seconds of its first pass (summed over the ranks) */
+    uint32_t *second;       /* dynamic: the second pass's order of the regions, costliest first */
     MPI_Win counter_window; /* dynamic: two counters on rank 0, one per pass */
     int64_t *counters;      /* rank 0's (NULL elsewhere) */
     int window_made;
@@ -116,13 +118,16 @@ static int64_t next_unit(wall_run *r, int pass, int64_t *cursor)
         return *cursor < count ? (*cursor)++ : -1;
     }
     int64_t one = 1, got;
+    /* dynamic */
     double wait = MPI_Wtime();
     MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, r->counter_window);
     MPI_Fetch_and_op(&one, &got, MPI_INT64_T, 0, pass, MPI_SUM, r->counter_window);
     MPI_Win_unlock(0, r->counter_window);
     r->idle += MPI_Wtime() - wait;
     r->bytes_sent += sizeof one;
-    return got < count ? got : -1;
+    if (got >= count)
+        return -1;
+    return pass ? (int64_t)r->second[got] : got;
 }
 
 /* Casts the rays of one pass over the units this rank takes. */
@@ -142,10 +147,52 @@ static int run_pass(wall_run *r, int pass, ip_error *err)
                 if (ip_engine_step(r->engine, 0, 0, NULL, err) != IP_OK)
                     return -1;
         }
-        r->busy += wall_cpu_seconds() - start;
+        double spent = wall_cpu_seconds() - start;
+        r->busy += spent;
+        if (pass == 0)
+            r->cost[u] = spent;
         r->units++;
     }
     return 0;
+}
+
+typedef struct costed {
+    double cost;
+    uint32_t region;
+} costed;
+
+static int compare_cost(const void *a, const void *b)
+{
+    const costed *x = a, *y = b;
+    if (x->cost != y->cost)
+        return x->cost > y->cost ? -1 : 1;
+    return (x->region > y->region) - (x->region < y->region);
+}
+
+/* After the first pass: every rank learns what each region's coarse rays cost, and the second
+ * pass hands out the costliest regions first (longest processing time first), so that the
+ * last units, which decide the balance, are small ones. Every rank computes the same order. */
+static void order_second_pass(wall_run *r)
+{
+    uint32_t n = r->layout.region_count;
+    double wait = MPI_Wtime();
+    MPI_Allreduce(MPI_IN_PLACE, r->cost, (int)n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    r->idle += MPI_Wtime() - wait;
+    r->bytes_sent += (uint64_t)n * sizeof *r->cost;
+    double start = wall_cpu_seconds();
+    costed *order = malloc(n * sizeof *order);
+    if (!order) { /* keep the progressive order */
+        for (uint32_t i = 0; i < n; i++)
+            r->second[i] = i;
+        return;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        order[i] = (costed){r->cost[i], i};
+    qsort(order, n, sizeof *order, compare_cost);
+    for (uint32_t i = 0; i < n; i++)
+        r->second[i] = order[i].region;
+    free(order);
+    r->busy += wall_cpu_seconds() - start;
 }
 
 /* Rank 0's wall image receives each tile. */
@@ -223,6 +270,8 @@ static int extract(wall_run *r)
         r->idle += MPI_Wtime() - wait;
         if (pass == 0) {
             r->coarse_seconds = MPI_Wtime() - r->start;
+            if (!r->o.is_static)
+                order_second_pass(r);
             if (r->o.coarse) {
                 composite(r, 0);
                 if (write_image(r, r->o.coarse) != 0)
@@ -398,6 +447,12 @@ static int open_run(wall_run *r)
         MPI_Win_unlock(0, r->counter_window);
     }
     size_t pixels = (size_t)r->layout.camera.width * r->layout.camera.height;
+    r->cost = calloc(r->layout.region_count, sizeof *r->cost);
+    r->second = malloc(r->layout.region_count * sizeof *r->second);
+    if (!r->cost || !r->second)
+        fprintf(stderr, "%s: out of memory for the regions\n", r->program);
+    if (!all_ok(r->cost && r->second))
+        return 1;
     int need_image = !r->o.tiles_dir || r->o.coarse;
     if (r->rank == 0 && need_image && !(r->image = malloc(4 * pixels)))
         fprintf(stderr, "%s: out of memory for the %ux%u image\n", r->program,
@@ -416,6 +471,8 @@ static void close_run(wall_run *r)
     ip_cache_destroy(r->cache);
     ip_store_close(r->store);
     free(r->layout.regions);
+    free(r->cost);
+    free(r->second);
     free(r->image);
 }
 
