@@ -10,15 +10,15 @@
 #
 #   tools/bench_wall.sh WORK_DIR [BUILD_DIR] [RAW_FILE]
 #   defaults: build ../shared/data/ct_head_visible_woman_512x512x234_uint16.raw
-#   IP_WALL_TILE (default 640x512): the tile of the bad case; IP_WALL_REPEATS (default 3):
-#   runs of each case, the one of median balance shown; IP_WALL_MPIRUN_ARGS: more mpirun
+#   IP_WALL_TILE (default 1280x1024): the tile of the bad case; IP_WALL_REPEATS (default 5):
+#   runs of each case, the one of median balance shown, with the range of balance; IP_WALL_MPIRUN_ARGS: more mpirun
 #   options (default --mca osc sm, see docs/scale-out.md)
 set -eu
 work=${1:?usage: tools/bench_wall.sh WORK_DIR [BUILD_DIR] [RAW_FILE]}
 build=${2:-build}
 raw=${3:-../shared/data/ct_head_visible_woman_512x512x234_uint16.raw}
-tile=${IP_WALL_TILE:-640x512}
-repeats=${IP_WALL_REPEATS:-3}
+tile=${IP_WALL_TILE:-1280x1024}
+repeats=${IP_WALL_REPEATS:-5}
 mpi_args=${IP_WALL_MPIRUN_ARGS:---mca osc sm}
 [ -f "$raw" ] || { echo "bench_wall: $raw is missing" >&2; exit 1; }
 for p in isobrick isowall; do
@@ -76,14 +76,16 @@ secs1=$(case_run one 1)
 busy1=$(top "$work/one.json" busy_s)
 tri1=$(top "$work/one.json" triangles)
 echo
-echo "| processes | mode | balance (max/mean busy) | sum busy_s | max busy_s | work / 1 process | triangles / 1 process | bytes sent | wall s |"
-echo "|---|---|---|---|---|---|---|---|---|"
+echo "| processes | mode | balance (max/mean busy) | balance over $repeats runs | sum busy_s | max busy_s | work / 1 process | triangles / 1 process | bytes sent | wall s |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
 row() { # row JSON NP MODE SECONDS
+    range=$(sort -n "${1%.json}.runs" | awk 'NR == 1 { lo = $1 } { hi = $1 } END { printf "%.3f-%.3f", lo, hi }')
     awk -v b="$(top "$1" balance)" -v s="$(top "$1" busy_s)" -v m="$(top "$1" max_busy_s)" \
+        -v range="$range" \
         -v t="$(top "$1" triangles)" -v bytes="$(top "$1" bytes_sent)" -v b1="$busy1" \
         -v t1="$tri1" -v np="$2" -v mode="$3" -v secs="$4" 'BEGIN {
-        printf "| %d | %s | %.3f | %.3f | %.3f | %.2f | %.2f | %.1f MB | %s |\n",
-               np, mode, b, s, m, s / b1, t / t1, bytes / 1e6, secs }'
+        printf "| %d | %s | %.3f | %s | %.3f | %.3f | %.2f | %.2f | %.1f MB | %s |\n",
+               np, mode, b, range, s, m, s / b1, t / t1, bytes / 1e6, secs }'
 }
 row "$work/one.json" 1 "one process" "$secs1"
 for np in 2 4 8; do
