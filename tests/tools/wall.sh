@@ -77,6 +77,15 @@ for c in 0 1 2; do
     done
 done
 
+# --- a bad brick file: one line from isowall (mpirun adds its own), exit 1, no image ---
+echo garbage >bad.ibv
+run_capture timeout 300 mpirun --oversubscribe --allow-run-as-root -np 4 "$bin/isowall" bad.ibv \
+    --iso 0.5 --wall 3x2 --tile 160x120 -o bad.png
+lines=$(printf '%s\n' "$err" | grep -c '^isowall: bad.ibv: ')
+check "a bad brick file: exit 1, one line naming it (got $rc, $lines lines)" \
+    test "$rc" = 1 -a "$lines" = 1
+check "a bad brick file: no image" test ! -e bad.png
+
 # --- bad values: usage errors before MPI starts ---
 expect_error 2 "--wall '0x2'" "$bin/isowall" g.ibv --iso 0.5 --wall 0x2 --tile 160x120
 expect_error 2 "--wall '3'" "$bin/isowall" g.ibv --iso 0.5 --wall 3 --tile 160x120
