@@ -11,15 +11,16 @@
 #   tools/bench_wall.sh WORK_DIR [BUILD_DIR] [RAW_FILE]
 #   defaults: build ../shared/data/ct_head_visible_woman_512x512x234_uint16.raw
 #   IP_WALL_TILE (default 1280x1024): the tile of the bad case; IP_WALL_REPEATS (default 5):
-#   runs of each case, the one of median balance shown, with the range of balance; IP_WALL_MPIRUN_ARGS: more mpirun
-#   options (default --mca osc sm, see docs/scale-out.md)
+#   runs of each case, the one of median balance shown, with the range of balance;
+#   IP_WALL_MPIRUN_ARGS: more mpirun options (default --mca osc sm --bind-to
+#   core:overload-allowed, see docs/scale-out.md)
 set -eu
 work=${1:?usage: tools/bench_wall.sh WORK_DIR [BUILD_DIR] [RAW_FILE]}
 build=${2:-build}
 raw=${3:-../shared/data/ct_head_visible_woman_512x512x234_uint16.raw}
 tile=${IP_WALL_TILE:-1280x1024}
 repeats=${IP_WALL_REPEATS:-5}
-mpi_args=${IP_WALL_MPIRUN_ARGS:---mca osc sm}
+mpi_args=${IP_WALL_MPIRUN_ARGS:---mca osc sm --bind-to core:overload-allowed}
 [ -f "$raw" ] || { echo "bench_wall: $raw is missing" >&2; exit 1; }
 for p in isobrick isowall; do
     [ -x "$build/$p" ] || { echo "bench_wall: $build/$p is missing (isowall needs MPI: tools/setup.sh)" >&2; exit 1; }

@@ -91,6 +91,28 @@ static int draw_tile(wall_composite *c, uint32_t t, const ip_mesh *mesh, uint8_t
     return st == IP_OK ? 0 : -1;
 }
 
+/* The background of tile t into buf, depth 0: the renderer's colours of the tile's first column
+ * (the background varies by row only), repeated along each row. Returns 0 or -1. */
+static int fill_background(wall_composite *c, uint32_t t, uint8_t *buf, uint8_t *column,
+                           ip_error *err)
+{
+    const wall_layout *w = c->layout;
+    size_t pixels = (size_t)w->tile_w * w->tile_h;
+    double start = wall_cpu_seconds();
+    ip_mesh empty;
+    ip_mesh_init(&empty);
+    ip_status st =
+        ip_raster_mesh_part(&empty, &w->camera, c->shading, w->lo, w->hi, t % w->cols * w->tile_w,
+                            t / w->cols * w->tile_h, 1, w->tile_h, NULL, column, err);
+    memset(buf, 0, pixels * sizeof(double));
+    uint8_t *rgba = buf + pixels * sizeof(double);
+    for (uint32_t y = 0; st == IP_OK && y < w->tile_h; y++)
+        for (uint32_t x = 0; x < w->tile_w; x++)
+            memcpy(rgba + 4 * ((size_t)y * w->tile_w + x), column + 4 * (size_t)y, 4);
+    c->busy_seconds += wall_cpu_seconds() - start;
+    return st == IP_OK ? 0 : -1;
+}
+
 int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *done, void *user,
                        ip_error *err)
 {
@@ -99,7 +121,8 @@ int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *d
     size_t pixels = (size_t)w->tile_w * w->tile_h, bytes = tile_bytes(pixels);
     uint8_t *mine = calloc(w->tile_count, 1), *all = malloc((size_t)w->tile_count * ranks);
     uint8_t *result = malloc(bytes), *own = malloc(bytes), *packed = malloc(HEADER + bytes);
-    int rc = mine && all && result && own && packed ? 0 : -1;
+    uint8_t *column = malloc(4 * (size_t)w->tile_h);
+    int rc = mine && all && result && own && packed && column ? 0 : -1;
     if (rc != 0) { /* the caller ends the job */
         err->code = IP_ERR_NOMEM;
         snprintf(err->message, sizeof err->message, "out of memory for a %ux%u tile", w->tile_w,
@@ -115,8 +138,6 @@ int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *d
                   MPI_COMM_WORLD);
     c->idle_seconds += MPI_Wtime() - wait;
     c->bytes_sent += (uint64_t)w->tile_count * (uint64_t)(ranks - 1);
-    ip_mesh empty;
-    ip_mesh_init(&empty);
     for (uint32_t t = 0; t < w->tile_count && rc == 0; t++) {
         int owner = c->owner_of(t, ranks), drawn = 0;
         if (owner != me) { /* draw, send the covered rectangle */
@@ -132,7 +153,7 @@ int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *d
             c->bytes_sent += n;
             continue;
         }
-        rc = draw_tile(c, t, &empty, result, err);   /* the background, depth 0 */
+        rc = fill_background(c, t, result, column, err);
         for (int r = 0; r < ranks && rc == 0; r++) { /* in rank order: ties to the lower */
             if (!all[(size_t)r * w->tile_count + t])
                 continue;
@@ -162,5 +183,6 @@ out:
     free(result);
     free(own);
     free(packed);
+    free(column);
     return rc;
 }
