@@ -368,6 +368,7 @@ ip_status ip_engine_set_region(ip_engine *e, uint32_t x, uint32_t y, uint32_t wi
     ip__ray_order_init(&e->order, width, height);
     uint32_t last = ip__ray_order_last_level(&e->order);
     ip__ray_order_set_local_from(&e->order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
+    e->tile_from = last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0; /* the region order's levels */
     /* the positions of rays [first_ray, first_ray + ray_count) of the region's order */
     ip_ray_order walk = e->order;
     uint32_t px, py;
@@ -485,8 +486,7 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
     ip_engine *e = w->engine;
     double dir[3];
     uint32_t cells[IP_SEED_MAX_CELLS][3];
-    ip_camera_pixel_ray(&e->basis, &e->camera, (double)x + e->region_x + 0.5,
-                        (double)y + e->region_y + 0.5, dir);
+    ip_camera_pixel_ray(&e->basis, &e->camera, x + 0.5, y + 0.5, dir);
     w->counts.rays++;
     double z = stop_depth(e, x, y), cos = ip__vec3_dot(dir, e->basis.forward);
     for (uint32_t k = 0; k < e->levels_used; k++) {
@@ -686,6 +686,8 @@ static unsigned take_rays(ip_engine *e, worker *w, order_ray *rays)
     unsigned n = 0;
     while (n < want && (w->holding || claim_range(e, w))) {
         if (ip__ray_order_next_before(&w->order, w->range_end, &rays[n].x, &rays[n].y)) {
+            rays[n].x += e->region_x; /* the image's pixel (see ip_engine_set_region()) */
+            rays[n].y += e->region_y;
             rays[n].level = ip__ray_order_level(&w->order);
             n++;
         } else
