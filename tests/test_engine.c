@@ -2,7 +2,8 @@
  * progressive mesh equals the image of the full extraction (same coverage, >= 99.99 % equal
  * pixels), and every progressive triangle is a triangle of the full result (same cell, same
  * vertices), with occlusion on (the default) as off. Also: occlusion extracts less hidden
- * surface; empty space reads summaries only; cancel and restart leave nothing stale. */
+ * surface; empty space reads summaries only; cancel and restart leave nothing stale; the image
+ * cast region by region on two engines composites to the full image. */
 #include <dirent.h>
 #include <math.h>
 #include <pthread.h>
@@ -642,6 +643,109 @@ static void check_ray_budgets(scene *s, float iso)
     ip_engine_destroy(e);
 }
 
+/* Sort-first in regions (ip_engine_set_region()): the image is cut into rectangles, each cast
+ * in two passes (its first rays, then the rest) by one of two engines, as two processes of a
+ * display wall would; every region casts exactly its rays, and the nearest-depth composite of
+ * the two meshes' parts (ip_raster_mesh_part()) equals the full extraction's image. */
+static void check_regions(scene *s, float iso)
+{
+    enum {
+        W = 203,
+        H = 151,
+        RW = 48,
+        RH = 40
+    };
+    ip_error err;
+    ip_camera cam;
+    REQUIRE(ip_camera_fit_axis(s->lo, s->hi, "-x", 30.0, W, H, &cam, &err) == IP_OK);
+    ip_engine *e[2]; /* the exact-image tolerance of check_view(): >= 99.99 % equal pixels */
+    ip_engine_options o;
+    ip_engine_options_default(&o);
+    o.lod = 0;
+    o.threads = 2;
+    for (int k = 0; k < 2; k++) {
+        REQUIRE(ip_engine_create(s->cache, &o, &e[k], &err) == IP_OK);
+        CHECK(ip_engine_set_region(e[k], 0, 0, 1, 1, 0, 1, &err) == IP_ERR_ARGUMENT);
+        REQUIRE(ip_engine_begin(e[k], &cam, iso, &err) == IP_OK);
+    }
+    CHECK(ip_engine_set_region(e[0], W - 7, 0, 8, 1, 0, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_engine_set_region(e[0], 0, 0, 0, 5, 0, 0, &err) == IP_ERR_ARGUMENT);
+    CHECK(ip_engine_set_region(e[0], 0, 0, 4, 4, 10, 7, &err) == IP_ERR_ARGUMENT);
+    uint64_t rays = 0, exact = 0, regions = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t y = 0; y < H; y += RH)
+            for (uint32_t x = 0; x < W; x += RW) {
+                uint32_t w = W - x < RW ? W - x : RW, h = H - y < RH ? H - y : RH;
+                uint64_t pixels = (uint64_t)w * h, coarse = pixels / 16 + 1;
+                uint64_t first = pass ? coarse : 0, count = pass ? pixels - coarse : coarse;
+                ip_engine *en = e[(x / RW + y / RH) % 2];
+                REQUIRE(ip_engine_set_region(en, x, y, w, h, first, count, &err) == IP_OK);
+                uint64_t cast = 0;
+                while (!ip_engine_done(en)) {
+                    ip_engine_counts c;
+                    REQUIRE(ip_engine_step(en, 37, 0, &c, &err) == IP_OK);
+                    cast += c.rays;
+                }
+                exact += cast == count;
+                rays += cast;
+                regions++;
+            }
+    CHECK_MSG(exact == regions && rays == (uint64_t)W * H,
+              "regions: %llu of %llu cast their rays; %llu rays for %d pixels",
+              (unsigned long long)exact, (unsigned long long)regions, (unsigned long long)rays,
+              W * H);
+    ip_mesh full;
+    ip_mesh_init(&full);
+    REQUIRE(ip_extract_full(s->cache, iso, 0, 0, &full, NULL, &err) == IP_OK);
+    size_t n = (size_t)W * H;
+    uint8_t *want = malloc(n * 4), *got = malloc(n * 4), *part = malloc(n * 4);
+    double *depth = malloc(n * sizeof *depth), *nearest = calloc(n, sizeof *nearest);
+    REQUIRE(want && got && part && depth && nearest);
+    REQUIRE(ip_raster_mesh(&full, &cam, s->lo, s->hi, NULL, want, &err) == IP_OK);
+    /* a part of the image is drawn exactly as in the whole image */
+    REQUIRE(ip_raster_mesh_part(&full, &cam, NULL, s->lo, s->hi, 31, 17, 40, 30, depth, part,
+                                &err) == IP_OK);
+    size_t part_diff = 0;
+    for (uint32_t y = 0; y < 30; y++)
+        part_diff +=
+            memcmp(part + 4 * (size_t)y * 40, want + 4 * ((y + 17) * (size_t)W + 31), 4 * 40) != 0;
+    CHECK_MSG(part_diff == 0, "ip_raster_mesh_part: %zu rows differ from the whole image",
+              part_diff);
+    CHECK(ip_raster_mesh_part(&full, &cam, NULL, s->lo, s->hi, W - 7, 0, 8, 1, depth, part, &err) ==
+          IP_ERR_ARGUMENT);
+    memcpy(got, want, n * 4);
+    for (int k = 0; k < 2; k++) {
+        REQUIRE(ip_raster_mesh_part(ip_engine_mesh(e[k]), &cam, NULL, s->lo, s->hi, 0, 0, W, H,
+                                    depth, part, &err) == IP_OK);
+        for (size_t i = 0; i < n; i++)
+            if (k == 0 || depth[i] > nearest[i]) {
+                nearest[i] = depth[i];
+                memcpy(got + 4 * i, part + 4 * i, 4);
+            }
+    }
+    size_t diff = 0, covered = 0;
+    for (size_t i = 0; i < n; i++) {
+        diff += memcmp(got + 4 * i, want + 4 * i, 4) != 0;
+        covered += nearest[i] > 0;
+    }
+    printf("test_engine: regions: %llu + %llu triangles (%llu full), %zu covered pixels, %zu "
+           "differ\n",
+           (unsigned long long)ip_engine_mesh(e[0])->triangle_count,
+           (unsigned long long)ip_engine_mesh(e[1])->triangle_count,
+           (unsigned long long)full.triangle_count, covered, diff);
+    CHECK_MSG(covered > n / 50, "regions: the surface covers only %zu pixels", covered);
+    CHECK_MSG(100.0 * (double)(n - diff) / (double)n >= 99.99,
+              "regions: %zu of %zu pixels differ from the full extraction's image", diff, n);
+    free(want);
+    free(got);
+    free(part);
+    free(depth);
+    free(nearest);
+    ip_mesh_free(&full);
+    ip_engine_destroy(e[0]);
+    ip_engine_destroy(e[1]);
+}
+
 static void check_shared_data(void)
 {
     const char *data = getenv("IP_SKIP_SHARED_DATA") ? NULL : getenv("IP_SHARED_DATA");
@@ -692,6 +796,7 @@ int main(void)
     check_view(&s, "gyroid", "+y", 0.6f, 96, 128);
     check_cancel_restart(&s, 0.5f, 0.45f);
     check_ray_budgets(&s, 0.5f);
+    check_regions(&s, 0.5f);
     check_threads(&s, 0.5f);
     close_scene(&s);
 

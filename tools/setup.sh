@@ -22,11 +22,12 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # compares against; GLFW and stb_easy_font for the viewer, and a virtual X server (xvfb-run) for
 # its test; python3 and numpy for the Python module (docs/python.md), which every build puts in
 # build/python; GDCM for DICOM series input and libtiff for TIFF input; help2man for the man
-# pages.
+# pages; OpenMPI (mpirun and its headers) for isowall, the display wall's parallel renderer
+# (docs/scale-out.md).
 packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang clang-format
           lz4 zstd libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri
           libglfw3-dev libstb-dev xvfb xauth python3 python3-numpy libgdcm-dev libtiff-dev
-          help2man"
+          help2man openmpi-bin libopenmpi-dev"
 
 install_missing() {
     missing=""

@@ -162,7 +162,23 @@ IP_API ip_status ip_engine_begin(ip_engine *engine, const ip_camera *camera, flo
 IP_API ip_status ip_engine_step(ip_engine *engine, uint64_t max_rays, double max_seconds,
                                 ip_engine_counts *counts, ip_error *err);
 
-/*! ip_engine_done() : 1 once every pixel has had its ray. */
+/*! ip_engine_set_region() : restricts the next steps to rays [first_ray, first_ray +
+ *  ray_count) of the progressive order of the rectangle of width x height pixels whose top-left
+ *  pixel is (x, y) in the image of ip_engine_begin()'s camera (the rectangle's own order: its
+ *  centre first, as for an image of that size, shifted to (x, y)). The mesh, the visited cells
+ *  and the occlusion coverage are kept, so a cell extracted for an earlier rectangle is not
+ *  extracted again; what the rays of the earlier rectangles did not finish is dropped.
+ *  ip_engine_done() is then 1 once those ray_count rays are cast. For sort-first parallel
+ *  rendering: every pixel given a ray in some rectangle, the union of the meshes shows the
+ *  image of one full run. Call after ip_engine_begin(), between steps.
+ *  @return IP_OK, or IP_ERR_ARGUMENT (before begin, an empty rectangle or one not inside the
+ *  image, more rays than the rectangle's pixels). */
+IP_API ip_status ip_engine_set_region(ip_engine *engine, uint32_t x, uint32_t y, uint32_t width,
+                                      uint32_t height, uint64_t first_ray, uint64_t ray_count,
+                                      ip_error *err);
+
+/*! ip_engine_done() : 1 once every pixel has had its ray (after ip_engine_set_region(): once
+ *  the region's rays have). */
 IP_API int ip_engine_done(const ip_engine *engine);
 
 /*! ip_engine_cancel() : asks a running or later step to stop at the next ray (any thread). */

@@ -129,6 +129,25 @@ IP_API ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count,
                                     const double lo[3], const double hi[3], uint8_t *rgba,
                                     ip_error *err);
 
+/*! ip_raster_mesh_part() : the part [x, x + width) x [y, y + height) (pixels) of the image
+ *  that ip_raster_mesh_shaded() draws of `mesh` for `camera` (the whole image's view, near and
+ *  far planes, guard band and background gradient), with the nearest depth: each pixel of the
+ *  part gets exactly the colour it has in the whole image, at a cost that grows with the
+ *  part's pixels, not the image's (triangles outside it are rejected by their bounds). For
+ *  sort-first parallel rendering, where each process draws its own triangles into the tiles
+ *  of a display wall and a composite keeps the nearest surface per pixel.
+ *  `inverse_depth` (may be NULL): width * height entries, top row first, 1 / view depth (world
+ *  units) of the surface each pixel shows, 0 where it shows none (a larger value is nearer).
+ *  `rgba` (may be NULL): width * height * 4 bytes, the shaded part. `shading` NULL is
+ *  ip_shading_default(). Buffers are the caller's. Reentrant.
+ *  @return IP_OK, IP_ERR_ARGUMENT (as ip_raster_mesh_shaded(), or a part that is empty or not
+ *  inside the image) or IP_ERR_NOMEM. */
+IP_API ip_status ip_raster_mesh_part(const ip_mesh *mesh, const ip_camera *camera,
+                                     const ip_shading *shading, const double lo[3],
+                                     const double hi[3], uint32_t x, uint32_t y, uint32_t width,
+                                     uint32_t height, double *inverse_depth, uint8_t *rgba,
+                                     ip_error *err);
+
 /*! ip_png_write() : writes an image given as width * height * 4 bytes (RGBA, top row first)
  *  as an 8-bit PNG: RGB when every alpha is 255, RGBA otherwise. The file appears only once
  *  complete (atomic); an existing `path` is replaced only when `force` is non-zero, and

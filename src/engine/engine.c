@@ -96,7 +96,9 @@ struct ip_engine {
     ip_ray_order order; /* the view's order, copied into each worker's iterator */
     uint64_t order_cells;
     atomic_uint_fast64_t next_position; /* the first position no worker has claimed */
-    atomic_uint_fast64_t rays_taken;    /* pixels handed out since begin */
+    atomic_uint_fast64_t rays_taken;    /* pixels handed out since begin (or set_region) */
+    uint64_t ray_target;                /* the pixels of the order to cast: done at rays_taken */
+    uint32_t region_x, region_y;        /* the order's pixel (0, 0) in the image */
     pthread_mutex_t leftover_lock;
     order_range *leftovers; /* at most one per worker (each holds one range at a time) */
     unsigned leftover_count;
@@ -244,6 +246,20 @@ double ip_engine_lod_distance(const ip_engine *e, uint32_t level)
     return level < e->levels_used ? e->lod_distance[level] : INFINITY;
 }
 
+/* Hands the reader (paused) the view and the order the workers are about to walk. */
+static void begin_prefetch(ip_engine *e)
+{
+    if (!e->prefetcher)
+        return;
+    ip__prefetch_view view = {e->camera,       e->basis,
+                              e->iso,          e->levels_used,
+                              e->lod_distance, e->order,
+                              e->order_cells,  &e->next_position,
+                              &e->cancel,      {e->options.clip, e->options.clip_count},
+                              e->region_x,     e->region_y};
+    ip__prefetcher_begin(e->prefetcher, &view);
+}
+
 ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_error *err)
 {
     ip_status st = ip_camera_check(camera, err);
@@ -267,6 +283,8 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     uint32_t last = ip__ray_order_last_level(&e->order);
     ip__ray_order_set_local_from(&e->order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
     e->order_cells = ip__ray_order_cells(&e->order);
+    e->ray_target = ip__ray_order_count(&e->order);
+    e->region_x = e->region_y = 0;
     atomic_store(&e->next_position, 0);
     atomic_store(&e->rays_taken, 0);
     e->leftover_count = 0;
@@ -324,14 +342,63 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     }
     atomic_store(&e->cancel, 0);
     e->begun = 1;
-    if (e->prefetcher) {
-        ip__prefetch_view view = {e->camera,       e->basis,
-                                  e->iso,          e->levels_used,
-                                  e->lod_distance, e->order,
-                                  e->order_cells,  &e->next_position,
-                                  &e->cancel,      {e->options.clip, e->options.clip_count}};
-        ip__prefetcher_begin(e->prefetcher, &view);
+    begin_prefetch(e);
+    return IP_OK;
+}
+
+ip_status ip_engine_set_region(ip_engine *e, uint32_t x, uint32_t y, uint32_t width,
+                               uint32_t height, uint64_t first_ray, uint64_t ray_count,
+                               ip_error *err)
+{
+    if (!e->begun)
+        return ip__fail(err, IP_ERR_ARGUMENT, "ip_engine_set_region() before ip_engine_begin()");
+    if (width == 0 || height == 0 || x >= e->camera.width || y >= e->camera.height ||
+        width > e->camera.width - x || height > e->camera.height - y)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "region %ux%u at (%u, %u) is not a non-empty part of the %ux%u image",
+                        width, height, x, y, e->camera.width, e->camera.height);
+    uint64_t pixels = (uint64_t)width * height;
+    if (first_ray > pixels || ray_count > pixels - first_ray)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "rays %llu + %llu are more than the region's %llu pixels",
+                        (unsigned long long)first_ray, (unsigned long long)ray_count,
+                        (unsigned long long)pixels);
+    if (e->prefetcher) /* it reads the order about to change */
+        ip__prefetcher_pause(e->prefetcher);
+    ip__ray_order_init(&e->order, width, height);
+    uint32_t last = ip__ray_order_last_level(&e->order);
+    ip__ray_order_set_local_from(&e->order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
+    e->tile_from = last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0; /* the region order's levels */
+    /* the positions of rays [first_ray, first_ray + ray_count) of the region's order */
+    ip_ray_order walk = e->order;
+    uint32_t px, py;
+    for (uint64_t i = 0; i < first_ray; i++)
+        ip__ray_order_next(&walk, &px, &py);
+    uint64_t start = ip__ray_order_position(&walk);
+    for (uint64_t i = 0; i < ray_count; i++)
+        ip__ray_order_next(&walk, &px, &py);
+    e->order_cells = ray_count > 0 ? ip__ray_order_position(&walk) : start;
+    e->ray_target = ray_count;
+    e->region_x = x;
+    e->region_y = y;
+    atomic_store(&e->next_position, start);
+    atomic_store(&e->rays_taken, 0);
+    pthread_mutex_lock(&e->leftover_lock);
+    e->leftover_count = 0;
+    atomic_store(&e->leftovers_waiting, 0);
+    pthread_mutex_unlock(&e->leftover_lock);
+    for (unsigned t = 0; t < e->threads; t++) {
+        e->workers[t].order = e->order;
+        e->workers[t].holding = 0;
+        for (uint32_t k = 0; k < e->levels_used; k++) { /* propagate within the rectangle */
+            double *window = e->workers[t].level[k].propagator.window;
+            window[0] = x;
+            window[1] = y;
+            window[2] = (double)x + width;
+            window[3] = (double)y + height;
+        }
     }
+    begin_prefetch(e);
     return IP_OK;
 }
 
@@ -342,7 +409,7 @@ void ip_engine_cancel(ip_engine *e)
 
 int ip_engine_done(const ip_engine *e)
 {
-    return e->begun && atomic_load(&((ip_engine *)e)->rays_taken) == ip__ray_order_count(&e->order);
+    return e->begun && atomic_load(&((ip_engine *)e)->rays_taken) == e->ray_target;
 }
 
 static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
@@ -619,6 +686,8 @@ static unsigned take_rays(ip_engine *e, worker *w, order_ray *rays)
     unsigned n = 0;
     while (n < want && (w->holding || claim_range(e, w))) {
         if (ip__ray_order_next_before(&w->order, w->range_end, &rays[n].x, &rays[n].y)) {
+            rays[n].x += e->region_x; /* the image's pixel (see ip_engine_set_region()) */
+            rays[n].y += e->region_y;
             rays[n].level = ip__ray_order_level(&w->order);
             n++;
         } else

@@ -100,7 +100,8 @@ static unsigned ray_bricks(ip__prefetcher *p, uint32_t x, uint32_t y, uint64_t *
     const ip__prefetch_view *v = &p->view;
     double dir[3];
     unsigned n = 0;
-    ip_camera_pixel_ray(&v->basis, &v->camera, x + 0.5, y + 0.5, dir);
+    ip_camera_pixel_ray(&v->basis, &v->camera, (double)x + v->region_x + 0.5,
+                        (double)y + v->region_y + 0.5, dir);
     for (uint32_t k = 0; k < v->levels_used && n < IP__PREFETCH_RAY_BRICKS; k++)
         n += ip__seed_ray_bricks(p->store, k, v->iso, &v->clip, v->camera.eye, dir, p->lod[k],
                                  p->lod[k + 1], out + n, IP__PREFETCH_RAY_BRICKS - n);

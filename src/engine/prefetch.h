@@ -56,6 +56,7 @@ typedef struct ip__prefetch_view {
     const atomic_uint_fast64_t *claimed; /* the first position no worker has claimed */
     const atomic_int *cancel;            /* the engine's cancel flag */
     ip_clip clip; /* the engine's planes: bricks wholly beyond one are not read ahead */
+    uint32_t region_x, region_y; /* the image pixel of the order's pixel (0, 0) */
 } ip__prefetch_view;
 
 /* Starts the reader thread (signals blocked), idle until ip__prefetcher_resume(). *out is the

@@ -24,6 +24,9 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     p->visited = visited;
     p->mesh = mesh;
     p->camera = camera;
+    p->window[0] = p->window[1] = 0;
+    p->window[2] = camera->width;
+    p->window[3] = camera->height;
     ip_camera_basis_of(camera, &p->basis);
     p->iso = iso;
     p->cutoff_versine = 1.0 - cos(options->cutoff_degrees * DEG);
@@ -110,8 +113,8 @@ static void cell_centre(const ip_sampler *s, const uint32_t cell[3], double cent
     *diagonal = sqrt(d2);
 }
 
-/* Whether any part of the cell may project into the image (a conservative test on its centre,
- * widened by the cell's projected size and a 2-pixel margin). Sets *pixels to the cell's
+/* Whether any part of the cell may project into the propagator's window of the image (a
+ * conservative test on its centre, widened by the cell's projected size and a 2-pixel margin). Sets *pixels to the cell's
  * projected size (its diagonal, in pixels) when it does. */
 static int in_frustum(const ip_propagator *p, const double centre[3], double diagonal,
                       double *pixels)
@@ -121,8 +124,8 @@ static int in_frustum(const ip_propagator *p, const double centre[3], double dia
         return 0;
     *pixels = diagonal / depth * p->pixel_scale;
     double margin = 2.0 + *pixels;
-    return x >= -margin && x <= p->camera->width + margin && y >= -margin &&
-           y <= p->camera->height + margin;
+    return x >= p->window[0] - margin && x <= p->window[2] + margin && y >= p->window[1] - margin &&
+           y <= p->window[3] + margin;
 }
 
 /* Whether surface extracted so far hides the cell at every pixel centre it may cover. A cell

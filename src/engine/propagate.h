@@ -30,6 +30,8 @@ typedef struct ip_propagator {
     double near_distance, far_distance; /* the level's distance band from the eye */
     ip_coverage *coverage;              /* occlusion: shared by the workers; NULL when off */
     ip_clip clip;                       /* the options' planes: dropped cells are not entered */
+    double window[4]; /* x0, y0, x1, y1 (pixels): propagation stays where cells may project
+                         into this part of the image (init: the whole image) */
     ip_queued_cell *queue;
     uint64_t queue_capacity;
 } ip_propagator;

@@ -112,8 +112,9 @@ typedef struct raster_view {
 } raster_view;
 
 typedef struct raster_target {
-    uint32_t width, height;
-    double *inverse_depth; /* 1 / view depth of the nearest surface; 0 where empty */
+    uint32_t width, height; /* of the part drawn */
+    uint32_t x, y;          /* its top-left pixel in the camera's image */
+    double *inverse_depth;  /* 1 / view depth of the nearest surface; 0 where empty */
     uint32_t *index;
     float *normal; /* 3 per pixel, or NULL when no image is wanted */
 } raster_target;
@@ -267,10 +268,11 @@ static void scan_triangle(raster_target *t, const screen_vertex v[3], int64_t ar
     int64_t x1 = floor_div(max_x - half, SUBPIXEL);
     int64_t y0 = floor_div(min_y - half + SUBPIXEL - 1, SUBPIXEL);
     int64_t y1 = floor_div(max_y - half, SUBPIXEL);
-    x0 = x0 < 0 ? 0 : x0;
-    y0 = y0 < 0 ? 0 : y0;
-    x1 = x1 >= (int64_t)t->width ? (int64_t)t->width - 1 : x1;
-    y1 = y1 >= (int64_t)t->height ? (int64_t)t->height - 1 : y1;
+    int64_t left = t->x, top = t->y, right = left + t->width - 1, bottom = top + t->height - 1;
+    x0 = x0 < left ? left : x0;
+    y0 = y0 < top ? top : y0;
+    x1 = x1 > right ? right : x1;
+    y1 = y1 > bottom ? bottom : y1;
     if (x0 > x1 || y0 > y1)
         return;
     int64_t px = x0 * SUBPIXEL + half, py = y0 * SUBPIXEL + half;
@@ -283,7 +285,8 @@ static void scan_triangle(raster_target *t, const screen_vertex v[3], int64_t ar
         for (int64_t x = x0; x <= x1; x++) {
             if ((r[0] | r[1] | r[2]) >= 0) {
                 int64_t w[3] = {r[0] + e[0].bias, r[1] + e[1].bias, r[2] + e[2].bias};
-                write_fragment(t, (size_t)y * t->width + (size_t)x, v, w, inverse_area, index);
+                write_fragment(t, (size_t)(y - top) * t->width + (size_t)(x - left), v, w,
+                               inverse_area, index);
             }
             for (int i = 0; i < 3; i++)
                 r[i] += e[i].step_x;
@@ -358,7 +361,7 @@ static void shade_image(const raster_target *t, const ip_camera *camera, const i
     ip_camera_basis_of(camera, &basis);
     for (uint32_t y = 0; y < t->height; y++) {
         uint8_t background[4];
-        shade_background(&s, y, t->height, background);
+        shade_background(&s, t->y + y, camera->height, background);
         for (uint32_t x = 0; x < t->width; x++) {
             size_t pixel = (size_t)y * t->width + x;
             uint8_t *out = rgba + 4 * pixel;
@@ -367,7 +370,8 @@ static void shade_image(const raster_target *t, const ip_camera *camera, const i
                 continue;
             }
             double ray[3];
-            ip_camera_pixel_ray(&basis, camera, x + 0.5, y + 0.5, ray);
+            ip_camera_pixel_ray(&basis, camera, (double)t->x + x + 0.5, (double)t->y + y + 0.5,
+                                ray);
             shade_surface(&s, t->normal + 3 * pixel, ray, out); /* |n . -ray| = |n . ray| */
         }
     }
@@ -401,27 +405,36 @@ static ip_status check_arguments(const ip_mesh *mesh, const ip_camera *camera, c
     return IP_OK;
 }
 
-static ip_status allocate_target(raster_target *t, const ip_camera *camera,
-                                 uint32_t *triangle_index, int with_normals, ip_error *err)
+/* The working buffers of the part [x, x + width) x [y, y + height) of the image; the caller's
+ * triangle_index and inverse_depth (either may be NULL) are used where given. */
+static ip_status allocate_target(raster_target *t, uint32_t x, uint32_t y, uint32_t width,
+                                 uint32_t height, uint32_t *triangle_index, double *inverse_depth,
+                                 int with_normals, ip_error *err)
 {
-    size_t pixels = (size_t)camera->width * camera->height;
+    size_t pixels = (size_t)width * height;
     memset(t, 0, sizeof *t);
-    t->width = camera->width;
-    t->height = camera->height;
-    t->inverse_depth = calloc(pixels, sizeof *t->inverse_depth);
+    t->x = x;
+    t->y = y;
+    t->width = width;
+    t->height = height;
+    t->inverse_depth = inverse_depth ? inverse_depth : malloc(pixels * sizeof *t->inverse_depth);
     t->index = triangle_index ? triangle_index : malloc(pixels * sizeof *t->index);
     t->normal = with_normals ? malloc(pixels * 3 * sizeof *t->normal) : NULL;
     if (!t->inverse_depth || !t->index || (with_normals && !t->normal))
-        return ip__fail(err, IP_ERR_NOMEM, "raster: out of memory for a %ux%u image", camera->width,
-                        camera->height);
-    for (size_t i = 0; i < pixels; i++)
+        return ip__fail(err, IP_ERR_NOMEM, "raster: out of memory for a %ux%u image", width,
+                        height);
+    for (size_t i = 0; i < pixels; i++) {
         t->index[i] = UINT32_MAX;
+        t->inverse_depth[i] = 0;
+    }
     return IP_OK;
 }
 
-static void free_target(raster_target *t, const uint32_t *triangle_index)
+static void free_target(raster_target *t, const uint32_t *triangle_index,
+                        const double *inverse_depth)
 {
-    free(t->inverse_depth);
+    if (t->inverse_depth != inverse_depth)
+        free(t->inverse_depth);
     if (t->index != triangle_index)
         free(t->index);
     free(t->normal);
@@ -439,6 +452,12 @@ static void raster_triangles(raster_target *t, const raster_view *view, const ip
     }
 }
 
+static ip_status raster_part(const ip_mesh *mesh, const ip_camera *camera,
+                             const ip_shading *shading, const double lo[3], const double hi[3],
+                             uint32_t x, uint32_t y, uint32_t width, uint32_t height,
+                             uint32_t *triangle_index, double *inverse_depth, uint8_t *rgba,
+                             ip_error *err);
+
 ip_status ip_raster_mesh(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
                          const double hi[3], uint32_t *triangle_index, uint8_t *rgba, ip_error *err)
 {
@@ -450,12 +469,43 @@ ip_status ip_raster_mesh_shaded(const ip_mesh *mesh, const ip_camera *camera,
                                 uint32_t *triangle_index, uint8_t *rgba, ip_error *err)
 {
     ip_status st = check_arguments(mesh, camera, lo, hi, err);
-    if (st == IP_OK && shading)
-        st = ip_shading_check(shading, err);
+    if (st != IP_OK)
+        return st;
+    return raster_part(mesh, camera, shading, lo, hi, 0, 0, camera->width, camera->height,
+                       triangle_index, NULL, rgba, err);
+}
+
+ip_status ip_raster_mesh_part(const ip_mesh *mesh, const ip_camera *camera,
+                              const ip_shading *shading, const double lo[3], const double hi[3],
+                              uint32_t x, uint32_t y, uint32_t width, uint32_t height,
+                              double *inverse_depth, uint8_t *rgba, ip_error *err)
+{
+    ip_status st = check_arguments(mesh, camera, lo, hi, err);
+    if (st != IP_OK)
+        return st;
+    if (width == 0 || height == 0 || x >= camera->width || y >= camera->height ||
+        width > camera->width - x || height > camera->height - y)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "raster: part %ux%u at (%u, %u) is not a non-empty part of the %ux%u "
+                        "image",
+                        width, height, x, y, camera->width, camera->height);
+    return raster_part(mesh, camera, shading, lo, hi, x, y, width, height, NULL, inverse_depth,
+                       rgba, err);
+}
+
+/* Draws the part [x, x + width) x [y, y + height) of the camera's image (checked). */
+static ip_status raster_part(const ip_mesh *mesh, const ip_camera *camera,
+                             const ip_shading *shading, const double lo[3], const double hi[3],
+                             uint32_t x, uint32_t y, uint32_t width, uint32_t height,
+                             uint32_t *triangle_index, double *inverse_depth, uint8_t *rgba,
+                             ip_error *err)
+{
+    ip_status st = shading ? ip_shading_check(shading, err) : IP_OK;
     if (st != IP_OK)
         return st;
     raster_target target;
-    st = allocate_target(&target, camera, triangle_index, rgba != NULL, err);
+    st = allocate_target(&target, x, y, width, height, triangle_index, inverse_depth, rgba != NULL,
+                         err);
     if (st == IP_OK) {
         raster_view view;
         setup_view(&view, camera, lo, hi);
@@ -463,7 +513,7 @@ ip_status ip_raster_mesh_shaded(const ip_mesh *mesh, const ip_camera *camera,
         if (rgba)
             shade_image(&target, camera, shading, rgba);
     }
-    free_target(&target, triangle_index);
+    free_target(&target, triangle_index, inverse_depth);
     return st;
 }
 
@@ -594,7 +644,7 @@ ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count, const ip_
         return ip__fail(err, IP_ERR_NOMEM, "raster: out of memory");
     raster_view view;
     setup_view(&view, camera, lo, hi);
-    st = allocate_target(&targets->opaque, camera, NULL, 1, err);
+    st = allocate_target(&targets->opaque, 0, 0, camera->width, camera->height, NULL, NULL, 1, err);
     uint32_t next = 0;
     for (size_t i = 0; st == IP_OK && i < count; i++) {
         const ip_surface *f = &surfaces[i];
@@ -604,15 +654,16 @@ ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count, const ip_
             next += (uint32_t)f->mesh->triangle_count;
             continue;
         }
-        st = allocate_target(&targets->layer[i], camera, NULL, 1, err);
+        st = allocate_target(&targets->layer[i], 0, 0, camera->width, camera->height, NULL, NULL, 1,
+                             err);
         if (st == IP_OK)
             raster_triangles(&targets->layer[i], &view, f->mesh, 0);
     }
     if (st == IP_OK)
         shade_surfaces(targets, surfaces, count, camera, &s, rgba);
-    free_target(&targets->opaque, NULL);
+    free_target(&targets->opaque, NULL, NULL);
     for (size_t i = 0; i < count; i++)
-        free_target(&targets->layer[i], NULL);
+        free_target(&targets->layer[i], NULL, NULL);
     free(targets);
     return st;
 }

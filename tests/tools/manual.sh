@@ -13,6 +13,10 @@ if [ -d "$bin/man" ]; then
                    ! sed -n "/^\.SH NAME/{n;p;}" "$0" | grep -Eq "^$1 \\\\- $1\$"' \
             "$bin/man/$program.1" "$program"
     done
+    if [ -x "$bin/isowall" ]; then # built where MPI was found
+        check "isowall.1 exists, with --wall and --tile" \
+            sh -c 'grep -q -- "-wall" "$0" && grep -q -- "-tile" "$0"' "$bin/man/isowall.1"
+    fi
     check "isorender.1 mentions --iso and --stats" \
         sh -c 'grep -q -- "-iso" "$0" && grep -q -- "-stats" "$0"' "$bin/man/isorender.1"
 else
@@ -30,6 +34,10 @@ check "the script registers isorender ($registered)" \
 check "isorender --mes completes to --mesh" test "$(complete_words isorender --mes)" = "--mesh"
 check "isobrick --sub completes to --subblock-size" \
     test "$(complete_words isobrick --sub)" = "--subblock-size"
+if [ -x "$bin/isowall" ]; then
+    check "isowall --sta completes to --static and --stats" \
+        test "$(complete_words isowall --sta | tr '\n' ' ')" = "--static --stats "
+fi
 touch completion_probe.ibv
 check "a file name completes" test "$(complete_words isorender completion_pr)" = "completion_probe.ibv"
 finish

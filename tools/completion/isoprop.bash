@@ -1,4 +1,4 @@
-# Bash completion for the isoprop programs (isobrick, isogen, isoinfo, isorender, isoview).
+# Bash completion for the isoprop programs (isobrick, isogen, isoinfo, isorender, isoview, isowall).
 # The option names come from the program's own --help, so that they follow its options;
 # after an option that takes a file, and for the positional argument, files are offered.
 _isoprop_complete() {
@@ -13,4 +13,4 @@ _isoprop_complete() {
         mapfile -t COMPREPLY < <(compgen -f -- "$cur")
     fi
 }
-complete -F _isoprop_complete isobrick isogen isoinfo isorender isoview
+complete -F _isoprop_complete isobrick isogen isoinfo isorender isoview isowall

@@ -1,0 +1,523 @@
+/* isowall: the run on every MPI process: extraction of the work units, the composite, the
+ * outputs and the statistics (see isowall.h). */
+#include <errno.h>
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "composite.h"
+#include "isoprop/cache.h"
+#include "isoprop/engine.h"
+#include "isoprop/store.h"
+
+/* What one rank did, gathered on rank 0 for --stats (doubles, so one MPI type carries it). */
+enum {
+    REC_BUSY,
+    REC_IDLE,
+    REC_UNITS,
+    REC_RAYS,
+    REC_SEEDS,
+    REC_CELLS,
+    REC_TRIANGLES,
+    REC_BYTES,
+    REC_RSS_MB,
+    REC_COUNT
+};
+
+typedef struct wall_run {
+    wall_options o;
+    int rank, ranks;
+    ip_store *store;
+    ip_cache *cache;
+    ip_engine *engine;
+    wall_layout layout;
+    double *cost;           /* per region: CPU seconds of its first pass (summed over the ranks) */
+    uint32_t *second;       /* dynamic: the second pass's order of the regions, costliest first */
+    MPI_Win counter_window; /* dynamic: two counters on rank 0, one per pass */
+    int64_t *counters;      /* rank 0's (NULL elsewhere) */
+    int window_made;
+    double busy, idle; /* CPU seconds on units; wall seconds waiting for work */
+    uint64_t units, bytes_sent;
+    wall_composite composite;
+    uint8_t *image; /* rank 0, one image: the wall's colours */
+    double start, coarse_seconds, extraction_seconds, total_seconds;
+    const char *program;
+} wall_run;
+
+/* The rank that takes unit u of a pass under --static: the owner of the unit's tile. */
+static int tile_owner(uint32_t tile, int ranks)
+{
+    return (int)(tile % (uint32_t)ranks);
+}
+
+static int rank_zero(uint32_t tile, int ranks)
+{
+    (void)tile, (void)ranks;
+    return 0;
+}
+
+/* Whether every rank succeeded (ok != 0 on each); every rank must call it. */
+static int all_ok(int ok)
+{
+    MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    return ok;
+}
+
+/* Prints the error of the first rank that failed, once for the whole job. */
+static int report_first_failure(const wall_run *r, int failed, const ip_error *err)
+{
+    int first = failed ? r->rank : r->ranks;
+    MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (first == r->rank)
+        tool_fail(r->program, err);
+    return first < r->ranks;
+}
+
+/* The camera over the whole wall, as isorender makes it for --size C*W x R*H. */
+static int setup_layout(wall_run *r, ip_error *err)
+{
+    wall_layout *w = &r->layout;
+    const ip_layout *l = ip_store_layout(r->store);
+    ip_layout_world_box(l, w->lo, w->hi);
+    w->cols = r->o.cols;
+    w->rows = r->o.rows;
+    w->tile_w = r->o.tile_w;
+    w->tile_h = r->o.tile_h;
+    w->tile_count = w->cols * w->rows;
+    if (r->o.common.camera) {
+        w->camera.width = r->o.common.width;
+        w->camera.height = r->o.common.height;
+        if (ip_camera_parse(r->o.common.camera, &w->camera, err) != IP_OK ||
+            ip_camera_check(&w->camera, err) != IP_OK)
+            return -1;
+    } else if (ip_camera_fit_axis(w->lo, w->hi, r->o.common.view, 30.0, r->o.common.width,
+                                  r->o.common.height, &w->camera, err) != IP_OK) {
+        return -1;
+    }
+    tool_apply_orbit(&r->o.orbit, &w->camera);
+    if (wall_layout_regions(w, r->o.unit_w, r->o.unit_h) != 0) {
+        err->code = IP_ERR_NOMEM;
+        snprintf(err->message, sizeof err->message, "out of memory for the regions");
+        return -1;
+    }
+    return 0;
+}
+
+/* The next unit of a pass: the counter's next value (dynamic), or this rank's next region
+ * (static, from *cursor). Returns the region's index, or -1 when the pass is done. */
+static int64_t next_unit(wall_run *r, int pass, int64_t *cursor)
+{
+    int64_t count = r->layout.region_count;
+    if (r->o.is_static) {
+        while (*cursor < count && tile_owner(r->layout.regions[*cursor].tile, r->ranks) != r->rank)
+            (*cursor)++;
+        return *cursor < count ? (*cursor)++ : -1;
+    }
+    int64_t one = 1, got;
+    /* dynamic */
+    double wait = MPI_Wtime();
+    MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, r->counter_window);
+    MPI_Fetch_and_op(&one, &got, MPI_INT64_T, 0, pass, MPI_SUM, r->counter_window);
+    MPI_Win_unlock(0, r->counter_window);
+    r->idle += MPI_Wtime() - wait;
+    r->bytes_sent += sizeof one;
+    if (got >= count)
+        return -1;
+    return pass ? (int64_t)r->second[got] : got;
+}
+
+/* Casts the rays of one pass over the units this rank takes. */
+static int run_pass(wall_run *r, int pass, ip_error *err)
+{
+    int64_t cursor = 0, u;
+    while ((u = next_unit(r, pass, &cursor)) >= 0) {
+        const wall_region *g = &r->layout.regions[u];
+        uint64_t pixels = (uint64_t)g->width * g->height, coarse = wall_coarse_rays(g);
+        uint64_t first = pass ? coarse : 0, count = pass ? pixels - coarse : coarse;
+        double start = wall_cpu_seconds();
+        if (count > 0) {
+            if (ip_engine_set_region(r->engine, g->x, g->y, g->width, g->height, first, count,
+                                     err) != IP_OK)
+                return -1;
+            while (!ip_engine_done(r->engine))
+                if (ip_engine_step(r->engine, 0, 0, NULL, err) != IP_OK)
+                    return -1;
+        }
+        double spent = wall_cpu_seconds() - start;
+        r->busy += spent;
+        if (pass == 0)
+            r->cost[u] = spent;
+        r->units++;
+    }
+    return 0;
+}
+
+typedef struct costed {
+    double cost;
+    uint32_t region;
+} costed;
+
+static int compare_cost(const void *a, const void *b)
+{
+    const costed *x = a, *y = b;
+    if (x->cost != y->cost)
+        return x->cost > y->cost ? -1 : 1;
+    return (x->region > y->region) - (x->region < y->region);
+}
+
+/* After the first pass: every rank learns what each region's coarse rays cost, and the second
+ * pass hands out the costliest regions first (longest processing time first), so that the
+ * last units, which decide the balance, are small ones. Every rank computes the same order. */
+static void order_second_pass(wall_run *r)
+{
+    uint32_t n = r->layout.region_count;
+    double wait = MPI_Wtime();
+    MPI_Allreduce(MPI_IN_PLACE, r->cost, (int)n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    r->idle += MPI_Wtime() - wait;
+    r->bytes_sent += (uint64_t)n * sizeof *r->cost;
+    double start = wall_cpu_seconds();
+    costed *order = malloc(n * sizeof *order);
+    if (!order) { /* keep the progressive order */
+        for (uint32_t i = 0; i < n; i++)
+            r->second[i] = i;
+        return;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        order[i] = (costed){r->cost[i], i};
+    qsort(order, n, sizeof *order, compare_cost);
+    for (uint32_t i = 0; i < n; i++)
+        r->second[i] = order[i].region;
+    free(order);
+    r->busy += wall_cpu_seconds() - start;
+}
+
+/* Rank 0's wall image receives each tile. */
+static int keep_in_image(uint32_t t, const uint8_t *rgba, void *user, ip_error *err)
+{
+    (void)err;
+    wall_run *r = user;
+    const wall_layout *w = &r->layout;
+    size_t x0 = (size_t)(t % w->cols) * w->tile_w, y0 = (size_t)(t / w->cols) * w->tile_h;
+    for (uint32_t y = 0; y < w->tile_h; y++)
+        memcpy(r->image + 4 * ((y0 + y) * w->camera.width + x0), rgba + 4 * (size_t)y * w->tile_w,
+               4 * (size_t)w->tile_w);
+    return 0;
+}
+
+/* --tiles-dir: the owner writes its tile as DIR/tile_COL_ROW.png. */
+static int write_tile(uint32_t t, const uint8_t *rgba, void *user, ip_error *err)
+{
+    wall_run *r = user;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/tile_%u_%u.png", r->o.tiles_dir, t % r->layout.cols,
+             t / r->layout.cols);
+    return ip_png_write(path, rgba, r->layout.tile_w, r->layout.tile_h, r->o.common.force, err) ==
+                   IP_OK
+               ? 0
+               : -1;
+}
+
+/* Composites the ranks' meshes as they are now into rank 0's image (tiles_dir NULL) or the
+ * tile files. A failure aborts the job (ranks may be waiting on this one). */
+static void composite(wall_run *r, int to_tiles)
+{
+    ip_error err;
+    ip_error_clear(&err);
+    r->composite.owner_of = to_tiles ? tile_owner : rank_zero;
+    if (wall_composite_run(&r->composite, ip_engine_mesh(r->engine),
+                           to_tiles ? write_tile : keep_in_image, r, &err) != 0) {
+        tool_fail(r->program, &err);
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+}
+
+/* Rank 0 writes the image; all ranks learn whether it worked. */
+static int write_image(wall_run *r, const char *path)
+{
+    int ok = 1;
+    if (r->rank == 0) {
+        ip_error err;
+        ip_error_clear(&err);
+        if (ip_png_write(path, r->image, r->layout.camera.width, r->layout.camera.height,
+                         r->o.common.force, &err) != IP_OK) {
+            tool_fail(r->program, &err);
+            ok = 0;
+        }
+    }
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    return ok ? 0 : -1;
+}
+
+/* Both passes, with the coarse composite between them when asked for. */
+static int extract(wall_run *r)
+{
+    ip_error err;
+    ip_error_clear(&err);
+    double wait = MPI_Wtime();
+    MPI_Barrier(MPI_COMM_WORLD);
+    r->start = MPI_Wtime();
+    r->idle += r->start - wait;
+    for (int pass = 0; pass < 2; pass++) {
+        int failed = run_pass(r, pass, &err) != 0;
+        if (report_first_failure(r, failed, &err))
+            return -1;
+        wait = MPI_Wtime();
+        MPI_Barrier(MPI_COMM_WORLD); /* the pass is done on every rank */
+        r->idle += MPI_Wtime() - wait;
+        if (pass == 0) {
+            r->coarse_seconds = MPI_Wtime() - r->start;
+            if (!r->o.is_static)
+                order_second_pass(r);
+            if (r->o.coarse) {
+                composite(r, 0);
+                if (write_image(r, r->o.coarse) != 0)
+                    return -1;
+            }
+        }
+    }
+    r->extraction_seconds = MPI_Wtime() - r->start;
+    composite(r, r->o.tiles_dir != NULL);
+    if (!r->o.tiles_dir && write_image(r, r->o.out) != 0)
+        return -1;
+    r->total_seconds = MPI_Wtime() - r->start;
+    return 0;
+}
+
+/* ---- statistics ---- */
+
+typedef struct stats_view {
+    const wall_run *r;
+    const double *records; /* REC_COUNT per rank */
+    ip_engine_counts totals;
+} stats_view;
+
+static double sum_of(const stats_view *v, int field)
+{
+    double s = 0;
+    for (int k = 0; k < v->r->ranks; k++)
+        s += v->records[k * REC_COUNT + field];
+    return s;
+}
+
+static double max_of(const stats_view *v, int field)
+{
+    double m = 0;
+    for (int k = 0; k < v->r->ranks; k++)
+        m = v->records[k * REC_COUNT + field] > m ? v->records[k * REC_COUNT + field] : m;
+    return m;
+}
+
+static double balance_of(const stats_view *v)
+{
+    double mean = sum_of(v, REC_BUSY) / v->r->ranks;
+    return mean > 0 ? max_of(v, REC_BUSY) / mean : 1.0;
+}
+
+static void fill_stats(FILE *out, void *user)
+{
+    const stats_view *v = user;
+    const wall_run *r = v->r;
+    const wall_layout *w = &r->layout;
+    const ip_camera *c = &w->camera;
+    fprintf(out, "{\n  \"program\": \"isowall\",\n  \"file\": ");
+    tool_json_string(out, r->o.file);
+    fprintf(out,
+            ",\n  \"iso\": %.9g,\n  \"width\": %u,\n  \"height\": %u,\n"
+            "  \"wall\": [%u, %u],\n  \"tile\": [%u, %u],\n  \"unit\": [%u, %u],\n"
+            "  \"camera\": [%.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g],\n"
+            "  \"processes\": %d,\n  \"static\": %s,\n  \"regions\": %u,\n  \"passes\": 2,\n"
+            "  \"units\": %.0f,\n  \"rays\": %.0f,\n  \"seeds\": %.0f,\n  \"cells\": %.0f,\n"
+            "  \"triangles\": %.0f,\n  \"bytes_sent\": %.0f,\n  \"tiles_drawn\": %llu,\n"
+            "  \"busy_s\": %.6f,\n  \"max_busy_s\": %.6f,\n  \"balance\": %.4f,\n"
+            "  \"coarse_s\": %.6f,\n  \"extraction_s\": %.6f,\n  \"time_s\": %.6f,\n"
+            "  \"threads\": %u,\n  \"lod\": %s,\n  \"occlusion\": %s,\n  \"prefetch\": %s,\n"
+            "  \"ranks\": [",
+            r->o.common.iso, c->width, c->height, w->cols, w->rows, w->tile_w, w->tile_h,
+            r->o.unit_w, r->o.unit_h, c->eye[0], c->eye[1], c->eye[2], c->target[0], c->target[1],
+            c->target[2], c->up[0], c->up[1], c->up[2], c->fov_y, r->ranks,
+            r->o.is_static ? "true" : "false", w->region_count, sum_of(v, REC_UNITS),
+            sum_of(v, REC_RAYS), sum_of(v, REC_SEEDS), sum_of(v, REC_CELLS),
+            sum_of(v, REC_TRIANGLES), sum_of(v, REC_BYTES),
+            (unsigned long long)r->composite.tiles_drawn, sum_of(v, REC_BUSY), max_of(v, REC_BUSY),
+            balance_of(v), r->coarse_seconds, r->extraction_seconds, r->total_seconds,
+            r->o.common.threads, r->o.common.lod ? "true" : "false",
+            r->o.common.occlusion ? "true" : "false", r->o.common.prefetch ? "true" : "false");
+    for (int k = 0; k < r->ranks; k++) {
+        const double *x = v->records + k * REC_COUNT;
+        fprintf(out,
+                "%s\n    {\"rank\": %d, \"busy_s\": %.6f, \"idle_s\": %.6f, \"units\": %.0f, "
+                "\"rays\": %.0f, \"seeds\": %.0f, \"cells\": %.0f, \"triangles\": %.0f, "
+                "\"bytes_sent\": %.0f, \"peak_rss_mb\": %.1f}",
+                k ? "," : "", k, x[REC_BUSY], x[REC_IDLE], x[REC_UNITS], x[REC_RAYS], x[REC_SEEDS],
+                x[REC_CELLS], x[REC_TRIANGLES], x[REC_BYTES], x[REC_RSS_MB]);
+    }
+    fprintf(out, "\n  ]\n}\n");
+}
+
+/* Gathers every rank's record on rank 0, which prints the summary and writes --stats. */
+static int report(wall_run *r)
+{
+    ip_engine_counts t;
+    ip_engine_totals(r->engine, &t);
+    struct rusage usage;
+    getrusage(RUSAGE_SELF, &usage);
+    double mine[REC_COUNT] = {
+        [REC_BUSY] = r->busy + r->composite.busy_seconds,
+        [REC_IDLE] = r->idle + r->composite.idle_seconds,
+        [REC_UNITS] = (double)r->units,
+        [REC_RAYS] = (double)t.rays,
+        [REC_SEEDS] = (double)t.seeds,
+        [REC_CELLS] = (double)t.cells,
+        [REC_TRIANGLES] = (double)t.triangles,
+        [REC_BYTES] = (double)(r->bytes_sent + r->composite.bytes_sent),
+        [REC_RSS_MB] = (double)usage.ru_maxrss / 1024.0,
+    };
+    double *all = r->rank == 0 ? malloc(sizeof mine * (size_t)r->ranks) : NULL;
+    if (r->rank == 0 && !all) {
+        fprintf(stderr, "%s: out of memory\n", r->program);
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    MPI_Gather(mine, REC_COUNT, MPI_DOUBLE, all, REC_COUNT, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    int ok = 1;
+    if (r->rank == 0) {
+        stats_view v = {r, all, t};
+        if (!r->o.common.quiet)
+            printf("%s: wall %ux%u of %ux%u (%.1f Mpixel), %d processes, %s: %.0f rays, %.0f "
+                   "triangles, busy %.3f s (max %.3f s, balance %.3f), %.3f s\n",
+                   r->o.file, r->layout.cols, r->layout.rows, r->layout.tile_w, r->layout.tile_h,
+                   r->layout.camera.width * (double)r->layout.camera.height / 1e6, r->ranks,
+                   r->o.is_static ? "static" : "dynamic", sum_of(&v, REC_RAYS),
+                   sum_of(&v, REC_TRIANGLES), sum_of(&v, REC_BUSY), max_of(&v, REC_BUSY),
+                   balance_of(&v), r->total_seconds);
+        if (r->o.common.stats && tool_write_text_file(r->program, r->o.common.stats,
+                                                      r->o.common.force, fill_stats, &v) != 0)
+            ok = 0;
+        free(all);
+    }
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    return ok ? 0 : 1;
+}
+
+/* ---- set-up ---- */
+
+/* Rank 0 checks the outputs (and makes --tiles-dir); every rank opens the file, its cache and
+ * engine. Returns 0, or 1 once the first failure has been reported. */
+static int open_run(wall_run *r)
+{
+    ip_error err;
+    ip_error_clear(&err);
+    int ok = 1;
+    if (r->rank == 0) {
+        const char *inputs[] = {r->o.file};
+        const char *outputs[] = {r->o.out, r->o.coarse, r->o.common.stats};
+        ok = tool_check_paths(r->program, inputs, 1, outputs, 3, r->o.common.force) == 0;
+        if (ok && r->o.tiles_dir && mkdir(r->o.tiles_dir, 0777) != 0 && errno != EEXIST) {
+            fprintf(stderr, "%s: %s: %s\n", r->program, r->o.tiles_dir, strerror(errno));
+            ok = 0;
+        }
+    }
+    if (!all_ok(ok))
+        return 1;
+    int failed = ip_store_open(r->o.file, &r->store, &err) != IP_OK;
+    if (!failed)
+        failed = ip_cache_create(r->store, r->o.common.cache_bytes, &r->cache, &err) != IP_OK ||
+                 setup_layout(r, &err) != 0;
+    if (!failed) {
+        ip_engine_options eo;
+        tool_engine_options(&r->o.common, &eo);
+        failed =
+            ip_engine_create(r->cache, &eo, &r->engine, &err) != IP_OK ||
+            ip_engine_begin(r->engine, &r->layout.camera, (float)r->o.common.iso, &err) != IP_OK;
+    }
+    if (report_first_failure(r, failed, &err))
+        return 1;
+    if (r->rank == 0)
+        tool_warn_iso_range(r->program, r->store, r->o.common.iso, NULL, 0);
+    size_t bytes = r->rank == 0 ? 2 * sizeof(int64_t) : 0;
+    MPI_Win_allocate((MPI_Aint)bytes, sizeof(int64_t), MPI_INFO_NULL, MPI_COMM_WORLD, &r->counters,
+                     &r->counter_window);
+    r->window_made = 1;
+    if (r->rank == 0) {
+        MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, r->counter_window);
+        r->counters[0] = r->counters[1] = 0;
+        MPI_Win_unlock(0, r->counter_window);
+    }
+    size_t pixels = (size_t)r->layout.camera.width * r->layout.camera.height;
+    r->cost = calloc(r->layout.region_count, sizeof *r->cost);
+    r->second = malloc(r->layout.region_count * sizeof *r->second);
+    if (!r->cost || !r->second)
+        fprintf(stderr, "%s: out of memory for the regions\n", r->program);
+    if (!all_ok(r->cost && r->second))
+        return 1;
+    int need_image = !r->o.tiles_dir || r->o.coarse;
+    if (r->rank == 0 && need_image && !(r->image = malloc(4 * pixels)))
+        fprintf(stderr, "%s: out of memory for the %ux%u image\n", r->program,
+                r->layout.camera.width, r->layout.camera.height);
+    if (!all_ok(r->rank != 0 || !need_image || r->image != NULL))
+        return 1;
+    r->composite = (wall_composite){&r->layout, &r->o.shading, r->rank, r->ranks, NULL, 0, 0, 0, 0};
+    return 0;
+}
+
+static void close_run(wall_run *r)
+{
+    if (r->window_made)
+        MPI_Win_free(&r->counter_window);
+    ip_engine_destroy(r->engine);
+    ip_cache_destroy(r->cache);
+    ip_store_close(r->store);
+    free(r->layout.regions);
+    free(r->cost);
+    free(r->second);
+    free(r->image);
+}
+
+/* Before MPI starts, every process parses the command line; only the first of the job prints
+ * what is wrong with it. */
+static int parse_quietly_off_rank_zero(int argc, char **argv, wall_options *o)
+{
+    const char *rank = getenv("OMPI_COMM_WORLD_RANK");
+    if (!rank)
+        rank = getenv("PMI_RANK");
+    int saved = -1;
+    if (rank && strcmp(rank, "0") != 0) {
+        fflush(stderr);
+        saved = dup(2);
+        FILE *null = fopen("/dev/null", "w");
+        if (null) {
+            dup2(fileno(null), 2);
+            fclose(null);
+        }
+    }
+    int rc = wall_parse_args(argc, argv, o);
+    if (saved >= 0) {
+        fflush(stderr);
+        dup2(saved, 2);
+        close(saved);
+    }
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    wall_run r;
+    memset(&r, 0, sizeof r);
+    r.program = "isowall";
+    int rc = parse_quietly_off_rank_zero(argc, argv, &r.o);
+    if (rc)
+        return rc;
+    int provided;
+    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+    MPI_Comm_rank(MPI_COMM_WORLD, &r.rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &r.ranks);
+    rc = open_run(&r);
+    if (rc == 0)
+        rc = extract(&r) == 0 ? report(&r) : 1;
+    close_run(&r);
+    MPI_Finalize();
+    return rc;
+}

@@ -1,0 +1,169 @@
+/* isowall's command line. */
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "isowall.h"
+
+static const char usage[] =
+    "usage: mpirun -np N isowall FILE.ibv --iso V --wall CxR --tile WxH [options]\n"
+    "Extracts the isosurface V progressively for a display wall of C x R tiles of W x H pixels\n"
+    "(one camera over the whole wall) on N MPI processes, sort-first with dynamic balance: the\n"
+    "wall is cut into many more screen regions than processes, each process takes the next\n"
+    "region from a shared counter when it is done with one, and casts its rays with its own\n"
+    "engine and cache over the same brick file; a first pass casts every region's coarse rays\n"
+    "(the whole wall's coarse image), a second the rest. Each process draws its triangles into\n"
+    "the tiles they touch (software rasterizer); per tile, the nearest surface wins.\n"
+    "  --wall CxR          display tiles across and down (required)\n"
+    "  --tile WxH          pixels of a display tile (required); the image is C*W x R*H\n"
+    "  --unit WxH          pixels of a screen region, inside a tile (default: an eighth of the\n"
+    "                      tile each way, rounded up)\n"
+    "  --static            no balance: the regions of tile t go to process t % N (one copy per\n"
+    "                      projector, the paper's display wall), for comparison\n"
+    "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
+    "                      (default -y; up is +z, or +y for the z views)\n"
+    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n" TOOL_ORBIT_OPTIONS_HELP
+    "  --color C           the surface colour: R,G,B (each 0 to 1) or #rrggbb\n"
+    "  --background C      one colour, or TOP:BOTTOM for a vertical gradient over the wall\n" TOOL_ENGINE_OPTIONS_HELP
+    "  --cache-mb N        each process's brick cache budget in MiB\n"
+    "  --threads N         engine threads per process (default 1)\n"
+    "  -o OUT.png          the whole wall as one image, composited on process 0 (default\n"
+    "                      isowall.png unless --tiles-dir)\n"
+    "  --tiles-dir DIR     instead, one PNG per display tile, tile_COL_ROW.png, written by the\n"
+    "                      tile's owner (process t % N), as a projector's PC would show it\n"
+    "  --coarse OUT.png    also the wall's image after the first (coarse) pass\n"
+    "  --stats OUT.json    counts and times: one record per process (busy_s: CPU seconds on\n"
+    "                      its regions and drawing; idle_s: wall seconds waiting for work or\n"
+    "                      the composite; units; rays; triangles; bytes_sent) and balance, the\n"
+    "                      largest busy_s over the mean\n"
+    "  -f, --force         replace existing outputs (regular files only; never an input)\n"
+    "  -q, --quiet         print nothing but errors and warnings\n"
+    "  --version           print the version and exit\n"
+    "The image equals isorender's (--software, same camera, --size C*W x R*H). Options take\n"
+    "their value as --iso V or --iso=V; -- ends the options.\n"
+    "Exit status: 0 success, 1 failure, 2 bad command line.\n";
+
+/* "AxB", both in [1, max]; returns 0 or -1. */
+static int parse_pair(const char *text, uint32_t max, uint32_t *a, uint32_t *b)
+{
+    const char *x = strchr(text, 'x');
+    uint64_t va, vb;
+    char first[32];
+    if (!x || (size_t)(x - text) >= sizeof first)
+        return -1;
+    memcpy(first, text, (size_t)(x - text));
+    first[x - text] = '\0';
+    if (tool_parse_u64(first, &va) != 0 || tool_parse_u64(x + 1, &vb) != 0 || va < 1 || vb < 1 ||
+        va > max || vb > max)
+        return -1;
+    *a = (uint32_t)va;
+    *b = (uint32_t)vb;
+    return 0;
+}
+
+static int parse_wall(const char *program, const tool_option *option, const char *const *values,
+                      void *base)
+{
+    (void)option;
+    wall_options *o = base;
+    if (parse_pair(values[0], 256, &o->cols, &o->rows) != 0)
+        return tool_usage_error(program, "--wall '%s' is not CxR, tiles across and down (1-256)",
+                                values[0]);
+    return 0;
+}
+
+static int parse_tile(const char *program, const tool_option *option, const char *const *values,
+                      void *base)
+{
+    (void)option;
+    wall_options *o = base;
+    if (parse_pair(values[0], 65536, &o->tile_w, &o->tile_h) != 0)
+        return tool_usage_error(program, "--tile '%s' is not WxH, pixels (1-65536)", values[0]);
+    return 0;
+}
+
+static int parse_unit(const char *program, const tool_option *option, const char *const *values,
+                      void *base)
+{
+    (void)option;
+    wall_options *o = base;
+    if (parse_pair(values[0], 65536, &o->unit_w, &o->unit_h) != 0)
+        return tool_usage_error(program, "--unit '%s' is not WxH, pixels (1-65536)", values[0]);
+    return 0;
+}
+
+static int parse_color(const char *program, const tool_option *option, const char *const *values,
+                       void *base)
+{
+    (void)option;
+    if (tool_parse_colour(values[0], ((wall_options *)base)->shading.surface) != 0)
+        return tool_usage_error(program, "--color '%s' is not R,G,B (each 0 to 1) or #rrggbb",
+                                values[0]);
+    return 0;
+}
+
+static int parse_background(const char *program, const tool_option *option,
+                            const char *const *values, void *base)
+{
+    (void)option;
+    wall_options *o = base;
+    if (tool_parse_background(values[0], o->shading.background_top, o->shading.background_bottom) !=
+        0)
+        return tool_usage_error(program, "--background '%s' is not a colour or TOP:BOTTOM",
+                                values[0]);
+    return 0;
+}
+
+static const tool_option wall_table[] = {
+    {"-o", NULL, 1, offsetof(wall_options, out), NULL, NULL, NULL},
+    {"--wall", NULL, 1, 0, parse_wall, NULL, NULL},
+    {"--tile", NULL, 1, 0, parse_tile, NULL, NULL},
+    {"--unit", NULL, 1, 0, parse_unit, NULL, NULL},
+    {"--static", NULL, 0, offsetof(wall_options, is_static), NULL, NULL, NULL},
+    {"--tiles-dir", NULL, 1, offsetof(wall_options, tiles_dir), NULL, NULL, NULL},
+    {"--coarse", NULL, 1, offsetof(wall_options, coarse), NULL, NULL, NULL},
+    TOOL_ORBIT_OPTION_ROWS(wall_options, orbit),
+    {"--color", NULL, 1, 0, parse_color, NULL, NULL},
+    {"--background", NULL, 1, 0, parse_background, NULL, NULL},
+};
+
+int wall_parse_args(int argc, char **argv, wall_options *o)
+{
+    memset(o, 0, sizeof *o);
+    tool_view_options_default(&o->common, 0, 0);
+    tool_orbit_options_default(&o->orbit);
+    ip_shading_default(&o->shading);
+    int rc = tool_parse_view_command_line("isowall", usage, &o->common, wall_table,
+                                          sizeof wall_table / sizeof wall_table[0], o, &o->file,
+                                          argc, argv);
+    if (rc)
+        return rc;
+    if (o->common.width || o->common.height)
+        return tool_usage_error("isowall", "--size is isorender's: give --wall CxR and --tile WxH");
+    if (o->common.rays || o->common.time_limit > 0)
+        return tool_usage_error("isowall", "--rays and --time are isorender's: isowall casts "
+                                           "every ray of the wall");
+    if (!o->cols || !o->tile_w)
+        return tool_usage_error("isowall", "--wall CxR and --tile WxH are required");
+    uint64_t width = (uint64_t)o->cols * o->tile_w, height = (uint64_t)o->rows * o->tile_h;
+    if (width > 65536 || height > 65536)
+        return tool_usage_error("isowall", "the wall's image %llux%llu is larger than 65536 a side",
+                                (unsigned long long)width, (unsigned long long)height);
+    if (o->unit_w > o->tile_w || o->unit_h > o->tile_h)
+        return tool_usage_error("isowall", "--unit %ux%u is larger than the tile %ux%u", o->unit_w,
+                                o->unit_h, o->tile_w, o->tile_h);
+    if (o->out && o->tiles_dir)
+        return tool_usage_error("isowall", "-o and --tiles-dir: one or the other");
+    if (!o->out && !o->tiles_dir)
+        o->out = "isowall.png";
+    if (!o->unit_w) {
+        o->unit_w = (o->tile_w + 7) / 8;
+        o->unit_h = (o->tile_h + 7) / 8;
+    }
+    if (!o->common.threads)
+        o->common.threads = 1;
+    o->common.width = (uint32_t)width;
+    o->common.height = (uint32_t)height;
+    return 0;
+}
