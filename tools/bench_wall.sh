@@ -2,7 +2,7 @@
 # The display wall's bad case (docs/scale-out.md): isowall on the Visible Woman head (skin
 # 600.5) on a 6x4 wall whose camera puts the whole head inside one display tile, with the
 # regions of each tile on the process that owns it (--static, one copy per projector, the
-# paper's wall) against the shared counter (dynamic), at 2, 4 and 8 processes, and one
+# paper's wall) against dynamic shares with stealing, at 2, 4 and 8 processes, and one
 # process for the total work; then a 6x4 wall of 1280x1024 tiles (31 Mpixel) with the whole
 # head in view, to show that it completes. Processes beyond the cores are oversubscribed, so
 # compare the CPU-busy seconds (busy_s), not the wall time. Prints Markdown tables; the JSON

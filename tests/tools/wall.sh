@@ -42,7 +42,7 @@ line=$("$compare" coarse.png ref.png --max-pct 100)
 check "the coarse pass's image has the wall's size: $line" test $? = 0
 for key in '"iso": 0.5' '"width": 480' '"height": 240' '"wall": \[3, 2\]' '"tile": \[160, 120\]' \
     '"processes": 4' '"static": false' '"balance": ' '"coarse_s": ' '"bytes_sent": ' \
-    '"rank": 3' '"busy_s": ' '"idle_s": '; do
+    '"rank": 3' '"busy_s": ' '"idle_s": ' '"stolen": '; do
     check "dyn.json has $key" grep -q "$key" dyn.json
 done
 ranks() { grep -c '"rank": ' "$1"; }
@@ -56,6 +56,9 @@ check "units add up to 2 passes x $regions regions ($(sum dyn.json units))" \
     test "$(sum dyn.json units)" = $((2 * regions))
 check "rays add up to the 115200 pixels ($(sum dyn.json rays))" test "$(sum dyn.json rays)" = 115200
 check "more regions than processes ($regions)" test "$regions" -gt 16
+over=$(grep '"rank": ' dyn.json | sed 's/.*"units": \([0-9]*\).*"stolen": \([0-9]*\).*/\1 \2/' |
+    awk '$2 > $1 { n++ } END { print n + 0 }')
+check "no process stole more units than it took ($over did)" test "$over" = 0
 busy=$(grep '"rank": ' dyn.json | grep -c '"units": [1-9]')
 check "every process took units ($busy of 4)" test "$busy" = 4
 

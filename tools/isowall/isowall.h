@@ -56,6 +56,11 @@ int wall_parse_args(int argc, char **argv, wall_options *o);
  * out of memory. */
 int wall_layout_regions(wall_layout *w, uint32_t unit_w, uint32_t unit_h);
 
+/* Writes the indices of the regions (as wall_layout_regions() made them with the same unit
+ * size) into order[0 .. region_count) in a Z order over the wall's grid of regions, so that any
+ * run of the order is a compact patch of neighbours. Returns 0, or -1 when out of memory. */
+int wall_spatial_order(const wall_layout *w, uint32_t unit_w, uint32_t unit_h, uint32_t *order);
+
 /* The rays of a region's first pass: one per 8 x 8 pixels, at least one. */
 uint64_t wall_coarse_rays(const wall_region *r);
 

@@ -47,6 +47,46 @@ int wall_layout_regions(wall_layout *w, uint32_t unit_w, uint32_t unit_h)
     return 0;
 }
 
+/* The Z-order key of grid cell (x, y): their bits interleaved, x's in the even places. */
+static uint64_t z_key(uint32_t x, uint32_t y)
+{
+    uint64_t key = 0;
+    for (unsigned b = 0; b < 32; b++)
+        key |= (uint64_t)(x >> b & 1u) << 2 * b | (uint64_t)(y >> b & 1u) << (2 * b + 1);
+    return key;
+}
+
+typedef struct keyed {
+    uint64_t key;
+    uint32_t region;
+} keyed;
+
+static int compare_key(const void *a, const void *b)
+{
+    const keyed *x = a, *y = b;
+    return (x->key > y->key) - (x->key < y->key);
+}
+
+int wall_spatial_order(const wall_layout *w, uint32_t unit_w, uint32_t unit_h, uint32_t *order)
+{
+    uint32_t per_x = (w->tile_w + unit_w - 1) / unit_w, per_y = (w->tile_h + unit_h - 1) / unit_h;
+    keyed *k = malloc((size_t)w->region_count * sizeof *k);
+    if (!k)
+        return -1;
+    for (uint32_t i = 0; i < w->region_count; i++) {
+        const wall_region *r = &w->regions[i];
+        uint32_t col = r->x / w->tile_w, row = r->y / w->tile_h;
+        uint32_t gx = col * per_x + (r->x - col * w->tile_w) / unit_w;
+        uint32_t gy = row * per_y + (r->y - row * w->tile_h) / unit_h;
+        k[i] = (keyed){z_key(gx, gy), i};
+    }
+    qsort(k, w->region_count, sizeof *k, compare_key);
+    for (uint32_t i = 0; i < w->region_count; i++)
+        order[i] = k[i].region;
+    free(k);
+    return 0;
+}
+
 uint64_t wall_coarse_rays(const wall_region *r)
 {
     uint64_t pixels = (uint64_t)r->width * r->height;

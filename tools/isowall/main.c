@@ -25,6 +25,7 @@ enum {
     REC_TRIANGLES,
     REC_BYTES,
     REC_RSS_MB,
+    REC_STOLEN,
     REC_COUNT
 };
 
@@ -35,13 +36,15 @@ typedef struct wall_run {
     ip_cache *cache;
     ip_engine *engine;
     wall_layout layout;
-    double *cost;           /* per region: CPU seconds of its first pass (summed over the ranks) */
-    uint32_t *second;       /* dynamic: the second pass's order of the regions, costliest first */
-    MPI_Win counter_window; /* dynamic: two counters on rank 0, one per pass */
-    int64_t *counters;      /* rank 0's (NULL elsewhere) */
+    double *cost;   /* per region: CPU seconds of its first pass (summed over the ranks) */
+    int *taker;     /* dynamic: per region, the rank that took its first pass */
+    uint32_t *list; /* dynamic: the current pass's regions, each rank's share contiguous */
+    double *weight; /* dynamic: prefix sums of the list's expected costs (region_count + 1) */
+    MPI_Win counter_window; /* dynamic: per pass, one share word per rank on rank 0 */
+    uint64_t *counters;     /* rank 0's (NULL elsewhere) */
     int window_made;
     double busy, idle; /* CPU seconds on units; wall seconds waiting for work */
-    uint64_t units, bytes_sent;
+    uint64_t units, bytes_sent, stolen;
     wall_composite composite;
     uint8_t *image; /* rank 0, one image: the wall's colours */
     double start, coarse_seconds, extraction_seconds, total_seconds;
@@ -107,8 +110,75 @@ static int setup_layout(wall_run *r, ip_error *err)
     return 0;
 }
 
-/* The next unit of a pass: the counter's next value (dynamic), or this rank's next region
- * (static, from *cursor). Returns the region's index, or -1 when the pass is done. */
+/* ---- dynamic units: a share of the list per rank, stolen from when a rank's own runs out ----
+ *
+ * Each pass has a list of the regions in which every rank's share is a contiguous run (the first
+ * pass: patches of 2 x 2 neighbouring regions spread over the wall; the second: the regions the
+ * rank took in the first pass, whose surface it has, by expected cost, most first). Rank 0's
+ * window holds, per pass and rank, one 64-bit word: the positions [lo, hi) of the list still
+ * unclaimed in that rank's share, lo in the low 32 bits. A rank takes its share's next position
+ * with one atomic add of 1 (lo >= hi: the share is spent); then it steals the far half (by
+ * expected cost) of the share with the most left, under an exclusive lock of the window, and the
+ * stolen run becomes its own share (which others may steal from in turn). A rank's regions stay
+ * neighbours or ones it has already seen, so its visited set and cache serve them, and the last
+ * units taken are small. */
+
+static uint64_t share_word(uint64_t lo, uint64_t hi)
+{
+    return lo | hi << 32;
+}
+
+/* One atomic fetch-and-op on word `slot` of rank 0's window; returns the word before it. */
+static uint64_t word_op(wall_run *r, int slot, uint64_t value, MPI_Op op)
+{
+    uint64_t got;
+    MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, r->counter_window);
+    MPI_Fetch_and_op(&value, &got, MPI_UINT64_T, 0, slot, op, r->counter_window);
+    MPI_Win_unlock(0, r->counter_window);
+    r->bytes_sent += sizeof value;
+    return got;
+}
+
+/* Steals from another rank's share of the pass: the far half of the one with the most expected
+ * cost left, and the rest of the stolen run becomes this rank's share, all under an exclusive
+ * lock of the window (so no other rank takes from the shares meanwhile). Returns the list
+ * position of the first unit taken, or -1 when every share is spent. words: room for ranks. */
+static int64_t steal(wall_run *r, int pass, uint64_t *words)
+{
+    int base = pass * r->ranks;
+    const double *w = r->weight;
+    MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, r->counter_window);
+    for (int k = 0; k < r->ranks; k++)
+        MPI_Fetch_and_op(NULL, &words[k], MPI_UINT64_T, 0, base + k, MPI_NO_OP, r->counter_window);
+    MPI_Win_flush(0, r->counter_window);
+    r->bytes_sent += (uint64_t)r->ranks * sizeof *words;
+    int victim = -1;
+    double most = 0;
+    for (int k = 0; k < r->ranks; k++) {
+        uint32_t lo = (uint32_t)words[k], hi = (uint32_t)(words[k] >> 32);
+        if (k != r->rank && lo < hi && (victim < 0 || w[hi] - w[lo] > most))
+            victim = k, most = w[hi] - w[lo];
+    }
+    int64_t at = -1;
+    if (victim >= 0) {
+        uint32_t lo = (uint32_t)words[victim], hi = (uint32_t)(words[victim] >> 32), cut = hi - 1;
+        while (cut > lo + 1 && w[hi] - w[cut] < most / 2)
+            cut--;
+        uint64_t theirs = share_word(lo, cut), mine = share_word(cut + 1, hi), old;
+        MPI_Fetch_and_op(&theirs, &old, MPI_UINT64_T, 0, base + victim, MPI_REPLACE,
+                         r->counter_window);
+        MPI_Fetch_and_op(&mine, &old, MPI_UINT64_T, 0, base + r->rank, MPI_REPLACE,
+                         r->counter_window);
+        r->bytes_sent += 2 * sizeof mine;
+        at = cut;
+    }
+    MPI_Win_unlock(0, r->counter_window);
+    return at;
+}
+
+/* The next unit of a pass: this rank's next region (static, from *cursor), or the next of its
+ * share, else a stolen one (dynamic; *cursor counts the steals). Returns the region's index,
+ * or -1 when the pass is done. */
 static int64_t next_unit(wall_run *r, int pass, int64_t *cursor)
 {
     int64_t count = r->layout.region_count;
@@ -117,17 +187,31 @@ static int64_t next_unit(wall_run *r, int pass, int64_t *cursor)
             (*cursor)++;
         return *cursor < count ? (*cursor)++ : -1;
     }
-    int64_t one = 1, got;
-    /* dynamic */
     double wait = MPI_Wtime();
-    MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, r->counter_window);
-    MPI_Fetch_and_op(&one, &got, MPI_INT64_T, 0, pass, MPI_SUM, r->counter_window);
-    MPI_Win_unlock(0, r->counter_window);
+    uint64_t mine = word_op(r, pass * r->ranks + r->rank, 1, MPI_SUM);
+    int64_t at = (uint32_t)mine < (uint32_t)(mine >> 32) ? (int64_t)(uint32_t)mine : -1;
+    if (at < 0) {
+        uint64_t *words = malloc((size_t)r->ranks * sizeof *words);
+        at = words ? steal(r, pass, words) : -1; /* out of memory: leave the rest to the others */
+        free(words);
+        *cursor += at >= 0;
+    }
     r->idle += MPI_Wtime() - wait;
-    r->bytes_sent += sizeof one;
-    if (got >= count)
+    if (at < 0)
         return -1;
-    return pass ? (int64_t)r->second[got] : got;
+    r->stolen += *cursor > 0;
+    return (int64_t)r->list[at];
+}
+
+/* Rank 0 sets every rank's share of the pass's list: rank k's is [bounds[k], bounds[k + 1]). */
+static void set_shares(wall_run *r, int pass, const uint32_t *bounds)
+{
+    if (r->rank != 0)
+        return;
+    MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, r->counter_window);
+    for (int k = 0; k < r->ranks; k++)
+        r->counters[pass * r->ranks + k] = share_word(bounds[k], bounds[k + 1]);
+    MPI_Win_unlock(0, r->counter_window);
 }
 
 /* Casts the rays of one pass over the units this rank takes. */
@@ -149,14 +233,17 @@ static int run_pass(wall_run *r, int pass, ip_error *err)
         }
         double spent = wall_cpu_seconds() - start;
         r->busy += spent;
-        if (pass == 0)
+        if (pass == 0) {
             r->cost[u] = spent;
+            r->taker[u] = r->rank;
+        }
         r->units++;
     }
     return 0;
 }
 
 typedef struct costed {
+    int taker;
     double cost;
     uint32_t region;
 } costed;
@@ -164,35 +251,122 @@ typedef struct costed {
 static int compare_cost(const void *a, const void *b)
 {
     const costed *x = a, *y = b;
+    if (x->taker != y->taker)
+        return x->taker < y->taker ? -1 : 1;
     if (x->cost != y->cost)
         return x->cost > y->cost ? -1 : 1;
     return (x->region > y->region) - (x->region < y->region);
 }
 
-/* After the first pass: every rank learns what each region's coarse rays cost, and the second
- * pass hands out the costliest regions first (longest processing time first), so that the
- * last units, which decide the balance, are small ones. Every rank computes the same order. */
-static void order_second_pass(wall_run *r)
+/* Every rank computes the same list and prefix sums of its weights (cost + 1e-9 s, so that a
+ * unit never weighs 0), and rank 0 sets the shares; bounds: ranks + 1 entries. */
+static void set_list(wall_run *r, int pass, const costed *order, uint32_t *bounds)
+{
+    uint32_t n = r->layout.region_count;
+    r->weight[0] = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        r->list[i] = order[i].region;
+        r->weight[i + 1] = r->weight[i] + order[i].cost + 1e-9;
+    }
+    set_shares(r, pass, bounds);
+}
+
+/* The first pass's list: the regions in a Z order over the wall's grid of regions, dealt out
+ * in blocks of 2 x 2 neighbours, block b to rank b % ranks, so that each rank's share is a
+ * contiguous run of the list made of small patches spread over the whole wall (the surface is
+ * not known yet: where it lies in one patch of the wall, every share has some of it). Returns
+ * 0, or -1 when out of memory. */
+static int first_list(wall_run *r)
+{
+    enum {
+        BLOCK = 4
+    };
+    uint32_t n = r->layout.region_count, blocks = (n + BLOCK - 1) / BLOCK;
+    costed *order = malloc(n * sizeof *order);
+    uint32_t *bounds = malloc(((size_t)r->ranks + 1) * sizeof *bounds);
+    int ok =
+        order && bounds && wall_spatial_order(&r->layout, r->o.unit_w, r->o.unit_h, r->list) == 0;
+    if (ok) {
+        uint32_t at = 0;
+        for (int k = 0; k < r->ranks; k++) {
+            bounds[k] = at;
+            for (uint32_t b = (uint32_t)k; b < blocks; b += (uint32_t)r->ranks)
+                for (uint32_t i = b * BLOCK; i < n && i < (b + 1) * BLOCK; i++)
+                    order[at++] = (costed){0, 1.0, r->list[i]};
+        }
+        bounds[r->ranks] = at;
+        set_list(r, 0, order, bounds);
+    }
+    free(order);
+    free(bounds);
+    return ok ? 0 : -1;
+}
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* What each region's second pass is expected to cost (CPU seconds, into expect[]), from what
+ * its first pass cost: twice that, plus its remaining rays at half the wall's typical cost of
+ * a first-pass ray (the median over the regions). Rays through empty space dominate the second
+ * pass, the surface the first: on the head of docs/scale-out.md, one process, this is the
+ * least-squares fit (a region's second pass: 1.6 ms plus 2.1 times its first). Returns 0, or
+ * -1 when out of memory. */
+static int expected_second(const wall_run *r, double *expect)
+{
+    uint32_t n = r->layout.region_count;
+    double *per_ray = malloc(n * sizeof *per_ray);
+    if (!per_ray)
+        return -1;
+    for (uint32_t i = 0; i < n; i++)
+        per_ray[i] = r->cost[i] / (double)wall_coarse_rays(&r->layout.regions[i]);
+    qsort(per_ray, n, sizeof *per_ray, compare_double);
+    double typical = per_ray[n / 2];
+    free(per_ray);
+    for (uint32_t i = 0; i < n; i++) {
+        const wall_region *g = &r->layout.regions[i];
+        uint64_t rest = (uint64_t)g->width * g->height - wall_coarse_rays(g);
+        expect[i] = 2 * r->cost[i] + (double)rest * typical / 2;
+    }
+    return 0;
+}
+
+/* After the first pass: every rank learns what each region's coarse rays cost and which rank
+ * cast them. In the second pass each rank's share is the regions it took in the first, so their
+ * surface is already in its mesh and visited set, by expected cost, most first (longest
+ * processing time first), so that the units stolen last, from the far ends, are cheap. Every
+ * rank computes the same order. Returns 0, or -1 when out of memory. */
+static int order_second_pass(wall_run *r)
 {
     uint32_t n = r->layout.region_count;
     double wait = MPI_Wtime();
     MPI_Allreduce(MPI_IN_PLACE, r->cost, (int)n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, r->taker, (int)n, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     r->idle += MPI_Wtime() - wait;
-    r->bytes_sent += (uint64_t)n * sizeof *r->cost;
+    r->bytes_sent += (uint64_t)n * (sizeof *r->cost + sizeof *r->taker);
     double start = wall_cpu_seconds();
     costed *order = malloc(n * sizeof *order);
-    if (!order) { /* keep the progressive order */
-        for (uint32_t i = 0; i < n; i++)
-            r->second[i] = i;
-        return;
+    uint32_t *bounds = calloc((size_t)r->ranks + 1, sizeof *bounds);
+    double *expect = malloc(n * sizeof *expect);
+    int ok = order && bounds && expect && expected_second(r, expect) == 0;
+    if (ok) {
+        for (uint32_t i = 0; i < n; i++) {
+            int t = r->taker[i] >= 0 && r->taker[i] < r->ranks ? r->taker[i] : 0;
+            order[i] = (costed){t, expect[i], i};
+            bounds[t + 1]++;
+        }
+        for (int k = 0; k < r->ranks; k++)
+            bounds[k + 1] += bounds[k];
+        qsort(order, n, sizeof *order, compare_cost);
+        set_list(r, 1, order, bounds);
     }
-    for (uint32_t i = 0; i < n; i++)
-        order[i] = (costed){r->cost[i], i};
-    qsort(order, n, sizeof *order, compare_cost);
-    for (uint32_t i = 0; i < n; i++)
-        r->second[i] = order[i].region;
     free(order);
+    free(bounds);
+    free(expect);
     r->busy += wall_cpu_seconds() - start;
+    return ok ? 0 : -1;
 }
 
 /* Rank 0's wall image receives each tile. */
@@ -270,8 +444,14 @@ static int extract(wall_run *r)
         r->idle += MPI_Wtime() - wait;
         if (pass == 0) {
             r->coarse_seconds = MPI_Wtime() - r->start;
-            if (!r->o.is_static)
-                order_second_pass(r);
+            if (!r->o.is_static) {
+                if (!all_ok(order_second_pass(r) == 0)) {
+                    if (r->rank == 0)
+                        fprintf(stderr, "%s: out of memory for the second pass\n", r->program);
+                    return -1;
+                }
+                MPI_Barrier(MPI_COMM_WORLD); /* the shares are set */
+            }
             if (r->o.coarse) {
                 composite(r, 0);
                 if (write_image(r, r->o.coarse) != 0)
@@ -351,9 +531,9 @@ static void fill_stats(FILE *out, void *user)
         fprintf(out,
                 "%s\n    {\"rank\": %d, \"busy_s\": %.6f, \"idle_s\": %.6f, \"units\": %.0f, "
                 "\"rays\": %.0f, \"seeds\": %.0f, \"cells\": %.0f, \"triangles\": %.0f, "
-                "\"bytes_sent\": %.0f, \"peak_rss_mb\": %.1f}",
+                "\"bytes_sent\": %.0f, \"peak_rss_mb\": %.1f, \"stolen\": %.0f}",
                 k ? "," : "", k, x[REC_BUSY], x[REC_IDLE], x[REC_UNITS], x[REC_RAYS], x[REC_SEEDS],
-                x[REC_CELLS], x[REC_TRIANGLES], x[REC_BYTES], x[REC_RSS_MB]);
+                x[REC_CELLS], x[REC_TRIANGLES], x[REC_BYTES], x[REC_RSS_MB], x[REC_STOLEN]);
     }
     fprintf(out, "\n  ]\n}\n");
 }
@@ -375,6 +555,7 @@ static int report(wall_run *r)
         [REC_TRIANGLES] = (double)t.triangles,
         [REC_BYTES] = (double)(r->bytes_sent + r->composite.bytes_sent),
         [REC_RSS_MB] = (double)usage.ru_maxrss / 1024.0,
+        [REC_STOLEN] = (double)r->stolen,
     };
     double *all = r->rank == 0 ? malloc(sizeof mine * (size_t)r->ranks) : NULL;
     if (r->rank == 0 && !all) {
@@ -437,21 +618,25 @@ static int open_run(wall_run *r)
         return 1;
     if (r->rank == 0)
         tool_warn_iso_range(r->program, r->store, r->o.common.iso, NULL, 0);
-    size_t bytes = r->rank == 0 ? 2 * sizeof(int64_t) : 0;
-    MPI_Win_allocate((MPI_Aint)bytes, sizeof(int64_t), MPI_INFO_NULL, MPI_COMM_WORLD, &r->counters,
+    size_t bytes = r->rank == 0 ? 2 * (size_t)r->ranks * sizeof(uint64_t) : 0;
+    MPI_Win_allocate((MPI_Aint)bytes, sizeof(uint64_t), MPI_INFO_NULL, MPI_COMM_WORLD, &r->counters,
                      &r->counter_window);
     r->window_made = 1;
-    if (r->rank == 0) {
-        MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, r->counter_window);
-        r->counters[0] = r->counters[1] = 0;
-        MPI_Win_unlock(0, r->counter_window);
-    }
     size_t pixels = (size_t)r->layout.camera.width * r->layout.camera.height;
-    r->cost = calloc(r->layout.region_count, sizeof *r->cost);
-    r->second = malloc(r->layout.region_count * sizeof *r->second);
-    if (!r->cost || !r->second)
+    uint32_t n = r->layout.region_count;
+    r->cost = calloc(n, sizeof *r->cost);
+    r->taker = malloc(n * sizeof *r->taker);
+    r->list = malloc(n * sizeof *r->list);
+    r->weight = malloc(((size_t)n + 1) * sizeof *r->weight);
+    int ok_regions = r->cost && r->taker && r->list && r->weight;
+    if (ok_regions) {
+        for (uint32_t i = 0; i < n; i++)
+            r->taker[i] = -1;
+        ok_regions = first_list(r) == 0;
+    }
+    if (!ok_regions)
         fprintf(stderr, "%s: out of memory for the regions\n", r->program);
-    if (!all_ok(r->cost && r->second))
+    if (!all_ok(ok_regions))
         return 1;
     int need_image = !r->o.tiles_dir || r->o.coarse;
     if (r->rank == 0 && need_image && !(r->image = malloc(4 * pixels)))
@@ -472,7 +657,9 @@ static void close_run(wall_run *r)
     ip_store_close(r->store);
     free(r->layout.regions);
     free(r->cost);
-    free(r->second);
+    free(r->taker);
+    free(r->list);
+    free(r->weight);
     free(r->image);
 }
 
