@@ -5,6 +5,7 @@
 #include <stdatomic.h>
 #include <sys/stat.h>
 
+#include "cache_prefetch.h"
 #include "check.h"
 #include "isoprop/cache.h"
 #include "isoprop/store.h"
@@ -378,6 +379,28 @@ static void test_group_ranges(const char *dir)
     ip_store_close(s);
 }
 
+/* ip__cache_pin_resident(): a pin of what is resident, never a read */
+static void test_pin_resident(const ip_store *s)
+{
+    ip_cache *c;
+    ip_cache_stats st;
+    ip_brick b;
+    REQUIRE(ip_cache_create(s, 8 * BRICK_BYTES, &c, NULL) == IP_OK);
+    CHECK(!ip__cache_pin_resident(c, 3, &b)); /* not resident: nothing read, nothing touched */
+    CHECK(!ip__cache_pin_resident(c, 1u << 30, &b)); /* no such brick */
+    ip_cache_get_stats(c, &st);
+    CHECK(st.misses == 0 && st.hits == 0 && st.resident_bytes == 0 && st.bricks_touched == 0);
+    pin_unpin(c, 3);
+    CHECK(ip__cache_pin_resident(c, 3, &b)); /* resident now: a hit on the same brick */
+    CHECK(b.index == 3 && brick_ok(&b));
+    ip_cache_get_stats(c, &st);
+    CHECK(st.misses == 1 && st.hits == 1 && st.pinned_bytes == BRICK_BYTES);
+    ip_cache_unpin_brick(c, &b);
+    ip_cache_get_stats(c, &st);
+    CHECK(st.pinned_bytes == 0);
+    ip_cache_destroy(c);
+}
+
 int main(void)
 {
     const char *dir = test_tmp_dir("test_cache");
@@ -389,6 +412,7 @@ int main(void)
     REQUIRE(ip_store_layout(s)->levels[0].brick_count == 64);
     test_scripted_lru(s);
     test_pinning(s);
+    test_pin_resident(s);
     test_threads(s);
     ip_store_close(s);
     test_corrupt_brick(dir, ibv);

@@ -60,7 +60,9 @@ static inline int meets(const index_beam *w, const double lo[3], const double hi
 static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[3], int side)
 {
     ip_seeder *s = w->s;
-    const ip_brick *brick = ip__sampler_cell_brick(s->sampler, lo);
+    /* only a brick the view has already loaded: a beam wider and deeper than its rays must not
+     * read bricks they would never read (not settled then: the rays walk) */
+    const ip_brick *brick = ip__sampler_resident_cell_brick(s->sampler, lo);
     if (!brick)
         return 0;
     ptrdiff_t corners[8];

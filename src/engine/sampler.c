@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cache_prefetch.h"
 #include "internal.h"
 #include "sampler.h"
 
@@ -46,7 +47,9 @@ void ip__sampler_free(ip_sampler *s)
     }
 }
 
-static const ip_brick *brick_at(ip_sampler *s, const uint32_t brick[3])
+/* The brick at `brick` (brick coordinates), pinned in a slot; with `resident_only`, NULL
+ * when the cache does not hold it (nothing is read, s->status stays as it was). */
+static const ip_brick *pinned_brick(ip_sampler *s, const uint32_t brick[3], int resident_only)
 {
     uint64_t g = ip_brick_global_index(s->layout, s->level, brick);
     for (unsigned i = 0; i < IP_SAMPLER_SLOTS; i++)
@@ -56,20 +59,32 @@ static const ip_brick *brick_at(ip_sampler *s, const uint32_t brick[3])
         }
     if (s->status != IP_OK)
         return NULL;
+    ip_brick got;
+    if (resident_only && !ip__cache_pin_resident(s->cache, g, &got))
+        return NULL;
     unsigned v = s->next_victim;
     s->next_victim = (v + 1) % IP_SAMPLER_SLOTS;
     if (s->used[v]) {
         ip_cache_unpin_brick(s->cache, &s->held[v]);
         s->used[v] = 0;
     }
-    ip_status st = ip_cache_pin_brick(s->cache, g, &s->held[v], &s->error);
-    if (st != IP_OK) {
-        s->status = st;
-        return NULL;
+    if (resident_only) {
+        s->held[v] = got;
+    } else {
+        ip_status st = ip_cache_pin_brick(s->cache, g, &s->held[v], &s->error);
+        if (st != IP_OK) {
+            s->status = st;
+            return NULL;
+        }
     }
     s->used[v] = 1;
     s->last = v;
     return &s->held[v];
+}
+
+static const ip_brick *brick_at(ip_sampler *s, const uint32_t brick[3])
+{
+    return pinned_brick(s, brick, 0);
 }
 
 const ip_brick *ip__sampler_cell_brick(ip_sampler *s, const uint32_t cell[3])
@@ -86,6 +101,14 @@ const ip_brick *ip__sampler_cell_brick(ip_sampler *s, const uint32_t cell[3])
     for (int a = 0; a < 3; a++)
         b[a] = cell[a] >> s->edge_shift;
     return brick_at(s, b);
+}
+
+const ip_brick *ip__sampler_resident_cell_brick(ip_sampler *s, const uint32_t cell[3])
+{
+    uint32_t b[3];
+    for (int a = 0; a < 3; a++)
+        b[a] = cell[a] >> s->edge_shift;
+    return pinned_brick(s, b, 1);
 }
 
 int ip__sampler_cell_values(ip_sampler *s, const uint32_t cell[3], float values[8])

@@ -42,6 +42,10 @@ void ip__sampler_release(ip_sampler *s);
  * failure (s->status and s->error say which brick). */
 const ip_brick *ip__sampler_cell_brick(ip_sampler *s, const uint32_t cell[3]);
 
+/* ip__sampler_cell_brick() for a brick the cache already holds: NULL, with nothing read and
+ * no failure recorded, when it does not. */
+const ip_brick *ip__sampler_resident_cell_brick(ip_sampler *s, const uint32_t cell[3]);
+
 /* The 8 corner values of `cell`, in marching-cubes corner order. Returns 0 after a failure. */
 int ip__sampler_cell_values(ip_sampler *s, const uint32_t cell[3], float values[8]);
 

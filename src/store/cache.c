@@ -630,6 +630,14 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
     return st;
 }
 
+int ip__cache_pin_resident(ip_cache *c, uint64_t g, ip_brick *b)
+{
+    if (g >= c->layout->brick_count || !try_pin(c, g, b))
+        return 0;
+    atomic_fetch_add_explicit(&c->hits[g % HIT_STRIPES].value, 1, memory_order_relaxed);
+    return 1;
+}
+
 uint64_t ip__cache_tick_now(const ip_cache *c)
 {
     return atomic_load(&((ip_cache *)c)->clock) + 1;

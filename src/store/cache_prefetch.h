@@ -31,6 +31,12 @@ typedef enum ip__prefetch_outcome {
  * pin or load came before tick `below`; blocks for the read and the decode. */
 ip__prefetch_outcome ip__cache_prefetch_brick(ip_cache *cache, uint64_t g, uint64_t below);
 
+/* Pins brick `g` only when it is resident (a hit, counted as one): 1 and *b filled, or 0, with
+ * nothing read, loaded or waited for (a brick being loaded by another thread is not resident
+ * yet). For tests that may give up where data is missing, such as the engine's beam tests:
+ * they must not make a view read bricks that its rays and propagation never need. */
+int ip__cache_pin_resident(ip_cache *cache, uint64_t g, ip_brick *b);
+
 /* The earliest tick a pin made from now on gets: bricks pinned after this call have ticks
  * >= the value, those pinned before have smaller ones. */
 uint64_t ip__cache_tick_now(const ip_cache *cache);
