@@ -418,6 +418,67 @@ static void check_coverage_box_test(void)
     ip__coverage_free(&c);
 }
 
+/* The full extraction of an isovalue at level 0 and its image under one camera, beside
+ * buffers for the image of a progressive mesh to compare with it. */
+typedef struct reference {
+    size_t n; /* pixels */
+    ip_mesh full;
+    uint32_t *index, *full_index; /* the triangle each pixel shows (UINT32_MAX: none) */
+    uint8_t *rgba, *full_rgba;
+} reference;
+
+static void reference_open(scene *s, const ip_camera *cam, float iso, reference *r)
+{
+    ip_error err;
+    r->n = (size_t)cam->width * cam->height;
+    r->index = malloc(r->n * 4);
+    r->full_index = malloc(r->n * 4);
+    r->rgba = malloc(r->n * 4);
+    r->full_rgba = malloc(r->n * 4);
+    REQUIRE(r->index && r->full_index && r->rgba && r->full_rgba);
+    ip_mesh_init(&r->full);
+    REQUIRE(ip_extract_full(s->cache, iso, 0, 1, &r->full, NULL, &err) == IP_OK);
+    REQUIRE(ip_raster_mesh(&r->full, cam, s->lo, s->hi, r->full_index, r->full_rgba, &err) ==
+            IP_OK);
+}
+
+static void reference_close(reference *r)
+{
+    free(r->index);
+    free(r->full_index);
+    free(r->rgba);
+    free(r->full_rgba);
+    ip_mesh_free(&r->full);
+}
+
+/* Draws `m` into r->index and r->rgba and counts the pixels whose coverage, and whose colour,
+ * differ from the full extraction's image. */
+static void reference_compare(scene *s, const ip_camera *cam, reference *r, const ip_mesh *m,
+                              size_t *coverage_diff, size_t *colour_diff)
+{
+    ip_error err;
+    REQUIRE(ip_raster_mesh(m, cam, s->lo, s->hi, r->index, r->rgba, &err) == IP_OK);
+    *coverage_diff = *colour_diff = 0;
+    for (size_t i = 0; i < r->n; i++) {
+        *coverage_diff += (r->index[i] == UINT32_MAX) != (r->full_index[i] == UINT32_MAX);
+        *colour_diff += memcmp(r->rgba + 4 * i, r->full_rgba + 4 * i, 4) != 0;
+    }
+}
+
+/* An engine at full resolution (lod off) with `threads` threads and occlusion on or off. */
+static ip_engine *full_resolution_engine(scene *s, unsigned threads, int occlusion)
+{
+    ip_engine *e;
+    ip_engine_options o;
+    ip_error err;
+    ip_engine_options_default(&o);
+    o.lod = 0;
+    o.threads = threads;
+    o.occlusion = occlusion;
+    REQUIRE(ip_engine_create(s->cache, &o, &e, &err) == IP_OK);
+    return e;
+}
+
 /* Occlusion on a volume with hidden surface (the Shepp-Logan phantom: the skull's inner
  * surface and the ellipsoids inside it, seen through the outer surface): with 1 and 2
  * threads it extracts fewer triangles than without, and the final image is the full
@@ -434,36 +495,22 @@ static void check_occlusion(const char *dir)
     const uint32_t w = 120, h = 100;
     const float iso = 25.5f; /* between air (0) and brain (0.2 of 255): every shell */
     REQUIRE(ip_camera_fit_axis(s.lo, s.hi, "+x", 30.0, w, h, &cam, &err) == IP_OK);
-    size_t n = (size_t)w * h;
-    uint32_t *index = malloc(n * 4), *full_index = malloc(n * 4);
-    uint8_t *rgba = malloc(n * 4), *full_rgba = malloc(n * 4);
-    REQUIRE(index && full_index && rgba && full_rgba);
-    ip_mesh full;
-    ip_mesh_init(&full);
-    REQUIRE(ip_extract_full(s.cache, iso, 0, 1, &full, NULL, &err) == IP_OK);
-    REQUIRE(ip_raster_mesh(&full, &cam, s.lo, s.hi, full_index, full_rgba, &err) == IP_OK);
+    reference r;
+    reference_open(&s, &cam, iso, &r);
     uint64_t triangles[2][2], visible[2][2];
     for (int threads = 1; threads <= 2; threads++)
         for (int occlusion = 0; occlusion <= 1; occlusion++) {
-            ip_engine *e;
-            ip_engine_options o;
-            ip_engine_options_default(&o);
-            o.lod = 0;
-            o.threads = (unsigned)threads;
-            o.occlusion = occlusion;
-            REQUIRE(ip_engine_create(s.cache, &o, &e, &err) == IP_OK);
+            ip_engine *e = full_resolution_engine(&s, (unsigned)threads, occlusion);
             ip_engine_counts t;
             run_all_rays(e, &cam, iso, &t);
             const ip_mesh *m = ip_engine_mesh(e);
-            REQUIRE(ip_raster_mesh(m, &cam, s.lo, s.hi, index, rgba, &err) == IP_OK);
-            size_t coverage_diff = 0, colour_diff = 0;
+            size_t coverage_diff, colour_diff;
+            reference_compare(&s, &cam, &r, m, &coverage_diff, &colour_diff);
             uint8_t *owns = calloc(m->triangle_count / 8 + 1, 1);
             REQUIRE(owns);
             uint64_t owners = 0;
-            for (size_t i = 0; i < n; i++) {
-                coverage_diff += (index[i] == UINT32_MAX) != (full_index[i] == UINT32_MAX);
-                colour_diff += memcmp(rgba + 4 * i, full_rgba + 4 * i, 4) != 0;
-                uint32_t k = index[i];
+            for (size_t i = 0; i < r.n; i++) {
+                uint32_t k = r.index[i];
                 if (k != UINT32_MAX && !(owns[k / 8] & (1u << (k % 8)))) {
                     owns[k / 8] |= (uint8_t)(1u << (k % 8));
                     owners++;
@@ -475,7 +522,7 @@ static void check_occlusion(const char *dir)
             printf("test_engine: occlusion %s, %d thread%s: %llu of %llu triangles extracted, "
                    "%llu visible, %llu cells deferred; %zu coverage, %zu colour differences\n",
                    occlusion ? "on" : "off", threads, threads > 1 ? "s" : "",
-                   (unsigned long long)m->triangle_count, (unsigned long long)full.triangle_count,
+                   (unsigned long long)m->triangle_count, (unsigned long long)r.full.triangle_count,
                    (unsigned long long)owners, (unsigned long long)t.deferred, coverage_diff,
                    colour_diff);
             CHECK_MSG(coverage_diff == 0 && colour_diff == 0,
@@ -493,11 +540,7 @@ static void check_occlusion(const char *dir)
                   (unsigned long long)triangles[k][1], (unsigned long long)triangles[k][0]);
         CHECK(visible[k][1] == visible[k][0]);
     }
-    free(index);
-    free(full_index);
-    free(rgba);
-    free(full_rgba);
-    ip_mesh_free(&full);
+    reference_close(&r);
     close_scene(&s);
 }
 
@@ -543,36 +586,19 @@ static void check_retirement(const char *dir)
     const float iso = 100.5f;
     ip_camera cam;
     REQUIRE(ip_camera_fit_axis(s.lo, s.hi, "-z", 30.0, w, h, &cam, &err) == IP_OK);
-    size_t n = (size_t)w * h;
-    uint32_t *index = malloc(n * 4), *full_index = malloc(n * 4);
-    uint8_t *rgba = malloc(n * 4), *full_rgba = malloc(n * 4);
-    REQUIRE(index && full_index && rgba && full_rgba);
-    ip_mesh full;
-    ip_mesh_init(&full);
-    REQUIRE(ip_extract_full(s.cache, iso, 0, 1, &full, NULL, &err) == IP_OK);
-    REQUIRE(ip_raster_mesh(&full, &cam, s.lo, s.hi, full_index, full_rgba, &err) == IP_OK);
-    size_t covered = 0;
+    reference r;
+    reference_open(&s, &cam, iso, &r);
+    size_t n = r.n, covered = 0;
     for (size_t i = 0; i < n; i++)
-        covered += full_index[i] != UINT32_MAX;
+        covered += r.full_index[i] != UINT32_MAX;
     uint64_t nodes[2] = {0, 0};
     for (int threads = 1; threads <= 2; threads++)
         for (int occlusion = 0; occlusion <= 1; occlusion++) {
-            ip_engine *e;
-            ip_engine_options o;
-            ip_engine_options_default(&o);
-            o.lod = 0;
-            o.threads = (unsigned)threads;
-            o.occlusion = occlusion;
-            REQUIRE(ip_engine_create(s.cache, &o, &e, &err) == IP_OK);
+            ip_engine *e = full_resolution_engine(&s, (unsigned)threads, occlusion);
             ip_engine_counts t;
             run_all_rays(e, &cam, iso, &t);
-            REQUIRE(ip_raster_mesh(ip_engine_mesh(e), &cam, s.lo, s.hi, index, rgba, &err) ==
-                    IP_OK);
-            size_t coverage_diff = 0, colour_diff = 0;
-            for (size_t i = 0; i < n; i++) {
-                coverage_diff += (index[i] == UINT32_MAX) != (full_index[i] == UINT32_MAX);
-                colour_diff += memcmp(rgba + 4 * i, full_rgba + 4 * i, 4) != 0;
-            }
+            size_t coverage_diff, colour_diff;
+            reference_compare(&s, &cam, &r, ip_engine_mesh(e), &coverage_diff, &colour_diff);
             printf("test_engine: wall, occlusion %s, %d thread%s: %llu rays, %llu retired, %llu "
                    "nodes walked, %llu cells; %zu covered pixels, %zu coverage, %zu colour "
                    "differences\n",
@@ -595,11 +621,7 @@ static void check_retirement(const char *dir)
         }
     CHECK_MSG(2 * nodes[1] < nodes[0], "%llu nodes walked with occlusion, %llu without",
               (unsigned long long)nodes[1], (unsigned long long)nodes[0]);
-    free(index);
-    free(full_index);
-    free(rgba);
-    free(full_rgba);
-    ip_mesh_free(&full);
+    reference_close(&r);
     close_scene(&s);
 }
 

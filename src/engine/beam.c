@@ -116,14 +116,9 @@ static int settled_brick(index_beam *w, const uint32_t b[3])
 {
     ip_seeder *s = w->s;
     const ip_layout *l = s->layout;
-    uint32_t origin[3], extent[3];
-    ip_brick_extent(l, s->level, b, origin, extent);
-    const uint32_t *bricks = s->grid[0];
-    uint64_t g = s->first_brick + b[0] + (uint64_t)bricks[0] * (b[1] + (uint64_t)bricks[1] * b[2]);
-    const float *ranges = ip_store_subblock_ranges(s->store, g);
-    uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge, n[3];
-    for (int k = 0; k < 3; k++)
-        n[k] = (extent[k] - 1 + se - 1) / se; /* sub-blocks that hold cells */
+    uint32_t origin[3], extent[3], n[3];
+    const float *ranges = ip__seeder_brick(s, b, origin, extent, n);
+    uint32_t per = l->brick_edge / l->subblock_edge;
     for (uint32_t i = 0; i < n[2]; i++)
         for (uint32_t j = 0; j < n[1]; j++)
             for (uint32_t h = 0; h < n[0]; h++) {
@@ -131,14 +126,8 @@ static int settled_brick(index_beam *w, const uint32_t b[3])
                 if (!ip__range_active(ranges[2 * sb], ranges[2 * sb + 1], s->iso))
                     continue;
                 uint32_t lo[3], hi[3];
-                double blo[3], bhi[3];
-                for (int k = 0; k < 3; k++) {
-                    uint32_t last = origin[k] + extent[k] - 1; /* one past the last cell */
-                    lo[k] = origin[k] + se * at[k];
-                    hi[k] = lo[k] + se < last ? lo[k] + se : last;
-                    blo[k] = lo[k];
-                    bhi[k] = hi[k];
-                }
+                ip__seeder_subblock_cells(s, origin, extent, at, lo, hi);
+                double blo[3] = {lo[0], lo[1], lo[2]}, bhi[3] = {hi[0], hi[1], hi[2]};
                 if (!meets(w, blo, bhi))
                     continue;
                 int side = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi);
@@ -154,10 +143,8 @@ static int settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
     if (depth == 0)
         return settled_brick(w, node);
     ip_seeder *s = w->s;
-    const ip_level_layout *lv = &s->layout->levels[s->level];
     const uint32_t *grid = s->grid[depth - 1];
     const float *ranges = s->ranges[depth - 1];
-    uint64_t span = (uint64_t)s->layout->brick_edge << (depth - 1);
     for (int c = 0; c < 8; c++) {
         uint32_t ch[3] = {2 * node[0] + (c & 1), 2 * node[1] + ((c >> 1) & 1),
                           2 * node[2] + ((c >> 2) & 1)};
@@ -167,16 +154,8 @@ static int settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
         if (!ip__range_active(ranges[2 * i], ranges[2 * i + 1], s->iso))
             continue;
         double lo[3], hi[3];
-        uint32_t first[3], last[3];
-        for (int k = 0; k < 3; k++) {
-            uint64_t a = ch[k] * span, b = a + span, cells = lv->dims[k] - 1;
-            lo[k] = (double)a;
-            hi[k] = (double)(b < cells ? b : cells);
-            first[k] = (uint32_t)lo[k];
-            last[k] = (uint32_t)hi[k];
-        }
-        if (!meets(w, lo, hi) ||
-            (s->clip.count && !ip__clip_keeps_samples(&s->clip, s->layout, s->level, first, last)))
+        ip__seeder_node_box(s, depth - 1, ch, lo, hi);
+        if (!meets(w, lo, hi) || !ip__seeder_node_kept(s, depth - 1, ch))
             continue;
         if (!settled_node(w, depth - 1, ch))
             return 0;
@@ -201,11 +180,10 @@ int ip__beam_settled(ip_seeder *s, const ip_visited *visited, const ip_beam *b)
     uint32_t depth = lv->octree_depth;
     if (!ip__range_active(s->ranges[depth][0], s->ranges[depth][1], s->iso))
         return 1;
-    double lo[3] = {0, 0, 0}, hi[3];
-    for (int k = 0; k < 3; k++)
-        hi[k] = (double)(lv->dims[k] - 1);
+    static const uint32_t root[3] = {0, 0, 0};
+    double lo[3], hi[3];
+    ip__seeder_node_box(s, depth, root, lo, hi);
     if (!meets(&w, lo, hi))
         return 1;
-    static const uint32_t root[3] = {0, 0, 0};
     return settled_node(&w, depth, root);
 }

@@ -23,10 +23,11 @@ void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
 
 /* 1 when every active cell of the seeder's level (a marching-cubes case other than 0 and
  * 255) that the clipping planes keep, that the beam may cross and whose nearest point lies
- * no deeper than b->max_depth is marked in `visited`; 0 when some may not be (or a brick in
- * the way could not be read: the sampler's status then says which). Reads the summaries,
- * and the cells of the bricks where an active sub-block meets the beam. Conservative: boxes
- * are tested against the beam's planes one at a time, so some that miss it count as met. */
+ * no deeper than b->max_depth is marked in `visited`; 0 when some may not be. Reads the
+ * summaries, and where an active sub-block meets the beam the cells of its brick, only if the
+ * cache already holds it (ip__sampler_resident_cell_brick(): a brick not resident counts as
+ * not settled, and nothing is read). Conservative: boxes are tested against the beam's planes
+ * one at a time, so some that miss it count as met. */
 int ip__beam_settled(ip_seeder *s, const ip_visited *visited, const ip_beam *b);
 
 #endif

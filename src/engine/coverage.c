@@ -70,9 +70,7 @@ ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const doub
     }
     c->centre_x = 0.5 * c->width;
     c->centre_y = 0.5 * c->height;
-    float inf = INFINITY;
-    unsigned bits;
-    memcpy(&bits, &inf, sizeof bits);
+    unsigned bits = ip__float_bits(INFINITY);
     for (size_t i = 0; i < n; i++) {
         atomic_init(&c->depth[i], bits);
         atomic_init(&c->solid[i], bits);
@@ -126,13 +124,6 @@ static int centre_range(double lo, double hi, double margin, uint32_t side, int6
     return 1;
 }
 
-static unsigned float_bits(float f)
-{
-    unsigned u;
-    memcpy(&u, &f, sizeof u);
-    return u;
-}
-
 /* Lowers entry i to `bits` (a non-negative float's bits, so integer order is float order). */
 static void lower(atomic_uint *entry, unsigned bits)
 {
@@ -172,7 +163,7 @@ static void add_projected(ip_coverage *c, const double *x, const double *y, cons
         inner[i] = IP_COVERAGE_SOLID_MARGIN * sqrt(ex[i] * ex[i] + ey[i] * ey[i]);
     }
     /* the next float above zmax (a positive finite float: its bits plus one) */
-    unsigned bits = float_bits((float)zmax) + 1;
+    unsigned bits = ip__float_bits((float)zmax) + 1;
     for (int64_t py = y0; py <= y1; py++) {
         double cy = py + 0.5;
         for (int64_t px = x0; px <= x1; px++) {
@@ -221,7 +212,7 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
     float f = (float)limit;
     if ((double)f > limit)
         f = nextafterf(f, 0.0f);
-    unsigned bits = float_bits(f);
+    unsigned bits = ip__float_bits(f);
     double xc = ip__vec3_dot(v, c->to_x) / zc + c->centre_x;
     double yc = ip__vec3_dot(v, c->to_y) / zc + c->centre_y;
     if (xc >= 0 && xc < c->width && yc >= 0 && yc < c->height &&

@@ -59,16 +59,30 @@ void ip__coverage_free(ip_coverage *c);
 /* Records `count` triangles (9 floats each, world units). Any thread. */
 void ip__coverage_add(ip_coverage *c, const float *positions, uint64_t count);
 
+/* The bits of a float, and back: an entry holds a non-negative float's bits, so that integer
+ * order is float order and an atomic integer minimum is a float minimum. */
+static inline unsigned ip__float_bits(float f)
+{
+    unsigned bits;
+    memcpy(&bits, &f, sizeof bits);
+    return bits;
+}
+
+static inline float ip__float_of_bits(unsigned bits)
+{
+    float f;
+    memcpy(&f, &bits, sizeof f);
+    return f;
+}
+
 /* The solid entry of pixel (x, y) (inside the image): an upper bound on the view depth (world
  * units) of an extracted triangle whose projection holds the pixel centre by at least
  * IP_COVERAGE_SOLID_MARGIN pixels from every edge, or +infinity where none is known. Bounds
  * the depth that the rasterizer shows there once that triangle is drawn. Any thread. */
 static inline double ip__coverage_solid(const ip_coverage *c, uint32_t x, uint32_t y)
 {
-    unsigned bits = atomic_load_explicit(&c->solid[(size_t)y * c->width + x], memory_order_relaxed);
-    float f;
-    memcpy(&f, &bits, sizeof f);
-    return f;
+    return ip__float_of_bits(
+        atomic_load_explicit(&c->solid[(size_t)y * c->width + x], memory_order_relaxed));
 }
 
 /* 1 when the world box [lo, hi] is certainly hidden: it lies wholly in front of the eye and

@@ -570,20 +570,6 @@ static int tile_settled(worker *w, uint32_t tx, uint32_t ty, double *solid)
     return 1;
 }
 
-static unsigned float_bits(float f)
-{
-    unsigned bits;
-    memcpy(&bits, &f, sizeof bits);
-    return bits;
-}
-
-static float float_of_bits(unsigned bits)
-{
-    float f;
-    memcpy(&f, &bits, sizeof f);
-    return f;
-}
-
 /* 1 when the ray of pixel (x, y), of the order's level `level`, may be retired without a walk
  * (counted): its solid coverage entry is no deeper than one its tile was found settled at
  * (tile_settled()), +infinity included. A tile is tested by the first ray of each of the
@@ -597,7 +583,7 @@ static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level)
     float z = (float)ip__coverage_solid(&e->coverage, x, y); /* a float's value: exact */
     tile *t = &e->tiles[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)];
     unsigned settled = atomic_load_explicit(&t->depth, memory_order_relaxed);
-    if (!(z <= float_of_bits(settled))) {
+    if (!(z <= ip__float_of_bits(settled))) {
         unsigned char pass = (unsigned char)(level - e->tile_from + 1);
         if (atomic_load_explicit(&t->tested, memory_order_relaxed) >= pass)
             return 0; /* tested in this level already */
@@ -605,12 +591,12 @@ static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level)
         double solid;
         if (!tile_settled(w, x >> TILE_SHIFT, y >> TILE_SHIFT, &solid))
             return 0;
-        unsigned bits = float_bits((float)solid); /* exact; raised, never lowered: both hold */
+        unsigned bits = ip__float_bits((float)solid); /* exact; raised, never lowered: both hold */
         while (bits > settled &&
                !atomic_compare_exchange_weak_explicit(&t->depth, &settled, bits,
                                                       memory_order_relaxed, memory_order_relaxed))
             ;
-        if (!(z <= float_of_bits(bits)))
+        if (!(z <= ip__float_of_bits(bits)))
             return 0;
     }
     w->counts.rays++;

@@ -234,15 +234,9 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
 static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], double t0, double t1)
 {
     const ip_layout *l = s->layout;
-    uint32_t origin[3], extent[3];
-    ip_brick_extent(l, s->level, b, origin, extent);
-    const uint32_t *bricks = s->grid[0];
-    uint64_t g = s->first_brick + b[0] + (uint64_t)bricks[0] * (b[1] + (uint64_t)bricks[1] * b[2]);
-    const float *ranges = ip_store_subblock_ranges(s->store, g);
+    uint32_t origin[3], extent[3], n[3];
+    const float *ranges = ip__seeder_brick(s, b, origin, extent, n);
     uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
-    uint32_t n[3];
-    for (int k = 0; k < 3; k++)
-        n[k] = (extent[k] - 1 + se - 1) / se; /* sub-blocks that hold cells */
     double base[3] = {origin[0], origin[1], origin[2]};
     dda d;
     dda_init(&d, r, base, se, n, t0, t1);
@@ -253,12 +247,8 @@ static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], dou
         int more = dda_next(&d, &exit_t);
         uint32_t sb = (uint32_t)at[0] + per * ((uint32_t)at[1] + per * (uint32_t)at[2]);
         if (active(&ranges[2 * sb], s->iso)) {
-            uint32_t lo[3], hi[3], last[3];
-            for (int k = 0; k < 3; k++) {
-                lo[k] = origin[k] + se * (uint32_t)at[k];
-                last[k] = origin[k] + extent[k] - 1; /* one past the brick's last cell */
-                hi[k] = lo[k] + se < last[k] ? lo[k] + se : last[k];
-            }
+            uint32_t lo[3], hi[3], sub[3] = {(uint32_t)at[0], (uint32_t)at[1], (uint32_t)at[2]};
+            ip__seeder_subblock_cells(s, origin, extent, sub, lo, hi);
             int side = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi);
             int found = side ? walk_cells(s, r, lo, hi, side, enter_t, exit_t) : 0;
             if (found)
@@ -273,34 +263,6 @@ typedef struct child_hit {
     uint32_t node[3];
     double t0, t1;
 } child_hit;
-
-/* Index box of octree node `node` at `depth` (depth 0: a brick). */
-static void node_box(const ip_seeder *s, uint32_t depth, const uint32_t node[3], double lo[3],
-                     double hi[3])
-{
-    const ip_level_layout *lv = &s->layout->levels[s->level];
-    for (int k = 0; k < 3; k++) {
-        uint64_t span = (uint64_t)s->layout->brick_edge << depth;
-        uint64_t a = node[k] * span, b = a + span, cells = lv->dims[k] - 1;
-        lo[k] = (double)a;
-        hi[k] = (double)(b < cells ? b : cells);
-    }
-}
-
-/* 1 unless the clipping planes drop every cell of node `node` at `depth`. */
-static int node_kept(const ip_seeder *s, uint32_t depth, const uint32_t node[3])
-{
-    if (s->clip.count == 0)
-        return 1;
-    double lo[3], hi[3];
-    node_box(s, depth, node, lo, hi);
-    uint32_t first[3], last[3];
-    for (int k = 0; k < 3; k++) {
-        first[k] = (uint32_t)lo[k];
-        last[k] = (uint32_t)hi[k];
-    }
-    return ip__clip_keeps_samples(&s->clip, s->layout, s->level, first, last);
-}
 
 static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uint32_t node[3],
                      double t0, double t1)
@@ -337,7 +299,7 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
         if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
             continue;
         uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
-        if (!active(&ranges[2 * i], s->iso) || !node_kept(s, depth - 1, ch))
+        if (!active(&ranges[2 * i], s->iso) || !ip__seeder_node_kept(s, depth - 1, ch))
             continue;
         double a = t0, b = t1;
         int missed = 0;
@@ -484,7 +446,7 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
     index_ray_init(&r, s->scale, eye, dir);
     across_basis(dir, r.u, r.w);
     double lo[3], hi[3], t0 = t_min, t1 = t_max;
-    node_box(s, depth, root, lo, hi);
+    ip__seeder_node_box(s, depth, root, lo, hi);
     if (!clip(&r, lo, hi, &t0, &t1))
         return 0;
     int found = walk_node(s, &r, depth, root, t0, t1);

@@ -33,6 +33,68 @@ typedef struct ip_seeder {
     ip_clip clip; /* nodes and cells wholly beyond a plane are passed over (none after init) */
 } ip_seeder;
 
+/* The pieces of the octree that the ray walk (seed.c) and the beam test (beam.c) both descend.
+ * Index space: cell (i, j, k) of the seeder's level is the box [i, i+1] x [j, j+1] x [k, k+1]. */
+
+/* Index box of octree node `node` at `depth` (depth 0: a brick). */
+static inline void ip__seeder_node_box(const ip_seeder *s, uint32_t depth, const uint32_t node[3],
+                                       double lo[3], double hi[3])
+{
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    for (int k = 0; k < 3; k++) {
+        uint64_t span = (uint64_t)s->layout->brick_edge << depth;
+        uint64_t a = node[k] * span, b = a + span, cells = lv->dims[k] - 1;
+        lo[k] = (double)a;
+        hi[k] = (double)(b < cells ? b : cells);
+    }
+}
+
+/* 1 unless the clipping planes drop every cell of node `node` at `depth`. */
+static inline int ip__seeder_node_kept(const ip_seeder *s, uint32_t depth, const uint32_t node[3])
+{
+    if (s->clip.count == 0)
+        return 1;
+    double lo[3], hi[3];
+    ip__seeder_node_box(s, depth, node, lo, hi);
+    uint32_t first[3], last[3];
+    for (int k = 0; k < 3; k++) {
+        first[k] = (uint32_t)lo[k];
+        last[k] = (uint32_t)hi[k];
+    }
+    return ip__clip_keeps_samples(&s->clip, s->layout, s->level, first, last);
+}
+
+/* Brick `b` (brick coordinates of the seeder's level): its first sample and extent (as
+ * ip_brick_extent()), in subblocks[] the sub-blocks along each axis that hold cells, and, as
+ * the return value, the summary's min/max pairs of its sub-blocks (x fastest, brick_edge /
+ * subblock_edge a side; owned by the store). */
+static inline const float *ip__seeder_brick(const ip_seeder *s, const uint32_t b[3],
+                                            uint32_t origin[3], uint32_t extent[3],
+                                            uint32_t subblocks[3])
+{
+    const ip_layout *l = s->layout;
+    ip_brick_extent(l, s->level, b, origin, extent);
+    const uint32_t *bricks = s->grid[0];
+    uint64_t g = s->first_brick + b[0] + (uint64_t)bricks[0] * (b[1] + (uint64_t)bricks[1] * b[2]);
+    for (int k = 0; k < 3; k++)
+        subblocks[k] = (extent[k] - 1 + l->subblock_edge - 1) / l->subblock_edge;
+    return ip_store_subblock_ranges(s->store, g);
+}
+
+/* The cells [lo, hi) of sub-block `at` of the brick whose first sample is `origin` and extent
+ * `extent` (ip__seeder_brick()). */
+static inline void ip__seeder_subblock_cells(const ip_seeder *s, const uint32_t origin[3],
+                                             const uint32_t extent[3], const uint32_t at[3],
+                                             uint32_t lo[3], uint32_t hi[3])
+{
+    uint32_t se = s->layout->subblock_edge;
+    for (int k = 0; k < 3; k++) {
+        uint32_t last = origin[k] + extent[k] - 1; /* one past the brick's last cell */
+        lo[k] = origin[k] + se * at[k];
+        hi[k] = lo[k] + se < last ? lo[k] + se : last;
+    }
+}
+
 /* A ray whose pixel centre lies within this distance of a triangle's projected edge extracts
  * the cell and goes on to the first triangle it clearly hits: a rasteriser (which snaps
  * vertices to 1/256 pixel) may decide either way there. Far larger than that rounding, far
