@@ -168,7 +168,10 @@ IP_API ip_status ip_engine_step(ip_engine *engine, uint64_t max_rays, double max
  *  centre first, as for an image of that size, shifted to (x, y)). The mesh, the visited cells
  *  and the occlusion coverage are kept, so a cell extracted for an earlier rectangle is not
  *  extracted again; what the rays of the earlier rectangles did not finish is dropped.
- *  ip_engine_done() is then 1 once those ray_count rays are cast. For sort-first parallel
+ *  Propagation stays within the rectangle's part of the view (a cell whose projection may
+ *  reach the rectangle, with a 2-pixel margin), leaving the surface beyond to the rays of the
+ *  rectangles around it. ip_engine_done() is then 1 once those ray_count rays are cast. From
+ *  the thread that drives the engine. For sort-first parallel
  *  rendering: every pixel given a ray in some rectangle, the union of the meshes shows the
  *  image of one full run. Call after ip_engine_begin(), between steps.
  *  @return IP_OK, or IP_ERR_ARGUMENT (before begin, an empty rectangle or one not inside the
