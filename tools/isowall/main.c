@@ -42,6 +42,7 @@ typedef struct wall_run {
     double *weight; /* dynamic: prefix sums of the list's expected costs (region_count + 1) */
     MPI_Win counter_window; /* dynamic: per pass, one share word per rank on rank 0 */
     uint64_t *counters;     /* rank 0's (NULL elsewhere) */
+    uint64_t *words;        /* dynamic: room for every rank's share word, for a steal */
     int window_made;
     double busy, idle; /* CPU seconds on units; wall seconds waiting for work */
     uint64_t units, bytes_sent, stolen;
@@ -142,11 +143,12 @@ static uint64_t word_op(wall_run *r, int slot, uint64_t value, MPI_Op op)
 /* Steals from another rank's share of the pass: the far half of the one with the most expected
  * cost left, and the rest of the stolen run becomes this rank's share, all under an exclusive
  * lock of the window (so no other rank takes from the shares meanwhile). Returns the list
- * position of the first unit taken, or -1 when every share is spent. words: room for ranks. */
-static int64_t steal(wall_run *r, int pass, uint64_t *words)
+ * position of the first unit taken, or -1 when every share is spent. */
+static int64_t steal(wall_run *r, int pass)
 {
     int base = pass * r->ranks;
     const double *w = r->weight;
+    uint64_t *words = r->words;
     MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, r->counter_window);
     for (int k = 0; k < r->ranks; k++)
         MPI_Fetch_and_op(NULL, &words[k], MPI_UINT64_T, 0, base + k, MPI_NO_OP, r->counter_window);
@@ -191,9 +193,7 @@ static int64_t next_unit(wall_run *r, int pass, int64_t *cursor)
     uint64_t mine = word_op(r, pass * r->ranks + r->rank, 1, MPI_SUM);
     int64_t at = (uint32_t)mine < (uint32_t)(mine >> 32) ? (int64_t)(uint32_t)mine : -1;
     if (at < 0) {
-        uint64_t *words = malloc((size_t)r->ranks * sizeof *words);
-        at = words ? steal(r, pass, words) : -1; /* out of memory: leave the rest to the others */
-        free(words);
+        at = steal(r, pass);
         *cursor += at >= 0;
     }
     r->idle += MPI_Wtime() - wait;
@@ -472,7 +472,6 @@ static int extract(wall_run *r)
 typedef struct stats_view {
     const wall_run *r;
     const double *records; /* REC_COUNT per rank */
-    ip_engine_counts totals;
 } stats_view;
 
 static double sum_of(const stats_view *v, int field)
@@ -565,7 +564,7 @@ static int report(wall_run *r)
     MPI_Gather(mine, REC_COUNT, MPI_DOUBLE, all, REC_COUNT, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     int ok = 1;
     if (r->rank == 0) {
-        stats_view v = {r, all, t};
+        stats_view v = {r, all};
         if (!r->o.common.quiet)
             printf("%s: wall %ux%u of %ux%u (%.1f Mpixel), %d processes, %s: %.0f rays, %.0f "
                    "triangles, busy %.3f s (max %.3f s, balance %.3f), %.3f s\n",
@@ -628,7 +627,8 @@ static int open_run(wall_run *r)
     r->taker = malloc(n * sizeof *r->taker);
     r->list = malloc(n * sizeof *r->list);
     r->weight = malloc(((size_t)n + 1) * sizeof *r->weight);
-    int ok_regions = r->cost && r->taker && r->list && r->weight;
+    r->words = malloc((size_t)r->ranks * sizeof *r->words);
+    int ok_regions = r->cost && r->taker && r->list && r->weight && r->words;
     if (ok_regions) {
         for (uint32_t i = 0; i < n; i++)
             r->taker[i] = -1;
@@ -660,6 +660,7 @@ static void close_run(wall_run *r)
     free(r->taker);
     free(r->list);
     free(r->weight);
+    free(r->words);
     free(r->image);
 }
 
