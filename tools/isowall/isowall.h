@@ -4,10 +4,12 @@
  * regions, each inside one tile. Work units are a region's first rays (its coarse levels) in a
  * first pass over the whole wall, then the rest of its rays in a second pass: every rank casts
  * the rays of the units it takes with its own engine (ip_engine_set_region()), keeping what it
- * extracted for earlier units. Units are handed out by a shared counter on rank 0
- * (MPI_Fetch_and_op, passive target), or with --static by display tile (tile t to rank t % N,
- * one copy per projector). Each rank then draws its own triangles into the tiles they touch,
- * and the tile's owner keeps the nearest surface of each pixel (direct-send compositing).
+ * extracted for earlier units. Each rank takes units from its own share of each pass's list,
+ * one word per rank in rank 0's MPI window (MPI_Fetch_and_op, passive target), and steals half
+ * of the fullest share once its own is spent (main.c); or with --static by display tile (tile t
+ * to rank t % N, one copy per projector). Each rank then draws its own triangles into the tiles
+ * they touch, and the tile's owner keeps the nearest surface of each pixel (direct-send
+ * compositing).
  * MPI stays in this program; the library knows nothing of it.
  */
 #ifndef ISOWALL_H
