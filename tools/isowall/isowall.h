@@ -45,7 +45,9 @@ typedef struct wall_layout {
     ip_camera camera; /* the whole wall: cols * tile_w x rows * tile_h pixels */
     double lo[3], hi[3];
     uint32_t cols, rows, tile_w, tile_h, tile_count;
-    wall_region *regions; /* in the progressive order across the wall */
+    uint32_t unit_w, unit_h; /* a region's pixels (less at a tile's right and bottom edges) */
+    uint32_t per_x, per_y;   /* regions across and down a tile */
+    wall_region *regions;    /* in the progressive order across the wall */
     uint32_t region_count;
 } wall_layout;
 
@@ -53,15 +55,15 @@ typedef struct wall_layout {
  * exits 0 after --help or --version. */
 int wall_parse_args(int argc, char **argv, wall_options *o);
 
-/* Cuts the wall into regions of the options' unit size, inside tiles, in the progressive order
- * (the coarse-to-fine ordered-dither order over the grid of regions). Returns 0, or -1 when
- * out of memory. */
+/* Cuts the wall into regions of unit_w x unit_h pixels, inside tiles, in the progressive order
+ * (the coarse-to-fine ordered-dither order over the grid of regions), and sets the unit size and
+ * the regions per tile. Returns 0, or -1 when out of memory. */
 int wall_layout_regions(wall_layout *w, uint32_t unit_w, uint32_t unit_h);
 
-/* Writes the indices of the regions (as wall_layout_regions() made them with the same unit
- * size) into order[0 .. region_count) in a Z order over the wall's grid of regions, so that any
- * run of the order is a compact patch of neighbours. Returns 0, or -1 when out of memory. */
-int wall_spatial_order(const wall_layout *w, uint32_t unit_w, uint32_t unit_h, uint32_t *order);
+/* Writes the indices of the regions (as wall_layout_regions() made them) into
+ * order[0 .. region_count) in a Z order over the wall's grid of regions, so that any run of the
+ * order is a compact patch of neighbours. Returns 0, or -1 when out of memory. */
+int wall_spatial_order(const wall_layout *w, uint32_t *order);
 
 /* The rays of a region's first pass: one per 8 x 8 pixels, at least one. */
 uint64_t wall_coarse_rays(const wall_region *r);

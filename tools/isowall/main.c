@@ -284,8 +284,7 @@ static int first_list(wall_run *r)
     uint32_t n = r->layout.region_count, blocks = (n + BLOCK - 1) / BLOCK;
     costed *order = malloc(n * sizeof *order);
     uint32_t *bounds = malloc(((size_t)r->ranks + 1) * sizeof *bounds);
-    int ok =
-        order && bounds && wall_spatial_order(&r->layout, r->o.unit_w, r->o.unit_h, r->list) == 0;
+    int ok = order && bounds && wall_spatial_order(&r->layout, r->list) == 0;
     if (ok) {
         uint32_t at = 0;
         for (int k = 0; k < r->ranks; k++) {
