@@ -2,9 +2,9 @@
 # wall's image, dynamic and --static, and the tiles of --tiles-dir equal isorender's software
 # image of the same camera and total size (>= 99.99 % identical pixels); the statistics have
 # one record per process whose units add up to the work units and rays to the pixels (with
-# --static: each tile's units on its owner, none stolen); bad
-# --wall, --tile and --unit values are usage errors (exit 2). Registered only where the build
-# found MPI; skipped when mpirun is missing.
+# --static: each tile's units on its owner, none stolen); bad --wall, --tile and --unit values
+# are usage errors (exit 2). Registered only where the build found MPI; skipped when mpirun is
+# missing.
 . "$(dirname "$0")/lib.sh"
 
 if ! command -v mpirun >/dev/null 2>&1; then
