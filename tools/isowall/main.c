@@ -178,28 +178,30 @@ static int64_t steal(wall_run *r, int pass)
     return at;
 }
 
-/* The next unit of a pass: this rank's next region (static, from *cursor), or the next of its
- * share, else a stolen one (dynamic; *cursor counts the steals). Returns the region's index,
- * or -1 when the pass is done. */
-static int64_t next_unit(wall_run *r, int pass, int64_t *cursor)
+/* --static: the next region from *cursor on whose tile this rank owns, or -1 when the pass is
+ * done. */
+static int64_t next_static(const wall_run *r, int64_t *cursor)
 {
     int64_t count = r->layout.region_count;
-    if (r->o.is_static) {
-        while (*cursor < count && tile_owner(r->layout.regions[*cursor].tile, r->ranks) != r->rank)
-            (*cursor)++;
-        return *cursor < count ? (*cursor)++ : -1;
-    }
+    while (*cursor < count && tile_owner(r->layout.regions[*cursor].tile, r->ranks) != r->rank)
+        (*cursor)++;
+    return *cursor < count ? (*cursor)++ : -1;
+}
+
+/* Dynamic: the next region of this rank's share of the pass, else a stolen one (*stealing is
+ * set from the first steal on: every later unit of the pass is from a stolen run). Returns the
+ * region's index, or -1 when the pass is done. */
+static int64_t next_dynamic(wall_run *r, int pass, int *stealing)
+{
     double wait = MPI_Wtime();
     uint64_t mine = word_op(r, pass * r->ranks + r->rank, 1, MPI_SUM);
     int64_t at = (uint32_t)mine < (uint32_t)(mine >> 32) ? (int64_t)(uint32_t)mine : -1;
-    if (at < 0) {
-        at = steal(r, pass);
-        *cursor += at >= 0;
-    }
+    if (at < 0 && (at = steal(r, pass)) >= 0)
+        *stealing = 1;
     r->idle += MPI_Wtime() - wait;
     if (at < 0)
         return -1;
-    r->stolen += *cursor > 0;
+    r->stolen += *stealing;
     return (int64_t)r->list[at];
 }
 
@@ -218,7 +220,8 @@ static void set_shares(wall_run *r, int pass, const uint32_t *bounds)
 static int run_pass(wall_run *r, int pass, ip_error *err)
 {
     int64_t cursor = 0, u;
-    while ((u = next_unit(r, pass, &cursor)) >= 0) {
+    int stealing = 0;
+    while ((u = r->o.is_static ? next_static(r, &cursor) : next_dynamic(r, pass, &stealing)) >= 0) {
         const wall_region *g = &r->layout.regions[u];
         uint64_t pixels = (uint64_t)g->width * g->height, coarse = wall_coarse_rays(g);
         uint64_t first = pass ? coarse : 0, count = pass ? pixels - coarse : coarse;
