@@ -58,6 +58,7 @@ static int tile_owner(uint32_t tile, int ranks)
     return (int)(tile % (uint32_t)ranks);
 }
 
+/* The owner of every tile when the composite goes to rank 0's one image. */
 static int rank_zero(uint32_t tile, int ranks)
 {
     (void)tile, (void)ranks;
@@ -124,6 +125,7 @@ static int setup_layout(wall_run *r, ip_error *err)
  * neighbours or ones it has already seen, so its visited set and cache serve them, and the last
  * units taken are small. */
 
+/* A share word: the unclaimed list positions [lo, hi), lo in the low 32 bits. */
 static uint64_t share_word(uint64_t lo, uint64_t hi)
 {
     return lo | hi << 32;
@@ -251,6 +253,8 @@ typedef struct costed {
     uint32_t region;
 } costed;
 
+/* qsort() order of the second pass's list: by taker, then most expected cost first, then by
+ * region (so that every rank sorts to the same list). */
 static int compare_cost(const void *a, const void *b)
 {
     const costed *x = a, *y = b;
@@ -304,6 +308,7 @@ static int first_list(wall_run *r)
     return ok ? 0 : -1;
 }
 
+/* qsort() order of doubles, ascending. */
 static int compare_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -476,6 +481,8 @@ typedef struct stats_view {
     const double *records; /* REC_COUNT per rank */
 } stats_view;
 
+/* The sum, the largest value, and the largest busy_s over the mean (1 when nobody was busy)
+ * of one field of the ranks' records. */
 static double sum_of(const stats_view *v, int field)
 {
     double s = 0;
@@ -498,6 +505,7 @@ static double balance_of(const stats_view *v)
     return mean > 0 ? max_of(v, REC_BUSY) / mean : 1.0;
 }
 
+/* Prints --stats' JSON (tool_write_text_file()'s fill; user: the stats_view). */
 static void fill_stats(FILE *out, void *user)
 {
     const stats_view *v = user;
@@ -650,6 +658,7 @@ static int open_run(wall_run *r)
     return 0;
 }
 
+/* Frees what open_run() made, as far as it got. */
 static void close_run(wall_run *r)
 {
     if (r->window_made)

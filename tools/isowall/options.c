@@ -61,6 +61,7 @@ static int parse_pair_option(const char *program, const tool_option *option,
                            tile ? &o->tile_w : &o->unit_w, tile ? &o->tile_h : &o->unit_h);
 }
 
+/* --color: the surface colour. */
 static int parse_color(const char *program, const tool_option *option, const char *const *values,
                        void *base)
 {
@@ -71,6 +72,7 @@ static int parse_color(const char *program, const tool_option *option, const cha
     return 0;
 }
 
+/* --background: one colour, or TOP:BOTTOM. */
 static int parse_background(const char *program, const tool_option *option,
                             const char *const *values, void *base)
 {
