@@ -13,7 +13,8 @@
 #   IP_WALL_TILE (default 1280x1024): the tile of the bad case; IP_WALL_REPEATS (default 5):
 #   runs of each case, the one of median balance shown, with the range of balance;
 #   IP_WALL_MPIRUN_ARGS: more mpirun options (default --mca osc sm --bind-to
-#   core:overload-allowed, see docs/scale-out.md)
+#   core:overload-allowed, see docs/scale-out.md); IP_WALL_BIG_PROCESSES (default 4): the
+#   processes of the 31-Mpixel run
 set -eu
 work=${1:?usage: tools/bench_wall.sh WORK_DIR [BUILD_DIR] [RAW_FILE]}
 build=${2:-build}
@@ -95,6 +96,12 @@ for np in 2 4 8; do
     secs=$(case_run "dynamic$np" "$np")
     row "$work/dynamic$np.json" "$np" dynamic "$secs"
 done
+echo
+printf 'units stolen (dynamic, summed over the processes, of %s):' "$(top "$work/one.json" units)"
+for np in 2 4 8; do
+    printf ' %s at %d' "$(grep -o '"stolen": [0-9]*' "$work/dynamic$np.json" | awk '{ s += $2 } END { print s + 0 }')" "$np"
+done
+echo
 
 # the whole head on a 31-Mpixel wall
 echo

@@ -619,35 +619,34 @@ int tool_parse_clip(const char *text, ip_clip_plane *plane)
 
 #define MAX_IMAGE_SIDE 16384 /* pixels; OpenGL's common maximum renderbuffer size */
 
-/* Parses --size WxH; returns 0, or 2 after a usage error that says what is wrong. */
-static int parse_size(const char *p, const char *text, uint32_t *w, uint32_t *h)
+int tool_parse_pair(const char *program, const char *option, const char *text, uint32_t max,
+                    const char *form, const char *const sides[2], const char *unit, uint32_t *a,
+                    uint32_t *b)
 {
     unsigned long long side[2];
     const char *q = text;
     for (int k = 0; k < 2; k++) {
         char *end;
         if (!isdigit((unsigned char)*q))
-            return tool_usage_error(p, "--size '%s' is not WxH (e.g. 1600x1200)", text);
+            return tool_usage_error(program, "%s '%s' is not %s", option, text, form);
         errno = 0;
         side[k] = strtoull(q, &end, 10);
         if (errno == ERANGE)
             side[k] = ULLONG_MAX;
         q = end;
         if (k == 0 && *q != 'x' && *q != 'X')
-            return tool_usage_error(p, "--size '%s' is not WxH (e.g. 1600x1200)", text);
+            return tool_usage_error(program, "%s '%s' is not %s", option, text, form);
         if (k == 0)
             q++;
     }
     if (*q != '\0')
-        return tool_usage_error(p, "--size '%s' is not WxH (e.g. 1600x1200)", text);
+        return tool_usage_error(program, "%s '%s' is not %s", option, text, form);
     for (int k = 0; k < 2; k++)
-        if (side[k] < 1 || side[k] > MAX_IMAGE_SIDE)
-            return tool_usage_error(p,
-                                    "--size '%s': the %s, %llu pixels, is not within 1 .. "
-                                    "%d",
-                                    text, k ? "height" : "width", side[k], MAX_IMAGE_SIDE);
-    *w = (uint32_t)side[0];
-    *h = (uint32_t)side[1];
+        if (side[k] < 1 || side[k] > max)
+            return tool_usage_error(program, "%s '%s': the %s, %llu %s, is not within 1 .. %u",
+                                    option, text, sides[k], side[k], unit, max);
+    *a = (uint32_t)side[0];
+    *b = (uint32_t)side[1];
     return 0;
 }
 
@@ -700,7 +699,9 @@ static int parse_size_option(const char *p, const tool_option *opt, const char *
 {
     tool_view_options *o = base;
     (void)opt;
-    return parse_size(p, v[0], &o->width, &o->height) != 0 ? 2 : 0;
+    static const char *const sides[2] = {"width", "height"};
+    return tool_parse_pair(p, "--size", v[0], MAX_IMAGE_SIDE, "WxH (e.g. 1600x1200)", sides,
+                           "pixels", &o->width, &o->height);
 }
 
 static int parse_rays(const char *p, const tool_option *opt, const char *const *v, void *base)

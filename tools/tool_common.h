@@ -34,6 +34,14 @@ int tool_parse_double3(const char *text, double out[3]);
  * one too large). */
 int tool_parse_dims(const char *program, const char *option, const char *text, uint32_t dims[3]);
 
+/* Parses the value of a two-number option ("AxB", each 1 .. max; x or X between): `form` says
+ * what it should be in the usage error ("WxH (e.g. 1600x1200)"), sides[] and `unit` name the
+ * numbers in the one about their range ("the height, 0 pixels, is not within 1 .. 16384").
+ * Returns 0, or 2 after that usage error. */
+int tool_parse_pair(const char *program, const char *option, const char *text, uint32_t max,
+                    const char *form, const char *const sides[2], const char *unit, uint32_t *a,
+                    uint32_t *b);
+
 /* Handles --version: prints "PROGRAM VERSION" (the library's, isoprop/version.h) on stdout. */
 void tool_print_version(const char *program);
 

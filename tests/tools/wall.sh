@@ -1,9 +1,10 @@
 # isowall, the display wall's parallel renderer, on 4 MPI processes (oversubscribed): the
 # wall's image, dynamic and --static, and the tiles of --tiles-dir equal isorender's software
 # image of the same camera and total size (>= 99.99 % identical pixels); the statistics have
-# one record per process whose units add up to the work units and rays to the pixels; bad
-# --wall, --tile and --unit values are usage errors (exit 2). Registered only where the build
-# found MPI; skipped when mpirun is missing.
+# one record per process whose units add up to the work units and rays to the pixels (with
+# --static: each tile's units on its owner, none stolen); bad --wall, --tile and --unit values
+# are usage errors (exit 2). Registered only where the build found MPI; skipped when mpirun is
+# missing.
 . "$(dirname "$0")/lib.sh"
 
 if ! command -v mpirun >/dev/null 2>&1; then
@@ -69,6 +70,13 @@ line=$("$compare" static.png ref.png --max-pct 0.01)
 check "static wall equals isorender's image: $line" test $? = 0
 check "static.json says static" grep -q '"static": true' static.json
 check "static rays add up to the pixels" test "$(sum static.json rays)" = 115200
+check "static: no units stolen ($(sum static.json stolen))" test "$(sum static.json stolen)" = 0
+# tiles 0-5 on 4 processes: processes 0 and 1 own two tiles, 2 and 3 one; per_tile: the units
+# of one tile, 2 passes x its 64 regions
+units=$(grep '"rank": ' static.json | grep -o '"units": [0-9]*' | awk '{ printf "%s ", $2 }')
+per_tile=$((2 * regions / 6))
+check "static: each process took its tiles' units ($units)" \
+    test "$units" = "$((2 * per_tile)) $((2 * per_tile)) $per_tile $per_tile "
 
 # --- one PNG per display tile, written by the tile's owner ---
 run_capture wall --azimuth 20 --elevation 15 --tiles-dir tiles --unit 32x24

@@ -5,10 +5,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "composite.h"
-
-#include <time.h>
 
 double wall_cpu_seconds(void)
 {
@@ -54,24 +53,44 @@ static size_t pack_covered(const uint8_t *tile, uint32_t tile_w, uint32_t tile_h
     return HEADER + n * (sizeof(double) + 4);
 }
 
-/* Keeps, per pixel of the packed rectangle, the nearer of `into` (a drawn tile) and the
- * packed pixel (strictly nearer: on equal depth the earlier contribution stays). */
-static void keep_nearest(uint8_t *into, uint32_t tile_w, uint32_t tile_h, const uint8_t *packed)
+/* A rectangle of drawn pixels to merge into a tile: at (x, y) within it, rows `stride` pixels
+ * apart in depth (doubles, maybe unaligned) and rgba. */
+typedef struct piece {
+    uint32_t x, y, width, height, stride;
+    const uint8_t *depth, *rgba;
+} piece;
+
+/* The rectangle that pack_covered() packed. */
+static piece unpacked(const uint8_t *packed)
 {
     uint32_t h[4];
     memcpy(h, packed, HEADER);
+    const uint8_t *depth = packed + HEADER;
+    return (piece){
+        h[0], h[1], h[2], h[3], h[2], depth, depth + (size_t)h[2] * h[3] * sizeof(double)};
+}
+
+/* The whole of a drawn tile (tile_bytes()). */
+static piece whole(const uint8_t *tile, uint32_t tile_w, uint32_t tile_h)
+{
+    return (piece){
+        0, 0, tile_w, tile_h, tile_w, tile, tile + (size_t)tile_w * tile_h * sizeof(double)};
+}
+
+/* Keeps, per pixel of the piece, the nearer of `into` (a drawn tile) and the piece's pixel
+ * (strictly nearer: on equal depth the earlier contribution stays). */
+static void keep_nearest(uint8_t *into, uint32_t tile_w, uint32_t tile_h, piece p)
+{
     double *depth = (double *)into;
     uint8_t *rgba = into + (size_t)tile_w * tile_h * sizeof(double);
-    size_t n = (size_t)h[2] * h[3];
-    const uint8_t *other_depth = packed + HEADER, *other_rgba = other_depth + n * sizeof(double);
-    for (uint32_t y = 0; y < h[3]; y++)
-        for (uint32_t x = 0; x < h[2]; x++) {
-            size_t i = (size_t)y * h[2] + x, j = (size_t)(h[1] + y) * tile_w + h[0] + x;
+    for (uint32_t y = 0; y < p.height; y++)
+        for (uint32_t x = 0; x < p.width; x++) {
+            size_t i = (size_t)y * p.stride + x, j = (size_t)(p.y + y) * tile_w + p.x + x;
             double d;
-            memcpy(&d, other_depth + i * sizeof(double), sizeof d);
+            memcpy(&d, p.depth + i * sizeof(double), sizeof d);
             if (d > depth[j]) {
                 depth[j] = d;
-                memcpy(rgba + 4 * j, other_rgba + 4 * i, 4);
+                memcpy(rgba + 4 * j, p.rgba + 4 * i, 4);
             }
         }
 }
@@ -143,7 +162,8 @@ int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *d
         if (owner != me) { /* draw, send the covered rectangle */
             if (!all[(size_t)me * w->tile_count + t])
                 continue;
-            rc = draw_tile(c, t, mesh, own, err);
+            if ((rc = draw_tile(c, t, mesh, own, err)) != 0)
+                break; /* the caller ends the job; the owner waits for nothing more */
             start = wall_cpu_seconds();
             size_t n = pack_covered(own, w->tile_w, w->tile_h, packed);
             c->busy_seconds += wall_cpu_seconds() - start;
@@ -157,11 +177,9 @@ int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *d
         for (int r = 0; r < ranks && rc == 0; r++) { /* in rank order: ties to the lower */
             if (!all[(size_t)r * w->tile_count + t])
                 continue;
-            if (r == me) {
-                rc = draw_tile(c, t, mesh, own, err);
-                start = wall_cpu_seconds();
-                pack_covered(own, w->tile_w, w->tile_h, packed);
-                c->busy_seconds += wall_cpu_seconds() - start;
+            if (r == me) { /* merged straight from the drawn tile, not packed first */
+                if ((rc = draw_tile(c, t, mesh, own, err)) != 0)
+                    break;
             } else {
                 wait = MPI_Wtime();
                 MPI_Recv(packed, (int)(HEADER + bytes), MPI_BYTE, r, (int)t, MPI_COMM_WORLD,
@@ -169,7 +187,8 @@ int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *d
                 c->idle_seconds += MPI_Wtime() - wait;
             }
             start = wall_cpu_seconds();
-            keep_nearest(result, w->tile_w, w->tile_h, packed);
+            keep_nearest(result, w->tile_w, w->tile_h,
+                         r == me ? whole(own, w->tile_w, w->tile_h) : unpacked(packed));
             c->busy_seconds += wall_cpu_seconds() - start;
             drawn = 1;
         }

@@ -4,10 +4,12 @@
  * regions, each inside one tile. Work units are a region's first rays (its coarse levels) in a
  * first pass over the whole wall, then the rest of its rays in a second pass: every rank casts
  * the rays of the units it takes with its own engine (ip_engine_set_region()), keeping what it
- * extracted for earlier units. Units are handed out by a shared counter on rank 0
- * (MPI_Fetch_and_op, passive target), or with --static by display tile (tile t to rank t % N,
- * one copy per projector). Each rank then draws its own triangles into the tiles they touch,
- * and the tile's owner keeps the nearest surface of each pixel (direct-send compositing).
+ * extracted for earlier units. Each rank takes units from its own share of each pass's list,
+ * one word per rank in rank 0's MPI window (MPI_Fetch_and_op, passive target), and steals half
+ * of the fullest share once its own is spent (main.c); or with --static by display tile (tile t
+ * to rank t % N, one copy per projector). Each rank then draws its own triangles into the tiles
+ * they touch, and the tile's owner keeps the nearest surface of each pixel (direct-send
+ * compositing).
  * MPI stays in this program; the library knows nothing of it.
  */
 #ifndef ISOWALL_H
@@ -43,7 +45,9 @@ typedef struct wall_layout {
     ip_camera camera; /* the whole wall: cols * tile_w x rows * tile_h pixels */
     double lo[3], hi[3];
     uint32_t cols, rows, tile_w, tile_h, tile_count;
-    wall_region *regions; /* in the progressive order across the wall */
+    uint32_t unit_w, unit_h; /* a region's pixels (less at a tile's right and bottom edges) */
+    uint32_t per_x, per_y;   /* regions across and down a tile */
+    wall_region *regions;    /* in the progressive order across the wall */
     uint32_t region_count;
 } wall_layout;
 
@@ -51,15 +55,15 @@ typedef struct wall_layout {
  * exits 0 after --help or --version. */
 int wall_parse_args(int argc, char **argv, wall_options *o);
 
-/* Cuts the wall into regions of the options' unit size, inside tiles, in the progressive order
- * (the coarse-to-fine ordered-dither order over the grid of regions). Returns 0, or -1 when
- * out of memory. */
+/* Cuts the wall into regions of unit_w x unit_h pixels, inside tiles, in the progressive order
+ * (the coarse-to-fine ordered-dither order over the grid of regions), and sets the unit size and
+ * the regions per tile. Returns 0, or -1 when out of memory. */
 int wall_layout_regions(wall_layout *w, uint32_t unit_w, uint32_t unit_h);
 
-/* Writes the indices of the regions (as wall_layout_regions() made them with the same unit
- * size) into order[0 .. region_count) in a Z order over the wall's grid of regions, so that any
- * run of the order is a compact patch of neighbours. Returns 0, or -1 when out of memory. */
-int wall_spatial_order(const wall_layout *w, uint32_t unit_w, uint32_t unit_h, uint32_t *order);
+/* Writes the indices of the regions (as wall_layout_regions() made them) into
+ * order[0 .. region_count) in a Z order over the wall's grid of regions, so that any run of the
+ * order is a compact patch of neighbours. Returns 0, or -1 when out of memory. */
+int wall_spatial_order(const wall_layout *w, uint32_t *order);
 
 /* The rays of a region's first pass: one per 8 x 8 pixels, at least one. */
 uint64_t wall_coarse_rays(const wall_region *r);

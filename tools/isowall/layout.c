@@ -24,6 +24,7 @@ int wall_layout_regions(wall_layout *w, uint32_t unit_w, uint32_t unit_h)
 {
     uint32_t per_x = (w->tile_w + unit_w - 1) / unit_w, per_y = (w->tile_h + unit_h - 1) / unit_h;
     uint32_t grid_x = per_x * w->cols, grid_y = per_y * w->rows, levels = 0;
+    w->unit_w = unit_w, w->unit_h = unit_h, w->per_x = per_x, w->per_y = per_y;
     while ((1u << levels) < grid_x || (1u << levels) < grid_y)
         levels++;
     w->region_count = grid_x * grid_y;
@@ -67,17 +68,16 @@ static int compare_key(const void *a, const void *b)
     return (x->key > y->key) - (x->key < y->key);
 }
 
-int wall_spatial_order(const wall_layout *w, uint32_t unit_w, uint32_t unit_h, uint32_t *order)
+int wall_spatial_order(const wall_layout *w, uint32_t *order)
 {
-    uint32_t per_x = (w->tile_w + unit_w - 1) / unit_w, per_y = (w->tile_h + unit_h - 1) / unit_h;
     keyed *k = malloc((size_t)w->region_count * sizeof *k);
     if (!k)
         return -1;
     for (uint32_t i = 0; i < w->region_count; i++) {
         const wall_region *r = &w->regions[i];
         uint32_t col = r->x / w->tile_w, row = r->y / w->tile_h;
-        uint32_t gx = col * per_x + (r->x - col * w->tile_w) / unit_w;
-        uint32_t gy = row * per_y + (r->y - row * w->tile_h) / unit_h;
+        uint32_t gx = col * w->per_x + (r->x - col * w->tile_w) / w->unit_w;
+        uint32_t gy = row * w->per_y + (r->y - row * w->tile_h) / w->unit_h;
         k[i] = (keyed){z_key(gx, gy), i};
     }
     qsort(k, w->region_count, sizeof *k, compare_key);

@@ -42,6 +42,7 @@ typedef struct wall_run {
     double *weight; /* dynamic: prefix sums of the list's expected costs (region_count + 1) */
     MPI_Win counter_window; /* dynamic: per pass, one share word per rank on rank 0 */
     uint64_t *counters;     /* rank 0's (NULL elsewhere) */
+    uint64_t *words;        /* dynamic: room for every rank's share word, for a steal */
     int window_made;
     double busy, idle; /* CPU seconds on units; wall seconds waiting for work */
     uint64_t units, bytes_sent, stolen;
@@ -57,6 +58,7 @@ static int tile_owner(uint32_t tile, int ranks)
     return (int)(tile % (uint32_t)ranks);
 }
 
+/* The owner of every tile when the composite goes to rank 0's one image. */
 static int rank_zero(uint32_t tile, int ranks)
 {
     (void)tile, (void)ranks;
@@ -123,6 +125,7 @@ static int setup_layout(wall_run *r, ip_error *err)
  * neighbours or ones it has already seen, so its visited set and cache serve them, and the last
  * units taken are small. */
 
+/* A share word: the unclaimed list positions [lo, hi), lo in the low 32 bits. */
 static uint64_t share_word(uint64_t lo, uint64_t hi)
 {
     return lo | hi << 32;
@@ -142,11 +145,12 @@ static uint64_t word_op(wall_run *r, int slot, uint64_t value, MPI_Op op)
 /* Steals from another rank's share of the pass: the far half of the one with the most expected
  * cost left, and the rest of the stolen run becomes this rank's share, all under an exclusive
  * lock of the window (so no other rank takes from the shares meanwhile). Returns the list
- * position of the first unit taken, or -1 when every share is spent. words: room for ranks. */
-static int64_t steal(wall_run *r, int pass, uint64_t *words)
+ * position of the first unit taken, or -1 when every share is spent. */
+static int64_t steal(wall_run *r, int pass)
 {
     int base = pass * r->ranks;
     const double *w = r->weight;
+    uint64_t *words = r->words;
     MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, r->counter_window);
     for (int k = 0; k < r->ranks; k++)
         MPI_Fetch_and_op(NULL, &words[k], MPI_UINT64_T, 0, base + k, MPI_NO_OP, r->counter_window);
@@ -176,30 +180,30 @@ static int64_t steal(wall_run *r, int pass, uint64_t *words)
     return at;
 }
 
-/* The next unit of a pass: this rank's next region (static, from *cursor), or the next of its
- * share, else a stolen one (dynamic; *cursor counts the steals). Returns the region's index,
- * or -1 when the pass is done. */
-static int64_t next_unit(wall_run *r, int pass, int64_t *cursor)
+/* --static: the next region from *cursor on whose tile this rank owns, or -1 when the pass is
+ * done. */
+static int64_t next_static(const wall_run *r, int64_t *cursor)
 {
     int64_t count = r->layout.region_count;
-    if (r->o.is_static) {
-        while (*cursor < count && tile_owner(r->layout.regions[*cursor].tile, r->ranks) != r->rank)
-            (*cursor)++;
-        return *cursor < count ? (*cursor)++ : -1;
-    }
+    while (*cursor < count && tile_owner(r->layout.regions[*cursor].tile, r->ranks) != r->rank)
+        (*cursor)++;
+    return *cursor < count ? (*cursor)++ : -1;
+}
+
+/* Dynamic: the next region of this rank's share of the pass, else a stolen one (*stealing is
+ * set from the first steal on: every later unit of the pass is from a stolen run). Returns the
+ * region's index, or -1 when the pass is done. */
+static int64_t next_dynamic(wall_run *r, int pass, int *stealing)
+{
     double wait = MPI_Wtime();
     uint64_t mine = word_op(r, pass * r->ranks + r->rank, 1, MPI_SUM);
     int64_t at = (uint32_t)mine < (uint32_t)(mine >> 32) ? (int64_t)(uint32_t)mine : -1;
-    if (at < 0) {
-        uint64_t *words = malloc((size_t)r->ranks * sizeof *words);
-        at = words ? steal(r, pass, words) : -1; /* out of memory: leave the rest to the others */
-        free(words);
-        *cursor += at >= 0;
-    }
+    if (at < 0 && (at = steal(r, pass)) >= 0)
+        *stealing = 1;
     r->idle += MPI_Wtime() - wait;
     if (at < 0)
         return -1;
-    r->stolen += *cursor > 0;
+    r->stolen += *stealing;
     return (int64_t)r->list[at];
 }
 
@@ -218,7 +222,8 @@ static void set_shares(wall_run *r, int pass, const uint32_t *bounds)
 static int run_pass(wall_run *r, int pass, ip_error *err)
 {
     int64_t cursor = 0, u;
-    while ((u = next_unit(r, pass, &cursor)) >= 0) {
+    int stealing = 0;
+    while ((u = r->o.is_static ? next_static(r, &cursor) : next_dynamic(r, pass, &stealing)) >= 0) {
         const wall_region *g = &r->layout.regions[u];
         uint64_t pixels = (uint64_t)g->width * g->height, coarse = wall_coarse_rays(g);
         uint64_t first = pass ? coarse : 0, count = pass ? pixels - coarse : coarse;
@@ -248,6 +253,8 @@ typedef struct costed {
     uint32_t region;
 } costed;
 
+/* qsort() order of the second pass's list: by taker, then most expected cost first, then by
+ * region (so that every rank sorts to the same list). */
 static int compare_cost(const void *a, const void *b)
 {
     const costed *x = a, *y = b;
@@ -284,8 +291,7 @@ static int first_list(wall_run *r)
     uint32_t n = r->layout.region_count, blocks = (n + BLOCK - 1) / BLOCK;
     costed *order = malloc(n * sizeof *order);
     uint32_t *bounds = malloc(((size_t)r->ranks + 1) * sizeof *bounds);
-    int ok =
-        order && bounds && wall_spatial_order(&r->layout, r->o.unit_w, r->o.unit_h, r->list) == 0;
+    int ok = order && bounds && wall_spatial_order(&r->layout, r->list) == 0;
     if (ok) {
         uint32_t at = 0;
         for (int k = 0; k < r->ranks; k++) {
@@ -302,6 +308,7 @@ static int first_list(wall_run *r)
     return ok ? 0 : -1;
 }
 
+/* qsort() order of doubles, ascending. */
 static int compare_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -472,9 +479,10 @@ static int extract(wall_run *r)
 typedef struct stats_view {
     const wall_run *r;
     const double *records; /* REC_COUNT per rank */
-    ip_engine_counts totals;
 } stats_view;
 
+/* The sum, the largest value, and the largest busy_s over the mean (1 when nobody was busy)
+ * of one field of the ranks' records. */
 static double sum_of(const stats_view *v, int field)
 {
     double s = 0;
@@ -497,6 +505,7 @@ static double balance_of(const stats_view *v)
     return mean > 0 ? max_of(v, REC_BUSY) / mean : 1.0;
 }
 
+/* Prints --stats' JSON (tool_write_text_file()'s fill; user: the stats_view). */
 static void fill_stats(FILE *out, void *user)
 {
     const stats_view *v = user;
@@ -565,7 +574,7 @@ static int report(wall_run *r)
     MPI_Gather(mine, REC_COUNT, MPI_DOUBLE, all, REC_COUNT, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     int ok = 1;
     if (r->rank == 0) {
-        stats_view v = {r, all, t};
+        stats_view v = {r, all};
         if (!r->o.common.quiet)
             printf("%s: wall %ux%u of %ux%u (%.1f Mpixel), %d processes, %s: %.0f rays, %.0f "
                    "triangles, busy %.3f s (max %.3f s, balance %.3f), %.3f s\n",
@@ -628,7 +637,8 @@ static int open_run(wall_run *r)
     r->taker = malloc(n * sizeof *r->taker);
     r->list = malloc(n * sizeof *r->list);
     r->weight = malloc(((size_t)n + 1) * sizeof *r->weight);
-    int ok_regions = r->cost && r->taker && r->list && r->weight;
+    r->words = malloc((size_t)r->ranks * sizeof *r->words);
+    int ok_regions = r->cost && r->taker && r->list && r->weight && r->words;
     if (ok_regions) {
         for (uint32_t i = 0; i < n; i++)
             r->taker[i] = -1;
@@ -648,6 +658,7 @@ static int open_run(wall_run *r)
     return 0;
 }
 
+/* Frees what open_run() made, as far as it got. */
 static void close_run(wall_run *r)
 {
     if (r->window_made)
@@ -660,6 +671,7 @@ static void close_run(wall_run *r)
     free(r->taker);
     free(r->list);
     free(r->weight);
+    free(r->words);
     free(r->image);
 }
 

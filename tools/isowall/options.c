@@ -47,55 +47,21 @@ static const char usage[] =
     "their value as --iso V or --iso=V; -- ends the options.\n"
     "Exit status: 0 success, 1 failure, 2 bad command line.\n";
 
-/* "AxB", both in [1, max]; returns 0 or -1. */
-static int parse_pair(const char *text, uint32_t max, uint32_t *a, uint32_t *b)
+/* --wall CxR, --tile WxH and --unit WxH (tool_parse_pair()). */
+static int parse_pair_option(const char *program, const tool_option *option,
+                             const char *const *values, void *base)
 {
-    const char *x = strchr(text, 'x');
-    uint64_t va, vb;
-    char first[32];
-    if (!x || (size_t)(x - text) >= sizeof first)
-        return -1;
-    memcpy(first, text, (size_t)(x - text));
-    first[x - text] = '\0';
-    if (tool_parse_u64(first, &va) != 0 || tool_parse_u64(x + 1, &vb) != 0 || va < 1 || vb < 1 ||
-        va > max || vb > max)
-        return -1;
-    *a = (uint32_t)va;
-    *b = (uint32_t)vb;
-    return 0;
-}
-
-static int parse_wall(const char *program, const tool_option *option, const char *const *values,
-                      void *base)
-{
-    (void)option;
+    static const char *const tiles[2] = {"columns", "rows"}, *const pixels[2] = {"width", "height"};
     wall_options *o = base;
-    if (parse_pair(values[0], 256, &o->cols, &o->rows) != 0)
-        return tool_usage_error(program, "--wall '%s' is not CxR, tiles across and down (1-256)",
-                                values[0]);
-    return 0;
+    if (strcmp(option->name, "--wall") == 0)
+        return tool_parse_pair(program, option->name, values[0], 256, "CxR, tiles across and down",
+                               tiles, "tiles", &o->cols, &o->rows);
+    int tile = strcmp(option->name, "--tile") == 0;
+    return tool_parse_pair(program, option->name, values[0], 65536, "WxH, pixels", pixels, "pixels",
+                           tile ? &o->tile_w : &o->unit_w, tile ? &o->tile_h : &o->unit_h);
 }
 
-static int parse_tile(const char *program, const tool_option *option, const char *const *values,
-                      void *base)
-{
-    (void)option;
-    wall_options *o = base;
-    if (parse_pair(values[0], 65536, &o->tile_w, &o->tile_h) != 0)
-        return tool_usage_error(program, "--tile '%s' is not WxH, pixels (1-65536)", values[0]);
-    return 0;
-}
-
-static int parse_unit(const char *program, const tool_option *option, const char *const *values,
-                      void *base)
-{
-    (void)option;
-    wall_options *o = base;
-    if (parse_pair(values[0], 65536, &o->unit_w, &o->unit_h) != 0)
-        return tool_usage_error(program, "--unit '%s' is not WxH, pixels (1-65536)", values[0]);
-    return 0;
-}
-
+/* --color: the surface colour. */
 static int parse_color(const char *program, const tool_option *option, const char *const *values,
                        void *base)
 {
@@ -106,6 +72,7 @@ static int parse_color(const char *program, const tool_option *option, const cha
     return 0;
 }
 
+/* --background: one colour, or TOP:BOTTOM. */
 static int parse_background(const char *program, const tool_option *option,
                             const char *const *values, void *base)
 {
@@ -120,9 +87,9 @@ static int parse_background(const char *program, const tool_option *option,
 
 static const tool_option wall_table[] = {
     {"-o", NULL, 1, offsetof(wall_options, out), NULL, NULL, NULL},
-    {"--wall", NULL, 1, 0, parse_wall, NULL, NULL},
-    {"--tile", NULL, 1, 0, parse_tile, NULL, NULL},
-    {"--unit", NULL, 1, 0, parse_unit, NULL, NULL},
+    {"--wall", NULL, 1, 0, parse_pair_option, NULL, NULL},
+    {"--tile", NULL, 1, 0, parse_pair_option, NULL, NULL},
+    {"--unit", NULL, 1, 0, parse_pair_option, NULL, NULL},
     {"--static", NULL, 0, offsetof(wall_options, is_static), NULL, NULL, NULL},
     {"--tiles-dir", NULL, 1, offsetof(wall_options, tiles_dir), NULL, NULL, NULL},
     {"--coarse", NULL, 1, offsetof(wall_options, coarse), NULL, NULL, NULL},
