@@ -318,8 +318,7 @@ static int compare_double(const void *a, const void *b)
 /* What each region's second pass is expected to cost (CPU seconds, into expect[]), from what
  * its first pass cost: twice that, plus its remaining rays at half the wall's typical cost of
  * a first-pass ray (the median over the regions). Rays through empty space dominate the second
- * pass, the surface the first: on the head of docs/scale-out.md, one process, this is the
- * least-squares fit (a region's second pass: 1.6 ms plus 2.1 times its first). Returns 0, or
+ * pass, the surface the first (a rule of thumb from the head of docs/scale-out.md). Returns 0, or
  * -1 when out of memory. */
 static int expected_second(const wall_run *r, double *expect)
 {
