@@ -199,6 +199,53 @@ static void test_depth(void)
     ip_mesh_free(&m);
 }
 
+/* A part of the image (ip_raster_mesh_part()) is exactly that part of the whole image, with
+ * 1 / depth of the surface each pixel shows; parts outside the image are refused. */
+static void test_part(void)
+{
+    ip_camera c = front_camera(W, H);
+    const double big[6] = {1, 1, 60, 1, 1, 45}, small[6] = {10, 10, 30, 10, 10, 30};
+    ip_mesh m;
+    ip_mesh_init(&m);
+    add_screen_triangle(&m, &c, big, 10.0);
+    add_screen_triangle(&m, &c, small, 8.0);
+    uint8_t whole[W * H * 4], part[W * H * 4];
+    uint32_t index[W * H];
+    double depth[W * H];
+    REQUIRE(ip_raster_mesh_shaded(&m, &c, NULL, box_lo, box_hi, index, whole, NULL) == IP_OK);
+    const uint32_t parts[4][4] = {
+        {0, 0, W, H}, {13, 7, 20, 15}, {W - 1, H - 1, 1, 1}, {30, 0, 34, H}};
+    for (int p = 0; p < 4; p++) {
+        const uint32_t x = parts[p][0], y = parts[p][1], w = parts[p][2], h = parts[p][3];
+        REQUIRE(ip_raster_mesh_part(&m, &c, NULL, box_lo, box_hi, x, y, w, h, depth, part, NULL) ==
+                IP_OK);
+        size_t rows_wrong = 0, depth_wrong = 0;
+        for (uint32_t j = 0; j < h; j++) {
+            rows_wrong += memcmp(part + (size_t)j * w * 4, whole + ((size_t)(y + j) * W + x) * 4,
+                                 (size_t)w * 4) != 0;
+            for (uint32_t i = 0; i < w; i++) {
+                uint32_t shown = index[(y + j) * W + x + i];
+                double want = shown == UINT32_MAX ? 0 : shown == 0 ? 1 / 10.0 : 1 / 8.0;
+                depth_wrong += fabs(depth[(size_t)j * w + i] - want) > 1e-6;
+            }
+        }
+        CHECK_MSG(rows_wrong == 0 && depth_wrong == 0, "part %d: %zu rows, %zu depths differ", p,
+                  rows_wrong, depth_wrong);
+    }
+    /* the depth alone, without an image */
+    REQUIRE(ip_raster_mesh_part(&m, &c, NULL, box_lo, box_hi, 0, 0, W, H, depth, NULL, NULL) ==
+            IP_OK);
+    CHECK(fabs(depth[15 * W + 15] - 1 / 8.0) < 1e-6 && depth[40 * W + 40] == 0);
+    ip_error err;
+    const uint32_t bad[4][4] = {{0, 0, 0, H}, {0, 0, W, 0}, {1, 0, W, H}, {0, H, 1, 1}};
+    for (int p = 0; p < 4; p++) {
+        CHECK(ip_raster_mesh_part(&m, &c, NULL, box_lo, box_hi, bad[p][0], bad[p][1], bad[p][2],
+                                  bad[p][3], depth, part, &err) == IP_ERR_ARGUMENT);
+        CHECK_CONTAINS(err.message, "part");
+    }
+    ip_mesh_free(&m);
+}
+
 /* A cube [-1, 1]^3 with outward normals: 12 triangles, each face's normal in `face`. */
 static void build_cube(ip_mesh *m, float face[12][3])
 {
@@ -615,6 +662,7 @@ int main(void)
     test_shared_edges_square();
     test_shared_edges_polygons();
     test_depth();
+    test_part();
     test_cube();
     test_head_on_shading();
     test_surfaces();

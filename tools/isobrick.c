@@ -279,6 +279,23 @@ static const char *filter_name(unsigned filters, char *text, size_t size)
     return text;
 }
 
+/* Ends a --verbose line with " NAME COUNT" for each combination of filters used (counts[] by
+ * filter bits), each with its share of `total` when that is not 0; " -" when none is. */
+static void print_filter_counts(const uint64_t counts[8], uint64_t total)
+{
+    int any = 0;
+    for (unsigned f = 0; f < 8; f++)
+        if (counts[f]) {
+            char name[32];
+            fprintf(stderr, " %s %llu", filter_name(f, name, sizeof name),
+                    (unsigned long long)counts[f]);
+            if (total)
+                fprintf(stderr, " (%.1f%%)", 100.0 * (double)counts[f] / (double)total);
+            any = 1;
+        }
+    fprintf(stderr, "%s\n", any ? "" : " -");
+}
+
 /* --verbose, after the run: each level's bricks as the file holds them (from its directory:
  * encodings, payload bytes, filters of the LZ4 bricks), then the filter choices over all
  * levels. Returns 0, or 1 when the new file cannot be read back. */
@@ -310,29 +327,15 @@ static int print_levels(const char *out)
                 level->brick_count == 1 ? "" : "s", (unsigned long long)count[IP_BRICK_CONSTANT],
                 (unsigned long long)count[IP_BRICK_LZ4], (unsigned long long)count[IP_BRICK_RAW],
                 tool_format_bytes(b, sizeof b, (double)stored));
-        int any = 0;
+        print_filter_counts(filters, 0);
         for (unsigned f = 0; f < 8; f++)
-            if (filters[f]) {
-                char name[32];
-                fprintf(stderr, " %s %llu", filter_name(f, name, sizeof name),
-                        (unsigned long long)filters[f]);
-                all_filters[f] += filters[f];
-                any = 1;
-            }
-        fprintf(stderr, "%s\n", any ? "" : " -");
+            all_filters[f] += filters[f];
     }
     uint64_t lz4 = 0;
     for (unsigned f = 0; f < 8; f++)
         lz4 += all_filters[f];
     fprintf(stderr, "isobrick: filters chosen for %llu LZ4 bricks:", (unsigned long long)lz4);
-    for (unsigned f = 0; f < 8; f++)
-        if (all_filters[f]) {
-            char name[32];
-            fprintf(stderr, " %s %llu (%.1f%%)", filter_name(f, name, sizeof name),
-                    (unsigned long long)all_filters[f],
-                    100.0 * (double)all_filters[f] / (double)lz4);
-        }
-    fprintf(stderr, "\n");
+    print_filter_counts(all_filters, lz4);
     ip_store_close(store);
     return 0;
 }

@@ -1105,6 +1105,19 @@ static int render_image(run *r, uint8_t *rgba, ip_renderer **keep, ip_error *err
     return st == IP_OK ? 0 : -1;
 }
 
+/* A run's "final_pixel_pct" (with checkpoints) and "visible_triangles" and "overdraw" (with
+ * the triangles' owners known), as JSON members. */
+static void json_quality(FILE *f, const run *r)
+{
+    if (r->checkpoint_count)
+        fprintf(f, ", \"final_pixel_pct\": %.4f",
+                r->checkpoints[r->checkpoint_count - 1].final_pct);
+    if (r->owners_known)
+        fprintf(f, ", \"visible_triangles\": %llu, \"overdraw\": %.4f",
+                (unsigned long long)r->visible_triangles,
+                overdraw(r->mesh->triangle_count, r->visible_triangles));
+}
+
 /* "surfaces": each surface's isovalue, colour, opacity, counts and mesh file. */
 static void json_surfaces(FILE *f, const run *r)
 {
@@ -1125,13 +1138,7 @@ static void json_surfaces(FILE *f, const run *r)
                 s->o.full || (s->engine && ip_engine_done(s->engine)) ? "true" : "false",
                 (unsigned long long)t->seeds, (unsigned long long)t->cells,
                 (unsigned long long)t->triangles, s->extraction_wall);
-        if (s->checkpoint_count)
-            fprintf(f, ", \"final_pixel_pct\": %.4f",
-                    s->checkpoints[s->checkpoint_count - 1].final_pct);
-        if (s->owners_known)
-            fprintf(f, ", \"visible_triangles\": %llu, \"overdraw\": %.4f",
-                    (unsigned long long)s->visible_triangles,
-                    overdraw(s->mesh->triangle_count, s->visible_triangles));
+        json_quality(f, s);
         if (!s->o.full)
             fprintf(f, ", \"deferred_cells\": %llu", (unsigned long long)t->deferred);
         if (s->o.mesh) {
@@ -1159,13 +1166,7 @@ static void json_counts(FILE *f, void *user)
                              r->extraction_wall,
                              r->progress_render_seconds};
     tool_write_run_json(f, &j);
-    if (r->checkpoint_count)
-        fprintf(f, ", \"final_pixel_pct\": %.4f",
-                r->checkpoints[r->checkpoint_count - 1].final_pct);
-    if (r->owners_known)
-        fprintf(f, ", \"visible_triangles\": %llu, \"overdraw\": %.4f",
-                (unsigned long long)r->visible_triangles,
-                overdraw(r->mesh->triangle_count, r->visible_triangles));
+    json_quality(f, r);
     if (r->o.scale_bar) {
         fprintf(f, ", \"scale_bar\": {\"length\": %.17g, \"unit\": ", r->bar.length);
         tool_json_string(f, scale_unit(r));

@@ -687,7 +687,6 @@ static int parse_iso(const char *p, const tool_option *opt, const char *const *v
     tool_view_options *o = base;
     if (tool_option_number(p, opt, v, base) != 0)
         return 2;
-    o->has_iso = 1;
     if (o->iso_count < TOOL_MAX_ISOS)
         o->isos[o->iso_count] = o->iso;
     o->iso_count++;
@@ -1077,7 +1076,7 @@ int tool_parse_view_command_line(const char *program, const char *usage, tool_vi
         return rc;
     if (!*file)
         return tool_usage_error(program, "no brick file");
-    if (!o->has_iso)
+    if (!o->iso_count)
         return tool_usage_error(program, "--iso V is required");
     return 0;
 }

@@ -119,7 +119,6 @@ int tool_parse_cache_mb(const char *text, uint64_t *bytes);
  * statistics file, --force and --quiet. */
 typedef struct tool_view_options {
     double iso;
-    int has_iso;
     /* every --iso in order (iso is the last), the first TOOL_MAX_ISOS of them; iso_count
      * counts them all */
     double isos[TOOL_MAX_ISOS];

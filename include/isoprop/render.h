@@ -123,7 +123,8 @@ IP_API ip_status ip_surfaces_check(const ip_surface *surfaces, size_t count, ip_
  *  gives the background and the lighting terms; its surface colour is not used. `rgba`:
  *  width * height * 4 bytes, caller-owned. Single-threaded; reentrant.
  *  @return IP_OK, IP_ERR_ARGUMENT (as ip_raster_mesh_shaded(), ip_surfaces_check() fails, or
- *  `rgba` is NULL) or IP_ERR_NOMEM (about 24 bytes a pixel per surface). */
+ *  `rgba` is NULL) or IP_ERR_NOMEM (24 bytes a pixel for the opaque surfaces together, 24
+ *  more for each translucent one). */
 IP_API ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count,
                                     const ip_camera *camera, const ip_shading *shading,
                                     const double lo[3], const double hi[3], uint8_t *rgba,
@@ -359,7 +360,8 @@ IP_API void ip_overlay_axis_directions(const ip_camera *camera, const ip_orienta
 
 /*! ip_overlay_axis_label() : the label of physical axis `axis` (0, 1, 2) in `space`: the
  *  anatomical direction its positive end points to ("R", "A", "S" in RAS; "L", "A", "S" in
- *  LAS; "L", "P", "S" in LPS), or "x", "y", "z" where the space is unknown. A static string. */
+ *  LAS; "L", "P", "S" in LPS), or "x", "y", "z" where the space is unknown; "" for another
+ *  axis. A static string. Thread-safe. */
 IP_API const char *ip_overlay_axis_label(ip_space space, int axis);
 
 /*! ip_overlay_axes_check() : whether the axis triad fits whole in an image of width x height
@@ -371,7 +373,8 @@ IP_API ip_status ip_overlay_axes_check(uint32_t width, uint32_t height, ip_error
  *  bottom-left corner: an arm for each physical axis (ip_overlay_axis_directions(); x red,
  *  y green, z blue) from a common centre, the nearer arms over the farther ones, each
  *  labelled at its tip (ip_overlay_axis_label()). An arm along the view is short, as the
- *  camera sees it. `box` (may be NULL) receives the corner box drawn in.
+ *  camera sees it. `box` (may be NULL) receives the corner box drawn in. Thread-safe on
+ *  distinct images.
  *  @return IP_OK or IP_ERR_ARGUMENT (a bad camera, a NULL image or orientation, an image the
  *  triad does not fit: ip_overlay_axes_check(); nothing is drawn). */
 IP_API ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
@@ -385,7 +388,7 @@ IP_API ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
  *  font has no other glyphs); light on a dark corner, dark where the corner's mean luma is
  *  over 140 of 255 (a white background). `box` (may be NULL) receives the corner box drawn
  *  in; `bar_box` (may be NULL) the bar's own pixels, ticks included. `unit` is read during
- *  the call only.
+ *  the call only. Thread-safe on distinct images.
  *  @return IP_OK, IP_ERR_ARGUMENT (a bad camera, a NULL image, a bar that is not finite and
  *  > 0, or a bar or label that would not fit whole in the image: nothing is drawn) or
  *  IP_ERR_NOMEM. */

@@ -87,15 +87,6 @@ static void shade_value(const ip_shading *s, const float colour[3], const float 
         out[i] = colour[i] * light + highlight;
 }
 
-static void shade_surface(const ip_shading *s, const float n[3], const double v[3], uint8_t out[4])
-{
-    double value[3];
-    shade_value(s, s->surface, n, v, value);
-    for (int i = 0; i < 3; i++)
-        out[i] = to_unorm8(value[i]);
-    out[3] = 255;
-}
-
 /* A vertex in view space: x right, y up, z the depth along the view direction (world units);
  * the normal stays in world space. */
 typedef struct view_vertex {
@@ -349,30 +340,102 @@ static void clip_and_raster(raster_target *t, const raster_view *view, const vie
         raster_triangle(t, view, &poly[cur][0], &poly[cur][i], &poly[cur][i + 1], index);
 }
 
-static void shade_image(const raster_target *t, const ip_camera *camera, const ip_shading *shading,
-                        uint8_t *rgba)
+/* The buffers of an image's surfaces, all of one part of the camera's image: one target for the
+ * opaque surfaces together (triangles numbered across them in surface order), one for each
+ * translucent one; first[i] is surface i's first triangle number in its target. One mesh is
+ * one opaque surface. */
+typedef struct surface_targets {
+    raster_target opaque;
+    raster_target layer[IP_MAX_SURFACES]; /* of the translucent surfaces */
+    uint32_t first[IP_MAX_SURFACES];
+} surface_targets;
+
+static int is_opaque(const ip_surface *f)
+{
+    return f->opacity >= 1.0f;
+}
+
+/* The surface the opaque target's triangle `index` belongs to. */
+static size_t opaque_surface_of(const surface_targets *st, const ip_surface *surfaces, size_t count,
+                                uint32_t index)
+{
+    size_t found = 0;
+    for (size_t i = 0; i < count; i++)
+        if (is_opaque(&surfaces[i]) && st->first[i] <= index)
+            found = i;
+    return found;
+}
+
+/* The pixel's colour: the nearest opaque surface (or the background), then each translucent
+ * surface whose nearest fragment is at least as near, blended over it in surface order. */
+static void shade_surfaces_pixel(const surface_targets *st, const ip_surface *surfaces,
+                                 size_t count, const ip_shading *s, const double ray[3],
+                                 size_t pixel, uint8_t out[4])
+{
+    const raster_target *o = &st->opaque;
+    double value[3];
+    if (o->index[pixel] != UINT32_MAX) {
+        const ip_surface *f = &surfaces[opaque_surface_of(st, surfaces, count, o->index[pixel])];
+        shade_value(s, f->colour, o->normal + 3 * pixel, ray, value);
+        for (int k = 0; k < 3; k++)
+            out[k] = to_unorm8(value[k]);
+    }
+    for (size_t i = 0; i < count; i++) {
+        const raster_target *t = &st->layer[i];
+        if (is_opaque(&surfaces[i]) || t->index[pixel] == UINT32_MAX ||
+            t->inverse_depth[pixel] < o->inverse_depth[pixel])
+            continue;
+        double a = surfaces[i].opacity;
+        shade_value(s, surfaces[i].colour, t->normal + 3 * pixel, ray, value);
+        for (int k = 0; k < 3; k++)
+            out[k] = to_unorm8(a * fmin(1.0, fmax(0.0, value[k])) + (1.0 - a) * (out[k] / 255.0));
+    }
+}
+
+/* Whether a surface shows at the pixel. */
+static int is_covered(const surface_targets *st, const ip_surface *surfaces, size_t count,
+                      size_t pixel)
+{
+    if (st->opaque.index[pixel] != UINT32_MAX)
+        return 1;
+    for (size_t i = 0; i < count; i++)
+        if (!is_opaque(&surfaces[i]) && st->layer[i].index[pixel] != UINT32_MAX)
+            return 1;
+    return 0;
+}
+
+/* `shading`, or ip_shading_default() when NULL. */
+static ip_shading shading_or_default(const ip_shading *shading)
 {
     ip_shading s;
     if (shading)
         s = *shading;
     else
         ip_shading_default(&s);
+    return s;
+}
+
+/* Shades the part of the image the targets hold into rgba (its width * height * 4 bytes): each
+ * pixel the background of its row of the whole image, then the surfaces that show there. */
+static void shade_image(const surface_targets *st, const ip_surface *surfaces, size_t count,
+                        const ip_camera *camera, const ip_shading *s, uint8_t *rgba)
+{
+    const raster_target *t = &st->opaque;
     ip_camera_basis basis;
     ip_camera_basis_of(camera, &basis);
     for (uint32_t y = 0; y < t->height; y++) {
         uint8_t background[4];
-        shade_background(&s, t->y + y, camera->height, background);
+        shade_background(s, t->y + y, camera->height, background);
         for (uint32_t x = 0; x < t->width; x++) {
             size_t pixel = (size_t)y * t->width + x;
             uint8_t *out = rgba + 4 * pixel;
-            if (t->index[pixel] == UINT32_MAX) {
-                memcpy(out, background, 4);
+            memcpy(out, background, 4);
+            if (!is_covered(st, surfaces, count, pixel))
                 continue;
-            }
-            double ray[3];
+            double ray[3]; /* |n . -ray| = |n . ray| */
             ip_camera_pixel_ray(&basis, camera, (double)t->x + x + 0.5, (double)t->y + y + 0.5,
                                 ray);
-            shade_surface(&s, t->normal + 3 * pixel, ray, out); /* |n . -ray| = |n . ray| */
+            shade_surfaces_pixel(st, surfaces, count, s, ray, pixel, out);
         }
     }
 }
@@ -503,17 +566,23 @@ static ip_status raster_part(const ip_mesh *mesh, const ip_camera *camera,
     ip_status st = shading ? ip_shading_check(shading, err) : IP_OK;
     if (st != IP_OK)
         return st;
-    raster_target target;
-    st = allocate_target(&target, x, y, width, height, triangle_index, inverse_depth, rgba != NULL,
+    surface_targets targets; /* the mesh as one opaque surface */
+    raster_target *target = &targets.opaque;
+    targets.first[0] = 0;
+    st = allocate_target(target, x, y, width, height, triangle_index, inverse_depth, rgba != NULL,
                          err);
     if (st == IP_OK) {
         raster_view view;
         setup_view(&view, camera, lo, hi);
-        raster_triangles(&target, &view, mesh, 0);
-        if (rgba)
-            shade_image(&target, camera, shading, rgba);
+        raster_triangles(target, &view, mesh, 0);
+        if (rgba) {
+            ip_shading s = shading_or_default(shading);
+            ip_surface one = {mesh, {0, 0, 0}, 1.0f};
+            memcpy(one.colour, s.surface, sizeof one.colour);
+            shade_image(&targets, &one, 1, camera, &s, rgba);
+        }
     }
-    free_target(&target, triangle_index, inverse_depth);
+    free_target(target, triangle_index, inverse_depth);
     return st;
 }
 
@@ -536,75 +605,6 @@ ip_status ip_surfaces_check(const ip_surface *surfaces, size_t count, ip_error *
                             (double)f->opacity);
     }
     return IP_OK;
-}
-
-/* The surfaces' buffers: one target for the opaque ones together (triangles numbered across
- * them in surface order), one for each translucent one; first[i] is surface i's first
- * triangle number in its target. */
-typedef struct surface_targets {
-    raster_target opaque;
-    raster_target layer[IP_MAX_SURFACES]; /* of the translucent surfaces */
-    uint32_t first[IP_MAX_SURFACES];
-} surface_targets;
-
-static int is_opaque(const ip_surface *f)
-{
-    return f->opacity >= 1.0f;
-}
-
-/* The surface the opaque target's triangle `index` belongs to. */
-static size_t opaque_surface_of(const surface_targets *st, const ip_surface *surfaces, size_t count,
-                                uint32_t index)
-{
-    size_t found = 0;
-    for (size_t i = 0; i < count; i++)
-        if (is_opaque(&surfaces[i]) && st->first[i] <= index)
-            found = i;
-    return found;
-}
-
-/* The pixel's colour: the nearest opaque surface (or the background), then each translucent
- * surface whose nearest fragment is at least as near, blended over it in surface order. */
-static void shade_surfaces_pixel(const surface_targets *st, const ip_surface *surfaces,
-                                 size_t count, const ip_shading *s, const double ray[3],
-                                 size_t pixel, uint8_t out[4])
-{
-    const raster_target *o = &st->opaque;
-    double value[3];
-    if (o->index[pixel] != UINT32_MAX) {
-        const ip_surface *f = &surfaces[opaque_surface_of(st, surfaces, count, o->index[pixel])];
-        shade_value(s, f->colour, o->normal + 3 * pixel, ray, value);
-        for (int k = 0; k < 3; k++)
-            out[k] = to_unorm8(value[k]);
-    }
-    for (size_t i = 0; i < count; i++) {
-        const raster_target *t = &st->layer[i];
-        if (is_opaque(&surfaces[i]) || t->index[pixel] == UINT32_MAX ||
-            t->inverse_depth[pixel] < o->inverse_depth[pixel])
-            continue;
-        double a = surfaces[i].opacity;
-        shade_value(s, surfaces[i].colour, t->normal + 3 * pixel, ray, value);
-        for (int k = 0; k < 3; k++)
-            out[k] = to_unorm8(a * fmin(1.0, fmax(0.0, value[k])) + (1.0 - a) * (out[k] / 255.0));
-    }
-}
-
-static void shade_surfaces(const surface_targets *st, const ip_surface *surfaces, size_t count,
-                           const ip_camera *camera, const ip_shading *s, uint8_t *rgba)
-{
-    ip_camera_basis basis;
-    ip_camera_basis_of(camera, &basis);
-    for (uint32_t y = 0; y < camera->height; y++) {
-        uint8_t background[4];
-        shade_background(s, y, camera->height, background);
-        for (uint32_t x = 0; x < camera->width; x++) {
-            size_t pixel = (size_t)y * camera->width + x;
-            double ray[3];
-            ip_camera_pixel_ray(&basis, camera, x + 0.5, y + 0.5, ray);
-            memcpy(rgba + 4 * pixel, background, 4);
-            shade_surfaces_pixel(st, surfaces, count, s, ray, pixel, rgba + 4 * pixel);
-        }
-    }
 }
 
 static ip_status check_surfaces(const ip_surface *surfaces, size_t count, const ip_camera *camera,
@@ -634,11 +634,6 @@ ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count, const ip_
         return st;
     if (!rgba)
         return ip__fail(err, IP_ERR_ARGUMENT, "raster: no image to draw the surfaces into");
-    ip_shading s;
-    if (shading)
-        s = *shading;
-    else
-        ip_shading_default(&s);
     surface_targets *targets = calloc(1, sizeof *targets);
     if (!targets)
         return ip__fail(err, IP_ERR_NOMEM, "raster: out of memory");
@@ -659,8 +654,10 @@ ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count, const ip_
         if (st == IP_OK)
             raster_triangles(&targets->layer[i], &view, f->mesh, 0);
     }
-    if (st == IP_OK)
-        shade_surfaces(targets, surfaces, count, camera, &s, rgba);
+    if (st == IP_OK) {
+        ip_shading s = shading_or_default(shading);
+        shade_image(targets, surfaces, count, camera, &s, rgba);
+    }
     free_target(&targets->opaque, NULL, NULL);
     for (size_t i = 0; i < count; i++)
         free_target(&targets->layer[i], NULL, NULL);

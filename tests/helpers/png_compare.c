@@ -17,32 +17,11 @@
  * over every pixel and the R, G and B channels, is printed with 4 decimals. Exit status 0, or
  * 2 when the sizes do not fit.
  */
-#include <png.h>
+#include "png_read.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static unsigned char *read_rgba(const char *path, png_uint_32 *width, png_uint_32 *height)
-{
-    png_image image;
-    memset(&image, 0, sizeof image);
-    image.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_file(&image, path)) {
-        fprintf(stderr, "png_compare: %s: %s\n", path, image.message);
-        return NULL;
-    }
-    image.format = PNG_FORMAT_RGBA;
-    unsigned char *rgba = malloc(PNG_IMAGE_SIZE(image));
-    if (!rgba || !png_image_finish_read(&image, NULL, rgba, 0, NULL)) {
-        fprintf(stderr, "png_compare: %s: %s\n", path, rgba ? image.message : "out of memory");
-        png_image_free(&image);
-        free(rgba);
-        return NULL;
-    }
-    *width = image.width;
-    *height = image.height;
-    return rgba;
-}
 
 /* Replaces the image by its rectangle crop[] = x, y, w, h; -1 when that lies outside it. */
 static int crop_image(unsigned char **rgba, png_uint_32 *width, png_uint_32 *height,
@@ -141,8 +120,8 @@ int main(int argc, char **argv)
     if (files != 2)
         goto usage;
     png_uint_32 w[2] = {0, 0}, h[2] = {0, 0};
-    unsigned char *a = read_rgba(path[0], &w[0], &h[0]);
-    unsigned char *b = a ? read_rgba(path[1], &w[1], &h[1]) : NULL;
+    unsigned char *a = png_read_rgba("png_compare", path[0], &w[0], &h[0]);
+    unsigned char *b = a ? png_read_rgba("png_compare", path[1], &w[1], &h[1]) : NULL;
     if (!b) {
         free(a);
         return 2;

@@ -9,33 +9,12 @@
  * the rule of a translucent surface whose nearest layer lies in front of what is under it.
  * Exit status: 0, 1 when an image cannot be read or written, 2 for a bad command line.
  */
+#include "png_read.h"
+
 #include <math.h>
-#include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static unsigned char *read_rgba(const char *path, png_uint_32 *width, png_uint_32 *height)
-{
-    png_image image;
-    memset(&image, 0, sizeof image);
-    image.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_file(&image, path)) {
-        fprintf(stderr, "png_over: %s: %s\n", path, image.message);
-        return NULL;
-    }
-    image.format = PNG_FORMAT_RGBA;
-    unsigned char *rgba = malloc(PNG_IMAGE_SIZE(image));
-    if (!rgba || !png_image_finish_read(&image, NULL, rgba, 0, NULL)) {
-        fprintf(stderr, "png_over: %s: %s\n", path, rgba ? image.message : "out of memory");
-        png_image_free(&image);
-        free(rgba);
-        return NULL;
-    }
-    *width = image.width;
-    *height = image.height;
-    return rgba;
-}
 
 int main(int argc, char **argv)
 {
@@ -53,7 +32,7 @@ int main(int argc, char **argv)
     unsigned char *img[3] = {NULL, NULL, NULL};
     int rc = 0;
     for (int i = 0; i < 3 && rc == 0; i++)
-        if (!(img[i] = read_rgba(argv[1 + i], &w[i], &h[i])))
+        if (!(img[i] = png_read_rgba("png_over", argv[1 + i], &w[i], &h[i])))
             rc = 1;
     if (rc == 0 && (w[1] != w[0] || w[2] != w[0] || h[1] != h[0] || h[2] != h[0])) {
         fprintf(stderr, "png_over: the images' sizes differ\n");

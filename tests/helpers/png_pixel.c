@@ -7,10 +7,10 @@
  * RGBA). Exit status: 0, or 2 for a bad command line, an unreadable image or a pixel outside
  * it.
  */
-#include <png.h>
+#include "png_read.h"
+
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
 int main(int argc, char **argv)
 {
@@ -20,22 +20,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: png_pixel IMAGE.png X,Y\n");
         return 2;
     }
-    png_image image;
-    memset(&image, 0, sizeof image);
-    image.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_file(&image, argv[1])) {
-        fprintf(stderr, "png_pixel: %s: %s\n", argv[1], image.message);
+    png_uint_32 width, height;
+    unsigned char *rgba = png_read_rgba("png_pixel", argv[1], &width, &height);
+    if (!rgba)
         return 2;
-    }
-    image.format = PNG_FORMAT_RGBA;
-    unsigned char *rgba = malloc(PNG_IMAGE_SIZE(image));
-    if (!rgba || !png_image_finish_read(&image, NULL, rgba, 0, NULL)) {
-        fprintf(stderr, "png_pixel: %s: %s\n", argv[1], rgba ? image.message : "out of memory");
-        png_image_free(&image);
-        free(rgba);
-        return 2;
-    }
-    long w = (long)image.width, h = (long)image.height;
+    long w = (long)width, h = (long)height;
     x = x < 0 ? w + x : x;
     y = y < 0 ? h + y : y;
     if (x < 0 || x >= w || y < 0 || y >= h) {
