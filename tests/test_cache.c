@@ -12,9 +12,11 @@
 #include "volumes.h"
 
 /* Every level-0 brick of the test volume: 9^3 uint8 samples (729 bytes, padded to 736), then
- * the least and greatest sample of each of its 4^3 cell groups. */
+ * the least and greatest sample of each of its cell groups (8 cells along each edge, in groups
+ * of IP_CELL_GROUP). */
 #define SAMPLE_BYTES 729
-#define BRICK_BYTES (736 + 4 * 4 * 4 * 2)
+#define GROUPS_PER_EDGE (8 / IP_CELL_GROUP)
+#define BRICK_BYTES (736 + GROUPS_PER_EDGE * GROUPS_PER_EDGE * GROUPS_PER_EDGE * 2)
 
 /* 33^3 uint8 samples, B = 8: 4x4x4 full level-0 bricks, then the pyramid. Sample value
  * depends on the brick so contents can be checked. */
@@ -322,7 +324,7 @@ static void test_threads(const ip_store *s)
 
 /* The cell-group ranges (ip_brick.group_ranges) of every brick of every level, against the
  * least and greatest corner of the group's cells sample by sample; dims whose bricks end with
- * odd cell counts (a last group one cell wide), int16 samples. */
+ * cell counts that IP_CELL_GROUP does not divide (a last group narrower), int16 samples. */
 static void test_group_ranges(const char *dir)
 {
     char raw[4200], ibv[4200];
@@ -348,17 +350,19 @@ static void test_group_ranges(const char *dir)
         ip_brick b;
         REQUIRE(ip_cache_pin_brick(c, g, &b, &err) == IP_OK);
         const int16_t *v = b.samples, *r = b.group_ranges;
-        const uint32_t *e = b.extent, n[3] = {e[0] / 2, e[1] / 2, e[2] / 2};
-        odd += (e[0] - 1) % 2 || (e[1] - 1) % 2 || (e[2] - 1) % 2;
+        const uint32_t *e = b.extent,
+                       n[3] = {ip_cell_groups(e[0]), ip_cell_groups(e[1]), ip_cell_groups(e[2])};
+        const uint32_t G = IP_CELL_GROUP;
+        odd += (e[0] - 1) % G || (e[1] - 1) % G || (e[2] - 1) % G;
         for (uint32_t gz = 0; gz < n[2]; gz++)
             for (uint32_t gy = 0; gy < n[1]; gy++)
                 for (uint32_t gx = 0; gx < n[0]; gx++) {
                     int least = INT16_MAX, most = INT16_MIN;
-                    /* every corner of every cell of the group: cells 2g and 2g + 1 where
-                     * the brick has it (cells are samples 0 .. extent - 2) */
-                    for (uint32_t cz = 2 * gz; cz < 2 * gz + 2 && cz + 1 < e[2]; cz++)
-                        for (uint32_t cy = 2 * gy; cy < 2 * gy + 2 && cy + 1 < e[1]; cy++)
-                            for (uint32_t cx = 2 * gx; cx < 2 * gx + 2 && cx + 1 < e[0]; cx++)
+                    /* every corner of every cell of the group: cells G g .. G g + G - 1 where
+                     * the brick has them (cells are samples 0 .. extent - 2) */
+                    for (uint32_t cz = G * gz; cz < G * gz + G && cz + 1 < e[2]; cz++)
+                        for (uint32_t cy = G * gy; cy < G * gy + G && cy + 1 < e[1]; cy++)
+                            for (uint32_t cx = G * gx; cx < G * gx + G && cx + 1 < e[0]; cx++)
                                 for (int k = 0; k < 8; k++) {
                                     int sample = v[cx + (k & 1) +
                                                    e[0] * (cy + ((k >> 1) & 1) +

@@ -39,15 +39,26 @@ extern "C" {
 
 typedef struct ip_cache ip_cache;
 
+/* Cells along each edge of a cell group (ip_brick.group_ranges). */
+#define IP_CELL_GROUP 4
+
+/*! ip_cell_groups() : the cell groups along an axis of a brick of `extent` samples
+ *  (extent - 1 cells, in groups of IP_CELL_GROUP, the last one narrower where they do not
+ *  divide evenly). */
+static inline uint32_t ip_cell_groups(uint32_t extent)
+{
+    return (extent + IP_CELL_GROUP - 2) / IP_CELL_GROUP;
+}
+
 /* A pinned, decoded brick. Owned by the cache; valid until ip_cache_unpin_brick().
  *
- * group_ranges: the brick's cells in groups of 2x2x2, extent[k] / 2 groups along axis k, x
- * fastest; group (i, j, k) holds the brick's cells 2i .. 2i + 1 along x (only 2i where the
- * brick's cell count is odd and 2i is its last cell), likewise along y and z. For each group,
- * the least and then the greatest of the samples at its cells' corners, as two samples of the
- * volume's type: computed once per decode, so that a reader can pass over the cells of a group
- * whose range the iso-value does not split (no corner >= iso, or none < iso) without reading
- * their corners. */
+ * group_ranges: the brick's cells in groups of G x G x G (G = IP_CELL_GROUP), ip_cell_groups(
+ * extent[k]) groups along axis k, x fastest; group (i, j, k) holds the brick's cells Gi ..
+ * Gi + G - 1 along x (fewer where the brick's cells end before), likewise along y and z. For
+ * each group, the least and then the greatest of the samples at its cells' corners, as two
+ * samples of the volume's type: computed once per decode, so that a reader can pass over the
+ * cells of a group whose range the iso-value does not split (no corner >= iso, or none < iso)
+ * without reading their corners. */
 typedef struct ip_brick {
     const void *samples;      /* extent[0] * extent[1] * extent[2] samples, host order, x fastest */
     const void *group_ranges; /* 2 samples per cell group, as described above */

@@ -67,30 +67,37 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
         return 0;
     ptrdiff_t corners[8];
     ip__corner_offsets(brick, corners);
-    size_t groups_x = brick->extent[0] / 2, groups_xy = groups_x * (brick->extent[1] / 2);
-    /* sub-blocks start on even cells: their groups are whole, bar a brick's odd last cell */
-    for (uint32_t gz = lo[2]; gz < hi[2]; gz += 2)
-        for (uint32_t gy = lo[1]; gy < hi[1]; gy += 2)
-            for (uint32_t gx = lo[0]; gx < hi[0]; gx += 2) {
-                uint32_t g1[3] = {gx + 2 < hi[0] ? gx + 2 : hi[0], gy + 2 < hi[1] ? gy + 2 : hi[1],
-                                  gz + 2 < hi[2] ? gz + 2 : hi[2]};
-                double blo[3] = {gx, gy, gz}, bhi[3] = {g1[0], g1[1], g1[2]};
+    size_t groups_x = ip_cell_groups(brick->extent[0]),
+           groups_xy = groups_x * ip_cell_groups(brick->extent[1]);
+    /* the groups the sub-block meets, each clipped to it: [g0, g1) */
+    uint32_t first[3];
+    for (int k = 0; k < 3; k++)
+        first[k] = lo[k] - (lo[k] - brick->origin[k]) % IP_CELL_GROUP;
+    for (uint32_t gz = first[2]; gz < hi[2]; gz += IP_CELL_GROUP)
+        for (uint32_t gy = first[1]; gy < hi[1]; gy += IP_CELL_GROUP)
+            for (uint32_t gx = first[0]; gx < hi[0]; gx += IP_CELL_GROUP) {
+                uint32_t g[3] = {gx, gy, gz}, g0[3], g1[3];
+                for (int k = 0; k < 3; k++) {
+                    g0[k] = g[k] > lo[k] ? g[k] : lo[k];
+                    g1[k] = g[k] + IP_CELL_GROUP < hi[k] ? g[k] + IP_CELL_GROUP : hi[k];
+                }
+                double blo[3] = {g0[0], g0[1], g0[2]}, bhi[3] = {g1[0], g1[1], g1[2]};
                 if (!meets(w, blo, bhi))
                     continue;
                 if (s->use_group_ranges) {
                     static const ptrdiff_t pair[2] = {0, 1};
                     float range[2];
-                    size_t at = ((gx - brick->origin[0]) >> 1) +
-                                groups_x * ((gy - brick->origin[1]) >> 1) +
-                                groups_xy * ((gz - brick->origin[2]) >> 1);
+                    size_t at = (gx - brick->origin[0]) / IP_CELL_GROUP +
+                                groups_x * ((gy - brick->origin[1]) / IP_CELL_GROUP) +
+                                groups_xy * ((gz - brick->origin[2]) / IP_CELL_GROUP);
                     ip__samples_gather(brick->group_ranges, s->layout->type, 2 * at, pair, 2,
                                        range);
                     if (!ip__range_active(range[0], range[1], s->iso))
                         continue;
                 }
-                for (uint32_t z = gz; z < g1[2]; z++)
-                    for (uint32_t y = gy; y < g1[1]; y++)
-                        for (uint32_t x = gx; x < g1[0]; x++) {
+                for (uint32_t z = g0[2]; z < g1[2]; z++)
+                    for (uint32_t y = g0[1]; y < g1[1]; y++)
+                        for (uint32_t x = g0[0]; x < g1[0]; x++) {
                             /* cheapest first: most cells here are extracted or inactive */
                             uint32_t c[3] = {x, y, z}, c1[3] = {x + 1, y + 1, z + 1};
                             if (ip__visited_test(w->visited, s->level, c))

@@ -180,7 +180,8 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
     /* The cells come in runs through one cell group (cache.h): its range is read when the run
      * enters it, and the corners of none of its cells when no cell of it can be active. The
      * cells visited and their order stay those of the cell DDA. */
-    size_t groups_x = brick->extent[0] / 2, groups_xy = groups_x * (brick->extent[1] / 2);
+    size_t groups_x = ip_cell_groups(brick->extent[0]),
+           groups_xy = groups_x * ip_cell_groups(brick->extent[1]);
     size_t group = SIZE_MAX;
     int group_active = 1;
     dda d;
@@ -189,8 +190,9 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
         s->nodes++;
         uint32_t c[3] = {lo[0] + (uint32_t)d.i[0], lo[1] + (uint32_t)d.i[1],
                          lo[2] + (uint32_t)d.i[2]};
-        size_t at = ((c[0] - brick->origin[0]) >> 1) + groups_x * ((c[1] - brick->origin[1]) >> 1) +
-                    groups_xy * ((c[2] - brick->origin[2]) >> 1);
+        size_t at = (c[0] - brick->origin[0]) / IP_CELL_GROUP +
+                    groups_x * ((c[1] - brick->origin[1]) / IP_CELL_GROUP) +
+                    groups_xy * ((c[2] - brick->origin[2]) / IP_CELL_GROUP);
         if (at != group && s->use_group_ranges) {
             static const ptrdiff_t pair[2] = {0, 1};
             float range[2];

@@ -396,18 +396,19 @@ static void give_work(ip_cache *c, void *w)
 }
 
 /* The last sample of cell group g along an axis of `extent` samples: the group's cells are
- * 2g and 2g + 1, or only 2g where that is the last cell. */
+ * G g .. G g + G - 1, or fewer where the axis's cells (samples 0 .. extent - 2) end before. */
 static uint32_t group_last_sample(uint32_t g, uint32_t extent)
 {
-    return 2 * g + 2 < extent - 1 ? 2 * g + 2 : extent - 1;
+    uint32_t last = IP_CELL_GROUP * (g + 1);
+    return last < extent - 1 ? last : extent - 1;
 }
 
 /* The cell-group ranges of a brick (ip_brick.group_ranges) from its samples `s` of type T, in
- * one pass over the samples: each pair of cell layers along z (3 sample slices) is reduced to
- * one slice of least and greatest values (`lo`, `hi`: extent[0] * extent[1] samples each),
- * each pair of cell rows of that along y to one row (`row_lo`, `row_hi`: extent[0] each),
- * whose windows of 3 samples along x are the groups. The first two steps are elementwise
- * over contiguous samples, which the compiler vectorises. */
+ * one pass over the samples: each group's layers of cells along z (G + 1 sample slices) are
+ * reduced to one slice of least and greatest values (`lo`, `hi`: extent[0] * extent[1]
+ * samples each), each group's rows along y of that to one row (`row_lo`, `row_hi`: extent[0]
+ * each), whose windows of G + 1 samples along x are the groups. The first two steps are
+ * elementwise over contiguous samples, which the compiler vectorises. */
 #define GROUP_RANGES_AS(T, name)                                                              \
     /* lo, hi[0 .. n) = the least of src_lo, the greatest of src_hi over the layers `first` \
      * .. `last` (inclusive), `stride` apart */ \
@@ -428,23 +429,22 @@ static uint32_t group_last_sample(uint32_t g, uint32_t extent)
     {                                                                                         \
         size_t row = e[0], slice = row * e[1];                                                \
         T *lo = scratch, *hi = lo + slice, *row_lo = hi + slice, *row_hi = row_lo + row;      \
-        for (uint32_t gz = 0; gz < e[2] / 2; gz++) {                                          \
-            layers_##name(lo, hi, s, s, slice, slice, 2 * gz, group_last_sample(gz, e[2]));   \
-            for (uint32_t gy = 0; gy < e[1] / 2; gy++) {                                      \
-                layers_##name(row_lo, row_hi, lo, hi, row, row, 2 * gy,                       \
+        uint32_t n[3] = {ip_cell_groups(e[0]), ip_cell_groups(e[1]), ip_cell_groups(e[2])};   \
+        for (uint32_t gz = 0; gz < n[2]; gz++) {                                              \
+            layers_##name(lo, hi, s, s, slice, slice, IP_CELL_GROUP *gz,                      \
+                          group_last_sample(gz, e[2]));                                       \
+            for (uint32_t gy = 0; gy < n[1]; gy++) {                                          \
+                layers_##name(row_lo, row_hi, lo, hi, row, row, IP_CELL_GROUP *gy,            \
                               group_last_sample(gy, e[1]));                                   \
-                /* the groups of 3 samples along x (all but the last where e[0] is even),  \
-                 * unrolled; then the last one of 2 */  \
-                const T *a = row_lo, *b = row_hi;                                             \
-                for (uint32_t gx = 0; gx < (e[0] - 1) / 2; gx++, a += 2, b += 2, out += 2) {  \
-                    T least = a[0] < a[1] ? a[0] : a[1], most = b[0] > b[1] ? b[0] : b[1];    \
-                    out[0] = a[2] < least ? a[2] : least;                                     \
-                    out[1] = b[2] > most ? b[2] : most;                                       \
-                }                                                                             \
-                if (e[0] % 2 == 0) {                                                          \
-                    out[0] = a[0] < a[1] ? a[0] : a[1];                                       \
-                    out[1] = b[0] > b[1] ? b[0] : b[1];                                       \
-                    out += 2;                                                                 \
+                for (uint32_t gx = 0; gx < n[0]; gx++, out += 2) {                            \
+                    uint32_t x = IP_CELL_GROUP * gx, last = group_last_sample(gx, e[0]);      \
+                    T least = row_lo[x], most = row_hi[x];                                    \
+                    for (x++; x <= last; x++) {                                               \
+                        least = row_lo[x] < least ? row_lo[x] : least;                        \
+                        most = row_hi[x] > most ? row_hi[x] : most;                           \
+                    }                                                                         \
+                    out[0] = least;                                                           \
+                    out[1] = most;                                                            \
                 }                                                                             \
             }                                                                                 \
         }                                                                                     \
@@ -460,7 +460,8 @@ static size_t entry_bytes(const uint32_t extent[3], ip_type type, size_t *group_
 {
     size_t size = ip_type_size(type);
     size_t samples = (size_t)extent[0] * extent[1] * extent[2] * size;
-    size_t groups = (size_t)(extent[0] / 2) * (extent[1] / 2) * (extent[2] / 2);
+    size_t groups =
+        (size_t)ip_cell_groups(extent[0]) * ip_cell_groups(extent[1]) * ip_cell_groups(extent[2]);
     *group_offset = (samples + 7) & ~(size_t)7;
     return *group_offset + 2 * groups * size;
 }
