@@ -56,8 +56,9 @@ static void test_every_pixel_once(void)
 }
 
 /* The order as specified, the slow way: every cell of every level decoded from scratch, and a
- * bitmap of the pixels cast so far instead of the iterator's reasoning about coarser centres. */
-static void reference_order(uint32_t w, uint32_t h, uint32_t (*out)[2])
+ * bitmap of the pixels cast so far instead of the iterator's reasoning about coarser centres.
+ * Levels from `local_from` on take the digits finest split first (Z-order). */
+static void reference_order(uint32_t w, uint32_t h, uint32_t local_from, uint32_t (*out)[2])
 {
     uint32_t kx = 0, ky = 0;
     while ((1ull << kx) < w)
@@ -71,18 +72,19 @@ static void reference_order(uint32_t w, uint32_t h, uint32_t (*out)[2])
     for (uint32_t level = 0; level <= (kx > ky ? kx : ky); level++) {
         uint32_t nx = level < kx ? level : kx, ny = level < ky ? level : ky;
         uint32_t both = nx < ny ? nx : ny, splits = nx > ny ? nx : ny;
+        int local = level >= local_from;
         for (uint64_t position = 0; position < (1ull << (nx + ny)); position++) {
             uint64_t p = position;
             uint32_t cx = 0, cy = 0;
             for (uint32_t s = 0; s < both; s++, p >>= 2) {
-                cx |= digit_x[p & 3] << (nx - 1 - s);
-                cy |= digit_y[p & 3] << (ny - 1 - s);
+                cx |= digit_x[p & 3] << (local ? s : nx - 1 - s);
+                cy |= digit_y[p & 3] << (local ? s : ny - 1 - s);
             }
             for (uint32_t s = both; s < splits; s++, p >>= 1) {
                 if (nx > both)
-                    cx |= (uint32_t)(p & 1) << (nx - 1 - s);
+                    cx |= (uint32_t)(p & 1) << (local ? s : nx - 1 - s);
                 else
-                    cy |= (uint32_t)(p & 1) << (ny - 1 - s);
+                    cy |= (uint32_t)(p & 1) << (local ? s : ny - 1 - s);
             }
             uint64_t x0 = (uint64_t)cx * w >> nx, x1 = (uint64_t)(cx + 1) * w >> nx;
             uint64_t y0 = (uint64_t)cy * h >> ny, y1 = (uint64_t)(cy + 1) * h >> ny;
@@ -101,34 +103,91 @@ static void reference_order(uint32_t w, uint32_t h, uint32_t (*out)[2])
     free(seen);
 }
 
-static int same_as_reference(uint32_t w, uint32_t h)
+/* Whether the iterator gives the reference order; with `range` > 0, walked in ranges of that
+ * many positions, each from a seek, as the engine's threads walk it. */
+static int same_as_reference(uint32_t w, uint32_t h, uint32_t local_from, uint64_t range)
 {
     uint32_t(*expected)[2] = malloc((size_t)w * h * sizeof *expected);
     REQUIRE(expected);
-    reference_order(w, h, expected);
+    reference_order(w, h, local_from, expected);
     ip_ray_order order;
     REQUIRE(ip__ray_order_init(&order, w, h) == IP_OK);
+    ip__ray_order_set_local_from(&order, local_from);
+    uint64_t cells = ip__ray_order_cells(&order), start = 0, end = range ? range : UINT64_MAX;
     int same = 1;
     uint32_t x, y;
-    for (size_t i = 0; i < (size_t)w * h && same; i++)
-        same = ip__ray_order_next(&order, &x, &y) && x == expected[i][0] && y == expected[i][1];
+    for (size_t i = 0; i < (size_t)w * h && same; i++) {
+        while (!ip__ray_order_next_before(&order, end, &x, &y) && start < cells) {
+            start = end < cells ? end : cells;
+            end = start + range;
+            ip__ray_order_seek(&order, start);
+        }
+        same = x == expected[i][0] && y == expected[i][1];
+    }
     free(expected);
+    ip__ray_order_seek(&order, cells);
     return same && !ip__ray_order_next(&order, &x, &y);
+}
+
+/* Ranges walked last first, each from a seek (as the engine's leftover ranges are): every
+ * range gives the pixels it gives in a walk from the start. */
+static void test_ranges_backwards(uint32_t w, uint32_t h, uint32_t local_from, uint64_t range)
+{
+    ip_ray_order order;
+    REQUIRE(ip__ray_order_init(&order, w, h) == IP_OK);
+    ip__ray_order_set_local_from(&order, local_from);
+    uint64_t cells = ip__ray_order_cells(&order), n = (uint64_t)w * h;
+    uint64_t ranges = (cells + range - 1) / range;
+    uint32_t(*forward)[2] = malloc(n * sizeof *forward);
+    uint64_t *first = malloc((ranges + 1) * sizeof *first); /* first pixel of each range */
+    REQUIRE(forward && first);
+    uint64_t i = 0;
+    for (uint64_t r = 0; r < ranges; r++) {
+        first[r] = i;
+        while (ip__ray_order_next_before(&order, (r + 1) * range, &forward[i][0], &forward[i][1]))
+            i++;
+    }
+    first[ranges] = i;
+    REQUIRE(i == n);
+    uint64_t differ = 0;
+    for (uint64_t r = ranges; r-- > 0;) {
+        ip__ray_order_seek(&order, r * range);
+        uint32_t x, y;
+        for (uint64_t j = first[r]; j < first[r + 1]; j++)
+            differ += !ip__ray_order_next_before(&order, (r + 1) * range, &x, &y) ||
+                      x != forward[j][0] || y != forward[j][1];
+        differ += ip__ray_order_next_before(&order, (r + 1) * range, &x, &y);
+    }
+    CHECK_MSG(differ == 0, "%ux%u, ranges of %llu walked backwards: %llu differ", w, h,
+              (unsigned long long)range, (unsigned long long)differ);
+    free(forward);
+    free(first);
 }
 
 static void test_matches_reference(void)
 {
     int mismatches = 0;
     for (uint32_t w = 1; w <= 40; w++)
-        for (uint32_t h = 1; h <= 40; h++)
-            if (!same_as_reference(w, h)) {
-                mismatches++;
-                fprintf(stderr, "%ux%u differs from the reference order\n", w, h);
-            }
+        for (uint32_t h = 1; h <= 40; h++) {
+            if (!same_as_reference(w, h, UINT32_MAX, 0))
+                fprintf(stderr, "%ux%u differs from the reference order\n", w, h), mismatches++;
+            if (!same_as_reference(w, h, 2, 7))
+                fprintf(stderr, "%ux%u, local from 2, in ranges of 7: differs\n", w, h),
+                    mismatches++;
+        }
     CHECK(mismatches == 0);
-    static const uint32_t sizes[][2] = {{640, 480}, {255, 257}, {1000, 3}, {129, 1025}};
-    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
-        CHECK_MSG(same_as_reference(sizes[i][0], sizes[i][1]), "%ux%u", sizes[i][0], sizes[i][1]);
+    static const uint32_t sizes[][2] = {
+        {640, 480}, {255, 257}, {1000, 3}, {129, 1025}, {1600, 1200}};
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
+        uint32_t w = sizes[i][0], h = sizes[i][1];
+        CHECK_MSG(same_as_reference(w, h, UINT32_MAX, 0), "%ux%u", w, h);
+        /* the engine's set-up: the last 3 levels local, ranges of a few hundred positions */
+        ip_ray_order order;
+        REQUIRE(ip__ray_order_init(&order, w, h) == IP_OK);
+        uint32_t last = ip__ray_order_last_level(&order);
+        CHECK_MSG(same_as_reference(w, h, last > 3 ? last - 3 : 0, 333), "%ux%u local", w, h);
+        test_ranges_backwards(w, h, last > 3 ? last - 3 : 0, 1000);
+    }
 }
 
 static void test_first_rays(void)

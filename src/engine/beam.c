@@ -69,6 +69,7 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
     ip__corner_offsets(brick, corners);
     size_t groups_x = ip_cell_groups(brick->extent[0]),
            groups_xy = groups_x * ip_cell_groups(brick->extent[1]);
+    const atomic_uint_fast64_t *marked = ip__visited_bitmap(w->visited, brick->index);
     /* the groups the sub-block meets, each clipped to it: [g0, g1) */
     uint32_t first[3];
     for (int k = 0; k < 3; k++)
@@ -100,7 +101,7 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
                         for (uint32_t x = g0[0]; x < g1[0]; x++) {
                             /* cheapest first: most cells here are extracted or inactive */
                             uint32_t c[3] = {x, y, z}, c1[3] = {x + 1, y + 1, z + 1};
-                            if (ip__visited_test(w->visited, s->level, c))
+                            if (ip__visited_test_in(w->visited, marked, c))
                                 continue;
                             float values[8];
                             ip__cell_values(brick, s->layout->type, corners, c, values);

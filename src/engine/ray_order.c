@@ -1,6 +1,8 @@
 /* Progressive ray order: a breadth-first quadtree over the screen, Bayer order within a level. */
 #include "ray_order.h"
 
+#include <string.h>
+
 /* Levels needed until a side is cut into cells of at most one pixel: ceil(log2(side)). */
 static uint32_t levels_for(uint32_t side)
 {
@@ -46,8 +48,16 @@ uint32_t ip__ray_order_level(const ip_ray_order *order)
     return min_u32(order->level, last);
 }
 
+/* Empties the memo of both axes: their cells belong to the level just left. */
+static void forget_cells(ip_ray_order *order)
+{
+    memset(order->memo[0].cell, 0xff, sizeof order->memo[0].cell);
+    memset(order->memo[1].cell, 0xff, sizeof order->memo[1].cell);
+}
+
 void ip__ray_order_reset(ip_ray_order *order)
 {
+    forget_cells(order);
     order->level = 0;
     order->next_cell = 0;
     order->level_base = 0;
@@ -155,15 +165,33 @@ static uint32_t centre_levels(uint32_t side, uint32_t axis_levels, uint32_t leve
     return found;
 }
 
-/* Whether pixel (px, py), the centre of cell (cx, cy) of the current level, was cast already. */
-static int cast_before(const ip_ray_order *order, uint32_t nx, uint32_t ny, uint32_t cx,
-                       uint32_t cy, uint32_t px, uint32_t py)
+/* The memo slot of cell `cell` of the current level along `axis` (0: x, 1: y), which the axis
+ * cuts into 2^splits cells, filled by fill_slot() unless it holds the cell already: its span
+ * and, for a cell of at most 2 pixels, the coarser levels whose cell had the same centre (a
+ * centre cast before is the first or last pixel of this cell along both axes, see
+ * centre_levels(), which needs cells at most 2 pixels wide). */
+static void fill_slot(ip_ray_order *order, unsigned axis, uint32_t splits, uint32_t cell,
+                      unsigned slot)
 {
-    uint32_t level = order->level;
-    uint32_t in_x = centre_levels(order->width, order->x_levels, level, nx, cx, px);
-    if (in_x == 0)
-        return 0;
-    return (in_x & centre_levels(order->height, order->y_levels, level, ny, cy, py)) != 0;
+    ip__ray_order_memo *m = &order->memo[axis];
+    uint32_t side = axis ? order->height : order->width, first, end;
+    uint32_t axis_levels = axis ? order->y_levels : order->x_levels;
+    cell_span(side, splits, cell, &first, &end);
+    m->cell[slot] = cell;
+    m->first[slot] = first;
+    m->end[slot] = end;
+    m->centres[slot] =
+        end > first && end - first <= 2
+            ? centre_levels(side, axis_levels, order->level, splits, cell, (first + end) >> 1)
+            : 0;
+}
+
+static inline unsigned memo_slot(ip_ray_order *order, unsigned axis, uint32_t splits, uint32_t cell)
+{
+    unsigned slot = cell & (IP__RAY_ORDER_MEMO - 1);
+    if (order->memo[axis].cell[slot] != cell)
+        fill_slot(order, axis, splits, cell, slot);
+    return slot;
 }
 
 /* The cell at `position` of the current level, decoded from scratch: every digit that
@@ -198,6 +226,7 @@ void ip__ray_order_seek(ip_ray_order *order, uint64_t position)
         order->level++;
     }
     order->next_cell = position - order->level_base;
+    forget_cells(order);
     if (order->level <= last_level)
         decode_cell(order, order->next_cell);
     else
@@ -220,20 +249,21 @@ int ip__ray_order_next_before(ip_ray_order *order, uint64_t end, uint32_t *x, ui
             cells = 0;
         else if (end - order->level_base < level_end)
             cells = end - order->level_base;
+        const ip__ray_order_memo *mx = &order->memo[0], *my = &order->memo[1];
         while (order->next_cell < cells) {
-            uint32_t cx = order->cell_x, cy = order->cell_y, x0, x1, y0, y1;
+            uint32_t cx = order->cell_x, cy = order->cell_y;
             next_cell(order, nx, ny);
-            cell_span(order->width, nx, cx, &x0, &x1);
-            cell_span(order->height, ny, cy, &y0, &y1);
-            if (x0 == x1 || y0 == y1)
+            unsigned sx = memo_slot(order, 0, nx, cx);
+            if (mx->first[sx] == mx->end[sx])
                 continue; /* an empty cell: the side is not a power of two */
-            uint32_t px = (x0 + x1) >> 1, py = (y0 + y1) >> 1;
-            /* A centre cast before is the first or last pixel of this cell along both axes (see
-             * centre_levels), which needs cells at most 2 pixels wide. */
-            if (x1 - x0 <= 2 && y1 - y0 <= 2 && cast_before(order, nx, ny, cx, cy, px, py))
+            unsigned sy = memo_slot(order, 1, ny, cy);
+            if (my->first[sy] == my->end[sy])
                 continue;
-            *x = px;
-            *y = py;
+            /* cast at a coarser level where both axes had this centre at the same level */
+            if (mx->centres[sx] & my->centres[sy])
+                continue;
+            *x = (mx->first[sx] + mx->end[sx]) >> 1;
+            *y = (my->first[sy] + my->end[sy]) >> 1;
             order->emitted++;
             return 1;
         }
@@ -243,6 +273,7 @@ int ip__ray_order_next_before(ip_ray_order *order, uint64_t end, uint32_t *x, ui
         order->level_base += cells;
         order->next_cell = 0;
         order->cell_x = order->cell_y = 0;
+        forget_cells(order);
     }
     return 0;
 }

@@ -34,9 +34,11 @@
  * is W / 2^k, and sqrt(2) * W / 2^k in Euclidean distance. Once level k is complete, every pixel
  * is within half a level-k cell of a cast ray along each axis.
  *
- * Cost: O(1) memory (the iterator is a small struct, no allocation). The order examines the
- * cells of every level, about 3 per pixel (at most about 5, for sides just above a power of
- * two), each in amortised O(1) time.
+ * Cost: O(1) memory (the iterator is a struct of about 2 KiB, no allocation). The order
+ * examines the cells of every level, about 3 per pixel (at most about 5, for sides just above a
+ * power of two), each in amortised O(1) time. Each axis's spans and coarser centres of the cells
+ * seen lately are remembered (IP__RAY_ORDER_MEMO slots per axis, by the cell's low bits): in the
+ * Z-order of local levels a cell's column and row come back many times in a row.
  * Thread safety: an iterator is used by one thread at a time; separate iterators are independent.
  */
 #ifndef ISOPROP_RAY_ORDER_H
@@ -52,6 +54,18 @@ extern "C" {
 
 #define IP_RAY_ORDER_MAX_SIDE (1u << 30) /* largest width or height accepted */
 
+#define IP__RAY_ORDER_MEMO 64 /* cells of the current level remembered per axis: a power of two */
+
+/* One axis's cells of the current level seen lately, in slot cell % IP__RAY_ORDER_MEMO. */
+typedef struct ip__ray_order_memo {
+    uint32_t cell[IP__RAY_ORDER_MEMO];    /* the cell in the slot; UINT32_MAX: none */
+    uint32_t first[IP__RAY_ORDER_MEMO];   /* its pixels [first, end) along the axis */
+    uint32_t end[IP__RAY_ORDER_MEMO];     /* (first == end: an empty cell) */
+    uint32_t centres[IP__RAY_ORDER_MEMO]; /* cells of at most 2 pixels: the coarser levels whose
+                                             cell along this axis had the same centre, as bits;
+                                             0 for wider cells */
+} ip__ray_order_memo;
+
 /* The iterator. Owned by the caller (usually on its stack); its fields are private. */
 typedef struct ip_ray_order {
     uint32_t width, height;
@@ -62,6 +76,7 @@ typedef struct ip_ray_order {
     uint32_t cell_x, cell_y;     /* that cell's column and row among the level's cells */
     uint64_t emitted;            /* pixels returned since init or reset */
     uint32_t local_from;         /* the first level walked in Z-order (UINT32_MAX: none) */
+    ip__ray_order_memo memo[2];  /* x, y: cells of `level` seen lately */
 } ip_ray_order;
 
 /*! ip__ray_order_init() : prepares `order` to walk a width x height image from the beginning.

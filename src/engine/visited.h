@@ -31,4 +31,26 @@ int ip__visited_mark(ip_visited *v, uint32_t level, const uint32_t cell[3]);
 /* 1 when the cell is marked. */
 int ip__visited_test(const ip_visited *v, uint32_t level, const uint32_t cell[3]);
 
+/* For tests of many cells of one brick: the bitmap of the brick of global index `brick`, NULL
+ * while none of its cells is marked (a bitmap published after this call is not seen, so a
+ * cell marked meanwhile may read as unmarked). */
+static inline const atomic_uint_fast64_t *ip__visited_bitmap(const ip_visited *v, uint64_t brick)
+{
+    return atomic_load_explicit(&v->bitmaps[brick], memory_order_acquire);
+}
+
+/* 1 when `cell` (of the level and brick whose bitmap is `m`, from ip__visited_bitmap()) is
+ * marked. */
+static inline int ip__visited_test_in(const ip_visited *v, const atomic_uint_fast64_t *m,
+                                      const uint32_t cell[3])
+{
+    if (!m)
+        return 0;
+    unsigned shift = v->edge_shift;
+    uint32_t mask = (UINT32_C(1) << shift) - 1;
+    uint64_t bit = (cell[0] & mask) + ((uint64_t)(cell[1] & mask) << shift) +
+                   ((uint64_t)(cell[2] & mask) << (2 * shift));
+    return (atomic_load_explicit(&m[bit >> 6], memory_order_relaxed) >> (bit & 63)) & 1;
+}
+
 #endif
