@@ -1,6 +1,7 @@
 /* Bricking round trips: every sample of every brick of every level, and every summary,
  * recomputed from the raw input; plus determinism, cancellation and memory limits. */
 #include <dirent.h>
+#include <fcntl.h>
 #include <math.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -322,9 +323,11 @@ static void test_cancel_and_limits(const char *dir)
 }
 
 /* The plan is a count of what the run allocates: for the head upsampled 6 times (3072 x 3072 x
- * 1404 uint16, 26.5 GB) on 2 threads it fits 1 GiB, holds the level-0 slab (33 planes), and a
- * volume 10 times deeper adds only 48 bytes per brick (directory entry, brick range, octree
- * node share, Morton order): the sub-block ranges wait on disk. */
+ * 1404 uint16, 26.5 GB) on 2 threads under a limit of 1 GiB it fits, holds the level-0 slab
+ * (33 planes) and no second chunk, and a volume 10 times deeper adds only 48 bytes per brick
+ * (directory entry, brick range, octree node share, Morton order): the sub-block ranges wait on
+ * disk. Without the limit the plan holds a second chunk (32 more planes) to read while one is
+ * encoded; the head upsampled 4 times (2048 x 2048 x 936) has room for it in 1 GiB. */
 static void test_memory_plan(void)
 {
     ip_input_desc desc;
@@ -337,16 +340,140 @@ static void test_memory_plan(void)
     ip_bricker_options o;
     ip_bricker_options_default(&o);
     o.threads = 2;
-    uint64_t plan = 0, deeper = 0;
+    o.memory_limit = (uint64_t)1024 << 20;
+    uint64_t plan = 0, deeper = 0, roomy = 0, x4 = 0;
     ip_error err;
     REQUIRE(ip_bricker_memory_needed(&desc, &o, &plan, &err) == IP_OK);
     CHECK_MSG(plan <= (uint64_t)1024 << 20, "plan %llu bytes", (unsigned long long)plan);
     CHECK(plan >= (uint64_t)33 * 3072 * 3072 * 2);
+    o.memory_limit = 0;
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &roomy, &err) == IP_OK);
+    CHECK(roomy - plan == (uint64_t)32 * 3072 * 3072 * 2);
+    desc.dims[0] = desc.dims[1] = 2048;
+    desc.dims[2] = 936;
+    o.memory_limit = (uint64_t)1024 << 20;
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &x4, &err) == IP_OK);
+    CHECK_MSG(x4 >= (uint64_t)65 * 2048 * 2048 * 2 && x4 <= (uint64_t)1024 << 20, "plan %llu bytes",
+              (unsigned long long)x4);
+    desc.dims[0] = desc.dims[1] = 3072;
+    o.memory_limit = (uint64_t)1024 << 20;
     desc.dims[2] = 14040;
     REQUIRE(ip_bricker_memory_needed(&desc, &o, &deeper, &err) == IP_OK);
     uint64_t more_bricks = (uint64_t)96 * 96 * (14040 / 32 - 1404 / 32) * 8 / 7 + 1;
     CHECK_MSG(deeper - plan <= more_bricks * 48, "plan grows by %llu bytes",
               (unsigned long long)(deeper - plan));
+}
+
+/* Bricks `input` with 8-cell bricks on 2 threads under `limit` bytes (0: none). */
+static int brick_limited(const char *input, const char *ibv, uint64_t limit,
+                         ip_bricker_report *report)
+{
+    ip_input_desc desc;
+    ip_error err;
+    ip_bricker_options o;
+    ip_bricker_options_default(&o);
+    o.brick_edge = 8;
+    o.subblock_edge = 4;
+    o.threads = 2;
+    o.memory_limit = limit;
+    o.force = 1;
+    if (ip_input_describe(input, NULL, &desc, &err) != IP_OK ||
+        ip_bricker_run(&desc, ibv, &o, report, &err) != IP_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return -1;
+    }
+    return 0;
+}
+
+/* Whether the file system under `path` reads it with O_DIRECT (4 KiB at 0 into an aligned
+ * buffer), as the bricker will try to. */
+static int direct_reads_work(const char *path)
+{
+    int fd = open(path, O_RDONLY | O_DIRECT);
+    void *buf = NULL;
+    int ok = fd >= 0 && posix_memalign(&buf, 4096, 4096) == 0 && pread(fd, buf, 4096, 0) == 4096;
+    free(buf);
+    if (fd >= 0)
+        close(fd);
+    return ok;
+}
+
+static int same_files(const char *a, const char *b)
+{
+    unsigned char *da = NULL, *db = NULL;
+    size_t sa = 0, sb = 0;
+    int same = read_file(a, &da, &sa) == 0 && read_file(b, &db, &sb) == 0 && sa == sb &&
+               memcmp(da, db, sa) == 0;
+    free(da);
+    free(db);
+    return same;
+}
+
+/* Direct and buffered reads, overlapped with the encoding or not, give the same file. The
+ * samples of a raw file whose planes suit O_DIRECT (256 x 256 uint16: 128 KiB planes, 5 chunks
+ * of 8-cell bricks) are bricked: as they are, the next chunk read while one is encoded; under a
+ * memory limit that leaves no room for the second chunk; and behind 100 bytes of a MetaImage
+ * HeaderSize, an offset no direct read meets, so that every read goes through the page cache. */
+static void test_direct_reads(const char *dir)
+{
+    char sub[4200], raw[4096], skewed[4400], mhd[4400], a[4400], b[4400], c[4400];
+    snprintf(sub, sizeof sub, "%s/direct", dir);
+    mkdir(sub, 0777);
+    uint32_t dims[3] = {256, 256, 41};
+    volume v = make_volume(sub, dims, IP_UINT16, 0, raw, sizeof raw);
+    snprintf(skewed, sizeof skewed, "%s/skewed.dat", sub);
+    snprintf(mhd, sizeof mhd, "%s/skewed.mhd", sub);
+    unsigned char *bytes;
+    size_t size;
+    REQUIRE(read_file(raw, &bytes, &size) == 0);
+    unsigned char header[100];
+    memset(header, 'h', sizeof header);
+    FILE *f = fopen(skewed, "wb");
+    REQUIRE(f && fwrite(header, 1, sizeof header, f) == sizeof header);
+    REQUIRE(fwrite(bytes, 1, size, f) == size && fclose(f) == 0);
+    free(bytes);
+    f = fopen(mhd, "w");
+    REQUIRE(f);
+    fprintf(f, "ObjectType = Image\nNDims = 3\nDimSize = 256 256 41\nElementType = MET_USHORT\n"
+               "HeaderSize = 100\nElementDataFile = skewed.dat\n");
+    REQUIRE(fclose(f) == 0);
+    snprintf(a, sizeof a, "%s/overlap.ibv", sub);
+    snprintf(b, sizeof b, "%s/serial.ibv", sub);
+    snprintf(c, sizeof c, "%s/buffered.ibv", sub);
+
+    ip_input_desc desc;
+    ip_bricker_options o;
+    ip_error err;
+    uint64_t least = 0, most = 0;
+    REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
+    ip_bricker_options_default(&o);
+    o.brick_edge = 8;
+    o.subblock_edge = 4;
+    o.threads = 2;
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &most, &err) == IP_OK);
+    o.memory_limit = 1; /* no plan fits: the answer is the smallest plan */
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &least, &err) == IP_OK);
+    /* the second chunk: 8 planes of 128 KiB, in whole 2 MiB pages */
+    CHECK_MSG(most > least, "plans of %llu and %llu bytes", (unsigned long long)most,
+              (unsigned long long)least);
+
+    ip_bricker_report ra, rb, rc;
+    REQUIRE(brick_limited(raw, a, 0, &ra) == 0);
+    REQUIRE(brick_limited(raw, b, least, &rb) == 0);
+    REQUIRE(brick_limited(mhd, c, 0, &rc) == 0);
+    CHECK(ra.read_overlap && !rb.read_overlap && rc.read_overlap);
+    CHECK(ra.memory_planned == most && rb.memory_planned == least);
+    int direct = direct_reads_work(raw);
+    printf("test_bricker: O_DIRECT reads %s here: %llu and %llu of %llu bytes read directly\n",
+           direct ? "work" : "do not work", (unsigned long long)ra.bytes_direct,
+           (unsigned long long)rb.bytes_direct, (unsigned long long)ra.input_bytes);
+    if (direct)
+        CHECK(ra.bytes_direct == ra.input_bytes && rb.bytes_direct == rb.input_bytes);
+    CHECK(rc.bytes_direct == 0);
+    check_file(a, &v);
+    CHECK_MSG(same_files(a, b), "%s and %s differ", a, b);
+    CHECK_MSG(same_files(a, c), "%s and %s differ", a, c);
+    free(v.values);
 }
 
 static void test_shared_data(const char *dir)
@@ -406,6 +533,7 @@ int main(void)
     test_deterministic(dir);
     test_cancel_and_limits(dir);
     test_memory_plan();
+    test_direct_reads(dir);
     test_shared_data(dir);
     return test_summary("test_bricker");
 }

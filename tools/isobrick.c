@@ -217,9 +217,24 @@ static int default_output(const char *input, char *out, size_t size)
     return snprintf(out, size, "bricks/%.*s.ibv", len, base) < (int)size ? 0 : -1;
 }
 
+/* How the input was read: "direct" (O_DIRECT, every byte), "buffered" (the page cache) or
+ * "N% direct", then whether the reading overlapped the encoding. */
+static const char *read_mode(const ip_bricker_report *r, char *text, size_t size)
+{
+    const char *overlap = r->read_overlap ? "overlapped" : "not overlapped";
+    if (r->bytes_direct == 0)
+        snprintf(text, size, "buffered, %s", overlap);
+    else if (r->bytes_direct >= r->input_bytes)
+        snprintf(text, size, "direct, %s", overlap);
+    else
+        snprintf(text, size, "%.0f%% direct, %s",
+                 100.0 * (double)r->bytes_direct / (double)r->input_bytes, overlap);
+    return text;
+}
+
 static void print_summary(const ip_bricker_report *r, const ip_input_desc *desc, const char *out)
 {
-    char in_b[32], file_b[32], rss_b[32];
+    char in_b[32], file_b[32], rss_b[32], mode[64];
     printf("wrote %s\n", out);
     printf("  input       %s (%llu bytes)\n",
            tool_format_bytes(in_b, sizeof in_b, (double)r->input_bytes),
@@ -235,8 +250,8 @@ static void print_summary(const ip_bricker_report *r, const ip_input_desc *desc,
            (unsigned long long)r->bricks_compressed, (unsigned long long)r->bricks_raw);
     printf("  time        %.2f s, %.1f MB/s on %u threads\n", r->seconds,
            r->seconds > 0 ? (double)r->input_bytes / r->seconds / 1e6 : 0.0, r->threads);
-    printf("  phases      read %.2f s, encode %.2f s, write %.2f s\n", r->seconds_read,
-           r->seconds_encode, r->seconds_write);
+    printf("  phases      read %.2f s (%s), encode %.2f s, write %.2f s\n", r->seconds_read,
+           read_mode(r, mode, sizeof mode), r->seconds_encode, r->seconds_write);
     printf("  peak RSS    %s (working memory planned: %s)\n",
            tool_format_bytes(rss_b, sizeof rss_b, (double)r->peak_rss),
            tool_format_bytes(in_b, sizeof in_b, (double)r->memory_planned));
@@ -391,8 +406,10 @@ int main(int argc, char **argv)
     }
     tool_progress_end(&progress.bar);
     if (o.verbose) {
-        fprintf(stderr, "isobrick: phases: read %.2f s, encode %.2f s, write %.2f s\n",
-                report.seconds_read, report.seconds_encode, report.seconds_write);
+        char mode[64];
+        fprintf(stderr, "isobrick: phases: read %.2f s (%s), encode %.2f s, write %.2f s\n",
+                report.seconds_read, read_mode(&report, mode, sizeof mode), report.seconds_encode,
+                report.seconds_write);
         if (print_levels(out) != 0)
             return 1;
     }

@@ -3,7 +3,9 @@
  * The input is read once, plane by plane. Each pyramid level keeps one slab of B+1 planes;
  * when a slab is full its layer of bricks is summarised and compressed on all threads (the
  * calling one and helpers started once per run, joined before ip_bricker_run() returns) and
- * appended to an unnamed spill file. At the end the payloads are copied into the output in
+ * appended to an unnamed spill file. Where the memory limit has room for B more level-0
+ * planes, a thread reads the next chunk of planes meanwhile; raw data whose planes suit the
+ * file system's direct I/O are read with O_DIRECT, past the page cache. At the end the payloads are copied into the output in
  * Morton order, followed by the summary section and the header. The output appears under its
  * name only when complete (see docs/format.md and src/common/atomic_file.h).
  */
@@ -51,12 +53,21 @@ typedef struct ip_bricker_report {
      * summarising, filtering, compressing, checksumming and spilling the bricks; putting the
      * payloads in order and writing the summary. */
     double seconds_read, seconds_encode, seconds_write;
+    /* Input bytes read with O_DIRECT, past the page cache: raw data whose offset and plane size
+     * suit the file system's direct I/O; 0 when every read was buffered. */
+    uint64_t bytes_direct;
+    /* Nonzero when a thread read each next chunk of planes while the last one was encoded (the
+     * plan had room for a second chunk of level-0 planes); seconds_read then counts only the
+     * reading the encoding did not hide. */
+    int read_overlap;
 } ip_bricker_report;
 
 /*! ip_bricker_options_default() : fills `options` with the defaults above. */
 IP_API void ip_bricker_options_default(ip_bricker_options *options);
 
-/*! ip_bricker_memory_needed() : working memory (bytes) a run with `options` needs for `input`.
+/*! ip_bricker_memory_needed() : working memory (bytes) a run with `options` needs for `input`:
+ *  the plan with a second chunk of level-0 planes (read while the one before is encoded) when
+ *  options->memory_limit is 0 or has room for it, else the smallest plan.
  *  @return IP_OK, or an error for options the layout rejects. */
 IP_API ip_status ip_bricker_memory_needed(const ip_input_desc *input,
                                           const ip_bricker_options *options, uint64_t *bytes,

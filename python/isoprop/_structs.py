@@ -56,7 +56,7 @@ class BrickerReport(ctypes.Structure):
                 ("bricks_raw", c_uint64), ("levels", c_uint32), ("threads", c_uint),
                 ("seconds", c_double), ("memory_planned", c_uint64), ("peak_rss", c_uint64),
                 ("seconds_read", c_double), ("seconds_encode", c_double),
-                ("seconds_write", c_double)]
+                ("seconds_write", c_double), ("bytes_direct", c_uint64), ("read_overlap", c_int)]
 
 
 class LevelLayout(ctypes.Structure):

@@ -2,6 +2,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,11 +23,14 @@
 #include "summary.h"
 
 /* One pyramid level's slab: the B+1 planes of the brick layer being filled, kept in a ring
- * of B+1 slots (level plane p lives in slot p % (B+1)), so that the + face of a layer stays
- * where it is when it becomes the - face of the next. */
+ * of B+1 slots (level plane p lives in slot p % slots), so that the + face of a layer stays
+ * where it is when it becomes the - face of the next. When reading overlaps encoding, level 0
+ * has 2B+1 slots: the B planes of the next chunk land in slots the layer being encoded does
+ * not use. */
 typedef struct level_slab {
     unsigned char *planes;
     size_t plane_bytes;
+    uint32_t slots;    /* planes in the ring */
     uint32_t arrived;  /* level planes placed so far: planes [0, arrived) */
     uint32_t layer;    /* next brick layer (bz) to compress */
     uint32_t *x_index; /* level-0 x of each level x (levels >= 1) */
@@ -50,11 +54,12 @@ typedef struct layer_ref {
     uint64_t count;
 } layer_ref;
 
-/* One run of the pool: the planes of a chunk to read, or the bricks of its layers to encode. */
+/* One run of the pool: the planes of a chunk to read or to feed to the coarser levels, or the
+ * bricks of its layers to encode. */
 typedef struct chunk_job {
     bricker *b;
     const ip_input_reader *reader;
-    uint32_t z0; /* reading: first level-0 plane */
+    uint32_t z0; /* reading and feeding: first level-0 plane */
     layer_ref layers[IP_MAX_LEVELS];
     uint32_t layer_count;
     uint64_t total;            /* planes or bricks */
@@ -69,6 +74,8 @@ struct bricker {
     size_t sample_size;
     unsigned threads;
     ip__pool *pool; /* reads and encodes every chunk; started at init */
+    int overlap;    /* a thread reads the next chunk while the pool encodes (read_ahead) */
+    atomic_uint_fast64_t direct_bytes; /* input bytes read with O_DIRECT */
     level_slab slabs[IP_MAX_LEVELS];
     brick_scratch *scratch;  /* one per job of a run (per thread) */
     ip_brick_entry *entries; /* offsets point into the spill file until the end */
@@ -93,10 +100,16 @@ static size_t brick_samples_max(const ip_layout *l)
     return e * e * e;
 }
 
-static uint64_t slab_bytes(const ip_layout *l, uint32_t k)
+/* Planes in level k's ring: B+1, and B more at level 0 when reading overlaps encoding. */
+static uint32_t slab_slots(const ip_layout *l, uint32_t k, int overlap)
+{
+    return l->brick_edge + 1 + (k == 0 && overlap ? l->brick_edge : 0);
+}
+
+static uint64_t slab_bytes(const ip_layout *l, uint32_t k, int overlap)
 {
     const ip_level_layout *lv = &l->levels[k];
-    return (uint64_t)(l->brick_edge + 1) * lv->dims[0] * lv->dims[1] * ip_type_size(l->type);
+    return (uint64_t)slab_slots(l, k, overlap) * lv->dims[0] * lv->dims[1] * ip_type_size(l->type);
 }
 
 /* Slabs are allocated in whole huge pages (alloc_slab()). */
@@ -124,13 +137,13 @@ static unsigned thread_count(const ip_bricker_options *o)
  * their index tables, a layer of sub-block ranges per level, the per-thread scratch, the
  * directory and brick ranges (the sub-block ranges wait in the spill file), the octree nodes,
  * the Morton order of the largest level and the buffer the summary is streamed through. */
-static uint64_t memory_for(const ip_layout *l, unsigned threads)
+static uint64_t memory_for(const ip_layout *l, unsigned threads, int overlap)
 {
     uint64_t total = 0, widest_level = 0;
     size_t bs = brick_samples_max(l);
     for (uint32_t k = 0; k < l->level_count; k++) {
         const ip_level_layout *lv = &l->levels[k];
-        total += slab_rounded(slab_bytes(l, k)) + layer_ranges_bytes(l, k);
+        total += slab_rounded(slab_bytes(l, k, overlap)) + layer_ranges_bytes(l, k);
         total += (uint64_t)(lv->dims[0] + lv->dims[1]) * sizeof(uint32_t);
         if (lv->brick_count > widest_level)
             widest_level = lv->brick_count;
@@ -141,6 +154,13 @@ static uint64_t memory_for(const ip_layout *l, unsigned threads)
     total += 2 * sizeof(float) * (l->node_count ? l->node_count : 1);
     total += widest_level * sizeof(uint64_t) + SUMMARY_CHUNK;
     return total;
+}
+
+/* Whether reading overlaps encoding: when the input has more than one chunk and the plan with
+ * the second level-0 chunk fits `limit` (0: no limit). */
+static int plan_overlap(const ip_layout *l, unsigned threads, uint64_t limit)
+{
+    return l->levels[0].bricks[2] > 1 && (limit == 0 || memory_for(l, threads, 1) <= limit);
 }
 
 void ip_bricker_options_default(ip_bricker_options *options)
@@ -157,8 +177,10 @@ ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_bricker_
     ip_layout l;
     ip_status st = ip__layout_init(&l, input->dims, input->type, input->spacing,
                                    options->brick_edge, options->subblock_edge, err);
-    if (st == IP_OK)
-        *bytes = memory_for(&l, thread_count(options));
+    if (st == IP_OK) {
+        unsigned threads = thread_count(options);
+        *bytes = memory_for(&l, threads, plan_overlap(&l, threads, options->memory_limit));
+    }
     return st;
 }
 
@@ -172,9 +194,9 @@ static void worker_failed(chunk_job *job, brick_scratch *s, ip_status st)
 
 /* ---- one brick ---- */
 
-static const unsigned char *slab_plane(const level_slab *slab, uint32_t edge, uint32_t plane)
+static const unsigned char *slab_plane(const level_slab *slab, uint32_t plane)
 {
-    return slab->planes + (size_t)(plane % (edge + 1)) * slab->plane_bytes;
+    return slab->planes + (size_t)(plane % slab->slots) * slab->plane_bytes;
 }
 
 /* Where the brick's slices lie in the slab: slice z of the brick starts at planes[z]. */
@@ -185,8 +207,8 @@ static void brick_planes(const level_slab *slab, const ip_layout *l, uint32_t le
     size_t ss = ip_type_size(l->type);
     size_t level_row = (size_t)l->levels[level].dims[0] * ss;
     for (uint32_t z = 0; z < extent[2]; z++)
-        planes[z] = slab_plane(slab, l->brick_edge, origin[2] + z) + (size_t)origin[1] * level_row +
-                    origin[0] * ss;
+        planes[z] =
+            slab_plane(slab, origin[2] + z) + (size_t)origin[1] * level_row + origin[0] * ss;
 }
 
 static void gather_brick(const unsigned char *const *planes, size_t level_row,
@@ -363,7 +385,7 @@ static void subsample_plane(const bricker *b, uint32_t k, uint32_t plane, const 
 {
     const level_slab *slab = &b->slabs[k];
     const ip_level_layout *lv = &b->layout.levels[k];
-    unsigned char *dst = (unsigned char *)slab_plane(slab, b->layout.brick_edge, plane);
+    unsigned char *dst = (unsigned char *)slab_plane(slab, plane);
     size_t row0 = b->layout.dims[0];
     if (b->sample_size == 1)
         subsample_8(slab, lv, src, row0, (uint8_t *)dst);
@@ -376,7 +398,7 @@ static void subsample_plane(const bricker *b, uint32_t k, uint32_t plane, const 
 /* Level-0 plane z is in its slot: places it in every coarser level that samples it. */
 static void feed_levels(const bricker *b, uint32_t z)
 {
-    const unsigned char *src = slab_plane(&b->slabs[0], b->layout.brick_edge, z);
+    const unsigned char *src = slab_plane(&b->slabs[0], z);
     for (uint32_t k = 1; k < b->layout.level_count; k++) {
         uint32_t plane;
         if (level_samples_plane(&b->layout, k, z, &plane))
@@ -397,8 +419,10 @@ static void read_worker(void *user, unsigned index)
         if (i >= job->total || atomic_load(&job->failed))
             break;
         uint32_t z = job->z0 + (uint32_t)i;
-        unsigned char *dst = (unsigned char *)slab_plane(&b->slabs[0], b->layout.brick_edge, z);
-        ip_status st = ip__input_read_planes_at(job->reader, z, 1, dst, &scratch->error);
+        unsigned char *dst = (unsigned char *)slab_plane(&b->slabs[0], z);
+        uint64_t direct = 0;
+        ip_status st = ip__input_read_planes_at(job->reader, z, 1, dst, &direct, &scratch->error);
+        atomic_fetch_add(&b->direct_bytes, direct);
         if (st != IP_OK) {
             worker_failed(job, scratch, st);
             break;
@@ -407,8 +431,16 @@ static void read_worker(void *user, unsigned index)
     }
 }
 
+/* Level-0 planes up to z1 are in the slabs, and every coarser plane they give. */
+static void planes_arrived(bricker *b, uint32_t z1)
+{
+    for (uint32_t k = 0; k < b->layout.level_count; k++)
+        b->slabs[k].arrived =
+            z1 == b->layout.dims[2] - 1 ? b->layout.levels[k].dims[2] : (z1 >> k) + 1;
+}
+
 /* Reads level-0 planes [z0, z1] into the slabs, on every thread when the input can be read
- * at any plane, else in order on this one (gzip). */
+ * at any plane, else in order on this one (gzip), and feeds the pyramid. */
 static ip_status read_chunk(bricker *b, ip_input_reader *reader, uint32_t z0, uint32_t z1,
                             ip_error *err)
 {
@@ -423,17 +455,111 @@ static ip_status read_chunk(bricker *b, ip_input_reader *reader, uint32_t z0, ui
         st = run_jobs(b, &job, read_worker, err);
     } else {
         for (uint32_t z = z0; st == IP_OK && z <= z1; z++) {
-            unsigned char *dst = (unsigned char *)slab_plane(&b->slabs[0], b->layout.brick_edge, z);
+            unsigned char *dst = (unsigned char *)slab_plane(&b->slabs[0], z);
             st = ip_input_read_planes(reader, dst, 1, err);
             if (st == IP_OK)
                 feed_levels(b, z);
         }
     }
-    for (uint32_t k = 0; st == IP_OK && k < b->layout.level_count; k++) {
-        b->slabs[k].arrived =
-            z1 == b->layout.dims[2] - 1 ? b->layout.levels[k].dims[2] : (z1 >> k) + 1;
+    if (st == IP_OK)
+        planes_arrived(b, z1);
+    return st;
+}
+
+/* One job of a feeding run (on the pool): places level-0 planes already read into the
+ * coarser levels. */
+static void feed_worker(void *user, unsigned index)
+{
+    chunk_job *job = user;
+    (void)index;
+    for (;;) {
+        uint64_t i = atomic_fetch_add(&job->next, 1);
+        if (i >= job->total)
+            break;
+        feed_levels(job->b, job->z0 + (uint32_t)i);
+    }
+}
+
+/* Feeds level-0 planes [z0, z1], read by the reader thread, to the pyramid on every thread. */
+static ip_status feed_chunk(bricker *b, uint32_t z0, uint32_t z1, ip_error *err)
+{
+    chunk_job job;
+    memset(&job, 0, sizeof job);
+    job.b = b;
+    job.z0 = z0;
+    job.total = z1 - z0 + 1;
+    ip_status st = b->layout.level_count > 1 ? run_jobs(b, &job, feed_worker, err) : IP_OK;
+    if (st == IP_OK)
+        planes_arrived(b, z1);
+    return st;
+}
+
+/* ---- reading ahead on a thread of its own ---- */
+
+/* The reader thread's work: level-0 planes [z0, z1] into their slots and nothing else, while
+ * the pool encodes the layers of the chunk before. The coarser levels are fed after the thread
+ * is joined, when no brick of theirs is being encoded. */
+typedef struct read_ahead {
+    bricker *b;
+    ip_input_reader *reader;
+    uint32_t z0, z1;
+    ip_status status;
+    ip_error error;
+    pthread_t thread;
+    int started;
+} read_ahead;
+
+/* Reads level-0 planes [z0, z1] into their slots on this thread: one read per run of slots
+ * that does not wrap around the ring. */
+static ip_status read_level0(bricker *b, ip_input_reader *reader, uint32_t z0, uint32_t z1,
+                             ip_error *err)
+{
+    const level_slab *slab = &b->slabs[0];
+    ip_status st = IP_OK;
+    for (uint32_t z = z0; st == IP_OK && z <= z1;) {
+        uint32_t slot = z % slab->slots, run = z1 - z + 1;
+        if (run > slab->slots - slot)
+            run = slab->slots - slot;
+        unsigned char *dst = slab->planes + (size_t)slot * slab->plane_bytes;
+        if (ip__input_positioned(reader)) {
+            uint64_t direct = 0;
+            st = ip__input_read_planes_at(reader, z, run, dst, &direct, err);
+            atomic_fetch_add(&b->direct_bytes, direct);
+        } else {
+            st = ip_input_read_planes(reader, dst, run, err);
+        }
+        z += run;
     }
     return st;
+}
+
+static void *read_ahead_main(void *arg)
+{
+    read_ahead *ra = arg;
+    ra->status = read_level0(ra->b, ra->reader, ra->z0, ra->z1, &ra->error);
+    return NULL;
+}
+
+/* Starts reading planes [z0, z1]; where no thread can be started, reads them now. */
+static void read_ahead_start(read_ahead *ra, uint32_t z0, uint32_t z1)
+{
+    ra->z0 = z0;
+    ra->z1 = z1;
+    ra->status = IP_OK;
+    ra->started = ip__thread_start(&ra->thread, read_ahead_main, ra) == 0;
+    if (!ra->started)
+        read_ahead_main(ra);
+}
+
+/* Waits for the reads read_ahead_start() began; their error goes to `err` (may be NULL). */
+static ip_status read_ahead_finish(read_ahead *ra, ip_error *err)
+{
+    if (ra->started)
+        pthread_join(ra->thread, NULL);
+    ra->started = 0;
+    if (ra->status != IP_OK && err)
+        *err = ra->error;
+    return ra->status;
 }
 
 /* ---- setup and teardown ---- */
@@ -457,7 +583,8 @@ static ip_status alloc_level(bricker *b, uint32_t k, ip_error *err)
     level_slab *slab = &b->slabs[k];
     const ip_level_layout *lv = &b->layout.levels[k];
     slab->plane_bytes = (size_t)lv->dims[0] * lv->dims[1] * b->sample_size;
-    slab->planes = alloc_slab(slab_bytes(&b->layout, k));
+    slab->slots = slab_slots(&b->layout, k, b->overlap);
+    slab->planes = alloc_slab(slab_bytes(&b->layout, k, b->overlap));
     slab->layer_ranges = malloc(layer_ranges_bytes(&b->layout, k));
     if (k > 0) {
         slab->x_index = malloc(lv->dims[0] * sizeof *slab->x_index);
@@ -534,7 +661,9 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
         b->layout.orientation = in->orientation;
     b->sample_size = ip_type_size(in->type);
     b->threads = thread_count(o);
-    uint64_t need = memory_for(&b->layout, b->threads);
+    b->overlap = plan_overlap(&b->layout, b->threads, o->memory_limit);
+    atomic_init(&b->direct_bytes, 0);
+    uint64_t need = memory_for(&b->layout, b->threads, b->overlap);
     b->report.memory_planned = need;
     if (o->memory_limit && need > o->memory_limit)
         return ip__fail(err, IP_ERR_LIMIT,
@@ -584,31 +713,63 @@ static void bricker_free(bricker *b)
 /* ---- streaming pass ---- */
 
 /* The input is read in chunks that each complete one layer of level-0 bricks: planes up to
- * B * (layer + 1). While a chunk is encoded the kernel reads the next one ahead into its page
- * cache (no memory of the process), so that a cold read overlaps with the encoding. */
+ * B * (layer + 1). While the pool encodes a chunk, the next one is read: by a thread of its own
+ * into the level-0 slots the chunk does not use when the plan has room for them (overlap),
+ * else by the kernel into its page cache (a read-ahead hint, no memory of the process; none
+ * when reads are direct). seconds_read counts what the encoding did not hide: the first chunk,
+ * the wait for the reader thread, and feeding the pyramid. */
 static ip_status stream_input(bricker *b, const ip_input_desc *in, ip_error *err)
 {
     ip_input_reader *reader = NULL;
     ip_status st = ip_input_open(in, &reader, err);
+    if (st == IP_OK && ip__input_positioned(reader))
+        (void)ip__input_direct_open(reader);
     uint64_t plane_bytes = b->slabs[0].plane_bytes;
     uint64_t total = plane_bytes * in->dims[2];
-    uint32_t edge = b->layout.brick_edge;
-    for (uint32_t z0 = 0; st == IP_OK && z0 < in->dims[2];) {
-        uint32_t z1 = layer_last_plane(&b->layout, 0, b->slabs[0].layer);
-        double t0 = ip_now_seconds();
-        st = read_chunk(b, reader, z0, z1, err);
+    read_ahead ahead;
+    memset(&ahead, 0, sizeof ahead);
+    ahead.b = b;
+    ahead.reader = reader;
+    uint32_t z1 = layer_last_plane(&b->layout, 0, 0);
+    double t0 = ip_now_seconds();
+    if (st == IP_OK)
+        st = read_chunk(b, reader, 0, z1, err);
+    b->report.seconds_read += ip_now_seconds() - t0;
+    while (st == IP_OK && z1 < in->dims[2] - 1) {
+        /* planes up to z1 are in the slabs: encode them while the next chunk is read */
+        uint32_t n0 = z1 + 1, n1 = layer_last_plane(&b->layout, 0, b->slabs[0].layer + 1);
+        if (b->overlap)
+            read_ahead_start(&ahead, n0, n1);
+        else
+            ip__input_prefetch(reader, n0, n1 - n0 + 1);
         double t1 = ip_now_seconds();
-        if (st == IP_OK) {
-            ip__input_prefetch(reader, z1 + 1, edge);
-            st = encode_ready_layers(b, err);
+        st = encode_ready_layers(b, err);
+        double t2 = ip_now_seconds();
+        if (b->overlap) {
+            ip_status read_st = read_ahead_finish(&ahead, st == IP_OK ? err : NULL);
+            if (st == IP_OK)
+                st = read_st;
+            if (st == IP_OK)
+                st = feed_chunk(b, n0, n1, err);
+        } else if (st == IP_OK) {
+            st = read_chunk(b, reader, n0, n1, err);
         }
-        b->report.seconds_read += t1 - t0;
-        b->report.seconds_encode += ip_now_seconds() - t1;
-        z0 = z1 + 1;
+        b->report.seconds_encode += t2 - t1;
+        b->report.seconds_read += ip_now_seconds() - t2;
         if (st == IP_OK && b->options->progress &&
-            b->options->progress(b->options->progress_user, z0 * plane_bytes, total))
+            b->options->progress(b->options->progress_user, n0 * plane_bytes, total))
             st = ip__fail(err, IP_ERR_CANCELLED, "%s: cancelled; no output written", b->out_path);
+        z1 = n1;
     }
+    double t3 = ip_now_seconds();
+    if (st == IP_OK)
+        st = encode_ready_layers(b, err);
+    b->report.seconds_encode += ip_now_seconds() - t3;
+    if (st == IP_OK && b->options->progress &&
+        b->options->progress(b->options->progress_user, total, total))
+        st = ip__fail(err, IP_ERR_CANCELLED, "%s: cancelled; no output written", b->out_path);
+    b->report.bytes_direct = atomic_load(&b->direct_bytes);
+    b->report.read_overlap = b->overlap;
     ip_input_close(reader);
     return st;
 }

@@ -2,6 +2,8 @@
  * gzip (and zlib) streams, then conversion to the host's byte order and a float32 check. */
 #include <errno.h>
 #include <fcntl.h>
+#include <stdatomic.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,6 +36,12 @@ struct ip_input_reader {
     /* TIFF and DICOM: a plane source instead of the data file */
     const ip__plane_source *source;
     void *source_state;
+    /* raw data read past the page cache (ip__input_direct_open()): the data file opened a
+     * second time with O_DIRECT, or -1; the alignments it needs; set for good at the first
+     * read the file system refuses */
+    int direct_fd;
+    uint32_t direct_mem_align, direct_offset_align;
+    atomic_int direct_refused;
     /* gzip only */
     z_stream zs;
     int zs_live;
@@ -102,6 +110,8 @@ ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_err
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the reader", desc->path);
     r->desc = *desc;
     r->fd = -1;
+    r->direct_fd = -1;
+    atomic_init(&r->direct_refused, 0);
     set_label(r);
     if ((status = measure(r, err)) != IP_OK) {
         ip_input_close(r);
@@ -151,6 +161,8 @@ void ip_input_close(ip_input_reader *reader)
         inflateEnd(&reader->zs);
     if (reader->fd >= 0)
         close(reader->fd);
+    if (reader->direct_fd >= 0)
+        close(reader->direct_fd);
     free(reader->in_buf);
     free(reader);
 }
@@ -425,10 +437,89 @@ int ip__input_positioned(const ip_input_reader *reader)
     return reader->desc.encoding == IP_ENCODING_RAW;
 }
 
+/* Where the kernel gives it (statx STATX_DIOALIGN), the alignment O_DIRECT needs of buffer
+ * addresses and of file offsets and lengths; 4096 for both where it does not. Returns 0 when
+ * the file system says it has no direct I/O. */
+static int direct_alignment(int fd, uint32_t *mem_align, uint32_t *offset_align)
+{
+    *mem_align = *offset_align = 4096;
+#ifdef STATX_DIOALIGN
+    struct statx stx;
+    if (statx(fd, "", AT_EMPTY_PATH, STATX_DIOALIGN, &stx) == 0 &&
+        (stx.stx_mask & STATX_DIOALIGN)) {
+        if (stx.stx_dio_mem_align == 0 || stx.stx_dio_offset_align == 0)
+            return 0;
+        *mem_align = stx.stx_dio_mem_align;
+        *offset_align = stx.stx_dio_offset_align;
+    }
+#endif
+    return 1;
+}
+
+/* Whether every plane starts and ends on the direct alignment in the file. A header of a size
+ * that is not a multiple (a .nii's 352 bytes) leaves the planes to buffered reads: reading the
+ * aligned superset and moving the samples into place would cost a copy of every plane. */
+static int planes_aligned(const ip_input_reader *r)
+{
+    uint64_t a = r->direct_offset_align;
+    return r->desc.data_offset % a == 0 && r->plane_bytes % a == 0;
+}
+
+int ip__input_direct_open(ip_input_reader *reader)
+{
+    ip_input_reader *r = reader;
+    if (!ip__input_positioned(r) || r->fd < 0)
+        return 0;
+    if (r->direct_fd >= 0)
+        return !atomic_load(&r->direct_refused);
+    int fd = open(r->desc.data_path, O_RDONLY | O_DIRECT | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
+        return 0; /* EINVAL: the file system has no O_DIRECT; any other error: the same */
+    /* the same file as the buffered descriptor, not one put in its place since */
+    struct stat a, b;
+    if (fstat(fd, &a) != 0 || fstat(r->fd, &b) != 0 || a.st_dev != b.st_dev ||
+        a.st_ino != b.st_ino ||
+        !direct_alignment(fd, &r->direct_mem_align, &r->direct_offset_align) ||
+        !planes_aligned(r)) {
+        close(fd);
+        return 0;
+    }
+    r->direct_fd = fd;
+    return 1;
+}
+
+/* Reads [offset, offset + size) into dst with O_DIRECT when the reader has it and the
+ * buffer, offset and size meet its alignment. Returns the bytes read that way: all of them,
+ * or fewer when the file system refused (EINVAL: direct reads stop for good) or a short read
+ * left an unaligned rest; the caller reads the rest through the page cache. */
+static size_t read_direct(const ip_input_reader *r, unsigned char *dst, size_t size,
+                          uint64_t offset)
+{
+    ip_input_reader *mut = (ip_input_reader *)r; /* only the atomic flag changes */
+    if (r->direct_fd < 0 || atomic_load(&r->direct_refused))
+        return 0;
+    uint64_t oa = r->direct_offset_align, ma = r->direct_mem_align;
+    size_t done = 0;
+    while (done < size && (offset + done) % oa == 0 && (size - done) % oa == 0 &&
+           (uintptr_t)(dst + done) % ma == 0) {
+        ssize_t n = pread(r->direct_fd, dst + done, size - done, (off_t)(offset + done));
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0 && errno == EINVAL)
+            atomic_store(&mut->direct_refused, 1);
+        if (n <= 0)
+            break;
+        done += (size_t)n;
+    }
+    return done;
+}
+
 ip_status ip__input_read_planes_at(const ip_input_reader *reader, uint32_t z, uint32_t count,
-                                   void *dst, ip_error *err)
+                                   void *dst, uint64_t *direct_bytes, ip_error *err)
 {
     const ip_input_reader *r = reader;
+    if (direct_bytes)
+        *direct_bytes = 0;
     if (!ip__input_positioned(r) || z > r->desc.dims[2] || count > r->desc.dims[2] - z)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: cannot read %u planes at z = %u", r->label,
                         count, z);
@@ -437,7 +528,11 @@ ip_status ip__input_read_planes_at(const ip_input_reader *reader, uint32_t z, ui
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: %u planes are too many to read at once",
                         r->label, count);
     uint64_t offset = r->desc.data_offset + (uint64_t)z * r->plane_bytes;
-    ip_status status = ip__pread_all(r->fd, dst, (size_t)bytes, offset, r->desc.data_path, err);
+    size_t fast = read_direct(r, dst, (size_t)bytes, offset);
+    if (direct_bytes)
+        *direct_bytes = fast;
+    ip_status status = ip__pread_all(r->fd, (unsigned char *)dst + fast, (size_t)bytes - fast,
+                                     offset + fast, r->desc.data_path, err);
     if (status != IP_OK)
         return status;
     size_t samples = (size_t)(bytes / r->sample_size);
@@ -452,6 +547,8 @@ void ip__input_prefetch(const ip_input_reader *reader, uint32_t z, uint32_t coun
     const ip_input_reader *r = reader;
     if (!ip__input_positioned(r) || z >= r->desc.dims[2] || count == 0)
         return;
+    if (r->direct_fd >= 0 && !atomic_load(&r->direct_refused))
+        return; /* direct reads bypass the page cache: nothing to read ahead into */
     if (count > r->desc.dims[2] - z)
         count = r->desc.dims[2] - z;
     uint64_t offset = r->desc.data_offset + (uint64_t)z * r->plane_bytes;

@@ -70,6 +70,8 @@ static void bricker(void)
     FIELD(ip_bricker_report, seconds_read);
     FIELD(ip_bricker_report, seconds_encode);
     FIELD(ip_bricker_report, seconds_write);
+    FIELD(ip_bricker_report, bytes_direct);
+    FIELD(ip_bricker_report, read_overlap);
 }
 
 static void layout(void)
