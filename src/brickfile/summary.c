@@ -86,7 +86,7 @@ DEFINE_BAND_RANGES(int16_t, band_ranges_i16)
 
 /* The brick's range: the non-empty sub-blocks cover every sample of the brick, so their union
  * is its range. */
-static void union_range(const float *ranges, size_t count, float brick_range[2])
+void ip__union_range(const float *ranges, size_t count, float brick_range[2])
 {
     brick_range[0] = INFINITY;
     brick_range[1] = -INFINITY;
@@ -123,7 +123,100 @@ void ip__summarise_planes(const unsigned char *const *planes, size_t row_bytes, 
         break;
     case IP_FLOAT32: break;
     }
-    union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
+    ip__union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
+}
+
+/* ---- a brick row of a layer, band by band ---- */
+
+/* uint16 samples are reduced as int16 shifted by 32768 (same order), so that SSE2's signed
+ * 16-bit min and max apply; the other types as they are. */
+#define KEEP(v) (v)
+#define SHIFT_U16(v) ((int16_t)((int32_t)(v)-32768))
+#define UNSHIFT_U16(v) ((int32_t)(v) + 32768)
+
+/* lo[x] = min(lo[x], row[x]), hi[x] = max(hi[x], row[x]) over a full-width row; `first` sets
+ * them to the row. */
+#define DEFINE_ROW_REDUCE(T, A, IN, NAME)                                                   \
+    static void NAME(A *restrict lo, A *restrict hi, const T *restrict row, uint32_t width, \
+                     int first)                                                             \
+    {                                                                                       \
+        if (first) {                                                                        \
+            for (uint32_t x = 0; x < width; x++)                                            \
+                lo[x] = hi[x] = (A)IN(row[x]);                                              \
+            return;                                                                         \
+        }                                                                                   \
+        for (uint32_t x = 0; x < width; x++) {                                              \
+            A v = (A)IN(row[x]);                                                            \
+            lo[x] = v < lo[x] ? v : lo[x];                                                  \
+            hi[x] = v > hi[x] ? v : hi[x];                                                  \
+        }                                                                                   \
+    }
+
+DEFINE_ROW_REDUCE(uint8_t, uint8_t, KEEP, row_reduce_u8)
+DEFINE_ROW_REDUCE(uint16_t, int16_t, SHIFT_U16, row_reduce_u16)
+DEFINE_ROW_REDUCE(int16_t, int16_t, KEEP, row_reduce_i16)
+
+/* Band (cy, cz) of brick row `by`: the rows of its samples reduced into lo/hi, then each
+ * sub-block of each brick of the row gets its stretch of them. */
+#define DEFINE_BRICK_ROW(T, A, REDUCE, OUT, NAME)                                               \
+    static void NAME(const ip__layer_rows *v, uint32_t by, A *lo_row, A *hi_row, float *ranges) \
+    {                                                                                           \
+        uint32_t s = v->subblock_edge, per = v->brick_edge / s, w = v->dims[0];                 \
+        size_t sub = (size_t)per * per * per;                                                   \
+        for (uint32_t cz = 0; cz < per; cz++)                                                   \
+            for (uint32_t cy = 0; cy < per; cy++) {                                             \
+                uint32_t y0 = by * v->brick_edge + cy * s, z0 = cz * s;                         \
+                uint32_t y1 = y0 + s < v->dims[1] - 1 ? y0 + s : v->dims[1] - 1;                \
+                uint32_t z1 = z0 + s < v->depth - 1 ? z0 + s : v->depth - 1;                    \
+                int empty = y0 >= v->dims[1] - 1 || z0 >= v->depth - 1;                         \
+                for (uint32_t z = z0; !empty && z <= z1; z++)                                   \
+                    for (uint32_t y = y0; y <= y1; y++)                                         \
+                        REDUCE(lo_row, hi_row, (const T *)(v->planes[z] + y * v->row_bytes), w, \
+                               z == z0 && y == y0);                                             \
+                for (uint32_t bx = 0; bx < v->bricks[0]; bx++) {                                \
+                    float *r = ranges + 2 * ((by * (size_t)v->bricks[0] + bx) * sub +           \
+                                             ((size_t)cz * per + cy) * per);                    \
+                    for (uint32_t cx = 0; cx < per; cx++) {                                     \
+                        uint32_t x0 = bx * v->brick_edge + cx * s;                              \
+                        uint32_t x1 = x0 + s < w - 1 ? x0 + s : w - 1;                          \
+                        if (empty || x0 >= w - 1) {                                             \
+                            r[2 * cx] = INFINITY;                                               \
+                            r[2 * cx + 1] = -INFINITY;                                          \
+                            continue;                                                           \
+                        }                                                                       \
+                        A lo = lo_row[x0], hi = hi_row[x0];                                     \
+                        for (uint32_t x = x0 + 1; x <= x1; x++) {                               \
+                            lo = lo_row[x] < lo ? lo_row[x] : lo;                               \
+                            hi = hi_row[x] > hi ? hi_row[x] : hi;                               \
+                        }                                                                       \
+                        r[2 * cx] = (float)OUT(lo);                                             \
+                        r[2 * cx + 1] = (float)OUT(hi);                                         \
+                    }                                                                           \
+                }                                                                               \
+            }                                                                                   \
+    }
+
+DEFINE_BRICK_ROW(uint8_t, uint8_t, row_reduce_u8, KEEP, brick_row_u8)
+DEFINE_BRICK_ROW(uint16_t, int16_t, row_reduce_u16, UNSHIFT_U16, brick_row_u16)
+DEFINE_BRICK_ROW(int16_t, int16_t, row_reduce_i16, KEEP, brick_row_i16)
+
+size_t ip__brick_row_scratch_bytes(uint32_t width, ip_type type)
+{
+    return 2 * (size_t)width * ip_type_size(type);
+}
+
+void ip__summarise_brick_row(const ip__layer_rows *layer, uint32_t by, void *scratch,
+                             float *layer_ranges)
+{
+    IP_ASSERT(layer->type != IP_FLOAT32 && layer->depth >= 2 && layer->dims[0] >= 2);
+    size_t half = (size_t)layer->dims[0] * ip_type_size(layer->type);
+    unsigned char *lo = scratch, *hi = lo + half;
+    switch (layer->type) {
+    case IP_UINT8: brick_row_u8(layer, by, (uint8_t *)lo, (uint8_t *)hi, layer_ranges); break;
+    case IP_UINT16: brick_row_u16(layer, by, (int16_t *)lo, (int16_t *)hi, layer_ranges); break;
+    case IP_INT16: brick_row_i16(layer, by, (int16_t *)lo, (int16_t *)hi, layer_ranges); break;
+    case IP_FLOAT32: break;
+    }
 }
 
 /* The sub-block ranges, one box at a time: float32 keeps this order of comparisons, so that
@@ -164,7 +257,7 @@ void ip__summarise_brick(const void *samples, ip_type type, const uint32_t exten
     uint32_t per_axis = brick_edge / subblock_edge;
     if (type == IP_FLOAT32) {
         box_ranges(samples, type, extent, subblock_edge, per_axis, ranges);
-        union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
+        ip__union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
         return;
     }
     const unsigned char *planes[IP_MAX_BRICK_EDGE + 1];
