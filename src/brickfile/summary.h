@@ -43,10 +43,10 @@ size_t ip__brick_row_scratch_bytes(uint32_t width, ip_type type);
 
 /* The sub-block ranges of brick row `by` of a layer, the same as ip__summarise_planes() gives
  * each of its bricks: each (y, z) band of sub-blocks is reduced over full-width rows (read in
- * order, one pass over the memory) into a row of minima and a row of maxima in `scratch`
- * (ip__brick_row_scratch_bytes()), then each sub-block reduces its stretch of them. Brick
- * (bx, by) of the layer gets its ranges at layer_ranges + 2 * (by * bricks[0] + bx) *
- * (B/s)^3, in the order of ip__summarise_planes(). */
+ * order, three at a time, each slice of the band once) into a row of minima and a row of
+ * maxima in `scratch` (ip__brick_row_scratch_bytes()), then each sub-block reduces its stretch
+ * of them. Brick (bx, by) of the layer gets its ranges at layer_ranges + 2 * (by * bricks[0] +
+ * bx) * (B/s)^3, in the order of ip__summarise_planes(). */
 void ip__summarise_brick_row(const ip__layer_rows *layer, uint32_t by, void *scratch,
                              float *layer_ranges);
 
