@@ -25,11 +25,38 @@ static float sample_at(const volume *v, uint32_t x, uint32_t y, uint32_t z)
     return v->values[x + (size_t)v->dims[0] * (y + (size_t)v->dims[1] * z)];
 }
 
-/* Smooth structure, flat regions and noise, representable exactly in every type. */
-static float pattern(uint32_t x, uint32_t y, uint32_t z, ip_type type, int constant)
+/* What make_volume() fills a volume with: the pattern below, one value, or noise_at(). */
+enum {
+    FILL_PATTERN,
+    FILL_CONSTANT,
+    FILL_NOISE
+};
+
+/* Noise over the type's whole range (its extremes included in a volume of a few hundred
+ * thousand 16-bit samples), so that every sub-block has a range of its own and a reduction in
+ * the wrong order or sign shows in the summaries. */
+static float noise_at(uint32_t x, uint32_t y, uint32_t z, ip_type type)
 {
-    if (constant)
+    uint32_t h = (x * 73856093u) ^ (y * 19349663u) ^ (z * 83492791u);
+    h ^= h >> 13;
+    h *= 0x5bd1e995u;
+    h ^= h >> 15;
+    switch (type) {
+    case IP_UINT8: return (float)(h & 0xffu);
+    case IP_UINT16: return (float)(h & 0xffffu);
+    case IP_INT16: return (float)((int32_t)(h & 0xffffu) - 32768);
+    case IP_FLOAT32: return (float)((int32_t)(h & 0xfffffu) - 524288) * 0.25f;
+    }
+    return 0.0f;
+}
+
+/* Smooth structure, flat regions and noise, representable exactly in every type. */
+static float pattern(uint32_t x, uint32_t y, uint32_t z, ip_type type, int fill)
+{
+    if (fill == FILL_CONSTANT)
         return type == IP_INT16 ? -77.0f : 77.0f;
+    if (fill == FILL_NOISE)
+        return noise_at(x, y, z, type);
     double r = sqrt((double)(x * x + y * y + z * z));
     double v = 100.0 + 90.0 * sin(r * 0.31) * cos(z * 0.17);
     if (x > 20 && y > 20)
@@ -54,7 +81,7 @@ static void write_value(void *dst, size_t i, ip_type type, float v)
     }
 }
 
-static volume make_volume(const char *dir, const uint32_t dims[3], ip_type type, int constant,
+static volume make_volume(const char *dir, const uint32_t dims[3], ip_type type, int fill,
                           char *path, size_t path_size)
 {
     volume v = {{dims[0], dims[1], dims[2]}, type, NULL};
@@ -65,11 +92,12 @@ static volume make_volume(const char *dir, const uint32_t dims[3], ip_type type,
     for (uint32_t z = 0, i = 0; z < dims[2]; z++)
         for (uint32_t y = 0; y < dims[1]; y++)
             for (uint32_t x = 0; x < dims[0]; x++, i++) {
-                v.values[i] = pattern(x, y, z, type, constant);
+                v.values[i] = pattern(x, y, z, type, fill);
                 write_value(raw, i, type, v.values[i]);
             }
     char name[256];
-    REQUIRE(ip_raw_file_name(name, sizeof name, constant ? "flat" : "vol", dims, type) == IP_OK);
+    const char *stem = fill == FILL_CONSTANT ? "flat" : fill == FILL_NOISE ? "noise" : "vol";
+    REQUIRE(ip_raw_file_name(name, sizeof name, stem, dims, type) == IP_OK);
     snprintf(path, path_size, "%s/%s", dir, name);
     FILE *f = fopen(path, "wb");
     REQUIRE(f && fwrite(raw, ip_type_size(type), n, f) == n && fclose(f) == 0);
@@ -224,19 +252,27 @@ static void round_trip_hc(const char *dir, ip_type type)
     free(v.values);
 }
 
-static void round_trip(const char *dir, uint32_t x, uint32_t y, uint32_t z, ip_type type,
-                       int constant, uint32_t b, uint32_t s)
+static void round_trip_on(const char *dir, uint32_t x, uint32_t y, uint32_t z, ip_type type,
+                          int fill, uint32_t b, uint32_t s, unsigned threads)
 {
     char raw[4096], ibv[4200];
     uint32_t dims[3] = {x, y, z};
-    volume v = make_volume(dir, dims, type, constant, raw, sizeof raw);
-    snprintf(ibv, sizeof ibv, "%s.b%u.ibv", raw, b);
+    volume v = make_volume(dir, dims, type, fill, raw, sizeof raw);
+    snprintf(ibv, sizeof ibv, "%s.b%u.s%u.ibv", raw, b, s);
     ip_bricker_report r;
-    CHECK_MSG(brick_file(raw, ibv, b, s, 2, &r) == 0, "%s", raw);
+    CHECK_MSG(brick_file(raw, ibv, b, s, threads, &r) == 0, "%s", raw);
     check_file(ibv, &v);
-    if (constant)
+    if (fill == FILL_CONSTANT)
         CHECK(r.bricks_constant == r.bricks);
+    if (fill == FILL_NOISE)
+        CHECK(r.bricks_constant == 0);
     free(v.values);
+}
+
+static void round_trip(const char *dir, uint32_t x, uint32_t y, uint32_t z, ip_type type, int fill,
+                       uint32_t b, uint32_t s)
+{
+    round_trip_on(dir, x, y, z, type, fill, b, s, 2);
 }
 
 static int read_file(const char *path, unsigned char **data, size_t *size)
@@ -527,6 +563,11 @@ int main(void)
         round_trip(dir, 32, 16, 8, (ip_type)t, 0, 8, 2);     /* samples a multiple of B */
         round_trip(dir, 40, 30, 20, (ip_type)t, 1, 8, 4);    /* constant */
         round_trip(dir, 37, 2, 29, (ip_type)t, 0, 4, 4);     /* flat axis, many levels */
+        /* noise: every sub-block range checked against the samples, several layers and brick
+         * rows per level, layers summarised by 1 to 3 threads */
+        round_trip_on(dir, 131, 77, 70, (ip_type)t, FILL_NOISE, 32, 8, 3);
+        round_trip_on(dir, 131, 77, 70, (ip_type)t, FILL_NOISE, 16, 4, 1);
+        round_trip_on(dir, 45, 52, 39, (ip_type)t, FILL_NOISE, 8, 2, 2);
     }
     for (int t = 0; t < IP_TYPE_COUNT; t++)
         round_trip_hc(dir, (ip_type)t);

@@ -43,6 +43,7 @@ typedef struct bricker bricker;
 /* Per-thread scratch for gathering and encoding one brick, and the thread's first error. */
 typedef struct brick_scratch {
     unsigned char *samples, *out, *work;
+    unsigned char *rows; /* integer types: the min and max rows of ip__summarise_brick_row() */
     ip_status status;
     ip_error error;
 } brick_scratch;
@@ -128,13 +129,21 @@ static uint64_t layer_ranges_bytes(const ip_layout *l, uint32_t k)
            sizeof(float);
 }
 
+/* Bytes of a thread's min and max rows for the summaries of integer levels (level 0 is the
+ * widest); float32 has none. */
+static size_t summary_rows_bytes(const ip_layout *l)
+{
+    return l->type == IP_FLOAT32 ? 0 : ip__brick_row_scratch_bytes(l->dims[0], l->type);
+}
+
 static unsigned thread_count(const ip_bricker_options *o)
 {
     return ip_thread_count(o->threads);
 }
 
 /* Everything the run allocates, counted from the same sizes the allocations use: the slabs and
- * their index tables, a layer of sub-block ranges per level, the per-thread scratch, the
+ * their index tables, a layer of sub-block ranges per level, the per-thread scratch (with its
+ * min and max rows), the
  * directory and brick ranges (the sub-block ranges wait in the spill file), the octree nodes,
  * the Morton order of the largest level and the buffer the summary is streamed through. */
 static uint64_t memory_for(const ip_layout *l, unsigned threads, int overlap)
@@ -149,7 +158,7 @@ static uint64_t memory_for(const ip_layout *l, unsigned threads, int overlap)
             widest_level = lv->brick_count;
     }
     total += (uint64_t)threads * (bs * ip_type_size(l->type) + ip__codec_bound(bs, l->type) +
-                                  ip__codec_work_size(bs, l->type));
+                                  ip__codec_work_size(bs, l->type) + summary_rows_bytes(l));
     total += l->brick_count * (sizeof(ip_brick_entry) + 2 * sizeof(float));
     total += 2 * sizeof(float) * (l->node_count ? l->node_count : 1);
     total += widest_level * sizeof(uint64_t) + SUMMARY_CHUNK;
@@ -251,9 +260,9 @@ static ip_status process_brick(bricker *b, const layer_ref *ref, uint64_t i, bri
         ip__summarise_brick(s->samples, l->type, extent, l->brick_edge, l->subblock_edge, range,
                             ranges);
     } else {
-        /* an integer brick is constant when its range is a single value: no copy is made */
-        ip__summarise_planes(planes, level_row, l->type, extent, l->brick_edge, l->subblock_edge,
-                             range, ranges);
+        /* its sub-block ranges are in the layer's (summarise_layers()); an integer brick is
+         * constant when its range is a single value: no copy is made */
+        ip__union_range(ranges, b->subblocks, range);
         if (range[0] == range[1]) {
             ip__codec_encode_constant(e);
             return IP_OK;
@@ -283,6 +292,37 @@ static void encode_worker(void *user, unsigned index)
         ip_status st = process_brick(job->b, &job->layers[r], i - job->layers[r].first, scratch);
         if (st != IP_OK)
             worker_failed(job, scratch, st);
+    }
+}
+
+/* One job of a summary run (on the pool): takes brick rows of the layers from the shared
+ * counter and writes the sub-block ranges of their bricks into the layers' ranges. */
+static void summary_worker(void *user, unsigned index)
+{
+    chunk_job *job = user;
+    bricker *b = job->b;
+    const ip_layout *l = &b->layout;
+    for (;;) {
+        uint64_t i = atomic_fetch_add(&job->next, 1);
+        if (i >= job->total)
+            break;
+        uint32_t r = 0;
+        while (i >= job->layers[r].first + job->layers[r].count)
+            r++;
+        const layer_ref *ref = &job->layers[r];
+        const level_slab *slab = &b->slabs[ref->level];
+        const ip_level_layout *lv = &l->levels[ref->level];
+        uint32_t brick[3] = {0, 0, ref->bz}, origin[3], extent[3];
+        ip_brick_extent(l, ref->level, brick, origin, extent);
+        const unsigned char *planes[IP_MAX_BRICK_EDGE + 1];
+        for (uint32_t z = 0; z < extent[2]; z++)
+            planes[z] = slab_plane(slab, origin[2] + z);
+        ip__layer_rows rows = {planes,        (size_t)lv->dims[0] * b->sample_size,
+                               l->type,       {lv->dims[0], lv->dims[1]},
+                               extent[2],     {lv->bricks[0], lv->bricks[1]},
+                               l->brick_edge, l->subblock_edge};
+        ip__summarise_brick_row(&rows, (uint32_t)(i - ref->first), b->scratch[index].rows,
+                                slab->layer_ranges);
     }
 }
 
@@ -317,6 +357,26 @@ static uint32_t layer_last_plane(const ip_layout *l, uint32_t k, uint32_t bz)
     return last < top ? (uint32_t)last : top;
 }
 
+/* The sub-block ranges of the layers of `encode` (integer types), brick row by brick row on
+ * every thread, before their bricks are encoded: full-width rows are read in order, which the
+ * memory serves faster than the short rows of one brick at a time. */
+static ip_status summarise_layers(bricker *b, const chunk_job *encode, ip_error *err)
+{
+    if (b->layout.type == IP_FLOAT32)
+        return IP_OK;
+    chunk_job job;
+    memset(&job, 0, sizeof job);
+    job.b = b;
+    job.layer_count = encode->layer_count;
+    for (uint32_t r = 0; r < encode->layer_count; r++) {
+        job.layers[r] = encode->layers[r];
+        job.layers[r].first = job.total;
+        job.layers[r].count = b->layout.levels[encode->layers[r].level].bricks[1];
+        job.total += job.layers[r].count;
+    }
+    return run_jobs(b, &job, summary_worker, err);
+}
+
 /* Encodes every layer whose planes have all arrived, on every thread, then sends each layer's
  * sub-block ranges to the spill file. A chunk completes at most one layer per level: a level-k
  * layer ends at a level-0 plane that is a multiple of B, or at the last plane. */
@@ -338,7 +398,9 @@ static ip_status encode_ready_layers(bricker *b, ip_error *err)
         ref->count = (uint64_t)l->levels[k].bricks[0] * l->levels[k].bricks[1];
         job.total += ref->count;
     }
-    ip_status st = job.total ? run_jobs(b, &job, encode_worker, err) : IP_OK;
+    ip_status st = job.total ? summarise_layers(b, &job, err) : IP_OK;
+    if (st == IP_OK && job.total)
+        st = run_jobs(b, &job, encode_worker, err);
     for (uint32_t r = 0; st == IP_OK && r < job.layer_count; r++) {
         const layer_ref *ref = &job.layers[r];
         level_slab *slab = &b->slabs[ref->level];
@@ -628,7 +690,10 @@ static ip_status alloc_scratch(bricker *b, ip_error *err)
         b->scratch[t].samples = malloc(bs * b->sample_size);
         b->scratch[t].out = malloc(ip__codec_bound(bs, b->layout.type));
         b->scratch[t].work = malloc(ip__codec_work_size(bs, b->layout.type));
-        if (!b->scratch[t].samples || !b->scratch[t].out || !b->scratch[t].work)
+        size_t rows = summary_rows_bytes(&b->layout);
+        b->scratch[t].rows = rows ? malloc(rows) : NULL;
+        if (!b->scratch[t].samples || !b->scratch[t].out || !b->scratch[t].work ||
+            (rows && !b->scratch[t].rows))
             return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", b->out_path);
     }
     return IP_OK;
@@ -702,6 +767,7 @@ static void bricker_free(bricker *b)
         free(b->scratch[t].samples);
         free(b->scratch[t].out);
         free(b->scratch[t].work);
+        free(b->scratch[t].rows);
     }
     free(b->scratch);
     free(b->entries);

@@ -86,7 +86,7 @@ DEFINE_BAND_RANGES(int16_t, band_ranges_i16)
 
 /* The brick's range: the non-empty sub-blocks cover every sample of the brick, so their union
  * is its range. */
-static void union_range(const float *ranges, size_t count, float brick_range[2])
+void ip__union_range(const float *ranges, size_t count, float brick_range[2])
 {
     brick_range[0] = INFINITY;
     brick_range[1] = -INFINITY;
@@ -123,7 +123,152 @@ void ip__summarise_planes(const unsigned char *const *planes, size_t row_bytes, 
         break;
     case IP_FLOAT32: break;
     }
-    union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
+    ip__union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
+}
+
+/* ---- a brick row of a layer, band by band ---- */
+
+/* uint16 samples are reduced as int16 shifted by 32768 (same order), so that SSE2's signed
+ * 16-bit min and max apply; the other types as they are. */
+#define KEEP(v) (v)
+#define SHIFT_U16(v) ((int16_t)((int32_t)(v)-32768))
+#define UNSHIFT_U16(v) ((int32_t)(v) + 32768)
+
+/* Reduces full-width rows sample by sample into lo and hi: up to three rows per pass, so that
+ * the two accumulator rows are loaded and stored once per three rows read. `init` sets lo and
+ * hi from the rows instead of merging into them. */
+#define DEFINE_ROWS3(T, A, IN, NAME)                                                             \
+    static void NAME(A *restrict lo, A *restrict hi, const T *restrict r0, const T *restrict r1, \
+                     const T *restrict r2, uint32_t width, int init)                             \
+    {                                                                                            \
+        if (init) {                                                                              \
+            for (uint32_t x = 0; x < width; x++) {                                               \
+                A a = (A)IN(r0[x]), b = (A)IN(r1[x]), c = (A)IN(r2[x]);                          \
+                A mn = a < b ? a : b, mx = a > b ? a : b;                                        \
+                lo[x] = c < mn ? c : mn;                                                         \
+                hi[x] = c > mx ? c : mx;                                                         \
+            }                                                                                    \
+            return;                                                                              \
+        }                                                                                        \
+        for (uint32_t x = 0; x < width; x++) {                                                   \
+            A a = (A)IN(r0[x]), b = (A)IN(r1[x]), c = (A)IN(r2[x]);                              \
+            A mn = a < b ? a : b, mx = a > b ? a : b;                                            \
+            mn = c < mn ? c : mn;                                                                \
+            mx = c > mx ? c : mx;                                                                \
+            lo[x] = mn < lo[x] ? mn : lo[x];                                                     \
+            hi[x] = mx > hi[x] ? mx : hi[x];                                                     \
+        }                                                                                        \
+    }
+
+DEFINE_ROWS3(uint8_t, uint8_t, KEEP, rows3_u8)
+DEFINE_ROWS3(uint16_t, int16_t, SHIFT_U16, rows3_u16)
+DEFINE_ROWS3(int16_t, int16_t, KEEP, rows3_i16)
+
+/* lo = min(lo, lo2), hi = max(hi, hi2) sample by sample. */
+#define DEFINE_MERGE(A, NAME)                                                                      \
+    static void NAME(A *restrict lo, A *restrict hi, const A *restrict lo2, const A *restrict hi2, \
+                     uint32_t width)                                                               \
+    {                                                                                              \
+        for (uint32_t x = 0; x < width; x++) {                                                     \
+            lo[x] = lo2[x] < lo[x] ? lo2[x] : lo[x];                                               \
+            hi[x] = hi2[x] > hi[x] ? hi2[x] : hi[x];                                               \
+        }                                                                                          \
+    }
+
+DEFINE_MERGE(uint8_t, merge_u8)
+DEFINE_MERGE(int16_t, merge_i16)
+
+/* Rows [y0, y1] of a slice reduced into lo and hi, three at a time (a last group of one or two
+ * repeats a row). */
+#define DEFINE_SLICE_BAND(T, A, ROWS3, NAME)                                                  \
+    static void NAME(A *lo, A *hi, const unsigned char *slice, size_t row_bytes, uint32_t y0, \
+                     uint32_t y1, uint32_t width, int init)                                   \
+    {                                                                                         \
+        for (uint32_t y = y0; y <= y1; y += 3, init = 0) {                                    \
+            uint32_t y_b = y + 1 <= y1 ? y + 1 : y1, y_c = y + 2 <= y1 ? y + 2 : y1;          \
+            ROWS3(lo, hi, (const T *)(slice + y * row_bytes),                                 \
+                  (const T *)(slice + y_b * row_bytes), (const T *)(slice + y_c * row_bytes), \
+                  width, init);                                                               \
+        }                                                                                     \
+    }
+
+DEFINE_SLICE_BAND(uint8_t, uint8_t, rows3_u8, slice_band_u8)
+DEFINE_SLICE_BAND(uint16_t, int16_t, rows3_u16, slice_band_u16)
+DEFINE_SLICE_BAND(int16_t, int16_t, rows3_i16, slice_band_i16)
+
+/* Brick row `by` band by band, y bands outer: band (cy, cz) reduces rows [y0, y1] of slices
+ * [z0, z1] into lo/hi, then each sub-block of each brick of the row takes its stretch of them.
+ * Slice z1 is reduced on its own (into lo2/hi2) and merged, and starts band cz + 1 as it is:
+ * each slice of the band is read once. */
+#define DEFINE_BRICK_ROW(A, SLICE, MERGE, OUT, NAME)                                            \
+    static void NAME(const ip__layer_rows *v, uint32_t by, A *rows, float *ranges)              \
+    {                                                                                           \
+        uint32_t s = v->subblock_edge, per = v->brick_edge / s, w = v->dims[0];                 \
+        size_t sub = (size_t)per * per * per;                                                   \
+        A *lo = rows, *hi = rows + w, *lo2 = rows + 2 * (size_t)w, *hi2 = rows + 3 * (size_t)w; \
+        for (uint32_t cy = 0; cy < per; cy++) {                                                 \
+            uint32_t y0 = by * v->brick_edge + cy * s;                                          \
+            uint32_t y1 = y0 + s < v->dims[1] - 1 ? y0 + s : v->dims[1] - 1;                    \
+            int carried = 0; /* lo2/hi2 hold slice z0 of this band */                           \
+            for (uint32_t cz = 0; cz < per; cz++) {                                             \
+                uint32_t z0 = cz * s, z1 = z0 + s < v->depth - 1 ? z0 + s : v->depth - 1;       \
+                int empty = y0 >= v->dims[1] - 1 || z0 >= v->depth - 1;                         \
+                if (!empty) {                                                                   \
+                    if (carried) {                                                              \
+                        A *t = lo;                                                              \
+                        lo = lo2, lo2 = t, t = hi, hi = hi2, hi2 = t;                           \
+                    } else {                                                                    \
+                        SLICE(lo, hi, v->planes[z0], v->row_bytes, y0, y1, w, 1);               \
+                    }                                                                           \
+                    for (uint32_t z = z0 + 1; z < z1; z++)                                      \
+                        SLICE(lo, hi, v->planes[z], v->row_bytes, y0, y1, w, 0);                \
+                    SLICE(lo2, hi2, v->planes[z1], v->row_bytes, y0, y1, w, 1);                 \
+                    MERGE(lo, hi, lo2, hi2, w);                                                 \
+                    carried = 1;                                                                \
+                }                                                                               \
+                for (uint32_t bx = 0; bx < v->bricks[0]; bx++) {                                \
+                    float *r = ranges + 2 * ((by * (size_t)v->bricks[0] + bx) * sub +           \
+                                             ((size_t)cz * per + cy) * per);                    \
+                    for (uint32_t cx = 0; cx < per; cx++) {                                     \
+                        uint32_t x0 = bx * v->brick_edge + cx * s;                              \
+                        uint32_t x1 = x0 + s < w - 1 ? x0 + s : w - 1;                          \
+                        if (empty || x0 >= w - 1) {                                             \
+                            r[2 * cx] = INFINITY;                                               \
+                            r[2 * cx + 1] = -INFINITY;                                          \
+                            continue;                                                           \
+                        }                                                                       \
+                        A mn = lo[x0], mx = hi[x0];                                             \
+                        for (uint32_t x = x0 + 1; x <= x1; x++) {                               \
+                            mn = lo[x] < mn ? lo[x] : mn;                                       \
+                            mx = hi[x] > mx ? hi[x] : mx;                                       \
+                        }                                                                       \
+                        r[2 * cx] = (float)OUT(mn);                                             \
+                        r[2 * cx + 1] = (float)OUT(mx);                                         \
+                    }                                                                           \
+                }                                                                               \
+            }                                                                                   \
+        }                                                                                       \
+    }
+
+DEFINE_BRICK_ROW(uint8_t, slice_band_u8, merge_u8, KEEP, brick_row_u8)
+DEFINE_BRICK_ROW(int16_t, slice_band_u16, merge_i16, UNSHIFT_U16, brick_row_u16)
+DEFINE_BRICK_ROW(int16_t, slice_band_i16, merge_i16, KEEP, brick_row_i16)
+
+size_t ip__brick_row_scratch_bytes(uint32_t width, ip_type type)
+{
+    return 4 * (size_t)width * ip_type_size(type);
+}
+
+void ip__summarise_brick_row(const ip__layer_rows *layer, uint32_t by, void *scratch,
+                             float *layer_ranges)
+{
+    IP_ASSERT(layer->type != IP_FLOAT32 && layer->depth >= 2 && layer->dims[0] >= 2);
+    switch (layer->type) {
+    case IP_UINT8: brick_row_u8(layer, by, scratch, layer_ranges); break;
+    case IP_UINT16: brick_row_u16(layer, by, scratch, layer_ranges); break;
+    case IP_INT16: brick_row_i16(layer, by, scratch, layer_ranges); break;
+    case IP_FLOAT32: break;
+    }
 }
 
 /* The sub-block ranges, one box at a time: float32 keeps this order of comparisons, so that
@@ -164,7 +309,7 @@ void ip__summarise_brick(const void *samples, ip_type type, const uint32_t exten
     uint32_t per_axis = brick_edge / subblock_edge;
     if (type == IP_FLOAT32) {
         box_ranges(samples, type, extent, subblock_edge, per_axis, ranges);
-        union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
+        ip__union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
         return;
     }
     const unsigned char *planes[IP_MAX_BRICK_EDGE + 1];

@@ -26,6 +26,33 @@ void ip__summarise_planes(const unsigned char *const *planes, size_t row_bytes, 
                           const uint32_t extent[3], uint32_t brick_edge, uint32_t subblock_edge,
                           float brick_range[2], float *ranges);
 
+/* One layer of bricks of an integer level (not float32) where it lies: row y of the layer's
+ * slice z starts at planes[z] + y * row_bytes, for y < dims[1] and z < depth. */
+typedef struct ip__layer_rows {
+    const unsigned char *const *planes;
+    size_t row_bytes;
+    ip_type type;
+    uint32_t dims[2];   /* the level's width and height in samples */
+    uint32_t depth;     /* slices of the layer: the z extent of its bricks */
+    uint32_t bricks[2]; /* bricks of the layer along x and y */
+    uint32_t brick_edge, subblock_edge;
+} ip__layer_rows;
+
+/* Bytes of scratch ip__summarise_brick_row() needs for a level `width` samples wide. */
+size_t ip__brick_row_scratch_bytes(uint32_t width, ip_type type);
+
+/* The sub-block ranges of brick row `by` of a layer, the same as ip__summarise_planes() gives
+ * each of its bricks: each (y, z) band of sub-blocks is reduced over full-width rows (read in
+ * order, three at a time, each slice of the band once) into a row of minima and a row of
+ * maxima in `scratch` (ip__brick_row_scratch_bytes()), then each sub-block reduces its stretch
+ * of them. Brick (bx, by) of the layer gets its ranges at layer_ranges + 2 * (by * bricks[0] +
+ * bx) * (B/s)^3, in the order of ip__summarise_planes(). */
+void ip__summarise_brick_row(const ip__layer_rows *layer, uint32_t by, void *scratch,
+                             float *layer_ranges);
+
+/* The union of `count` ranges (2 floats each): a brick's range from its sub-blocks'. */
+void ip__union_range(const float *ranges, size_t count, float range[2]);
+
 /* Called by ip__octree_walk() once per node with the union of its children's ranges, as
  * read at that moment; a nonzero return stops the walk and is returned by it. */
 typedef int (*ip_octree_node_fn)(void *user, uint32_t level, uint32_t depth, const uint32_t node[3],
