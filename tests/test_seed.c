@@ -93,7 +93,7 @@ static void mark_active(ip_visited *v, ip_sampler *sampler, const ip_layout *l, 
             }
 }
 
-/* Beams of 8x8-pixel tiles: as the visited cells grow, the answers of one visited set that
+/* Beams of 8x8-pixel tiles, 3 pixels apart: as the visited cells grow, the answers of one visited set that
  * keeps the sub-blocks and cell groups the tests found settled (ip__visited_mark_part()) are
  * those of a set built afresh with the same cells and no such record; and the records pass
  * over something (the fresh set's tests read more cells). */
@@ -120,8 +120,8 @@ static void check_beams(ip_cache *cache, const char *axis, float iso)
         mark_active(&kept, &sampler, l, iso, shares[p]);
         ip__visited_clear(&fresh);
         mark_active(&fresh, &sampler, l, iso, shares[p]);
-        for (uint32_t ty = 0; ty < camera.height; ty += 8)
-            for (uint32_t tx = 0; tx < camera.width; tx += 8) {
+        for (uint32_t ty = 0; ty < camera.height; ty += 3) /* tiles that overlap */
+            for (uint32_t tx = 0; tx < camera.width; tx += 3) {
                 double corner[4][3];
                 double cx[4] = {tx, tx + 8.0, tx + 8.0, tx}, cy[4] = {ty, ty, ty + 8.0, ty + 8.0};
                 for (int i = 0; i < 4; i++)

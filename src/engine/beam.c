@@ -56,10 +56,11 @@ static inline int meets(const index_beam *w, const double lo[3], const double hi
 }
 
 /* The cells [lo, hi) of sub-block `sb` (index within its brick), by cell groups (cache.h): 1
- * when every active cell the beam may meet is visited. A sub-block, or a cell group, every
- * active cell of which is visited, met by the beam or not, is recorded as settled
- * (ip__visited_mark_part()), and later tests pass over it at once: cells once visited stay so.
- * Groups are recorded only where sub-blocks hold whole groups. */
+ * when every active cell the beam may meet is visited. A cell group the beam meets every
+ * active cell of which is visited is recorded as settled (ip__visited_mark_part()), and so is
+ * a sub-block all of whose groups are (or hold no active cell); later tests pass over them
+ * at once: cells once visited stay so. Groups are recorded only where sub-blocks hold whole
+ * groups; the groups the beam does not meet are not looked at. */
 static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[3], int side,
                          uint32_t sb)
 {
@@ -107,7 +108,12 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
                     if (!ip__range_active(range[0], range[1], s->iso))
                         continue;
                 }
-                int group_meets = -1, group_whole = 1; /* not yet known; so far */
+                double blo[3] = {g0[0], g0[1], g0[2]}, bhi[3] = {g1[0], g1[1], g1[2]};
+                if (!meets(w, blo, bhi)) {
+                    whole = 0; /* not looked at: the sub-block is not known to be whole */
+                    continue;
+                }
+                int group_whole = 1;
                 for (uint32_t z = g0[2]; z < g1[2]; z++)
                     for (uint32_t y = g0[1]; y < g1[1]; y++)
                         for (uint32_t x = g0[0]; x < g1[0]; x++) {
@@ -124,13 +130,8 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
                                 !ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))
                                 continue;
                             whole = group_whole = 0;
-                            if (group_meets < 0) {
-                                double blo[3] = {g0[0], g0[1], g0[2]},
-                                       bhi[3] = {g1[0], g1[1], g1[2]};
-                                group_meets = meets(w, blo, bhi);
-                            }
                             double clo[3] = {x, y, z}, chi[3] = {x + 1.0, y + 1.0, z + 1.0};
-                            if (group_meets && meets(w, clo, chi))
+                            if (meets(w, clo, chi))
                                 return 0;
                         }
                 if (group_whole && record_groups) /* out of memory: not recorded, no harm */
