@@ -546,6 +546,67 @@ static void test_ranges(uint32_t w, uint32_t h, uint32_t local_from, uint64_t ra
               (unsigned long long)differ, (unsigned long long)n);
 }
 
+static int pixel_less(const void *a, const void *b)
+{
+    const uint32_t *p = a, *q = b;
+    return p[1] != q[1] ? (p[1] > q[1]) - (p[1] < q[1]) : (p[0] > q[0]) - (p[0] < q[0]);
+}
+
+/* Blocks (ip__ray_order_block(), ip__ray_order_skip_block()): a walk that moves past every
+ * block of 4^k cells it stands at, in ranges from seeks, returns the pixels of next() with
+ * each block's pixels in place of the same number of next()'s, as the same set; the pixel
+ * count and emitted() add up, and blocks are found only in local levels. */
+static void test_blocks(uint32_t w, uint32_t h, uint32_t local_from, uint32_t k, uint64_t range)
+{
+    uint64_t n = (uint64_t)w * h;
+    uint32_t(*expected)[2] = malloc(n * sizeof *expected), (*got)[2] = malloc(n * sizeof *got);
+    REQUIRE(expected && got);
+    ip_ray_order order;
+    REQUIRE(ip__ray_order_init(&order, w, h) == IP_OK);
+    ip__ray_order_set_local_from(&order, local_from);
+    for (uint64_t i = 0; i < n; i++)
+        REQUIRE(ip__ray_order_next(&order, &expected[i][0], &expected[i][1]));
+    ip__ray_order_reset(&order);
+    uint64_t cells = ip__ray_order_cells(&order), i = 0, blocks = 0, wrong = 0, early = 0;
+    uint32_t xs[256], ys[256];
+    for (uint64_t start = 0; start < cells; start += range) {
+        ip__ray_order_seek(&order, start);
+        uint64_t end = start + range;
+        for (;;) {
+            unsigned count;
+            uint64_t at = ip__ray_order_position(&order);
+            if (at + ((uint64_t)1 << 2 * k) <= end &&
+                ip__ray_order_block(&order, k, xs, ys, &count)) {
+                REQUIRE(i + count <= n);
+                early += ip__ray_order_level(&order) < local_from;
+                uint64_t before = ip__ray_order_emitted(&order);
+                ip__ray_order_skip_block(&order, k, count);
+                wrong += ip__ray_order_emitted(&order) != before + count ||
+                         ip__ray_order_position(&order) != at + ((uint64_t)1 << 2 * k);
+                for (unsigned j = 0; j < count; j++)
+                    got[i + j][0] = xs[j], got[i + j][1] = ys[j];
+                qsort(got + i, count, sizeof *got, pixel_less);
+                qsort(expected + i, count, sizeof *expected, pixel_less);
+                blocks++;
+                i += count;
+            } else if (ip__ray_order_next_before(&order, end, &got[i][0], &got[i][1])) {
+                REQUIRE(i < n);
+                i++;
+            } else
+                break;
+        }
+    }
+    for (uint64_t j = 0; j < i && j < n; j++)
+        wrong += got[j][0] != expected[j][0] || got[j][1] != expected[j][1];
+    CHECK_MSG(i == n && wrong == 0 && early == 0 && blocks > 0,
+              "%ux%u, blocks of 4^%u, ranges of %llu: %llu pixels of %llu, %llu wrong, %llu "
+              "blocks (%llu before the local levels)",
+              w, h, k, (unsigned long long)range, (unsigned long long)i, (unsigned long long)n,
+              (unsigned long long)wrong, (unsigned long long)blocks, (unsigned long long)early);
+    free(expected);
+    free(got);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 3 && strcmp(argv[1], "--bench") == 0)
@@ -572,5 +633,10 @@ int main(int argc, char **argv)
     test_ranges(1000, 1, 3, 7);
     test_ranges(1, 1, 0, 1);
     test_ranges(255, 257, 5, 3);
+    test_blocks(1600, 1200, 8, 3, 1000);
+    test_blocks(255, 257, 5, 2, 333);
+    test_blocks(97, 61, 4, 1, 16);
+    test_blocks(640, 480, 0, 4, 1u << 20);
+    test_blocks(1000, 3, 2, 1, 64); /* the shorter axis stops splitting: few blocks */
     return test_summary("test_ray_order");
 }

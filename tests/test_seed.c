@@ -3,6 +3,7 @@
  * clock. */
 #include <math.h>
 
+#include "beam.h"
 #include "check.h"
 #include "isoprop/camera.h"
 #include "seed.h"
@@ -68,6 +69,88 @@ static void check_view(ip_cache *cache, const char *axis, float iso)
     ip__sampler_free(&sampler);
 }
 
+/* Marks in v every active cell of level 0 whose hash is below `share` of 256: the same cells
+ * every time, and more as `share` grows. */
+static void mark_active(ip_visited *v, ip_sampler *sampler, const ip_layout *l, float iso,
+                        unsigned share)
+{
+    const uint32_t *d = l->levels[0].dims;
+    for (uint32_t z = 0; z + 1 < d[2]; z++)
+        for (uint32_t y = 0; y + 1 < d[1]; y++)
+            for (uint32_t x = 0; x + 1 < d[0]; x++) {
+                uint32_t c[3] = {x, y, z};
+                if ((x * 73856093u ^ y * 19349663u ^ z * 83492791u) % 256 >= share)
+                    continue;
+                const ip_brick *b = ip__sampler_cell_brick(sampler, c);
+                REQUIRE(b);
+                ptrdiff_t corners[8];
+                float values[8];
+                ip__corner_offsets(b, corners);
+                ip__cell_values(b, l->type, corners, c, values);
+                unsigned mc = ip__mc_case(values, iso);
+                if (mc != 0 && mc != 255)
+                    REQUIRE(ip__visited_mark(v, 0, c) >= 0);
+            }
+}
+
+/* Beams of 8x8-pixel tiles, 3 pixels apart: as the visited cells grow, the answers of one visited set that
+ * keeps the sub-blocks and cell groups the tests found settled (ip__visited_mark_part()) are
+ * those of a set built afresh with the same cells and no such record; and the records pass
+ * over something (the fresh set's tests read more cells). */
+static void check_beams(ip_cache *cache, const char *axis, float iso)
+{
+    const ip_layout *l = ip_store_layout(ip_cache_store(cache));
+    double lo[3], hi[3];
+    ip_camera camera;
+    ip_camera_basis basis;
+    ip_error err;
+    ip_layout_world_box(l, lo, hi);
+    REQUIRE(ip_camera_fit_axis(lo, hi, axis, 30.0, 160, 120, &camera, &err) == IP_OK);
+    ip_camera_basis_of(&camera, &basis);
+    ip_sampler sampler;
+    REQUIRE(ip__sampler_init(&sampler, cache, 0) == IP_OK);
+    ip_seeder seeder;
+    ip__seeder_init(&seeder, &sampler, iso, 2.0 * basis.tan_half_y / camera.height);
+    ip_visited kept, fresh;
+    REQUIRE(ip__visited_init(&kept, l) == IP_OK);
+    REQUIRE(ip__visited_init(&fresh, l) == IP_OK);
+    uint64_t tests = 0, differ = 0, settled = 0, parts = 0;
+    static const unsigned shares[] = {0, 64, 160, 240, 256};
+    for (size_t p = 0; p < sizeof shares / sizeof shares[0]; p++) {
+        mark_active(&kept, &sampler, l, iso, shares[p]);
+        ip__visited_clear(&fresh);
+        mark_active(&fresh, &sampler, l, iso, shares[p]);
+        for (uint32_t ty = 0; ty < camera.height; ty += 3) /* tiles that overlap */
+            for (uint32_t tx = 0; tx < camera.width; tx += 3) {
+                double corner[4][3];
+                double cx[4] = {tx, tx + 8.0, tx + 8.0, tx}, cy[4] = {ty, ty, ty + 8.0, ty + 8.0};
+                for (int i = 0; i < 4; i++)
+                    ip_camera_pixel_ray(&basis, &camera, cx[i], cy[i], corner[i]);
+                ip_beam beam;
+                ip__beam_init(&beam, camera.eye, basis.forward, corner, INFINITY);
+                int a = ip__beam_settled(&seeder, &kept, &beam);
+                int b = ip__beam_settled(&seeder, &fresh, &beam);
+                differ += a != b;
+                settled += a;
+                tests++;
+            }
+    }
+    /* the records the kept set holds: bits past the cells' of its bitmaps */
+    for (uint64_t g = 0; g < l->brick_count; g++) {
+        const atomic_uint_fast64_t *m = ip__visited_bitmap(&kept, g);
+        for (uint64_t part = 0; m && part < kept.subblocks_per_brick + 64; part++)
+            parts += ip__visited_part_in(&kept, m, part);
+    }
+    CHECK_MSG(differ == 0 && settled > tests / 4 && settled < tests && parts > 0,
+              "view %s, iso %g: %llu of %llu beam tests differ, %llu settled, %llu parts "
+              "recorded",
+              axis, (double)iso, (unsigned long long)differ, (unsigned long long)tests,
+              (unsigned long long)settled, (unsigned long long)parts);
+    ip__visited_free(&kept);
+    ip__visited_free(&fresh);
+    ip__sampler_free(&sampler);
+}
+
 int main(void)
 {
     const char *dir = test_tmp_dir("test_seed");
@@ -82,6 +165,8 @@ int main(void)
     check_view(cache, "-y", 1000.5f);
     check_view(cache, "+x", -300.5f);
     check_view(cache, "-z", -300.5f);
+    check_beams(cache, "-y", 1000.5f);
+    check_beams(cache, "+x", -300.5f);
     ip_cache_destroy(cache);
     ip_store_close(store);
     return test_summary("test_seed");

@@ -9,7 +9,7 @@
  * it unless it lies wholly beyond max_depth or wholly outside one plane. */
 typedef struct index_beam {
     ip_seeder *s;
-    const ip_visited *visited;
+    ip_visited *visited;
     double normal[4][3]; /* the planes' normals with index coordinates: n[a] * scale[a] */
     double offset[4];    /* - n . eye */
     double forward[3];   /* forward[a] * scale[a] */
@@ -55,9 +55,14 @@ static inline int meets(const index_beam *w, const double lo[3], const double hi
     return 1;
 }
 
-/* The cells [lo, hi) of one sub-block, by cell groups (cache.h): 1 when every active cell the
- * beam may meet is visited. */
-static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[3], int side)
+/* The cells [lo, hi) of sub-block `sb` (index within its brick), by cell groups (cache.h): 1
+ * when every active cell the beam may meet is visited. A cell group the beam meets every
+ * active cell of which is visited is recorded as settled (ip__visited_mark_part()), and so is
+ * a sub-block all of whose groups are (or hold no active cell); later tests pass over them
+ * at once: cells once visited stay so. Groups are recorded only where sub-blocks hold whole
+ * groups; the groups the beam does not meet are not looked at. */
+static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[3], int side,
+                         uint32_t sb)
 {
     ip_seeder *s = w->s;
     /* only a brick the view has already loaded: a beam wider and deeper than its rays must not
@@ -65,11 +70,16 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
     const ip_brick *brick = ip__sampler_resident_cell_brick(s->sampler, lo);
     if (!brick)
         return 0;
+    const atomic_uint_fast64_t *marked = ip__visited_bitmap(w->visited, brick->index);
+    if (ip__visited_part_in(w->visited, marked, sb))
+        return 1;
+    uint32_t per_group = (s->layout->brick_edge + IP_CELL_GROUP - 1) / IP_CELL_GROUP;
+    int record_groups = s->layout->subblock_edge >= IP_CELL_GROUP;
     ptrdiff_t corners[8];
     ip__corner_offsets(brick, corners);
     size_t groups_x = ip_cell_groups(brick->extent[0]),
            groups_xy = groups_x * ip_cell_groups(brick->extent[1]);
-    const atomic_uint_fast64_t *marked = ip__visited_bitmap(w->visited, brick->index);
+    int whole = 1; /* no active cell of the sub-block unvisited so far */
     /* the groups the sub-block meets, each clipped to it: [g0, g1) */
     uint32_t first[3];
     for (int k = 0; k < 3; k++)
@@ -82,20 +92,28 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
                     g0[k] = g[k] > lo[k] ? g[k] : lo[k];
                     g1[k] = g[k] + IP_CELL_GROUP < hi[k] ? g[k] + IP_CELL_GROUP : hi[k];
                 }
-                double blo[3] = {g0[0], g0[1], g0[2]}, bhi[3] = {g1[0], g1[1], g1[2]};
-                if (!meets(w, blo, bhi))
+                uint32_t gi[3] = {(gx - brick->origin[0]) / IP_CELL_GROUP,
+                                  (gy - brick->origin[1]) / IP_CELL_GROUP,
+                                  (gz - brick->origin[2]) / IP_CELL_GROUP};
+                uint64_t part = w->visited->subblocks_per_brick + gi[0] +
+                                per_group * (gi[1] + (uint64_t)per_group * gi[2]);
+                if (record_groups && ip__visited_part_in(w->visited, marked, part))
                     continue;
                 if (s->use_group_ranges) {
                     static const ptrdiff_t pair[2] = {0, 1};
                     float range[2];
-                    size_t at = (gx - brick->origin[0]) / IP_CELL_GROUP +
-                                groups_x * ((gy - brick->origin[1]) / IP_CELL_GROUP) +
-                                groups_xy * ((gz - brick->origin[2]) / IP_CELL_GROUP);
+                    size_t at = gi[0] + groups_x * gi[1] + groups_xy * gi[2];
                     ip__samples_gather(brick->group_ranges, s->layout->type, 2 * at, pair, 2,
                                        range);
                     if (!ip__range_active(range[0], range[1], s->iso))
                         continue;
                 }
+                double blo[3] = {g0[0], g0[1], g0[2]}, bhi[3] = {g1[0], g1[1], g1[2]};
+                if (!meets(w, blo, bhi)) {
+                    whole = 0; /* not looked at: the sub-block is not known to be whole */
+                    continue;
+                }
+                int group_whole = 1;
                 for (uint32_t z = g0[2]; z < g1[2]; z++)
                     for (uint32_t y = g0[1]; y < g1[1]; y++)
                         for (uint32_t x = g0[0]; x < g1[0]; x++) {
@@ -108,14 +126,19 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
                             unsigned mc = ip__mc_case(values, s->iso);
                             if (mc == 0 || mc == 255)
                                 continue;
-                            double clo[3] = {x, y, z}, chi[3] = {x + 1.0, y + 1.0, z + 1.0};
-                            if (!meets(w, clo, chi))
+                            if (side != IP__CLIP_KEEPS_ALL &&
+                                !ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))
                                 continue;
-                            if (side == IP__CLIP_KEEPS_ALL ||
-                                ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))
+                            whole = group_whole = 0;
+                            double clo[3] = {x, y, z}, chi[3] = {x + 1.0, y + 1.0, z + 1.0};
+                            if (meets(w, clo, chi))
                                 return 0;
                         }
+                if (group_whole && record_groups) /* out of memory: not recorded, no harm */
+                    (void)ip__visited_mark_part(w->visited, brick->index, part);
             }
+    if (whole)
+        (void)ip__visited_mark_part(w->visited, brick->index, sb);
     return 1;
 }
 
@@ -139,7 +162,7 @@ static int settled_brick(index_beam *w, const uint32_t b[3])
                 if (!meets(w, blo, bhi))
                     continue;
                 int side = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi);
-                if (side && !settled_cells(w, lo, hi, side))
+                if (side && !settled_cells(w, lo, hi, side, sb))
                     return 0;
             }
     return 1;
@@ -171,7 +194,7 @@ static int settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
     return 1;
 }
 
-int ip__beam_settled(ip_seeder *s, const ip_visited *visited, const ip_beam *b)
+int ip__beam_settled(ip_seeder *s, ip_visited *visited, const ip_beam *b)
 {
     index_beam w;
     w.s = s;

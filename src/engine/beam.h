@@ -27,7 +27,8 @@ void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
  * summaries, and where an active sub-block meets the beam the cells of its brick, only if the
  * cache already holds it (ip__sampler_resident_cell_brick(): a brick not resident counts as
  * not settled, and nothing is read). Conservative: boxes are tested against the beam's planes
- * one at a time, so some that miss it count as met. */
-int ip__beam_settled(ip_seeder *s, const ip_visited *visited, const ip_beam *b);
+ * one at a time, so some that miss it count as met. Records in `visited` the sub-blocks it
+ * finds wholly visited (ip__visited_mark_subblock()), which later tests pass over. */
+int ip__beam_settled(ip_seeder *s, ip_visited *visited, const ip_beam *b);
 
 #endif

@@ -604,6 +604,55 @@ static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level)
     return 1;
 }
 
+/* The Z-order levels' aligned blocks of 4^BLOCK_LOG4 cells whose pixels retire() would all
+ * retire are passed over at once (retire_block()). */
+#define BLOCK_LOG4 3
+#define BLOCK_CELLS (1u << 2 * BLOCK_LOG4)
+
+#define RETIRED_PER_BATCH 4096 /* rays of blocks a batch may retire at once, at most */
+
+/* Takes `rays` of the step's budget when the step has one; 0 when it has fewer left. */
+static int take_budget(ip_engine *e, uint64_t rays)
+{
+    if (!e->step_limited)
+        return 1;
+    uint64_t left = atomic_load(&e->step_rays_left);
+    do {
+        if (left < rays)
+            return 0;
+    } while (!atomic_compare_exchange_weak(&e->step_rays_left, &left, left - rays));
+    return 1;
+}
+
+/* When the worker's iterator stands at such a block, within its range, whose pixels are each
+ * retired by retire()'s own test as the tiles stand (none is tested here) and fit the step's
+ * budget: moves past it, counts its rays as retired and returns 1 with their number in
+ * *count. Otherwise the rays are left to be walked or retired one by one (0). */
+static int retire_block(ip_engine *e, worker *w, unsigned *count)
+{
+    if (!e->options.occlusion || ip__ray_order_position(&w->order) + BLOCK_CELLS > w->range_end)
+        return 0;
+    uint32_t xs[BLOCK_CELLS], ys[BLOCK_CELLS];
+    unsigned n;
+    if (!ip__ray_order_block(&w->order, BLOCK_LOG4, xs, ys, &n) ||
+        ip__ray_order_level(&w->order) < e->tile_from)
+        return 0;
+    for (unsigned i = 0; i < n; i++) {
+        uint32_t x = xs[i] + e->region_x, y = ys[i] + e->region_y;
+        float z = (float)ip__coverage_solid(&e->coverage, x, y); /* a float's value: exact */
+        const tile *t = &e->tiles[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)];
+        if (!(z <= ip__float_of_bits(atomic_load_explicit(&t->depth, memory_order_relaxed))))
+            return 0;
+    }
+    if (!take_budget(e, n))
+        return 0;
+    ip__ray_order_skip_block(&w->order, BLOCK_LOG4, n);
+    w->counts.rays += n;
+    w->counts.retired += n;
+    *count = n;
+    return 1;
+}
+
 /* Gives the worker a range of the order to walk: the earliest one left unfinished by a step,
  * else the next unclaimed one. Ranges start small, so that the first rays (the coarsest levels)
  * keep their order closely, and grow with the position to at most RANGE_MAX. Returns 0 once
@@ -653,10 +702,12 @@ static void leave_range(ip_engine *e, worker *w)
     w->holding = 0;
 }
 
-/* Takes up to RAY_BATCH pixels of the order for this step from the worker's ranges; returns
- * how many. */
-static unsigned take_rays(ip_engine *e, worker *w, order_ray *rays)
+/* Takes up to RAY_BATCH pixels of the order for this step from the worker's ranges: those to
+ * walk or retire one by one into rays[0 .. *count), and whole blocks retired at once; returns
+ * how many pixels in all (0: none left for this step). */
+static uint64_t take_rays(ip_engine *e, worker *w, order_ray *rays, unsigned *count)
 {
+    *count = 0;
     if (atomic_load_explicit(&e->step_stopped, memory_order_relaxed) ||
         (e->step_deadline > 0 && ip_now_seconds() >= e->step_deadline))
         return 0;
@@ -670,8 +721,12 @@ static unsigned take_rays(ip_engine *e, worker *w, order_ray *rays)
         } while (!atomic_compare_exchange_weak(&e->step_rays_left, &left, left - want));
     }
     unsigned n = 0;
-    while (n < want && (w->holding || claim_range(e, w))) {
-        if (ip__ray_order_next_before(&w->order, w->range_end, &rays[n].x, &rays[n].y)) {
+    uint64_t retired = 0; /* rays of blocks passed over at once */
+    while (n < want && retired < RETIRED_PER_BATCH && (w->holding || claim_range(e, w))) {
+        unsigned block;
+        if (retire_block(e, w, &block))
+            retired += block;
+        else if (ip__ray_order_next_before(&w->order, w->range_end, &rays[n].x, &rays[n].y)) {
             rays[n].x += e->region_x; /* the image's pixel (see ip_engine_set_region()) */
             rays[n].y += e->region_y;
             rays[n].level = ip__ray_order_level(&w->order);
@@ -681,8 +736,9 @@ static unsigned take_rays(ip_engine *e, worker *w, order_ray *rays)
     }
     if (e->step_limited && n < want) /* the order ran out: give the rest of the share back */
         atomic_fetch_add(&e->step_rays_left, want - n);
-    atomic_fetch_add(&e->rays_taken, n);
-    return n;
+    atomic_fetch_add(&e->rays_taken, n + retired);
+    *count = n;
+    return n + retired;
 }
 
 /* Moves the worker's triangles to the engine's mesh. */
@@ -704,7 +760,7 @@ static void work(void *user, unsigned index)
     worker *w = &e->workers[index];
     order_ray rays[RAY_BATCH];
     unsigned n;
-    while (w->status == IP_OK && (n = take_rays(e, w, rays)) > 0) {
+    while (w->status == IP_OK && take_rays(e, w, rays, &n) > 0) {
         /* The clock is read once per batch: seeding is the batch's time less what
          * propagation and extraction measured of it. */
         double t0 = ip_now_seconds();

@@ -233,6 +233,52 @@ void ip__ray_order_seek(ip_ray_order *order, uint64_t position)
         order->cell_x = order->cell_y = 0;
 }
 
+int ip__ray_order_block(ip_ray_order *order, uint32_t k, uint32_t *xs, uint32_t *ys,
+                        unsigned *count)
+{
+    uint32_t level = order->level;
+    if (k > IP__RAY_ORDER_BLOCK_MAX || level > ip__ray_order_last_level(order) ||
+        level < order->local_from)
+        return 0;
+    uint32_t nx = min_u32(level, order->x_levels), ny = min_u32(level, order->y_levels);
+    uint64_t size = (uint64_t)1 << 2 * k;
+    if (k > min_u32(nx, ny) || order->next_cell % size != 0 ||
+        order->next_cell + size > (uint64_t)1 << (nx + ny))
+        return 0;
+    /* the block's low k bits of each cell index run through every value (local levels set
+     * bit s of each index from digit s of the position) */
+    uint32_t side = 1u << k, cx0 = order->cell_x, cy0 = order->cell_y;
+    unsigned sx[1u << IP__RAY_ORDER_BLOCK_MAX], sy[1u << IP__RAY_ORDER_BLOCK_MAX];
+    for (uint32_t i = 0; i < side; i++) {
+        sx[i] = memo_slot(order, 0, nx, cx0 + i);
+        sy[i] = memo_slot(order, 1, ny, cy0 + i);
+    }
+    const ip__ray_order_memo *mx = &order->memo[0], *my = &order->memo[1];
+    unsigned n = 0;
+    for (uint32_t j = 0; j < side; j++) {
+        if (my->first[sy[j]] == my->end[sy[j]])
+            continue;
+        uint32_t y = (my->first[sy[j]] + my->end[sy[j]]) >> 1, centres = my->centres[sy[j]];
+        for (uint32_t i = 0; i < side; i++)
+            if (mx->first[sx[i]] != mx->end[sx[i]] && !(mx->centres[sx[i]] & centres)) {
+                xs[n] = (mx->first[sx[i]] + mx->end[sx[i]]) >> 1;
+                ys[n++] = y;
+            }
+    }
+    *count = n;
+    return 1;
+}
+
+void ip__ray_order_skip_block(ip_ray_order *order, uint32_t k, unsigned count)
+{
+    uint32_t nx = min_u32(order->level, order->x_levels),
+             ny = min_u32(order->level, order->y_levels);
+    order->next_cell += (uint64_t)1 << 2 * k;
+    order->emitted += count;
+    if (order->next_cell < (uint64_t)1 << (nx + ny))
+        decode_cell(order, order->next_cell);
+}
+
 int ip__ray_order_next(ip_ray_order *order, uint32_t *x, uint32_t *y)
 {
     return ip__ray_order_next_before(order, UINT64_MAX, x, y);

@@ -131,6 +131,23 @@ void ip__ray_order_seek(ip_ray_order *order, uint64_t position);
  *  with the iterator at `end` (or done), when no cell before `end` has a pixel left. */
 int ip__ray_order_next_before(ip_ray_order *order, uint64_t end, uint32_t *x, uint32_t *y);
 
+/* Blocks. In a local level the positions [m 4^k, (m + 1) 4^k) are the cells of one aligned
+ * square of 2^k x 2^k cells (k up to the level's splits of the shorter axis), so a caller that
+ * can account for all the pixels of such a square at once may move past it in one step. */
+
+#define IP__RAY_ORDER_BLOCK_MAX 4 /* the largest k: blocks of at most 256 cells */
+
+/*! ip__ray_order_block() : when the iterator stands at the first cell of an aligned block of
+ *  4^k cells (k <= IP__RAY_ORDER_BLOCK_MAX) of a local level, the pixels next() would return
+ *  from the block, in xs[0 .. *count), ys[0 .. *count) (4^k entries each at most, in another
+ *  order than next()'s), and 1; else 0, nothing written. Does not move the iterator. */
+int ip__ray_order_block(ip_ray_order *order, uint32_t k, uint32_t *xs, uint32_t *ys,
+                        unsigned *count);
+
+/*! ip__ray_order_skip_block() : moves past the block that ip__ray_order_block() described,
+ *  its `count` pixels counted as returned (emitted()); the next pixel is the first after it. */
+void ip__ray_order_skip_block(ip_ray_order *order, uint32_t k, unsigned count);
+
 /*! ip__ray_order_reset() : starts the same order again from its first pixel. */
 void ip__ray_order_reset(ip_ray_order *order);
 

@@ -3,14 +3,18 @@
 #include <string.h>
 
 #include "internal.h"
+#include "isoprop/cache.h"
 #include "visited.h"
 
 ip_status ip__visited_init(ip_visited *v, const ip_layout *layout)
 {
     memset(v, 0, sizeof *v);
     v->layout = layout;
-    uint64_t b = layout->brick_edge;
-    v->words_per_brick = (b * b * b + 63) / 64;
+    uint64_t b = layout->brick_edge, per = b / layout->subblock_edge;
+    uint64_t groups = (b + IP_CELL_GROUP - 1) / IP_CELL_GROUP;
+    v->cells_per_brick = b * b * b;
+    v->subblocks_per_brick = per * per * per;
+    v->words_per_brick = (b * b * b + per * per * per + groups * groups * groups + 63) / 64;
     v->edge_shift = ip__ceil_log2(b);
     v->bitmaps = calloc(layout->brick_count, sizeof *v->bitmaps);
     atomic_init(&v->bytes, 0);
@@ -51,14 +55,14 @@ static uint64_t locate(const ip_visited *v, uint32_t level, const uint32_t cell[
     return ip_brick_global_index(v->layout, level, brick);
 }
 
-int ip__visited_mark(ip_visited *v, uint32_t level, const uint32_t cell[3])
+/* Brick g's bitmap, allocated and published first if it has none; NULL when out of memory. */
+static atomic_uint_fast64_t *brick_bitmap(ip_visited *v, uint64_t g)
 {
-    uint64_t bit, g = locate(v, level, cell, &bit);
     atomic_uint_fast64_t *m = atomic_load_explicit(&v->bitmaps[g], memory_order_acquire);
     if (!m) {
         atomic_uint_fast64_t *fresh = calloc(v->words_per_brick, sizeof *fresh);
         if (!fresh)
-            return -1;
+            return NULL;
         atomic_uint_fast64_t *expected = NULL;
         if (atomic_compare_exchange_strong(&v->bitmaps[g], &expected, fresh)) {
             m = fresh;
@@ -68,8 +72,27 @@ int ip__visited_mark(ip_visited *v, uint32_t level, const uint32_t cell[3])
             m = expected;
         }
     }
+    return m;
+}
+
+int ip__visited_mark(ip_visited *v, uint32_t level, const uint32_t cell[3])
+{
+    uint64_t bit, g = locate(v, level, cell, &bit);
+    atomic_uint_fast64_t *m = brick_bitmap(v, g);
+    if (!m)
+        return -1;
     uint_fast64_t mask = (uint_fast64_t)1 << (bit & 63);
     return (atomic_fetch_or(&m[bit >> 6], mask) & mask) != 0;
+}
+
+int ip__visited_mark_part(ip_visited *v, uint64_t brick, uint64_t part)
+{
+    atomic_uint_fast64_t *m = brick_bitmap(v, brick);
+    if (!m)
+        return -1;
+    uint64_t bit = v->cells_per_brick + part;
+    atomic_fetch_or(&m[bit >> 6], (uint_fast64_t)1 << (bit & 63));
+    return 0;
 }
 
 int ip__visited_test(const ip_visited *v, uint32_t level, const uint32_t cell[3])

@@ -14,8 +14,10 @@ typedef struct ip_visited {
     const ip_layout *layout;
     _Atomic(atomic_uint_fast64_t *) *bitmaps; /* one per brick of every level, or NULL */
     uint64_t words_per_brick;
-    unsigned edge_shift;        /* log2 of the brick edge (a power of two) */
-    atomic_uint_fast64_t bytes; /* allocated bitmap bytes */
+    uint64_t cells_per_brick;     /* B^3: the cells' bits, then one per sub-block, then one */
+    uint64_t subblocks_per_brick; /* per cell group (IP_CELL_GROUP^3 cells): see "Settled" */
+    unsigned edge_shift;          /* log2 of the brick edge (a power of two) */
+    atomic_uint_fast64_t bytes;   /* allocated bitmap bytes */
 } ip_visited;
 
 ip_status ip__visited_init(ip_visited *v, const ip_layout *layout);
@@ -30,6 +32,15 @@ int ip__visited_mark(ip_visited *v, uint32_t level, const uint32_t cell[3]);
 
 /* 1 when the cell is marked. */
 int ip__visited_test(const ip_visited *v, uint32_t level, const uint32_t cell[3]);
+
+/* Settled parts: the beam tests' record of sub-blocks and cell groups every active cell of
+ * which (that the clipping planes keep) is marked, so that later tests pass over them. Part
+ * `part` of a brick is sub-block `part` (index within the brick, x fastest) below
+ * subblocks_per_brick, else cell group part - subblocks_per_brick (likewise, over the brick's
+ * B / IP_CELL_GROUP groups a side); a bit of each after the cells' bits of the brick's bitmap,
+ * which once set stays set until ip__visited_clear(). Marks part `part` of the brick of
+ * global index `brick`; 0, or -1 when out of memory. */
+int ip__visited_mark_part(ip_visited *v, uint64_t brick, uint64_t part);
 
 /* For tests of many cells of one brick: the bitmap of the brick of global index `brick`, NULL
  * while none of its cells is marked (a bitmap published after this call is not seen, so a
@@ -50,6 +61,17 @@ static inline int ip__visited_test_in(const ip_visited *v, const atomic_uint_fas
     uint32_t mask = (UINT32_C(1) << shift) - 1;
     uint64_t bit = (cell[0] & mask) + ((uint64_t)(cell[1] & mask) << shift) +
                    ((uint64_t)(cell[2] & mask) << (2 * shift));
+    return (atomic_load_explicit(&m[bit >> 6], memory_order_relaxed) >> (bit & 63)) & 1;
+}
+
+/* 1 when part `part` of the brick whose bitmap is `m` (ip__visited_bitmap()) is marked
+ * settled (ip__visited_mark_part()). */
+static inline int ip__visited_part_in(const ip_visited *v, const atomic_uint_fast64_t *m,
+                                      uint64_t part)
+{
+    if (!m)
+        return 0;
+    uint64_t bit = v->cells_per_brick + part;
     return (atomic_load_explicit(&m[bit >> 6], memory_order_relaxed) >> (bit & 63)) & 1;
 }
 
