@@ -570,6 +570,12 @@ static int tile_settled(worker *w, uint32_t tx, uint32_t ty, double *solid)
     return 1;
 }
 
+/* The tile of image pixel (x, y). */
+static tile *pixel_tile(ip_engine *e, uint32_t x, uint32_t y)
+{
+    return &e->tiles[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)];
+}
+
 /* 1 when the ray of pixel (x, y), of the order's level `level`, may be retired without a walk
  * (counted): its solid coverage entry is no deeper than one its tile was found settled at
  * (tile_settled()), +infinity included. A tile is tested by the first ray of each of the
@@ -581,7 +587,7 @@ static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level)
     if (!e->options.occlusion || level < e->tile_from)
         return 0;
     float z = (float)ip__coverage_solid(&e->coverage, x, y); /* a float's value: exact */
-    tile *t = &e->tiles[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)];
+    tile *t = pixel_tile(e, x, y);
     unsigned settled = atomic_load_explicit(&t->depth, memory_order_relaxed);
     if (!(z <= ip__float_of_bits(settled))) {
         unsigned char pass = (unsigned char)(level - e->tile_from + 1);
@@ -639,9 +645,9 @@ static int retire_block(ip_engine *e, worker *w, unsigned *count)
         return 0;
     for (unsigned i = 0; i < n; i++) {
         uint32_t x = xs[i] + e->region_x, y = ys[i] + e->region_y;
-        float z = (float)ip__coverage_solid(&e->coverage, x, y); /* a float's value: exact */
-        const tile *t = &e->tiles[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)];
-        if (!(z <= ip__float_of_bits(atomic_load_explicit(&t->depth, memory_order_relaxed))))
+        float z = (float)ip__coverage_solid(&e->coverage, x, y); /* as in retire() */
+        unsigned settled = atomic_load_explicit(&pixel_tile(e, x, y)->depth, memory_order_relaxed);
+        if (!(z <= ip__float_of_bits(settled)))
             return 0;
     }
     if (!take_budget(e, n))
