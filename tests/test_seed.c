@@ -19,21 +19,28 @@ static void brick_phantom(const char *dir, char *ibv, size_t size)
     test_brick_raw(raw, ibv, 16, 8);
 }
 
+/* A 160x120 camera fitted to the volume along `axis`, and a sampler of its level 0. */
+static void view_setup(ip_cache *cache, const char *axis, ip_camera *camera, ip_camera_basis *basis,
+                       ip_sampler *sampler)
+{
+    const ip_layout *l = ip_store_layout(ip_cache_store(cache));
+    double lo[3], hi[3];
+    ip_error err;
+    ip_layout_world_box(l, lo, hi);
+    REQUIRE(ip_camera_fit_axis(lo, hi, axis, 30.0, 160, 120, camera, &err) == IP_OK);
+    ip_camera_basis_of(camera, basis);
+    REQUIRE(ip__sampler_init(sampler, cache, 0) == IP_OK);
+}
+
 /* Casts every pixel's ray through level 0 twice, without the group ranges and with them,
  * and compares what each ray finds. */
 static void check_view(ip_cache *cache, const char *axis, float iso)
 {
-    const ip_layout *l = ip_store_layout(ip_cache_store(cache));
-    double lo[3], hi[3];
     ip_camera camera;
     ip_camera_basis basis;
-    ip_error err;
-    ip_layout_world_box(l, lo, hi);
-    REQUIRE(ip_camera_fit_axis(lo, hi, axis, 30.0, 160, 120, &camera, &err) == IP_OK);
-    ip_camera_basis_of(&camera, &basis);
     ip_sampler sampler;
+    view_setup(cache, axis, &camera, &basis, &sampler);
     ip_seeder plain, grouped;
-    REQUIRE(ip__sampler_init(&sampler, cache, 0) == IP_OK);
     double pixel_angle = 2.0 * basis.tan_half_y / camera.height;
     ip__seeder_init(&plain, &sampler, iso, pixel_angle);
     ip__seeder_init(&grouped, &sampler, iso, pixel_angle);
@@ -93,22 +100,17 @@ static void mark_active(ip_visited *v, ip_sampler *sampler, const ip_layout *l, 
             }
 }
 
-/* Beams of 8x8-pixel tiles, 3 pixels apart: as the visited cells grow, the answers of one visited set that
- * keeps the sub-blocks and cell groups the tests found settled (ip__visited_mark_part()) are
- * those of a set built afresh with the same cells and no such record; and the records pass
- * over something (the fresh set's tests read more cells). */
+/* Beams of 8x8-pixel tiles, 3 pixels apart: as the visited cells grow, the answers of one
+ * visited set that keeps the sub-blocks and cell groups the tests found settled
+ * (ip__visited_mark_part()) are those of a set built afresh with the same cells and no such
+ * record; and some are recorded. */
 static void check_beams(ip_cache *cache, const char *axis, float iso)
 {
     const ip_layout *l = ip_store_layout(ip_cache_store(cache));
-    double lo[3], hi[3];
     ip_camera camera;
     ip_camera_basis basis;
-    ip_error err;
-    ip_layout_world_box(l, lo, hi);
-    REQUIRE(ip_camera_fit_axis(lo, hi, axis, 30.0, 160, 120, &camera, &err) == IP_OK);
-    ip_camera_basis_of(&camera, &basis);
     ip_sampler sampler;
-    REQUIRE(ip__sampler_init(&sampler, cache, 0) == IP_OK);
+    view_setup(cache, axis, &camera, &basis, &sampler);
     ip_seeder seeder;
     ip__seeder_init(&seeder, &sampler, iso, 2.0 * basis.tan_half_y / camera.height);
     ip_visited kept, fresh;
