@@ -576,6 +576,17 @@ static tile *pixel_tile(ip_engine *e, uint32_t x, uint32_t y)
     return &e->tiles[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)];
 }
 
+/* 1 when the ray of image pixel (x, y) is retired by its tile as it stands: its solid entry is
+ * no deeper than the depth its tile was found settled at (`settled`, a float's bits). A tile
+ * settled with no bound (+infinity) retires every ray, and the coverage is not read. */
+static int pixel_settled(const ip_engine *e, uint32_t x, uint32_t y, unsigned settled)
+{
+    if (settled == ip__float_bits(INFINITY))
+        return 1;
+    float z = (float)ip__coverage_solid(&e->coverage, x, y); /* a float's value: exact */
+    return z <= ip__float_of_bits(settled);
+}
+
 /* 1 when the ray of pixel (x, y), of the order's level `level`, may be retired without a walk
  * (counted): its solid coverage entry is no deeper than one its tile was found settled at
  * (tile_settled()), +infinity included. A tile is tested by the first ray of each of the
@@ -586,10 +597,9 @@ static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level)
     ip_engine *e = w->engine;
     if (!e->options.occlusion || level < e->tile_from)
         return 0;
-    float z = (float)ip__coverage_solid(&e->coverage, x, y); /* a float's value: exact */
     tile *t = pixel_tile(e, x, y);
     unsigned settled = atomic_load_explicit(&t->depth, memory_order_relaxed);
-    if (!(z <= ip__float_of_bits(settled))) {
+    if (!pixel_settled(e, x, y, settled)) {
         unsigned char pass = (unsigned char)(level - e->tile_from + 1);
         if (atomic_load_explicit(&t->tested, memory_order_relaxed) >= pass)
             return 0; /* tested in this level already */
@@ -602,7 +612,7 @@ static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level)
                !atomic_compare_exchange_weak_explicit(&t->depth, &settled, bits,
                                                       memory_order_relaxed, memory_order_relaxed))
             ;
-        if (!(z <= ip__float_of_bits(bits)))
+        if (!pixel_settled(e, x, y, bits))
             return 0;
     }
     w->counts.rays++;
@@ -645,9 +655,8 @@ static int retire_block(ip_engine *e, worker *w, unsigned *count)
         return 0;
     for (unsigned i = 0; i < n; i++) {
         uint32_t x = xs[i] + e->region_x, y = ys[i] + e->region_y;
-        float z = (float)ip__coverage_solid(&e->coverage, x, y); /* as in retire() */
         unsigned settled = atomic_load_explicit(&pixel_tile(e, x, y)->depth, memory_order_relaxed);
-        if (!(z <= ip__float_of_bits(settled)))
+        if (!pixel_settled(e, x, y, settled))
             return 0;
     }
     if (!take_budget(e, n))
