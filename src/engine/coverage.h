@@ -31,10 +31,11 @@
 #define IP_COVERAGE_MAX_PIXELS 1024 /* the largest box or triangle (bounding pixels) used */
 
 /* A triangle records a pixel centre as solidly covered when the centre lies inside its exact
- * projection by at least this distance (pixels) from every edge: far more than the 1/256-pixel
- * vertex snapping of the rasterizer can move an edge (at most sqrt(2) / 512 pixel), so the
- * rasterizer draws the triangle there in any mesh that holds it. */
-#define IP_COVERAGE_SOLID_MARGIN (1.0 / 64)
+ * projection by at least this distance (pixels) from every edge: 2.8 times what the
+ * 1/256-pixel vertex snapping of the rasterizer can move a point (at most sqrt(2) / 512
+ * pixel), so the rasterizer draws the triangle there in any mesh that holds it (the argument
+ * is at cast_ray() in engine.c). */
+#define IP_COVERAGE_SOLID_MARGIN (1.0 / 128)
 
 typedef struct ip_coverage {
     ip_camera camera;

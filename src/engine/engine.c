@@ -460,11 +460,13 @@ static double stop_depth(const ip_engine *e, uint32_t x, uint32_t y)
  * nothing further can show: at t = (z + reach) / cos, z the entry widened by DEPTH_MARGIN,
  * reach a cell's extent along the view, cos the cosine between the ray and the view. Why the
  * image stays exact. The entry z means: an extracted triangle T, kept in the mesh, holds the
- * pixel centre by 1/64 pixel or more from each of its edges and has its vertices no deeper
- * than z. The rasterizer moves a vertex by at most sqrt(2) / 512 pixel when it snaps it, and
- * an affine map moving the corners of T that little moves no point of T more, so T still
- * holds the centre after snapping (the disc of 1/64 pixel around it lies in T, and the
- * snapped T covers the point of that disc it maps to the centre); the depth it is drawn with
+ * pixel centre by IP_COVERAGE_SOLID_MARGIN (1/128 pixel) or more from each of its edges and
+ * has its vertices no deeper than z. The rasterizer moves a vertex by at most sqrt(2) / 512
+ * pixel (0.0028) when it snaps it, and an affine map moving the corners of T that little
+ * moves no point of T more, so T still holds the centre after snapping (the disc of the
+ * margin around it lies in T, the snapped disc's boundary stays within 0.0028 pixel of the
+ * circle, so it still winds around the centre: any margin above 0.0028 pixel would do, and
+ * 1/128 is 2.8 times that); the depth it is drawn with
  * there interpolates 1 / depth between its vertices, so is at most z. A cell the walk enters
  * at t holds the ray's point at view depth t * cos, so its box reaches no nearer than
  * t * cos - reach; a cell entered beyond the stop has its box, and so every vertex of its
