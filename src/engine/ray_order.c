@@ -217,7 +217,7 @@ static void decode_cell(ip_ray_order *order, uint64_t position)
 
 void ip__ray_order_seek(ip_ray_order *order, uint64_t position)
 {
-    uint32_t last_level = ip__ray_order_last_level(order);
+    uint32_t last_level = ip__ray_order_last_level(order), was = order->level;
     order->level = 0;
     order->level_base = 0;
     while (order->level <= last_level &&
@@ -226,7 +226,8 @@ void ip__ray_order_seek(ip_ray_order *order, uint64_t position)
         order->level++;
     }
     order->next_cell = position - order->level_base;
-    forget_cells(order);
+    if (order->level != was) /* the memo holds cells of the level it was filled in */
+        forget_cells(order);
     if (order->level <= last_level)
         decode_cell(order, order->next_cell);
     else

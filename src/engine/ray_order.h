@@ -37,8 +37,9 @@
  * Cost: O(1) memory (the iterator is a struct of about 2 KiB, no allocation). The order
  * examines the cells of every level, about 3 per pixel (at most about 5, for sides just above a
  * power of two), each in amortised O(1) time. Each axis's spans and coarser centres of the cells
- * seen lately are remembered (IP__RAY_ORDER_MEMO slots per axis, by the cell's low bits): in the
- * Z-order of local levels a cell's column and row come back many times in a row.
+ * seen lately are remembered (IP__RAY_ORDER_MEMO slots per axis, by the cell's low bits; kept
+ * across seeks within a level): in the Z-order of local levels a cell's column and row come
+ * back many times in a row.
  * Thread safety: an iterator is used by one thread at a time; separate iterators are independent.
  */
 #ifndef ISOPROP_RAY_ORDER_H
