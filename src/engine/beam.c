@@ -174,15 +174,9 @@ static int settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
     if (depth == 0)
         return settled_brick(w, node);
     ip_seeder *s = w->s;
-    const uint32_t *grid = s->grid[depth - 1];
-    const float *ranges = s->ranges[depth - 1];
     for (int c = 0; c < 8; c++) {
-        uint32_t ch[3] = {2 * node[0] + (c & 1), 2 * node[1] + ((c >> 1) & 1),
-                          2 * node[2] + ((c >> 2) & 1)};
-        if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
-            continue;
-        uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
-        if (!ip__range_active(ranges[2 * i], ranges[2 * i + 1], s->iso))
+        uint32_t ch[3];
+        if (!ip__seeder_active_child(s, depth, node, c, ch))
             continue;
         double lo[3], hi[3];
         ip__seeder_node_box(s, depth - 1, ch, lo, hi);

@@ -21,7 +21,7 @@
 #define RAY_BATCH 16   /* rays a worker takes at once: small, so the order stays progressive */
 #define RANGE_MIN 16   /* positions of the ray order a worker claims at once, at the start... */
 #define RANGE_MAX 1024 /* ...and at most, later: 1/256 of the positions already handed out */
-#define LOCAL_LEVELS 3 /* ray order: the finest levels cast in Z-order (see begin) */
+#define LOCAL_LEVELS 3 /* ray order: the finest levels cast in Z-order (start_order()) */
 #define FLUSH_TRIANGLES 16384 /* a worker's buffer moves to the engine's mesh past this size */
 #define DEPTH_MARGIN 1e-5     /* relative: float rounding of vertices (as coverage.c's boxes) */
 #define TILE_SHIFT 3          /* bulk retirement: tiles of 8 x 8 pixels */
@@ -88,7 +88,8 @@ struct ip_engine {
     tile *tiles;
     size_t tile_capacity;
     uint32_t tiles_x, tiles_y;
-    uint32_t tile_from; /* the first ray-order level whose rays test their tile */
+    uint32_t tile_from; /* the first ray-order level whose rays test their tile: the first
+                           of the order's local levels (start_order()) */
     /* The ray order is handed out in ranges of positions: a worker claims the next range
      * with one atomic add (or takes a range another worker left unfinished at the end of a
      * step, the earliest first) and walks it with its own iterator, so no lock is held while
@@ -246,6 +247,20 @@ double ip_engine_lod_distance(const ip_engine *e, uint32_t level)
     return level < e->levels_used ? e->lod_distance[level] : INFINITY;
 }
 
+/* The ray order of a width x height image (the view's, or a region's), from its first pixel.
+ * The finest levels (cells of at most 2^LOCAL_LEVELS pixels a side, most of the rays) are
+ * cast in Z-order: consecutive rays then cross the same bricks and sub-blocks while they are
+ * still in the processor's caches. The image is nearly complete by then, so the coarser
+ * levels, which make it, keep their spread-out order. Those levels' rays also test their
+ * tiles (retire()). */
+static void start_order(ip_engine *e, uint32_t width, uint32_t height)
+{
+    ip__ray_order_init(&e->order, width, height);
+    uint32_t last = ip__ray_order_last_level(&e->order);
+    e->tile_from = last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0;
+    ip__ray_order_set_local_from(&e->order, e->tile_from);
+}
+
 /* Hands the reader (paused) the view and the order the workers are about to walk. */
 static void begin_prefetch(ip_engine *e)
 {
@@ -275,13 +290,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     ip_camera_basis_of(&e->camera, &e->basis);
     e->iso = iso;
     memset(&e->totals, 0, sizeof e->totals);
-    ip__ray_order_init(&e->order, camera->width, camera->height);
-    /* The finest levels (cells of at most 2^LOCAL_LEVELS pixels a side, most of the rays)
-     * are cast in Z-order: consecutive rays then cross the same bricks and sub-blocks while
-     * they are still in the processor's caches. The image is nearly complete by then, so
-     * the coarser levels, which make it, keep their spread-out order. */
-    uint32_t last = ip__ray_order_last_level(&e->order);
-    ip__ray_order_set_local_from(&e->order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
+    start_order(e, camera->width, camera->height);
     e->order_cells = ip__ray_order_cells(&e->order);
     e->ray_target = ip__ray_order_count(&e->order);
     e->region_x = e->region_y = 0;
@@ -296,7 +305,6 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
         for (int a = 0; a < 3; a++)
             e->cell_reach[k] += layout->spacing[a] * (double)(1u << k) * fabs(e->basis.forward[a]);
     }
-    e->tile_from = last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0;
     if (e->options.occlusion) {
         double lo[3], hi[3];
         ip_layout_world_box(layout, lo, hi);
@@ -365,10 +373,7 @@ ip_status ip_engine_set_region(ip_engine *e, uint32_t x, uint32_t y, uint32_t wi
                         (unsigned long long)pixels);
     if (e->prefetcher) /* it reads the order about to change */
         ip__prefetcher_pause(e->prefetcher);
-    ip__ray_order_init(&e->order, width, height);
-    uint32_t last = ip__ray_order_last_level(&e->order);
-    ip__ray_order_set_local_from(&e->order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
-    e->tile_from = last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0; /* the region order's levels */
+    start_order(e, width, height);
     /* the positions of rays [first_ray, first_ray + ray_count) of the region's order */
     ip_ray_order walk = e->order;
     uint32_t px, py;
@@ -652,8 +657,7 @@ static int retire_block(ip_engine *e, worker *w, unsigned *count)
         return 0;
     uint32_t xs[BLOCK_CELLS], ys[BLOCK_CELLS];
     unsigned n;
-    if (!ip__ray_order_block(&w->order, BLOCK_LOG4, xs, ys, &n) ||
-        ip__ray_order_level(&w->order) < e->tile_from)
+    if (!ip__ray_order_block(&w->order, BLOCK_LOG4, xs, ys, &n)) /* only in tile_from on */
         return 0;
     for (unsigned i = 0; i < n; i++) {
         uint32_t x = xs[i] + e->region_x, y = ys[i] + e->region_y;

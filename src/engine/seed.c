@@ -274,8 +274,6 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
         return walk_brick(s, r, node, t0, t1);
     child_hit hits[8];
     int count = 0;
-    const uint32_t *grid = s->grid[depth - 1];
-    const float *ranges = s->ranges[depth - 1];
     /* The children's boxes (node_box()) share their planes: along each axis, the ray's
      * parameters at the low and high planes of the low (0) and high (1) children, ordered as
      * clip() orders them, computed once for the 8 children from the same operands as clip()
@@ -296,12 +294,9 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
         }
     }
     for (int c = 0; c < 8; c++) {
-        uint32_t ch[3] = {2 * node[0] + (c & 1), 2 * node[1] + ((c >> 1) & 1),
-                          2 * node[2] + ((c >> 2) & 1)};
-        if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
-            continue;
-        uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
-        if (!active(&ranges[2 * i], s->iso) || !ip__seeder_node_kept(s, depth - 1, ch))
+        uint32_t ch[3];
+        if (!ip__seeder_active_child(s, depth, node, c, ch) ||
+            !ip__seeder_node_kept(s, depth - 1, ch))
             continue;
         double a = t0, b = t1;
         int missed = 0;

@@ -49,6 +49,21 @@ static inline void ip__seeder_node_box(const ip_seeder *s, uint32_t depth, const
     }
 }
 
+/* Child c (0..7: bit k is the upper half along axis k) of node `node` at `depth` (> 0), in
+ * ch: 1 when the level has it and its summary range holds the iso-value, else 0. */
+static inline int ip__seeder_active_child(const ip_seeder *s, uint32_t depth,
+                                          const uint32_t node[3], int c, uint32_t ch[3])
+{
+    const uint32_t *grid = s->grid[depth - 1];
+    for (int k = 0; k < 3; k++)
+        ch[k] = 2 * node[k] + ((c >> k) & 1);
+    if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
+        return 0;
+    uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
+    const float *range = s->ranges[depth - 1] + 2 * i;
+    return ip__range_active(range[0], range[1], s->iso);
+}
+
 /* 1 unless the clipping planes drop every cell of node `node` at `depth`. */
 static inline int ip__seeder_node_kept(const ip_seeder *s, uint32_t depth, const uint32_t node[3])
 {
