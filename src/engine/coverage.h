@@ -1,9 +1,10 @@
 /* The coverage depth buffer of occlusion-aware propagation. Internal.
  *
- * Two entries per pixel of the image. The first, `depth`: an upper bound on the view depth of the nearest extracted
- * triangle whose projection holds the pixel's centre (+infinity where none is known yet). The second, `solid`, the same bound from the triangles
- * whose projection holds the centre by a margin (IP_COVERAGE_SOLID_MARGIN), which the
- * rasterizer draws there whatever its rounding: rays stop at it (see engine.c, cast_ray()).
+ * Two entries per pixel of the image. The first, `depth`: an upper bound on the view depth of
+ * the nearest extracted triangle whose projection holds the pixel's centre (+infinity where
+ * none is known yet). The second, `solid`: the same bound from the triangles whose projection
+ * holds the centre by a margin (IP_COVERAGE_SOLID_MARGIN), which the rasterizer draws there
+ * whatever its rounding: rays stop at it (see engine.c, cast_ray()).
  * Workers add the triangles they extract and test, before queueing a cell, whether extracted
  * surface already hides it (docs/occlusion.md; the argument is in coverage.c).
  *
