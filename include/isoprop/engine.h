@@ -31,7 +31,7 @@
  * may cover (it stays unvisited). Such a cell cannot show in the final image, and since every
  * pixel's ray still extracts its own first-hit cell, the guarantee above is unchanged; what
  * changes is how much hidden surface is extracted (docs/occlusion.md). The buffer also keeps,
- * per pixel, the depth of surface that holds the pixel centre by 1/64 pixel or more, which the
+ * per pixel, the depth of surface that holds the pixel centre by 1/128 pixel or more, which the
  * rasterizer draws there whatever its rounding: a ray stops its walk where cells lie wholly
  * behind that depth (nothing there can show at its pixel), and the rays of an 8 x 8 pixel tile
  * whose pixels are all so covered are retired without a walk once a test of the tile's beam

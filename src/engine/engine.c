@@ -540,11 +540,11 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
  * *solid can extract nothing any more: every active cell that such a ray could enter before its
  * stop (cast_ray()), at any level, is extracted already. *solid is the deepest entry among the
  * tile's pixels covered solidly, or +infinity when none is (then the test is for every ray of
- * the tile, which must find nothing new anywhere: a tile outside the surface's image). The beam of the
- * tile's pixel centres (widened by TILE_SLACK) is tested against the octree down to the cells,
- * up to that depth plus a cell's reach along the view. The rays it admits would then find only
- * extracted cells, now or later (entries only decrease and cells stay extracted), and do
- * nothing: their walks can be left out, and the mesh is the one the walks would leave. */
+ * the tile, which must find nothing new anywhere: a tile outside the surface's image). The beam
+ * of the tile's pixel centres (widened by TILE_SLACK) is tested against the octree down to the
+ * cells, up to that depth plus a cell's reach along the view. The rays it admits would then
+ * find only extracted cells, now or later (entries only decrease and cells stay extracted),
+ * and do nothing: their walks can be left out, and the mesh is the one the walks would leave. */
 static int tile_settled(worker *w, uint32_t tx, uint32_t ty, double *solid)
 {
     ip_engine *e = w->engine;
