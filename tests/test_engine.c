@@ -16,6 +16,7 @@
 #include "isoprop/engine.h"
 #include "isoprop/generate.h"
 #include "isoprop/render.h"
+#include "volumes.h"
 
 /* The stated tolerance of adaptive resolution against full resolution, on the long gyroid of
  * check_lod(): pixels whose coverage changes, in % of covered pixels, and the mean absolute
@@ -572,14 +573,7 @@ static void check_retirement(const char *dir)
     REQUIRE(f && fwrite(v, 1, count, f) == count && fclose(f) == 0);
     free(v);
     REQUIRE(snprintf(ibv, sizeof ibv, "%s/wall.ibv", dir) < (int)sizeof ibv);
-    ip_input_desc in;
-    ip_bricker_options bo;
-    REQUIRE(ip_input_describe(raw, NULL, &in, &err) == IP_OK);
-    ip_bricker_options_default(&bo);
-    bo.brick_edge = 16;
-    bo.subblock_edge = 4;
-    bo.force = 1;
-    REQUIRE(ip_bricker_run(&in, ibv, &bo, NULL, &err) == IP_OK);
+    test_brick_raw(raw, ibv, 16, 4);
     scene s;
     open_scene(ibv, &s);
     const uint32_t w = 128, h = 112;
