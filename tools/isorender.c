@@ -748,16 +748,8 @@ static int setup_camera(run *r, ip_error *err)
 {
     const ip_layout *l = ip_store_layout(r->store);
     ip_layout_world_box(l, r->lo, r->hi);
-    if (r->o.common.camera) {
-        r->camera.width = r->o.common.width;
-        r->camera.height = r->o.common.height;
-        if (ip_camera_parse(r->o.common.camera, &r->camera, err) != IP_OK ||
-            ip_camera_check(&r->camera, err) != IP_OK)
-            return -1;
-    } else if (ip_camera_fit_axis(r->lo, r->hi, r->o.common.view, 30.0, r->o.common.width,
-                                  r->o.common.height, &r->camera, err) != IP_OK) {
+    if (tool_view_camera(&r->o.common, r->lo, r->hi, &r->camera, err) != 0)
         return -1;
-    }
     r->view_camera = r->camera;
     tool_apply_orbit(&r->o.orbit, &r->camera);
     return 0;

@@ -858,6 +858,20 @@ static int hex_digit(char c)
     return c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
 }
 
+int tool_view_camera(const tool_view_options *o, const double lo[3], const double hi[3],
+                     ip_camera *camera, ip_error *err)
+{
+    if (!o->camera)
+        return ip_camera_fit_axis(lo, hi, o->view, 30.0, o->width, o->height, camera, err) == IP_OK
+                   ? 0
+                   : -1;
+    camera->width = o->width;
+    camera->height = o->height;
+    if (ip_camera_parse(o->camera, camera, err) != IP_OK || ip_camera_check(camera, err) != IP_OK)
+        return -1;
+    return 0;
+}
+
 int tool_parse_colour(const char *text, float rgb[3])
 {
     if (text[0] == '#') {

@@ -286,6 +286,12 @@ void tool_orbit_options_default(tool_orbit_options *o);
  * divided by it. The camera stays valid. */
 void tool_apply_orbit(const tool_orbit_options *o, ip_camera *camera);
 
+/* The camera of the view options: --camera E,T,U,FOV (checked) or, without it, --view AXIS
+ * fitted to the world box [lo, hi] (30 degrees), of --size pixels; before any orbit. Returns 0,
+ * or -1 with err set. */
+int tool_view_camera(const tool_view_options *o, const double lo[3], const double hi[3],
+                     ip_camera *camera, ip_error *err);
+
 /* Parses a colour: "R,G,B" (numbers in [0, 1]) or "#rrggbb" (hexadecimal). Returns 0, or -1
  * on bad text. */
 int tool_parse_colour(const char *text, float rgb[3]);
