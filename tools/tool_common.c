@@ -671,6 +671,17 @@ int tool_option_positive(const char *p, const tool_option *opt, const char *cons
     return parse_double_option(p, opt, v[0], base, 1);
 }
 
+int tool_option_background(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    ip_shading *s = (ip_shading *)((char *)base + opt->offset);
+    if (tool_parse_background(v[0], s->background_top, s->background_bottom) != 0)
+        return tool_usage_error(p,
+                                "%s '%s' is not a colour (R,G,B or #rrggbb) or TOP:BOTTOM, two "
+                                "of them",
+                                opt->name, v[0]);
+    return 0;
+}
+
 int tool_parse_threads(const char *program, const char *text, unsigned max, unsigned *threads)
 {
     uint64_t n;

@@ -10,6 +10,7 @@
 #include "isoprop/camera.h"
 #include "isoprop/engine.h"
 #include "isoprop/input.h"
+#include "isoprop/render.h"
 #include "isoprop/status.h"
 #include "isoprop/store.h"
 #include "isoprop/system.h"
@@ -207,6 +208,11 @@ tool_option_parse tool_option_number, tool_option_positive;
 /* Parses --cache-mb N (tool_parse_cache_mb()) into the uint64_t (bytes) at base + offset; a
  * bad value is "bad --cache-mb 'VALUE'". */
 tool_option_parse tool_option_cache_mb;
+
+/* Parses --background (tool_parse_background()) into the background colours of the ip_shading
+ * at base + offset; a bad value is "--background 'VALUE' is not a colour (R,G,B or #rrggbb) or
+ * TOP:BOTTOM, two of them". */
+tool_option_parse tool_option_background;
 
 /* Parses --threads N: 1 .. max, else "--threads must be 1-MAX". Returns 0, or 2 after the
  * usage error. */
