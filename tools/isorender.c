@@ -189,8 +189,7 @@ typedef struct run {
 
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
                           void *base);
-static tool_option_parse parse_color, parse_background, parse_turntable, parse_aa, parse_smooth,
-    parse_opacity;
+static tool_option_parse parse_color, parse_turntable, parse_aa, parse_smooth, parse_opacity;
 
 static const tool_option isorender_options[] = {
     {"-o", NULL, 1, offsetof(options, out), NULL, NULL, NULL},
@@ -207,7 +206,7 @@ static const tool_option isorender_options[] = {
     TOOL_ORBIT_OPTION_ROWS(options, orbit),
     {"--color", NULL, 1, 0, parse_color, NULL, NULL},
     {"--opacity", NULL, 1, 0, parse_opacity, NULL, NULL},
-    {"--background", NULL, 1, 0, parse_background, NULL, NULL},
+    {"--background", NULL, 1, offsetof(options, shading), tool_option_background, NULL, NULL},
     {"--turntable", NULL, 1, 0, parse_turntable, NULL, NULL},
     {"--mp4", NULL, 1, offsetof(options, mp4), NULL, NULL, NULL},
     {"--aa", NULL, 1, 0, parse_aa, NULL, NULL},
@@ -329,20 +328,6 @@ static void surface_of(const run *r, size_t i, const uint64_t *prefix, ip_mesh *
                                               : surface_palette[i - 1];
     memcpy(out->colour, colour, sizeof out->colour);
     out->opacity = i < o->opacity_count ? o->opacity[i] : 1.0f;
-}
-
-static int parse_background(const char *program, const tool_option *option,
-                            const char *const *values, void *base)
-{
-    options *o = base;
-    (void)option;
-    if (tool_parse_background(values[0], o->shading.background_top, o->shading.background_bottom) !=
-        0)
-        return tool_usage_error(program,
-                                "--background '%s' is not a colour (R,G,B or #rrggbb) or "
-                                "TOP:BOTTOM, two of them",
-                                values[0]);
-    return 0;
 }
 
 #define AA_MAX_SAMPLES 16
@@ -748,16 +733,8 @@ static int setup_camera(run *r, ip_error *err)
 {
     const ip_layout *l = ip_store_layout(r->store);
     ip_layout_world_box(l, r->lo, r->hi);
-    if (r->o.common.camera) {
-        r->camera.width = r->o.common.width;
-        r->camera.height = r->o.common.height;
-        if (ip_camera_parse(r->o.common.camera, &r->camera, err) != IP_OK ||
-            ip_camera_check(&r->camera, err) != IP_OK)
-            return -1;
-    } else if (ip_camera_fit_axis(r->lo, r->hi, r->o.common.view, 30.0, r->o.common.width,
-                                  r->o.common.height, &r->camera, err) != IP_OK) {
+    if (tool_view_camera(&r->o.common, r->lo, r->hi, &r->camera, err) != 0)
         return -1;
-    }
     r->view_camera = r->camera;
     tool_apply_orbit(&r->o.orbit, &r->camera);
     return 0;

@@ -671,6 +671,17 @@ int tool_option_positive(const char *p, const tool_option *opt, const char *cons
     return parse_double_option(p, opt, v[0], base, 1);
 }
 
+int tool_option_background(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    ip_shading *s = (ip_shading *)((char *)base + opt->offset);
+    if (tool_parse_background(v[0], s->background_top, s->background_bottom) != 0)
+        return tool_usage_error(p,
+                                "%s '%s' is not a colour (R,G,B or #rrggbb) or TOP:BOTTOM, two "
+                                "of them",
+                                opt->name, v[0]);
+    return 0;
+}
+
 int tool_parse_threads(const char *program, const char *text, unsigned max, unsigned *threads)
 {
     uint64_t n;
@@ -856,6 +867,20 @@ static int hex_digit(char c)
         return c - '0';
     c = (char)tolower((unsigned char)c);
     return c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
+}
+
+int tool_view_camera(const tool_view_options *o, const double lo[3], const double hi[3],
+                     ip_camera *camera, ip_error *err)
+{
+    if (!o->camera)
+        return ip_camera_fit_axis(lo, hi, o->view, 30.0, o->width, o->height, camera, err) == IP_OK
+                   ? 0
+                   : -1;
+    camera->width = o->width;
+    camera->height = o->height;
+    if (ip_camera_parse(o->camera, camera, err) != IP_OK || ip_camera_check(camera, err) != IP_OK)
+        return -1;
+    return 0;
 }
 
 int tool_parse_colour(const char *text, float rgb[3])

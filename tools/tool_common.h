@@ -10,6 +10,7 @@
 #include "isoprop/camera.h"
 #include "isoprop/engine.h"
 #include "isoprop/input.h"
+#include "isoprop/render.h"
 #include "isoprop/status.h"
 #include "isoprop/store.h"
 #include "isoprop/system.h"
@@ -208,6 +209,11 @@ tool_option_parse tool_option_number, tool_option_positive;
  * bad value is "bad --cache-mb 'VALUE'". */
 tool_option_parse tool_option_cache_mb;
 
+/* Parses --background (tool_parse_background()) into the background colours of the ip_shading
+ * at base + offset; a bad value is "--background 'VALUE' is not a colour (R,G,B or #rrggbb) or
+ * TOP:BOTTOM, two of them". */
+tool_option_parse tool_option_background;
+
 /* Parses --threads N: 1 .. max, else "--threads must be 1-MAX". Returns 0, or 2 after the
  * usage error. */
 int tool_parse_threads(const char *program, const char *text, unsigned max, unsigned *threads);
@@ -285,6 +291,12 @@ void tool_orbit_options_default(tool_orbit_options *o);
  * target (ip_camera_orbit()), and narrows its field of view by the zoom: tan(fov / 2) is
  * divided by it. The camera stays valid. */
 void tool_apply_orbit(const tool_orbit_options *o, ip_camera *camera);
+
+/* The camera of the view options: --camera E,T,U,FOV (checked) or, without it, --view AXIS
+ * fitted to the world box [lo, hi] (30 degrees), of --size pixels; before any orbit. Returns 0,
+ * or -1 with err set. */
+int tool_view_camera(const tool_view_options *o, const double lo[3], const double hi[3],
+                     ip_camera *camera, ip_error *err);
 
 /* Parses a colour: "R,G,B" (numbers in [0, 1]) or "#rrggbb" (hexadecimal). Returns 0, or -1
  * on bad text. */

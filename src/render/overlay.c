@@ -58,14 +58,16 @@ static void blend(const canvas *cv, int x, int y, colour c, double a)
     p[3] = 255;
 }
 
-/* A filled rectangle of pixels [x0, x1) x [y0, y1). */
+/* A filled rectangle of pixels [x0, x1) x [y0, y1): opaque, so each pixel becomes `c` (what
+ * blend() gives at full coverage) without blending. */
 static void fill_rect(const canvas *cv, int x0, int y0, int x1, int y1, colour c)
 {
     x0 = x0 < 0 ? 0 : x0, y0 = y0 < 0 ? 0 : y0; /* the rest is outside the image */
     x1 = x1 > cv->width ? cv->width : x1, y1 = y1 > cv->height ? cv->height : y1;
+    const uint8_t px[4] = {c.r, c.g, c.b, 255};
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++)
-            blend(cv, x, y, c, 1);
+            memcpy(cv->rgba + ((size_t)y * (size_t)cv->width + (size_t)x) * 4, px, 4);
 }
 
 /* An anti-aliased segment from (ax, ay) to (bx, by) (pixel coordinates, pixel centres at

@@ -173,10 +173,12 @@ static int extract_full(viewer *v)
     v->restart = 0; /* the full mesh serves every view, a change made while paused included */
     ip_mesh_clear(&v->full_mesh);
     memset(&v->full_counts, 0, sizeof v->full_counts);
+    tool_view_options common; /* the clipping planes as they apply now */
+    clip_options(v, &common);
     double start = ip_now_seconds();
-    if (ip_extract_full_clipped(v->cache, (float)v->iso, 0, v->o.common.threads, v->o.common.clip,
-                                v->clip_on ? v->o.common.clip_count : 0, &v->full_mesh,
-                                &v->full_counts, &v->err) != IP_OK)
+    if (ip_extract_full_clipped(v->cache, (float)v->iso, 0, common.threads, common.clip,
+                                common.clip_count, &v->full_mesh, &v->full_counts,
+                                &v->err) != IP_OK)
         return -1;
     v->full_wall = ip_now_seconds() - start;
     v->pass_render = 0;

@@ -93,16 +93,8 @@ static int setup_layout(wall_run *r, ip_error *err)
     w->tile_w = r->o.tile_w;
     w->tile_h = r->o.tile_h;
     w->tile_count = w->cols * w->rows;
-    if (r->o.common.camera) {
-        w->camera.width = r->o.common.width;
-        w->camera.height = r->o.common.height;
-        if (ip_camera_parse(r->o.common.camera, &w->camera, err) != IP_OK ||
-            ip_camera_check(&w->camera, err) != IP_OK)
-            return -1;
-    } else if (ip_camera_fit_axis(w->lo, w->hi, r->o.common.view, 30.0, r->o.common.width,
-                                  r->o.common.height, &w->camera, err) != IP_OK) {
+    if (tool_view_camera(&r->o.common, w->lo, w->hi, &w->camera, err) != 0)
         return -1;
-    }
     tool_apply_orbit(&r->o.orbit, &w->camera);
     if (wall_layout_regions(w, r->o.unit_w, r->o.unit_h) != 0) {
         err->code = IP_ERR_NOMEM;

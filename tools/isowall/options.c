@@ -72,19 +72,6 @@ static int parse_color(const char *program, const tool_option *option, const cha
     return 0;
 }
 
-/* --background: one colour, or TOP:BOTTOM. */
-static int parse_background(const char *program, const tool_option *option,
-                            const char *const *values, void *base)
-{
-    (void)option;
-    wall_options *o = base;
-    if (tool_parse_background(values[0], o->shading.background_top, o->shading.background_bottom) !=
-        0)
-        return tool_usage_error(program, "--background '%s' is not a colour or TOP:BOTTOM",
-                                values[0]);
-    return 0;
-}
-
 static const tool_option wall_table[] = {
     {"-o", NULL, 1, offsetof(wall_options, out), NULL, NULL, NULL},
     {"--wall", NULL, 1, 0, parse_pair_option, NULL, NULL},
@@ -95,7 +82,7 @@ static const tool_option wall_table[] = {
     {"--coarse", NULL, 1, offsetof(wall_options, coarse), NULL, NULL, NULL},
     TOOL_ORBIT_OPTION_ROWS(wall_options, orbit),
     {"--color", NULL, 1, 0, parse_color, NULL, NULL},
-    {"--background", NULL, 1, 0, parse_background, NULL, NULL},
+    {"--background", NULL, 1, offsetof(wall_options, shading), tool_option_background, NULL, NULL},
 };
 
 int wall_parse_args(int argc, char **argv, wall_options *o)
