@@ -143,9 +143,9 @@ static unsigned thread_count(const ip_bricker_options *o)
 
 /* Everything the run allocates, counted from the same sizes the allocations use: the slabs and
  * their index tables, a layer of sub-block ranges per level, the per-thread scratch (with its
- * min and max rows), the
- * directory and brick ranges (the sub-block ranges wait in the spill file), the octree nodes,
- * the Morton order of the largest level and the buffer the summary is streamed through. */
+ * min and max rows), the directory and brick ranges (the sub-block ranges wait in the spill
+ * file), the octree nodes, the Morton order of the largest level and the buffer the summary is
+ * streamed through. */
 static uint64_t memory_for(const ip_layout *l, unsigned threads, int overlap)
 {
     uint64_t total = 0, widest_level = 0;
