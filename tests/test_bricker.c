@@ -198,27 +198,31 @@ static void check_file(const char *ibv, const volume *v)
     ip_store_close(s);
 }
 
-static int brick_file_at(const char *raw, const char *ibv, uint32_t b, uint32_t s, unsigned threads,
-                         int level, ip_bricker_report *report)
+/* Bricks `input` into `ibv` (replaced) with options `o`; 0, or -1 with the error printed. */
+static int brick_with(const char *input, const char *ibv, ip_bricker_options *o,
+                      ip_bricker_report *report)
 {
     ip_input_desc desc;
     ip_error err;
-    ip_bricker_options o;
-    if (ip_input_describe(raw, NULL, &desc, &err) != IP_OK) {
+    o->force = 1;
+    if (ip_input_describe(input, NULL, &desc, &err) != IP_OK ||
+        ip_bricker_run(&desc, ibv, o, report, &err) != IP_OK) {
         fprintf(stderr, "%s\n", err.message);
         return -1;
     }
+    return 0;
+}
+
+static int brick_file_at(const char *raw, const char *ibv, uint32_t b, uint32_t s, unsigned threads,
+                         int level, ip_bricker_report *report)
+{
+    ip_bricker_options o;
     ip_bricker_options_default(&o);
     o.brick_edge = b;
     o.subblock_edge = s;
     o.threads = threads;
     o.lz4_level = level;
-    o.force = 1;
-    if (ip_bricker_run(&desc, ibv, &o, report, &err) != IP_OK) {
-        fprintf(stderr, "%s\n", err.message);
-        return -1;
-    }
-    return 0;
+    return brick_with(raw, ibv, &o, report);
 }
 
 static int brick_file(const char *raw, const char *ibv, uint32_t b, uint32_t s, unsigned threads,
@@ -391,8 +395,7 @@ static void test_memory_plan(void)
     REQUIRE(ip_bricker_memory_needed(&desc, &o, &x4, &err) == IP_OK);
     CHECK_MSG(x4 >= (uint64_t)65 * 2048 * 2048 * 2 && x4 <= (uint64_t)1024 << 20, "plan %llu bytes",
               (unsigned long long)x4);
-    desc.dims[0] = desc.dims[1] = 3072;
-    o.memory_limit = (uint64_t)1024 << 20;
+    desc.dims[0] = desc.dims[1] = 3072; /* and the limit of 1 GiB still */
     desc.dims[2] = 14040;
     REQUIRE(ip_bricker_memory_needed(&desc, &o, &deeper, &err) == IP_OK);
     uint64_t more_bricks = (uint64_t)96 * 96 * (14040 / 32 - 1404 / 32) * 8 / 7 + 1;
@@ -404,21 +407,13 @@ static void test_memory_plan(void)
 static int brick_limited(const char *input, const char *ibv, uint64_t limit,
                          ip_bricker_report *report)
 {
-    ip_input_desc desc;
-    ip_error err;
     ip_bricker_options o;
     ip_bricker_options_default(&o);
     o.brick_edge = 8;
     o.subblock_edge = 4;
     o.threads = 2;
     o.memory_limit = limit;
-    o.force = 1;
-    if (ip_input_describe(input, NULL, &desc, &err) != IP_OK ||
-        ip_bricker_run(&desc, ibv, &o, report, &err) != IP_OK) {
-        fprintf(stderr, "%s\n", err.message);
-        return -1;
-    }
-    return 0;
+    return brick_with(input, ibv, &o, report);
 }
 
 /* Whether the file system under `path` reads it with O_DIRECT (4 KiB at 0 into an aligned

@@ -172,6 +172,16 @@ static void expect_sform_map(const char *name, const ip_input_desc *d, const dou
     CHECK_MSG(worst < 1e-5, "%s: index (3,4,5) off its sform position by %g", name, worst);
 }
 
+/* s's srow: the columns of `turn` times `spacing`, then `origin` (sform_code left as it is). */
+static void put_sform(nifti_style *s, const double spacing[3], const double origin[3])
+{
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++)
+            s->srow[r][c] = turn[r][c] * spacing[c];
+        s->srow[r][3] = origin[r];
+    }
+}
+
 static void describe_ok(const char *path, ip_input_desc *d)
 {
     ip_error err;
@@ -197,11 +207,7 @@ static void test_orientation(void)
     for (int version = 1; version <= 2; version++) {
         nifti_style s = style_of(version, version == 2, 0);
         memcpy(s.pixdim, pixdim, sizeof pixdim);
-        for (int r = 0; r < 3; r++) {
-            for (int c = 0; c < 3; c++)
-                s.srow[r][c] = turn[r][c] * spacing[c];
-            s.srow[r][3] = sform_origin[r];
-        }
+        put_sform(&s, spacing, sform_origin);
         s.quatern[0] = 0.2, s.quatern[1] = 0.4, s.quatern[2] = 0.4;
         memcpy(s.qoffset, qoffset, sizeof qoffset);
 
@@ -252,11 +258,7 @@ static void test_orientation(void)
     }
     /* --spacing still replaces an sform's spacing; the directions stay */
     nifti_style s = style_of(1, 0, 0);
-    for (int r = 0; r < 3; r++) {
-        for (int c = 0; c < 3; c++)
-            s.srow[r][c] = turn[r][c] * spacing[c];
-        s.srow[r][3] = sform_origin[r];
-    }
+    put_sform(&s, spacing, sform_origin);
     s.sform_code = 4;
     REQUIRE(write_nifti(in_scratch(path, "override.nii"), IP_UINT8, dims, samples, &s) == 0);
     ip_input_overrides o = {0};

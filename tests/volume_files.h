@@ -176,6 +176,25 @@ static inline int16_t nifti_datatype(ip_type type)
     return codes[type];
 }
 
+/* The qform and sform fields of s: version 1 has float32 values and int16 codes, version 2
+ * float64 values and int32 codes; in both, quatern_b .. _d, qoffset_x .. _z and srow_x .. _z
+ * follow each other. */
+static inline void nifti_put_forms(unsigned char *h, const nifti_style *s, int v1)
+{
+    int be = s->big_endian, code = v1 ? 2 : 4;
+    size_t real = v1 ? 4 : 8, codes = v1 ? 252 : 344, quatern = v1 ? 256 : 352;
+    void (*put_real)(unsigned char *, double, int) = v1 ? nifti_put_f32 : nifti_put_f64;
+    put_real(h + (v1 ? 76 : 104), s->qfac, be);
+    nifti_put(h + codes, (uint32_t)s->qform_code, code, be);
+    nifti_put(h + codes + code, (uint32_t)s->sform_code, code, be);
+    for (int i = 0; i < 3; i++) {
+        put_real(h + quatern + real * i, s->quatern[i], be);
+        put_real(h + quatern + real * (3 + i), s->qoffset[i], be);
+        for (int j = 0; j < 4; j++)
+            put_real(h + quatern + real * (6 + 4 * i + j), s->srow[i][j], be);
+    }
+}
+
 /* The header (348 or 540 bytes) into h, zeroed first; returns its size. */
 static inline size_t nifti_header(unsigned char *h, ip_type type, const uint32_t dims[3],
                                   const nifti_style *s)
@@ -200,15 +219,6 @@ static inline size_t nifti_header(unsigned char *h, ip_type type, const uint32_t
         nifti_put_f32(h + 112, s->slope, be);
         nifti_put_f32(h + 116, s->intercept, be);
         h[123] = 2; /* millimetres */
-        nifti_put_f32(h + 76, s->qfac, be);
-        nifti_put(h + 252, (uint16_t)s->qform_code, 2, be);
-        nifti_put(h + 254, (uint16_t)s->sform_code, 2, be);
-        for (int i = 0; i < 3; i++) {
-            nifti_put_f32(h + 256 + 4 * i, s->quatern[i], be);
-            nifti_put_f32(h + 268 + 4 * i, s->qoffset[i], be);
-            for (int j = 0; j < 4; j++)
-                nifti_put_f32(h + 280 + 16 * i + 4 * j, s->srow[i][j], be);
-        }
         memcpy(h + 344, "n+1", 4);
     } else {
         memcpy(h + 4, "n+2\0\r\n\032\n", 8);
@@ -222,16 +232,8 @@ static inline size_t nifti_header(unsigned char *h, ip_type type, const uint32_t
         nifti_put_f64(h + 176, s->slope, be);
         nifti_put_f64(h + 184, s->intercept, be);
         nifti_put(h + 500, 2, 4, be);
-        nifti_put_f64(h + 104, s->qfac, be);
-        nifti_put(h + 344, (uint32_t)s->qform_code, 4, be);
-        nifti_put(h + 348, (uint32_t)s->sform_code, 4, be);
-        for (int i = 0; i < 3; i++) {
-            nifti_put_f64(h + 352 + 8 * i, s->quatern[i], be);
-            nifti_put_f64(h + 376 + 8 * i, s->qoffset[i], be);
-            for (int j = 0; j < 4; j++)
-                nifti_put_f64(h + 400 + 32 * i + 8 * j, s->srow[i][j], be);
-        }
     }
+    nifti_put_forms(h, s, v1);
     return size;
 }
 

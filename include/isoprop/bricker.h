@@ -5,9 +5,10 @@
  * calling one and helpers started once per run, joined before ip_bricker_run() returns) and
  * appended to an unnamed spill file. Where the memory limit has room for B more level-0
  * planes, a thread reads the next chunk of planes meanwhile; raw data whose planes suit the
- * file system's direct I/O are read with O_DIRECT, past the page cache. At the end the payloads are copied into the output in
- * Morton order, followed by the summary section and the header. The output appears under its
- * name only when complete (see docs/format.md and src/common/atomic_file.h).
+ * file system's direct I/O are read with O_DIRECT, past the page cache. At the end the
+ * payloads are copied into the output in Morton order, followed by the summary section and the
+ * header. The output appears under its name only when complete (see docs/format.md and
+ * src/common/atomic_file.h).
  */
 #ifndef ISOPROP_BRICKER_H
 #define ISOPROP_BRICKER_H

@@ -143,9 +143,9 @@ static unsigned thread_count(const ip_bricker_options *o)
 
 /* Everything the run allocates, counted from the same sizes the allocations use: the slabs and
  * their index tables, a layer of sub-block ranges per level, the per-thread scratch (with its
- * min and max rows), the
- * directory and brick ranges (the sub-block ranges wait in the spill file), the octree nodes,
- * the Morton order of the largest level and the buffer the summary is streamed through. */
+ * min and max rows), the directory and brick ranges (the sub-block ranges wait in the spill
+ * file), the octree nodes, the Morton order of the largest level and the buffer the summary is
+ * streamed through. */
 static uint64_t memory_for(const ip_layout *l, unsigned threads, int overlap)
 {
     uint64_t total = 0, widest_level = 0;
@@ -778,6 +778,15 @@ static void bricker_free(bricker *b)
 
 /* ---- streaming pass ---- */
 
+/* Tells the caller's progress callback that `done` of `total` input bytes are read and
+ * encoded; IP_ERR_CANCELLED when it asks to stop. */
+static ip_status report_progress(const bricker *b, uint64_t done, uint64_t total, ip_error *err)
+{
+    if (b->options->progress && b->options->progress(b->options->progress_user, done, total))
+        return ip__fail(err, IP_ERR_CANCELLED, "%s: cancelled; no output written", b->out_path);
+    return IP_OK;
+}
+
 /* The input is read in chunks that each complete one layer of level-0 bricks: planes up to
  * B * (layer + 1). While the pool encodes a chunk, the next one is read: by a thread of its own
  * into the level-0 slots the chunk does not use when the plan has room for them (overlap),
@@ -788,8 +797,8 @@ static ip_status stream_input(bricker *b, const ip_input_desc *in, ip_error *err
 {
     ip_input_reader *reader = NULL;
     ip_status st = ip_input_open(in, &reader, err);
-    if (st == IP_OK && ip__input_positioned(reader))
-        (void)ip__input_direct_open(reader);
+    if (st == IP_OK)
+        (void)ip__input_direct_open(reader); /* raw data only; else the reads stay buffered */
     uint64_t plane_bytes = b->slabs[0].plane_bytes;
     uint64_t total = plane_bytes * in->dims[2];
     read_ahead ahead;
@@ -822,18 +831,16 @@ static ip_status stream_input(bricker *b, const ip_input_desc *in, ip_error *err
         }
         b->report.seconds_encode += t2 - t1;
         b->report.seconds_read += ip_now_seconds() - t2;
-        if (st == IP_OK && b->options->progress &&
-            b->options->progress(b->options->progress_user, n0 * plane_bytes, total))
-            st = ip__fail(err, IP_ERR_CANCELLED, "%s: cancelled; no output written", b->out_path);
+        if (st == IP_OK)
+            st = report_progress(b, n0 * plane_bytes, total, err);
         z1 = n1;
     }
     double t3 = ip_now_seconds();
     if (st == IP_OK)
         st = encode_ready_layers(b, err);
     b->report.seconds_encode += ip_now_seconds() - t3;
-    if (st == IP_OK && b->options->progress &&
-        b->options->progress(b->options->progress_user, total, total))
-        st = ip__fail(err, IP_ERR_CANCELLED, "%s: cancelled; no output written", b->out_path);
+    if (st == IP_OK)
+        st = report_progress(b, total, total, err);
     b->report.bytes_direct = atomic_load(&b->direct_bytes);
     b->report.read_overlap = b->overlap;
     ip_input_close(reader);

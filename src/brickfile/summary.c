@@ -34,56 +34,6 @@ void ip__box_range(const void *samples, ip_type type, const uint32_t extent[3],
     }
 }
 
-/* Sub-block ranges of an integer brick whose row y of slice z starts at planes[z] + y *
- * row_bytes: the rows of one (y, z) band of sub-blocks are first reduced sample by sample into
- * a row of minima and a row of maxima (a loop the compiler vectorises), then each sub-block
- * reduces its stretch of those two rows. Same ranges as ip__box_range() per sub-block, about
- * a third of the time. */
-#define DEFINE_BAND_RANGES(T, NAME)                                                             \
-    static void NAME(const unsigned char *const *planes, size_t row_bytes, const uint32_t e[3], \
-                     uint32_t edge, uint32_t per_axis, float *ranges)                           \
-    {                                                                                           \
-        T lo_row[IP_MAX_BRICK_EDGE + 1], hi_row[IP_MAX_BRICK_EDGE + 1];                         \
-        size_t i = 0;                                                                           \
-        for (uint32_t bz = 0; bz < per_axis; bz++)                                              \
-            for (uint32_t by = 0; by < per_axis; by++) {                                        \
-                uint32_t z0 = bz * edge, y0 = by * edge;                                        \
-                uint32_t z1 = z0 + edge < e[2] - 1 ? z0 + edge : e[2] - 1;                      \
-                uint32_t y1 = y0 + edge < e[1] - 1 ? y0 + edge : e[1] - 1;                      \
-                int empty_band = z0 >= e[2] - 1 || y0 >= e[1] - 1;                              \
-                for (uint32_t x = 0; !empty_band && x < e[0]; x++)                              \
-                    lo_row[x] = hi_row[x] = ((const T *)(planes[z0] + y0 * row_bytes))[x];      \
-                for (uint32_t z = z0; !empty_band && z <= z1; z++)                              \
-                    for (uint32_t y = y0; y <= y1; y++) {                                       \
-                        const T *row = (const T *)(planes[z] + y * row_bytes);                  \
-                        for (uint32_t x = 0; x < e[0]; x++) {                                   \
-                            lo_row[x] = row[x] < lo_row[x] ? row[x] : lo_row[x];                \
-                            hi_row[x] = row[x] > hi_row[x] ? row[x] : hi_row[x];                \
-                        }                                                                       \
-                    }                                                                           \
-                for (uint32_t bx = 0; bx < per_axis; bx++, i++) {                               \
-                    uint32_t x0 = bx * edge;                                                    \
-                    uint32_t x1 = x0 + edge < e[0] - 1 ? x0 + edge : e[0] - 1;                  \
-                    if (empty_band || x0 >= e[0] - 1) {                                         \
-                        ranges[2 * i] = INFINITY;                                               \
-                        ranges[2 * i + 1] = -INFINITY;                                          \
-                        continue;                                                               \
-                    }                                                                           \
-                    T lo = lo_row[x0], hi = hi_row[x0];                                         \
-                    for (uint32_t x = x0 + 1; x <= x1; x++) {                                   \
-                        lo = lo_row[x] < lo ? lo_row[x] : lo;                                   \
-                        hi = hi_row[x] > hi ? hi_row[x] : hi;                                   \
-                    }                                                                           \
-                    ranges[2 * i] = (float)lo;                                                  \
-                    ranges[2 * i + 1] = (float)hi;                                              \
-                }                                                                               \
-            }                                                                                   \
-    }
-
-DEFINE_BAND_RANGES(uint8_t, band_ranges_u8)
-DEFINE_BAND_RANGES(uint16_t, band_ranges_u16)
-DEFINE_BAND_RANGES(int16_t, band_ranges_i16)
-
 /* The brick's range: the non-empty sub-blocks cover every sample of the brick, so their union
  * is its range. */
 void ip__union_range(const float *ranges, size_t count, float brick_range[2])
@@ -102,28 +52,6 @@ static void check_shape(const uint32_t extent[3], uint32_t brick_edge, uint32_t 
     for (int a = 0; a < 3; a++)
         IP_ASSERT(extent[a] >= 2 && extent[a] <= brick_edge + 1);
     (void)extent, (void)brick_edge, (void)subblock_edge;
-}
-
-void ip__summarise_planes(const unsigned char *const *planes, size_t row_bytes, ip_type type,
-                          const uint32_t extent[3], uint32_t brick_edge, uint32_t subblock_edge,
-                          float brick_range[2], float *ranges)
-{
-    check_shape(extent, brick_edge, subblock_edge);
-    IP_ASSERT(type != IP_FLOAT32);
-    uint32_t per_axis = brick_edge / subblock_edge;
-    switch (type) {
-    case IP_UINT8:
-        band_ranges_u8(planes, row_bytes, extent, subblock_edge, per_axis, ranges);
-        break;
-    case IP_UINT16:
-        band_ranges_u16(planes, row_bytes, extent, subblock_edge, per_axis, ranges);
-        break;
-    case IP_INT16:
-        band_ranges_i16(planes, row_bytes, extent, subblock_edge, per_axis, ranges);
-        break;
-    case IP_FLOAT32: break;
-    }
-    ip__union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
 }
 
 /* ---- a brick row of a layer, band by band ---- */
@@ -312,12 +240,16 @@ void ip__summarise_brick(const void *samples, ip_type type, const uint32_t exten
         ip__union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
         return;
     }
+    /* an integer brick is a layer of one brick: its row 0 */
     const unsigned char *planes[IP_MAX_BRICK_EDGE + 1];
     size_t row_bytes = (size_t)extent[0] * ip_type_size(type);
     for (uint32_t z = 0; z < extent[2]; z++)
         planes[z] = (const unsigned char *)samples + (size_t)z * extent[1] * row_bytes;
-    ip__summarise_planes(planes, row_bytes, type, extent, brick_edge, subblock_edge, brick_range,
-                         ranges);
+    ip__layer_rows layer = {planes,    row_bytes, type,       {extent[0], extent[1]},
+                            extent[2], {1, 1},    brick_edge, subblock_edge};
+    int16_t scratch[4 * (IP_MAX_BRICK_EDGE + 1)]; /* ip__brick_row_scratch_bytes(extent[0]) */
+    ip__summarise_brick_row(&layer, 0, scratch, ranges);
+    ip__union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
 }
 
 /* The union of the ranges of the children of `node` at `depth` of `level`. */

@@ -19,13 +19,6 @@ void ip__summarise_brick(const void *samples, ip_type type, const uint32_t exten
                          uint32_t brick_edge, uint32_t subblock_edge, float brick_range[2],
                          float *ranges);
 
-/* ip__summarise_brick() for an integer brick (not float32) read where it lies: row y of its
- * slice z starts at planes[z] + y * row_bytes (so a brick inside the bricker's slabs needs no
- * copy to be summarised, and one found constant none at all). */
-void ip__summarise_planes(const unsigned char *const *planes, size_t row_bytes, ip_type type,
-                          const uint32_t extent[3], uint32_t brick_edge, uint32_t subblock_edge,
-                          float brick_range[2], float *ranges);
-
 /* One layer of bricks of an integer level (not float32) where it lies: row y of the layer's
  * slice z starts at planes[z] + y * row_bytes, for y < dims[1] and z < depth. */
 typedef struct ip__layer_rows {
@@ -41,12 +34,12 @@ typedef struct ip__layer_rows {
 /* Bytes of scratch ip__summarise_brick_row() needs for a level `width` samples wide. */
 size_t ip__brick_row_scratch_bytes(uint32_t width, ip_type type);
 
-/* The sub-block ranges of brick row `by` of a layer, the same as ip__summarise_planes() gives
+/* The sub-block ranges of brick row `by` of a layer, the same as ip__summarise_brick() gives
  * each of its bricks: each (y, z) band of sub-blocks is reduced over full-width rows (read in
  * order, three at a time, each slice of the band once) into a row of minima and a row of
  * maxima in `scratch` (ip__brick_row_scratch_bytes()), then each sub-block reduces its stretch
  * of them. Brick (bx, by) of the layer gets its ranges at layer_ranges + 2 * (by * bricks[0] +
- * bx) * (B/s)^3, in the order of ip__summarise_planes(). */
+ * bx) * (B/s)^3, in the order of ip__summarise_brick(). */
 void ip__summarise_brick_row(const ip__layer_rows *layer, uint32_t by, void *scratch,
                              float *layer_ranges);
 

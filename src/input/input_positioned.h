@@ -32,8 +32,8 @@ ip_status ip__input_read_planes_at(const ip_input_reader *reader, uint32_t z, ui
 
 /*! ip__input_prefetch() : asks the kernel to start reading planes [z, z + count) into the page
  *  cache (posix_fadvise WILLNEED) and returns at once; planes past the end are ignored, and so
- *  is the whole call for a gzip reader and while reads are direct. The pages are the kernel's cache, not the process's
- *  memory. Thread-safe. */
+ *  is the whole call for a gzip reader and while reads are direct. The pages are the kernel's
+ *  cache, not the process's memory. Thread-safe. */
 void ip__input_prefetch(const ip_input_reader *reader, uint32_t z, uint32_t count);
 
 #endif

@@ -465,13 +465,20 @@ static int planes_aligned(const ip_input_reader *r)
     return r->desc.data_offset % a == 0 && r->plane_bytes % a == 0;
 }
 
+/* Whether reads go past the page cache: the O_DIRECT descriptor is open and no read was
+ * refused yet. */
+static int direct_on(const ip_input_reader *r)
+{
+    return r->direct_fd >= 0 && !atomic_load(&r->direct_refused);
+}
+
 int ip__input_direct_open(ip_input_reader *reader)
 {
     ip_input_reader *r = reader;
     if (!ip__input_positioned(r) || r->fd < 0)
         return 0;
     if (r->direct_fd >= 0)
-        return !atomic_load(&r->direct_refused);
+        return direct_on(r);
     int fd = open(r->desc.data_path, O_RDONLY | O_DIRECT | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0)
         return 0; /* EINVAL: the file system has no O_DIRECT; any other error: the same */
@@ -496,7 +503,7 @@ static size_t read_direct(const ip_input_reader *r, unsigned char *dst, size_t s
                           uint64_t offset)
 {
     ip_input_reader *mut = (ip_input_reader *)r; /* only the atomic flag changes */
-    if (r->direct_fd < 0 || atomic_load(&r->direct_refused))
+    if (!direct_on(r))
         return 0;
     uint64_t oa = r->direct_offset_align, ma = r->direct_mem_align;
     size_t done = 0;
@@ -547,7 +554,7 @@ void ip__input_prefetch(const ip_input_reader *reader, uint32_t z, uint32_t coun
     const ip_input_reader *r = reader;
     if (!ip__input_positioned(r) || z >= r->desc.dims[2] || count == 0)
         return;
-    if (r->direct_fd >= 0 && !atomic_load(&r->direct_refused))
+    if (direct_on(r))
         return; /* direct reads bypass the page cache: nothing to read ahead into */
     if (count > r->desc.dims[2] - z)
         count = r->desc.dims[2] - z;
