@@ -100,10 +100,54 @@ static void mark_active(ip_visited *v, ip_sampler *sampler, const ip_layout *l, 
             }
 }
 
+/* The depth short of which `beam` is settled, found the slow way: the least nearest depth
+ * (world units) of the active cells of level 0 not marked in v whose box is not wholly outside
+ * one of the beam's planes (cells [i, i+1] x ... scaled by the spacing); +infinity when there
+ * is none. */
+static double settled_depth(const ip_beam *beam, const ip_visited *v, ip_sampler *sampler,
+                            const ip_layout *l, float iso)
+{
+    const uint32_t *d = l->levels[0].dims;
+    double least = INFINITY;
+    for (uint32_t z = 0; z + 1 < d[2]; z++)
+        for (uint32_t y = 0; y + 1 < d[1]; y++)
+            for (uint32_t x = 0; x + 1 < d[0]; x++) {
+                uint32_t c[3] = {x, y, z};
+                double lo[3], hi[3], near = 0;
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = c[a] * l->spacing[a] - beam->eye[a];
+                    hi[a] = (c[a] + 1.0) * l->spacing[a] - beam->eye[a];
+                    near += beam->forward[a] * (beam->forward[a] >= 0 ? lo[a] : hi[a]);
+                }
+                int out = near >= least;
+                for (int p = 0; p < 4 && !out; p++) {
+                    const double *n = beam->normal[p];
+                    out = n[0] * (n[0] >= 0 ? hi[0] : lo[0]) + n[1] * (n[1] >= 0 ? hi[1] : lo[1]) +
+                              n[2] * (n[2] >= 0 ? hi[2] : lo[2]) <
+                          0;
+                }
+                if (out || ip__visited_test(v, 0, c))
+                    continue;
+                const ip_brick *b = ip__sampler_cell_brick(sampler, c);
+                REQUIRE(b);
+                ptrdiff_t corners[8];
+                float values[8];
+                ip__corner_offsets(b, corners);
+                ip__cell_values(b, l->type, corners, c, values);
+                unsigned mc = ip__mc_case(values, iso);
+                if (mc != 0 && mc != 255)
+                    least = near;
+            }
+    return least;
+}
+
 /* Beams of 8x8-pixel tiles, 3 pixels apart: as the visited cells grow, the answers of one
  * visited set that keeps the sub-blocks and cell groups the tests found settled
  * (ip__visited_mark_part()) are those of a set built afresh with the same cells and no such
- * record; and some are recorded. */
+ * record, and some are recorded. Where a beam is not settled, the depth it is settled short
+ * of is the nearest depth of the nearest cell that may spoil it (checked on every 4th tile
+ * against settled_depth()), and a beam whose min_depth skips what lies nearer than that gives
+ * the same depth. */
 static void check_beams(ip_cache *cache, const char *axis, float iso)
 {
     const ip_layout *l = ip_store_layout(ip_cache_store(cache));
@@ -116,7 +160,7 @@ static void check_beams(ip_cache *cache, const char *axis, float iso)
     ip_visited kept, fresh;
     REQUIRE(ip__visited_init(&kept, l) == IP_OK);
     REQUIRE(ip__visited_init(&fresh, l) == IP_OK);
-    uint64_t tests = 0, differ = 0, settled = 0, parts = 0;
+    uint64_t tests = 0, differ = 0, settled = 0, parts = 0, deep = 0, wrong = 0, floored = 0;
     static const unsigned shares[] = {0, 64, 160, 240, 256};
     for (size_t p = 0; p < sizeof shares / sizeof shares[0]; p++) {
         mark_active(&kept, &sampler, l, iso, shares[p]);
@@ -130,11 +174,22 @@ static void check_beams(ip_cache *cache, const char *axis, float iso)
                     ip_camera_pixel_ray(&basis, &camera, cx[i], cy[i], corner[i]);
                 ip_beam beam;
                 ip__beam_init(&beam, camera.eye, basis.forward, corner, INFINITY);
-                int a = ip__beam_settled(&seeder, &kept, &beam);
-                int b = ip__beam_settled(&seeder, &fresh, &beam);
-                differ += a != b;
+                double ta, tb;
+                int a = ip__beam_settled(&seeder, &kept, &beam, &ta);
+                int b = ip__beam_settled(&seeder, &fresh, &beam, &tb);
+                differ += a != b || ta != tb;
                 settled += a;
                 tests++;
+                if (a || (tx + ty) % 4 != 0)
+                    continue;
+                double want = settled_depth(&beam, &fresh, &sampler, l, iso);
+                wrong += !(fabs(ta - want) <= 1e-9 * want);
+                deep++;
+                /* what lies wholly nearer than that depth less two cells is settled:
+                 * passing over it changes nothing */
+                beam.min_depth = ta - 2 * fmax(l->spacing[0], fmax(l->spacing[1], l->spacing[2]));
+                double tc;
+                floored += ip__beam_settled(&seeder, &fresh, &beam, &tc) != 0 || tc != ta;
             }
     }
     /* the records the kept set holds: bits past the cells' of its bitmaps */
@@ -148,6 +203,11 @@ static void check_beams(ip_cache *cache, const char *axis, float iso)
               "recorded",
               axis, (double)iso, (unsigned long long)differ, (unsigned long long)tests,
               (unsigned long long)settled, (unsigned long long)parts);
+    CHECK_MSG(wrong == 0 && floored == 0 && deep > 100,
+              "view %s, iso %g: of %llu beams not settled, %llu gave the wrong depth, %llu "
+              "another with min_depth",
+              axis, (double)iso, (unsigned long long)deep, (unsigned long long)wrong,
+              (unsigned long long)floored);
     ip__visited_free(&kept);
     ip__visited_free(&fresh);
     ip__sampler_free(&sampler);

@@ -13,7 +13,9 @@ typedef struct index_beam {
     double normal[4][3]; /* the planes' normals with index coordinates: n[a] * scale[a] */
     double offset[4];    /* - n . eye */
     double forward[3];   /* forward[a] * scale[a] */
-    double limit;        /* max_depth + forward . eye */
+    double limit;        /* max_depth + forward . eye, lowered below each box found unsettled */
+    double floor;        /* min_depth + forward . eye */
+    int flip;            /* bit a: forward[a] < 0 (the nearer half along axis a is the high) */
 } index_beam;
 
 void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
@@ -34,15 +36,27 @@ void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
         b->forward[a] = forward[a];
     }
     b->max_depth = max_depth;
+    b->min_depth = -INFINITY;
+}
+
+/* The index box [lo, hi]'s nearest point's forward . p (its view depth + forward . eye). */
+static inline double nearest(const index_beam *w, const double lo[3], const double hi[3])
+{
+    double z = 0;
+    for (int a = 0; a < 3; a++)
+        z += w->forward[a] * (w->forward[a] >= 0 ? lo[a] : hi[a]);
+    return z;
 }
 
 /* 1 when the index box [lo, hi] may meet the beam. */
 static inline int meets(const index_beam *w, const double lo[3], const double hi[3])
 {
-    double z = 0;
-    for (int a = 0; a < 3; a++)
-        z += w->forward[a] * (w->forward[a] >= 0 ? lo[a] : hi[a]);
-    if (z > w->limit)
+    double near = 0, far = 0;
+    for (int a = 0; a < 3; a++) {
+        near += w->forward[a] * (w->forward[a] >= 0 ? lo[a] : hi[a]);
+        far += w->forward[a] * (w->forward[a] >= 0 ? hi[a] : lo[a]);
+    }
+    if (near > w->limit || far < w->floor)
         return 0;
     for (int p = 0; p < 4; p++) {
         const double *n = w->normal[p];
@@ -55,24 +69,36 @@ static inline int meets(const index_beam *w, const double lo[3], const double hi
     return 1;
 }
 
-/* The cells [lo, hi) of sub-block `sb` (index within its brick), by cell groups (cache.h): 1
- * when every active cell the beam may meet is visited. A cell group the beam meets every
+/* The index box [lo, hi], met by the beam, may hold an active cell that is not visited: the
+ * beam is settled only short of its nearest point from now on, and boxes wholly beyond that
+ * are passed over. */
+static void unsettled(index_beam *w, const double lo[3], const double hi[3])
+{
+    double z = nextafter(nearest(w, lo, hi), -INFINITY);
+    w->limit = z < w->limit ? z : w->limit;
+}
+
+/* The cells [lo, hi) of sub-block `sb` (index within its brick), by cell groups (cache.h):
+ * those that are active and not visited lower the beam's limit (unsettled()). A cell group the beam meets every
  * active cell of which is visited is recorded as settled (ip__visited_mark_part()), and so is
  * a sub-block all of whose groups are (or hold no active cell); later tests pass over them
  * at once: cells once visited stay so. Groups are recorded only where sub-blocks hold whole
  * groups; the groups the beam does not meet are not looked at. */
-static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[3], int side,
-                         uint32_t sb)
+static void settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[3], int side,
+                          uint32_t sb)
 {
     ip_seeder *s = w->s;
     /* only a brick the view has already loaded: a beam wider and deeper than its rays must not
      * read bricks they would never read (not settled then: the rays walk) */
     const ip_brick *brick = ip__sampler_resident_cell_brick(s->sampler, lo);
-    if (!brick)
-        return 0;
+    if (!brick) {
+        double blo[3] = {lo[0], lo[1], lo[2]}, bhi[3] = {hi[0], hi[1], hi[2]};
+        unsettled(w, blo, bhi);
+        return;
+    }
     const atomic_uint_fast64_t *marked = ip__visited_bitmap(w->visited, brick->index);
     if (ip__visited_part_in(w->visited, marked, sb))
-        return 1;
+        return;
     uint32_t per_group = (s->layout->brick_edge + IP_CELL_GROUP - 1) / IP_CELL_GROUP;
     int record_groups = s->layout->subblock_edge >= IP_CELL_GROUP;
     ptrdiff_t corners[8];
@@ -132,27 +158,28 @@ static int settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi[
                             whole = group_whole = 0;
                             double clo[3] = {x, y, z}, chi[3] = {x + 1.0, y + 1.0, z + 1.0};
                             if (meets(w, clo, chi))
-                                return 0;
+                                unsettled(w, clo, chi);
                         }
                 if (group_whole && record_groups) /* out of memory: not recorded, no harm */
                     (void)ip__visited_mark_part(w->visited, brick->index, part);
             }
     if (whole)
         (void)ip__visited_mark_part(w->visited, brick->index, sb);
-    return 1;
 }
 
-/* The sub-blocks of brick `b`. */
-static int settled_brick(index_beam *w, const uint32_t b[3])
+/* The sub-blocks of brick `b`, nearest first along each axis. */
+static void settled_brick(index_beam *w, const uint32_t b[3])
 {
     ip_seeder *s = w->s;
     const ip_layout *l = s->layout;
     uint32_t origin[3], extent[3], n[3];
     const float *ranges = ip__seeder_brick(s, b, origin, extent, n);
     uint32_t per = l->brick_edge / l->subblock_edge;
-    for (uint32_t i = 0; i < n[2]; i++)
-        for (uint32_t j = 0; j < n[1]; j++)
-            for (uint32_t h = 0; h < n[0]; h++) {
+    for (uint32_t ii = 0; ii < n[2]; ii++)
+        for (uint32_t jj = 0; jj < n[1]; jj++)
+            for (uint32_t hh = 0; hh < n[0]; hh++) {
+                uint32_t h = w->flip & 1 ? n[0] - 1 - hh : hh, j = w->flip & 2 ? n[1] - 1 - jj : jj,
+                         i = w->flip & 4 ? n[2] - 1 - ii : ii;
                 uint32_t sb = h + per * (j + per * i), at[3] = {h, j, i};
                 if (!ip__range_active(ranges[2 * sb], ranges[2 * sb + 1], s->iso))
                     continue;
@@ -162,19 +189,22 @@ static int settled_brick(index_beam *w, const uint32_t b[3])
                 if (!meets(w, blo, bhi))
                     continue;
                 int side = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi);
-                if (side && !settled_cells(w, lo, hi, side, sb))
-                    return 0;
+                if (side)
+                    settled_cells(w, lo, hi, side, sb);
             }
-    return 1;
 }
 
-/* Node `node` of octree depth `depth` (0: a brick), which meets the beam. */
-static int settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
+/* Node `node` of octree depth `depth` (0: a brick), which meets the beam: its children,
+ * nearest first along each axis, so that the limit falls early. */
+static void settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
 {
-    if (depth == 0)
-        return settled_brick(w, node);
+    if (depth == 0) {
+        settled_brick(w, node);
+        return;
+    }
     ip_seeder *s = w->s;
-    for (int c = 0; c < 8; c++) {
+    for (int i = 0; i < 8; i++) {
+        int c = i ^ w->flip;
         uint32_t ch[3];
         if (!ip__seeder_active_child(s, depth, node, c, ch))
             continue;
@@ -182,20 +212,25 @@ static int settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
         ip__seeder_node_box(s, depth - 1, ch, lo, hi);
         if (!meets(w, lo, hi) || !ip__seeder_node_kept(s, depth - 1, ch))
             continue;
-        if (!settled_node(w, depth - 1, ch))
-            return 0;
+        settled_node(w, depth - 1, ch);
     }
-    return 1;
 }
 
-int ip__beam_settled(ip_seeder *s, ip_visited *visited, const ip_beam *b)
+int ip__beam_settled(ip_seeder *s, ip_visited *visited, const ip_beam *b, double *settled_to)
 {
     index_beam w;
     w.s = s;
     w.visited = visited;
-    w.limit = b->max_depth + ip__vec3_dot(b->forward, b->eye);
-    for (int a = 0; a < 3; a++)
+    double at_eye = ip__vec3_dot(b->forward, b->eye);
+    w.limit = b->max_depth + at_eye;
+    w.floor = b->min_depth + at_eye;
+    double limit = w.limit;
+    *settled_to = b->max_depth;
+    w.flip = 0;
+    for (int a = 0; a < 3; a++) {
         w.forward[a] = b->forward[a] * s->scale[a];
+        w.flip |= (b->forward[a] < 0) << a;
+    }
     for (int p = 0; p < 4; p++) {
         w.offset[p] = -ip__vec3_dot(b->normal[p], b->eye);
         for (int a = 0; a < 3; a++)
@@ -210,5 +245,9 @@ int ip__beam_settled(ip_seeder *s, ip_visited *visited, const ip_beam *b)
     ip__seeder_node_box(s, depth, root, lo, hi);
     if (!meets(&w, lo, hi))
         return 1;
-    return settled_node(&w, depth, root);
+    settled_node(&w, depth, root);
+    if (w.limit == limit)
+        return 1;
+    *settled_to = w.limit - at_eye;
+    return 0;
 }

@@ -58,6 +58,8 @@ typedef struct worker {
 typedef struct tile {
     atomic_uint depth;   /* a float's bits: the rays of its pixels whose solid entry is no
                             deeper need no walk (0: none known; +infinity: every ray) */
+    atomic_uint from;    /* a float's bits: a view depth short of which its rays find nothing
+                            new (0: none known) */
     atomic_uchar tested; /* 1 + the last ray-order level (from tile_from) it was tested in */
 } tile;
 
@@ -320,6 +322,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
             return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
         for (size_t t = 0; t < tiles; t++) {
             atomic_init(&e->tiles[t].depth, 0);
+            atomic_init(&e->tiles[t].from, 0);
             atomic_init(&e->tiles[t].tested, 0);
         }
     }
@@ -487,8 +490,15 @@ static double stop_depth(const ip_engine *e, uint32_t x, uint32_t y)
  * rays work. Entries only decrease and each is backed by a triangle already in a worker's mesh,
  * so a stale read only stops the walk later. The edge of the solid margin matters: the plain
  * coverage entry also counts centres on a triangle's edge, where snapping may uncover a
- * silhouette and show the surface behind, which this ray must then still find. */
-static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
+ * silhouette and show the surface behind, which this ray must then still find.
+ *
+ * The walk starts at view depth `from` (t = from / cos), where its tile's beam was found
+ * settled short of it (test_tile()): every active cell the ray could enter before is extracted
+ * already, and would only end the walk there (a cell hit squarely) or be passed over. Walking
+ * on from `from` then finds what the full walk finds past it and at most more cells behind an
+ * extracted one, all of the true surface: each is extracted or propagated from as a walk would
+ * (the image stays exact: a pixel's own first-hit cell is either extracted already or found). */
+static ip_status cast_ray(worker *w, uint32_t x, uint32_t y, double from)
 {
     ip_engine *e = w->engine;
     double dir[3];
@@ -504,9 +514,12 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
         t_max = stop < t_max ? stop : t_max;
         if (t_max < e->lod_distance[k])
             return IP_OK;
+        double t_min = from / cos > e->lod_distance[k] ? from / cos : e->lod_distance[k];
+        if (t_min > t_max)
+            continue;
         uint64_t nodes = lt->seeder.nodes;
-        int found = ip__seed_find(&lt->seeder, e->camera.eye, dir, e->lod_distance[k], t_max, cells,
-                                  &count, &seed_index);
+        int found = ip__seed_find(&lt->seeder, e->camera.eye, dir, t_min, t_max, cells, &count,
+                                  &seed_index);
         w->counts.nodes += lt->seeder.nodes - nodes;
         if (found < 0) {
             w->failed_level = k;
@@ -536,30 +549,56 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y)
     return IP_OK;
 }
 
-/* 1 when the rays of tile (tx, ty) whose solid coverage entry (coverage.h) is no deeper than
- * *solid can extract nothing any more: every active cell that such a ray could enter before its
- * stop (cast_ray()), at any level, is extracted already. *solid is the deepest entry among the
- * tile's pixels covered solidly, or +infinity when none is (then the test is for every ray of
- * the tile, which must find nothing new anywhere: a tile outside the surface's image). The beam
- * of the tile's pixel centres (widened by TILE_SLACK) is tested against the octree down to the
- * cells, up to that depth plus a cell's reach along the view. The rays it admits would then
- * find only extracted cells, now or later (entries only decrease and cells stay extracted),
- * and do nothing: their walks can be left out, and the mesh is the one the walks would leave. */
-static int tile_settled(worker *w, uint32_t tx, uint32_t ty, double *solid)
+/* The tile of image pixel (x, y). */
+static tile *pixel_tile(ip_engine *e, uint32_t x, uint32_t y)
+{
+    return &e->tiles[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)];
+}
+
+/* Raises a tile's bound `bound` to `bits` (a float's bits): either bound holds. */
+static void raise_bound(atomic_uint *bound, unsigned bits)
+{
+    unsigned old = atomic_load_explicit(bound, memory_order_relaxed);
+    while (bits > old && !atomic_compare_exchange_weak_explicit(
+                             bound, &old, bits, memory_order_relaxed, memory_order_relaxed))
+        ;
+}
+
+/* The bits of the largest float no larger than v * (1 - 1e-12) (v > 0), else 0. */
+static unsigned float_below(double v)
+{
+    v *= 1.0 - 1e-12;
+    float f = (float)v;
+    f = (double)f > v ? nextafterf(f, 0.0f) : f;
+    return f > 0 ? ip__float_bits(f) : 0;
+}
+
+/* Tests tile (tx, ty): which of its rays can still extract something. Let D be the deepest
+ * solid coverage entry (coverage.h) among its pixels, +infinity when none is covered solidly
+ * (a tile outside the surface's image, whose rays must then find nothing anywhere). The beam of
+ * its pixel centres (widened by TILE_SLACK) is tested against the octree down to the cells, at
+ * every level, up to D's stop (cast_ray()) plus a cell's reach along the view
+ * (ip__beam_settled()). Where every active cell there is extracted, the rays of the tile whose
+ * solid entry is no deeper than D would find only extracted cells, now or later (entries only
+ * decrease and cells stay extracted), and do nothing: their walks can be left out (the tile's
+ * `depth` is raised to D), and the mesh is the one the walks would leave. Where some may not
+ * be, the test learns the depth short of which the beam is settled: the rays whose stop lies
+ * short of it are left out in the same way (a lower `depth`), and the tile's other rays need
+ * not look short of it (its `from`): the cells there are extracted or inactive. */
+static void test_tile(worker *w, uint32_t tx, uint32_t ty, tile *t)
 {
     ip_engine *e = w->engine;
     uint32_t x0 = tx << TILE_SHIFT, y0 = ty << TILE_SHIFT;
     uint32_t x1 = x0 + (1u << TILE_SHIFT), y1 = y0 + (1u << TILE_SHIFT);
     x1 = x1 < e->camera.width ? x1 : e->camera.width;
     y1 = y1 < e->camera.height ? y1 : e->camera.height;
-    double deepest = 0; /* over the pixels covered solidly; +infinity when there is none */
+    double deepest = 0; /* over the pixels covered solidly; +infinity when none is */
     for (uint32_t y = y0; y < y1; y++)
         for (uint32_t x = x0; x < x1; x++) {
             double z = ip__coverage_solid(&e->coverage, x, y);
             deepest = z < INFINITY && z > deepest ? z : deepest;
         }
     deepest = deepest > 0 ? deepest : INFINITY;
-    *solid = deepest;
     double stop = deepest / (1.0 - DEPTH_MARGIN); /* as stop_depth() */
     double corner[4][3];
     double cx[4] = {x0 + 0.5 - TILE_SLACK, x1 - 0.5 + TILE_SLACK, x1 - 0.5 + TILE_SLACK,
@@ -568,19 +607,25 @@ static int tile_settled(worker *w, uint32_t tx, uint32_t ty, double *solid)
                     y1 - 0.5 + TILE_SLACK};
     for (int i = 0; i < 4; i++)
         ip_camera_pixel_ray(&e->basis, &e->camera, cx[i], cy[i], corner[i]);
+    int whole = 1;
+    double from = INFINITY; /* every level's beam is settled short of it */
+    /* what an earlier test found settled stays so: the beam need not look there again */
+    double known = ip__float_of_bits(atomic_load_explicit(&t->from, memory_order_relaxed));
     for (uint32_t k = 0; k < e->levels_used; k++) {
         ip_beam beam;
+        double to;
         ip__beam_init(&beam, e->camera.eye, e->basis.forward, corner, stop + e->cell_reach[k]);
-        if (!ip__beam_settled(&w->level[k].seeder, &e->visited, &beam))
-            return 0;
+        beam.min_depth = known;
+        if (!ip__beam_settled(&w->level[k].seeder, &e->visited, &beam, &to)) {
+            whole = 0;
+            stop = to - e->cell_reach[k] < stop ? to - e->cell_reach[k] : stop;
+        }
+        from = to < from ? to : from;
     }
-    return 1;
-}
-
-/* The tile of image pixel (x, y). */
-static tile *pixel_tile(ip_engine *e, uint32_t x, uint32_t y)
-{
-    return &e->tiles[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)];
+    raise_bound(&t->depth, whole ? ip__float_bits((float)deepest) /* exact */
+                                 : float_below(stop * (1.0 - DEPTH_MARGIN)));
+    if (from < INFINITY)
+        raise_bound(&t->from, float_below(from));
 }
 
 /* 1 when the ray of image pixel (x, y) is retired by its tile as it stands: its solid entry is
@@ -596,31 +641,27 @@ static int pixel_settled(const ip_engine *e, uint32_t x, uint32_t y, unsigned se
 
 /* 1 when the ray of pixel (x, y), of the order's level `level`, may be retired without a walk
  * (counted): its solid coverage entry is no deeper than one its tile was found settled at
- * (tile_settled()), +infinity included. A tile is tested by the first ray of each of the
- * Z-order levels (ray_order.h) that it does not retire; an entry found settled stays so.
- * Without occlusion, never. */
-static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level)
+ * (test_tile()), +infinity included. A tile is tested by the first ray of each of the
+ * Z-order levels (ray_order.h) that it does not retire; what it was found settled at stays so.
+ * Otherwise 0, with *from the view depth short of which the ray can find nothing new (0 when
+ * none is known). Without occlusion, never. */
+static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level, double *from)
 {
     ip_engine *e = w->engine;
+    *from = 0;
     if (!e->options.occlusion || level < e->tile_from)
         return 0;
     tile *t = pixel_tile(e, x, y);
-    unsigned settled = atomic_load_explicit(&t->depth, memory_order_relaxed);
-    if (!pixel_settled(e, x, y, settled)) {
+    if (!pixel_settled(e, x, y, atomic_load_explicit(&t->depth, memory_order_relaxed))) {
         unsigned char pass = (unsigned char)(level - e->tile_from + 1);
-        if (atomic_load_explicit(&t->tested, memory_order_relaxed) >= pass)
-            return 0; /* tested in this level already */
-        atomic_store_explicit(&t->tested, pass, memory_order_relaxed);
-        double solid;
-        if (!tile_settled(w, x >> TILE_SHIFT, y >> TILE_SHIFT, &solid))
+        if (atomic_load_explicit(&t->tested, memory_order_relaxed) < pass) {
+            atomic_store_explicit(&t->tested, pass, memory_order_relaxed);
+            test_tile(w, x >> TILE_SHIFT, y >> TILE_SHIFT, t);
+        }
+        if (!pixel_settled(e, x, y, atomic_load_explicit(&t->depth, memory_order_relaxed))) {
+            *from = ip__float_of_bits(atomic_load_explicit(&t->from, memory_order_relaxed));
             return 0;
-        unsigned bits = ip__float_bits((float)solid); /* exact; raised, never lowered: both hold */
-        while (bits > settled &&
-               !atomic_compare_exchange_weak_explicit(&t->depth, &settled, bits,
-                                                      memory_order_relaxed, memory_order_relaxed))
-            ;
-        if (!pixel_settled(e, x, y, bits))
-            return 0;
+        }
     }
     w->counts.rays++;
     w->counts.retired++;
@@ -791,8 +832,9 @@ static void work(void *user, unsigned index)
                 w->status = IP_ERR_CANCELLED;
                 break;
             }
-            if (!retire(w, rays[i].x, rays[i].y, rays[i].level))
-                w->status = cast_ray(w, rays[i].x, rays[i].y);
+            double from;
+            if (!retire(w, rays[i].x, rays[i].y, rays[i].level, &from))
+                w->status = cast_ray(w, rays[i].x, rays[i].y, from);
         }
         double seeding = ip_now_seconds() - t0 -
                          (w->counts.propagation_seconds + w->counts.extraction_seconds - inner);
