@@ -621,19 +621,20 @@ static void check_retirement(const char *dir)
 
 /* Step budgets with the ray order handed out in ranges to several workers: each step casts
  * exactly its budget (the rest at the end), a step cut short by its deadline leaves no pixel
- * out, and the rays add up to the pixels once the engine is done. */
-static void check_ray_budgets(scene *s, float iso)
+ * out, and the rays add up to the pixels once the engine is done. At width x height, with
+ * blocks of the Z-order levels whose rays to walk overfill a batch at the larger size. */
+static void check_ray_budgets(scene *s, float iso, uint32_t width, uint32_t height)
 {
     ip_error err;
     ip_camera cam;
-    REQUIRE(ip_camera_fit_axis(s->lo, s->hi, "-x", 30.0, 97, 61, &cam, &err) == IP_OK);
+    REQUIRE(ip_camera_fit_axis(s->lo, s->hi, "-x", 30.0, width, height, &cam, &err) == IP_OK);
     ip_engine *e;
     ip_engine_options o;
     ip_engine_options_default(&o);
     o.threads = 4;
     REQUIRE(ip_engine_create(s->cache, &o, &e, &err) == IP_OK);
     REQUIRE(ip_engine_begin(e, &cam, iso, &err) == IP_OK);
-    uint64_t pixels = 97 * 61, cast = 0, exact = 0, steps = 0;
+    uint64_t pixels = (uint64_t)width * height, cast = 0, exact = 0, steps = 0;
     static const uint64_t budgets[] = {1, 5, 37, 64, 100, 1000};
     while (!ip_engine_done(e)) {
         uint64_t budget = budgets[steps % (sizeof budgets / sizeof budgets[0])];
@@ -811,7 +812,8 @@ int main(void)
     check_view(&s, "gyroid", "-x", 0.5f, 128, 96);
     check_view(&s, "gyroid", "+y", 0.6f, 96, 128);
     check_cancel_restart(&s, 0.5f, 0.45f);
-    check_ray_budgets(&s, 0.5f);
+    check_ray_budgets(&s, 0.5f, 97, 61);
+    check_ray_budgets(&s, 0.5f, 320, 240);
     check_regions(&s, 0.5f);
     check_threads(&s, 0.5f);
     close_scene(&s);

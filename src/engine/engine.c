@@ -63,9 +63,12 @@ typedef struct tile {
     atomic_uchar tested; /* 1 + the last ray-order level (from tile_from) it was tested in */
 } tile;
 
-/* A ray of the order: its pixel and the order's level it belongs to. */
+/* A ray of the order: its pixel and the order's level it belongs to; with `tested`, its tile
+ * was consulted already (retire()) and the ray is to be walked from view depth `from`. */
 typedef struct order_ray {
     uint32_t x, y, level;
+    int tested;
+    double from;
 } order_ray;
 
 struct ip_engine {
@@ -639,41 +642,50 @@ static int pixel_settled(const ip_engine *e, uint32_t x, uint32_t y, unsigned se
     return z <= ip__float_of_bits(settled);
 }
 
-/* 1 when the ray of pixel (x, y), of the order's level `level`, may be retired without a walk
- * (counted): its solid coverage entry is no deeper than one its tile was found settled at
- * (test_tile()), +infinity included. A tile is tested by the first ray of each of the
- * Z-order levels (ray_order.h) that it does not retire; what it was found settled at stays so.
+/* 1 when the ray of image pixel (x, y), of the order's Z-order level `level`, is retired by
+ * its tile: its solid coverage entry is no deeper than one its tile was found settled at
+ * (test_tile()), +infinity included. A tile is tested by the first ray of each of the Z-order
+ * levels (ray_order.h) that it does not retire; what it was found settled at stays so.
  * Otherwise 0, with *from the view depth short of which the ray can find nothing new (0 when
- * none is known). Without occlusion, never. */
-static int retire(worker *w, uint32_t x, uint32_t y, uint32_t level, double *from)
+ * none is known). Counts nothing. */
+static int tile_retires(worker *w, uint32_t x, uint32_t y, uint32_t level, double *from)
 {
     ip_engine *e = w->engine;
-    *from = 0;
-    if (!e->options.occlusion || level < e->tile_from)
-        return 0;
     tile *t = pixel_tile(e, x, y);
-    if (!pixel_settled(e, x, y, atomic_load_explicit(&t->depth, memory_order_relaxed))) {
-        unsigned char pass = (unsigned char)(level - e->tile_from + 1);
-        if (atomic_load_explicit(&t->tested, memory_order_relaxed) < pass) {
-            atomic_store_explicit(&t->tested, pass, memory_order_relaxed);
-            test_tile(w, x >> TILE_SHIFT, y >> TILE_SHIFT, t);
-        }
-        if (!pixel_settled(e, x, y, atomic_load_explicit(&t->depth, memory_order_relaxed))) {
-            *from = ip__float_of_bits(atomic_load_explicit(&t->from, memory_order_relaxed));
-            return 0;
-        }
+    if (pixel_settled(e, x, y, atomic_load_explicit(&t->depth, memory_order_relaxed)))
+        return 1;
+    unsigned char pass = (unsigned char)(level - e->tile_from + 1);
+    if (atomic_load_explicit(&t->tested, memory_order_relaxed) < pass) {
+        atomic_store_explicit(&t->tested, pass, memory_order_relaxed);
+        test_tile(w, x >> TILE_SHIFT, y >> TILE_SHIFT, t);
+        if (pixel_settled(e, x, y, atomic_load_explicit(&t->depth, memory_order_relaxed)))
+            return 1;
     }
+    *from = ip__float_of_bits(atomic_load_explicit(&t->from, memory_order_relaxed));
+    return 0;
+}
+
+/* 1 when ray r may be retired without a walk (counted): tile_retires(), in the Z-order
+ * levels, with occlusion. Otherwise 0, with *from where its walk may start (0: at the eye). */
+static int retire(worker *w, const order_ray *r, double *from)
+{
+    ip_engine *e = w->engine;
+    *from = r->tested ? r->from : 0;
+    if (r->tested || !e->options.occlusion || r->level < e->tile_from ||
+        !tile_retires(w, r->x, r->y, r->level, from))
+        return 0;
     w->counts.rays++;
     w->counts.retired++;
     return 1;
 }
 
-/* The Z-order levels' aligned blocks of 4^BLOCK_LOG4 cells whose pixels retire() would all
- * retire are passed over at once (retire_block()). */
+/* The Z-order levels' aligned blocks of 4^BLOCK_LOG4 cells are taken at once, their pixels
+ * that retire() would retire passed over (take_block()). */
 #define BLOCK_LOG4 3
 #define BLOCK_CELLS (1u << 2 * BLOCK_LOG4)
 
-#define RETIRED_PER_BATCH 4096 /* rays of blocks a batch may retire at once, at most */
+#define RETIRED_PER_BATCH 4096             /* rays of blocks a batch may retire at once, at most */
+#define RAY_ROOM (RAY_BATCH + BLOCK_CELLS) /* a batch's rays, a block's overfill included */
 
 /* Takes `rays` of the step's budget when the step has one; 0 when it has fewer left. */
 static int take_budget(ip_engine *e, uint64_t rays)
@@ -688,30 +700,40 @@ static int take_budget(ip_engine *e, uint64_t rays)
     return 1;
 }
 
-/* When the worker's iterator stands at such a block, within its range, whose pixels are each
- * retired by retire()'s own test as the tiles stand (none is tested here) and fit the step's
- * budget: moves past it, counts its rays as retired and returns 1 with their number in
- * *count. Otherwise the rays are left to be walked or retired one by one (0). */
-static int retire_block(ip_engine *e, worker *w, unsigned *count)
+/* When the worker's iterator stands at such a block, within its range: the block's pixels
+ * whose tile retires them (tile_retires(), which tests a tile where retire() would: at its
+ * first ray of the level that it does not retire) are counted as retired, their number in
+ * *count, and the others, when there are at most `space`, go to rays[0 .. *walk), to be
+ * walked; the iterator moves past the block, and 1 is returned. The step's budget pays for the
+ * retired rays and those to walk beyond `share` (the batch's share of it left). 0, and nothing
+ * done but tests of tiles, where the iterator stands at no such block, more than `space`
+ * pixels are left, or the budget cannot pay. */
+static int take_block(ip_engine *e, worker *w, order_ray *rays, unsigned space, unsigned share,
+                      unsigned *count, unsigned *walk)
 {
     if (!e->options.occlusion || ip__ray_order_position(&w->order) + BLOCK_CELLS > w->range_end)
         return 0;
     uint32_t xs[BLOCK_CELLS], ys[BLOCK_CELLS];
-    unsigned n;
+    unsigned n, left = 0;
     if (!ip__ray_order_block(&w->order, BLOCK_LOG4, xs, ys, &n)) /* only in tile_from on */
         return 0;
+    uint32_t level = ip__ray_order_level(&w->order);
     for (unsigned i = 0; i < n; i++) {
         uint32_t x = xs[i] + e->region_x, y = ys[i] + e->region_y;
-        unsigned settled = atomic_load_explicit(&pixel_tile(e, x, y)->depth, memory_order_relaxed);
-        if (!pixel_settled(e, x, y, settled))
+        double from;
+        if (tile_retires(w, x, y, level, &from))
+            continue;
+        if (left == space)
             return 0;
+        rays[left++] = (order_ray){x, y, level, 1, from};
     }
-    if (!take_budget(e, n))
+    if (!take_budget(e, n - left + (left > share ? left - share : 0)))
         return 0;
     ip__ray_order_skip_block(&w->order, BLOCK_LOG4, n);
-    w->counts.rays += n;
-    w->counts.retired += n;
-    *count = n;
+    w->counts.rays += n - left;
+    w->counts.retired += n - left;
+    *count = n - left;
+    *walk = left;
     return 1;
 }
 
@@ -764,9 +786,10 @@ static void leave_range(ip_engine *e, worker *w)
     w->holding = 0;
 }
 
-/* Takes up to RAY_BATCH pixels of the order for this step from the worker's ranges: those to
- * walk or retire one by one into rays[0 .. *count), and whole blocks retired at once; returns
- * how many pixels in all (0: none left for this step). */
+/* Takes up to RAY_BATCH pixels of the order for this step from the worker's ranges (up to
+ * RAY_ROOM when the rays of a block overfill it): those to walk or retire one by one into
+ * rays[0 .. *count), and the rays of blocks retired at once; returns how many pixels in all
+ * (0: none left for this step). */
 static uint64_t take_rays(ip_engine *e, worker *w, order_ray *rays, unsigned *count)
 {
     *count = 0;
@@ -785,13 +808,15 @@ static uint64_t take_rays(ip_engine *e, worker *w, order_ray *rays, unsigned *co
     unsigned n = 0;
     uint64_t retired = 0; /* rays of blocks passed over at once */
     while (n < want && retired < RETIRED_PER_BATCH && (w->holding || claim_range(e, w))) {
-        unsigned block;
-        if (retire_block(e, w, &block))
+        unsigned block, walk;
+        if (take_block(e, w, rays + n, RAY_ROOM - n, (unsigned)(want - n), &block, &walk)) {
             retired += block;
-        else if (ip__ray_order_next_before(&w->order, w->range_end, &rays[n].x, &rays[n].y)) {
+            n += walk;
+        } else if (ip__ray_order_next_before(&w->order, w->range_end, &rays[n].x, &rays[n].y)) {
             rays[n].x += e->region_x; /* the image's pixel (see ip_engine_set_region()) */
             rays[n].y += e->region_y;
             rays[n].level = ip__ray_order_level(&w->order);
+            rays[n].tested = 0;
             n++;
         } else
             w->holding = 0;
@@ -820,7 +845,7 @@ static void work(void *user, unsigned index)
 {
     ip_engine *e = user;
     worker *w = &e->workers[index];
-    order_ray rays[RAY_BATCH];
+    order_ray rays[RAY_ROOM];
     unsigned n;
     while (w->status == IP_OK && take_rays(e, w, rays, &n) > 0) {
         /* The clock is read once per batch: seeding is the batch's time less what
@@ -833,7 +858,7 @@ static void work(void *user, unsigned index)
                 break;
             }
             double from;
-            if (!retire(w, rays[i].x, rays[i].y, rays[i].level, &from))
+            if (!retire(w, &rays[i], &from))
                 w->status = cast_ray(w, rays[i].x, rays[i].y, from);
         }
         double seeding = ip_now_seconds() - t0 -
