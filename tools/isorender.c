@@ -799,10 +799,10 @@ static int extract_progressive(run *r, ip_error *err)
             ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
             return -1;
     }
+    strip_plan_rays(r);
+    double start = ip_now_seconds(); /* a view's time counts its set-up (the coverage buffer) */
     if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK)
         return -1;
-    strip_plan_rays(r);
-    double start = ip_now_seconds();
     uint64_t target = 1, limit = r->o.common.rays ? r->o.common.rays : UINT64_MAX;
     tool_progress bar;
     tool_progress_start(&bar, !r->o.common.quiet, "ISORENDER_PROGRESS");

@@ -43,8 +43,8 @@
 #define BOX_DEPTH_MARGIN 1e-5    /* relative */
 #define NEAR_MARGIN (1.0 + 1e-6) /* relative to the near plane */
 
-ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const double lo[3],
-                             const double hi[3])
+ip_status ip__coverage_prepare(ip_coverage *c, const ip_camera *camera, const double lo[3],
+                               const double hi[3])
 {
     size_t n = (size_t)camera->width * camera->height;
     if (n > c->capacity) {
@@ -70,12 +70,26 @@ ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const doub
     }
     c->centre_x = 0.5 * c->width;
     c->centre_y = 0.5 * c->height;
+    return IP_OK;
+}
+
+void ip__coverage_clear(ip_coverage *c, unsigned part, unsigned parts)
+{
+    size_t n = (size_t)c->width * c->height, first = n * part / parts, end = n * (part + 1) / parts;
     unsigned bits = ip__float_bits(INFINITY);
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = first; i < end; i++) {
         atomic_init(&c->depth[i], bits);
         atomic_init(&c->solid[i], bits);
     }
-    return IP_OK;
+}
+
+ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const double lo[3],
+                             const double hi[3])
+{
+    ip_status st = ip__coverage_prepare(c, camera, lo, hi);
+    if (st == IP_OK)
+        ip__coverage_clear(c, 0, 1);
+    return st;
 }
 
 void ip__coverage_free(ip_coverage *c)

@@ -280,6 +280,20 @@ static void begin_prefetch(ip_engine *e)
     ip__prefetcher_begin(e->prefetcher, &view);
 }
 
+/* One worker's share of the occlusion state to start over (a job of the engine's pool): its
+ * part of the coverage buffer and of the tiles. */
+static void clear_view(void *user, unsigned index)
+{
+    ip_engine *e = user;
+    ip__coverage_clear(&e->coverage, index, e->threads);
+    size_t tiles = (size_t)e->tiles_x * e->tiles_y;
+    for (size_t t = tiles * index / e->threads; t < tiles * (index + 1) / e->threads; t++) {
+        atomic_init(&e->tiles[t].depth, 0);
+        atomic_init(&e->tiles[t].from, 0);
+        atomic_init(&e->tiles[t].tested, 0);
+    }
+}
+
 ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_error *err)
 {
     ip_status st = ip_camera_check(camera, err);
@@ -321,13 +335,9 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
             e->tiles = malloc(tiles * sizeof *e->tiles);
             e->tile_capacity = e->tiles ? tiles : 0;
         }
-        if (!e->tiles || ip__coverage_reset(&e->coverage, camera, lo, hi) != IP_OK)
+        if (!e->tiles || ip__coverage_prepare(&e->coverage, camera, lo, hi) != IP_OK)
             return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
-        for (size_t t = 0; t < tiles; t++) {
-            atomic_init(&e->tiles[t].depth, 0);
-            atomic_init(&e->tiles[t].from, 0);
-            atomic_init(&e->tiles[t].tested, 0);
-        }
+        ip__pool_run(e->pool, e->threads, clear_view, e);
     }
     double pixel_angle = 2.0 * e->basis.tan_half_y / camera->height;
     for (unsigned t = 0; t < e->threads; t++) {
