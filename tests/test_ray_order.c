@@ -607,6 +607,25 @@ static void test_blocks(uint32_t w, uint32_t h, uint32_t local_from, uint32_t k,
     free(got);
 }
 
+/* ip__ray_order_level_position(): seeking to it puts the iterator at its level's first cell,
+ * one before it in the level before, and past the last level it is the number of cells. */
+static void test_level_positions(uint32_t w, uint32_t h)
+{
+    ip_ray_order order;
+    REQUIRE(ip__ray_order_init(&order, w, h) == IP_OK);
+    uint32_t last = ip__ray_order_last_level(&order), wrong = 0;
+    for (uint32_t k = 1; k <= last; k++) {
+        uint64_t at = ip__ray_order_level_position(&order, k);
+        ip__ray_order_seek(&order, at);
+        wrong += ip__ray_order_level(&order) != k || ip__ray_order_position(&order) != at;
+        ip__ray_order_seek(&order, at - 1);
+        wrong += ip__ray_order_level(&order) != k - 1;
+    }
+    CHECK_MSG(wrong == 0 && ip__ray_order_level_position(&order, 0) == 0 &&
+                  ip__ray_order_level_position(&order, last + 1) == ip__ray_order_cells(&order),
+              "%ux%u: %u level positions wrong", w, h, wrong);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 3 && strcmp(argv[1], "--bench") == 0)
@@ -638,5 +657,8 @@ int main(int argc, char **argv)
     test_blocks(97, 61, 4, 1, 16);
     test_blocks(640, 480, 0, 4, 1u << 20);
     test_blocks(1000, 3, 2, 1, 64); /* the shorter axis stops splitting: few blocks */
+    test_level_positions(1600, 1200);
+    test_level_positions(1000, 3);
+    test_level_positions(1, 1);
     return test_summary("test_ray_order");
 }

@@ -26,6 +26,10 @@
 #define DEPTH_MARGIN 1e-5     /* relative: float rounding of vertices (as coverage.c's boxes) */
 #define TILE_SHIFT 3          /* bulk retirement: tiles of 8 x 8 pixels */
 #define TILE_SLACK (1.0 / 64) /* pixels added around a tile's pixel centres for its beam */
+/* The Z-order levels' aligned blocks of 4^BLOCK_LOG4 cells are taken at once, their pixels
+ * that retire() would retire passed over (take_block()). */
+#define BLOCK_LOG4 3
+#define BLOCK_CELLS (1u << 2 * BLOCK_LOG4)
 
 /* A worker's tools for one pyramid level: pinned bricks, seeding state, propagation queue. */
 typedef struct level_tools {
@@ -93,8 +97,9 @@ struct ip_engine {
     tile *tiles;
     size_t tile_capacity;
     uint32_t tiles_x, tiles_y;
-    uint32_t tile_from; /* the first ray-order level whose rays test their tile: the first
+    uint32_t tile_from;   /* the first ray-order level whose rays test their tile: the first
                            of the order's local levels (start_order()) */
+    uint32_t block_phase; /* the position of tile_from's first cell, modulo BLOCK_CELLS */
     /* The ray order is handed out in ranges of positions: a worker claims the next range
      * with one atomic add (or takes a range another worker left unfinished at the end of a
      * step, the earliest first) and walks it with its own iterator, so no lock is held while
@@ -264,6 +269,7 @@ static void start_order(ip_engine *e, uint32_t width, uint32_t height)
     uint32_t last = ip__ray_order_last_level(&e->order);
     e->tile_from = last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0;
     ip__ray_order_set_local_from(&e->order, e->tile_from);
+    e->block_phase = ip__ray_order_level_position(&e->order, e->tile_from) % BLOCK_CELLS;
 }
 
 /* Hands the reader (paused) the view and the order the workers are about to walk. */
@@ -689,11 +695,6 @@ static int retire(worker *w, const order_ray *r, double *from)
     return 1;
 }
 
-/* The Z-order levels' aligned blocks of 4^BLOCK_LOG4 cells are taken at once, their pixels
- * that retire() would retire passed over (take_block()). */
-#define BLOCK_LOG4 3
-#define BLOCK_CELLS (1u << 2 * BLOCK_LOG4)
-
 #define RETIRED_PER_BATCH 4096             /* rays of blocks a batch may retire at once, at most */
 #define RAY_ROOM (RAY_BATCH + BLOCK_CELLS) /* a batch's rays, a block's overfill included */
 
@@ -777,6 +778,11 @@ static int claim_range(ip_engine *e, worker *w)
         length = start / 256 < RANGE_MIN   ? RANGE_MIN
                  : start / 256 > RANGE_MAX ? RANGE_MAX
                                            : start / 256;
+        if (length >= BLOCK_CELLS) /* ends on a block's edge, so that later ranges hold whole
+                                      blocks (take_block()) */
+            length +=
+                (BLOCK_CELLS - (start + length + BLOCK_CELLS - e->block_phase) % BLOCK_CELLS) %
+                BLOCK_CELLS;
     } while (!atomic_compare_exchange_weak(&e->next_position, &start, start + length));
     ip__ray_order_seek(&w->order, start);
     w->range_end = e->order_cells - start < length ? e->order_cells : start + length;

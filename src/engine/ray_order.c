@@ -71,12 +71,17 @@ static uint64_t level_cells(const ip_ray_order *order, uint32_t level)
     return (uint64_t)1 << (min_u32(level, order->x_levels) + min_u32(level, order->y_levels));
 }
 
-uint64_t ip__ray_order_cells(const ip_ray_order *order)
+uint64_t ip__ray_order_level_position(const ip_ray_order *order, uint32_t level)
 {
     uint64_t cells = 0;
-    for (uint32_t k = 0; k <= ip__ray_order_last_level(order); k++)
+    for (uint32_t k = 0; k < level && k <= ip__ray_order_last_level(order); k++)
         cells += level_cells(order, k);
     return cells;
+}
+
+uint64_t ip__ray_order_cells(const ip_ray_order *order)
+{
+    return ip__ray_order_level_position(order, ip__ray_order_last_level(order) + 1);
 }
 
 uint64_t ip__ray_order_position(const ip_ray_order *order)

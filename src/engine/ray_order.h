@@ -120,6 +120,10 @@ uint32_t ip__ray_order_last_level(const ip_ray_order *order);
 /*! ip__ray_order_cells() : the number of positions, over every level (>= width * height). */
 uint64_t ip__ray_order_cells(const ip_ray_order *order);
 
+/*! ip__ray_order_level_position() : the position of the first cell of `level`
+ *  (ip__ray_order_cells() for a level past the last). */
+uint64_t ip__ray_order_level_position(const ip_ray_order *order, uint32_t level);
+
 /*! ip__ray_order_position() : the position of the next cell the iterator examines
  *  (ip__ray_order_cells() once it is done). */
 uint64_t ip__ray_order_position(const ip_ray_order *order);
