@@ -16,6 +16,9 @@ typedef struct index_beam {
     double limit;        /* max_depth + forward . eye, lowered below each box found unsettled */
     double floor;        /* min_depth + forward . eye */
     int flip;            /* bit a: forward[a] < 0 (the nearer half along axis a is the high) */
+    double eye[3];       /* the eye, in index coordinates */
+    double step[4][3];   /* along corner ray i, index units per unit of view depth */
+    double at_eye;       /* forward . eye (world) */
 } index_beam;
 
 void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
@@ -35,8 +38,28 @@ void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
         b->eye[a] = eye[a];
         b->forward[a] = forward[a];
     }
+    for (int i = 0; i < 4; i++)
+        for (int a = 0; a < 3; a++)
+            b->corner[i][a] = corner[i][a];
     b->max_depth = max_depth;
     b->min_depth = -INFINITY;
+}
+
+/* The part of the beam between view depths z0 and z1 (0 <= z0 <= z1) lies within the convex
+ * hull of the 8 points where its corner rays cross those depths: its bounding box, in index
+ * coordinates, in [lo, hi]. */
+static void slice_box(const index_beam *w, double z0, double z1, double lo[3], double hi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        lo[a] = INFINITY;
+        hi[a] = -INFINITY;
+        for (int i = 0; i < 4; i++)
+            for (int e = 0; e < 2; e++) {
+                double v = w->eye[a] + w->step[i][a] * (e ? z1 : z0);
+                lo[a] = v < lo[a] ? v : lo[a];
+                hi[a] = v > hi[a] ? v : hi[a];
+            }
+    }
 }
 
 /* The index box [lo, hi]'s nearest point's forward . p (its view depth + forward . eye). */
@@ -167,19 +190,39 @@ static void settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi
         (void)ip__visited_mark_part(w->visited, brick->index, sb);
 }
 
-/* The sub-blocks of brick `b`, nearest first along each axis. */
-static void settled_brick(index_beam *w, const uint32_t b[3])
+/* The sub-blocks of brick `b` (its box [blo, bhi]) within the bounding box of the beam's part
+ * between the brick's nearest and farthest depths, nearest first along each axis. */
+static void settled_brick(index_beam *w, const uint32_t b[3], const double box_lo[3],
+                          const double box_hi[3])
 {
     ip_seeder *s = w->s;
     const ip_layout *l = s->layout;
     uint32_t origin[3], extent[3], n[3];
     const float *ranges = ip__seeder_brick(s, b, origin, extent, n);
-    uint32_t per = l->brick_edge / l->subblock_edge;
-    for (uint32_t ii = 0; ii < n[2]; ii++)
-        for (uint32_t jj = 0; jj < n[1]; jj++)
-            for (uint32_t hh = 0; hh < n[0]; hh++) {
-                uint32_t h = w->flip & 1 ? n[0] - 1 - hh : hh, j = w->flip & 2 ? n[1] - 1 - jj : jj,
-                         i = w->flip & 4 ? n[2] - 1 - ii : ii;
+    uint32_t per = l->brick_edge / l->subblock_edge, first[3], last[3];
+    double z0 = nearest(w, box_lo, box_hi) - w->at_eye, z1 = w->limit - w->at_eye, far = -w->at_eye;
+    for (int a = 0; a < 3; a++)
+        far += w->forward[a] * (w->forward[a] >= 0 ? box_hi[a] : box_lo[a]);
+    z0 = z0 > 0 ? z0 : 0;
+    z1 = z1 < far ? z1 : far;
+    if (!(z0 <= z1))
+        return;
+    double slo[3], shi[3];
+    slice_box(w, z0, z1, slo, shi);
+    for (int a = 0; a < 3; a++) {
+        double se = l->subblock_edge, f = floor((slo[a] - origin[a]) / se - 1e-9),
+               e = floor((shi[a] - origin[a]) / se + 1e-9);
+        first[a] = f > 0 ? (uint32_t)f : 0;
+        last[a] = e < n[a] - 1.0 ? (uint32_t)e : n[a] - 1;
+        if (!(e >= 0) || first[a] > last[a])
+            return;
+    }
+    for (uint32_t ii = first[2]; ii <= last[2]; ii++)
+        for (uint32_t jj = first[1]; jj <= last[1]; jj++)
+            for (uint32_t hh = first[0]; hh <= last[0]; hh++) {
+                uint32_t h = w->flip & 1 ? first[0] + last[0] - hh : hh,
+                         j = w->flip & 2 ? first[1] + last[1] - jj : jj,
+                         i = w->flip & 4 ? first[2] + last[2] - ii : ii;
                 uint32_t sb = h + per * (j + per * i), at[3] = {h, j, i};
                 if (!ip__range_active(ranges[2 * sb], ranges[2 * sb + 1], s->iso))
                     continue;
@@ -199,7 +242,9 @@ static void settled_brick(index_beam *w, const uint32_t b[3])
 static void settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
 {
     if (depth == 0) {
-        settled_brick(w, node);
+        double lo[3], hi[3];
+        ip__seeder_node_box(w->s, 0, node, lo, hi);
+        settled_brick(w, node, lo, hi);
         return;
     }
     ip_seeder *s = w->s;
@@ -222,6 +267,14 @@ int ip__beam_settled(ip_seeder *s, ip_visited *visited, const ip_beam *b, double
     w.s = s;
     w.visited = visited;
     double at_eye = ip__vec3_dot(b->forward, b->eye);
+    w.at_eye = at_eye;
+    for (int i = 0; i < 4; i++) {
+        double cosine = ip__vec3_dot(b->corner[i], b->forward);
+        for (int a = 0; a < 3; a++)
+            w.step[i][a] = b->corner[i][a] / cosine / s->scale[a];
+    }
+    for (int a = 0; a < 3; a++)
+        w.eye[a] = b->eye[a] / s->scale[a];
     w.limit = b->max_depth + at_eye;
     w.floor = b->min_depth + at_eye;
     double limit = w.limit;

@@ -12,9 +12,10 @@
 typedef struct ip_beam {
     double eye[3];
     double normal[4][3];
-    double forward[3]; /* the view direction (unit) */
-    double max_depth;  /* view depth (world units): cells wholly beyond it are passed over */
-    double min_depth;  /* and those wholly nearer than this, known settled (-infinity: none) */
+    double forward[3];   /* the view direction (unit) */
+    double corner[4][3]; /* the corner directions (unit) */
+    double max_depth;    /* view depth (world units): cells wholly beyond it are passed over */
+    double min_depth;    /* and those wholly nearer than this, known settled (-infinity: none) */
 } ip_beam;
 
 /* The beam of the rays from the eye through the four corner directions `corner` (unit, in
