@@ -12,6 +12,7 @@
 
 #include "check.h"
 #include "coverage.h"
+#include "reach.h"
 #include "isoprop/bricker.h"
 #include "isoprop/engine.h"
 #include "isoprop/generate.h"
@@ -417,6 +418,66 @@ static void check_coverage_box_test(void)
     double wide_lo[3] = {-3, -0.5, 1}, wide_hi[3] = {0.5, 0.5, 2};
     CHECK(!ip__coverage_hides(&c, wide_lo, wide_hi)); /* reaches past the wall's image */
     ip__coverage_free(&c);
+}
+
+/* The tiles a box may show in (ip__reach_box(), tiles of 8x8 pixels): every pixel whose ray
+ * meets one of 200 random boxes in front of the eye lies in a marked tile, and no tile is
+ * marked more than one tile away from such a pixel's, for boxes that show in more than a few
+ * pixels; a box behind the eye marks every tile. */
+static void check_reach_box(void)
+{
+    ip_camera cam = {{0, 0, -40}, {0, 0, 0}, {0, 1, 0}, 40.0, 160, 120};
+    ip_camera_basis basis;
+    ip_camera_basis_of(&cam, &basis);
+    const uint32_t tx = 20, ty = 15;
+    unsigned char reached[20 * 15];
+    uint64_t seed = 12345, missed = 0, loose = 0, boxes = 0;
+    for (int b = 0; b < 200; b++) {
+        double lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            double c = (double)(seed >> 11) / 9007199254740992.0 * 20 - 10;
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            double h = (double)(seed >> 11) / 9007199254740992.0 * 2 + 0.05;
+            lo[a] = c - h;
+            hi[a] = c + h;
+        }
+        memset(reached, 0, sizeof reached);
+        ip__reach_box(&basis, &cam, lo, hi, 3, tx, ty, reached);
+        uint32_t hit_lo[2] = {tx, ty}, hit_hi[2] = {0, 0}, hits = 0;
+        for (uint32_t y = 0; y < cam.height; y++)
+            for (uint32_t x = 0; x < cam.width; x++) {
+                double d[3], t0 = 0, t1 = INFINITY;
+                ip_camera_pixel_ray(&basis, &cam, x + 0.5, y + 0.5, d);
+                for (int a = 0; a < 3; a++) { /* slab test of the ray against the box */
+                    double u = (lo[a] - cam.eye[a]) / d[a], v = (hi[a] - cam.eye[a]) / d[a];
+                    t0 = fmax(t0, fmin(u, v));
+                    t1 = fmin(t1, fmax(u, v));
+                }
+                if (!(t0 <= t1))
+                    continue;
+                hits++;
+                missed += !reached[(y >> 3) * tx + (x >> 3)];
+                hit_lo[0] = x >> 3 < hit_lo[0] ? x >> 3 : hit_lo[0];
+                hit_lo[1] = y >> 3 < hit_lo[1] ? y >> 3 : hit_lo[1];
+                hit_hi[0] = x >> 3 > hit_hi[0] ? x >> 3 : hit_hi[0];
+                hit_hi[1] = y >> 3 > hit_hi[1] ? y >> 3 : hit_hi[1];
+            }
+        if (hits < 16)
+            continue;
+        boxes++;
+        for (uint32_t y = 0; y < ty; y++)
+            for (uint32_t x = 0; x < tx; x++)
+                loose += reached[y * tx + x] && (x + 1 < hit_lo[0] || x > hit_hi[0] + 1 ||
+                                                 y + 1 < hit_lo[1] || y > hit_hi[1] + 1);
+    }
+    CHECK_MSG(missed == 0 && loose == 0 && boxes > 50,
+              "%llu pixels hit in unmarked tiles, %llu tiles marked too far, %llu boxes",
+              (unsigned long long)missed, (unsigned long long)loose, (unsigned long long)boxes);
+    double back_lo[3] = {-1, -1, -45}, back_hi[3] = {1, 1, -42};
+    memset(reached, 0, sizeof reached);
+    ip__reach_box(&basis, &cam, back_lo, back_hi, 3, tx, ty, reached);
+    CHECK(memchr(reached, 0, sizeof reached) == NULL);
 }
 
 /* The full extraction of an isovalue at level 0 and its image under one camera, beside
@@ -826,6 +887,7 @@ int main(void)
 
     check_lod(dir);
     check_coverage_box_test();
+    check_reach_box();
     check_occlusion(dir);
     check_retirement(dir);
     check_shared_data();

@@ -15,6 +15,7 @@
 #include "prefetch.h"
 #include "ray_order.h"
 #include "propagate.h"
+#include "reach.h"
 #include "seed.h"
 #include "vec3.h"
 
@@ -99,6 +100,7 @@ struct ip_engine {
     double cell_reach[IP_MAX_LEVELS];       /* a level-k cell's extent along the view (world) */
     /* With occlusion: bulk retirement of the rays of 8 x 8 pixel tiles (see retire()). */
     tile *tiles;
+    unsigned char *reached; /* per tile: some active brick may show in it (settle_unreached()) */
     size_t tile_capacity;
     uint32_t tiles_x, tiles_y;
     uint32_t tile_from;   /* the first ray-order level whose rays test their tile: the first
@@ -221,6 +223,7 @@ void ip_engine_destroy(ip_engine *e)
     free(e->workers);
     free(e->leftovers);
     free(e->tiles);
+    free(e->reached);
     ip__visited_free(&e->visited);
     ip__coverage_free(&e->coverage);
     ip_mesh_free(&e->mesh);
@@ -306,6 +309,20 @@ static void clear_view(void *user, unsigned index)
     }
 }
 
+/* The tiles that no brick holding the isovalue (at a level the view uses) may show in are
+ * settled from the start with no bound (ip__reach_tiles()): no ray of theirs can meet an active
+ * cell, so none is walked and no beam is tested for them. After clear_view(). */
+static void settle_unreached(ip_engine *e)
+{
+    ip__reach_tiles(ip_cache_store(e->cache), e->iso, e->levels_used, &e->basis, &e->camera,
+                    TILE_SHIFT, e->tiles_x, e->tiles_y, e->reached);
+    size_t tiles = (size_t)e->tiles_x * e->tiles_y;
+    for (size_t t = 0; t < tiles; t++)
+        if (!e->reached[t])
+            atomic_store_explicit(&e->tiles[t].depth, ip__float_bits(INFINITY),
+                                  memory_order_relaxed);
+}
+
 ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_error *err)
 {
     ip_status st = ip_camera_check(camera, err);
@@ -345,12 +362,15 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
         size_t tiles = (size_t)e->tiles_x * e->tiles_y;
         if (tiles > e->tile_capacity) {
             free(e->tiles);
+            free(e->reached);
             e->tiles = malloc(tiles * sizeof *e->tiles);
-            e->tile_capacity = e->tiles ? tiles : 0;
+            e->reached = malloc(tiles);
+            e->tile_capacity = e->tiles && e->reached ? tiles : 0;
         }
-        if (!e->tiles || ip__coverage_prepare(&e->coverage, camera, lo, hi) != IP_OK)
+        if (!e->tile_capacity || ip__coverage_prepare(&e->coverage, camera, lo, hi) != IP_OK)
             return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
         ip__pool_run(e->pool, e->threads, clear_view, e);
+        settle_unreached(e);
     }
     double pixel_angle = 2.0 * e->basis.tan_half_y / camera->height;
     for (unsigned t = 0; t < e->threads; t++) {
