@@ -32,20 +32,24 @@ static void view_setup(ip_cache *cache, const char *axis, ip_camera *camera, ip_
     REQUIRE(ip__sampler_init(sampler, cache, 0) == IP_OK);
 }
 
-/* Casts every pixel's ray through level 0 twice, without the group ranges and with them,
- * and compares what each ray finds. */
+/* Casts every pixel's ray through level 0 three times: without the group ranges, with them
+ * (the default), and down the octree instead of over the bricks by a DDA (short_walk 0); what
+ * each ray finds must not change. */
 static void check_view(ip_cache *cache, const char *axis, float iso)
 {
     ip_camera camera;
     ip_camera_basis basis;
     ip_sampler sampler;
     view_setup(cache, axis, &camera, &basis, &sampler);
-    ip_seeder plain, grouped;
+    ip_seeder plain, grouped, octree;
     double pixel_angle = 2.0 * basis.tan_half_y / camera.height;
     ip__seeder_init(&plain, &sampler, iso, pixel_angle);
     ip__seeder_init(&grouped, &sampler, iso, pixel_angle);
+    ip__seeder_init(&octree, &sampler, iso, pixel_angle);
     CHECK(grouped.use_group_ranges == 1); /* the default */
     plain.use_group_ranges = 0;
+    octree.short_walk = 0; /* down the octree, where the others walk the bricks by a DDA */
+    uint64_t walks_differ = 0;
     uint64_t rays = 0, differ = 0, seeds = 0;
     for (uint32_t y = 0; y < camera.height; y++)
         for (uint32_t x = 0; x < camera.width; x++) {
@@ -57,12 +61,21 @@ static void check_view(ip_cache *cache, const char *axis, float iso)
             int fa = ip__seed_find(&plain, camera.eye, dir, 0, INFINITY, a, &na, &sa);
             int fb = ip__seed_find(&grouped, camera.eye, dir, 0, INFINITY, b, &nb, &sb);
             REQUIRE(fa >= 0 && fb >= 0);
+            uint32_t c[IP_SEED_MAX_CELLS][3];
+            unsigned nc;
+            int sc, fc = ip__seed_find(&octree, camera.eye, dir, 0, INFINITY, c, &nc, &sc);
+            walks_differ += fc != fb || nc != nb || sc != sb || memcmp(c, b, nb * sizeof b[0]) != 0;
             differ += fa != fb || na != nb || sa != sb || memcmp(a, b, na * sizeof a[0]) != 0;
             seeds += fa == 1;
             rays++;
         }
     CHECK_MSG(differ == 0, "view %s, iso %g: %llu of %llu rays found other cells", axis,
               (double)iso, (unsigned long long)differ, (unsigned long long)rays);
+    CHECK_MSG(walks_differ == 0 && octree.nodes > grouped.nodes,
+              "view %s, iso %g: %llu of %llu rays found other cells down the octree (%llu "
+              "nodes, %llu by the bricks)",
+              axis, (double)iso, (unsigned long long)walks_differ, (unsigned long long)rays,
+              (unsigned long long)octree.nodes, (unsigned long long)grouped.nodes);
     CHECK_MSG(seeds > rays / 20, "view %s, iso %g: only %llu seeds", axis, (double)iso,
               (unsigned long long)seeds);
     /* the same cells reach the triangle test; far fewer have their corners read (groups of

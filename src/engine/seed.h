@@ -10,6 +10,10 @@
  * an axis (ip__layout_init() bounds the dimensions and the brick edge). */
 #define IP_SEED_MAX_DEPTH 31
 
+/* The walk down the octree skips empty space in long rays; a DDA over the bricks costs less
+ * for a stretch of up to this many bricks (the head's every ray, at 16 x 16 x 8 bricks). */
+#define IP_SEED_SHORT_WALK 32.0
+
 typedef struct ip_seeder {
     ip_sampler *sampler;
     const ip_store *store;
@@ -21,6 +25,9 @@ typedef struct ip_seeder {
     uint64_t cells_read;   /* cells whose 8 corners were read (to find their case) */
     uint64_t nodes; /* octree nodes (bricks included), sub-blocks and cells that rays entered */
     int use_group_ranges; /* 1 (the default): pass over the cells of inactive cell groups */
+    double short_walk;    /* bricks: a stretch of a ray no longer (in its longest axis) is walked
+                          over the bricks by a DDA rather than down the octree (the default
+                          IP_SEED_SHORT_WALK; the same cells are found either way) */
     uint32_t (*found)[3]; /* the cells of the current ray (see ip__seed_find) */
     unsigned found_count;
     int seed_index; /* position in found of the first cell the ray is inside, or -1 */
@@ -121,7 +128,8 @@ static inline void ip__seeder_subblock_cells(const ip_seeder *s, const uint32_t 
 void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_angle);
 
 /* Casts the ray eye + t * dir (world units, dir of unit length, t_min <= t <= t_max) through
- * the octree of the seeder's level, front to back. The seed is the first cell with a triangle
+ * the octree of the seeder's level, front to back (a stretch of up to s->short_walk bricks
+ * over the bricks by a DDA). The seed is the first cell with a triangle
  * the ray passes inside. Fills cells[0 .. *count) (room for IP_SEED_MAX_CELLS) with every cell
  * the ray passed inside or within the margin of, in order, up to the first it passes inside by
  * more than the margin (where it stops); *seed_index is the seed's position there, or -1.
