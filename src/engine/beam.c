@@ -212,10 +212,10 @@ static void settled_brick(index_beam *w, const uint32_t b[3], const double box_l
     for (int a = 0; a < 3; a++) {
         double se = l->subblock_edge, f = floor((slo[a] - origin[a]) / se - 1e-9),
                e = floor((shi[a] - origin[a]) / se + 1e-9);
+        if (!(e >= 0) || !(f < n[a])) /* the box misses the brick (or is not a number) */
+            return;
         first[a] = f > 0 ? (uint32_t)f : 0;
         last[a] = e < n[a] - 1.0 ? (uint32_t)e : n[a] - 1;
-        if (!(e >= 0) || first[a] > last[a])
-            return;
     }
     for (uint32_t ii = first[2]; ii <= last[2]; ii++)
         for (uint32_t jj = first[1]; jj <= last[1]; jj++)

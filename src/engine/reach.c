@@ -29,6 +29,8 @@ void ip__reach_box(const ip_camera_basis *basis, const ip_camera *camera, const 
            tx1 = fmin(floor((max_x + 0.5) / side), tiles_x - 1.0);
     double ty0 = fmax(floor((min_y - 1.5) / side), 0),
            ty1 = fmin(floor((max_y + 0.5) / side), tiles_y - 1.0);
+    if (!(tx0 <= tx1)) /* left or right of the image */
+        return;
     for (double ty = ty0; ty <= ty1; ty++)
         memset(reached + (size_t)ty * tiles_x + (size_t)tx0, 1, (size_t)(tx1 - tx0) + 1);
 }
