@@ -72,6 +72,16 @@ typedef struct tile {
     atomic_uint cells;   /* the engine's cells_done when it was tested last */
 } tile;
 
+/* Cells a propagation handed out (ip_share): a part of its queue, for the ray `dir`. */
+typedef struct shared_cells {
+    uint32_t level;
+    unsigned count;
+    double dir[3];
+    ip_queued_cell cells[IP_SHARE_CELLS];
+} shared_cells;
+
+#define SHARED_MAX 16 /* parts of queues waiting at most */
+
 /* A ray of the order: its pixel and the order's level it belongs to; with `tested`, its tile
  * was consulted already (retire()) and the ray is to be walked from view depth `from`. */
 typedef struct order_ray {
@@ -128,6 +138,15 @@ struct ip_engine {
     double step_deadline;                /* 0: none */
     ip_engine_counts totals;
     atomic_int cancel;
+    /* Parts of long propagations' queues, for the workers left without rays in a step
+     * (help()): a stack of SHARED_MAX under share_lock, with the workers waiting for it
+     * (`hungry`, read by the propagations) and those that may still add to it (`working`). */
+    pthread_mutex_t share_lock;
+    pthread_cond_t share_wake;
+    shared_cells *shared;
+    unsigned shared_count;
+    unsigned working;
+    atomic_int hungry;
 };
 
 void ip_engine_options_default(ip_engine_options *o)
@@ -180,11 +199,15 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     atomic_init(&e->step_stopped, 0);
     pthread_mutex_init(&e->leftover_lock, NULL);
     pthread_mutex_init(&e->mesh_lock, NULL);
+    pthread_mutex_init(&e->share_lock, NULL);
+    pthread_cond_init(&e->share_wake, NULL);
+    atomic_init(&e->hungry, 0);
     ip_mesh_init(&e->mesh);
     e->mesh.with_cells = options->cell_ids != 0;
     e->workers = calloc(e->threads, sizeof *e->workers);
     e->leftovers = calloc(e->threads, sizeof *e->leftovers);
-    ip_status st = e->workers && e->leftovers
+    e->shared = malloc(SHARED_MAX * sizeof *e->shared);
+    ip_status st = e->workers && e->leftovers && e->shared
                        ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
                        : IP_ERR_NOMEM;
     if (st == IP_OK)
@@ -229,6 +252,9 @@ void ip_engine_destroy(ip_engine *e)
     ip_mesh_free(&e->mesh);
     pthread_mutex_destroy(&e->leftover_lock);
     pthread_mutex_destroy(&e->mesh_lock);
+    pthread_mutex_destroy(&e->share_lock);
+    pthread_cond_destroy(&e->share_wake);
+    free(e->shared);
     free(e);
 }
 
@@ -294,6 +320,56 @@ static void begin_prefetch(ip_engine *e)
     ip__prefetcher_begin(e->prefetcher, &view);
 }
 
+/* ip_share's give(): keeps a part of a propagation's queue for a worker without rays, and
+ * wakes one. 0 when SHARED_MAX parts wait already. */
+static int give_cells(void *user, uint32_t level, const ip_queued_cell *cells, unsigned count,
+                      const double dir[3])
+{
+    ip_engine *e = user;
+    pthread_mutex_lock(&e->share_lock);
+    int room = e->shared_count < SHARED_MAX && count <= IP_SHARE_CELLS;
+    if (room) {
+        shared_cells *c = &e->shared[e->shared_count++];
+        c->level = level;
+        c->count = count;
+        memcpy(c->dir, dir, sizeof c->dir);
+        memcpy(c->cells, cells, count * sizeof *cells);
+        pthread_cond_signal(&e->share_wake);
+    }
+    pthread_mutex_unlock(&e->share_lock);
+    return room;
+}
+
+/* A worker whose step has no rays left for it propagates from the parts of queues other
+ * workers hand out (give_cells()) until none is left and no worker may hand out more: the
+ * step ends with every queued cell extracted, as when one worker propagated it all. */
+static void help(ip_engine *e, worker *w)
+{
+    pthread_mutex_lock(&e->share_lock);
+    e->working--;
+    while (w->status == IP_OK) {
+        if (e->shared_count > 0) {
+            shared_cells c = e->shared[--e->shared_count];
+            e->working++;
+            pthread_mutex_unlock(&e->share_lock);
+            w->status = ip__propagate_queued(&w->level[c.level].propagator, c.cells, c.count, c.dir,
+                                             &w->counts);
+            if (w->status != IP_OK)
+                w->failed_level = c.level;
+            pthread_mutex_lock(&e->share_lock);
+            e->working--;
+            continue;
+        }
+        if (e->working == 0)
+            break;
+        atomic_fetch_add(&e->hungry, 1);
+        pthread_cond_wait(&e->share_wake, &e->share_lock);
+        atomic_fetch_sub(&e->hungry, 1);
+    }
+    pthread_cond_broadcast(&e->share_wake); /* the others may wait for working to reach 0 */
+    pthread_mutex_unlock(&e->share_lock);
+}
+
 /* One worker's share of the occlusion state to start over (a job of the engine's pool): its
  * part of the coverage buffer and of the tiles. */
 static void clear_view(void *user, unsigned index)
@@ -334,6 +410,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
         ip__prefetcher_pause(e->prefetcher);
     ip__visited_clear(&e->visited);
     ip_mesh_clear(&e->mesh);
+    e->shared_count = 0; /* what a cancelled or failed step left */
     e->camera = *camera;
     ip_camera_basis_of(&e->camera, &e->basis);
     e->iso = iso;
@@ -395,6 +472,8 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
                                     e->lod_distance[k + 1],
                                     e->options.occlusion ? &e->coverage : NULL) != IP_OK)
                 return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
+            if (e->threads > 1)
+                lt->propagator.share = (ip_share){&e->hungry, give_cells, e};
         }
     }
     atomic_store(&e->cancel, 0);
@@ -925,6 +1004,9 @@ static void work(void *user, unsigned index)
             w->status == IP_OK)
             w->status = IP_ERR_NOMEM;
     }
+    help(e, w);
+    atomic_fetch_add_explicit(&e->cells_done, (unsigned)(w->counts.cells - published),
+                              memory_order_relaxed);
     if (flush_triangles(w) != IP_OK && w->status == IP_OK)
         w->status = IP_ERR_NOMEM;
     if (w->status != IP_OK) /* the step fails: the other workers take no more rays */
@@ -946,13 +1028,15 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
     atomic_store(&e->step_stopped, 0);
     e->step_deadline = max_seconds > 0 ? ip_now_seconds() + max_seconds : 0;
     /* A small step shares its rays between the threads (each ray may propagate a large part
-     * of the surface): a batch of ceil(rays / threads), one thread per ray at most. */
-    unsigned threads = e->threads;
+     * of the surface): a batch of ceil(rays / threads), one thread per ray at most. Every
+     * worker runs: those left without rays help the others' propagations (help()). */
+    unsigned threads = e->threads, batch_threads = threads;
     e->step_batch = RAY_BATCH;
     if (max_rays && max_rays < (uint64_t)threads * RAY_BATCH) {
-        threads = max_rays < threads ? (unsigned)max_rays : threads;
-        e->step_batch = (unsigned)((max_rays + threads - 1) / threads);
+        batch_threads = max_rays < threads ? (unsigned)max_rays : threads;
+        e->step_batch = (unsigned)((max_rays + batch_threads - 1) / batch_threads);
     }
+    e->working = threads;
     for (unsigned t = 0; t < threads; t++) {
         worker *w = &e->workers[t];
         memset(&w->counts, 0, sizeof w->counts);

@@ -13,6 +13,7 @@
 #define TIMING_STRIDE 16    /* extractions per timed extraction */
 #define MIN_TEST_PIXELS 2.0 /* the smallest box (projected diagonal) tested for occlusion */
 #define MAX_TEST_SHIFT 3    /* ...grown to at most 8 cells a side */
+#define SHARE_STRIDE 8      /* extractions between offers of cells to idle workers */
 
 ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
                               ip_mesh *mesh, const ip_camera *camera, float iso,
@@ -173,6 +174,16 @@ static ip_status grow_queue(ip_propagator *p, uint64_t head, uint64_t tail)
 ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
                         ip_engine_counts *counts)
 {
+    double centre[3], diagonal;
+    cell_centre(p->sampler, seed, centre, &diagonal);
+    ip_queued_cell q = {{seed[0], seed[1], seed[2]},
+                        (float)versine_to(p->camera->eye, dir, centre)};
+    return ip__propagate_queued(p, &q, 1, dir, counts);
+}
+
+ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, unsigned count,
+                               const double dir[3], ip_engine_counts *counts)
+{
     static const int offsets[6][3] = {{-1, 0, 0}, {1, 0, 0},  {0, -1, 0},
                                       {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
     const uint32_t *dims = p->sampler->dims;
@@ -181,11 +192,14 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
     uint64_t extracted = 0;
     double centre[3], diagonal;
     const int clipping = p->clip.count > 0; /* without planes no cell is tested */
-    cell_centre(p->sampler, seed, centre, &diagonal);
     uint64_t head = 0, tail = 0;
-    p->queue[tail++] =
-        (ip_queued_cell){{seed[0], seed[1], seed[2]}, (float)versine_to(eye, dir, centre)};
     ip_status st = IP_OK;
+    if (count > p->queue_capacity)
+        st = ip__array_reserve(&p->queue, &p->queue_capacity, count, sizeof *p->queue, 4096);
+    if (st != IP_OK)
+        return st;
+    memcpy(p->queue, cells, count * sizeof *cells);
+    tail = count;
     while (head < tail && st == IP_OK) {
         ip_queued_cell q = p->queue[head++];
         unsigned mc;
@@ -247,6 +261,12 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
                 p->queue[tail++] =
                     (ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)};
         }
+        /* the newest part of a long queue to a worker waiting for cells */
+        if (p->share.hungry && extracted % SHARE_STRIDE == 0 && tail - head >= 2 * IP_SHARE_CELLS &&
+            atomic_load_explicit(p->share.hungry, memory_order_relaxed) > 0 &&
+            p->share.give(p->share.user, p->sampler->level, p->queue + tail - IP_SHARE_CELLS,
+                          IP_SHARE_CELLS, dir))
+            tail -= IP_SHARE_CELLS;
     }
     double total = ip_now_seconds() - start;
     extracting = extracting < total ? extracting : total;

@@ -17,6 +17,20 @@ typedef struct ip_queued_cell {
                         * predecessors (angles compare as their versines, without atan2) */
 } ip_queued_cell;
 
+#define IP_SHARE_CELLS 16 /* cells a propagation hands out at once */
+
+/* Where a propagation may hand part of its queue to idle workers (engine.c): while `hungry`
+ * (workers waiting for cells) is above 0, give() may be offered `count` queued cells, already
+ * marked visited, of the propagation for the ray `dir`, at the propagator's level; it returns
+ * 1 when it took them (another worker propagates from them), 0 when it had no room. All zero:
+ * nothing is handed out. */
+typedef struct ip_share {
+    atomic_int *hungry;
+    int (*give)(void *user, uint32_t level, const ip_queued_cell *cells, unsigned count,
+                const double dir[3]);
+    void *user;
+} ip_share;
+
 typedef struct ip_propagator {
     ip_sampler *sampler;
     ip_visited *visited;
@@ -34,6 +48,7 @@ typedef struct ip_propagator {
                          into this part of the image (init: the whole image) */
     ip_queued_cell *queue;
     uint64_t queue_capacity;
+    ip_share share; /* zero after init: set by the engine */
 } ip_propagator;
 
 /* Propagation within one level, into the cells the options' clipping planes keep: cells whose centre lies outside the distance band
@@ -52,6 +67,11 @@ void ip__propagator_free(ip_propagator *p);
  * @return IP_OK, IP_ERR_NOMEM or the sampler's error. */
 ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
                         ip_engine_counts *counts);
+
+/* Propagates from `count` queued cells (already marked visited) of a propagation for the ray
+ * `dir`, as if they were its queue: the cells another propagation handed out (ip_share). */
+ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, unsigned count,
+                               const double dir[3], ip_engine_counts *counts);
 
 /* Triangulates `cell` and appends its triangles to `mesh`. Sets *mc_case. Returns the number of
  * triangles, or -1 on a read failure / out of memory (status in *st). */
