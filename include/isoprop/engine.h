@@ -56,7 +56,10 @@
  * ones later; what a step's budget or deadline leaves of a range is cast first by the next
  * step, so every pixel has one ray and one thread casts exactly the sequential order), the
  * visited set (an atomic bit per cell) and the cache, and keep their own triangle buffers,
- * moved to the mesh every few thousand triangles and at the end of the step. Which thread extracts a cell varies from run to
+ * moved to the mesh every few thousand triangles and at the end of the step. A worker left
+ * without rays in a step takes cells from the queue of a long propagation of another, so that
+ * a step of fewer rays than threads keeps every thread busy; a step returns once every cell
+ * queued in it is extracted. Which thread extracts a cell varies from run to
  * run, so the triangles' order and, where propagations meet, which cells are extracted may
  * vary; what every pixel finally shows does not (each pixel's own ray extracts its seed).
  * With several threads the times are summed over the threads. ip_engine_cancel() may be
