@@ -420,6 +420,53 @@ static void check_coverage_box_test(void)
     ip__coverage_free(&c);
 }
 
+/* ip__coverage_reach(): the entries of tiles not kept are left as they are by a clear, a
+ * triangle over them records nothing there, and a box reaching them is never found hidden,
+ * while one within the kept tiles behind the same triangles is. */
+static void check_coverage_reach(void)
+{
+    ip_camera cam = {{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 60.0, 64, 48};
+    ip_camera_basis basis;
+    ip_camera_basis_of(&cam, &basis);
+    double lo[3] = {-5, -5, -20}, hi[3] = {5, 5, 20};
+    ip_coverage c;
+    memset(&c, 0, sizeof c);
+    REQUIRE(ip__coverage_reset(&c, &cam, lo, hi) == IP_OK);
+    for (size_t i = 0; i < 64 * 48; i++) { /* a value no clear writes */
+        atomic_store(&c.depth[i], 12345u);
+        atomic_store(&c.solid[i], 12345u);
+    }
+    /* boxes behind a wall, left and right of the image's centre: the left one's half kept */
+    double left_lo[3] = {-1.6, -0.5, 1}, left_hi[3] = {-0.9, 0.5, 2};
+    double right_lo[3] = {0.9, -0.5, 1}, right_hi[3] = {1.6, 0.5, 2};
+    double centre[3] = {-1.25, 0, 1.5}, px, py, depth;
+    REQUIRE(ip_camera_project(&basis, &cam, centre, &px, &py, &depth));
+    unsigned char reached[8 * 6];
+    for (int t = 0; t < 8 * 6; t++)
+        reached[t] = (t % 8 < 4) == (px < 32);
+    REQUIRE(ip__coverage_prepare(&c, &cam, lo, hi) == IP_OK);
+    ip__coverage_reach(&c, reached, 3, 8);
+    ip__coverage_clear(&c, 0, 2);
+    ip__coverage_clear(&c, 1, 2);
+    const float wall[18] = {-2, -2, 0, 2, -2, 0, 2, 2, 0, -2, -2, 0, 2, 2, 0, -2, 2, 0};
+    ip__coverage_add(&c, wall, 2);
+    size_t wrong = 0;
+    for (uint32_t y = 0; y < 48; y++)
+        for (uint32_t x = 0; x < 64; x++) {
+            unsigned d = atomic_load(&c.depth[y * 64 + x]), sd = atomic_load(&c.solid[y * 64 + x]);
+            wrong += reached[(y >> 3) * 8 + (x >> 3)] ? d == 12345u || sd == 12345u
+                                                      : d != 12345u || sd != 12345u;
+        }
+    CHECK_MSG(wrong == 0, "%zu entries kept or dropped wrongly", wrong);
+    CHECK(ip__coverage_hides(&c, left_lo, left_hi));
+    CHECK(!ip__coverage_hides(&c, right_lo, right_hi));
+    ip__coverage_reach(&c, NULL, 3, 8); /* every entry again: the right one is hidden too */
+    ip__coverage_clear(&c, 0, 1);
+    ip__coverage_add(&c, wall, 2);
+    CHECK(ip__coverage_hides(&c, right_lo, right_hi));
+    ip__coverage_free(&c);
+}
+
 /* The tiles a box may show in (ip__reach_box(), tiles of 8x8 pixels): every pixel whose ray
  * meets one of 200 random boxes in front of the eye lies in a marked tile, and no tile is
  * marked more than one tile away from such a pixel's, for boxes that show in more than a few
@@ -888,6 +935,7 @@ int main(void)
     check_lod(dir);
     check_coverage_box_test();
     check_reach_box();
+    check_coverage_reach();
     check_occlusion(dir);
     check_retirement(dir);
     check_shared_data();

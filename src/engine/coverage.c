@@ -70,17 +70,37 @@ ip_status ip__coverage_prepare(ip_coverage *c, const ip_camera *camera, const do
     }
     c->centre_x = 0.5 * c->width;
     c->centre_y = 0.5 * c->height;
+    c->reached = NULL;
     return IP_OK;
+}
+
+void ip__coverage_reach(ip_coverage *c, const unsigned char *reached, unsigned shift,
+                        uint32_t tiles_x)
+{
+    c->reached = reached;
+    c->reached_shift = shift;
+    c->reached_x = tiles_x;
+}
+
+/* 1 when pixel (x, y)'s entries are kept (ip__coverage_reach()). */
+static inline int kept(const ip_coverage *c, int64_t x, int64_t y)
+{
+    return !c->reached || c->reached[(size_t)(y >> c->reached_shift) * c->reached_x +
+                                     (size_t)(x >> c->reached_shift)];
 }
 
 void ip__coverage_clear(ip_coverage *c, unsigned part, unsigned parts)
 {
-    size_t n = (size_t)c->width * c->height, first = n * part / parts, end = n * (part + 1) / parts;
+    uint32_t first = (uint32_t)((uint64_t)c->height * part / parts),
+             end = (uint32_t)((uint64_t)c->height * (part + 1) / parts);
     unsigned bits = ip__float_bits(INFINITY);
-    for (size_t i = first; i < end; i++) {
-        atomic_init(&c->depth[i], bits);
-        atomic_init(&c->solid[i], bits);
-    }
+    for (uint32_t y = first; y < end; y++)
+        for (uint32_t x = 0; x < c->width; x++)
+            if (kept(c, x, y)) {
+                size_t i = (size_t)y * c->width + x;
+                atomic_init(&c->depth[i], bits);
+                atomic_init(&c->solid[i], bits);
+            }
 }
 
 ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const double lo[3],
@@ -182,6 +202,8 @@ static void add_projected(ip_coverage *c, const double *x, const double *y, cons
         double cy = py + 0.5;
         for (int64_t px = x0; px <= x1; px++) {
             double cx = px + 0.5;
+            if (!kept(c, px, py)) /* not expected: a caller's triangles stay in kept tiles */
+                continue;
             double e0 = ex[0] * (cy - vy[0]) - ey[0] * (cx - vx[0]);
             double e1 = ex[1] * (cy - vy[1]) - ey[1] * (cx - vx[1]);
             double e2 = ex[2] * (cy - vy[2]) - ey[2] * (cx - vx[2]);
@@ -230,8 +252,9 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
     double xc = ip__vec3_dot(v, c->to_x) / zc + c->centre_x;
     double yc = ip__vec3_dot(v, c->to_y) / zc + c->centre_y;
     if (xc >= 0 && xc < c->width && yc >= 0 && yc < c->height &&
-        atomic_load_explicit(&c->depth[(size_t)yc * c->width + (size_t)xc], memory_order_relaxed) >=
-            bits)
+        (!kept(c, (int64_t)xc, (int64_t)yc) ||
+         atomic_load_explicit(&c->depth[(size_t)yc * c->width + (size_t)xc],
+                              memory_order_relaxed) >= bits))
         return 0;
     double min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY;
     for (int k = 0; k < 8; k++) {
@@ -250,7 +273,8 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
         return 0;
     for (int64_t py = y0; py <= y1; py++)
         for (int64_t px = x0; px <= x1; px++)
-            if (atomic_load_explicit(&c->depth[(size_t)py * c->width + (size_t)px],
+            if (!kept(c, px, py) ||
+                atomic_load_explicit(&c->depth[(size_t)py * c->width + (size_t)px],
                                      memory_order_relaxed) >= bits)
                 return 0;
     return 1;

@@ -48,6 +48,12 @@ typedef struct ip_coverage {
     atomic_uint *depth; /* width * height entries: the bits of a float depth, +inf: unknown */
     atomic_uint *solid; /* the same, from triangles holding the centre by the solid margin */
     size_t capacity;    /* entries allocated */
+    /* NULL, or per tile of 2^reached_shift pixels a side (reached_x of them a row): whether its
+     * entries are kept. The others are never cleared, written or read: no extracted surface
+     * can show there (ip__coverage_reach()). */
+    const unsigned char *reached;
+    unsigned reached_shift;
+    uint32_t reached_x;
 } ip_coverage;
 
 /* Starts over for `camera` (image size and view) and the volume's world box [lo, hi]: every
@@ -62,6 +68,15 @@ ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const doub
 ip_status ip__coverage_prepare(ip_coverage *c, const ip_camera *camera, const double lo[3],
                                const double hi[3]);
 void ip__coverage_clear(ip_coverage *c, unsigned part, unsigned parts);
+
+/* After ip__coverage_prepare() and before ip__coverage_clear(): keeps only the entries of the
+ * tiles of 2^shift pixels marked in `reached` (tiles_x a row; borrowed, NULL: every entry).
+ * The caller vouches that no triangle it adds reaches another tile (its image lies within a
+ * marked tile's pixels); boxes reaching another tile are never found hidden, and the solid
+ * entries of the others must not be read (ip__coverage_solid()). Clearing then writes only
+ * the kept entries, and the memory of the others is never touched. */
+void ip__coverage_reach(ip_coverage *c, const unsigned char *reached, unsigned shift,
+                        uint32_t tiles_x);
 
 void ip__coverage_free(ip_coverage *c);
 
@@ -84,7 +99,7 @@ static inline float ip__float_of_bits(unsigned bits)
     return f;
 }
 
-/* The solid entry of pixel (x, y) (inside the image): an upper bound on the view depth (world
+/* The solid entry of pixel (x, y) (inside the image, in a kept tile): an upper bound on the view depth (world
  * units) of an extracted triangle whose projection holds the pixel centre by at least
  * IP_COVERAGE_SOLID_MARGIN pixels from every edge, or +infinity where none is known. Bounds
  * the depth that the rasterizer shows there once that triangle is drawn. Any thread. */

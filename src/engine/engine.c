@@ -378,25 +378,24 @@ static void clear_view(void *user, unsigned index)
     ip__coverage_clear(&e->coverage, index, e->threads);
     size_t tiles = (size_t)e->tiles_x * e->tiles_y;
     for (size_t t = tiles * index / e->threads; t < tiles * (index + 1) / e->threads; t++) {
-        atomic_init(&e->tiles[t].depth, 0);
+        /* a tile no active brick shows in: settled with no bound (reach_view()) */
+        atomic_init(&e->tiles[t].depth, e->reached[t] ? 0 : ip__float_bits(INFINITY));
         atomic_init(&e->tiles[t].from, 0);
         atomic_init(&e->tiles[t].tested, 0);
         atomic_init(&e->tiles[t].cells, 0);
     }
 }
 
-/* The tiles that no brick holding the isovalue (at a level the view uses) may show in are
- * settled from the start with no bound (ip__reach_tiles()): no ray of theirs can meet an active
- * cell, so none is walked and no beam is tested for them. After clear_view(). */
-static void settle_unreached(ip_engine *e)
+/* The tiles that some brick holding the isovalue (at a level the view uses) may show in
+ * (ip__reach_tiles()). The others are settled from the start with no bound (clear_view()): no
+ * ray of theirs can meet an active cell, so none is walked (cast_ray()) and no beam is tested
+ * for them; and no triangle can show there, so the coverage keeps no entries for them
+ * (ip__coverage_reach()): they are neither cleared nor, in a fresh process, touched at all. */
+static void reach_view(ip_engine *e)
 {
     ip__reach_tiles(ip_cache_store(e->cache), e->iso, e->levels_used, &e->basis, &e->camera,
                     TILE_SHIFT, e->tiles_x, e->tiles_y, e->reached);
-    size_t tiles = (size_t)e->tiles_x * e->tiles_y;
-    for (size_t t = 0; t < tiles; t++)
-        if (!e->reached[t])
-            atomic_store_explicit(&e->tiles[t].depth, ip__float_bits(INFINITY),
-                                  memory_order_relaxed);
+    ip__coverage_reach(&e->coverage, e->reached, TILE_SHIFT, e->tiles_x);
 }
 
 ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_error *err)
@@ -446,8 +445,8 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
         }
         if (!e->tile_capacity || ip__coverage_prepare(&e->coverage, camera, lo, hi) != IP_OK)
             return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
+        reach_view(e);
         ip__pool_run(e->pool, e->threads, clear_view, e);
-        settle_unreached(e);
     }
     double pixel_angle = 2.0 * e->basis.tan_half_y / camera->height;
     for (unsigned t = 0; t < e->threads; t++) {
@@ -628,8 +627,11 @@ static ip_status cast_ray(worker *w, uint32_t x, uint32_t y, double from)
     ip_engine *e = w->engine;
     double dir[3];
     uint32_t cells[IP_SEED_MAX_CELLS][3];
-    ip_camera_pixel_ray(&e->basis, &e->camera, x + 0.5, y + 0.5, dir);
     w->counts.rays++;
+    if (e->options.occlusion &&
+        !e->reached[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)])
+        return IP_OK; /* no active brick shows in its tile (reach_view()): nothing to find */
+    ip_camera_pixel_ray(&e->basis, &e->camera, x + 0.5, y + 0.5, dir);
     double z = stop_depth(e, x, y), cos = ip__vec3_dot(dir, e->basis.forward);
     for (uint32_t k = 0; k < e->levels_used; k++) {
         level_tools *lt = &w->level[k];
