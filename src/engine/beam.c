@@ -71,15 +71,16 @@ static inline double nearest(const index_beam *w, const double lo[3], const doub
     return z;
 }
 
+/* The index box [lo, hi]'s farthest point's forward . p. */
+static inline double farthest(const index_beam *w, const double lo[3], const double hi[3])
+{
+    return nearest(w, hi, lo);
+}
+
 /* 1 when the index box [lo, hi] may meet the beam. */
 static inline int meets(const index_beam *w, const double lo[3], const double hi[3])
 {
-    double near = 0, far = 0;
-    for (int a = 0; a < 3; a++) {
-        near += w->forward[a] * (w->forward[a] >= 0 ? lo[a] : hi[a]);
-        far += w->forward[a] * (w->forward[a] >= 0 ? hi[a] : lo[a]);
-    }
-    if (near > w->limit || far < w->floor)
+    if (nearest(w, lo, hi) > w->limit || farthest(w, lo, hi) < w->floor)
         return 0;
     for (int p = 0; p < 4; p++) {
         const double *n = w->normal[p];
@@ -102,8 +103,9 @@ static void unsettled(index_beam *w, const double lo[3], const double hi[3])
 }
 
 /* The cells [lo, hi) of sub-block `sb` (index within its brick), by cell groups (cache.h):
- * those that are active and not visited lower the beam's limit (unsettled()). A cell group the beam meets every
- * active cell of which is visited is recorded as settled (ip__visited_mark_part()), and so is
+ * those that are active and not visited lower the beam's limit (unsettled()). A cell group the
+ * beam meets every active cell of which is visited is recorded as settled
+ * (ip__visited_mark_part()), and so is
  * a sub-block all of whose groups are (or hold no active cell); later tests pass over them
  * at once: cells once visited stay so. Groups are recorded only where sub-blocks hold whole
  * groups; the groups the beam does not meet are not looked at. */
@@ -190,8 +192,8 @@ static void settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi
         (void)ip__visited_mark_part(w->visited, brick->index, sb);
 }
 
-/* The sub-blocks of brick `b` (its box [blo, bhi]) within the bounding box of the beam's part
- * between the brick's nearest and farthest depths, nearest first along each axis. */
+/* The sub-blocks of brick `b` (its index box [box_lo, box_hi]) within the bounding box of the
+ * beam's part between the brick's nearest and farthest depths, nearest first along each axis. */
 static void settled_brick(index_beam *w, const uint32_t b[3], const double box_lo[3],
                           const double box_hi[3])
 {
@@ -200,9 +202,8 @@ static void settled_brick(index_beam *w, const uint32_t b[3], const double box_l
     uint32_t origin[3], extent[3], n[3];
     const float *ranges = ip__seeder_brick(s, b, origin, extent, n);
     uint32_t per = l->brick_edge / l->subblock_edge, first[3], last[3];
-    double z0 = nearest(w, box_lo, box_hi) - w->at_eye, z1 = w->limit - w->at_eye, far = -w->at_eye;
-    for (int a = 0; a < 3; a++)
-        far += w->forward[a] * (w->forward[a] >= 0 ? box_hi[a] : box_lo[a]);
+    double z0 = nearest(w, box_lo, box_hi) - w->at_eye, z1 = w->limit - w->at_eye,
+           far = farthest(w, box_lo, box_hi) - w->at_eye;
     z0 = z0 > 0 ? z0 : 0;
     z1 = z1 < far ? z1 : far;
     if (!(z0 <= z1))

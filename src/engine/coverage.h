@@ -99,10 +99,10 @@ static inline float ip__float_of_bits(unsigned bits)
     return f;
 }
 
-/* The solid entry of pixel (x, y) (inside the image, in a kept tile): an upper bound on the view depth (world
- * units) of an extracted triangle whose projection holds the pixel centre by at least
- * IP_COVERAGE_SOLID_MARGIN pixels from every edge, or +infinity where none is known. Bounds
- * the depth that the rasterizer shows there once that triangle is drawn. Any thread. */
+/* The solid entry of pixel (x, y) (inside the image, in a kept tile): an upper bound on the
+ * view depth (world units) of an extracted triangle whose projection holds the pixel centre by
+ * at least IP_COVERAGE_SOLID_MARGIN pixels from every edge, or +infinity where none is known.
+ * Bounds the depth that the rasterizer shows there once that triangle is drawn. Any thread. */
 static inline double ip__coverage_solid(const ip_coverage *c, uint32_t x, uint32_t y)
 {
     return ip__float_of_bits(

@@ -110,7 +110,7 @@ struct ip_engine {
     double cell_reach[IP_MAX_LEVELS];       /* a level-k cell's extent along the view (world) */
     /* With occlusion: bulk retirement of the rays of 8 x 8 pixel tiles (see retire()). */
     tile *tiles;
-    unsigned char *reached; /* per tile: some active brick may show in it (settle_unreached()) */
+    unsigned char *reached; /* per tile: some active brick may show in it (reach_view()) */
     size_t tile_capacity;
     uint32_t tiles_x, tiles_y;
     uint32_t tile_from;   /* the first ray-order level whose rays test their tile: the first
@@ -971,6 +971,16 @@ static ip_status flush_triangles(worker *w)
     return st;
 }
 
+/* Adds the cells the worker extracted since *published (of its step's counts) to the engine's
+ * cells_done, which decides when tiles are tested again (tile_retires()). */
+static void publish_cells(ip_engine *e, const worker *w, uint64_t *published)
+{
+    if (w->counts.cells != *published)
+        atomic_fetch_add_explicit(&e->cells_done, (unsigned)(w->counts.cells - *published),
+                                  memory_order_relaxed);
+    *published = w->counts.cells;
+}
+
 /* One worker's share of a step (a job of the engine's pool): batches of rays until the step's
  * budget, the order or the time runs out, or a worker fails. */
 static void work(void *user, unsigned index)
@@ -997,18 +1007,13 @@ static void work(void *user, unsigned index)
         double seeding = ip_now_seconds() - t0 -
                          (w->counts.propagation_seconds + w->counts.extraction_seconds - inner);
         w->counts.intersection_seconds += seeding > 0 ? seeding : 0;
-        if (w->counts.cells != published) {
-            atomic_fetch_add_explicit(&e->cells_done, (unsigned)(w->counts.cells - published),
-                                      memory_order_relaxed);
-            published = w->counts.cells;
-        }
+        publish_cells(e, w, &published);
         if (w->mesh.triangle_count >= FLUSH_TRIANGLES && flush_triangles(w) != IP_OK &&
             w->status == IP_OK)
             w->status = IP_ERR_NOMEM;
     }
     help(e, w);
-    atomic_fetch_add_explicit(&e->cells_done, (unsigned)(w->counts.cells - published),
-                              memory_order_relaxed);
+    publish_cells(e, w, &published);
     if (flush_triangles(w) != IP_OK && w->status == IP_OK)
         w->status = IP_ERR_NOMEM;
     if (w->status != IP_OK) /* the step fails: the other workers take no more rays */

@@ -342,9 +342,7 @@ static int walk_bricks(ip_seeder *s, const index_ray *r, double t0, double t1)
         uint32_t b[3] = {(uint32_t)d.i[0], (uint32_t)d.i[1], (uint32_t)d.i[2]};
         double enter_t = d.t, exit_t;
         int more = dda_next(&d, &exit_t);
-        const float *range =
-            s->ranges[0] + 2 * (b[0] + (uint64_t)grid[0] * (b[1] + (uint64_t)grid[1] * b[2]));
-        if (active(range, s->iso) && ip__seeder_node_kept(s, 0, b)) {
+        if (ip__seeder_node_active(s, 0, b) && ip__seeder_node_kept(s, 0, b)) {
             int found = walk_brick(s, r, b, enter_t, exit_t);
             if (found)
                 return found;

@@ -56,6 +56,16 @@ static inline void ip__seeder_node_box(const ip_seeder *s, uint32_t depth, const
     }
 }
 
+/* 1 when the summary range (min, max) of node `node` at `depth`, which the level has, holds
+ * the iso-value. */
+static inline int ip__seeder_node_active(const ip_seeder *s, uint32_t depth, const uint32_t node[3])
+{
+    const uint32_t *grid = s->grid[depth];
+    uint64_t i = node[0] + (uint64_t)grid[0] * (node[1] + (uint64_t)grid[1] * node[2]);
+    const float *range = s->ranges[depth] + 2 * i;
+    return ip__range_active(range[0], range[1], s->iso);
+}
+
 /* Child c (0..7: bit k is the upper half along axis k) of node `node` at `depth` (> 0), in
  * ch: 1 when the level has it and its summary range holds the iso-value, else 0. */
 static inline int ip__seeder_active_child(const ip_seeder *s, uint32_t depth,
@@ -66,9 +76,7 @@ static inline int ip__seeder_active_child(const ip_seeder *s, uint32_t depth,
         ch[k] = 2 * node[k] + ((c >> k) & 1);
     if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
         return 0;
-    uint64_t i = ch[0] + (uint64_t)grid[0] * (ch[1] + (uint64_t)grid[1] * ch[2]);
-    const float *range = s->ranges[depth - 1] + 2 * i;
-    return ip__range_active(range[0], range[1], s->iso);
+    return ip__seeder_node_active(s, depth - 1, ch);
 }
 
 /* 1 unless the clipping planes drop every cell of node `node` at `depth`. */

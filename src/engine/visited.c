@@ -43,15 +43,13 @@ void ip__visited_free(ip_visited *v)
 /* The brick of a cell and the cell's bit inside it. */
 static uint64_t locate(const ip_visited *v, uint32_t level, const uint32_t cell[3], uint64_t *bit)
 {
-    unsigned shift = v->edge_shift;
-    uint32_t brick[3], local[3], mask = (UINT32_C(1) << shift) - 1;
+    uint32_t brick[3];
     IP_ASSERT(level < v->layout->level_count);
     for (int a = 0; a < 3; a++) {
         IP_ASSERT(cell[a] < v->layout->levels[level].dims[a] - 1);
-        brick[a] = cell[a] >> shift;
-        local[a] = cell[a] & mask;
+        brick[a] = cell[a] >> v->edge_shift;
     }
-    *bit = local[0] + ((uint64_t)local[1] << shift) + ((uint64_t)local[2] << (2 * shift));
+    *bit = ip__visited_cell_bit(v, cell);
     return ip_brick_global_index(v->layout, level, brick);
 }
 

@@ -50,6 +50,15 @@ static inline const atomic_uint_fast64_t *ip__visited_bitmap(const ip_visited *v
     return atomic_load_explicit(&v->bitmaps[brick], memory_order_acquire);
 }
 
+/* The bit of `cell` (level coordinates) in its brick's bitmap: the brick's cells x fastest. */
+static inline uint64_t ip__visited_cell_bit(const ip_visited *v, const uint32_t cell[3])
+{
+    unsigned shift = v->edge_shift;
+    uint32_t mask = (UINT32_C(1) << shift) - 1;
+    return (cell[0] & mask) + ((uint64_t)(cell[1] & mask) << shift) +
+           ((uint64_t)(cell[2] & mask) << (2 * shift));
+}
+
 /* 1 when `cell` (of the level and brick whose bitmap is `m`, from ip__visited_bitmap()) is
  * marked. */
 static inline int ip__visited_test_in(const ip_visited *v, const atomic_uint_fast64_t *m,
@@ -57,10 +66,7 @@ static inline int ip__visited_test_in(const ip_visited *v, const atomic_uint_fas
 {
     if (!m)
         return 0;
-    unsigned shift = v->edge_shift;
-    uint32_t mask = (UINT32_C(1) << shift) - 1;
-    uint64_t bit = (cell[0] & mask) + ((uint64_t)(cell[1] & mask) << shift) +
-                   ((uint64_t)(cell[2] & mask) << (2 * shift));
+    uint64_t bit = ip__visited_cell_bit(v, cell);
     return (atomic_load_explicit(&m[bit >> 6], memory_order_relaxed) >> (bit & 63)) & 1;
 }
 
