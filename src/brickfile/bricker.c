@@ -276,6 +276,15 @@ static ip_status process_brick(bricker *b, const layer_ref *ref, uint64_t i, bri
     return e->stored_size > 0 ? spill_payload(b, e, s->out, &s->error) : IP_OK;
 }
 
+/* The layer of `job` that its item `i` (a brick or a brick row) belongs to. */
+static const layer_ref *job_layer(const chunk_job *job, uint64_t i)
+{
+    uint32_t r = 0;
+    while (i >= job->layers[r].first + job->layers[r].count)
+        r++;
+    return &job->layers[r];
+}
+
 /* One job of an encoding run (on the pool): takes bricks from the shared counter until none is
  * left, with scratch buffers of its own. */
 static void encode_worker(void *user, unsigned index)
@@ -286,10 +295,8 @@ static void encode_worker(void *user, unsigned index)
         uint64_t i = atomic_fetch_add(&job->next, 1);
         if (i >= job->total || atomic_load(&job->failed))
             break;
-        uint32_t r = 0;
-        while (i >= job->layers[r].first + job->layers[r].count)
-            r++;
-        ip_status st = process_brick(job->b, &job->layers[r], i - job->layers[r].first, scratch);
+        const layer_ref *ref = job_layer(job, i);
+        ip_status st = process_brick(job->b, ref, i - ref->first, scratch);
         if (st != IP_OK)
             worker_failed(job, scratch, st);
     }
@@ -306,10 +313,7 @@ static void summary_worker(void *user, unsigned index)
         uint64_t i = atomic_fetch_add(&job->next, 1);
         if (i >= job->total)
             break;
-        uint32_t r = 0;
-        while (i >= job->layers[r].first + job->layers[r].count)
-            r++;
-        const layer_ref *ref = &job->layers[r];
+        const layer_ref *ref = job_layer(job, i);
         const level_slab *slab = &b->slabs[ref->level];
         const ip_level_layout *lv = &l->levels[ref->level];
         uint32_t brick[3] = {0, 0, ref->bz}, origin[3], extent[3];
