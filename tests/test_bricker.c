@@ -293,6 +293,18 @@ static int read_file(const char *path, unsigned char **data, size_t *size)
     return got == *size ? 0 : -1;
 }
 
+/* Whether the files at a and b are both readable and hold the same bytes. */
+static int same_files(const char *a, const char *b)
+{
+    unsigned char *da = NULL, *db = NULL;
+    size_t sa = 0, sb = 0;
+    int same = read_file(a, &da, &sa) == 0 && read_file(b, &db, &sb) == 0 && sa == sb &&
+               memcmp(da, db, sa) == 0;
+    free(da);
+    free(db);
+    return same;
+}
+
 static void test_deterministic(const char *dir)
 {
     char raw[4096], a[4200], b[4200];
@@ -301,12 +313,7 @@ static void test_deterministic(const char *dir)
     snprintf(a, sizeof a, "%s/t1.ibv", dir);
     snprintf(b, sizeof b, "%s/t3.ibv", dir);
     REQUIRE(brick_file(raw, a, 8, 4, 1, NULL) == 0 && brick_file(raw, b, 8, 4, 3, NULL) == 0);
-    unsigned char *da, *db;
-    size_t sa, sb;
-    REQUIRE(read_file(a, &da, &sa) == 0 && read_file(b, &db, &sb) == 0);
-    CHECK(sa == sb && memcmp(da, db, sa) == 0);
-    free(da);
-    free(db);
+    CHECK_MSG(same_files(a, b), "%s and %s differ", a, b);
     free(v.values);
 }
 
@@ -429,17 +436,6 @@ static int direct_reads_work(const char *path)
     return ok;
 }
 
-static int same_files(const char *a, const char *b)
-{
-    unsigned char *da = NULL, *db = NULL;
-    size_t sa = 0, sb = 0;
-    int same = read_file(a, &da, &sa) == 0 && read_file(b, &db, &sb) == 0 && sa == sb &&
-               memcmp(da, db, sa) == 0;
-    free(da);
-    free(db);
-    return same;
-}
-
 /* Direct and buffered reads, overlapped with the encoding or not, give the same file. The
  * samples of a raw file whose planes suit O_DIRECT (256 x 256 uint16: 128 KiB planes, 5 chunks
  * of 8-cell bricks) are bricked: as they are, the next chunk read while one is encoded; under a
@@ -451,7 +447,7 @@ static void test_direct_reads(const char *dir)
     snprintf(sub, sizeof sub, "%s/direct", dir);
     mkdir(sub, 0777);
     uint32_t dims[3] = {256, 256, 41};
-    volume v = make_volume(sub, dims, IP_UINT16, 0, raw, sizeof raw);
+    volume v = make_volume(sub, dims, IP_UINT16, FILL_PATTERN, raw, sizeof raw);
     snprintf(skewed, sizeof skewed, "%s/skewed.dat", sub);
     snprintf(mhd, sizeof mhd, "%s/skewed.mhd", sub);
     unsigned char *bytes;
