@@ -408,6 +408,16 @@ static void test_memory_plan(void)
     uint64_t more_bricks = (uint64_t)96 * 96 * (14040 / 32 - 1404 / 32) * 8 / 7 + 1;
     CHECK_MSG(deeper - plan <= more_bricks * 48, "plan grows by %llu bytes",
               (unsigned long long)(deeper - plan));
+    /* one layer of level-0 bricks (32 planes): nothing to read while it is encoded, so no
+     * second chunk even without a limit; a limit of 1 byte gives the smallest plan */
+    uint64_t one_layer = 0, smallest = 0;
+    desc.dims[2] = 32;
+    o.memory_limit = 0;
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &one_layer, &err) == IP_OK);
+    o.memory_limit = 1;
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &smallest, &err) == IP_OK);
+    CHECK_MSG(one_layer == smallest, "plans of %llu and %llu bytes", (unsigned long long)one_layer,
+              (unsigned long long)smallest);
 }
 
 /* Bricks `input` with 8-cell bricks on 2 threads under `limit` bytes (0: none). */
