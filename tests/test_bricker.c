@@ -293,6 +293,18 @@ static int read_file(const char *path, unsigned char **data, size_t *size)
     return got == *size ? 0 : -1;
 }
 
+/* Whether the files at a and b are both readable and hold the same bytes. */
+static int same_files(const char *a, const char *b)
+{
+    unsigned char *da = NULL, *db = NULL;
+    size_t sa = 0, sb = 0;
+    int same = read_file(a, &da, &sa) == 0 && read_file(b, &db, &sb) == 0 && sa == sb &&
+               memcmp(da, db, sa) == 0;
+    free(da);
+    free(db);
+    return same;
+}
+
 static void test_deterministic(const char *dir)
 {
     char raw[4096], a[4200], b[4200];
@@ -301,12 +313,7 @@ static void test_deterministic(const char *dir)
     snprintf(a, sizeof a, "%s/t1.ibv", dir);
     snprintf(b, sizeof b, "%s/t3.ibv", dir);
     REQUIRE(brick_file(raw, a, 8, 4, 1, NULL) == 0 && brick_file(raw, b, 8, 4, 3, NULL) == 0);
-    unsigned char *da, *db;
-    size_t sa, sb;
-    REQUIRE(read_file(a, &da, &sa) == 0 && read_file(b, &db, &sb) == 0);
-    CHECK(sa == sb && memcmp(da, db, sa) == 0);
-    free(da);
-    free(db);
+    CHECK_MSG(same_files(a, b), "%s and %s differ", a, b);
     free(v.values);
 }
 
@@ -401,6 +408,16 @@ static void test_memory_plan(void)
     uint64_t more_bricks = (uint64_t)96 * 96 * (14040 / 32 - 1404 / 32) * 8 / 7 + 1;
     CHECK_MSG(deeper - plan <= more_bricks * 48, "plan grows by %llu bytes",
               (unsigned long long)(deeper - plan));
+    /* one layer of level-0 bricks (32 planes): nothing to read while it is encoded, so no
+     * second chunk even without a limit; a limit of 1 byte gives the smallest plan */
+    uint64_t one_layer = 0, smallest = 0;
+    desc.dims[2] = 32;
+    o.memory_limit = 0;
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &one_layer, &err) == IP_OK);
+    o.memory_limit = 1;
+    REQUIRE(ip_bricker_memory_needed(&desc, &o, &smallest, &err) == IP_OK);
+    CHECK_MSG(one_layer == smallest, "plans of %llu and %llu bytes", (unsigned long long)one_layer,
+              (unsigned long long)smallest);
 }
 
 /* Bricks `input` with 8-cell bricks on 2 threads under `limit` bytes (0: none). */
@@ -429,17 +446,6 @@ static int direct_reads_work(const char *path)
     return ok;
 }
 
-static int same_files(const char *a, const char *b)
-{
-    unsigned char *da = NULL, *db = NULL;
-    size_t sa = 0, sb = 0;
-    int same = read_file(a, &da, &sa) == 0 && read_file(b, &db, &sb) == 0 && sa == sb &&
-               memcmp(da, db, sa) == 0;
-    free(da);
-    free(db);
-    return same;
-}
-
 /* Direct and buffered reads, overlapped with the encoding or not, give the same file. The
  * samples of a raw file whose planes suit O_DIRECT (256 x 256 uint16: 128 KiB planes, 5 chunks
  * of 8-cell bricks) are bricked: as they are, the next chunk read while one is encoded; under a
@@ -451,7 +457,7 @@ static void test_direct_reads(const char *dir)
     snprintf(sub, sizeof sub, "%s/direct", dir);
     mkdir(sub, 0777);
     uint32_t dims[3] = {256, 256, 41};
-    volume v = make_volume(sub, dims, IP_UINT16, 0, raw, sizeof raw);
+    volume v = make_volume(sub, dims, IP_UINT16, FILL_PATTERN, raw, sizeof raw);
     snprintf(skewed, sizeof skewed, "%s/skewed.dat", sub);
     snprintf(mhd, sizeof mhd, "%s/skewed.mhd", sub);
     unsigned char *bytes;

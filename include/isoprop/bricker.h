@@ -68,7 +68,8 @@ IP_API void ip_bricker_options_default(ip_bricker_options *options);
 
 /*! ip_bricker_memory_needed() : working memory (bytes) a run with `options` needs for `input`:
  *  the plan with a second chunk of level-0 planes (read while the one before is encoded) when
- *  options->memory_limit is 0 or has room for it, else the smallest plan.
+ *  the input has more than one layer of level-0 bricks and options->memory_limit is 0 or has
+ *  room for it, else the smallest plan.
  *  @return IP_OK, or an error for options the layout rejects. */
 IP_API ip_status ip_bricker_memory_needed(const ip_input_desc *input,
                                           const ip_bricker_options *options, uint64_t *bytes,

@@ -276,6 +276,15 @@ static ip_status process_brick(bricker *b, const layer_ref *ref, uint64_t i, bri
     return e->stored_size > 0 ? spill_payload(b, e, s->out, &s->error) : IP_OK;
 }
 
+/* The layer of `job` that its item `i` (a brick or a brick row) belongs to. */
+static const layer_ref *job_layer(const chunk_job *job, uint64_t i)
+{
+    uint32_t r = 0;
+    while (i >= job->layers[r].first + job->layers[r].count)
+        r++;
+    return &job->layers[r];
+}
+
 /* One job of an encoding run (on the pool): takes bricks from the shared counter until none is
  * left, with scratch buffers of its own. */
 static void encode_worker(void *user, unsigned index)
@@ -286,10 +295,8 @@ static void encode_worker(void *user, unsigned index)
         uint64_t i = atomic_fetch_add(&job->next, 1);
         if (i >= job->total || atomic_load(&job->failed))
             break;
-        uint32_t r = 0;
-        while (i >= job->layers[r].first + job->layers[r].count)
-            r++;
-        ip_status st = process_brick(job->b, &job->layers[r], i - job->layers[r].first, scratch);
+        const layer_ref *ref = job_layer(job, i);
+        ip_status st = process_brick(job->b, ref, i - ref->first, scratch);
         if (st != IP_OK)
             worker_failed(job, scratch, st);
     }
@@ -306,10 +313,7 @@ static void summary_worker(void *user, unsigned index)
         uint64_t i = atomic_fetch_add(&job->next, 1);
         if (i >= job->total)
             break;
-        uint32_t r = 0;
-        while (i >= job->layers[r].first + job->layers[r].count)
-            r++;
-        const layer_ref *ref = &job->layers[r];
+        const layer_ref *ref = job_layer(job, i);
         const level_slab *slab = &b->slabs[ref->level];
         const ip_level_layout *lv = &l->levels[ref->level];
         uint32_t brick[3] = {0, 0, ref->bz}, origin[3], extent[3];
@@ -501,33 +505,6 @@ static void planes_arrived(bricker *b, uint32_t z1)
             z1 == b->layout.dims[2] - 1 ? b->layout.levels[k].dims[2] : (z1 >> k) + 1;
 }
 
-/* Reads level-0 planes [z0, z1] into the slabs, on every thread when the input can be read
- * at any plane, else in order on this one (gzip), and feeds the pyramid. */
-static ip_status read_chunk(bricker *b, ip_input_reader *reader, uint32_t z0, uint32_t z1,
-                            ip_error *err)
-{
-    ip_status st = IP_OK;
-    if (ip__input_positioned(reader)) {
-        chunk_job job;
-        memset(&job, 0, sizeof job);
-        job.b = b;
-        job.reader = reader;
-        job.z0 = z0;
-        job.total = z1 - z0 + 1;
-        st = run_jobs(b, &job, read_worker, err);
-    } else {
-        for (uint32_t z = z0; st == IP_OK && z <= z1; z++) {
-            unsigned char *dst = (unsigned char *)slab_plane(&b->slabs[0], z);
-            st = ip_input_read_planes(reader, dst, 1, err);
-            if (st == IP_OK)
-                feed_levels(b, z);
-        }
-    }
-    if (st == IP_OK)
-        planes_arrived(b, z1);
-    return st;
-}
-
 /* One job of a feeding run (on the pool): places level-0 planes already read into the
  * coarser levels. */
 static void feed_worker(void *user, unsigned index)
@@ -556,21 +533,6 @@ static ip_status feed_chunk(bricker *b, uint32_t z0, uint32_t z1, ip_error *err)
     return st;
 }
 
-/* ---- reading ahead on a thread of its own ---- */
-
-/* The reader thread's work: level-0 planes [z0, z1] into their slots and nothing else, while
- * the pool encodes the layers of the chunk before. The coarser levels are fed after the thread
- * is joined, when no brick of theirs is being encoded. */
-typedef struct read_ahead {
-    bricker *b;
-    ip_input_reader *reader;
-    uint32_t z0, z1;
-    ip_status status;
-    ip_error error;
-    pthread_t thread;
-    int started;
-} read_ahead;
-
 /* Reads level-0 planes [z0, z1] into their slots on this thread: one read per run of slots
  * that does not wrap around the ring. */
 static ip_status read_level0(bricker *b, ip_input_reader *reader, uint32_t z0, uint32_t z1,
@@ -594,6 +556,43 @@ static ip_status read_level0(bricker *b, ip_input_reader *reader, uint32_t z0, u
     }
     return st;
 }
+
+/* Reads level-0 planes [z0, z1] into the slabs and feeds the pyramid: on every thread, each
+ * plane fed as it arrives, when the input can be read at any plane; else read in order on this
+ * thread (gzip), then fed on every thread. */
+static ip_status read_chunk(bricker *b, ip_input_reader *reader, uint32_t z0, uint32_t z1,
+                            ip_error *err)
+{
+    if (!ip__input_positioned(reader)) {
+        ip_status st = read_level0(b, reader, z0, z1, err);
+        return st == IP_OK ? feed_chunk(b, z0, z1, err) : st;
+    }
+    chunk_job job;
+    memset(&job, 0, sizeof job);
+    job.b = b;
+    job.reader = reader;
+    job.z0 = z0;
+    job.total = z1 - z0 + 1;
+    ip_status st = run_jobs(b, &job, read_worker, err);
+    if (st == IP_OK)
+        planes_arrived(b, z1);
+    return st;
+}
+
+/* ---- reading ahead on a thread of its own ---- */
+
+/* The reader thread's work: level-0 planes [z0, z1] into their slots and nothing else, while
+ * the pool encodes the layers of the chunk before. The coarser levels are fed after the thread
+ * is joined, when no brick of theirs is being encoded. */
+typedef struct read_ahead {
+    bricker *b;
+    ip_input_reader *reader;
+    uint32_t z0, z1;
+    ip_status status;
+    ip_error error;
+    pthread_t thread;
+    int started;
+} read_ahead;
 
 static void *read_ahead_main(void *arg)
 {

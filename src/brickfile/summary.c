@@ -247,7 +247,9 @@ void ip__summarise_brick(const void *samples, ip_type type, const uint32_t exten
         planes[z] = (const unsigned char *)samples + (size_t)z * extent[1] * row_bytes;
     ip__layer_rows layer = {planes,    row_bytes, type,       {extent[0], extent[1]},
                             extent[2], {1, 1},    brick_edge, subblock_edge};
-    int16_t scratch[4 * (IP_MAX_BRICK_EDGE + 1)]; /* ip__brick_row_scratch_bytes(extent[0]) */
+    /* ip__brick_row_scratch_bytes(extent[0], type): 4 rows of at most 2-byte samples */
+    int16_t scratch[4 * (IP_MAX_BRICK_EDGE + 1)];
+    IP_ASSERT(ip__brick_row_scratch_bytes(extent[0], type) <= sizeof scratch);
     ip__summarise_brick_row(&layer, 0, scratch, ranges);
     ip__union_range(ranges, (size_t)per_axis * per_axis * per_axis, brick_range);
 }

@@ -600,10 +600,8 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
     uint32_t level, brick[3];
     ip_brick_coords(c->layout, g, &level, brick);
     note_touch(c, g, level);
-    if (try_pin(c, g, b)) {
-        atomic_fetch_add_explicit(&c->hits[g % HIT_STRIPES].value, 1, memory_order_relaxed);
+    if (ip__cache_pin_resident(c, g, b))
         return IP_OK;
-    }
     double t0 = ip_now_seconds(); /* from here on the caller waits for the brick */
     pthread_mutex_t *lock = &c->stripe_lock[g % STRIPES];
     pthread_mutex_lock(lock);
