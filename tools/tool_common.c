@@ -860,17 +860,17 @@ static int hex_digit(char c)
     return c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
 }
 
-int tool_view_camera(const tool_view_options *o, const double lo[3], const double hi[3],
-                     ip_camera *camera, ip_error *err)
+int tool_camera_of(const char *camera_text, const char *axis, uint32_t width, uint32_t height,
+                   const double lo[3], const double hi[3], ip_camera *camera, ip_error *err)
 {
-    if (!o->camera)
-        return ip_camera_fit_axis(lo, hi, o->view, 30.0, o->width, o->height, camera, err) == IP_OK
-                   ? 0
-                   : -1;
-    camera->width = o->width;
-    camera->height = o->height;
-    if (ip_camera_parse(o->camera, camera, err) != IP_OK || ip_camera_check(camera, err) != IP_OK)
+    ip_camera c = {.width = width, .height = height};
+    if (camera_text) {
+        if (ip_camera_parse(camera_text, &c, err) != IP_OK || ip_camera_check(&c, err) != IP_OK)
+            return -1;
+    } else if (ip_camera_fit_axis(lo, hi, axis, 30.0, width, height, &c, err) != IP_OK) {
         return -1;
+    }
+    *camera = c;
     return 0;
 }
 
