@@ -733,7 +733,8 @@ static int setup_camera(run *r, ip_error *err)
 {
     const ip_layout *l = ip_store_layout(r->store);
     ip_layout_world_box(l, r->lo, r->hi);
-    if (tool_view_camera(&r->o.common, r->lo, r->hi, &r->camera, err) != 0)
+    if (tool_camera_of(r->o.common.camera, r->o.common.view, r->o.common.width, r->o.common.height,
+                       r->lo, r->hi, &r->camera, err) != 0)
         return -1;
     r->view_camera = r->camera;
     tool_apply_orbit(&r->o.orbit, &r->camera);

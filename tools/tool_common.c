@@ -92,28 +92,34 @@ int tool_parse_double3(const char *text, double out[3])
     return tok ? -1 : 0;
 }
 
+/* Reads text as n whole numbers joined by 'x' or 'X' ("1600x1200", "512x512x234") into
+ * value[] (one too large for them reads as ULLONG_MAX). Returns 0, or -1 when it is not that. */
+static int scan_whole_numbers(const char *text, int n, unsigned long long *value)
+{
+    const char *p = text;
+    for (int k = 0; k < n; k++) {
+        char *end;
+        if (!isdigit((unsigned char)*p))
+            return -1;
+        errno = 0;
+        value[k] = strtoull(p, &end, 10);
+        if (errno == ERANGE)
+            value[k] = ULLONG_MAX;
+        p = end;
+        if (k + 1 < n) {
+            if (*p != 'x' && *p != 'X')
+                return -1;
+            p++;
+        }
+    }
+    return *p == '\0' ? 0 : -1;
+}
+
 int tool_parse_dims(const char *program, const char *option, const char *text, uint32_t dims[3])
 {
     static const char axes[3] = {'x', 'y', 'z'};
     unsigned long long value[3];
-    const char *p = text;
-    int count = 0;
-    for (; count < 3; count++) {
-        char *end;
-        if (!isdigit((unsigned char)*p))
-            break;
-        errno = 0;
-        value[count] = strtoull(p, &end, 10);
-        if (errno == ERANGE)
-            value[count] = ULLONG_MAX;
-        p = end;
-        if (count < 2) {
-            if (*p != 'x' && *p != 'X')
-                break;
-            p++;
-        }
-    }
-    if (count < 3 || *p != '\0')
+    if (scan_whole_numbers(text, 3, value) != 0)
         return tool_usage_error(program,
                                 "%s '%s' is not XxYxZ (three whole numbers, e.g. "
                                 "512x512x234)",
@@ -624,22 +630,7 @@ int tool_parse_pair(const char *program, const char *option, const char *text, u
                     uint32_t *b)
 {
     unsigned long long side[2];
-    const char *q = text;
-    for (int k = 0; k < 2; k++) {
-        char *end;
-        if (!isdigit((unsigned char)*q))
-            return tool_usage_error(program, "%s '%s' is not %s", option, text, form);
-        errno = 0;
-        side[k] = strtoull(q, &end, 10);
-        if (errno == ERANGE)
-            side[k] = ULLONG_MAX;
-        q = end;
-        if (k == 0 && *q != 'x' && *q != 'X')
-            return tool_usage_error(program, "%s '%s' is not %s", option, text, form);
-        if (k == 0)
-            q++;
-    }
-    if (*q != '\0')
+    if (scan_whole_numbers(text, 2, side) != 0)
         return tool_usage_error(program, "%s '%s' is not %s", option, text, form);
     for (int k = 0; k < 2; k++)
         if (side[k] < 1 || side[k] > max)
@@ -869,17 +860,17 @@ static int hex_digit(char c)
     return c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
 }
 
-int tool_view_camera(const tool_view_options *o, const double lo[3], const double hi[3],
-                     ip_camera *camera, ip_error *err)
+int tool_camera_of(const char *camera_text, const char *axis, uint32_t width, uint32_t height,
+                   const double lo[3], const double hi[3], ip_camera *camera, ip_error *err)
 {
-    if (!o->camera)
-        return ip_camera_fit_axis(lo, hi, o->view, 30.0, o->width, o->height, camera, err) == IP_OK
-                   ? 0
-                   : -1;
-    camera->width = o->width;
-    camera->height = o->height;
-    if (ip_camera_parse(o->camera, camera, err) != IP_OK || ip_camera_check(camera, err) != IP_OK)
+    ip_camera c = {.width = width, .height = height};
+    if (camera_text) {
+        if (ip_camera_parse(camera_text, &c, err) != IP_OK || ip_camera_check(&c, err) != IP_OK)
+            return -1;
+    } else if (ip_camera_fit_axis(lo, hi, axis, 30.0, width, height, &c, err) != IP_OK) {
         return -1;
+    }
+    *camera = c;
     return 0;
 }
 

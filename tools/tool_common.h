@@ -292,11 +292,11 @@ void tool_orbit_options_default(tool_orbit_options *o);
  * divided by it. The camera stays valid. */
 void tool_apply_orbit(const tool_orbit_options *o, ip_camera *camera);
 
-/* The camera of the view options: --camera E,T,U,FOV (checked) or, without it, --view AXIS
- * fitted to the world box [lo, hi] (30 degrees), of --size pixels; before any orbit. Returns 0,
- * or -1 with err set. */
-int tool_view_camera(const tool_view_options *o, const double lo[3], const double hi[3],
-                     ip_camera *camera, ip_error *err);
+/* A camera of width x height pixels: camera_text ("E,T,U,FOV", checked; --camera) or, when it
+ * is NULL, the view along `axis` (--view) fitted to the world box [lo, hi] (30 degrees); before
+ * any orbit. Returns 0, or -1 with err set and *camera untouched. */
+int tool_camera_of(const char *camera_text, const char *axis, uint32_t width, uint32_t height,
+                   const double lo[3], const double hi[3], ip_camera *camera, ip_error *err);
 
 /* Parses a colour: "R,G,B" (numbers in [0, 1]) or "#rrggbb" (hexadecimal). Returns 0, or -1
  * on bad text. */

@@ -1,10 +1,10 @@
 # isowall, the display wall's parallel renderer, on 4 MPI processes (oversubscribed): the
 # wall's image, dynamic and --static, and the tiles of --tiles-dir equal isorender's software
 # image of the same camera and total size (>= 99.99 % identical pixels); the statistics have
-# one record per process whose units add up to the work units and rays to the pixels (with
-# --static: each tile's units on its owner, none stolen); bad --wall, --tile and --unit values
-# are usage errors (exit 2). Registered only where the build found MPI; skipped when mpirun is
-# missing.
+# one record per process whose units add up to the work units and rays to the pixels, fewer of
+# them stolen than taken (with --static: each tile's units on its owner, none stolen); bad
+# --wall, --tile and --unit values are usage errors (exit 2). Registered only where the build
+# found MPI; skipped when mpirun is missing.
 . "$(dirname "$0")/lib.sh"
 
 if ! command -v mpirun >/dev/null 2>&1; then
@@ -60,6 +60,11 @@ check "more regions than processes ($regions)" test "$regions" -gt 16
 over=$(grep '"rank": ' dyn.json | sed 's/.*"units": \([0-9]*\).*"stolen": \([0-9]*\).*/\1 \2/' |
     awk '$2 > $1 { n++ } END { print n + 0 }')
 check "no process stole more units than it took ($over did)" test "$over" = 0
+# every share starts non-empty (more blocks of 4 regions than processes), so the first unit
+# taken is from its taker's own share: fewer units stolen than taken
+stolen=$(sum dyn.json stolen)
+check "fewer units stolen than taken ($stolen of $(sum dyn.json units))" \
+    test "$stolen" -lt "$(sum dyn.json units)"
 busy=$(grep '"rank": ' dyn.json | grep -c '"units": [1-9]')
 check "every process took units ($busy of 4)" test "$busy" = 4
 

@@ -12,15 +12,8 @@
 
 int camera_from(viewer *v, const char *camera_text, const char *axis, ip_camera *out, ip_error *err)
 {
-    ip_camera c = v->camera;
-    if (camera_text) {
-        if (ip_camera_parse(camera_text, &c, err) != IP_OK || ip_camera_check(&c, err) != IP_OK)
-            return -1;
-    } else if (ip_camera_fit_axis(v->lo, v->hi, axis, 30.0, c.width, c.height, &c, err) != IP_OK) {
-        return -1;
-    }
-    *out = c;
-    return 0;
+    return tool_camera_of(camera_text, axis, v->camera.width, v->camera.height, v->lo, v->hi, out,
+                          err);
 }
 
 void change_view(viewer *v)

@@ -38,6 +38,7 @@ typedef struct wall_options {
 typedef struct wall_region {
     uint32_t x, y, width, height; /* pixels of the wall's image */
     uint32_t tile;                /* row * cols + column */
+    uint32_t gx, gy;              /* its cell in the wall's grid of regions */
 } wall_region;
 
 /* The wall: its camera, tiles and regions in the progressive order. */
@@ -45,9 +46,7 @@ typedef struct wall_layout {
     ip_camera camera; /* the whole wall: cols * tile_w x rows * tile_h pixels */
     double lo[3], hi[3];
     uint32_t cols, rows, tile_w, tile_h, tile_count;
-    uint32_t unit_w, unit_h; /* a region's pixels (less at a tile's right and bottom edges) */
-    uint32_t per_x, per_y;   /* regions across and down a tile */
-    wall_region *regions;    /* in the progressive order across the wall */
+    wall_region *regions; /* in the progressive order across the wall */
     uint32_t region_count;
 } wall_layout;
 
@@ -56,8 +55,8 @@ typedef struct wall_layout {
 int wall_parse_args(int argc, char **argv, wall_options *o);
 
 /* Cuts the wall into regions of unit_w x unit_h pixels, inside tiles, in the progressive order
- * (the coarse-to-fine ordered-dither order over the grid of regions), and sets the unit size and
- * the regions per tile. Returns 0, or -1 when out of memory. */
+ * (the coarse-to-fine ordered-dither order over the grid of regions). Returns 0, or -1 when out
+ * of memory. */
 int wall_layout_regions(wall_layout *w, uint32_t unit_w, uint32_t unit_h);
 
 /* Writes the indices of the regions (as wall_layout_regions() made them) into

@@ -24,7 +24,6 @@ int wall_layout_regions(wall_layout *w, uint32_t unit_w, uint32_t unit_h)
 {
     uint32_t per_x = (w->tile_w + unit_w - 1) / unit_w, per_y = (w->tile_h + unit_h - 1) / unit_h;
     uint32_t grid_x = per_x * w->cols, grid_y = per_y * w->rows, levels = 0;
-    w->unit_w = unit_w, w->unit_h = unit_h, w->per_x = per_x, w->per_y = per_y;
     while ((1u << levels) < grid_x || (1u << levels) < grid_y)
         levels++;
     w->region_count = grid_x * grid_y;
@@ -44,6 +43,7 @@ int wall_layout_regions(wall_layout *w, uint32_t unit_w, uint32_t unit_h)
         r->width = ux + 1 < per_x ? unit_w : w->tile_w - ux * unit_w;
         r->height = uy + 1 < per_y ? unit_h : w->tile_h - uy * unit_h;
         r->tile = row * w->cols + col;
+        r->gx = gx, r->gy = gy;
     }
     return 0;
 }
@@ -74,11 +74,7 @@ int wall_spatial_order(const wall_layout *w, uint32_t *order)
     if (!k)
         return -1;
     for (uint32_t i = 0; i < w->region_count; i++) {
-        const wall_region *r = &w->regions[i];
-        uint32_t col = r->x / w->tile_w, row = r->y / w->tile_h;
-        uint32_t gx = col * w->per_x + (r->x - col * w->tile_w) / w->unit_w;
-        uint32_t gy = row * w->per_y + (r->y - row * w->tile_h) / w->unit_h;
-        k[i] = (keyed){z_key(gx, gy), i};
+        k[i] = (keyed){z_key(w->regions[i].gx, w->regions[i].gy), i};
     }
     qsort(k, w->region_count, sizeof *k, compare_key);
     for (uint32_t i = 0; i < w->region_count; i++)

@@ -93,7 +93,8 @@ static int setup_layout(wall_run *r, ip_error *err)
     w->tile_w = r->o.tile_w;
     w->tile_h = r->o.tile_h;
     w->tile_count = w->cols * w->rows;
-    if (tool_view_camera(&r->o.common, w->lo, w->hi, &w->camera, err) != 0)
+    if (tool_camera_of(r->o.common.camera, r->o.common.view, r->o.common.width, r->o.common.height,
+                       w->lo, w->hi, &w->camera, err) != 0)
         return -1;
     tool_apply_orbit(&r->o.orbit, &w->camera);
     if (wall_layout_regions(w, r->o.unit_w, r->o.unit_h) != 0) {
