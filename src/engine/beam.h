@@ -1,5 +1,5 @@
 /* Beams: whether the rays through a screen tile could still extract anything, tested once for
- * the whole tile against the min/max octree (bulk retirement of rays; see engine.c). Internal. */
+ * the whole tile against the min/max octree (bulk retirement of rays; see retire.c). Internal. */
 #ifndef ISOPROP_BEAM_H
 #define ISOPROP_BEAM_H
 

@@ -4,7 +4,7 @@
  * the nearest extracted triangle whose projection holds the pixel's centre (+infinity where
  * none is known yet). The second, `solid`: the same bound from the triangles whose projection
  * holds the centre by a margin (IP_COVERAGE_SOLID_MARGIN), which the rasterizer draws there
- * whatever its rounding: rays stop at it (see engine.c, cast_ray()).
+ * whatever its rounding: rays stop at it (see cast.c, ip__engine_cast_ray()).
  * Workers add the triangles they extract and test, before queueing a cell, whether extracted
  * surface already hides it (docs/occlusion.md; the argument is in coverage.c).
  *
@@ -35,7 +35,7 @@
  * projection by at least this distance (pixels) from every edge: 2.8 times what the
  * 1/256-pixel vertex snapping of the rasterizer can move a point (at most sqrt(2) / 512
  * pixel), so the rasterizer draws the triangle there in any mesh that holds it (the argument
- * is at cast_ray() in engine.c). */
+ * is at ip__engine_cast_ray() in cast.c). */
 #define IP_COVERAGE_SOLID_MARGIN (1.0 / 128)
 
 typedef struct ip_coverage {

@@ -78,7 +78,8 @@ typedef struct ip_mc_vertex {
 
 /*! ip__mc_case() : the case index (0..255) of a cell: bit i is set when corner_values[i] >= iso.
  *  A NaN value is never >= iso, so it counts as outside. An inline definition: seeding and the
- *  full extraction classify every cell they visit with it; src/engine/mc.c holds the external one. */
+ *  full extraction classify every cell they visit with it; src/engine/mc.c holds the external
+ *  one. */
 inline unsigned ip__mc_case(const float corner_values[8], float iso)
 {
     unsigned mc_case = 0;

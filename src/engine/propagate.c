@@ -115,8 +115,8 @@ static void cell_centre(const ip_sampler *s, const uint32_t cell[3], double cent
 }
 
 /* Whether any part of the cell may project into the propagator's window of the image (a
- * conservative test on its centre, widened by the cell's projected size and a 2-pixel margin). Sets *pixels to the cell's
- * projected size (its diagonal, in pixels) when it does. */
+ * conservative test on its centre, widened by the cell's projected size and a 2-pixel margin). Sets
+ * *pixels to the cell's projected size (its diagonal, in pixels) when it does. */
 static int in_frustum(const ip_propagator *p, const double centre[3], double diagonal,
                       double *pixels)
 {

@@ -19,7 +19,7 @@ typedef struct ip_queued_cell {
 
 #define IP_SHARE_CELLS 16 /* cells a propagation hands out at once */
 
-/* Where a propagation may hand part of its queue to idle workers (engine.c): while `hungry`
+/* Where a propagation may hand part of its queue to idle workers (share.c): while `hungry`
  * (workers waiting for cells) is above 0, give() may be offered `count` queued cells, already
  * marked visited, of the propagation for the ray `dir`, at the propagator's level; it returns
  * 1 when it took them (another worker propagates from them), 0 when it had no room. All zero:
@@ -51,11 +51,12 @@ typedef struct ip_propagator {
     ip_share share; /* zero after init: set by the engine */
 } ip_propagator;
 
-/* Propagation within one level, into the cells the options' clipping planes keep: cells whose centre lies outside the distance band
- * [near_distance, far_distance) from the eye belong to another level and stop it (the paper's
- * resolution boundary). With `coverage` (NULL: off), the triangles it extracts are recorded
- * there, and a neighbour that recorded surface already hides is deferred: neither queued nor
- * marked visited, so that a ray seeding it later still extracts it (coverage.c). */
+/* Propagation within one level, into the cells the options' clipping planes keep: cells whose
+ * centre lies outside the distance band [near_distance, far_distance) from the eye belong to
+ * another level and stop it (the paper's resolution boundary). With `coverage` (NULL: off), the
+ * triangles it extracts are recorded there, and a neighbour that recorded surface already hides is
+ * deferred: neither queued nor marked visited, so that a ray seeding it later still extracts it
+ * (coverage.c). */
 ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
                               ip_mesh *mesh, const ip_camera *camera, float iso,
                               const ip_engine_options *options, double near_distance,

@@ -1,0 +1,48 @@
+/* Idle workers help the others' propagations: parts of long queues handed out during a step. */
+#include <string.h>
+#include "engine_state.h"
+
+int ip__engine_give_cells(void *user, uint32_t level, const ip_queued_cell *cells, unsigned count,
+                          const double dir[3])
+{
+    ip_engine *e = user;
+    pthread_mutex_lock(&e->share_lock);
+    int room = e->shared_count < SHARED_MAX && count <= IP_SHARE_CELLS;
+    if (room) {
+        ip_shared_cells *c = &e->shared[e->shared_count++];
+        c->level = level;
+        c->count = count;
+        memcpy(c->dir, dir, sizeof c->dir);
+        memcpy(c->cells, cells, count * sizeof *cells);
+        pthread_cond_signal(&e->share_wake);
+    }
+    pthread_mutex_unlock(&e->share_lock);
+    return room;
+}
+
+void ip__engine_help(ip_engine *e, ip_engine_worker *w)
+{
+    pthread_mutex_lock(&e->share_lock);
+    e->working--;
+    while (w->status == IP_OK) {
+        if (e->shared_count > 0) {
+            ip_shared_cells c = e->shared[--e->shared_count];
+            e->working++;
+            pthread_mutex_unlock(&e->share_lock);
+            w->status = ip__propagate_queued(&w->level[c.level].propagator, c.cells, c.count, c.dir,
+                                             &w->counts);
+            if (w->status != IP_OK)
+                w->failed_level = c.level;
+            pthread_mutex_lock(&e->share_lock);
+            e->working--;
+            continue;
+        }
+        if (e->working == 0)
+            break;
+        atomic_fetch_add(&e->hungry, 1);
+        pthread_cond_wait(&e->share_wake, &e->share_lock);
+        atomic_fetch_sub(&e->hungry, 1);
+    }
+    pthread_cond_broadcast(&e->share_wake); /* the others may wait for working to reach 0 */
+    pthread_mutex_unlock(&e->share_lock);
+}
