@@ -23,7 +23,7 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     memset(p, 0, sizeof *p);
     p->sampler = sampler;
     p->visited = visited;
-    p->mesh = mesh;
+    p->out = (ip_cell_output){mesh, coverage, coverage && options->cull};
     p->camera = camera;
     p->window[0] = p->window[1] = 0;
     p->window[2] = camera->width;
@@ -37,7 +37,6 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
     p->near_distance = near_distance;
     p->far_distance = far_distance;
-    p->coverage = coverage;
     p->queue_capacity = 4096;
     p->queue = malloc(p->queue_capacity * sizeof *p->queue);
     return p->queue ? IP_OK : IP_ERR_NOMEM;
@@ -49,8 +48,8 @@ void ip__propagator_free(ip_propagator *p)
     p->queue = NULL;
 }
 
-int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float iso,
-                     unsigned *mc_case, ip_status *st)
+int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t cell[3], float iso,
+                     unsigned *mc_case, uint64_t *culled, ip_status *st)
 {
     ip_mc_vertex v[IP_MC_MAX_VERTICES];
     int n = ip__sampler_triangulate(s, cell, iso, v, mc_case);
@@ -66,19 +65,29 @@ int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float
     const ip_level_layout *lv = &s->layout->levels[s->level];
     uint64_t linear =
         cell[0] + (uint64_t)(lv->dims[0] - 1) * (cell[1] + (uint64_t)(lv->dims[1] - 1) * cell[2]);
+    for (int t = 0; t < n; t++)
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++)
+                pos[9 * t + 3 * k + a] = v[3 * t + k].position[a];
+    uint32_t shows = out->coverage ? ip__coverage_add(out->coverage, pos, (unsigned)n) : 0;
+    int kept = 0;
     for (int t = 0; t < n; t++) {
-        ids[t] = ip_cell_id(s->level, linear);
+        if (out->cull && !(shows >> t & 1))
+            continue; /* drawn at no pixel centre of the image */
+        ids[kept] = ip_cell_id(s->level, linear);
         for (int k = 0; k < 3; k++)
             for (int a = 0; a < 3; a++) {
-                pos[9 * t + 3 * k + a] = v[3 * t + k].position[a];
-                nor[9 * t + 3 * k + a] = ip_normal_pack(v[3 * t + k].normal[a]);
+                pos[9 * kept + 3 * k + a] = v[3 * t + k].position[a];
+                nor[9 * kept + 3 * k + a] = ip_normal_pack(v[3 * t + k].normal[a]);
             }
+        kept++;
     }
-    if (ip_mesh_append(mesh, pos, nor, ids, (uint64_t)n) != IP_OK) {
+    *culled += (uint64_t)(n - kept);
+    if (kept > 0 && ip_mesh_append(out->mesh, pos, nor, ids, (uint64_t)kept) != IP_OK) {
         *st = IP_ERR_NOMEM;
         return -1;
     }
-    return n;
+    return kept;
 }
 
 /* 1 - cos of the angle between the unit ray `dir` and the direction from the eye to `p`: it
@@ -147,7 +156,7 @@ static int hidden(const ip_propagator *p, const uint32_t cell[3], double pixels)
         lo[a] = p->sampler->world[a][first];
         hi[a] = p->sampler->world[a][end];
     }
-    return ip__coverage_hides(p->coverage, lo, hi);
+    return ip__coverage_hides(p->out.coverage, lo, hi);
 }
 
 /* 1 unless the clipping planes drop `cell`; only called when there are planes. */
@@ -207,16 +216,13 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
          * what a third of a cell's marching cubes does); the split is an estimate. */
         int timed = extracted++ % TIMING_STRIDE == 0;
         double t0 = timed ? ip_now_seconds() : 0;
-        int n = ip__extract_cell(p->sampler, p->mesh, q.cell, p->iso, &mc, &st);
+        int n = ip__extract_cell(p->sampler, &p->out, q.cell, p->iso, &mc, &counts->culled, &st);
         if (timed)
             extracting += TIMING_STRIDE * (ip_now_seconds() - t0);
         if (n < 0)
             break;
         counts->cells++;
         counts->triangles += (uint64_t)n;
-        if (p->coverage && n > 0)
-            ip__coverage_add(p->coverage, p->mesh->positions + 9 * (p->mesh->triangle_count - n),
-                             (uint64_t)n);
         unsigned faces = ip__mc_crossed_faces(mc);
         double folded = faces ? foldback_limit(p, q.max_versine) : 0.0;
         if (tail + 6 > p->queue_capacity && (st = grow_queue(p, head, tail)) == IP_OK) {
@@ -250,7 +256,7 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
                 if (d < p->near_distance || d >= p->far_distance)
                     continue; /* another level's band: the resolution boundary */
             }
-            if (p->coverage && hidden(p, n3, pixels)) {
+            if (p->out.coverage && hidden(p, n3, pixels)) {
                 counts->deferred++; /* left unmarked: a ray that seeds it extracts it */
                 continue;
             }

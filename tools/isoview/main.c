@@ -114,7 +114,7 @@ static int create_engine(viewer *v, ip_error *err)
     tool_view_options common;
     clip_options(v, &common);
     ip_engine_options eo;
-    tool_engine_options(&common, &eo);
+    tool_engine_options(&common, v->o.aa > 1, &eo); /* multisampling: every triangle */
     ip_engine *engine;
     if (ip_engine_create(v->cache, &eo, &engine, err) != IP_OK)
         return -1;
