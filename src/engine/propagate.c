@@ -48,28 +48,54 @@ void ip__propagator_free(ip_propagator *p)
     p->queue = NULL;
 }
 
+/* The positions of the triangles of an active cell (case mc_case, corner values `values`) as
+ * ip__mc_triangulate_cell() puts them: 9 floats a triangle into pos. Returns the count. */
+static int cell_positions(const ip_sampler *s, const uint32_t cell[3], const float values[8],
+                          float iso, unsigned mc_case, float *pos)
+{
+    float lo[3], hi[3], points[12][3];
+    ip__sampler_cell_box(s, cell, lo, hi);
+    ip__mc_cell_edge_points(values, iso, lo, hi, points);
+    const int8_t *row = ip__mc_triangle_table[mc_case];
+    int n = ip__mc_triangle_count[mc_case];
+    for (int i = 0; i < 3 * n; i++)
+        memcpy(pos + 3 * i, points[row[i]], 3 * sizeof(float));
+    return n;
+}
+
 int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t cell[3], float iso,
                      unsigned *mc_case, uint64_t *culled, ip_status *st)
 {
-    ip_mc_vertex v[IP_MC_MAX_VERTICES];
-    int n = ip__sampler_triangulate(s, cell, iso, v, mc_case);
-    if (n < 0) {
+    float values[8];
+    if (ip__sampler_cell_case(s, cell, iso, values, mc_case) < 0) {
         *st = s->status;
         return -1;
     }
-    if (n == 0)
+    if (*mc_case == 0 || *mc_case == 255)
         return 0;
     float pos[9 * IP_MC_MAX_TRIANGLES];
     int16_t nor[9 * IP_MC_MAX_TRIANGLES];
     uint64_t ids[IP_MC_MAX_TRIANGLES];
+    /* With a coverage, the positions first: they are recorded, and the triangles drawn at no
+     * pixel centre culled, before the normals (the gradients) are worked out for the rest. */
+    uint32_t shows = ~0u;
+    if (out->coverage) {
+        int n = cell_positions(s, cell, values, iso, *mc_case, pos);
+        shows = ip__coverage_add(out->coverage, pos, (unsigned)n);
+        if (out->cull && !(shows & ((1u << n) - 1))) {
+            *culled += (uint64_t)n;
+            return 0;
+        }
+    }
+    ip_mc_vertex v[IP_MC_MAX_VERTICES];
+    int n = ip__sampler_cell_triangles(s, cell, values, iso, v);
+    if (n < 0) {
+        *st = s->status;
+        return -1;
+    }
     const ip_level_layout *lv = &s->layout->levels[s->level];
     uint64_t linear =
         cell[0] + (uint64_t)(lv->dims[0] - 1) * (cell[1] + (uint64_t)(lv->dims[1] - 1) * cell[2]);
-    for (int t = 0; t < n; t++)
-        for (int k = 0; k < 3; k++)
-            for (int a = 0; a < 3; a++)
-                pos[9 * t + 3 * k + a] = v[3 * t + k].position[a];
-    uint32_t shows = out->coverage ? ip__coverage_add(out->coverage, pos, (unsigned)n) : 0;
     int kept = 0;
     for (int t = 0; t < n; t++) {
         if (out->cull && !(shows >> t & 1))
