@@ -12,6 +12,7 @@
 
 #include "check.h"
 #include "coverage.h"
+#include "depth_queue.h"
 #include "reach.h"
 #include "isoprop/bricker.h"
 #include "isoprop/engine.h"
@@ -418,6 +419,59 @@ static void check_coverage_box_test(void)
     double wide_lo[3] = {-3, -0.5, 1}, wide_hi[3] = {0.5, 0.5, 2};
     CHECK(!ip__coverage_hides(&c, wide_lo, wide_hi)); /* reaches past the wall's image */
     ip__coverage_free(&c);
+}
+
+/* The depth queue: cells come out bucket by bucket, nearest first, whatever the order they
+ * went in (depths beyond the range in the first or last bucket); take_far() takes from the far
+ * end; slots are used again, so queueing and taking one at a time needs no more; a start
+ * empties what an earlier use left. */
+static void check_depth_queue(void)
+{
+    ip_depth_queue q;
+    ip__depth_queue_init(&q);
+    ip__depth_queue_start(&q, 100.0, 0.5);
+    uint64_t seed = 99;
+    unsigned n = 5000;
+    for (unsigned i = 0; i < n; i++) {
+        seed = seed * 6364136223846793005ull + 1;
+        double depth = 100.0 + 900.0 * ((double)(seed >> 11) / 0x1p53 - 0.2);
+        ip_queued_cell c = {{i, 0, 0}, (float)depth}; /* the depth kept in max_versine */
+        REQUIRE(ip__depth_queue_push(&q, &c, depth) == IP_OK);
+    }
+    ip_queued_cell far[4];
+    CHECK(ip__depth_queue_take_far(&q, far, 4) == 4);
+    for (int k = 0; k < 4; k++)
+        CHECK(far[k].max_versine >= 100.0 + 0.75 * IP_DEPTH_BUCKETS * 0.5 - 0.5);
+    unsigned taken = 4, out_of_order = 0;
+    double last_bucket = -1;
+    ip_queued_cell c;
+    while (ip__depth_queue_pop(&q, &c)) {
+        double b = floor((c.max_versine - (100.0 - 0.25 * IP_DEPTH_BUCKETS * 0.5)) / 0.5);
+        b = b < 0 ? 0 : b > IP_DEPTH_BUCKETS - 1 ? IP_DEPTH_BUCKETS - 1 : b;
+        out_of_order += b < last_bucket;
+        last_bucket = b;
+        taken++;
+    }
+    CHECK_MSG(taken == n && out_of_order == 0, "depth queue: %u of %u taken, %u out of order",
+              taken, n, out_of_order);
+    uint32_t capacity = q.capacity;
+    unsigned wrong = 0;
+    for (unsigned i = 0; i < 3 * capacity; i++) { /* one in, one out: no growth */
+        ip_queued_cell one = {{i, 1, 2}, 0};
+        REQUIRE(ip__depth_queue_push(&q, &one, 150.0 + i % 7) == IP_OK);
+        wrong += !ip__depth_queue_pop(&q, &c) || c.cell[0] != i;
+    }
+    CHECK(wrong == 0 && q.capacity == capacity);
+    ip_queued_cell left = {{7, 7, 7}, 0};
+    REQUIRE(ip__depth_queue_push(&q, &left, 120.0) == IP_OK);
+    ip__depth_queue_start(&q, 10.0, 1.0); /* leaves nothing of the cell above */
+    CHECK(!ip__depth_queue_pop(&q, &c));
+    ip_queued_cell a = {{1, 0, 0}, 0}, b = {{2, 0, 0}, 0};
+    REQUIRE(ip__depth_queue_push(&q, &a, 30.0) == IP_OK);
+    REQUIRE(ip__depth_queue_push(&q, &b, 12.0) == IP_OK);
+    CHECK(ip__depth_queue_pop(&q, &c) && c.cell[0] == 2);
+    CHECK(ip__depth_queue_pop(&q, &c) && c.cell[0] == 1 && !ip__depth_queue_pop(&q, &c));
+    ip__depth_queue_free(&q);
 }
 
 /* Distance (pixels) from point (px, py) to the triangle with corners (x[k], y[k]): 0 inside. */
@@ -1087,6 +1141,7 @@ int main(void)
     check_lod(dir);
     check_coverage_box_test();
     check_cull_mask();
+    check_depth_queue();
     check_reach_box();
     check_coverage_reach();
     check_occlusion(dir);

@@ -37,15 +37,13 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
     p->near_distance = near_distance;
     p->far_distance = far_distance;
-    p->queue_capacity = 4096;
-    p->queue = malloc(p->queue_capacity * sizeof *p->queue);
-    return p->queue ? IP_OK : IP_ERR_NOMEM;
+    ip__depth_queue_init(&p->queue);
+    return IP_OK;
 }
 
 void ip__propagator_free(ip_propagator *p)
 {
-    free(p->queue);
-    p->queue = NULL;
+    ip__depth_queue_free(&p->queue);
 }
 
 /* The positions of the triangles of an active cell (case mc_case, corner values `values`) as
@@ -196,14 +194,29 @@ static int cell_kept(const ip_propagator *p, const uint32_t cell[3])
     return ip__clip_keeps_box(&p->clip, lo, hi);
 }
 
-static ip_status grow_queue(ip_propagator *p, uint64_t head, uint64_t tail)
+/* The view depth of world point `p`. */
+static double view_depth(const ip_propagator *p, const double point[3])
 {
-    /* keep the live part [head, tail) and move it to the front */
-    memmove(p->queue, p->queue + head, (tail - head) * sizeof *p->queue);
-    if (tail - head + 6 > p->queue_capacity / 2) /* doubles it */
-        return ip__array_reserve(&p->queue, &p->queue_capacity, p->queue_capacity + 1,
-                                 sizeof *p->queue, 4096);
-    return IP_OK;
+    double v[3];
+    ip__vec3_sub(point, p->camera->eye, v);
+    return ip__vec3_dot(v, p->basis.forward);
+}
+
+/* Offers IP_SHARE_CELLS of the farthest queued cells to a waiting worker (ip_share); puts them
+ * back when it has no room. */
+static ip_status share(ip_propagator *p, const double dir[3])
+{
+    ip_queued_cell part[IP_SHARE_CELLS];
+    unsigned n = ip__depth_queue_take_far(&p->queue, part, IP_SHARE_CELLS);
+    if (p->share.give(p->share.user, p->sampler->level, part, n, dir))
+        return IP_OK;
+    ip_status st = IP_OK;
+    double centre[3], diagonal;
+    for (unsigned i = 0; i < n && st == IP_OK; i++) {
+        cell_centre(p->sampler, part[i].cell, centre, &diagonal);
+        st = ip__depth_queue_push(&p->queue, &part[i], view_depth(p, centre));
+    }
+    return st;
 }
 
 ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
@@ -227,16 +240,16 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
     uint64_t extracted = 0;
     double centre[3], diagonal;
     const int clipping = p->clip.count > 0; /* without planes no cell is tested */
-    uint64_t head = 0, tail = 0;
     ip_status st = IP_OK;
-    if (count > p->queue_capacity)
-        st = ip__array_reserve(&p->queue, &p->queue_capacity, count, sizeof *p->queue, 4096);
-    if (st != IP_OK)
-        return st;
-    memcpy(p->queue, cells, count * sizeof *cells);
-    tail = count;
-    while (head < tail && st == IP_OK) {
-        ip_queued_cell q = p->queue[head++];
+    /* nearest first (depth_queue.h), in buckets of half the first cell's diagonal */
+    cell_centre(p->sampler, cells[0].cell, centre, &diagonal);
+    ip__depth_queue_start(&p->queue, view_depth(p, centre), 0.5 * diagonal);
+    for (unsigned i = 0; i < count && st == IP_OK; i++) {
+        cell_centre(p->sampler, cells[i].cell, centre, &diagonal);
+        st = ip__depth_queue_push(&p->queue, &cells[i], view_depth(p, centre));
+    }
+    ip_queued_cell q;
+    while (st == IP_OK && ip__depth_queue_pop(&p->queue, &q)) {
         unsigned mc;
         /* The clock is read around one extraction in TIMING_STRIDE (a clock read costs about
          * what a third of a cell's marching cubes does); the split is an estimate. */
@@ -251,10 +264,6 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
         counts->triangles += (uint64_t)n;
         unsigned faces = ip__mc_crossed_faces(mc);
         double folded = faces ? foldback_limit(p, q.max_versine) : 0.0;
-        if (tail + 6 > p->queue_capacity && (st = grow_queue(p, head, tail)) == IP_OK) {
-            tail -= head;
-            head = 0;
-        }
         for (int f = 0; f < 6 && st == IP_OK; f++) {
             if (!(faces & (1u << f)))
                 continue;
@@ -290,15 +299,16 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
             if (was < 0)
                 st = IP_ERR_NOMEM;
             else if (!was)
-                p->queue[tail++] =
-                    (ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)};
+                st = ip__depth_queue_push(
+                    &p->queue,
+                    &(ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)},
+                    view_depth(p, centre));
         }
-        /* the newest part of a long queue to a worker waiting for cells */
-        if (p->share.hungry && extracted % SHARE_STRIDE == 0 && tail - head >= 2 * IP_SHARE_CELLS &&
-            atomic_load_explicit(p->share.hungry, memory_order_relaxed) > 0 &&
-            p->share.give(p->share.user, p->sampler->level, p->queue + tail - IP_SHARE_CELLS,
-                          IP_SHARE_CELLS, dir))
-            tail -= IP_SHARE_CELLS;
+        /* the farthest part of a long queue to a worker waiting for cells */
+        if (p->share.hungry && extracted % SHARE_STRIDE == 0 &&
+            p->queue.count >= 2 * IP_SHARE_CELLS &&
+            atomic_load_explicit(p->share.hungry, memory_order_relaxed) > 0 && st == IP_OK)
+            st = share(p, dir);
     }
     double total = ip_now_seconds() - start;
     extracting = extracting < total ? extracting : total;

@@ -8,14 +8,9 @@
 #include "isoprop/mesh.h"
 #include "clip.h"
 #include "coverage.h"
+#include "depth_queue.h"
 #include "sampler.h"
 #include "visited.h"
-
-typedef struct ip_queued_cell {
-    uint32_t cell[3];
-    float max_versine; /* 1 - cos of the largest angle to the seed's ray among the cell's
-                        * predecessors (angles compare as their versines, without atan2) */
-} ip_queued_cell;
 
 #define IP_SHARE_CELLS 16 /* cells a propagation hands out at once */
 
@@ -52,11 +47,10 @@ typedef struct ip_propagator {
     double pixel_scale;                 /* pixels per unit of (size / depth) */
     double near_distance, far_distance; /* the level's distance band from the eye */
     ip_clip clip;                       /* the options' planes: dropped cells are not entered */
-    double window[4]; /* x0, y0, x1, y1 (pixels): propagation stays where cells may project
+    double window[4];     /* x0, y0, x1, y1 (pixels): propagation stays where cells may project
                          into this part of the image (init: the whole image) */
-    ip_queued_cell *queue;
-    uint64_t queue_capacity;
-    ip_share share; /* zero after init: set by the engine */
+    ip_depth_queue queue; /* nearest first */
+    ip_share share;       /* zero after init: set by the engine */
 } ip_propagator;
 
 /* Propagation within one level, into the cells the options' clipping planes keep: cells whose
