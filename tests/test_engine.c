@@ -393,16 +393,33 @@ static void check_cancel_restart(scene *s, float iso_a, float iso_b)
     ip_engine_destroy(fresh);
 }
 
+/* A number in [0, 1) from the generator state *seed. */
+static double unit_random(uint64_t *seed)
+{
+    *seed = *seed * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(*seed >> 11) / 9007199254740992.0;
+}
+
+/* The coverage tests' camera (64x48 pixels, the eye at z = -10 looking along +z) and an
+ * empty coverage for it, of a volume box around the eye (-5..5 in x and y, -20..20 in z). */
+static void test_coverage(ip_camera *cam, ip_camera_basis *basis, ip_coverage *c)
+{
+    *cam = (ip_camera){{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 60.0, 64, 48};
+    ip_camera_basis_of(cam, basis);
+    double lo[3] = {-5, -5, -20}, hi[3] = {5, 5, 20};
+    memset(c, 0, sizeof *c);
+    REQUIRE(ip__coverage_reset(c, cam, lo, hi) == IP_OK);
+}
+
 /* The coverage buffer's test on its own: a wall of two triangles hides a box behind it, but
  * never a box in front of it, one crossing the near plane, one behind the eye, or one whose
  * projection reaches past the wall. */
 static void check_coverage_box_test(void)
 {
-    ip_camera cam = {{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 60.0, 64, 48};
-    double lo[3] = {-5, -5, -20}, hi[3] = {5, 5, 20}; /* the volume's box: the eye is inside */
+    ip_camera cam;
+    ip_camera_basis basis;
     ip_coverage c;
-    memset(&c, 0, sizeof c);
-    REQUIRE(ip__coverage_reset(&c, &cam, lo, hi) == IP_OK);
+    test_coverage(&cam, &basis, &c); /* the volume's box holds the eye */
     double a[3] = {-0.5, -0.5, 1}, b[3] = {0.5, 0.5, 2};
     CHECK(!ip__coverage_hides(&c, a, b)); /* nothing recorded yet */
     const float wall[18] = {-2, -2, 0, 2, -2, 0, 2, 2, 0, -2, -2, 0, 2, 2, 0, -2, 2, 0};
@@ -433,8 +450,7 @@ static void check_depth_queue(void)
     uint64_t seed = 99;
     unsigned n = 5000;
     for (unsigned i = 0; i < n; i++) {
-        seed = seed * 6364136223846793005ull + 1;
-        double depth = 100.0 + 900.0 * ((double)(seed >> 11) / 0x1p53 - 0.2);
+        double depth = 100.0 + 900.0 * (unit_random(&seed) - 0.2);
         ip_queued_cell c = {{i, 0, 0}, (float)depth}; /* the depth kept in max_versine */
         REQUIRE(ip__depth_queue_push(&q, &c, depth) == IP_OK);
     }
@@ -502,29 +518,20 @@ static double point_triangle_distance(const double x[3], const double y[3], doub
  * but not for many. */
 static void check_cull_mask(void)
 {
-    ip_camera cam = {{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 60.0, 64, 48};
+    ip_camera cam;
     ip_camera_basis basis;
-    ip_camera_basis_of(&cam, &basis);
-    double lo[3] = {-5, -5, -5}, hi[3] = {5, 5, 5};
     ip_coverage c;
-    memset(&c, 0, sizeof c);
-    REQUIRE(ip__coverage_reset(&c, &cam, lo, hi) == IP_OK);
+    test_coverage(&cam, &basis, &c);
     uint64_t seed = 12345;
     unsigned tested = 0, shown = 0, wrong = 0, extra = 0;
     for (int n = 0; n < 20000; n++) {
         float tri[9];
         double x[3], y[3];
-        double cx = -2 + 68 * ((double)((seed = seed * 6364136223846793005ull + 1) >> 11) / 0x1p53);
-        double cy = -2 + 52 * ((double)((seed = seed * 6364136223846793005ull + 1) >> 11) / 0x1p53);
-        double size =
-            0.1 + 2.5 * ((double)((seed = seed * 6364136223846793005ull + 1) >> 11) / 0x1p53);
+        double cx = -2 + 68 * unit_random(&seed), cy = -2 + 52 * unit_random(&seed);
+        double size = 0.1 + 2.5 * unit_random(&seed);
         for (int k = 0; k < 3; k++) {
-            double px = cx + size * ((double)((seed = seed * 6364136223846793005ull + 1) >> 11) /
-                                         0x1p53 -
-                                     0.5),
-                   py = cy + size * ((double)((seed = seed * 6364136223846793005ull + 1) >> 11) /
-                                         0x1p53 -
-                                     0.5);
+            double px = cx + size * (unit_random(&seed) - 0.5),
+                   py = cy + size * (unit_random(&seed) - 0.5);
             double dir[3], depth = 12.0;
             ip_camera_pixel_ray(&basis, &cam, px, py, dir);
             double t = depth / (dir[0] * basis.forward[0] + dir[1] * basis.forward[1] +
@@ -630,14 +637,12 @@ static void check_culling(scene *s, float iso)
  * while one within the kept tiles behind the same triangles is. */
 static void check_coverage_reach(void)
 {
-    ip_camera cam = {{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 60.0, 64, 48};
+    ip_camera cam;
     ip_camera_basis basis;
-    ip_camera_basis_of(&cam, &basis);
-    double lo[3] = {-5, -5, -20}, hi[3] = {5, 5, 20};
     ip_coverage c;
-    memset(&c, 0, sizeof c);
-    REQUIRE(ip__coverage_reset(&c, &cam, lo, hi) == IP_OK);
-    for (size_t i = 0; i < 64 * 48; i++) { /* a value no clear writes */
+    test_coverage(&cam, &basis, &c);
+    double lo[3] = {-5, -5, -20}, hi[3] = {5, 5, 20}; /* test_coverage()'s box */
+    for (size_t i = 0; i < 64 * 48; i++) {            /* a value no clear writes */
         atomic_store(&c.depth[i], 12345u);
         atomic_store(&c.solid[i], 12345u);
     }
@@ -687,10 +692,8 @@ static void check_reach_box(void)
     for (int b = 0; b < 200; b++) {
         double lo[3], hi[3];
         for (int a = 0; a < 3; a++) {
-            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-            double c = (double)(seed >> 11) / 9007199254740992.0 * 20 - 10;
-            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-            double h = (double)(seed >> 11) / 9007199254740992.0 * 2 + 0.05;
+            double c = unit_random(&seed) * 20 - 10;
+            double h = unit_random(&seed) * 2 + 0.05;
             lo[a] = c - h;
             hi[a] = c + h;
         }
