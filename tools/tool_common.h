@@ -155,7 +155,8 @@ typedef struct tool_view_options {
     "  --prefetch on|off   a background thread reads and decodes the bricks the next rays need\n"  \
     "                      (default on)\n"                                                         \
     "  --cull on|off       with --occlusion: keep no triangle the image shows at no pixel\n"       \
-    "                      centre (default on, unless the mesh is written or multisampled)\n"      \
+    "                      centre (default: isorender and isowall on, unless --mesh or --aa;\n"    \
+    "                      isoview off)\n"                                                         \
     "  --clip SPEC         keep one side of a plane, world units (repeatable, up to 6):\n"         \
     "                      x=40 keeps x >= 40, -x=40 keeps x <= 40 (y, z alike),\n"                \
     "                      A,B,C,D keeps A*x + B*y + C*z + D >= 0\n"
