@@ -12,6 +12,7 @@
 
 #include "check.h"
 #include "coverage.h"
+#include "depth_queue.h"
 #include "reach.h"
 #include "isoprop/bricker.h"
 #include "isoprop/engine.h"
@@ -392,16 +393,33 @@ static void check_cancel_restart(scene *s, float iso_a, float iso_b)
     ip_engine_destroy(fresh);
 }
 
+/* A number in [0, 1) from the generator state *seed. */
+static double unit_random(uint64_t *seed)
+{
+    *seed = *seed * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(*seed >> 11) / 9007199254740992.0;
+}
+
+/* The coverage tests' camera (64x48 pixels, the eye at z = -10 looking along +z) and an
+ * empty coverage for it, of a volume box around the eye (-5..5 in x and y, -20..20 in z). */
+static void test_coverage(ip_camera *cam, ip_camera_basis *basis, ip_coverage *c)
+{
+    *cam = (ip_camera){{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 60.0, 64, 48};
+    ip_camera_basis_of(cam, basis);
+    double lo[3] = {-5, -5, -20}, hi[3] = {5, 5, 20};
+    memset(c, 0, sizeof *c);
+    REQUIRE(ip__coverage_reset(c, cam, lo, hi) == IP_OK);
+}
+
 /* The coverage buffer's test on its own: a wall of two triangles hides a box behind it, but
  * never a box in front of it, one crossing the near plane, one behind the eye, or one whose
  * projection reaches past the wall. */
 static void check_coverage_box_test(void)
 {
-    ip_camera cam = {{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 60.0, 64, 48};
-    double lo[3] = {-5, -5, -20}, hi[3] = {5, 5, 20}; /* the volume's box: the eye is inside */
+    ip_camera cam;
+    ip_camera_basis basis;
     ip_coverage c;
-    memset(&c, 0, sizeof c);
-    REQUIRE(ip__coverage_reset(&c, &cam, lo, hi) == IP_OK);
+    test_coverage(&cam, &basis, &c); /* the volume's box holds the eye */
     double a[3] = {-0.5, -0.5, 1}, b[3] = {0.5, 0.5, 2};
     CHECK(!ip__coverage_hides(&c, a, b)); /* nothing recorded yet */
     const float wall[18] = {-2, -2, 0, 2, -2, 0, 2, 2, 0, -2, -2, 0, 2, 2, 0, -2, 2, 0};
@@ -420,19 +438,211 @@ static void check_coverage_box_test(void)
     ip__coverage_free(&c);
 }
 
+/* The depth queue: cells come out bucket by bucket, nearest first, whatever the order they
+ * went in (depths beyond the range in the first or last bucket); take_far() takes from the far
+ * end; slots are used again, so queueing and taking one at a time needs no more; a start
+ * empties what an earlier use left. */
+static void check_depth_queue(void)
+{
+    ip_depth_queue q;
+    ip__depth_queue_init(&q);
+    ip__depth_queue_start(&q, 100.0, 0.5);
+    uint64_t seed = 99;
+    unsigned n = 5000;
+    for (unsigned i = 0; i < n; i++) {
+        double depth = 100.0 + 900.0 * (unit_random(&seed) - 0.2);
+        ip_queued_cell c = {{i, 0, 0}, (float)depth}; /* the depth kept in max_versine */
+        REQUIRE(ip__depth_queue_push(&q, &c, depth) == IP_OK);
+    }
+    ip_queued_cell far[4];
+    CHECK(ip__depth_queue_take_far(&q, far, 4) == 4);
+    for (int k = 0; k < 4; k++)
+        CHECK(far[k].max_versine >= 100.0 + 0.75 * IP_DEPTH_BUCKETS * 0.5 - 0.5);
+    unsigned taken = 4, out_of_order = 0;
+    double last_bucket = -1;
+    ip_queued_cell c;
+    while (ip__depth_queue_pop(&q, &c)) {
+        double b = floor((c.max_versine - (100.0 - 0.25 * IP_DEPTH_BUCKETS * 0.5)) / 0.5);
+        b = b < 0 ? 0 : b > IP_DEPTH_BUCKETS - 1 ? IP_DEPTH_BUCKETS - 1 : b;
+        out_of_order += b < last_bucket;
+        last_bucket = b;
+        taken++;
+    }
+    CHECK_MSG(taken == n && out_of_order == 0, "depth queue: %u of %u taken, %u out of order",
+              taken, n, out_of_order);
+    uint32_t capacity = q.capacity;
+    unsigned wrong = 0;
+    for (unsigned i = 0; i < 3 * capacity; i++) { /* one in, one out: no growth */
+        ip_queued_cell one = {{i, 1, 2}, 0};
+        REQUIRE(ip__depth_queue_push(&q, &one, 150.0 + i % 7) == IP_OK);
+        wrong += !ip__depth_queue_pop(&q, &c) || c.cell[0] != i;
+    }
+    CHECK(wrong == 0 && q.capacity == capacity);
+    ip_queued_cell left = {{7, 7, 7}, 0};
+    REQUIRE(ip__depth_queue_push(&q, &left, 120.0) == IP_OK);
+    ip__depth_queue_start(&q, 10.0, 1.0); /* leaves nothing of the cell above */
+    CHECK(!ip__depth_queue_pop(&q, &c));
+    ip_queued_cell a = {{1, 0, 0}, 0}, b = {{2, 0, 0}, 0};
+    REQUIRE(ip__depth_queue_push(&q, &a, 30.0) == IP_OK);
+    REQUIRE(ip__depth_queue_push(&q, &b, 12.0) == IP_OK);
+    CHECK(ip__depth_queue_pop(&q, &c) && c.cell[0] == 2);
+    CHECK(ip__depth_queue_pop(&q, &c) && c.cell[0] == 1 && !ip__depth_queue_pop(&q, &c));
+    ip__depth_queue_free(&q);
+}
+
+/* Distance (pixels) from point (px, py) to the triangle with corners (x[k], y[k]): 0 inside. */
+static double point_triangle_distance(const double x[3], const double y[3], double px, double py)
+{
+    double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    int inside = 1;
+    double nearest = INFINITY;
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3;
+        double ex = x[j] - x[i], ey = y[j] - y[i];
+        double side = ex * (py - y[i]) - ey * (px - x[i]); /* > 0: left of the edge */
+        inside &= area > 0 ? side >= 0 : side <= 0;
+        double t = ((px - x[i]) * ex + (py - y[i]) * ey) / (ex * ex + ey * ey);
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        double dx = x[i] + t * ex - px, dy = y[i] + t * ey - py;
+        double d = sqrt(dx * dx + dy * dy);
+        nearest = d < nearest ? d : nearest;
+    }
+    return inside ? 0 : nearest;
+}
+
+/* Culling's test (ip__coverage_add()'s mask): small random triangles facing the eye, many
+ * smaller than a pixel, some off the image. A triangle's bit is set whenever some pixel centre
+ * of the image lies within IP_COVERAGE_SHOW_MARGIN of its projection (a brute-force search;
+ * triangles within 1e-6 pixel of that margin, or of no area, are left out). It may be set for
+ * a few more (the test widens each edge by the margin, which reaches farther at the corners),
+ * but not for many. */
+static void check_cull_mask(void)
+{
+    ip_camera cam;
+    ip_camera_basis basis;
+    ip_coverage c;
+    test_coverage(&cam, &basis, &c);
+    uint64_t seed = 12345;
+    unsigned tested = 0, shown = 0, wrong = 0, extra = 0;
+    for (int n = 0; n < 20000; n++) {
+        float tri[9];
+        double x[3], y[3];
+        double cx = -2 + 68 * unit_random(&seed), cy = -2 + 52 * unit_random(&seed);
+        double size = 0.1 + 2.5 * unit_random(&seed);
+        for (int k = 0; k < 3; k++) {
+            double px = cx + size * (unit_random(&seed) - 0.5),
+                   py = cy + size * (unit_random(&seed) - 0.5);
+            double dir[3], depth = 12.0;
+            ip_camera_pixel_ray(&basis, &cam, px, py, dir);
+            double t = depth / (dir[0] * basis.forward[0] + dir[1] * basis.forward[1] +
+                                dir[2] * basis.forward[2]);
+            double world[3];
+            for (int a = 0; a < 3; a++) {
+                tri[3 * k + a] = (float)(cam.eye[a] + t * dir[a]);
+                world[a] = tri[3 * k + a];
+            }
+            double z;
+            REQUIRE(ip_camera_project(&basis, &cam, world, &x[k], &y[k], &z));
+        }
+        double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+        if (fabs(area) < 1e-6)
+            continue;
+        double nearest = INFINITY;
+        for (int py = 0; py < 48; py++)
+            for (int px = 0; px < 64; px++) {
+                double d = point_triangle_distance(x, y, px + 0.5, py + 0.5);
+                nearest = d < nearest ? d : nearest;
+            }
+        if (fabs(nearest - IP_COVERAGE_SHOW_MARGIN) < 1e-6)
+            continue;
+        int want = nearest <= IP_COVERAGE_SHOW_MARGIN;
+        int got = (int)(ip__coverage_add(&c, tri, 1) & 1);
+        if (want && !got)
+            printf("test_engine: cull mask: triangle (%.6f %.6f) (%.6f %.6f) (%.6f %.6f) culled, "
+                   "its nearest centre %.9f pixel away\n",
+                   x[0], y[0], x[1], y[1], x[2], y[2], nearest);
+        tested++;
+        shown += (unsigned)want;
+        wrong += (unsigned)(want && !got);
+        extra += (unsigned)(got && !want);
+    }
+    printf("test_engine: cull mask: %u triangles, %u within the margin of a pixel centre, %u "
+           "culled wrongly, %u kept beyond it\n",
+           tested, shown, wrong, extra);
+    CHECK(tested > 15000 && shown > tested / 10 && shown < tested - tested / 10);
+    CHECK_MSG(wrong == 0, "cull mask: %u of %u triangles culled wrongly", wrong, tested);
+    CHECK_MSG(extra < tested / 100, "cull mask: %u of %u triangles kept beyond the margin", extra,
+              tested);
+    ip__coverage_free(&c);
+}
+
+/* Culling (ip_engine_options.cull) against keeping every triangle, on one thread where cells
+ * are smaller than pixels: the same cells are extracted in the same order (a culled triangle
+ * records nothing), so the kept and culled triangles add up to those kept without culling,
+ * every kept one is among them, and the image is the same after a few rays and after all. */
+static void check_culling(scene *s, float iso)
+{
+    ip_error err;
+    ip_camera cam;
+    REQUIRE(ip_camera_fit_axis(s->lo, s->hi, "-y", 30.0, 40, 30, &cam, &err) == IP_OK);
+    ip_engine *e[2];
+    for (int cull = 0; cull <= 1; cull++) {
+        ip_engine_options o;
+        ip_engine_options_default(&o);
+        o.lod = 0;
+        o.threads = 1;
+        o.cell_ids = 1;
+        o.cull = cull;
+        REQUIRE(ip_engine_create(s->cache, &o, &e[cull], &err) == IP_OK);
+        REQUIRE(ip_engine_begin(e[cull], &cam, iso, &err) == IP_OK);
+    }
+    size_t n = (size_t)cam.width * cam.height;
+    uint32_t *index[2] = {malloc(n * 4), malloc(n * 4)};
+    uint8_t *rgba[2] = {malloc(n * 4), malloc(n * 4)};
+    REQUIRE(index[0] && index[1] && rgba[0] && rgba[1]);
+    ip_engine_counts t[2];
+    for (int stage = 0; stage < 2; stage++) { /* 40 rays, then all */
+        for (int k = 0; k < 2; k++) {
+            do
+                REQUIRE(ip_engine_step(e[k], stage == 0 ? 40 : 0, 0, NULL, &err) == IP_OK);
+            while (stage == 1 && !ip_engine_done(e[k]));
+            ip_engine_totals(e[k], &t[k]);
+            REQUIRE(ip_raster_mesh(ip_engine_mesh(e[k]), &cam, s->lo, s->hi, index[k], rgba[k],
+                                   &err) == IP_OK);
+        }
+        size_t differ = 0;
+        for (size_t i = 0; i < n; i++)
+            differ += (index[0][i] == UINT32_MAX) != (index[1][i] == UINT32_MAX) ||
+                      memcmp(rgba[0] + 4 * i, rgba[1] + 4 * i, 4) != 0;
+        const ip_mesh *kept = ip_engine_mesh(e[1]), *whole = ip_engine_mesh(e[0]);
+        printf("test_engine: culling, %llu rays: %llu triangles kept, %llu culled, %llu without "
+               "culling; %zu pixels differ\n",
+               (unsigned long long)t[1].rays, (unsigned long long)t[1].triangles,
+               (unsigned long long)t[1].culled, (unsigned long long)t[0].triangles, differ);
+        CHECK_MSG(differ == 0, "culling: %zu pixels differ after %llu rays", differ,
+                  (unsigned long long)t[1].rays);
+        CHECK(t[0].rays == t[1].rays && t[0].cells == t[1].cells && t[0].culled == 0);
+        CHECK(t[1].culled > 0 && t[1].triangles + t[1].culled == t[0].triangles);
+        CHECK(kept->triangle_count == t[1].triangles && triangles_not_in(kept, whole) == 0);
+    }
+    for (int k = 0; k < 2; k++) {
+        free(index[k]);
+        free(rgba[k]);
+        ip_engine_destroy(e[k]);
+    }
+}
+
 /* ip__coverage_reach(): the entries of tiles not kept are left as they are by a clear, a
  * triangle over them records nothing there, and a box reaching them is never found hidden,
  * while one within the kept tiles behind the same triangles is. */
 static void check_coverage_reach(void)
 {
-    ip_camera cam = {{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 60.0, 64, 48};
+    ip_camera cam;
     ip_camera_basis basis;
-    ip_camera_basis_of(&cam, &basis);
-    double lo[3] = {-5, -5, -20}, hi[3] = {5, 5, 20};
     ip_coverage c;
-    memset(&c, 0, sizeof c);
-    REQUIRE(ip__coverage_reset(&c, &cam, lo, hi) == IP_OK);
-    for (size_t i = 0; i < 64 * 48; i++) { /* a value no clear writes */
+    test_coverage(&cam, &basis, &c);
+    double lo[3] = {-5, -5, -20}, hi[3] = {5, 5, 20}; /* test_coverage()'s box */
+    for (size_t i = 0; i < 64 * 48; i++) {            /* a value no clear writes */
         atomic_store(&c.depth[i], 12345u);
         atomic_store(&c.solid[i], 12345u);
     }
@@ -482,10 +692,8 @@ static void check_reach_box(void)
     for (int b = 0; b < 200; b++) {
         double lo[3], hi[3];
         for (int a = 0; a < 3; a++) {
-            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-            double c = (double)(seed >> 11) / 9007199254740992.0 * 20 - 10;
-            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-            double h = (double)(seed >> 11) / 9007199254740992.0 * 2 + 0.05;
+            double c = unit_random(&seed) * 20 - 10;
+            double h = unit_random(&seed) * 2 + 0.05;
             lo[a] = c - h;
             hi[a] = c + h;
         }
@@ -924,6 +1132,7 @@ int main(void)
     check_ray_budgets(&s, 0.5f, 320, 240);
     check_regions(&s, 0.5f);
     check_threads(&s, 0.5f);
+    check_culling(&s, 0.5f);
     close_scene(&s);
 
     make_volume(dir, IP_FIELD_MARSCHNER_LOBB, 41, IP_UINT16, 16, ibv, sizeof ibv);
@@ -934,6 +1143,8 @@ int main(void)
 
     check_lod(dir);
     check_coverage_box_test();
+    check_cull_mask();
+    check_depth_queue();
     check_reach_box();
     check_coverage_reach();
     check_occlusion(dir);

@@ -777,13 +777,20 @@ static void step_report(const run *r, tool_progress *bar, uint64_t limit)
     }
 }
 
+/* Whether the run keeps every triangle it extracts (no culling, ip_engine_options.cull): the
+ * mesh is written out, or drawn with multisampling, which samples more than pixel centres. */
+static int keeps_whole_mesh(const run *r)
+{
+    return r->o.mesh != NULL || r->o.aa > 1;
+}
+
 /* The engine with the command line's options, cancelled by a signal; made once. */
 static int create_engine(run *r, ip_error *err)
 {
     if (r->engine)
         return 0;
     ip_engine_options eo;
-    tool_engine_options(&r->o.common, &eo);
+    tool_engine_options(&r->o.common, keeps_whole_mesh(r), &eo);
     if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
         return -1;
     tool_signals_cancel_engine(r->engine);
@@ -1150,13 +1157,17 @@ static void json_counts(FILE *f, void *user)
         tool_json_string(f, scale_unit(r));
         fprintf(f, ", \"pixel_size\": %.17g, \"pixels\": %.17g}", r->bar.pixel_size, r->bar.pixels);
     }
-    if (!r->o.full)
+    if (!r->o.full) {
+        ip_engine_options eo;
+        tool_engine_options(&r->o.common, keeps_whole_mesh(r), &eo);
         fprintf(f,
                 ", \"occlusion\": %s, \"deferred_cells\": %llu, \"retired_rays\": %llu, "
-                "\"ray_nodes\": %llu, \"prefetch\": %s",
+                "\"ray_nodes\": %llu, \"prefetch\": %s, \"cull\": %s, \"culled_triangles\": %llu",
                 r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred,
                 (unsigned long long)r->totals.retired, (unsigned long long)r->totals.nodes,
-                r->o.common.prefetch ? "true" : "false");
+                r->o.common.prefetch ? "true" : "false", eo.occlusion && eo.cull ? "true" : "false",
+                (unsigned long long)r->totals.culled);
+    }
     fprintf(f, ", \"warnings\": [");
     for (size_t i = 0, written = 0; i <= r->other_count; i++) {
         const run *s = surface_run_c(r, i);

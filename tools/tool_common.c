@@ -565,10 +565,11 @@ void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t he
     o->pixel_error = 1.0;
     o->occlusion = 1;
     o->prefetch = 1;
+    o->cull = -1;
     o->cache_bytes = ip_cache_default_budget();
 }
 
-void tool_engine_options(const tool_view_options *o, ip_engine_options *eo)
+void tool_engine_options(const tool_view_options *o, int whole, ip_engine_options *eo)
 {
     ip_engine_options_default(eo);
     eo->cutoff_degrees = o->cutoff;
@@ -578,6 +579,7 @@ void tool_engine_options(const tool_view_options *o, ip_engine_options *eo)
     eo->pixel_error = o->pixel_error;
     eo->occlusion = o->occlusion;
     eo->prefetch = o->prefetch;
+    eo->cull = o->cull < 0 ? !whole : o->cull;
     eo->clip_count = o->clip_count;
     memcpy(eo->clip, o->clip, sizeof eo->clip);
 }
@@ -748,6 +750,12 @@ static int parse_prefetch(const char *p, const tool_option *opt, const char *con
     return parse_on_off(p, v[0], &((tool_view_options *)base)->prefetch, "--prefetch");
 }
 
+static int parse_cull(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    (void)opt;
+    return parse_on_off(p, v[0], &((tool_view_options *)base)->cull, "--cull");
+}
+
 int tool_option_cache_mb(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     if (tool_parse_cache_mb(v[0], (uint64_t *)((char *)base + opt->offset)) != 0)
@@ -813,6 +821,7 @@ static const tool_option view_options[] = {
      NULL},
     {"--occlusion", NULL, 1, 0, parse_occlusion, NULL, NULL},
     {"--prefetch", NULL, 1, 0, parse_prefetch, NULL, NULL},
+    {"--cull", NULL, 1, 0, parse_cull, NULL, NULL},
     {"--clip", NULL, 1, 0, parse_clip_option, NULL, NULL},
     {"--cache-mb", NULL, 1, VIEW_FIELD(cache_bytes), tool_option_cache_mb, NULL, NULL},
     {"--stats", NULL, 1, VIEW_FIELD(stats), NULL, NULL, NULL},

@@ -46,12 +46,13 @@ int tool_parse_pair(const char *program, const char *option, const char *text, u
 /* Handles --version: prints "PROGRAM VERSION" (the library's, isoprop/version.h) on stdout. */
 void tool_print_version(const char *program);
 
-/* Checks every file of a run before any work, so that a bad one fails the run at once:
- * each input (NULL entries are skipped) exists and is a regular file (a FIFO or a device is
- * refused, never opened); no output is an input (the same file by device and inode, however
- * spelled); no two outputs are the same file; each output may be written (absent, or a
- * regular file and `force`; a directory, device or FIFO is refused even with force; see
- * isoprop/output.h). An output "-" is standard output, which at most one output may be. Returns 0, or 1 after printing one line "PROGRAM: path: problem". */
+/* Checks every file of a run before any work, so that a bad one fails the run at once: each input
+ * (NULL entries are skipped) exists and is a regular file (a FIFO or a device is refused, never
+ * opened); no output is an input (the same file by device and inode, however spelled); no two
+ * outputs are the same file; each output may be written (absent, or a regular file and `force`; a
+ * directory, device or FIFO is refused even with force; see isoprop/output.h). An output "-" is
+ * standard output, which at most one output may be. Returns 0, or 1 after printing one line
+ * "PROGRAM: path: problem". */
 int tool_check_paths(const char *program, const char *const *inputs, size_t input_count,
                      const char *const *outputs, size_t output_count, int force);
 
@@ -132,8 +133,9 @@ typedef struct tool_view_options {
     unsigned threads;          /* 0: every core */
     int lod;
     double pixel_error;
-    int occlusion;                          /* --occlusion on|off */
-    int prefetch;                           /* --prefetch on|off */
+    int occlusion; /* --occlusion on|off */
+    int prefetch;  /* --prefetch on|off */
+    int cull; /* --cull on|off; -1 (the default): the program decides (tool_engine_options()) */
     unsigned clip_count;                    /* --clip SPEC, repeatable */
     ip_clip_plane clip[IP_MAX_CLIP_PLANES]; /* world units (tool_parse_clip()) */
     uint64_t cache_bytes;
@@ -152,6 +154,9 @@ typedef struct tool_view_options {
     "  --occlusion on|off  propagation skips cells that extracted surface hides (default on)\n"    \
     "  --prefetch on|off   a background thread reads and decodes the bricks the next rays need\n"  \
     "                      (default on)\n"                                                         \
+    "  --cull on|off       with --occlusion: keep no triangle the image shows at no pixel\n"       \
+    "                      centre (default: isorender and isowall on, unless --mesh or --aa;\n"    \
+    "                      isoview off)\n"                                                         \
     "  --clip SPEC         keep one side of a plane, world units (repeatable, up to 6):\n"         \
     "                      x=40 keeps x >= 40, -x=40 keeps x <= 40 (y, z alike),\n"                \
     "                      A,B,C,D keeps A*x + B*y + C*z + D >= 0\n"
@@ -165,8 +170,10 @@ void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t he
  * is not one (an unknown axis, a bad number, a zero normal). */
 int tool_parse_clip(const char *text, ip_clip_plane *plane);
 
-/* The engine options the shared options ask for (the clipping planes too). */
-void tool_engine_options(const tool_view_options *o, ip_engine_options *eo);
+/* The engine options the shared options ask for (the clipping planes too). Triangles are
+ * culled (ip_engine_options.cull) as --cull says, or when it was not given, unless `whole`:
+ * the program writes the mesh out or draws it with multisampling. */
+void tool_engine_options(const tool_view_options *o, int whole, ip_engine_options *eo);
 
 /* ---- the command line, parsed from tables ----
  *
@@ -238,9 +245,9 @@ typedef struct tool_command_line {
  * with status 0 after --help or --version. */
 int tool_parse_command_line(const tool_command_line *c, int argc, char **argv);
 
-/* The shared options of tool_view_options as a table over `o`: --iso, --size, --view,
- * --camera, --rays, --time, --cutoff, --foldback, --threads, --lod, --pixel-error, --occlusion, --prefetch,
- * --clip, --cache-mb, --stats, --force and --quiet (-q). */
+/* The shared options of tool_view_options as a table over `o`: --iso, --size, --view, --camera,
+ * --rays, --time, --cutoff, --foldback, --threads, --lod, --pixel-error, --occlusion, --prefetch,
+ * --cull, --clip, --cache-mb, --stats, --force and --quiet (-q). */
 tool_option_table tool_view_option_table(tool_view_options *o);
 
 /* The command line of isorender and isoview: the shared view options and the program's

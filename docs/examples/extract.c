@@ -82,6 +82,7 @@ static ip_status extract_progressive(ip_cache *cache, const request *q, ip_engin
     ip_engine_options options;
     ip_engine_options_default(&options);
     options.threads = q->threads;
+    options.cull = 0; /* the mesh is written out: keep what the image would not show too */
     ip_status st = ip_engine_create(cache, &options, engine, err);
     if (st != IP_OK)
         return st;

@@ -36,8 +36,15 @@
  * behind that depth (nothing there can show at its pixel), and the rays of an 8 x 8 pixel tile
  * whose pixels are all so covered are retired without a walk once a test of the tile's beam
  * against the octree finds every active cell those walks could enter extracted already
- * (`retired`); the guarantee above is unchanged (the arguments are in engine.c). 8 bytes a
- * pixel.
+ * (`retired`); the guarantee above is unchanged (the arguments are in cast.c and retire.c). 8
+ * bytes a pixel.
+ *
+ * Culling (options.cull, on by default, with occlusion): a triangle no pixel centre of the
+ * image lies within 1/64 pixel of is drawn at no pixel of it (a rasterizer samples pixel
+ * centres, and snaps vertices by far less), so it is not kept in the mesh and is counted in
+ * `culled` instead. The image is the same, every step; the mesh is not the surface's whole
+ * front but what this view's image needs. Keep them (cull 0) for a mesh to be written out,
+ * drawn with multisampling or from another view (docs/occlusion.md).
  *
  * Reading ahead (options.prefetch, on by default): one more thread per engine reads and
  * decodes into the cache, from the first step after ip_engine_begin() on and between steps,
@@ -106,6 +113,8 @@ typedef struct ip_engine_options {
     int occlusion;           /* occlusion-aware propagation (see Occlusion above; default on) */
     int prefetch;            /* a background reader loads the bricks the next rays need (see
                                 Reading ahead above; default on) */
+    int cull;                /* with occlusion: triangles drawn at no pixel centre of the view's
+                                image are not kept (see Culling above; default on) */
     unsigned clip_count;     /* planes in use in clip (0: none, the default) */
     ip_clip_plane clip[IP_MAX_CLIP_PLANES]; /* the surface is kept where every plane keeps it:
                                                the exact-image guarantee holds for the kept
@@ -131,6 +140,7 @@ typedef struct ip_engine_counts {
                           without a walk (see Occlusion above) */
     uint64_t nodes;    /* octree nodes (bricks included), sub-blocks and cells the rays' walks
                           entered: the seeding work, independent of the clock */
+    uint64_t culled;   /* with options.cull: triangles made and not kept, not in `triangles` */
 } ip_engine_counts;
 
 typedef struct ip_engine ip_engine;

@@ -55,7 +55,9 @@ def run_stats(run, counts, cache):
     if not run.full:
         out.update({"occlusion": bool(run.options.occlusion), "deferred_cells": counts.deferred,
                     "retired_rays": counts.retired, "ray_nodes": counts.nodes,
-                    "prefetch": bool(run.options.prefetch)})
+                    "prefetch": bool(run.options.prefetch),
+                    "cull": bool(run.options.occlusion and run.options.cull),
+                    "culled_triangles": counts.culled})
     out["warnings"] = list(run.warnings)
     return out
 
@@ -64,4 +66,4 @@ def counts_dict(counts):
     """One step's ip_engine_counts as a dict."""
     return {"rays": counts.rays, "seeds": counts.seeds, "cells": counts.cells,
             "triangles": counts.triangles, "deferred": counts.deferred,
-            "retired": counts.retired, "nodes": counts.nodes}
+            "retired": counts.retired, "nodes": counts.nodes, "culled": counts.culled}

@@ -21,7 +21,8 @@ DEFAULT_SIZE = (1600, 1200)  # isorender's
 VIEW_FOV = 30.0  # degrees: the field of view of the named views (isorender --view)
 
 
-def _engine_options(threads, cutoff, foldback, lod, pixel_error, occlusion, prefetch):
+def _engine_options(threads, cutoff, foldback, lod, pixel_error, occlusion, prefetch,
+                    cull=False):
     o = S.EngineOptions()
     lib.ip_engine_options_default(ctypes.byref(o))
     if cutoff is not None:
@@ -30,6 +31,7 @@ def _engine_options(threads, cutoff, foldback, lod, pixel_error, occlusion, pref
         o.foldback_degrees = foldback
     o.threads, o.lod, o.pixel_error = threads, int(bool(lod)), pixel_error
     o.occlusion, o.prefetch = int(bool(occlusion)), int(bool(prefetch))
+    o.cull = int(bool(cull))
     return o
 
 
@@ -172,7 +174,8 @@ class File:
     # -- extraction -----------------------------------------------------------------------
     def extract(self, iso, *, view="-y", camera=None, size=DEFAULT_SIZE, rays=None, full=False,
                 time_limit=None, threads=0, cutoff=None, foldback=None, lod=True,
-                pixel_error=1.0, occlusion=True, prefetch=True, cache_mb=None, on_step=None):
+                pixel_error=1.0, occlusion=True, prefetch=True, cull=False, cache_mb=None,
+                on_step=None):
         """Extracts the isosurface `iso` and returns a Mesh (vertices, normals, faces, stats).
 
         Progressive (the default), as isorender: rays in the paper's order for the image of
@@ -180,13 +183,14 @@ class File:
         on) or `camera` (a dict eye/target/up/fov or isorender's --camera text), until every
         pixel has had its ray, `rays` rays or `time_limit` seconds. full=True triangulates
         every active cell instead (isorender --full; the view does not matter). threads (0:
-        every core), cutoff and foldback (degrees), lod, pixel_error, occlusion and prefetch
-        are isorender's options; cache_mb the brick cache's budget (the cache stays warm
+        every core), cutoff and foldback (degrees), lod, pixel_error, occlusion, prefetch and
+        cull are isorender's options (cull off by default here: the mesh is the product, not an
+        image of it); cache_mb the brick cache's budget (the cache stays warm
         between calls). on_step(step), if given, sees each step (as extract_steps() yields).
         Raises isoprop.Error for a file that cannot be read."""
         kw = dict(view=view, camera=camera, size=size, threads=threads, cutoff=cutoff,
                   foldback=foldback, lod=lod, pixel_error=pixel_error, occlusion=occlusion,
-                  prefetch=prefetch, cache_mb=cache_mb)
+                  prefetch=prefetch, cull=cull, cache_mb=cache_mb)
         if full:
             if rays is not None or time_limit is not None or on_step is not None:
                 raise ValueError("full=True extracts everything: no rays, time_limit or on_step")
@@ -221,10 +225,10 @@ class File:
 
     def _begin(self, iso, view="-y", camera=None, size=DEFAULT_SIZE, threads=0, cutoff=None,
                foldback=None, lod=True, pixel_error=1.0, occlusion=True, prefetch=True,
-               cache_mb=None):
+               cull=False, cache_mb=None):
         cam = self._camera(view, camera, size)
         options = _engine_options(threads, cutoff, foldback, lod, pixel_error, occlusion,
-                                  prefetch)
+                                  prefetch, cull)
         cache = self._cache_for(cache_mb)
         run = _Run(self, iso, False, cam, options)
         err, engine = new_error(), ctypes.c_void_p()

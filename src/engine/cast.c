@@ -1,17 +1,18 @@
 /* A pixel's ray: the walk through each distance band's octree, its seed and propagation. */
 #include <math.h>
 
-#include "vec3.h"
 #include "engine_state.h"
 #include "internal.h"
+#include "vec3.h"
 
-/* Extracts one cell without propagating from it. */
+/* Extracts one cell without propagating from it, into what its propagations extract into. */
 static ip_status extract_one(ip_engine_worker *w, ip_level_tools *lt, const uint32_t cell[3])
 {
     unsigned mc;
     ip_status st = IP_OK;
     double t0 = ip_now_seconds();
-    int n = ip__extract_cell(&lt->sampler, &w->mesh, cell, w->engine->iso, &mc, &st);
+    int n = ip__extract_cell(&lt->sampler, &lt->propagator.out, cell, w->engine->iso, &mc,
+                             &w->counts.culled, &st);
     w->counts.extraction_seconds += ip_now_seconds() - t0;
     if (n < 0)
         return st;

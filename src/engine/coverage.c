@@ -167,46 +167,59 @@ static void lower(atomic_uint *entry, unsigned bits)
         ;
 }
 
-/* Records one triangle, its corners projected: image x, y (pixels) and view depth z. */
-static void add_projected(ip_coverage *c, const double *x, const double *y, const double *z)
+/* Records one triangle, its corners projected: image x, y (pixels) and view depth z. Returns
+ * 0 when it can be drawn at no pixel centre (ip__coverage_add()), else 1. */
+static int add_projected(ip_coverage *c, const double *x, const double *y, const double *z)
 {
     double zmax = 0;
     for (int k = 0; k < 3; k++) {
         if (!(z[k] >= c->near_plane * NEAR_MARGIN && z[k] <= c->far_plane))
-            return; /* clipped by the renderers, or behind the eye */
+            return 1; /* clipped by the renderers, or behind the eye */
         zmax = z[k] > zmax ? z[k] : zmax;
     }
     /* Most triangles are smaller than a pixel: the pixel centres of the bounding rectangle
-     * first, and nothing more when it holds none. */
+     * (widened by the show margin) first, and nothing more when it holds none. */
     int64_t x0, x1, y0, y1;
-    if (!centre_range(min3(x[0], x[1], x[2]), max3(x[0], x[1], x[2]), 0, c->width, &x0, &x1) ||
-        !centre_range(min3(y[0], y[1], y[2]), max3(y[0], y[1], y[2]), 0, c->height, &y0, &y1) ||
-        (x1 - x0 + 1) * (y1 - y0 + 1) > IP_COVERAGE_MAX_PIXELS)
-        return;
+    if (!centre_range(min3(x[0], x[1], x[2]), max3(x[0], x[1], x[2]), IP_COVERAGE_SHOW_MARGIN,
+                      c->width, &x0, &x1) ||
+        !centre_range(min3(y[0], y[1], y[2]), max3(y[0], y[1], y[2]), IP_COVERAGE_SHOW_MARGIN,
+                      c->height, &y0, &y1))
+        return 0;
+    if ((x1 - x0 + 1) * (y1 - y0 + 1) > IP_COVERAGE_MAX_PIXELS)
+        return 1;
     double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
     if (!(fabs(area) > 1e-9))
-        return;
+        return 1;
     int o1 = area < 0 ? 2 : 1, o2 = 3 - o1; /* counter-clockwise: inside is left of every edge */
     double vx[3] = {x[0], x[o1], x[o2]}, vy[3] = {y[0], y[o1], y[o2]};
-    double ex[3], ey[3], need[3], inner[3];
+    /* e_i, the edge function at a centre, is its distance inside edge i times the edge's
+     * length: `need` admits centres on the edge (within rounding), `inner` those the solid
+     * margin inside it, `show` those within the show margin outside it */
+    double ex[3], ey[3], need[3], inner[3], show[3];
     for (int i = 0; i < 3; i++) {
         int j = i == 2 ? 0 : i + 1;
         ex[i] = vx[j] - vx[i];
         ey[i] = vy[j] - vy[i];
         need[i] = -EDGE_TOLERANCE * (fabs(ex[i]) + fabs(ey[i])); /* >= the edge's length */
-        inner[i] = IP_COVERAGE_SOLID_MARGIN * sqrt(ex[i] * ex[i] + ey[i] * ey[i]);
+        double length = sqrt(ex[i] * ex[i] + ey[i] * ey[i]);
+        inner[i] = IP_COVERAGE_SOLID_MARGIN * length;
+        show[i] = -IP_COVERAGE_SHOW_MARGIN * length;
     }
     /* the next float above zmax (a positive finite float: its bits plus one) */
     unsigned bits = ip__float_bits((float)zmax) + 1;
+    int shows = 0;
     for (int64_t py = y0; py <= y1; py++) {
         double cy = py + 0.5;
         for (int64_t px = x0; px <= x1; px++) {
             double cx = px + 0.5;
-            if (!kept(c, px, py)) /* not expected: a caller's triangles stay in kept tiles */
-                continue;
             double e0 = ex[0] * (cy - vy[0]) - ey[0] * (cx - vx[0]);
             double e1 = ex[1] * (cy - vy[1]) - ey[1] * (cx - vx[1]);
             double e2 = ex[2] * (cy - vy[2]) - ey[2] * (cx - vx[2]);
+            if (!(e0 >= show[0] && e1 >= show[1] && e2 >= show[2]))
+                continue;
+            shows = 1;
+            if (!kept(c, px, py)) /* not expected: a caller's triangles stay in kept tiles */
+                continue;
             if (e0 >= need[0] && e1 >= need[1] && e2 >= need[2]) {
                 size_t at = (size_t)py * c->width + (size_t)px;
                 lower(&c->depth[at], bits);
@@ -215,19 +228,22 @@ static void add_projected(ip_coverage *c, const double *x, const double *y, cons
             }
         }
     }
+    return shows;
 }
 
-void ip__coverage_add(ip_coverage *c, const float *positions, uint64_t count)
+uint32_t ip__coverage_add(ip_coverage *c, const float *positions, unsigned count)
 {
-    for (uint64_t t = 0; t < count; t++) {
+    uint32_t shows = 0;
+    for (unsigned t = 0; t < count; t++) {
         double x[3], y[3], z[3];
         for (int k = 0; k < 3; k++) {
             const float *f = positions + 9 * t + 3 * k;
             double p[3] = {f[0], f[1], f[2]};
             project(c, p, &x[k], &y[k], &z[k]);
         }
-        add_projected(c, x, y, z);
+        shows |= (uint32_t)add_projected(c, x, y, z) << t;
     }
+    return shows;
 }
 
 int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi[3])

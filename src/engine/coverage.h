@@ -80,8 +80,18 @@ void ip__coverage_reach(ip_coverage *c, const unsigned char *reached, unsigned s
 
 void ip__coverage_free(ip_coverage *c);
 
-/* Records `count` triangles (9 floats each, world units). Any thread. */
-void ip__coverage_add(ip_coverage *c, const float *positions, uint64_t count);
+/* A triangle may show in the image when some pixel centre lies within this distance (pixels)
+ * of its exact projection: 5.5 times what the rasterizer's 1/256-pixel vertex snapping can
+ * move a point (sqrt(2) / 512 pixel). One whose projection is farther from every centre is
+ * drawn at none, in any mesh (ip__coverage_add()). */
+#define IP_COVERAGE_SHOW_MARGIN (1.0 / 64)
+
+/* Records `count` triangles (9 floats each, world units; count <= 32). Any thread. Returns a
+ * mask, bit t set unless triangle t can be drawn at no pixel centre of the image: it lies
+ * wholly between the near and far planes, its projection is non-degenerate and within
+ * IP_COVERAGE_MAX_PIXELS bounding pixels, and no pixel centre of the image lies within
+ * IP_COVERAGE_SHOW_MARGIN of it. A triangle without its bit records nothing. */
+uint32_t ip__coverage_add(ip_coverage *c, const float *positions, unsigned count);
 
 /* The bits of a float, and back: an entry holds a non-negative float's bits, so that integer
  * order is float order and an atomic integer minimum is a float minimum. */

@@ -23,6 +23,7 @@ void ip_engine_options_default(ip_engine_options *o)
     o->cell_ids = 0;
     o->occlusion = 1;
     o->prefetch = 1;
+    o->cull = 1;
     o->clip_count = 0;
 }
 
@@ -370,6 +371,7 @@ static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
     to->deferred += from->deferred;
     to->retired += from->retired;
     to->nodes += from->nodes;
+    to->culled += from->culled;
 }
 
 /* Moves the worker's triangles to the engine's mesh. */

@@ -23,7 +23,7 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     memset(p, 0, sizeof *p);
     p->sampler = sampler;
     p->visited = visited;
-    p->mesh = mesh;
+    p->out = (ip_cell_output){mesh, coverage, coverage && options->cull};
     p->camera = camera;
     p->window[0] = p->window[1] = 0;
     p->window[2] = camera->width;
@@ -37,48 +37,81 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
     p->near_distance = near_distance;
     p->far_distance = far_distance;
-    p->coverage = coverage;
-    p->queue_capacity = 4096;
-    p->queue = malloc(p->queue_capacity * sizeof *p->queue);
-    return p->queue ? IP_OK : IP_ERR_NOMEM;
+    ip__depth_queue_init(&p->queue);
+    return IP_OK;
 }
 
 void ip__propagator_free(ip_propagator *p)
 {
-    free(p->queue);
-    p->queue = NULL;
+    ip__depth_queue_free(&p->queue);
 }
 
-int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float iso,
-                     unsigned *mc_case, ip_status *st)
+/* The positions of the triangles of an active cell (case mc_case, corner values `values`) as
+ * ip__mc_triangulate_cell() puts them: 9 floats a triangle into pos. Returns the count. */
+static int cell_positions(const ip_sampler *s, const uint32_t cell[3], const float values[8],
+                          float iso, unsigned mc_case, float *pos)
 {
-    ip_mc_vertex v[IP_MC_MAX_VERTICES];
-    int n = ip__sampler_triangulate(s, cell, iso, v, mc_case);
-    if (n < 0) {
+    float lo[3], hi[3], points[12][3];
+    ip__sampler_cell_box(s, cell, lo, hi);
+    ip__mc_cell_edge_points(values, iso, lo, hi, points);
+    const int8_t *row = ip__mc_triangle_table[mc_case];
+    int n = ip__mc_triangle_count[mc_case];
+    for (int i = 0; i < 3 * n; i++)
+        memcpy(pos + 3 * i, points[row[i]], 3 * sizeof(float));
+    return n;
+}
+
+int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t cell[3], float iso,
+                     unsigned *mc_case, uint64_t *culled, ip_status *st)
+{
+    float values[8];
+    if (ip__sampler_cell_case(s, cell, iso, values, mc_case) < 0) {
         *st = s->status;
         return -1;
     }
-    if (n == 0)
+    if (*mc_case == 0 || *mc_case == 255)
         return 0;
     float pos[9 * IP_MC_MAX_TRIANGLES];
     int16_t nor[9 * IP_MC_MAX_TRIANGLES];
     uint64_t ids[IP_MC_MAX_TRIANGLES];
+    /* With a coverage, the positions first: they are recorded, and the triangles drawn at no
+     * pixel centre culled, before the normals (the gradients) are worked out for the rest. */
+    uint32_t shows = ~0u;
+    if (out->coverage) {
+        int n = cell_positions(s, cell, values, iso, *mc_case, pos);
+        shows = ip__coverage_add(out->coverage, pos, (unsigned)n);
+        if (out->cull && !(shows & ((1u << n) - 1))) {
+            *culled += (uint64_t)n;
+            return 0;
+        }
+    }
+    ip_mc_vertex v[IP_MC_MAX_VERTICES];
+    int n = ip__sampler_cell_triangles(s, cell, values, iso, v);
+    if (n < 0) {
+        *st = s->status;
+        return -1;
+    }
     const ip_level_layout *lv = &s->layout->levels[s->level];
     uint64_t linear =
         cell[0] + (uint64_t)(lv->dims[0] - 1) * (cell[1] + (uint64_t)(lv->dims[1] - 1) * cell[2]);
+    int kept = 0;
     for (int t = 0; t < n; t++) {
-        ids[t] = ip_cell_id(s->level, linear);
+        if (out->cull && !(shows >> t & 1))
+            continue; /* drawn at no pixel centre of the image */
+        ids[kept] = ip_cell_id(s->level, linear);
         for (int k = 0; k < 3; k++)
             for (int a = 0; a < 3; a++) {
-                pos[9 * t + 3 * k + a] = v[3 * t + k].position[a];
-                nor[9 * t + 3 * k + a] = ip_normal_pack(v[3 * t + k].normal[a]);
+                pos[9 * kept + 3 * k + a] = v[3 * t + k].position[a];
+                nor[9 * kept + 3 * k + a] = ip_normal_pack(v[3 * t + k].normal[a]);
             }
+        kept++;
     }
-    if (ip_mesh_append(mesh, pos, nor, ids, (uint64_t)n) != IP_OK) {
+    *culled += (uint64_t)(n - kept);
+    if (kept > 0 && ip_mesh_append(out->mesh, pos, nor, ids, (uint64_t)kept) != IP_OK) {
         *st = IP_ERR_NOMEM;
         return -1;
     }
-    return n;
+    return kept;
 }
 
 /* 1 - cos of the angle between the unit ray `dir` and the direction from the eye to `p`: it
@@ -147,7 +180,7 @@ static int hidden(const ip_propagator *p, const uint32_t cell[3], double pixels)
         lo[a] = p->sampler->world[a][first];
         hi[a] = p->sampler->world[a][end];
     }
-    return ip__coverage_hides(p->coverage, lo, hi);
+    return ip__coverage_hides(p->out.coverage, lo, hi);
 }
 
 /* 1 unless the clipping planes drop `cell`; only called when there are planes. */
@@ -161,14 +194,29 @@ static int cell_kept(const ip_propagator *p, const uint32_t cell[3])
     return ip__clip_keeps_box(&p->clip, lo, hi);
 }
 
-static ip_status grow_queue(ip_propagator *p, uint64_t head, uint64_t tail)
+/* The view depth of world point `p`. */
+static double view_depth(const ip_propagator *p, const double point[3])
 {
-    /* keep the live part [head, tail) and move it to the front */
-    memmove(p->queue, p->queue + head, (tail - head) * sizeof *p->queue);
-    if (tail - head + 6 > p->queue_capacity / 2) /* doubles it */
-        return ip__array_reserve(&p->queue, &p->queue_capacity, p->queue_capacity + 1,
-                                 sizeof *p->queue, 4096);
-    return IP_OK;
+    double v[3];
+    ip__vec3_sub(point, p->camera->eye, v);
+    return ip__vec3_dot(v, p->basis.forward);
+}
+
+/* Offers IP_SHARE_CELLS of the farthest queued cells to a waiting worker (ip_share); puts them
+ * back when it has no room. */
+static ip_status share(ip_propagator *p, const double dir[3])
+{
+    ip_queued_cell part[IP_SHARE_CELLS];
+    unsigned n = ip__depth_queue_take_far(&p->queue, part, IP_SHARE_CELLS);
+    if (p->share.give(p->share.user, p->sampler->level, part, n, dir))
+        return IP_OK;
+    ip_status st = IP_OK;
+    double centre[3], diagonal;
+    for (unsigned i = 0; i < n && st == IP_OK; i++) {
+        cell_centre(p->sampler, part[i].cell, centre, &diagonal);
+        st = ip__depth_queue_push(&p->queue, &part[i], view_depth(p, centre));
+    }
+    return st;
 }
 
 ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
@@ -192,37 +240,30 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
     uint64_t extracted = 0;
     double centre[3], diagonal;
     const int clipping = p->clip.count > 0; /* without planes no cell is tested */
-    uint64_t head = 0, tail = 0;
     ip_status st = IP_OK;
-    if (count > p->queue_capacity)
-        st = ip__array_reserve(&p->queue, &p->queue_capacity, count, sizeof *p->queue, 4096);
-    if (st != IP_OK)
-        return st;
-    memcpy(p->queue, cells, count * sizeof *cells);
-    tail = count;
-    while (head < tail && st == IP_OK) {
-        ip_queued_cell q = p->queue[head++];
+    /* nearest first (depth_queue.h), in buckets of half the first cell's diagonal */
+    cell_centre(p->sampler, cells[0].cell, centre, &diagonal);
+    ip__depth_queue_start(&p->queue, view_depth(p, centre), 0.5 * diagonal);
+    for (unsigned i = 0; i < count && st == IP_OK; i++) {
+        cell_centre(p->sampler, cells[i].cell, centre, &diagonal);
+        st = ip__depth_queue_push(&p->queue, &cells[i], view_depth(p, centre));
+    }
+    ip_queued_cell q;
+    while (st == IP_OK && ip__depth_queue_pop(&p->queue, &q)) {
         unsigned mc;
         /* The clock is read around one extraction in TIMING_STRIDE (a clock read costs about
          * what a third of a cell's marching cubes does); the split is an estimate. */
         int timed = extracted++ % TIMING_STRIDE == 0;
         double t0 = timed ? ip_now_seconds() : 0;
-        int n = ip__extract_cell(p->sampler, p->mesh, q.cell, p->iso, &mc, &st);
+        int n = ip__extract_cell(p->sampler, &p->out, q.cell, p->iso, &mc, &counts->culled, &st);
         if (timed)
             extracting += TIMING_STRIDE * (ip_now_seconds() - t0);
         if (n < 0)
             break;
         counts->cells++;
         counts->triangles += (uint64_t)n;
-        if (p->coverage && n > 0)
-            ip__coverage_add(p->coverage, p->mesh->positions + 9 * (p->mesh->triangle_count - n),
-                             (uint64_t)n);
         unsigned faces = ip__mc_crossed_faces(mc);
         double folded = faces ? foldback_limit(p, q.max_versine) : 0.0;
-        if (tail + 6 > p->queue_capacity && (st = grow_queue(p, head, tail)) == IP_OK) {
-            tail -= head;
-            head = 0;
-        }
         for (int f = 0; f < 6 && st == IP_OK; f++) {
             if (!(faces & (1u << f)))
                 continue;
@@ -250,7 +291,7 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
                 if (d < p->near_distance || d >= p->far_distance)
                     continue; /* another level's band: the resolution boundary */
             }
-            if (p->coverage && hidden(p, n3, pixels)) {
+            if (p->out.coverage && hidden(p, n3, pixels)) {
                 counts->deferred++; /* left unmarked: a ray that seeds it extracts it */
                 continue;
             }
@@ -258,15 +299,16 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
             if (was < 0)
                 st = IP_ERR_NOMEM;
             else if (!was)
-                p->queue[tail++] =
-                    (ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)};
+                st = ip__depth_queue_push(
+                    &p->queue,
+                    &(ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)},
+                    view_depth(p, centre));
         }
-        /* the newest part of a long queue to a worker waiting for cells */
-        if (p->share.hungry && extracted % SHARE_STRIDE == 0 && tail - head >= 2 * IP_SHARE_CELLS &&
-            atomic_load_explicit(p->share.hungry, memory_order_relaxed) > 0 &&
-            p->share.give(p->share.user, p->sampler->level, p->queue + tail - IP_SHARE_CELLS,
-                          IP_SHARE_CELLS, dir))
-            tail -= IP_SHARE_CELLS;
+        /* the farthest part of a long queue to a worker waiting for cells */
+        if (p->share.hungry && extracted % SHARE_STRIDE == 0 &&
+            p->queue.count >= 2 * IP_SHARE_CELLS &&
+            atomic_load_explicit(p->share.hungry, memory_order_relaxed) > 0 && st == IP_OK)
+            st = share(p, dir);
     }
     double total = ip_now_seconds() - start;
     extracting = extracting < total ? extracting : total;

@@ -8,14 +8,9 @@
 #include "isoprop/mesh.h"
 #include "clip.h"
 #include "coverage.h"
+#include "depth_queue.h"
 #include "sampler.h"
 #include "visited.h"
-
-typedef struct ip_queued_cell {
-    uint32_t cell[3];
-    float max_versine; /* 1 - cos of the largest angle to the seed's ray among the cell's
-                        * predecessors (angles compare as their versines, without atan2) */
-} ip_queued_cell;
 
 #define IP_SHARE_CELLS 16 /* cells a propagation hands out at once */
 
@@ -31,10 +26,19 @@ typedef struct ip_share {
     void *user;
 } ip_share;
 
+/* Where a cell's triangles go (ip__extract_cell()): to `mesh`; with `coverage` (NULL: none),
+ * recorded there first, and with `cull` as well, only those that may show in its image
+ * (ip__coverage_add()) are appended. */
+typedef struct ip_cell_output {
+    ip_mesh *mesh;
+    ip_coverage *coverage;
+    int cull;
+} ip_cell_output;
+
 typedef struct ip_propagator {
     ip_sampler *sampler;
     ip_visited *visited;
-    ip_mesh *mesh;
+    ip_cell_output out;
     const ip_camera *camera;
     ip_camera_basis basis;
     float iso;
@@ -42,21 +46,19 @@ typedef struct ip_propagator {
     double cos_foldback, sin_foldback;  /* of the fold-back tolerance */
     double pixel_scale;                 /* pixels per unit of (size / depth) */
     double near_distance, far_distance; /* the level's distance band from the eye */
-    ip_coverage *coverage;              /* occlusion: shared by the workers; NULL when off */
     ip_clip clip;                       /* the options' planes: dropped cells are not entered */
-    double window[4]; /* x0, y0, x1, y1 (pixels): propagation stays where cells may project
+    double window[4];     /* x0, y0, x1, y1 (pixels): propagation stays where cells may project
                          into this part of the image (init: the whole image) */
-    ip_queued_cell *queue;
-    uint64_t queue_capacity;
-    ip_share share; /* zero after init: set by the engine */
+    ip_depth_queue queue; /* nearest first */
+    ip_share share;       /* zero after init: set by the engine */
 } ip_propagator;
 
 /* Propagation within one level, into the cells the options' clipping planes keep: cells whose
  * centre lies outside the distance band [near_distance, far_distance) from the eye belong to
  * another level and stop it (the paper's resolution boundary). With `coverage` (NULL: off), the
- * triangles it extracts are recorded there, and a neighbour that recorded surface already hides is
- * deferred: neither queued nor marked visited, so that a ray seeding it later still extracts it
- * (coverage.c). */
+ * triangles it extracts are recorded there (and with options->cull, only those that may show
+ * are kept), and a neighbour that recorded surface already hides is deferred: neither queued
+ * nor marked visited, so that a ray seeding it later still extracts it (coverage.c). */
 ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited *visited,
                               ip_mesh *mesh, const ip_camera *camera, float iso,
                               const ip_engine_options *options, double near_distance,
@@ -74,9 +76,10 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
 ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, unsigned count,
                                const double dir[3], ip_engine_counts *counts);
 
-/* Triangulates `cell` and appends its triangles to `mesh`. Sets *mc_case. Returns the number of
- * triangles, or -1 on a read failure / out of memory (status in *st). */
-int ip__extract_cell(ip_sampler *s, ip_mesh *mesh, const uint32_t cell[3], float iso,
-                     unsigned *mc_case, ip_status *st);
+/* Triangulates `cell` and hands its triangles to `out`. Sets *mc_case, and adds to *culled the
+ * triangles culled (none without out->cull). Returns the number of triangles appended, or -1 on
+ * a read failure / out of memory (status in *st). */
+int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t cell[3], float iso,
+                     unsigned *mc_case, uint64_t *culled, ip_status *st);
 
 #endif

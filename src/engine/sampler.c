@@ -202,12 +202,9 @@ static double span(const ip_sampler *s, int a, int64_t i)
     return s->world[a][h] - s->world[a][l];
 }
 
-int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
-                            unsigned *mc_case)
+int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, float values[8],
+                          unsigned *mc_case)
 {
-    float values[8], outer[24], gradients[8][3], lo[3], hi[3];
-    /* The case first, from the 8 corners alone: most cells of an active sub-block are not
-     * active, and need neither the gradient neighbours nor the divisions. */
     const ip_brick *b = ip__sampler_cell_brick(s, cell);
     if (!b)
         return -1;
@@ -215,9 +212,15 @@ int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip
     ip__corner_offsets(b, corners);
     ip__cell_values(b, s->layout->type, corners, cell, values);
     *mc_case = ip__mc_case(values, iso);
-    if (*mc_case == 0 || *mc_case == 255)
-        return 0;
-    if (!gradient_neighbours(s, cell, b, outer))
+    return 1;
+}
+
+int ip__sampler_cell_triangles(ip_sampler *s, const uint32_t cell[3], const float values[8],
+                               float iso, ip_mc_vertex *out)
+{
+    float outer[24], gradients[8][3], lo[3], hi[3];
+    const ip_brick *b = ip__sampler_cell_brick(s, cell);
+    if (!b || !gradient_neighbours(s, cell, b, outer))
         return -1;
     double d[2][3]; /* per axis, the span around the cell's low and high corners */
     for (int a = 0; a < 3; a++)
@@ -232,4 +235,17 @@ int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip
         }
     ip__sampler_cell_box(s, cell, lo, hi);
     return ip__mc_triangulate_cell(values, (const float(*)[3])gradients, iso, lo, hi, out);
+}
+
+int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
+                            unsigned *mc_case)
+{
+    /* The case first, from the 8 corners alone: most cells of an active sub-block are not
+     * active, and need neither the gradient neighbours nor the divisions. */
+    float values[8];
+    if (ip__sampler_cell_case(s, cell, iso, values, mc_case) < 0)
+        return -1;
+    if (*mc_case == 0 || *mc_case == 255)
+        return 0;
+    return ip__sampler_cell_triangles(s, cell, values, iso, out);
 }

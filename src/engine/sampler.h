@@ -107,6 +107,15 @@ void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float lo[
 int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
                             unsigned *mc_case);
 
+/* ip__sampler_triangulate() in two parts, for a caller that may not need the triangles' normals
+ * (the gradients are most of the work): the cell's corner values and case (returns 1, or -1
+ * after a failure); then, for an active case, its triangles from those values (the count, or
+ * -1 after a failure). */
+int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, float values[8],
+                          unsigned *mc_case);
+int ip__sampler_cell_triangles(ip_sampler *s, const uint32_t cell[3], const float values[8],
+                               float iso, ip_mc_vertex *out);
+
 /* 1 when the range [lo, hi] (over cell corners) may hold an active cell for `iso`: some corner
  * >= iso and some corner < iso. */
 static inline int ip__range_active(float lo, float hi, float iso)

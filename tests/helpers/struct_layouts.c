@@ -157,6 +157,7 @@ static void engine(void)
     FIELD(ip_engine_options, cell_ids);
     FIELD(ip_engine_options, occlusion);
     FIELD(ip_engine_options, prefetch);
+    FIELD(ip_engine_options, cull);
     FIELD(ip_engine_options, clip_count);
     FIELD(ip_engine_options, clip);
     SIZE(ip_clip_plane);
@@ -174,6 +175,7 @@ static void engine(void)
     FIELD(ip_engine_counts, deferred);
     FIELD(ip_engine_counts, retired);
     FIELD(ip_engine_counts, nodes);
+    FIELD(ip_engine_counts, culled);
     SIZE(ip_mesh);
     FIELD(ip_mesh, positions);
     FIELD(ip_mesh, normals);

@@ -92,6 +92,21 @@ class Extract(unittest.TestCase):
         self.assertTrue(mesh.stats["done"])
         self.assertEqual(mesh.stats["rays"], SIZE[0] * SIZE[1])
 
+    def test_cull_equals_isorender_cull_on(self):
+        """cull=True keeps what isorender --mesh --cull on keeps, and fewer triangles than the
+        default, which keeps them all; the counts add up."""
+        ply, stats = self.isorender("culled", "--view", "+x", "--cull", "on")
+        self.assertTrue(stats["cull"])
+        mesh = self.f.extract(ISO, view="+x", size=SIZE, threads=1, cull=True)
+        self.assert_same_triangles(mesh, ply)
+        self.assertTrue(mesh.stats["cull"])
+        self.assertEqual(mesh.stats["culled_triangles"], stats["culled_triangles"])
+        whole = self.f.extract(ISO, view="+x", size=SIZE, threads=1)
+        self.assertFalse(whole.stats["cull"])
+        self.assertEqual(whole.stats["culled_triangles"], 0)
+        self.assertGreater(mesh.stats["culled_triangles"], 0)
+        self.assertEqual(len(mesh) + mesh.stats["culled_triangles"], len(whole))
+
     def test_camera_text_and_dict(self):
         text = "24,-80,30,24,20,26,0,0,1,35"
         ply, _ = self.isorender("camera", "--camera", text)

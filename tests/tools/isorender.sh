@@ -25,7 +25,8 @@ for key in cache budget_bytes resident_bytes resident_peak_bytes hits misses evi
            bytes_decompressed decode_seconds bricks_touched bricks_total hit_rate \
            peak_rss_bytes rays seeds cells triangles intersection_s propagation_s \
            extraction_s rendering_s visible_triangles overdraw occlusion deferred_cells \
-           retired_rays ray_nodes prefetch prefetched prefetch_hits bytes_read_disk wait_seconds; do
+           retired_rays ray_nodes prefetch cull culled_triangles prefetched prefetch_hits \
+           bytes_read_disk wait_seconds; do
     check "stats has \"$key\"" sh -c 'printf "%s" "$0" | grep -q "\"$1\":"' "$json" "$key"
 done
 check "every pixel had its ray" sh -c 'printf "%s" "$0" | grep -q "\"rays\": 19200, \"rays_total\": 19200, \"done\": true"' "$json"
@@ -69,6 +70,35 @@ check "prefetch off says so" grep -q '"prefetch": false' n.json
 check "prefetch off loads nothing ahead" grep -q '"prefetched": 0, "prefetch_hits": 0' n.json
 check "prefetch on and off make the same picture" cmp -s p.png n.png
 expect_error 2 "--prefetch" "$bin/isorender" s.ibv --iso 1 --prefetch maybe -o x.png
+
+# culling: on by default, off when the mesh is written (unless asked for); the same picture
+# either way, and on one thread the culled and kept triangles add up to those kept without
+cull_run() { # NAME OPTIONS...
+    cull_name=$1
+    shift
+    run_capture "$bin/isorender" s.ibv --iso 100.5 --size 64x48 --view -y --lod off --threads 1 \
+        -o "$cull_name.png" --stats "$cull_name.json" --software --quiet "$@"
+}
+json_number() { sed "s/.*\"$2\": \([0-9]*\).*/\1/" "$1"; }
+cull_run c
+check "culling by default succeeds" test "$rc" = 0
+check "culling is on by default" grep -q '"cull": true' c.json
+cull_run c0 --cull off
+check "--cull off says so" grep -q '"cull": false, "culled_triangles": 0' c0.json
+kept=$(json_number c.json triangles) culled=$(json_number c.json culled_triangles)
+whole=$(json_number c0.json triangles)
+check "some triangles are culled (0 < $culled)" test "$culled" -gt 0
+check "kept and culled add up to the triangles kept without ($kept + $culled = $whole)" \
+    test $((kept + culled)) = "$whole"
+check "culling on and off make the same picture" cmp -s c.png c0.png
+cull_run cm --mesh cm.ply
+check "with --mesh nothing is culled" grep -q '"cull": false, "culled_triangles": 0' cm.json
+cull_run cmc --mesh cmc.ply --cull on
+check "--mesh with --cull on culls" grep -q '"cull": true' cmc.json
+faces=$(head -c 400 cmc.ply | sed -n 's/^element face \([0-9]*\).*/\1/p')
+check "the PLY holds the kept triangles ($faces = $kept)" test "$faces" = "$kept"
+check "culled images match with and without --mesh" cmp -s c.png cm.png
+expect_error 2 "--cull" "$bin/isorender" s.ibv --iso 1 --cull maybe -o x.png
 
 # the full extraction and the progressive one make the same picture
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o f.png --full --software --quiet

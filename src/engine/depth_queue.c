@@ -1,0 +1,117 @@
+/* A propagation's queue of cells, nearest first, in buckets of view depth. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "depth_queue.h"
+
+#define NONE UINT32_MAX
+
+void ip__depth_queue_init(ip_depth_queue *q)
+{
+    memset(q, 0, sizeof *q);
+    q->free = NONE;
+    for (unsigned b = 0; b < IP_DEPTH_BUCKETS; b++)
+        q->head[b] = NONE;
+    q->first = IP_DEPTH_BUCKETS;
+    q->last = 0;
+    q->scale = 1.0;
+}
+
+void ip__depth_queue_free(ip_depth_queue *q)
+{
+    free(q->cells);
+    free(q->next);
+    ip__depth_queue_init(q);
+}
+
+void ip__depth_queue_start(ip_depth_queue *q, double around, double width)
+{
+    for (uint32_t b = q->first; b <= q->last && b < IP_DEPTH_BUCKETS; b++)
+        q->head[b] = NONE; /* what a propagation that stopped early left */
+    q->first = IP_DEPTH_BUCKETS;
+    q->last = 0;
+    q->count = 0;
+    q->used = 0;
+    q->free = NONE;
+    q->scale = 1.0 / width;
+    q->base = around - 0.25 * IP_DEPTH_BUCKETS * width;
+}
+
+/* The bucket of view depth `depth`, clamped to the range. */
+static uint32_t bucket_of(const ip_depth_queue *q, double depth)
+{
+    double b = (depth - q->base) * q->scale;
+    return b <= 0 ? 0 : b >= IP_DEPTH_BUCKETS - 1 ? IP_DEPTH_BUCKETS - 1 : (uint32_t)b;
+}
+
+/* A slot for one more cell: a free one, else a new one. NONE when out of memory. */
+static uint32_t new_slot(ip_depth_queue *q)
+{
+    if (q->free != NONE) {
+        uint32_t s = q->free;
+        q->free = q->next[s];
+        return s;
+    }
+    if (q->used == q->capacity) {
+        uint32_t grown = q->capacity ? q->capacity * 2 : 4096;
+        if (grown <= q->capacity || grown == NONE)
+            return NONE;
+        ip_queued_cell *cells = realloc(q->cells, grown * sizeof *cells);
+        if (!cells)
+            return NONE;
+        q->cells = cells;
+        uint32_t *next = realloc(q->next, grown * sizeof *next);
+        if (!next)
+            return NONE;
+        q->next = next;
+        q->capacity = grown;
+    }
+    return q->used++;
+}
+
+ip_status ip__depth_queue_push(ip_depth_queue *q, const ip_queued_cell *cell, double depth)
+{
+    uint32_t s = new_slot(q);
+    if (s == NONE)
+        return IP_ERR_NOMEM;
+    uint32_t b = bucket_of(q, depth);
+    q->cells[s] = *cell;
+    q->next[s] = q->head[b];
+    q->head[b] = s;
+    q->first = b < q->first ? b : q->first;
+    q->last = b > q->last ? b : q->last;
+    q->count++;
+    return IP_OK;
+}
+
+/* Takes the newest cell of bucket b (not empty) into *cell. */
+static void take(ip_depth_queue *q, uint32_t b, ip_queued_cell *cell)
+{
+    uint32_t s = q->head[b];
+    *cell = q->cells[s];
+    q->head[b] = q->next[s];
+    q->next[s] = q->free;
+    q->free = s;
+    q->count--;
+}
+
+int ip__depth_queue_pop(ip_depth_queue *q, ip_queued_cell *cell)
+{
+    if (q->count == 0)
+        return 0;
+    while (q->head[q->first] == NONE)
+        q->first++;
+    take(q, q->first, cell);
+    return 1;
+}
+
+unsigned ip__depth_queue_take_far(ip_depth_queue *q, ip_queued_cell *out, unsigned max)
+{
+    unsigned n = 0;
+    while (n < max && q->count > 0) {
+        while (q->head[q->last] == NONE)
+            q->last--;
+        take(q, q->last, &out[n++]);
+    }
+    return n;
+}
