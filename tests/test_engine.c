@@ -663,7 +663,8 @@ static void check_coverage_reach(void)
     size_t wrong = 0;
     for (uint32_t y = 0; y < 48; y++)
         for (uint32_t x = 0; x < 64; x++) {
-            unsigned d = atomic_load(&c.depth[y * 64 + x]), sd = atomic_load(&c.solid[y * 64 + x]);
+            size_t at = ip__coverage_index(&c, x, y);
+            unsigned d = atomic_load(&c.depth[at]), sd = atomic_load(&c.solid[at]);
             wrong += reached[(y >> 3) * 8 + (x >> 3)] ? d == 12345u || sd == 12345u
                                                       : d != 12345u || sd != 12345u;
         }

@@ -46,7 +46,9 @@
 ip_status ip__coverage_prepare(ip_coverage *c, const ip_camera *camera, const double lo[3],
                                const double hi[3])
 {
-    size_t n = (size_t)camera->width * camera->height;
+    uint32_t tiles_x = (camera->width + IP_COVERAGE_TILE - 1) >> IP_COVERAGE_TILE_SHIFT,
+             tiles_y = (camera->height + IP_COVERAGE_TILE - 1) >> IP_COVERAGE_TILE_SHIFT;
+    size_t n = (size_t)tiles_x * tiles_y << 2 * IP_COVERAGE_TILE_SHIFT;
     if (n > c->capacity) {
         free(c->depth);
         free(c->solid);
@@ -62,6 +64,7 @@ ip_status ip__coverage_prepare(ip_coverage *c, const ip_camera *camera, const do
     ip_camera_basis_of(camera, &c->basis);
     ip_camera_depth_range(camera, lo, hi, &c->near_plane, &c->far_plane);
     c->width = camera->width;
+    c->tiles_x = tiles_x;
     c->height = camera->height;
     /* ip_camera_project() with one division */
     for (int a = 0; a < 3; a++) {
@@ -89,18 +92,38 @@ static inline int kept(const ip_coverage *c, int64_t x, int64_t y)
                                      (size_t)(x >> c->reached_shift)];
 }
 
+/* 1 when some pixel of layout tile (tx, ty) has its entries kept. */
+static int tile_kept(const ip_coverage *c, uint32_t tx, uint32_t ty)
+{
+    if (!c->reached)
+        return 1;
+    int64_t step = c->reached_shift < IP_COVERAGE_TILE_SHIFT ? (int64_t)1 << c->reached_shift
+                                                             : IP_COVERAGE_TILE;
+    int64_t x0 = (int64_t)tx << IP_COVERAGE_TILE_SHIFT, y0 = (int64_t)ty << IP_COVERAGE_TILE_SHIFT;
+    for (int64_t y = y0; y < y0 + IP_COVERAGE_TILE && y < c->height; y += step)
+        for (int64_t x = x0; x < x0 + IP_COVERAGE_TILE && x < c->width; x += step)
+            if (kept(c, x, y))
+                return 1;
+    return 0;
+}
+
 void ip__coverage_clear(ip_coverage *c, unsigned part, unsigned parts)
 {
-    uint32_t first = (uint32_t)((uint64_t)c->height * part / parts),
-             end = (uint32_t)((uint64_t)c->height * (part + 1) / parts);
+    uint32_t tiles_y = (c->height + IP_COVERAGE_TILE - 1) >> IP_COVERAGE_TILE_SHIFT;
+    uint32_t first = (uint32_t)((uint64_t)tiles_y * part / parts),
+             end = (uint32_t)((uint64_t)tiles_y * (part + 1) / parts);
     unsigned bits = ip__float_bits(INFINITY);
-    for (uint32_t y = first; y < end; y++)
-        for (uint32_t x = 0; x < c->width; x++)
-            if (kept(c, x, y)) {
-                size_t i = (size_t)y * c->width + x;
+    for (uint32_t ty = first; ty < end; ty++)
+        for (uint32_t tx = 0; tx < c->tiles_x; tx++) {
+            if (!tile_kept(c, tx, ty))
+                continue;
+            size_t at = ip__coverage_index(c, (uint64_t)tx << IP_COVERAGE_TILE_SHIFT,
+                                           (uint64_t)ty << IP_COVERAGE_TILE_SHIFT);
+            for (size_t i = at; i < at + IP_COVERAGE_TILE * IP_COVERAGE_TILE; i++) {
                 atomic_init(&c->depth[i], bits);
                 atomic_init(&c->solid[i], bits);
             }
+        }
 }
 
 ip_status ip__coverage_reset(ip_coverage *c, const ip_camera *camera, const double lo[3],
@@ -221,7 +244,7 @@ static int add_projected(ip_coverage *c, const double *x, const double *y, const
             if (!kept(c, px, py)) /* not expected: a caller's triangles stay in kept tiles */
                 continue;
             if (e0 >= need[0] && e1 >= need[1] && e2 >= need[2]) {
-                size_t at = (size_t)py * c->width + (size_t)px;
+                size_t at = ip__coverage_index(c, (uint64_t)px, (uint64_t)py);
                 lower(&c->depth[at], bits);
                 if (e0 >= inner[0] && e1 >= inner[1] && e2 >= inner[2])
                     lower(&c->solid[at], bits);
@@ -269,7 +292,7 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
     double yc = ip__vec3_dot(v, c->to_y) / zc + c->centre_y;
     if (xc >= 0 && xc < c->width && yc >= 0 && yc < c->height &&
         (!kept(c, (int64_t)xc, (int64_t)yc) ||
-         atomic_load_explicit(&c->depth[(size_t)yc * c->width + (size_t)xc],
+         atomic_load_explicit(&c->depth[ip__coverage_index(c, (uint64_t)xc, (uint64_t)yc)],
                               memory_order_relaxed) >= bits))
         return 0;
     double min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY;
@@ -290,7 +313,7 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
     for (int64_t py = y0; py <= y1; py++)
         for (int64_t px = x0; px <= x1; px++)
             if (!kept(c, px, py) ||
-                atomic_load_explicit(&c->depth[(size_t)py * c->width + (size_t)px],
+                atomic_load_explicit(&c->depth[ip__coverage_index(c, (uint64_t)px, (uint64_t)py)],
                                      memory_order_relaxed) >= bits)
                 return 0;
     return 1;

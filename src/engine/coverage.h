@@ -38,6 +38,12 @@
  * is at ip__engine_cast_ray() in cast.c). */
 #define IP_COVERAGE_SOLID_MARGIN (1.0 / 128)
 
+/* Entries are stored tile by tile, the IP_COVERAGE_TILE^2 pixels of a tile row by row in 256
+ * contiguous bytes per buffer: the few pixels a small box or triangle covers lie in one or two
+ * cache lines, and only the memory of the tiles kept (ip__coverage_reach()) is ever touched. */
+#define IP_COVERAGE_TILE_SHIFT 3
+#define IP_COVERAGE_TILE (1u << IP_COVERAGE_TILE_SHIFT)
+
 typedef struct ip_coverage {
     ip_camera camera;
     ip_camera_basis basis;
@@ -45,7 +51,9 @@ typedef struct ip_coverage {
     double to_x[3], to_y[3];      /* image x, y = dot(p - eye, to_x or to_y) / depth + centre */
     double centre_x, centre_y;
     uint32_t width, height;
-    atomic_uint *depth; /* width * height entries: the bits of a float depth, +inf: unknown */
+    uint32_t tiles_x;   /* tiles of IP_COVERAGE_TILE pixels a side in a row of the image */
+    atomic_uint *depth; /* per pixel, tile by tile (ip__coverage_index()): the bits of a float
+                           depth, +inf: unknown */
     atomic_uint *solid; /* the same, from triangles holding the centre by the solid margin */
     size_t capacity;    /* entries allocated */
     /* NULL, or per tile of 2^reached_shift pixels a side (reached_x of them a row): whether its
@@ -109,6 +117,16 @@ static inline float ip__float_of_bits(unsigned bits)
     return f;
 }
 
+/* Where pixel (x, y)'s entries are in c->depth and c->solid. */
+static inline size_t ip__coverage_index(const ip_coverage *c, uint64_t x, uint64_t y)
+{
+    size_t tile =
+        (size_t)(y >> IP_COVERAGE_TILE_SHIFT) * c->tiles_x + (size_t)(x >> IP_COVERAGE_TILE_SHIFT);
+    return tile << 2 * IP_COVERAGE_TILE_SHIFT |
+           (size_t)((y & (IP_COVERAGE_TILE - 1)) << IP_COVERAGE_TILE_SHIFT |
+                    (x & (IP_COVERAGE_TILE - 1)));
+}
+
 /* The solid entry of pixel (x, y) (inside the image, in a kept tile): an upper bound on the
  * view depth (world units) of an extracted triangle whose projection holds the pixel centre by
  * at least IP_COVERAGE_SOLID_MARGIN pixels from every edge, or +infinity where none is known.
@@ -116,7 +134,7 @@ static inline float ip__float_of_bits(unsigned bits)
 static inline double ip__coverage_solid(const ip_coverage *c, uint32_t x, uint32_t y)
 {
     return ip__float_of_bits(
-        atomic_load_explicit(&c->solid[(size_t)y * c->width + x], memory_order_relaxed));
+        atomic_load_explicit(&c->solid[ip__coverage_index(c, x, y)], memory_order_relaxed));
 }
 
 /* 1 when the world box [lo, hi] is certainly hidden: it lies wholly in front of the eye and

@@ -241,6 +241,8 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
     double centre[3], diagonal;
     const int clipping = p->clip.count > 0; /* without planes no cell is tested */
     ip_status st = IP_OK;
+    if (count == 0)
+        return st;
     /* nearest first (depth_queue.h), in buckets of half the first cell's diagonal */
     cell_centre(p->sampler, cells[0].cell, centre, &diagonal);
     ip__depth_queue_start(&p->queue, view_depth(p, centre), 0.5 * diagonal);
