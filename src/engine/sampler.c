@@ -236,16 +236,3 @@ int ip__sampler_cell_triangles(ip_sampler *s, const uint32_t cell[3], const floa
     ip__sampler_cell_box(s, cell, lo, hi);
     return ip__mc_triangulate_cell(values, (const float(*)[3])gradients, iso, lo, hi, out);
 }
-
-int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
-                            unsigned *mc_case)
-{
-    /* The case first, from the 8 corners alone: most cells of an active sub-block are not
-     * active, and need neither the gradient neighbours nor the divisions. */
-    float values[8];
-    if (ip__sampler_cell_case(s, cell, iso, values, mc_case) < 0)
-        return -1;
-    if (*mc_case == 0 || *mc_case == 255)
-        return 0;
-    return ip__sampler_cell_triangles(s, cell, values, iso, out);
-}

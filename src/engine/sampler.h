@@ -102,15 +102,12 @@ static inline void ip__cell_values(const ip_brick *b, ip_type type, const ptrdif
  * so that neighbouring cells get the same bits for their shared corners. */
 void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float lo[3], float hi[3]);
 
-/* Triangulates `cell` with gradient normals: writes up to IP_MC_MAX_VERTICES vertices and the
- * marching-cubes case. Returns the number of triangles, or -1 after a failure. */
-int ip__sampler_triangulate(ip_sampler *s, const uint32_t cell[3], float iso, ip_mc_vertex *out,
-                            unsigned *mc_case);
-
-/* ip__sampler_triangulate() in two parts, for a caller that may not need the triangles' normals
- * (the gradients are most of the work): the cell's corner values and case (returns 1, or -1
- * after a failure); then, for an active case, its triangles from those values (the count, or
- * -1 after a failure). */
+/* A cell's triangulation with gradient normals, in two parts, for a caller that may not need
+ * the normals (the gradients are most of the work): the cell's corner values and
+ * marching-cubes case (returns 1, or -1 after a failure); then, for an active case, its
+ * triangles from those values, up to IP_MC_MAX_VERTICES vertices (the count, or -1 after a
+ * failure). The case first: most cells of an active sub-block are not active, and need neither
+ * the gradient neighbours nor the divisions. */
 int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, float values[8],
                           unsigned *mc_case);
 int ip__sampler_cell_triangles(ip_sampler *s, const uint32_t cell[3], const float values[8],
