@@ -652,7 +652,7 @@ phases() {
             d["ip__extract_cell"] = "marching cubes of one cell, mesh append"
             d["ip__sampler_cell_case"] = "the 8 corners of a cell and its case"
             d["ip__coverage_add"] = "triangles into the coverage, and their cull test"
-            d["ip__sampler_cell_triangles"] = "24 neighbours, gradients and MC of a kept cell"
+            d["ip__sampler_cell_normals"] = "24 neighbours and gradients of a kept cell, its normals"
             d["ip_now_seconds"] = "clock_gettime for the phase times"
             d["ip_cache_pin_brick"] = "brick cache (decode on a miss)"
             d["render_image"] = "isorender: final OpenGL image"

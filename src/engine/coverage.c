@@ -36,6 +36,7 @@
 #include <string.h>
 
 #include "coverage.h"
+#include "internal.h"
 #include "vec3.h"
 
 #define EDGE_TOLERANCE 1e-7      /* pixels */
@@ -80,6 +81,7 @@ ip_status ip__coverage_prepare(ip_coverage *c, const ip_camera *camera, const do
 void ip__coverage_reach(ip_coverage *c, const unsigned char *reached, unsigned shift,
                         uint32_t tiles_x)
 {
+    IP_ASSERT(!reached || shift >= IP_COVERAGE_TILE_SHIFT);
     c->reached = reached;
     c->reached_shift = shift;
     c->reached_x = tiles_x;
@@ -92,21 +94,6 @@ static inline int kept(const ip_coverage *c, int64_t x, int64_t y)
                                      (size_t)(x >> c->reached_shift)];
 }
 
-/* 1 when some pixel of layout tile (tx, ty) has its entries kept. */
-static int tile_kept(const ip_coverage *c, uint32_t tx, uint32_t ty)
-{
-    if (!c->reached)
-        return 1;
-    int64_t step = c->reached_shift < IP_COVERAGE_TILE_SHIFT ? (int64_t)1 << c->reached_shift
-                                                             : IP_COVERAGE_TILE;
-    int64_t x0 = (int64_t)tx << IP_COVERAGE_TILE_SHIFT, y0 = (int64_t)ty << IP_COVERAGE_TILE_SHIFT;
-    for (int64_t y = y0; y < y0 + IP_COVERAGE_TILE && y < c->height; y += step)
-        for (int64_t x = x0; x < x0 + IP_COVERAGE_TILE && x < c->width; x += step)
-            if (kept(c, x, y))
-                return 1;
-    return 0;
-}
-
 void ip__coverage_clear(ip_coverage *c, unsigned part, unsigned parts)
 {
     uint32_t tiles_y = (c->height + IP_COVERAGE_TILE - 1) >> IP_COVERAGE_TILE_SHIFT;
@@ -115,7 +102,8 @@ void ip__coverage_clear(ip_coverage *c, unsigned part, unsigned parts)
     unsigned bits = ip__float_bits(INFINITY);
     for (uint32_t ty = first; ty < end; ty++)
         for (uint32_t tx = 0; tx < c->tiles_x; tx++) {
-            if (!tile_kept(c, tx, ty))
+            if (!kept(c, (int64_t)tx << IP_COVERAGE_TILE_SHIFT,
+                      (int64_t)ty << IP_COVERAGE_TILE_SHIFT)) /* the whole layout tile */
                 continue;
             size_t at = ip__coverage_index(c, (uint64_t)tx << IP_COVERAGE_TILE_SHIFT,
                                            (uint64_t)ty << IP_COVERAGE_TILE_SHIFT);

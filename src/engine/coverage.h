@@ -78,7 +78,8 @@ ip_status ip__coverage_prepare(ip_coverage *c, const ip_camera *camera, const do
 void ip__coverage_clear(ip_coverage *c, unsigned part, unsigned parts);
 
 /* After ip__coverage_prepare() and before ip__coverage_clear(): keeps only the entries of the
- * tiles of 2^shift pixels marked in `reached` (tiles_x a row; borrowed, NULL: every entry).
+ * tiles of 2^shift pixels marked in `reached` (tiles_x a row; borrowed, NULL: every entry;
+ * shift >= IP_COVERAGE_TILE_SHIFT, so that each tile of the entries' layout lies in one).
  * The caller vouches that no triangle it adds reaches another tile (its image lies within a
  * marked tile's pixels); boxes reaching another tile are never found hidden, and the solid
  * entries of the others must not be read (ip__coverage_solid()). Clearing then writes only

@@ -23,7 +23,6 @@
  * that ip__engine_retire() would retire passed over (ip__engine_take_block()). */
 #define BLOCK_LOG4 3
 #define BLOCK_CELLS (1u << 2 * BLOCK_LOG4)
-#define RETIRED_PER_BATCH 4096             /* rays of blocks a batch may retire at once, at most */
 #define RAY_ROOM (RAY_BATCH + BLOCK_CELLS) /* a batch's rays, a block's overfill included */
 
 /* A worker's tools for one pyramid level: pinned bricks, seeding state, propagation queue. */

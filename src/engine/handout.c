@@ -6,6 +6,7 @@
 
 #define RANGE_MIN 16   /* positions of the ray order a worker claims at once, at the start... */
 #define RANGE_MAX 1024 /* ...and at most, later: 1/256 of the positions already handed out */
+#define RETIRED_PER_BATCH 4096 /* rays of blocks a batch may retire at once, at most */
 
 int ip__engine_take_budget(ip_engine *e, uint64_t rays)
 {

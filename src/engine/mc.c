@@ -104,26 +104,19 @@ static void edge_normal(const float values[8], const float gradients[8][3], floa
 int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], float iso,
                             const float lo[3], const float hi[3], ip_mc_vertex *out)
 {
+    /* Each crossing is shared by up to 4 triangles of the cell: computed once. */
+    float points[12][3], normals[12][3];
     unsigned mc_case = ip__mc_case(values, iso);
-    unsigned crossed = ip__mc_edge_table[mc_case];
-    if (crossed == 0)
+    if (!ip__mc_cell_edge_points(values, iso, lo, hi, points))
         return 0;
-    /* Each crossing is shared by up to 4 triangles of the cell: compute it once. */
-    ip_mc_vertex at_edge[12];
-    const float inverse_size[3] = {1.0f / (hi[0] - lo[0]), 1.0f / (hi[1] - lo[1]),
-                                   1.0f / (hi[2] - lo[2])};
-    for (unsigned e = 0; e < 12; e++) {
-        if (!(crossed >> e & 1u))
-            continue;
-        float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
-                                values[ip__mc_edge_corners[e][1]], iso);
-        edge_position(e, t, lo, hi, at_edge[e].position);
-        edge_normal(values, gradients, iso, e, t, inverse_size, at_edge[e].normal);
-    }
+    ip__mc_cell_edge_normals(values, gradients, iso, lo, hi, normals);
     const int8_t *row = ip__mc_triangle_table[mc_case];
     int count = ip__mc_triangle_count[mc_case];
     for (int i = 0; i < 3 * count; i++)
-        out[i] = at_edge[row[i]];
+        for (unsigned a = 0; a < 3; a++) {
+            out[i].position[a] = points[row[i]][a];
+            out[i].normal[a] = normals[row[i]][a];
+        }
     return count;
 }
 
@@ -136,6 +129,21 @@ unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float l
             float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
                                     values[ip__mc_edge_corners[e][1]], iso);
             edge_position(e, t, lo, hi, points[e]);
+        }
+    return crossed;
+}
+
+unsigned ip__mc_cell_edge_normals(const float values[8], const float gradients[8][3], float iso,
+                                  const float lo[3], const float hi[3], float normals[12][3])
+{
+    unsigned crossed = ip__mc_edge_table[ip__mc_case(values, iso)];
+    const float inverse_size[3] = {1.0f / (hi[0] - lo[0]), 1.0f / (hi[1] - lo[1]),
+                                   1.0f / (hi[2] - lo[2])};
+    for (unsigned e = 0; e < 12; e++)
+        if (crossed >> e & 1u) {
+            float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
+                                    values[ip__mc_edge_corners[e][1]], iso);
+            edge_normal(values, gradients, iso, e, t, inverse_size, normals[e]);
         }
     return crossed;
 }

@@ -123,6 +123,13 @@ int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], 
 unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float lo[3],
                                  const float hi[3], float points[12][3]);
 
+/*! ip__mc_cell_edge_normals() : the normals ip__mc_triangulate_cell() (same arguments) gives its
+ *  vertices, per crossed edge: normals[e] for every edge e whose bit is set in the returned
+ *  mask; the others are left alone. With ip__mc_cell_edge_points(), a caller that may drop
+ *  some of a cell's triangles works out the normals only for a cell it keeps. */
+unsigned ip__mc_cell_edge_normals(const float values[8], const float gradients[8][3], float iso,
+                                  const float lo[3], const float hi[3], float normals[12][3]);
+
 /*! ip__mc_ray_hits_cell() : whether the ray ray_origin + t * ray_dir, t >= 0, hits a triangle of
  *  the cell's triangulation (either side), as produced by ip__mc_triangulate_cell with the same
  *  values, iso, lo and hi. A ray can cross an active cell without touching its triangles;

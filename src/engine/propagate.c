@@ -4,7 +4,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "array.h"
 #include "internal.h"
 #include "propagate.h"
 #include "vec3.h"
@@ -46,21 +45,6 @@ void ip__propagator_free(ip_propagator *p)
     ip__depth_queue_free(&p->queue);
 }
 
-/* The positions of the triangles of an active cell (case mc_case, corner values `values`) as
- * ip__mc_triangulate_cell() puts them: 9 floats a triangle into pos. Returns the count. */
-static int cell_positions(const ip_sampler *s, const uint32_t cell[3], const float values[8],
-                          float iso, unsigned mc_case, float *pos)
-{
-    float lo[3], hi[3], points[12][3];
-    ip__sampler_cell_box(s, cell, lo, hi);
-    ip__mc_cell_edge_points(values, iso, lo, hi, points);
-    const int8_t *row = ip__mc_triangle_table[mc_case];
-    int n = ip__mc_triangle_count[mc_case];
-    for (int i = 0; i < 3 * n; i++)
-        memcpy(pos + 3 * i, points[row[i]], 3 * sizeof(float));
-    return n;
-}
-
 int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t cell[3], float iso,
                      unsigned *mc_case, uint64_t *culled, ip_status *st)
 {
@@ -71,23 +55,26 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
     }
     if (*mc_case == 0 || *mc_case == 255)
         return 0;
+    /* The vertices first: they are recorded in the coverage, and with culling the triangles
+     * drawn at no pixel centre dropped, before the normals (the gradients) are worked out. */
+    float lo[3], hi[3], points[12][3], normals[12][3];
+    ip__sampler_cell_box(s, cell, lo, hi);
+    ip__mc_cell_edge_points(values, iso, lo, hi, points);
+    const int8_t *row = ip__mc_triangle_table[*mc_case];
+    int n = ip__mc_triangle_count[*mc_case];
     float pos[9 * IP_MC_MAX_TRIANGLES];
     int16_t nor[9 * IP_MC_MAX_TRIANGLES];
     uint64_t ids[IP_MC_MAX_TRIANGLES];
-    /* With a coverage, the positions first: they are recorded, and the triangles drawn at no
-     * pixel centre culled, before the normals (the gradients) are worked out for the rest. */
-    uint32_t shows = ~0u;
-    if (out->coverage) {
-        int n = cell_positions(s, cell, values, iso, *mc_case, pos);
-        shows = ip__coverage_add(out->coverage, pos, (unsigned)n);
-        if (out->cull && !(shows & ((1u << n) - 1))) {
-            *culled += (uint64_t)n;
-            return 0;
-        }
+    for (int i = 0; i < 3 * n; i++)
+        memcpy(pos + 3 * i, points[row[i]], sizeof points[0]);
+    uint32_t shows = out->coverage ? ip__coverage_add(out->coverage, pos, (unsigned)n) : 0;
+    if (!out->cull)
+        shows = ~0u;
+    if (!(shows & ((1u << n) - 1))) {
+        *culled += (uint64_t)n;
+        return 0;
     }
-    ip_mc_vertex v[IP_MC_MAX_VERTICES];
-    int n = ip__sampler_cell_triangles(s, cell, values, iso, v);
-    if (n < 0) {
+    if (ip__sampler_cell_normals(s, cell, values, iso, normals) < 0) {
         *st = s->status;
         return -1;
     }
@@ -96,31 +83,29 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
         cell[0] + (uint64_t)(lv->dims[0] - 1) * (cell[1] + (uint64_t)(lv->dims[1] - 1) * cell[2]);
     int kept = 0;
     for (int t = 0; t < n; t++) {
-        if (out->cull && !(shows >> t & 1))
+        if (!(shows >> t & 1))
             continue; /* drawn at no pixel centre of the image */
         ids[kept] = ip_cell_id(s->level, linear);
         for (int k = 0; k < 3; k++)
             for (int a = 0; a < 3; a++) {
-                pos[9 * kept + 3 * k + a] = v[3 * t + k].position[a];
-                nor[9 * kept + 3 * k + a] = ip_normal_pack(v[3 * t + k].normal[a]);
+                pos[9 * kept + 3 * k + a] = points[row[3 * t + k]][a];
+                nor[9 * kept + 3 * k + a] = ip_normal_pack(normals[row[3 * t + k]][a]);
             }
         kept++;
     }
     *culled += (uint64_t)(n - kept);
-    if (kept > 0 && ip_mesh_append(out->mesh, pos, nor, ids, (uint64_t)kept) != IP_OK) {
+    if (ip_mesh_append(out->mesh, pos, nor, ids, (uint64_t)kept) != IP_OK) {
         *st = IP_ERR_NOMEM;
         return -1;
     }
     return kept;
 }
 
-/* 1 - cos of the angle between the unit ray `dir` and the direction from the eye to `p`: it
- * grows with the angle over [0, pi], so it orders angles as they do, without atan2. */
-static double versine_to(const double eye[3], const double dir[3], const double p[3])
+/* 1 - cos of the angle between the unit ray `dir` and v (of length `length`), the direction
+ * from the eye to a point: it grows with the angle over [0, pi], so it orders angles as they
+ * do, without atan2. */
+static double versine(const double dir[3], const double v[3], double length)
 {
-    double v[3];
-    ip__vec3_sub(p, eye, v);
-    double length = ip__vec3_length(v);
     return length > 0 ? 1.0 - ip__vec3_dot(dir, v) / length : 0.0;
 }
 
@@ -222,10 +207,10 @@ static ip_status share(ip_propagator *p, const double dir[3])
 ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double dir[3],
                         ip_engine_counts *counts)
 {
-    double centre[3], diagonal;
+    double centre[3], diagonal, v[3];
     cell_centre(p->sampler, seed, centre, &diagonal);
-    ip_queued_cell q = {{seed[0], seed[1], seed[2]},
-                        (float)versine_to(p->camera->eye, dir, centre)};
+    ip__vec3_sub(centre, p->camera->eye, v);
+    ip_queued_cell q = {{seed[0], seed[1], seed[2]}, (float)versine(dir, v, ip__vec3_length(v))};
     return ip__propagate_queued(p, &q, 1, dir, counts);
 }
 
@@ -282,17 +267,13 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
                 (clipping && !cell_kept(p, n3)))
                 continue;
             cell_centre(p->sampler, n3, centre, &diagonal);
-            double a = versine_to(eye, dir, centre);
-            double pixels;
+            double v[3];
+            ip__vec3_sub(centre, eye, v);
+            double distance = ip__vec3_length(v), a = versine(dir, v, distance), pixels;
             if (a > p->cutoff_versine || a < folded || !in_frustum(p, centre, diagonal, &pixels))
                 continue;
-            if (p->near_distance > 0 || p->far_distance < INFINITY) {
-                double v[3];
-                ip__vec3_sub(centre, eye, v);
-                double d = ip__vec3_length(v);
-                if (d < p->near_distance || d >= p->far_distance)
-                    continue; /* another level's band: the resolution boundary */
-            }
+            if (distance < p->near_distance || distance >= p->far_distance)
+                continue; /* another level's band: the resolution boundary */
             if (p->out.coverage && hidden(p, n3, pixels)) {
                 counts->deferred++; /* left unmarked: a ray that seeds it extracts it */
                 continue;
@@ -304,7 +285,7 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
                 st = ip__depth_queue_push(
                     &p->queue,
                     &(ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)},
-                    view_depth(p, centre));
+                    ip__vec3_dot(v, p->basis.forward));
         }
         /* the farthest part of a long queue to a worker waiting for cells */
         if (p->share.hungry && extracted % SHARE_STRIDE == 0 &&

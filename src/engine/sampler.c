@@ -215,8 +215,8 @@ int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, floa
     return 1;
 }
 
-int ip__sampler_cell_triangles(ip_sampler *s, const uint32_t cell[3], const float values[8],
-                               float iso, ip_mc_vertex *out)
+int ip__sampler_cell_normals(ip_sampler *s, const uint32_t cell[3], const float values[8],
+                             float iso, float normals[12][3])
 {
     float outer[24], gradients[8][3], lo[3], hi[3];
     const ip_brick *b = ip__sampler_cell_brick(s, cell);
@@ -234,5 +234,6 @@ int ip__sampler_cell_triangles(ip_sampler *s, const uint32_t cell[3], const floa
             gradients[c][a] = d[h][a] > 0 ? (float)((vh - vl) / d[h][a]) : 0.0f;
         }
     ip__sampler_cell_box(s, cell, lo, hi);
-    return ip__mc_triangulate_cell(values, (const float(*)[3])gradients, iso, lo, hi, out);
+    return (int)ip__mc_cell_edge_normals(values, (const float(*)[3])gradients, iso, lo, hi,
+                                         normals);
 }

@@ -102,16 +102,16 @@ static inline void ip__cell_values(const ip_brick *b, ip_type type, const ptrdif
  * so that neighbouring cells get the same bits for their shared corners. */
 void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float lo[3], float hi[3]);
 
-/* A cell's triangulation with gradient normals, in two parts, for a caller that may not need
- * the normals (the gradients are most of the work): the cell's corner values and
- * marching-cubes case (returns 1, or -1 after a failure); then, for an active case, its
- * triangles from those values, up to IP_MC_MAX_VERTICES vertices (the count, or -1 after a
- * failure). The case first: most cells of an active sub-block are not active, and need neither
- * the gradient neighbours nor the divisions. */
+/* A cell in two parts, for a caller that may not need its normals (the gradients are most of
+ * the work): its corner values and marching-cubes case (returns 1, or -1 after a failure);
+ * then, for an active case, the gradient normals at its edge crossings from those values, as
+ * ip__mc_cell_edge_normals() gives them (the mask of crossed edges, or -1 after a failure).
+ * The case first: most cells of an active sub-block are not active, and need neither the
+ * gradient neighbours nor the divisions. The vertices are ip__mc_cell_edge_points()'. */
 int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, float values[8],
                           unsigned *mc_case);
-int ip__sampler_cell_triangles(ip_sampler *s, const uint32_t cell[3], const float values[8],
-                               float iso, ip_mc_vertex *out);
+int ip__sampler_cell_normals(ip_sampler *s, const uint32_t cell[3], const float values[8],
+                             float iso, float normals[12][3]);
 
 /* 1 when the range [lo, hi] (over cell corners) may hold an active cell for `iso`: some corner
  * >= iso and some corner < iso. */
