@@ -136,8 +136,8 @@ int tool_parse_dims(const char *program, const char *option, const char *text, u
                                     "(at most %llu)",
                                     option, text, axes[k], (1ull << 31) - 1);
     }
-    if (ip_dims_parse(text, dims) != IP_OK) /* cannot fail after the checks above */
-        return tool_usage_error(program, "%s '%s' is not XxYxZ", option, text);
+    for (int k = 0; k < 3; k++)
+        dims[k] = (uint32_t)value[k];
     return 0;
 }
 

@@ -236,9 +236,11 @@ class File:
                                    ctypes.byref(err)), err)
         run.engine = engine
         self._runs.add(run)
-        try:
-            check(lib.ip_engine_begin(engine, ctypes.byref(cam), float(iso), ctypes.byref(err)),
-                  err)
+        try:  # the view's set-up counts in its time, as in isorender
+            start = lib.ip_now_seconds()
+            st = lib.ip_engine_begin(engine, ctypes.byref(cam), float(iso), ctypes.byref(err))
+            run.wall_seconds = lib.ip_now_seconds() - start
+            check(st, err)
         except BaseException:
             self._end(run)
             raise

@@ -519,7 +519,8 @@ static void feed_worker(void *user, unsigned index)
     }
 }
 
-/* Feeds level-0 planes [z0, z1], read by the reader thread, to the pyramid on every thread. */
+/* Feeds level-0 planes [z0, z1], already in their slots (read by the reader thread, or in order
+ * by read_chunk()), to the pyramid on every thread. */
 static ip_status feed_chunk(bricker *b, uint32_t z0, uint32_t z1, ip_error *err)
 {
     chunk_job job;

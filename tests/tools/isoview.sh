@@ -19,6 +19,16 @@ expect_error 1 "nothere.ibv" "$bin/isoview" nothere.ibv --iso 1
 expect_error 2 "view" "$bin/isoview" s.ibv --iso 1 --view +w
 printf 'iso 1\norbit 10\n' >bad.txt
 expect_error 1 "bad.txt:2" "$bin/isoview" s.ibv --iso 1 --script bad.txt
+# a script's views and cameras are checked as --view and --camera are, before any window
+printf 'view +w\n' >badview.txt
+expect_error 1 "badview.txt:1: view '+w' is not one of" "$bin/isoview" s.ibv --iso 1 \
+    --script badview.txt
+printf 'iso 1\ncamera 1,2,3\n' >badcamera.txt
+expect_error 1 "badcamera.txt:2: --camera '1,2,3' is not" "$bin/isoview" s.ibv --iso 1 \
+    --script badcamera.txt
+printf 'camera 0,0,0,0,0,0,0,0,1,35\n' >samepoint.txt
+expect_error 1 "samepoint.txt:1: camera: eye and target coincide" "$bin/isoview" s.ibv --iso 1 \
+    --script samepoint.txt
 expect_error 1 "cannot open a window" env -u DISPLAY -u WAYLAND_DISPLAY "$bin/isoview" s.ibv --iso 1
 # --clip as isorender takes it, and the script's clip on|off
 expect_error 2 "bad --clip 'w=3'" "$bin/isoview" s.ibv --iso 1 --clip w=3

@@ -61,17 +61,17 @@ static int parse_command(viewer *v, char *line, command *c, ip_error *err)
     if (extra)
         goto too_many;
     if (!strcmp(word, "camera")) {
-        ip_camera probe = v->camera;
+        ip_camera probe; /* checked now, applied when the command runs */
         if (args != 1)
             goto arguments;
-        if (ip_camera_parse(arg1, &probe, err) != IP_OK || ip_camera_check(&probe, err) != IP_OK)
+        if (camera_from(v, arg1, NULL, &probe, err) != 0)
             return -1;
         c->kind = COMMAND_CAMERA;
     } else if (!strcmp(word, "view")) {
         ip_camera probe;
         if (args != 1)
             goto arguments;
-        if (ip_camera_fit_axis(v->lo, v->hi, arg1, 30.0, 64, 48, &probe, err) != IP_OK)
+        if (camera_from(v, NULL, arg1, &probe, err) != 0)
             return -1;
         c->kind = COMMAND_VIEW;
     } else if (!strcmp(word, "iso")) {
