@@ -155,27 +155,39 @@ static double max3(double a, double b, double c)
     return m > c ? m : c;
 }
 
-/* The pixel centres (x + 0.5) within [lo - margin, hi + margin], clamped to [0, side). */
+/* The pixel centres (x + 0.5) within [lo - margin, hi + margin], clamped to [0, side); none
+ * when either end is NaN. Rounded through integers, not ceil() and floor(), which are calls on
+ * the x86-64 baseline: both ends are first clamped to [-1, side], where that changes nothing
+ * the clamp to [0, side) would not. */
 static int centre_range(double lo, double hi, double margin, uint32_t side, int64_t *first,
                         int64_t *last)
 {
-    double a = ceil(lo - 0.5 - margin), b = floor(hi - 0.5 + margin);
-    a = a < 0 ? 0 : a;
-    b = b > side - 1.0 ? side - 1.0 : b;
-    if (!(a <= b))
+    double a = lo - 0.5 - margin, b = hi - 0.5 + margin;
+    if (!(a <= b) || !(a <= side) || !(b >= -1.0))
+        return 0; /* NaN, or nothing of [0, side) */
+    a = a < -1.0 ? -1.0 : a;
+    b = b > side ? (double)side : b;
+    int64_t ia = (int64_t)a, ib = (int64_t)b; /* toward zero */
+    ia += (double)ia < a;                     /* ceil(a) */
+    ib -= (double)ib > b;                     /* floor(b) */
+    ia = ia < 0 ? 0 : ia;
+    ib = ib > (int64_t)side - 1 ? (int64_t)side - 1 : ib;
+    if (ia > ib)
         return 0;
-    *first = (int64_t)a;
-    *last = (int64_t)b;
+    *first = ia;
+    *last = ib;
     return 1;
 }
 
-/* Lowers entry i to `bits` (a non-negative float's bits, so integer order is float order). */
+/* Lowers an entry to `bits` (a non-negative float's bits, so integer order is float order).
+ * A plain store, not a compare-and-swap loop: two threads lowering one entry at once may leave
+ * the larger of their two depths, never a depth no triangle recorded. Every entry stays what
+ * coverage.h says (a depth some extracted triangle has there, or farther): a lost lowering
+ * only defers fewer cells and retires fewer rays. */
 static void lower(atomic_uint *entry, unsigned bits)
 {
-    unsigned old = atomic_load_explicit(entry, memory_order_relaxed);
-    while (bits < old && !atomic_compare_exchange_weak_explicit(
-                             entry, &old, bits, memory_order_relaxed, memory_order_relaxed))
-        ;
+    if (bits < atomic_load_explicit(entry, memory_order_relaxed))
+        atomic_store_explicit(entry, bits, memory_order_relaxed);
 }
 
 /* Records one triangle, its corners projected: image x, y (pixels) and view depth z. Returns
@@ -242,6 +254,30 @@ static int add_projected(ip_coverage *c, const double *x, const double *y, const
     return shows;
 }
 
+uint32_t ip__coverage_add_indexed(ip_coverage *c, const float points[][3], const int8_t *corners,
+                                  unsigned count)
+{
+    double px[32], py[32], pz[32];
+    uint32_t projected = 0, shows = 0;
+    for (unsigned t = 0; t < count; t++) {
+        double x[3], y[3], z[3];
+        for (int k = 0; k < 3; k++) {
+            unsigned i = (unsigned)corners[3 * t + k];
+            IP_ASSERT(i < 32);
+            if (!(projected >> i & 1)) {
+                double p[3] = {points[i][0], points[i][1], points[i][2]};
+                project(c, p, &px[i], &py[i], &pz[i]);
+                projected |= UINT32_C(1) << i;
+            }
+            x[k] = px[i];
+            y[k] = py[i];
+            z[k] = pz[i];
+        }
+        shows |= (uint32_t)add_projected(c, x, y, z) << t;
+    }
+    return shows;
+}
+
 uint32_t ip__coverage_add(ip_coverage *c, const float *positions, unsigned count)
 {
     uint32_t shows = 0;
@@ -273,9 +309,9 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
         return 0; /* crosses the near plane or lies behind the eye: never deferred */
     double limit = zmin * (1.0 - BOX_DEPTH_MARGIN);
     float f = (float)limit;
-    if ((double)f > limit)
-        f = nextafterf(f, 0.0f);
     unsigned bits = ip__float_bits(f);
+    if ((double)f > limit) /* the float below (f > 0: one less in its bits) */
+        bits--;
     double xc = ip__vec3_dot(v, c->to_x) / zc + c->centre_x;
     double yc = ip__vec3_dot(v, c->to_y) / zc + c->centre_y;
     if (xc >= 0 && xc < c->width && yc >= 0 && yc < c->height &&

@@ -102,6 +102,12 @@ void ip__coverage_free(ip_coverage *c);
  * IP_COVERAGE_SHOW_MARGIN of it. A triangle without its bit records nothing. */
 uint32_t ip__coverage_add(ip_coverage *c, const float *positions, unsigned count);
 
+/* The same for triangles given as indices into `points` (world units): corner k of triangle t
+ * is points[corners[3 * t + k]], each index below 32. Each point is projected once, however
+ * many triangles share it (a cell's edge crossings). */
+uint32_t ip__coverage_add_indexed(ip_coverage *c, const float points[][3], const int8_t *corners,
+                                  unsigned count);
+
 /* The bits of a float, and back: an entry holds a non-negative float's bits, so that integer
  * order is float order and an atomic integer minimum is a float minimum. */
 static inline unsigned ip__float_bits(float f)

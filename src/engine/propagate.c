@@ -65,9 +65,10 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
     float pos[9 * IP_MC_MAX_TRIANGLES];
     int16_t nor[9 * IP_MC_MAX_TRIANGLES];
     uint64_t ids[IP_MC_MAX_TRIANGLES];
-    for (int i = 0; i < 3 * n; i++)
-        memcpy(pos + 3 * i, points[row[i]], sizeof points[0]);
-    uint32_t shows = out->coverage ? ip__coverage_add(out->coverage, pos, (unsigned)n) : 0;
+    uint32_t shows = out->coverage ? ip__coverage_add_indexed(out->coverage,
+                                                              (const float(*)[3])points, row,
+                                                              (unsigned)n)
+                                   : 0;
     if (!out->cull)
         shows = ~0u;
     if (!(shows & ((1u << n) - 1))) {
@@ -217,9 +218,9 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
 ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, unsigned count,
                                const double dir[3], ip_engine_counts *counts)
 {
-    static const int offsets[6][3] = {{-1, 0, 0}, {1, 0, 0},  {0, -1, 0},
-                                      {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
     const uint32_t *dims = p->sampler->dims;
+    ip_visited *visited = p->visited;
+    const uint32_t level = p->sampler->level, shift = visited->edge_shift;
     const double *eye = p->camera->eye;
     double start = ip_now_seconds(), extracting = 0;
     uint64_t extracted = 0;
@@ -251,19 +252,26 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
         counts->triangles += (uint64_t)n;
         unsigned faces = ip__mc_crossed_faces(mc);
         double folded = faces ? foldback_limit(p, q.max_versine) : 0.0;
+        /* The bitmap of the cell's brick, which holds most of its neighbours (it exists: the
+         * cell was marked before it was queued). */
+        atomic_uint_fast64_t *home = NULL;
+        if (faces) {
+            uint32_t brick[3] = {q.cell[0] >> shift, q.cell[1] >> shift, q.cell[2] >> shift};
+            home = (atomic_uint_fast64_t *)ip__visited_bitmap(
+                visited, ip_brick_global_index(visited->layout, level, brick));
+        }
         for (int f = 0; f < 6 && st == IP_OK; f++) {
             if (!(faces & (1u << f)))
                 continue;
-            int64_t c[3];
-            int inside = 1;
-            for (int a = 0; a < 3; a++) {
-                c[a] = (int64_t)q.cell[a] + offsets[f][a];
-                inside &= c[a] >= 0 && c[a] < (int64_t)dims[a] - 1;
-            }
-            if (!inside)
-                continue;
-            uint32_t n3[3] = {(uint32_t)c[0], (uint32_t)c[1], (uint32_t)c[2]};
-            if (ip__visited_test(p->visited, p->sampler->level, n3) ||
+            /* face f: -x, +x, -y, +y, -z, +z */
+            unsigned axis = (unsigned)f >> 1;
+            if (f & 1 ? q.cell[axis] + 2 >= dims[axis] : q.cell[axis] == 0)
+                continue; /* beyond the volume */
+            uint32_t n3[3] = {q.cell[0], q.cell[1], q.cell[2]};
+            n3[axis] += f & 1 ? 1u : UINT32_MAX;
+            int same = home && n3[axis] >> shift == q.cell[axis] >> shift;
+            if ((same ? ip__visited_test_in(visited, home, n3)
+                      : ip__visited_test(visited, level, n3)) ||
                 (clipping && !cell_kept(p, n3)))
                 continue;
             cell_centre(p->sampler, n3, centre, &diagonal);
@@ -278,7 +286,8 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
                 counts->deferred++; /* left unmarked: a ray that seeds it extracts it */
                 continue;
             }
-            int was = ip__visited_mark(p->visited, p->sampler->level, n3);
+            int was = same ? ip__visited_mark_in(visited, home, n3)
+                           : ip__visited_mark(visited, level, n3);
             if (was < 0)
                 st = IP_ERR_NOMEM;
             else if (!was)
