@@ -231,6 +231,12 @@ static int add_projected(ip_coverage *c, const double *x, const double *y, const
     /* the next float above zmax (a positive finite float: its bits plus one) */
     unsigned bits = ip__float_bits((float)zmax) + 1;
     int shows = 0;
+    /* whether the pixels' entries are kept: once for a rectangle within one kept tile (most
+     * are), else pixel by pixel (-1) */
+    int all_kept = !c->reached ? 1
+                   : (x0 ^ x1) >> c->reached_shift || (y0 ^ y1) >> c->reached_shift
+                       ? -1
+                       : kept(c, x0, y0);
     for (int64_t py = y0; py <= y1; py++) {
         double cy = py + 0.5;
         for (int64_t px = x0; px <= x1; px++) {
@@ -241,8 +247,8 @@ static int add_projected(ip_coverage *c, const double *x, const double *y, const
             if (!(e0 >= show[0] && e1 >= show[1] && e2 >= show[2]))
                 continue;
             shows = 1;
-            if (!kept(c, px, py)) /* not expected: a caller's triangles stay in kept tiles */
-                continue;
+            if (all_kept == 0 || (all_kept < 0 && !kept(c, px, py)))
+                continue; /* not expected: a caller's triangles stay in kept tiles */
             if (e0 >= need[0] && e1 >= need[1] && e2 >= need[2]) {
                 size_t at = ip__coverage_index(c, (uint64_t)px, (uint64_t)py);
                 lower(&c->depth[at], bits);

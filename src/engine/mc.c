@@ -22,6 +22,19 @@ unsigned ip__mc_crossed_faces(unsigned mc_case)
     return faces;
 }
 
+/* The index of the lowest set bit of m (not 0). */
+static unsigned lowest_bit(unsigned m)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return (unsigned)__builtin_ctz(m);
+#else
+    unsigned i = 0;
+    while (!(m >> i & 1u))
+        i++;
+    return i;
+#endif
+}
+
 /* Where the surface crosses the edge from v0 (low corner) to v1, as a fraction of the edge.
  * Always measured from the low corner, so the cells sharing an edge compute the same bits. */
 static float edge_fraction(float v0, float v1, float iso)
@@ -124,12 +137,12 @@ unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float l
                                  const float hi[3], float points[12][3])
 {
     unsigned crossed = ip__mc_edge_table[ip__mc_case(values, iso)];
-    for (unsigned e = 0; e < 12; e++)
-        if (crossed >> e & 1u) {
-            float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
-                                    values[ip__mc_edge_corners[e][1]], iso);
-            edge_position(e, t, lo, hi, points[e]);
-        }
+    for (unsigned left = crossed; left; left &= left - 1) {
+        unsigned e = lowest_bit(left);
+        float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
+                                values[ip__mc_edge_corners[e][1]], iso);
+        edge_position(e, t, lo, hi, points[e]);
+    }
     return crossed;
 }
 
@@ -139,12 +152,12 @@ unsigned ip__mc_cell_edge_normals(const float values[8], const float gradients[8
     unsigned crossed = ip__mc_edge_table[ip__mc_case(values, iso)];
     const float inverse_size[3] = {1.0f / (hi[0] - lo[0]), 1.0f / (hi[1] - lo[1]),
                                    1.0f / (hi[2] - lo[2])};
-    for (unsigned e = 0; e < 12; e++)
-        if (crossed >> e & 1u) {
-            float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
-                                    values[ip__mc_edge_corners[e][1]], iso);
-            edge_normal(values, gradients, iso, e, t, inverse_size, normals[e]);
-        }
+    for (unsigned left = crossed; left; left &= left - 1) {
+        unsigned e = lowest_bit(left);
+        float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
+                                values[ip__mc_edge_corners[e][1]], iso);
+        edge_normal(values, gradients, iso, e, t, inverse_size, normals[e]);
+    }
     return crossed;
 }
 
