@@ -301,16 +301,27 @@ uint32_t ip__coverage_add(ip_coverage *c, const float *positions, unsigned count
 
 int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi[3])
 {
+    double centre[3], v[3];
+    for (int a = 0; a < 3; a++)
+        centre[a] = 0.5 * (lo[a] + hi[a]);
+    ip__vec3_sub(centre, c->camera.eye, v);
+    double zc = ip__vec3_dot(v, c->basis.forward);
+    if (!(zc > 0.0))
+        return 0; /* nor is its nearest point beyond the near plane: never hidden */
+    return ip__coverage_hides_seen(c, lo, hi, zc, ip__vec3_dot(v, c->to_x) / zc + c->centre_x,
+                                   ip__vec3_dot(v, c->to_y) / zc + c->centre_y);
+}
+
+int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3],
+                            double zc, double xc, double yc)
+{
     /* The nearest depth first (depth is linear: the centre's less the half extents along the
      * view), then the entry under the centre: most boxes tested are in view, and fail there
      * without the projection of the 8 corners. */
-    double centre[3], v[3], reach = 0;
-    for (int a = 0; a < 3; a++) {
-        centre[a] = 0.5 * (lo[a] + hi[a]);
+    double reach = 0;
+    for (int a = 0; a < 3; a++)
         reach += 0.5 * (hi[a] - lo[a]) * fabs(c->basis.forward[a]);
-    }
-    ip__vec3_sub(centre, c->camera.eye, v);
-    double zc = ip__vec3_dot(v, c->basis.forward), zmin = zc - reach;
+    double zmin = zc - reach;
     if (!(zmin >= c->near_plane * NEAR_MARGIN))
         return 0; /* crosses the near plane or lies behind the eye: never deferred */
     double limit = zmin * (1.0 - BOX_DEPTH_MARGIN);
@@ -318,8 +329,6 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
     unsigned bits = ip__float_bits(f);
     if ((double)f > limit) /* the float below (f > 0: one less in its bits) */
         bits--;
-    double xc = ip__vec3_dot(v, c->to_x) / zc + c->centre_x;
-    double yc = ip__vec3_dot(v, c->to_y) / zc + c->centre_y;
     if (xc >= 0 && xc < c->width && yc >= 0 && yc < c->height &&
         (!kept(c, (int64_t)xc, (int64_t)yc) ||
          atomic_load_explicit(&c->depth[ip__coverage_index(c, (uint64_t)xc, (uint64_t)yc)],

@@ -150,4 +150,10 @@ static inline double ip__coverage_solid(const ip_coverage *c, uint32_t x, uint32
  * in doubt. Any thread. */
 int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi[3]);
 
+/* The same, given the box's centre as the caller has seen it: its view depth zc and image
+ * position (xc, yc), pixels, worked out as the coverage projects (v . to_x / zc + width / 2,
+ * v the centre less the eye; y likewise). */
+int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3],
+                            double zc, double xc, double yc);
+
 #endif
