@@ -334,11 +334,29 @@ int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const doub
          atomic_load_explicit(&c->depth[ip__coverage_index(c, (uint64_t)xc, (uint64_t)yc)],
                               memory_order_relaxed) >= bits))
         return 0;
+    /* The corners' projections: each of (v . to_x, v . to_y, depth), v from the eye, is the
+     * low corner's plus the steps along the axes where the corner is high (the rounding this
+     * differs by is far below BOX_MARGIN). */
+    double v0[3], step[3][3], sum[8][3];
+    ip__vec3_sub(lo, c->camera.eye, v0);
+    sum[0][0] = ip__vec3_dot(v0, c->to_x);
+    sum[0][1] = ip__vec3_dot(v0, c->to_y);
+    sum[0][2] = ip__vec3_dot(v0, c->basis.forward);
+    for (int a = 0; a < 3; a++) {
+        double d = hi[a] - lo[a];
+        step[a][0] = d * c->to_x[a];
+        step[a][1] = d * c->to_y[a];
+        step[a][2] = d * c->basis.forward[a];
+    }
+    for (int k = 1; k < 8; k++) {
+        int a = k & 1 ? 0 : k & 2 ? 1 : 2, from = k & ~(1 << a); /* k less its lowest bit */
+        for (int i = 0; i < 3; i++)
+            sum[k][i] = sum[from][i] + step[a][i];
+    }
     double min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY;
     for (int k = 0; k < 8; k++) {
-        double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
-        double x, y, z;
-        project(c, p, &x, &y, &z);
+        double r = 1.0 / sum[k][2];
+        double x = sum[k][0] * r + c->centre_x, y = sum[k][1] * r + c->centre_y;
         min_x = x < min_x ? x : min_x;
         max_x = x > max_x ? x : max_x;
         min_y = y < min_y ? y : min_y;
