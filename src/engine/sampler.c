@@ -186,9 +186,11 @@ static int gradient_neighbours(ip_sampler *s, const uint32_t cell[3], const ip_b
     }
     /* The brick's own first: a brick read below may take the slot of `b` (the slot then
      * describes the new brick, which sample_at() checks like any other). */
-    for (int i = 0; i < 24; i++)
-        if (held[(i / 3 >> i % 3) & 1][i % 3])
-            out[i] = ip_sample_get(b->samples, s->layout->type, first + (size_t)offsets[i]);
+    for (int c = 0; c < 8; c++)
+        for (int a = 0; a < 3; a++)
+            if (held[(c >> a) & 1][a])
+                out[3 * c + a] =
+                    ip_sample_get(b->samples, s->layout->type, first + (size_t)offsets[3 * c + a]);
     for (int c = 0; c < 8; c++)
         for (int a = 0; a < 3; a++) {
             int h = (c >> a) & 1;
