@@ -66,10 +66,9 @@ static void populate_ahead(ip_mesh *m, uint64_t old_count, uint64_t old_capacity
 {
     if (old_count == 0 && old_capacity > 0 && new_count <= old_capacity)
         return;
-    uint64_t before =
-        old_count == 0 ? old_capacity
-                       : (old_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES *
-                             POPULATE_TRIANGLES;
+    uint64_t before = old_count == 0 ? old_capacity
+                                     : (old_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES *
+                                           POPULATE_TRIANGLES;
     uint64_t after = (new_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES * POPULATE_TRIANGLES;
     before = before < old_capacity ? before : old_capacity;
     after = after < m->capacity ? after : m->capacity;

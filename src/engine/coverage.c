@@ -312,8 +312,8 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
                                    ip__vec3_dot(v, c->to_y) / zc + c->centre_y);
 }
 
-int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3],
-                            double zc, double xc, double yc)
+int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3], double zc,
+                            double xc, double yc)
 {
     /* The nearest depth first (depth is linear: the centre's less the half extents along the
      * view), then the entry under the centre: most boxes tested are in view, and fail there

@@ -16,9 +16,11 @@
  * writes. Boxes and triangles larger than IP_COVERAGE_MAX_PIXELS are simply not used (not
  * deferred, not recorded), which is always safe.
  *
- * Thread-safe: entries are atomic; a write is an atomic minimum (compare-and-swap), a read a
- * relaxed load. Entries only decrease, and every value ever stored is backed by a triangle
- * already in a worker's mesh, so a stale read only makes the test less eager. */
+ * Thread-safe: entries are atomic; a write lowers one with a relaxed load and store (not a
+ * compare-and-swap loop: two threads lowering one entry at once may leave the larger of their
+ * two depths, so an entry may rise, though never above a depth some triangle recorded there),
+ * a read is a relaxed load. Every value ever stored is backed by a triangle already in a
+ * worker's mesh, so a stale or risen entry only makes the tests less eager. */
 #ifndef ISOPROP_COVERAGE_H
 #define ISOPROP_COVERAGE_H
 
@@ -153,7 +155,7 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
 /* The same, given the box's centre as the caller has seen it: its view depth zc and image
  * position (xc, yc), pixels, worked out as the coverage projects (v . to_x / zc + width / 2,
  * v the centre less the eye; y likewise). */
-int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3],
-                            double zc, double xc, double yc);
+int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3], double zc,
+                            double xc, double yc);
 
 #endif

@@ -126,8 +126,9 @@ unsigned ip__mc_cell_edge_points(const float values[8], unsigned mc_case, float 
 
 /*! ip__mc_cell_edge_normals() : the normals ip__mc_triangulate_cell() (same arguments) gives its
  *  vertices, per crossed edge: normals[e] for every edge e whose bit is set in the returned
- *  mask; the others are left alone (`mc_case` as there). With ip__mc_cell_edge_points(), a caller that may drop
- *  some of a cell's triangles works out the normals only for a cell it keeps. */
+ *  mask; the others are left alone (`mc_case` as there). With ip__mc_cell_edge_points(), a
+ *  caller that may drop some of a cell's triangles works out the normals only for a cell it
+ *  keeps. */
 unsigned ip__mc_cell_edge_normals(const float values[8], unsigned mc_case,
                                   const float gradients[8][3], float iso, const float lo[3],
                                   const float hi[3], float normals[12][3]);

@@ -41,8 +41,8 @@ struct ip__prefetcher {
     int plan_done, finished;
     int batch_open, batch_loaded; /* a batch is queued; a load of it read a brick */
     unsigned idle_batches;        /* batches in a row that read none */
-    uint64_t below;         /* ticks before the view began: evictable for a load ahead */
-    unsigned char *planned; /* one flag per brick */
+    uint64_t below;               /* ticks before the view began: evictable for a load ahead */
+    unsigned char *planned;       /* one flag per brick */
     uint64_t queue[QUEUE_SIZE];
     unsigned head, count, hinted; /* loaded up to head, asked of the kernel up to hinted */
     uint64_t hinted_bytes;        /* payload bytes of queue[head .. hinted) */

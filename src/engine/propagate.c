@@ -69,10 +69,10 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
     float pos[9 * IP_MC_MAX_TRIANGLES];
     int16_t nor[9 * IP_MC_MAX_TRIANGLES];
     uint64_t ids[IP_MC_MAX_TRIANGLES];
-    uint32_t shows = out->coverage ? ip__coverage_add_indexed(out->coverage,
-                                                              (const float(*)[3])points, row,
-                                                              (unsigned)n)
-                                   : 0;
+    uint32_t shows =
+        out->coverage
+            ? ip__coverage_add_indexed(out->coverage, (const float(*)[3])points, row, (unsigned)n)
+            : 0;
     if (!out->cull)
         shows = ~0u;
     if (!(shows & ((1u << n) - 1))) {
@@ -312,8 +312,7 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
             else if (!was)
                 st = ip__depth_queue_push(
                     &p->queue,
-                    &(ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)},
-                    depth);
+                    &(ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)}, depth);
         }
         /* the farthest part of a long queue to a worker waiting for cells */
         if (p->share.hungry && extracted % SHARE_STRIDE == 0 &&

@@ -248,6 +248,6 @@ int ip__sampler_cell_normals(ip_sampler *s, const uint32_t cell[3], const float 
             gradients[c][a] = (float)((double)(vh - vl) * inverse[h][a]);
         }
     ip__sampler_cell_box(s, cell, lo, hi);
-    return (int)ip__mc_cell_edge_normals(values, mc_case, (const float(*)[3])gradients, iso, lo,
-                                         hi, normals);
+    return (int)ip__mc_cell_edge_normals(values, mc_case, (const float(*)[3])gradients, iso, lo, hi,
+                                         normals);
 }
