@@ -13,6 +13,7 @@
 #include "check.h"
 #include "coverage.h"
 #include "depth_queue.h"
+#include "mc.h"
 #include "reach.h"
 #include "isoprop/bricker.h"
 #include "isoprop/engine.h"
@@ -574,6 +575,65 @@ static void check_cull_mask(void)
     CHECK_MSG(extra < tested / 100, "cull mask: %u of %u triangles kept beyond the margin", extra,
               tested);
     ip__coverage_free(&c);
+}
+
+/* ip__coverage_add_indexed(), which projects each of a cell's crossings once, against
+ * ip__coverage_add() given the same triangles corner by corner: random cells of one to three
+ * pixels, partly off the image, give the same masks and, entry for entry, the same coverage. */
+static void check_coverage_indexed(void)
+{
+    ip_camera cam;
+    ip_camera_basis basis;
+    ip_coverage by_corner, indexed;
+    test_coverage(&cam, &basis, &by_corner);
+    test_coverage(&cam, &basis, &indexed);
+    uint64_t seed = 4242;
+    unsigned cells = 0, differ = 0, shown = 0;
+    double pixel = 2.0 * 12.0 * basis.tan_half_y / cam.height; /* world units at depth 12 */
+    for (int n = 0; n < 4000; n++) {
+        float values[8];
+        for (int i = 0; i < 8; i++)
+            values[i] = (float)unit_random(&seed);
+        unsigned mc = ip__mc_case(values, 0.5f);
+        int count = ip__mc_triangle_count[mc];
+        if (count == 0)
+            continue;
+        double dir[3], size = pixel * (1.0 + 2.0 * unit_random(&seed));
+        ip_camera_pixel_ray(&basis, &cam, -2 + 68 * unit_random(&seed),
+                            -2 + 52 * unit_random(&seed), dir);
+        double t = 12.0 / (dir[0] * basis.forward[0] + dir[1] * basis.forward[1] +
+                           dir[2] * basis.forward[2]);
+        float lo[3], hi[3], points[12][3], corners[9 * IP_MC_MAX_TRIANGLES];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = (float)(cam.eye[a] + t * dir[a]);
+            hi[a] = (float)(lo[a] + size);
+        }
+        ip__mc_cell_edge_points(values, mc, 0.5f, lo, hi, points);
+        const int8_t *row = ip__mc_triangle_table[mc];
+        for (int i = 0; i < 3 * count; i++)
+            memcpy(corners + 3 * i, points[row[i]], sizeof points[0]);
+        uint32_t a = ip__coverage_add(&by_corner, corners, (unsigned)count);
+        uint32_t b =
+            ip__coverage_add_indexed(&indexed, (const float(*)[3])points, row, (unsigned)count);
+        cells++;
+        differ += a != b;
+        shown += a != 0;
+    }
+    unsigned entries = 0, written = 0, unequal = 0;
+    for (size_t i = 0; i < by_corner.capacity; i++) {
+        unsigned d = atomic_load(&by_corner.depth[i]), s2 = atomic_load(&by_corner.solid[i]);
+        entries++;
+        written += d != ip__float_bits(INFINITY);
+        unequal += d != atomic_load(&indexed.depth[i]) || s2 != atomic_load(&indexed.solid[i]);
+    }
+    printf("test_engine: indexed coverage: %u cells (%u shown), %u masks differ; %u of %u entries "
+           "written, %u differ\n",
+           cells, shown, differ, written, entries, unequal);
+    CHECK(cells > 3000 && shown > cells / 4 && written > entries / 4);
+    CHECK_MSG(differ == 0 && unequal == 0, "indexed coverage: %u masks, %u entries differ", differ,
+              unequal);
+    ip__coverage_free(&by_corner);
+    ip__coverage_free(&indexed);
 }
 
 /* Culling (ip_engine_options.cull) against keeping every triangle, on one thread where cells
@@ -1145,6 +1205,7 @@ int main(void)
     check_lod(dir);
     check_coverage_box_test();
     check_cull_mask();
+    check_coverage_indexed();
     check_depth_queue();
     check_reach_box();
     check_coverage_reach();

@@ -48,8 +48,9 @@ static inline int16_t ip_normal_pack(float v)
     if (!(v == v))
         return 0;
     float s = v * 32767.0f;
-    s = s > 32767.0f ? 32767.0f : s < -32767.0f ? -32767.0f : s;
-    return (int16_t)(s < 0 ? s - 0.5f : s + 0.5f);
+    s = s > 32767.0f ? 32767.0f : s;
+    s = s < -32767.0f ? -32767.0f : s;
+    return (int16_t)(s + (s < 0 ? -0.5f : 0.5f)); /* halves away from zero, truncated */
 }
 
 /*! ip_normal_unpack() : the component a packed value stands for (value / 32767). */

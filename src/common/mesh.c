@@ -58,12 +58,17 @@ ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
  * (or the capacity): the part of [0, that) not populated before this append, which grows the
  * mesh from `old_count` triangles in arrays of `old_capacity`. Appends are small (a cell's triangles),
  * so this is one system call per POPULATE_TRIANGLES triangles or growth of the arrays instead
- * of a page fault per page written (internal.h). */
+ * of a page fault per page written (internal.h). A cleared mesh filled again (the engine's
+ * buffers, every few thousand triangles) populates only what its arrays grow by: the pages it
+ * held were written before, and asking again would walk them all for nothing. */
 static void populate_ahead(ip_mesh *m, uint64_t old_count, uint64_t old_capacity,
                            uint64_t new_count)
 {
-    uint64_t before =
-        (old_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES * POPULATE_TRIANGLES;
+    if (old_count == 0 && old_capacity > 0 && new_count <= old_capacity)
+        return;
+    uint64_t before = old_count == 0 ? old_capacity
+                                     : (old_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES *
+                                           POPULATE_TRIANGLES;
     uint64_t after = (new_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES * POPULATE_TRIANGLES;
     before = before < old_capacity ? before : old_capacity;
     after = after < m->capacity ? after : m->capacity;

@@ -155,27 +155,39 @@ static double max3(double a, double b, double c)
     return m > c ? m : c;
 }
 
-/* The pixel centres (x + 0.5) within [lo - margin, hi + margin], clamped to [0, side). */
+/* The pixel centres (x + 0.5) within [lo - margin, hi + margin], clamped to [0, side); none
+ * when either end is NaN. Rounded through integers, not ceil() and floor(), which are calls on
+ * the x86-64 baseline: both ends are first clamped to [-1, side], where that changes nothing
+ * the clamp to [0, side) would not. */
 static int centre_range(double lo, double hi, double margin, uint32_t side, int64_t *first,
                         int64_t *last)
 {
-    double a = ceil(lo - 0.5 - margin), b = floor(hi - 0.5 + margin);
-    a = a < 0 ? 0 : a;
-    b = b > side - 1.0 ? side - 1.0 : b;
-    if (!(a <= b))
+    double a = lo - 0.5 - margin, b = hi - 0.5 + margin;
+    if (!(a <= b) || !(a <= side) || !(b >= -1.0))
+        return 0; /* NaN, or nothing of [0, side) */
+    a = a < -1.0 ? -1.0 : a;
+    b = b > side ? (double)side : b;
+    int64_t ia = (int64_t)a, ib = (int64_t)b; /* toward zero */
+    ia += (double)ia < a;                     /* ceil(a) */
+    ib -= (double)ib > b;                     /* floor(b) */
+    ia = ia < 0 ? 0 : ia;
+    ib = ib > (int64_t)side - 1 ? (int64_t)side - 1 : ib;
+    if (ia > ib)
         return 0;
-    *first = (int64_t)a;
-    *last = (int64_t)b;
+    *first = ia;
+    *last = ib;
     return 1;
 }
 
-/* Lowers entry i to `bits` (a non-negative float's bits, so integer order is float order). */
+/* Lowers an entry to `bits` (a non-negative float's bits, so integer order is float order).
+ * A plain store, not a compare-and-swap loop: two threads lowering one entry at once may leave
+ * the larger of their two depths, never a depth no triangle recorded. Every entry stays what
+ * coverage.h says (a depth some extracted triangle has there, or farther): a lost lowering
+ * only defers fewer cells and retires fewer rays. */
 static void lower(atomic_uint *entry, unsigned bits)
 {
-    unsigned old = atomic_load_explicit(entry, memory_order_relaxed);
-    while (bits < old && !atomic_compare_exchange_weak_explicit(
-                             entry, &old, bits, memory_order_relaxed, memory_order_relaxed))
-        ;
+    if (bits < atomic_load_explicit(entry, memory_order_relaxed))
+        atomic_store_explicit(entry, bits, memory_order_relaxed);
 }
 
 /* Records one triangle, its corners projected: image x, y (pixels) and view depth z. Returns
@@ -219,6 +231,12 @@ static int add_projected(ip_coverage *c, const double *x, const double *y, const
     /* the next float above zmax (a positive finite float: its bits plus one) */
     unsigned bits = ip__float_bits((float)zmax) + 1;
     int shows = 0;
+    /* whether the pixels' entries are kept: once for a rectangle within one kept tile (most
+     * are), else pixel by pixel (-1) */
+    int all_kept = !c->reached ? 1
+                   : (x0 ^ x1) >> c->reached_shift || (y0 ^ y1) >> c->reached_shift
+                       ? -1
+                       : kept(c, x0, y0);
     for (int64_t py = y0; py <= y1; py++) {
         double cy = py + 0.5;
         for (int64_t px = x0; px <= x1; px++) {
@@ -229,8 +247,8 @@ static int add_projected(ip_coverage *c, const double *x, const double *y, const
             if (!(e0 >= show[0] && e1 >= show[1] && e2 >= show[2]))
                 continue;
             shows = 1;
-            if (!kept(c, px, py)) /* not expected: a caller's triangles stay in kept tiles */
-                continue;
+            if (all_kept == 0 || (all_kept < 0 && !kept(c, px, py)))
+                continue; /* not expected: a caller's triangles stay in kept tiles */
             if (e0 >= need[0] && e1 >= need[1] && e2 >= need[2]) {
                 size_t at = ip__coverage_index(c, (uint64_t)px, (uint64_t)py);
                 lower(&c->depth[at], bits);
@@ -238,6 +256,30 @@ static int add_projected(ip_coverage *c, const double *x, const double *y, const
                     lower(&c->solid[at], bits);
             }
         }
+    }
+    return shows;
+}
+
+uint32_t ip__coverage_add_indexed(ip_coverage *c, const float points[][3], const int8_t *corners,
+                                  unsigned count)
+{
+    double px[32], py[32], pz[32];
+    uint32_t projected = 0, shows = 0;
+    for (unsigned t = 0; t < count; t++) {
+        double x[3], y[3], z[3];
+        for (int k = 0; k < 3; k++) {
+            unsigned i = (unsigned)corners[3 * t + k];
+            IP_ASSERT(i < 32);
+            if (!(projected >> i & 1)) {
+                double p[3] = {points[i][0], points[i][1], points[i][2]};
+                project(c, p, &px[i], &py[i], &pz[i]);
+                projected |= UINT32_C(1) << i;
+            }
+            x[k] = px[i];
+            y[k] = py[i];
+            z[k] = pz[i];
+        }
+        shows |= (uint32_t)add_projected(c, x, y, z) << t;
     }
     return shows;
 }
@@ -259,35 +301,62 @@ uint32_t ip__coverage_add(ip_coverage *c, const float *positions, unsigned count
 
 int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi[3])
 {
+    double centre[3], v[3];
+    for (int a = 0; a < 3; a++)
+        centre[a] = 0.5 * (lo[a] + hi[a]);
+    ip__vec3_sub(centre, c->camera.eye, v);
+    double zc = ip__vec3_dot(v, c->basis.forward);
+    if (!(zc > 0.0))
+        return 0; /* nor is its nearest point beyond the near plane: never hidden */
+    return ip__coverage_hides_seen(c, lo, hi, zc, ip__vec3_dot(v, c->to_x) / zc + c->centre_x,
+                                   ip__vec3_dot(v, c->to_y) / zc + c->centre_y);
+}
+
+int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3], double zc,
+                            double xc, double yc)
+{
     /* The nearest depth first (depth is linear: the centre's less the half extents along the
      * view), then the entry under the centre: most boxes tested are in view, and fail there
      * without the projection of the 8 corners. */
-    double centre[3], v[3], reach = 0;
-    for (int a = 0; a < 3; a++) {
-        centre[a] = 0.5 * (lo[a] + hi[a]);
+    double reach = 0;
+    for (int a = 0; a < 3; a++)
         reach += 0.5 * (hi[a] - lo[a]) * fabs(c->basis.forward[a]);
-    }
-    ip__vec3_sub(centre, c->camera.eye, v);
-    double zc = ip__vec3_dot(v, c->basis.forward), zmin = zc - reach;
+    double zmin = zc - reach;
     if (!(zmin >= c->near_plane * NEAR_MARGIN))
         return 0; /* crosses the near plane or lies behind the eye: never deferred */
     double limit = zmin * (1.0 - BOX_DEPTH_MARGIN);
     float f = (float)limit;
-    if ((double)f > limit)
-        f = nextafterf(f, 0.0f);
     unsigned bits = ip__float_bits(f);
-    double xc = ip__vec3_dot(v, c->to_x) / zc + c->centre_x;
-    double yc = ip__vec3_dot(v, c->to_y) / zc + c->centre_y;
+    if ((double)f > limit) /* the float below (f > 0: one less in its bits) */
+        bits--;
     if (xc >= 0 && xc < c->width && yc >= 0 && yc < c->height &&
         (!kept(c, (int64_t)xc, (int64_t)yc) ||
          atomic_load_explicit(&c->depth[ip__coverage_index(c, (uint64_t)xc, (uint64_t)yc)],
                               memory_order_relaxed) >= bits))
         return 0;
+    /* The corners' projections: each of (v . to_x, v . to_y, depth), v from the eye, is the
+     * low corner's plus the steps along the axes where the corner is high (the rounding this
+     * differs by is far below BOX_MARGIN). */
+    double v0[3], step[3][3], sum[8][3];
+    ip__vec3_sub(lo, c->camera.eye, v0);
+    sum[0][0] = ip__vec3_dot(v0, c->to_x);
+    sum[0][1] = ip__vec3_dot(v0, c->to_y);
+    sum[0][2] = ip__vec3_dot(v0, c->basis.forward);
+    for (int a = 0; a < 3; a++) {
+        double d = hi[a] - lo[a];
+        step[a][0] = d * c->to_x[a];
+        step[a][1] = d * c->to_y[a];
+        step[a][2] = d * c->basis.forward[a];
+    }
+    for (int k = 1; k < 8; k++) {
+        int a = k & 1 ? 0 : k & 2 ? 1 : 2, from = k & ~(1 << a); /* k less its lowest bit */
+        for (int i = 0; i < 3; i++)
+            sum[k][i] = sum[from][i] + step[a][i];
+    }
     double min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY;
     for (int k = 0; k < 8; k++) {
-        double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
-        double x, y, z;
-        project(c, p, &x, &y, &z);
+        double r = 1.0 / sum[k][2];
+        double x = sum[k][0] * r + c->centre_x, y = sum[k][1] * r + c->centre_y;
         min_x = x < min_x ? x : min_x;
         max_x = x > max_x ? x : max_x;
         min_y = y < min_y ? y : min_y;

@@ -16,9 +16,11 @@
  * writes. Boxes and triangles larger than IP_COVERAGE_MAX_PIXELS are simply not used (not
  * deferred, not recorded), which is always safe.
  *
- * Thread-safe: entries are atomic; a write is an atomic minimum (compare-and-swap), a read a
- * relaxed load. Entries only decrease, and every value ever stored is backed by a triangle
- * already in a worker's mesh, so a stale read only makes the test less eager. */
+ * Thread-safe: entries are atomic; a write lowers one with a relaxed load and store (not a
+ * compare-and-swap loop: two threads lowering one entry at once may leave the larger of their
+ * two depths, so an entry may rise, though never above a depth some triangle recorded there),
+ * a read is a relaxed load. Every value ever stored is backed by a triangle already in a
+ * worker's mesh, so a stale or risen entry only makes the tests less eager. */
 #ifndef ISOPROP_COVERAGE_H
 #define ISOPROP_COVERAGE_H
 
@@ -102,6 +104,12 @@ void ip__coverage_free(ip_coverage *c);
  * IP_COVERAGE_SHOW_MARGIN of it. A triangle without its bit records nothing. */
 uint32_t ip__coverage_add(ip_coverage *c, const float *positions, unsigned count);
 
+/* The same for triangles given as indices into `points` (world units): corner k of triangle t
+ * is points[corners[3 * t + k]], each index below 32. Each point is projected once, however
+ * many triangles share it (a cell's edge crossings). */
+uint32_t ip__coverage_add_indexed(ip_coverage *c, const float points[][3], const int8_t *corners,
+                                  unsigned count);
+
 /* The bits of a float, and back: an entry holds a non-negative float's bits, so that integer
  * order is float order and an atomic integer minimum is a float minimum. */
 static inline unsigned ip__float_bits(float f)
@@ -143,5 +151,11 @@ static inline double ip__coverage_solid(const ip_coverage *c, uint32_t x, uint32
  * centre it may cover the recorded surface is nearer than the box's nearest point. 0 when
  * in doubt. Any thread. */
 int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi[3]);
+
+/* The same, given the box's centre as the caller has seen it: its view depth zc and image
+ * position (xc, yc), pixels, worked out as the coverage projects (v . to_x / zc + width / 2,
+ * v the centre less the eye; y likewise). */
+int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3], double zc,
+                            double xc, double yc);
 
 #endif

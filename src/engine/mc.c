@@ -22,6 +22,19 @@ unsigned ip__mc_crossed_faces(unsigned mc_case)
     return faces;
 }
 
+/* The index of the lowest set bit of m (not 0). */
+static unsigned lowest_bit(unsigned m)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return (unsigned)__builtin_ctz(m);
+#else
+    unsigned i = 0;
+    while (!(m >> i & 1u))
+        i++;
+    return i;
+#endif
+}
+
 /* Where the surface crosses the edge from v0 (low corner) to v1, as a fraction of the edge.
  * Always measured from the low corner, so the cells sharing an edge compute the same bits. */
 static float edge_fraction(float v0, float v1, float iso)
@@ -107,9 +120,9 @@ int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], 
     /* Each crossing is shared by up to 4 triangles of the cell: computed once. */
     float points[12][3], normals[12][3];
     unsigned mc_case = ip__mc_case(values, iso);
-    if (!ip__mc_cell_edge_points(values, iso, lo, hi, points))
+    if (!ip__mc_cell_edge_points(values, mc_case, iso, lo, hi, points))
         return 0;
-    ip__mc_cell_edge_normals(values, gradients, iso, lo, hi, normals);
+    ip__mc_cell_edge_normals(values, mc_case, gradients, iso, lo, hi, normals);
     const int8_t *row = ip__mc_triangle_table[mc_case];
     int count = ip__mc_triangle_count[mc_case];
     for (int i = 0; i < 3 * count; i++)
@@ -120,31 +133,32 @@ int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], 
     return count;
 }
 
-unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float lo[3],
-                                 const float hi[3], float points[12][3])
+unsigned ip__mc_cell_edge_points(const float values[8], unsigned mc_case, float iso,
+                                 const float lo[3], const float hi[3], float points[12][3])
 {
-    unsigned crossed = ip__mc_edge_table[ip__mc_case(values, iso)];
-    for (unsigned e = 0; e < 12; e++)
-        if (crossed >> e & 1u) {
-            float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
-                                    values[ip__mc_edge_corners[e][1]], iso);
-            edge_position(e, t, lo, hi, points[e]);
-        }
+    unsigned crossed = ip__mc_edge_table[mc_case & 0xFFu];
+    for (unsigned left = crossed; left; left &= left - 1) {
+        unsigned e = lowest_bit(left);
+        float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
+                                values[ip__mc_edge_corners[e][1]], iso);
+        edge_position(e, t, lo, hi, points[e]);
+    }
     return crossed;
 }
 
-unsigned ip__mc_cell_edge_normals(const float values[8], const float gradients[8][3], float iso,
-                                  const float lo[3], const float hi[3], float normals[12][3])
+unsigned ip__mc_cell_edge_normals(const float values[8], unsigned mc_case,
+                                  const float gradients[8][3], float iso, const float lo[3],
+                                  const float hi[3], float normals[12][3])
 {
-    unsigned crossed = ip__mc_edge_table[ip__mc_case(values, iso)];
+    unsigned crossed = ip__mc_edge_table[mc_case & 0xFFu];
     const float inverse_size[3] = {1.0f / (hi[0] - lo[0]), 1.0f / (hi[1] - lo[1]),
                                    1.0f / (hi[2] - lo[2])};
-    for (unsigned e = 0; e < 12; e++)
-        if (crossed >> e & 1u) {
-            float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
-                                    values[ip__mc_edge_corners[e][1]], iso);
-            edge_normal(values, gradients, iso, e, t, inverse_size, normals[e]);
-        }
+    for (unsigned left = crossed; left; left &= left - 1) {
+        unsigned e = lowest_bit(left);
+        float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
+                                values[ip__mc_edge_corners[e][1]], iso);
+        edge_normal(values, gradients, iso, e, t, inverse_size, normals[e]);
+    }
     return crossed;
 }
 

@@ -118,17 +118,20 @@ int ip__mc_triangulate_cell(const float values[8], const float gradients[8][3], 
 /*! ip__mc_cell_edge_points() : the points where the surface crosses the cell's edges, exactly
  *  where ip__mc_triangulate_cell() (same values, iso, lo, hi) puts its vertices, without
  *  the normals: points[e] is set for every edge e whose bit is set in the returned mask
- *  (ip__mc_edge_table of the cell's case); the others are left alone. A cell's triangles are
- *  then the rows of ip__mc_triangle_table. No allocation. */
-unsigned ip__mc_cell_edge_points(const float values[8], float iso, const float lo[3],
-                                 const float hi[3], float points[12][3]);
+ *  (ip__mc_edge_table of the cell's case, `mc_case`, which is ip__mc_case(values, iso)); the
+ *  others are left alone. A cell's triangles are then the rows of ip__mc_triangle_table. No
+ *  allocation. */
+unsigned ip__mc_cell_edge_points(const float values[8], unsigned mc_case, float iso,
+                                 const float lo[3], const float hi[3], float points[12][3]);
 
 /*! ip__mc_cell_edge_normals() : the normals ip__mc_triangulate_cell() (same arguments) gives its
  *  vertices, per crossed edge: normals[e] for every edge e whose bit is set in the returned
- *  mask; the others are left alone. With ip__mc_cell_edge_points(), a caller that may drop
- *  some of a cell's triangles works out the normals only for a cell it keeps. */
-unsigned ip__mc_cell_edge_normals(const float values[8], const float gradients[8][3], float iso,
-                                  const float lo[3], const float hi[3], float normals[12][3]);
+ *  mask; the others are left alone (`mc_case` as there). With ip__mc_cell_edge_points(), a
+ *  caller that may drop some of a cell's triangles works out the normals only for a cell it
+ *  keeps. */
+unsigned ip__mc_cell_edge_normals(const float values[8], unsigned mc_case,
+                                  const float gradients[8][3], float iso, const float lo[3],
+                                  const float hi[3], float normals[12][3]);
 
 /*! ip__mc_ray_hits_cell() : whether the ray ray_origin + t * ray_dir, t >= 0, hits a triangle of
  *  the cell's triangulation (either side), as produced by ip__mc_triangulate_cell with the same

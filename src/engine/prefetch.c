@@ -19,6 +19,7 @@
 #define PLAN_BATCH 32                                         /* rays planned at once */
 #define QUEUE_SIZE (PLAN_BATCH * IP__PREFETCH_RAY_BRICKS * 7) /* their bricks and neighbours */
 #define WAIT_NS 1000000L /* how long the reader sleeps when it is far enough ahead */
+#define IDLE_BATCHES 4   /* batches in a row that load nothing: the view's bricks are in */
 
 struct ip__prefetcher {
     ip_cache *cache;
@@ -38,8 +39,10 @@ struct ip__prefetcher {
     ip_ray_order order; /* where the plan has got to */
     uint32_t plan_last_level;
     int plan_done, finished;
-    uint64_t below;         /* ticks before the view began: evictable for a load ahead */
-    unsigned char *planned; /* one flag per brick */
+    int batch_open, batch_loaded; /* a batch is queued; a load of it read a brick */
+    unsigned idle_batches;        /* batches in a row that read none */
+    uint64_t below;               /* ticks before the view began: evictable for a load ahead */
+    unsigned char *planned;       /* one flag per brick */
     uint64_t queue[QUEUE_SIZE];
     unsigned head, count, hinted; /* loaded up to head, asked of the kernel up to hinted */
     uint64_t hinted_bytes;        /* payload bytes of queue[head .. hinted) */
@@ -113,6 +116,15 @@ static unsigned ray_bricks(ip__prefetcher *p, uint32_t x, uint32_t y, uint64_t *
  * as it may go, -1 when the plan is done. */
 static int plan(ip__prefetcher *p)
 {
+    /* Planning walks the summaries for every ray (a third thread beside the workers): it
+     * stops for the view once IDLE_BATCHES batches in a row found every brick resident, as a
+     * warm cache does from the start. The workers still load whatever they miss. */
+    if (p->batch_open) {
+        p->idle_batches = p->batch_loaded ? 0 : p->idle_batches + 1;
+        p->batch_open = p->batch_loaded = 0;
+        if (p->idle_batches >= IDLE_BATCHES)
+            p->plan_done = 1;
+    }
     uint64_t claimed = atomic_load(p->view.claimed);
     uint64_t at = ip__ray_order_position(&p->order);
     if (at < claimed) { /* the workers have these rays: their bricks are theirs to load */
@@ -140,6 +152,7 @@ static int plan(ip__prefetcher *p)
         enqueue(p, found[i]);
     for (unsigned i = 0; i < n; i++)
         enqueue_neighbours(p, found[i]);
+    p->batch_open = rays > 0;
     return rays > 0 ? 1 : p->plan_done ? -1 : 0;
 }
 
@@ -180,8 +193,10 @@ static void load_next(ip__prefetcher *p)
     ip_brick_entry be;
     ip_store_brick_entry(p->store, g, &be);
     p->hinted_bytes -= be.stored_size; /* hint() has passed it: hinted > head */
-    if (ip__cache_prefetch_brick(p->cache, g, p->below) == IP__PREFETCH_FULL)
+    ip__prefetch_outcome got = ip__cache_prefetch_brick(p->cache, g, p->below);
+    if (got == IP__PREFETCH_FULL)
         p->finished = 1; /* the budget holds this view's bricks: stop until the next view */
+    p->batch_loaded |= got == IP__PREFETCH_LOADED;
 }
 
 /* The reader's work on the current view, until it is done or asked to stop. */
@@ -294,6 +309,8 @@ void ip__prefetcher_begin(ip__prefetcher *p, const ip__prefetch_view *view)
     p->hinted_bytes = 0;
     p->plan_done = 0;
     p->finished = 0;
+    p->batch_open = p->batch_loaded = 0;
+    p->idle_batches = 0;
     p->below = ip__cache_tick_now(p->cache);
 }
 

@@ -19,9 +19,11 @@
  * ip__cache_prefetch_brick() (cache_prefetch.h: within the budget, evicting only bricks not
  * pinned since the view began).
  *
- * When it stops: the plan is done; the cache has no room left for it (the budget is full of
- * bricks of this view, or pinned: it stays idle until the next view); the engine is cancelled;
- * or the engine pauses it (a new view, destroy). It runs between steps too.
+ * When it stops: the plan is done; 4 batches of the plan in a row loaded nothing (the view's
+ * bricks are resident, as in a warm cache: planning would only take a core from the workers,
+ * who load what they still miss themselves); the cache has no room left for it (the budget is
+ * full of bricks of this view, or pinned: it stays idle until the next view); the engine is
+ * cancelled; or the engine pauses it (a new view, destroy). It runs between steps too.
  *
  * Threads: the functions are called by the engine's driving thread only; the reader thread
  * reads the view only between resume and pause, and writes nothing but the cache. */

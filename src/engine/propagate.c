@@ -34,6 +34,10 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     p->sin_foldback = sin(options->foldback_degrees * DEG);
     p->clip = (ip_clip){options->clip, options->clip_count};
     p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
+    for (int a = 0; a < 3; a++) {
+        p->to_x[a] = p->basis.right[a] * 0.5 * camera->width / p->basis.tan_half_x;
+        p->to_y[a] = -p->basis.up[a] * 0.5 * camera->height / p->basis.tan_half_y;
+    }
     p->near_distance = near_distance;
     p->far_distance = far_distance;
     ip__depth_queue_init(&p->queue);
@@ -59,22 +63,23 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
      * drawn at no pixel centre dropped, before the normals (the gradients) are worked out. */
     float lo[3], hi[3], points[12][3], normals[12][3];
     ip__sampler_cell_box(s, cell, lo, hi);
-    ip__mc_cell_edge_points(values, iso, lo, hi, points);
+    ip__mc_cell_edge_points(values, *mc_case, iso, lo, hi, points);
     const int8_t *row = ip__mc_triangle_table[*mc_case];
     int n = ip__mc_triangle_count[*mc_case];
     float pos[9 * IP_MC_MAX_TRIANGLES];
     int16_t nor[9 * IP_MC_MAX_TRIANGLES];
     uint64_t ids[IP_MC_MAX_TRIANGLES];
-    for (int i = 0; i < 3 * n; i++)
-        memcpy(pos + 3 * i, points[row[i]], sizeof points[0]);
-    uint32_t shows = out->coverage ? ip__coverage_add(out->coverage, pos, (unsigned)n) : 0;
+    uint32_t shows =
+        out->coverage
+            ? ip__coverage_add_indexed(out->coverage, (const float(*)[3])points, row, (unsigned)n)
+            : 0;
     if (!out->cull)
         shows = ~0u;
     if (!(shows & ((1u << n) - 1))) {
         *culled += (uint64_t)n;
         return 0;
     }
-    if (ip__sampler_cell_normals(s, cell, values, iso, normals) < 0) {
+    if (ip__sampler_cell_normals(s, cell, values, *mc_case, iso, normals) < 0) {
         *st = s->status;
         return -1;
     }
@@ -133,30 +138,42 @@ static void cell_centre(const ip_sampler *s, const uint32_t cell[3], double cent
 }
 
 /* Whether any part of the cell may project into the propagator's window of the image (a
- * conservative test on its centre, widened by the cell's projected size and a 2-pixel margin). Sets
- * *pixels to the cell's projected size (its diagonal, in pixels) when it does. */
-static int in_frustum(const ip_propagator *p, const double centre[3], double diagonal,
-                      double *pixels)
+ * conservative test on its centre, widened by the cell's projected size and a 2-pixel margin).
+ * `v` is the centre less the eye, `depth` its view depth. Sets the centre's image position
+ * (pixels) and *pixels to the cell's projected size (its diagonal, in pixels) when it does. */
+static int in_frustum(const ip_propagator *p, const double v[3], double depth, double diagonal,
+                      double *x, double *y, double *pixels)
 {
-    double x, y, depth;
-    if (!ip_camera_project(&p->basis, p->camera, centre, &x, &y, &depth))
+    if (!(depth > 0.0))
         return 0;
+    *x = ip__vec3_dot(v, p->to_x) / depth + 0.5 * p->camera->width;
+    *y = ip__vec3_dot(v, p->to_y) / depth + 0.5 * p->camera->height;
     *pixels = diagonal / depth * p->pixel_scale;
     double margin = 2.0 + *pixels;
-    return x >= p->window[0] - margin && x <= p->window[2] + margin && y >= p->window[1] - margin &&
-           y <= p->window[3] + margin;
+    return *x >= p->window[0] - margin && *x <= p->window[2] + margin &&
+           *y >= p->window[1] - margin && *y <= p->window[3] + margin;
 }
 
 /* Whether surface extracted so far hides the cell at every pixel centre it may cover. A cell
  * smaller than MIN_TEST_PIXELS on screen is tested through the aligned block of 2^k cells
  * around it that is not (up to 2^MAX_TEST_SHIFT cells a side): a box under a pixel holds no
  * pixel centre and could never be found hidden, and whatever hides the block hides every cell
- * in it (its pixel centres are among the block's, its nearest point no nearer). */
-static int hidden(const ip_propagator *p, const uint32_t cell[3], double pixels)
+ * in it (its pixel centres are among the block's, its nearest point no nearer). The cell's
+ * centre seen from the eye (in_frustum()) is the box's when it is tested alone. */
+static int hidden(const ip_propagator *p, const uint32_t cell[3], double pixels, double depth,
+                  double x, double y)
 {
     unsigned k = 0;
     while (k < MAX_TEST_SHIFT && pixels * (double)(1u << k) < MIN_TEST_PIXELS)
         k++;
+    if (k == 0) {
+        double lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = p->sampler->world[a][cell[a]];
+            hi[a] = p->sampler->world[a][cell[a] + 1];
+        }
+        return ip__coverage_hides_seen(p->out.coverage, lo, hi, depth, x, y);
+    }
     double lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
         uint32_t first = cell[a] >> k << k, end = first + (1u << k),
@@ -217,9 +234,9 @@ ip_status ip__propagate(ip_propagator *p, const uint32_t seed[3], const double d
 ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, unsigned count,
                                const double dir[3], ip_engine_counts *counts)
 {
-    static const int offsets[6][3] = {{-1, 0, 0}, {1, 0, 0},  {0, -1, 0},
-                                      {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
     const uint32_t *dims = p->sampler->dims;
+    ip_visited *visited = p->visited;
+    const uint32_t level = p->sampler->level, shift = visited->edge_shift;
     const double *eye = p->camera->eye;
     double start = ip_now_seconds(), extracting = 0;
     uint64_t extracted = 0;
@@ -251,41 +268,51 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
         counts->triangles += (uint64_t)n;
         unsigned faces = ip__mc_crossed_faces(mc);
         double folded = faces ? foldback_limit(p, q.max_versine) : 0.0;
+        /* The bitmap of the cell's brick, which holds most of its neighbours (it exists: the
+         * cell was marked before it was queued). */
+        atomic_uint_fast64_t *home = NULL;
+        if (faces) {
+            uint32_t brick[3] = {q.cell[0] >> shift, q.cell[1] >> shift, q.cell[2] >> shift};
+            home = (atomic_uint_fast64_t *)ip__visited_bitmap(
+                visited, ip_brick_global_index(visited->layout, level, brick));
+        }
         for (int f = 0; f < 6 && st == IP_OK; f++) {
             if (!(faces & (1u << f)))
                 continue;
-            int64_t c[3];
-            int inside = 1;
-            for (int a = 0; a < 3; a++) {
-                c[a] = (int64_t)q.cell[a] + offsets[f][a];
-                inside &= c[a] >= 0 && c[a] < (int64_t)dims[a] - 1;
-            }
-            if (!inside)
-                continue;
-            uint32_t n3[3] = {(uint32_t)c[0], (uint32_t)c[1], (uint32_t)c[2]};
-            if (ip__visited_test(p->visited, p->sampler->level, n3) ||
+            /* face f: -x, +x, -y, +y, -z, +z */
+            unsigned axis = (unsigned)f >> 1;
+            if (f & 1 ? q.cell[axis] + 2 >= dims[axis] : q.cell[axis] == 0)
+                continue; /* beyond the volume */
+            uint32_t n3[3] = {q.cell[0], q.cell[1], q.cell[2]};
+            n3[axis] += f & 1 ? 1u : UINT32_MAX;
+            int same = home && n3[axis] >> shift == q.cell[axis] >> shift;
+            if ((same ? ip__visited_test_in(visited, home, n3)
+                      : ip__visited_test(visited, level, n3)) ||
                 (clipping && !cell_kept(p, n3)))
                 continue;
             cell_centre(p->sampler, n3, centre, &diagonal);
             double v[3];
             ip__vec3_sub(centre, eye, v);
-            double distance = ip__vec3_length(v), a = versine(dir, v, distance), pixels;
-            if (a > p->cutoff_versine || a < folded || !in_frustum(p, centre, diagonal, &pixels))
+            double distance = ip__vec3_length(v), a = versine(dir, v, distance);
+            if (a > p->cutoff_versine || a < folded)
+                continue;
+            double depth = ip__vec3_dot(v, p->basis.forward), x, y, pixels;
+            if (!in_frustum(p, v, depth, diagonal, &x, &y, &pixels))
                 continue;
             if (distance < p->near_distance || distance >= p->far_distance)
                 continue; /* another level's band: the resolution boundary */
-            if (p->out.coverage && hidden(p, n3, pixels)) {
+            if (p->out.coverage && hidden(p, n3, pixels, depth, x, y)) {
                 counts->deferred++; /* left unmarked: a ray that seeds it extracts it */
                 continue;
             }
-            int was = ip__visited_mark(p->visited, p->sampler->level, n3);
+            int was = same ? ip__visited_mark_in(visited, home, n3)
+                           : ip__visited_mark(visited, level, n3);
             if (was < 0)
                 st = IP_ERR_NOMEM;
             else if (!was)
                 st = ip__depth_queue_push(
                     &p->queue,
-                    &(ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)},
-                    ip__vec3_dot(v, p->basis.forward));
+                    &(ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)}, depth);
         }
         /* the farthest part of a long queue to a worker waiting for cells */
         if (p->share.hungry && extracted % SHARE_STRIDE == 0 &&

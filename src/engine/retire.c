@@ -41,12 +41,13 @@ static unsigned float_below(double v)
  * its pixel centres (widened by TILE_SLACK) is tested against the octree down to the cells, at
  * every level, up to D's stop (ip__engine_cast_ray()) plus a cell's reach along the view
  * (ip__beam_settled()). Where every active cell there is extracted, the rays of the tile whose
- * solid entry is no deeper than D would find only extracted cells, now or later (entries only
- * decrease and cells stay extracted), and do nothing: their walks can be left out (the tile's
- * `depth` is raised to D), and the mesh is the one the walks would leave. Where some may not
- * be, the test learns the depth short of which the beam is settled: the rays whose stop lies
- * short of it are left out in the same way (a lower `depth`), and the tile's other rays need
- * not look short of it (its `from`): the cells there are extracted or inactive. */
+ * solid entry is no deeper than D would find only extracted cells, now or later (cells stay
+ * extracted; a ray whose entry reads deeper than D when it comes, as two writers racing may leave
+ * it (coverage.h), is simply not left out), and do nothing: their walks can be left out (the tile's
+ * `depth` is raised to D), and the mesh is the one the walks would leave. Where some may not be,
+ * the test learns the depth short of which the beam is settled: the rays whose stop lies short of
+ * it are left out in the same way (a lower `depth`), and the tile's other rays need not look short
+ * of it (its `from`): the cells there are extracted or inactive. */
 static void test_tile(ip_engine_worker *w, uint32_t tx, uint32_t ty, ip_engine_tile *t)
 {
     ip_engine *e = w->engine;

@@ -153,40 +153,52 @@ static int sample_at(ip_sampler *s, const ip_brick *near, const int64_t p[3], fl
 /* The sample next to corner c of `cell` outwards along axis a (one below the cell where the
  * corner is on its low side, one above where it is on its high side), clamped to the volume:
  * with the corner across the cell it gives the central difference of the corner's gradient.
- * Gathered as out[3 * c + a]: from the cell's brick when it holds all 24 (one typed read),
- * else sample by sample from whichever brick holds each. Returns 0 after a failure. */
+ * Gathered as out[3 * c + a]: from the cell's brick when it holds all 24 (one typed read).
+ * A cell on a face of its brick (about one in six) reads those the brick holds the same way,
+ * and only the others, beyond that face, sample by sample from whichever brick holds each.
+ * Returns 0 after a failure. */
 static int gradient_neighbours(ip_sampler *s, const uint32_t cell[3], const ip_brick *b,
                                float out[24])
 {
     ptrdiff_t stride[3] = {1, (ptrdiff_t)b->extent[0],
                            (ptrdiff_t)b->extent[0] * (ptrdiff_t)b->extent[1]};
-    ptrdiff_t below[3], above[3];
+    ptrdiff_t step[2][3]; /* to the sample below (0) or above (1) along each axis */
+    int held[2][3];       /* whether the brick holds it */
     int inside = 1;
     for (int a = 0; a < 3; a++) {
         /* clamped at the volume's faces: the corner itself, which the brick holds */
         int low = cell[a] > 0, high = cell[a] + 2 < s->dims[a];
-        below[a] = low ? -stride[a] : 0;
-        above[a] = high ? stride[a] : 0;
-        inside &= (!low || cell[a] > b->origin[a]) &&
-                  (!high || cell[a] + 2 < b->origin[a] + b->extent[a]);
+        step[0][a] = low ? -stride[a] : 0;
+        step[1][a] = high ? stride[a] : 0;
+        held[0][a] = !low || cell[a] > b->origin[a];
+        held[1][a] = !high || cell[a] + 2 < b->origin[a] + b->extent[a];
+        inside &= held[0][a] & held[1][a];
     }
+    ptrdiff_t corners[8], offsets[24];
+    ip__corner_offsets(b, corners);
+    for (int c = 0; c < 8; c++)
+        for (int a = 0; a < 3; a++)
+            offsets[3 * c + a] = corners[c] + step[(c >> a) & 1][a];
+    size_t first = ip__sample_index(b, cell);
     if (inside) {
-        ptrdiff_t corners[8], offsets[24];
-        ip__corner_offsets(b, corners);
-        for (int c = 0; c < 8; c++)
-            for (int a = 0; a < 3; a++)
-                offsets[3 * c + a] = corners[c] + ((c >> a) & 1 ? above[a] : below[a]);
-        ip__samples_gather(b->samples, s->layout->type, ip__sample_index(b, cell), offsets, 24,
-                           out);
+        ip__samples_gather(b->samples, s->layout->type, first, offsets, 24, out);
         return 1;
     }
-    /* A brick read here may take the slot of `b`: the slot then describes the new brick,
-     * which sample_at() checks like any other, so `b` stays safe to pass until a failure. */
+    /* The brick's own first: a brick read below may take the slot of `b` (the slot then
+     * describes the new brick, which sample_at() checks like any other). */
+    for (int c = 0; c < 8; c++)
+        for (int a = 0; a < 3; a++)
+            if (held[(c >> a) & 1][a])
+                out[3 * c + a] =
+                    ip_sample_get(b->samples, s->layout->type, first + (size_t)offsets[3 * c + a]);
     for (int c = 0; c < 8; c++)
         for (int a = 0; a < 3; a++) {
+            int h = (c >> a) & 1;
+            if (held[h][a])
+                continue;
             int64_t p[3] = {(int64_t)cell[0] + (c & 1), (int64_t)cell[1] + ((c >> 1) & 1),
                             (int64_t)cell[2] + ((c >> 2) & 1)};
-            p[a] += (c >> a) & 1 ? 1 : -1;
+            p[a] += h ? 1 : -1;
             if (!sample_at(s, b, p, &out[3 * c + a]))
                 return 0;
         }
@@ -216,24 +228,26 @@ int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, floa
 }
 
 int ip__sampler_cell_normals(ip_sampler *s, const uint32_t cell[3], const float values[8],
-                             float iso, float normals[12][3])
+                             unsigned mc_case, float iso, float normals[12][3])
 {
     float outer[24], gradients[8][3], lo[3], hi[3];
     const ip_brick *b = ip__sampler_cell_brick(s, cell);
     if (!b || !gradient_neighbours(s, cell, b, outer))
         return -1;
-    double d[2][3]; /* per axis, the span around the cell's low and high corners */
+    double inverse[2][3]; /* per axis, 1 / the span around the cell's low and high corners */
     for (int a = 0; a < 3; a++)
-        for (int h = 0; h < 2; h++)
-            d[h][a] = span(s, a, (int64_t)cell[a] + h);
+        for (int h = 0; h < 2; h++) {
+            double d = span(s, a, (int64_t)cell[a] + h);
+            inverse[h][a] = d > 0 ? 1.0 / d : 0.0;
+        }
     for (int c = 0; c < 8; c++)
         for (int a = 0; a < 3; a++) {
             int h = (c >> a) & 1;
             float across = values[c ^ (1 << a)];
             float vh = h ? outer[3 * c + a] : across, vl = h ? across : outer[3 * c + a];
-            gradients[c][a] = d[h][a] > 0 ? (float)((vh - vl) / d[h][a]) : 0.0f;
+            gradients[c][a] = (float)((double)(vh - vl) * inverse[h][a]);
         }
     ip__sampler_cell_box(s, cell, lo, hi);
-    return (int)ip__mc_cell_edge_normals(values, (const float(*)[3])gradients, iso, lo, hi,
+    return (int)ip__mc_cell_edge_normals(values, mc_case, (const float(*)[3])gradients, iso, lo, hi,
                                          normals);
 }

@@ -111,7 +111,7 @@ void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float lo[
 int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, float values[8],
                           unsigned *mc_case);
 int ip__sampler_cell_normals(ip_sampler *s, const uint32_t cell[3], const float values[8],
-                             float iso, float normals[12][3]);
+                             unsigned mc_case, float iso, float normals[12][3]);
 
 /* 1 when the range [lo, hi] (over cell corners) may hold an active cell for `iso`: some corner
  * >= iso and some corner < iso. */

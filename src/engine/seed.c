@@ -124,7 +124,7 @@ static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc, co
 {
     static const float zero[3] = {0, 0, 0};
     float points[12][3];
-    unsigned crossed = ip__mc_cell_edge_points(values, s->iso, zero, size, points);
+    unsigned crossed = ip__mc_cell_edge_points(values, mc, s->iso, zero, size, points);
     /* each crossing point projected once, though up to 4 triangles share it */
     double p[12][2];
     unsigned behind = 0;

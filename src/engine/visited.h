@@ -70,6 +70,16 @@ static inline int ip__visited_test_in(const ip_visited *v, const atomic_uint_fas
     return (atomic_load_explicit(&m[bit >> 6], memory_order_relaxed) >> (bit & 63)) & 1;
 }
 
+/* Marks `cell` (of the level and brick whose bitmap is `m`, not NULL); returns 1 if it was
+ * already marked, 0 if this call marked it: ip__visited_mark() without finding the bitmap. */
+static inline int ip__visited_mark_in(const ip_visited *v, atomic_uint_fast64_t *m,
+                                      const uint32_t cell[3])
+{
+    uint64_t bit = ip__visited_cell_bit(v, cell);
+    uint_fast64_t mask = (uint_fast64_t)1 << (bit & 63);
+    return (atomic_fetch_or(&m[bit >> 6], mask) & mask) != 0;
+}
+
 /* 1 when part `part` of the brick whose bitmap is `m` (ip__visited_bitmap()) is marked
  * settled (ip__visited_mark_part()). */
 static inline int ip__visited_part_in(const ip_visited *v, const atomic_uint_fast64_t *m,
