@@ -467,9 +467,22 @@ static void test_populated_growth(void)
                     m.cells[t] == t * 7;
     CHECK_MSG(same, "%llu triangles appended, %llu kept", (unsigned long long)total,
               (unsigned long long)m.triangle_count);
+    /* the populated mark: ahead of the triangles, within the arrays, past a clear */
+    uint64_t populated = m.populated;
+    CHECK_MSG(populated >= total && populated <= m.capacity && populated % 16384 == 0,
+              "%llu of %llu triangles populated, %llu allocated", (unsigned long long)populated,
+              (unsigned long long)total, (unsigned long long)m.capacity);
     ip_mesh_clear(&m);
     REQUIRE(ip_mesh_append(&m, p, n, cells, 1) == IP_OK);
     CHECK(m.triangle_count == 1 && m.cells[0] == cells[0]);
+    for (uint64_t i = 1; i < total; i++) /* filled again to the same size: nothing asked again */
+        REQUIRE(ip_mesh_append(&m, p, n, cells, 1) == IP_OK);
+    CHECK(m.populated == populated);
+    /* grown: the mark holds the moved triangles, then goes ahead of them again */
+    for (uint64_t before = m.capacity; m.capacity == before;)
+        REQUIRE(ip_mesh_append(&m, p, n, cells, 1) == IP_OK);
+    CHECK(m.populated > m.triangle_count && m.populated <= m.triangle_count + 16384 &&
+          m.populated <= m.capacity);
 
     unsigned char *buffer = malloc(3 << 20);
     REQUIRE(buffer);

@@ -90,15 +90,11 @@ static void check_view(ip_cache *cache, const char *axis, float iso)
 }
 
 /* 1 when cell c of level 0 is active for iso (a marching-cubes case other than 0 and 255). */
-static int cell_active(ip_sampler *sampler, const ip_layout *l, float iso, const uint32_t c[3])
+static int cell_active(ip_sampler *sampler, float iso, const uint32_t c[3])
 {
-    const ip_brick *b = ip__sampler_cell_brick(sampler, c);
-    REQUIRE(b);
-    ptrdiff_t corners[8];
     float values[8];
-    ip__corner_offsets(b, corners);
-    ip__cell_values(b, l->type, corners, c, values);
-    unsigned mc = ip__mc_case(values, iso);
+    unsigned mc;
+    REQUIRE(ip__sampler_cell_case(sampler, c, iso, values, &mc) == 1);
     return mc != 0 && mc != 255;
 }
 
@@ -113,7 +109,7 @@ static void mark_active(ip_visited *v, ip_sampler *sampler, const ip_layout *l, 
             for (uint32_t x = 0; x + 1 < d[0]; x++) {
                 uint32_t c[3] = {x, y, z};
                 if ((x * 73856093u ^ y * 19349663u ^ z * 83492791u) % 256 < share &&
-                    cell_active(sampler, l, iso, c))
+                    cell_active(sampler, iso, c))
                     REQUIRE(ip__visited_mark(v, 0, c) >= 0);
             }
 }
@@ -144,7 +140,7 @@ static double settled_depth(const ip_beam *beam, const ip_visited *v, ip_sampler
                               n[2] * (n[2] >= 0 ? hi[2] : lo[2]) <
                           0;
                 }
-                if (!out && !ip__visited_test(v, 0, c) && cell_active(sampler, l, iso, c))
+                if (!out && !ip__visited_test(v, 0, c) && cell_active(sampler, iso, c))
                     least = near;
             }
     return least;

@@ -717,6 +717,10 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     if (o->scale_unit && !o->scale_bar)
         return tool_usage_error("isorender", "--scale-unit needs --scale-bar");
+    /* Triangles no pixel centre shows are culled unless the mesh is written out, or drawn with
+     * multisampling, which samples more than pixel centres (or --cull says otherwise). */
+    if (o->common.cull < 0)
+        o->common.cull = !o->mesh && o->aa <= 1;
     ip_error why;
     if (o->axes && ip_overlay_axes_check(o->common.width, o->common.height, &why) != IP_OK)
         return tool_usage_error("isorender", "--%s", why.message); /* "--axes: the triad..." */
@@ -777,20 +781,13 @@ static void step_report(const run *r, tool_progress *bar, uint64_t limit)
     }
 }
 
-/* Whether the run keeps every triangle it extracts (no culling, ip_engine_options.cull): the
- * mesh is written out, or drawn with multisampling, which samples more than pixel centres. */
-static int keeps_whole_mesh(const run *r)
-{
-    return r->o.mesh != NULL || r->o.aa > 1;
-}
-
 /* The engine with the command line's options, cancelled by a signal; made once. */
 static int create_engine(run *r, ip_error *err)
 {
     if (r->engine)
         return 0;
     ip_engine_options eo;
-    tool_engine_options(&r->o.common, keeps_whole_mesh(r), &eo);
+    tool_engine_options(&r->o.common, &eo);
     if (ip_engine_create(r->cache, &eo, &r->engine, err) != IP_OK)
         return -1;
     tool_signals_cancel_engine(r->engine);
@@ -1158,14 +1155,13 @@ static void json_counts(FILE *f, void *user)
         fprintf(f, ", \"pixel_size\": %.17g, \"pixels\": %.17g}", r->bar.pixel_size, r->bar.pixels);
     }
     if (!r->o.full) {
-        ip_engine_options eo;
-        tool_engine_options(&r->o.common, keeps_whole_mesh(r), &eo);
         fprintf(f,
                 ", \"occlusion\": %s, \"deferred_cells\": %llu, \"retired_rays\": %llu, "
                 "\"ray_nodes\": %llu, \"prefetch\": %s, \"cull\": %s, \"culled_triangles\": %llu",
                 r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred,
                 (unsigned long long)r->totals.retired, (unsigned long long)r->totals.nodes,
-                r->o.common.prefetch ? "true" : "false", eo.occlusion && eo.cull ? "true" : "false",
+                r->o.common.prefetch ? "true" : "false",
+                r->o.common.occlusion && r->o.common.cull ? "true" : "false",
                 (unsigned long long)r->totals.culled);
     }
     fprintf(f, ", \"warnings\": [");

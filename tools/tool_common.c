@@ -569,7 +569,7 @@ void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t he
     o->cache_bytes = ip_cache_default_budget();
 }
 
-void tool_engine_options(const tool_view_options *o, int whole, ip_engine_options *eo)
+void tool_engine_options(const tool_view_options *o, ip_engine_options *eo)
 {
     ip_engine_options_default(eo);
     eo->cutoff_degrees = o->cutoff;
@@ -579,7 +579,7 @@ void tool_engine_options(const tool_view_options *o, int whole, ip_engine_option
     eo->pixel_error = o->pixel_error;
     eo->occlusion = o->occlusion;
     eo->prefetch = o->prefetch;
-    eo->cull = o->cull < 0 ? !whole : o->cull;
+    eo->cull = o->cull > 0;
     eo->clip_count = o->clip_count;
     memcpy(eo->clip, o->clip, sizeof eo->clip);
 }

@@ -135,7 +135,7 @@ typedef struct tool_view_options {
     double pixel_error;
     int occlusion; /* --occlusion on|off */
     int prefetch;  /* --prefetch on|off */
-    int cull; /* --cull on|off; -1 (the default): the program decides (tool_engine_options()) */
+    int cull;      /* --cull on|off; -1 when not given, until the program settles its default */
     unsigned clip_count;                    /* --clip SPEC, repeatable */
     ip_clip_plane clip[IP_MAX_CLIP_PLANES]; /* world units (tool_parse_clip()) */
     uint64_t cache_bytes;
@@ -170,10 +170,9 @@ void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t he
  * is not one (an unknown axis, a bad number, a zero normal). */
 int tool_parse_clip(const char *text, ip_clip_plane *plane);
 
-/* The engine options the shared options ask for (the clipping planes too). Triangles are
- * culled (ip_engine_options.cull) as --cull says, or when it was not given, unless `whole`:
- * the program writes the mesh out or draws it with multisampling. */
-void tool_engine_options(const tool_view_options *o, int whole, ip_engine_options *eo);
+/* The engine options the shared options ask for (the clipping planes too; triangles culled as
+ * o->cull, which the program has settled by then). */
+void tool_engine_options(const tool_view_options *o, ip_engine_options *eo);
 
 /* ---- the command line, parsed from tables ----
  *

@@ -36,7 +36,8 @@
  * behind that depth (nothing there can show at its pixel), and the rays of an 8 x 8 pixel tile
  * whose pixels are all so covered are retired without a walk once a test of the tile's beam
  * against the octree finds every active cell those walks could enter extracted already
- * (`retired`); the guarantee above is unchanged (the arguments are in cast.c and retire.c). 8
+ * (`retired`), as are at once those of a tile the image of no brick holding the isovalue
+ * reaches; the guarantee above is unchanged (the arguments are in cast.c and retire.c). 8
  * bytes a pixel.
  *
  * Culling (options.cull, on by default, with occlusion): a triangle no pixel centre of the

@@ -37,7 +37,8 @@ typedef struct ip_mesh {
     uint64_t *cells;  /* per triangle: ip_cell_id() of the cell it came from; NULL
                                 unless with_cells */
     uint64_t triangle_count;
-    uint64_t capacity; /* triangles allocated */
+    uint64_t capacity;  /* triangles allocated */
+    uint64_t populated; /* triangles whose pages appends have had populated (ip_mesh_append()) */
     int with_cells; /* keep cell ids: set before the first append, or by ip_mesh_init_with_cells() */
 } ip_mesh;
 

@@ -131,7 +131,7 @@ class Mesh(ctypes.Structure):
     """ip_mesh (mesh.h)"""
     _fields_ = [("positions", ctypes.POINTER(c_float)), ("normals", ctypes.POINTER(c_int16)),
                 ("cells", ctypes.POINTER(c_uint64)), ("triangle_count", c_uint64),
-                ("capacity", c_uint64), ("with_cells", c_int)]
+                ("capacity", c_uint64), ("populated", c_uint64), ("with_cells", c_int)]
 
 
 # Every mirror, by its C name: what the layout test checks.

@@ -41,6 +41,8 @@ ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
      * large blocks are moved by remapping pages, not copied, so the cost stays low. */
     uint64_t cap =
         ip__array_capacity(m->capacity, triangles, 1024, 9 * sizeof(float), IP_ARRAY_HALF);
+    /* Moved arrays hold their triangles; what was populated past them may not have moved. */
+    m->populated = m->populated < m->triangle_count ? m->populated : m->triangle_count;
     /* the arrays that grew keep the old contents when a later one cannot */
     ip_status st = cap ? ip__array_resize(&m->positions, cap, 9 * sizeof(float)) : IP_ERR_NOMEM;
     if (st == IP_OK)
@@ -54,30 +56,24 @@ ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
 
 #define POPULATE_TRIANGLES 16384 /* the arrays are populated this many triangles ahead */
 
-/* Populates the arrays' pages up to the next multiple of POPULATE_TRIANGLES past `new_count`
- * (or the capacity): the part of [0, that) not populated before this append, which grows the
- * mesh from `old_count` triangles in arrays of `old_capacity`. Appends are small (a cell's triangles),
- * so this is one system call per POPULATE_TRIANGLES triangles or growth of the arrays instead
- * of a page fault per page written (internal.h). A cleared mesh filled again (the engine's
- * buffers, every few thousand triangles) populates only what its arrays grow by: the pages it
- * held were written before, and asking again would walk them all for nothing. */
-static void populate_ahead(ip_mesh *m, uint64_t old_count, uint64_t old_capacity,
-                           uint64_t new_count)
+/* Populates the arrays' pages from m->populated up to the next multiple of POPULATE_TRIANGLES
+ * past `new_count` (or the capacity). Appends are small (a cell's triangles), so this is one
+ * system call per POPULATE_TRIANGLES triangles instead of a page fault per page written
+ * (internal.h). The mark outlives ip_mesh_clear(): a mesh filled again (the engine's buffers,
+ * every few thousand triangles; its mesh, every view) does not ask for its pages again, which
+ * would walk them all for nothing. */
+static void populate_ahead(ip_mesh *m, uint64_t new_count)
 {
-    if (old_count == 0 && old_capacity > 0 && new_count <= old_capacity)
-        return;
-    uint64_t before = old_count == 0 ? old_capacity
-                                     : (old_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES *
-                                           POPULATE_TRIANGLES;
     uint64_t after = (new_count + POPULATE_TRIANGLES - 1) / POPULATE_TRIANGLES * POPULATE_TRIANGLES;
-    before = before < old_capacity ? before : old_capacity;
     after = after < m->capacity ? after : m->capacity;
+    uint64_t before = m->populated;
     if (after <= before)
         return;
     ip__memory_populate(m->positions + 9 * before, (after - before) * 9 * sizeof(float));
     ip__memory_populate(m->normals + 9 * before, (after - before) * 9 * sizeof(int16_t));
     if (m->with_cells)
         ip__memory_populate(m->cells + before, (after - before) * sizeof(uint64_t));
+    m->populated = after;
 }
 
 ip_status ip_mesh_append(ip_mesh *m, const float *positions, const int16_t *normals,
@@ -85,11 +81,10 @@ ip_status ip_mesh_append(ip_mesh *m, const float *positions, const int16_t *norm
 {
     if (count == 0)
         return IP_OK; /* the arrays of an empty mesh may be NULL */
-    uint64_t old_count = m->triangle_count, old_capacity = m->capacity;
     ip_status st = ip_mesh_reserve(m, m->triangle_count + count);
     if (st != IP_OK)
         return st;
-    populate_ahead(m, old_count, old_capacity, old_count + count);
+    populate_ahead(m, m->triangle_count + count);
     memcpy(m->positions + 9 * m->triangle_count, positions, count * 9 * sizeof(float));
     memcpy(m->normals + 9 * m->triangle_count, normals, count * 9 * sizeof(int16_t));
     if (m->with_cells)

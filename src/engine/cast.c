@@ -58,21 +58,18 @@ static double stop_depth(const ip_engine *e, uint32_t x, uint32_t y)
  * matters: the plain coverage entry also counts centres on a triangle's edge, where snapping may
  * uncover a silhouette and show the surface behind, which this ray must then still find.
  *
-  * The walk starts at view depth `from` (t = from / cos), where its tile's beam was found settled
-  * short of it (test_tile() in retire.c): every active cell the ray could enter before is extracted
-  * already, and would only end the walk there (a cell hit squarely) or be passed over. Walking on
-  * from `from` then finds what the full walk finds past it and at most more cells behind an
-  * extracted one, all of the true surface: each is extracted or propagated from as a walk would
-  * (the image stays exact: a pixel's own first-hit cell is either extracted already or found). */
+ * The walk starts at view depth `from` (t = from / cos), where its tile's beam was found settled
+ * short of it (test_tile() in retire.c): every active cell the ray could enter before is extracted
+ * already, and would only end the walk there (a cell hit squarely) or be passed over. Walking on
+ * from `from` then finds what the full walk finds past it and at most more cells behind an
+ * extracted one, all of the true surface: each is extracted or propagated from as a walk would
+ * (the image stays exact: a pixel's own first-hit cell is either extracted already or found). */
 ip_status ip__engine_cast_ray(ip_engine_worker *w, uint32_t x, uint32_t y, double from)
 {
     ip_engine *e = w->engine;
     double dir[3];
     uint32_t cells[IP_SEED_MAX_CELLS][3];
     w->counts.rays++;
-    if (e->options.occlusion &&
-        !e->reached[(size_t)(y >> TILE_SHIFT) * e->tiles_x + (x >> TILE_SHIFT)])
-        return IP_OK; /* no active brick shows in its tile (reach_view()): nothing to find */
     ip_camera_pixel_ray(&e->basis, &e->camera, x + 0.5, y + 0.5, dir);
     double z = stop_depth(e, x, y), cos = ip__vec3_dot(dir, e->basis.forward);
     for (uint32_t k = 0; k < e->levels_used; k++) {

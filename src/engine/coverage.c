@@ -67,13 +67,7 @@ ip_status ip__coverage_prepare(ip_coverage *c, const ip_camera *camera, const do
     c->width = camera->width;
     c->tiles_x = tiles_x;
     c->height = camera->height;
-    /* ip_camera_project() with one division */
-    for (int a = 0; a < 3; a++) {
-        c->to_x[a] = c->basis.right[a] * 0.5 * c->width / c->basis.tan_half_x;
-        c->to_y[a] = -c->basis.up[a] * 0.5 * c->height / c->basis.tan_half_y;
-    }
-    c->centre_x = 0.5 * c->width;
-    c->centre_y = 0.5 * c->height;
+    ip__image_axes_of(&c->basis, c->width, c->height, &c->axes);
     c->reached = NULL;
     return IP_OK;
 }
@@ -139,8 +133,8 @@ static void project(const ip_coverage *c, const double p[3], double *x, double *
     ip__vec3_sub(p, c->camera.eye, v);
     *z = ip__vec3_dot(v, c->basis.forward);
     double r = 1.0 / *z;
-    *x = ip__vec3_dot(v, c->to_x) * r + c->centre_x;
-    *y = ip__vec3_dot(v, c->to_y) * r + c->centre_y;
+    *x = ip__vec3_dot(v, c->axes.to_x) * r + c->axes.centre_x;
+    *y = ip__vec3_dot(v, c->axes.to_y) * r + c->axes.centre_y;
 }
 
 static double min3(double a, double b, double c)
@@ -286,16 +280,11 @@ uint32_t ip__coverage_add_indexed(ip_coverage *c, const float points[][3], const
 
 uint32_t ip__coverage_add(ip_coverage *c, const float *positions, unsigned count)
 {
+    static const int8_t corners[3] = {0, 1, 2};
     uint32_t shows = 0;
-    for (unsigned t = 0; t < count; t++) {
-        double x[3], y[3], z[3];
-        for (int k = 0; k < 3; k++) {
-            const float *f = positions + 9 * t + 3 * k;
-            double p[3] = {f[0], f[1], f[2]};
-            project(c, p, &x[k], &y[k], &z[k]);
-        }
-        shows |= (uint32_t)add_projected(c, x, y, z) << t;
-    }
+    for (unsigned t = 0; t < count; t++)
+        shows |= ip__coverage_add_indexed(c, (const float(*)[3])(positions + 9 * t), corners, 1)
+                 << t;
     return shows;
 }
 
@@ -308,8 +297,9 @@ int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi
     double zc = ip__vec3_dot(v, c->basis.forward);
     if (!(zc > 0.0))
         return 0; /* nor is its nearest point beyond the near plane: never hidden */
-    return ip__coverage_hides_seen(c, lo, hi, zc, ip__vec3_dot(v, c->to_x) / zc + c->centre_x,
-                                   ip__vec3_dot(v, c->to_y) / zc + c->centre_y);
+    double xc, yc;
+    ip__image_position(&c->axes, v, zc, &xc, &yc);
+    return ip__coverage_hides_seen(c, lo, hi, zc, xc, yc);
 }
 
 int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3], double zc,
@@ -339,13 +329,13 @@ int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const doub
      * differs by is far below BOX_MARGIN). */
     double v0[3], step[3][3], sum[8][3];
     ip__vec3_sub(lo, c->camera.eye, v0);
-    sum[0][0] = ip__vec3_dot(v0, c->to_x);
-    sum[0][1] = ip__vec3_dot(v0, c->to_y);
+    sum[0][0] = ip__vec3_dot(v0, c->axes.to_x);
+    sum[0][1] = ip__vec3_dot(v0, c->axes.to_y);
     sum[0][2] = ip__vec3_dot(v0, c->basis.forward);
     for (int a = 0; a < 3; a++) {
         double d = hi[a] - lo[a];
-        step[a][0] = d * c->to_x[a];
-        step[a][1] = d * c->to_y[a];
+        step[a][0] = d * c->axes.to_x[a];
+        step[a][1] = d * c->axes.to_y[a];
         step[a][2] = d * c->basis.forward[a];
     }
     for (int k = 1; k < 8; k++) {
@@ -356,7 +346,7 @@ int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const doub
     double min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY;
     for (int k = 0; k < 8; k++) {
         double r = 1.0 / sum[k][2];
-        double x = sum[k][0] * r + c->centre_x, y = sum[k][1] * r + c->centre_y;
+        double x = sum[k][0] * r + c->axes.centre_x, y = sum[k][1] * r + c->axes.centre_y;
         min_x = x < min_x ? x : min_x;
         max_x = x > max_x ? x : max_x;
         min_y = y < min_y ? y : min_y;

@@ -30,6 +30,7 @@
 
 #include "isoprop/camera.h"
 #include "isoprop/status.h"
+#include "vec3.h"
 
 #define IP_COVERAGE_MAX_PIXELS 1024 /* the largest box or triangle (bounding pixels) used */
 
@@ -46,12 +47,39 @@
 #define IP_COVERAGE_TILE_SHIFT 3
 #define IP_COVERAGE_TILE (1u << IP_COVERAGE_TILE_SHIFT)
 
+/* The image projection the coverage and propagation share: a point v (world units, from the
+ * eye) at view depth z > 0 shows at image x = v . to_x / z + centre_x (pixels), y likewise.
+ * One definition, so that a caller of ip__coverage_hides_seen() gets the very bits that
+ * ip__coverage_hides() would work out. */
+typedef struct ip_image_axes {
+    double to_x[3], to_y[3];
+    double centre_x, centre_y;
+} ip_image_axes;
+
+static inline void ip__image_axes_of(const ip_camera_basis *b, uint32_t width, uint32_t height,
+                                     ip_image_axes *ax)
+{
+    for (int a = 0; a < 3; a++) {
+        ax->to_x[a] = b->right[a] * 0.5 * width / b->tan_half_x;
+        ax->to_y[a] = -b->up[a] * 0.5 * height / b->tan_half_y;
+    }
+    ax->centre_x = 0.5 * width;
+    ax->centre_y = 0.5 * height;
+}
+
+/* Image position (pixels) of v (from the eye) at view depth z > 0 (ip_image_axes). */
+static inline void ip__image_position(const ip_image_axes *ax, const double v[3], double z,
+                                      double *x, double *y)
+{
+    *x = ip__vec3_dot(v, ax->to_x) / z + ax->centre_x;
+    *y = ip__vec3_dot(v, ax->to_y) / z + ax->centre_y;
+}
+
 typedef struct ip_coverage {
     ip_camera camera;
     ip_camera_basis basis;
     double near_plane, far_plane; /* the renderers' clip planes for the volume's box */
-    double to_x[3], to_y[3];      /* image x, y = dot(p - eye, to_x or to_y) / depth + centre */
-    double centre_x, centre_y;
+    ip_image_axes axes;
     uint32_t width, height;
     uint32_t tiles_x;   /* tiles of IP_COVERAGE_TILE pixels a side in a row of the image */
     atomic_uint *depth; /* per pixel, tile by tile (ip__coverage_index()): the bits of a float
@@ -153,8 +181,8 @@ static inline double ip__coverage_solid(const ip_coverage *c, uint32_t x, uint32
 int ip__coverage_hides(const ip_coverage *c, const double lo[3], const double hi[3]);
 
 /* The same, given the box's centre as the caller has seen it: its view depth zc and image
- * position (xc, yc), pixels, worked out as the coverage projects (v . to_x / zc + width / 2,
- * v the centre less the eye; y likewise). */
+ * position (xc, yc), pixels, by ip__image_position() with the coverage's axes (v the centre
+ * less the eye). */
 int ip__coverage_hides_seen(const ip_coverage *c, const double lo[3], const double hi[3], double zc,
                             double xc, double yc);
 

@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "array.h"
 #include "depth_queue.h"
 
 #define NONE UINT32_MAX
@@ -19,8 +20,7 @@ void ip__depth_queue_init(ip_depth_queue *q)
 
 void ip__depth_queue_free(ip_depth_queue *q)
 {
-    free(q->cells);
-    free(q->next);
+    free(q->slots);
     ip__depth_queue_init(q);
 }
 
@@ -49,23 +49,12 @@ static uint32_t new_slot(ip_depth_queue *q)
 {
     if (q->free != NONE) {
         uint32_t s = q->free;
-        q->free = q->next[s];
+        q->free = q->slots[s].next;
         return s;
     }
-    if (q->used == q->capacity) {
-        uint32_t grown = q->capacity ? q->capacity * 2 : 4096;
-        if (grown <= q->capacity || grown == NONE)
-            return NONE;
-        ip_queued_cell *cells = realloc(q->cells, grown * sizeof *cells);
-        if (!cells)
-            return NONE;
-        q->cells = cells;
-        uint32_t *next = realloc(q->next, grown * sizeof *next);
-        if (!next)
-            return NONE;
-        q->next = next;
-        q->capacity = grown;
-    }
+    if (q->used == NONE || ip__array_reserve(&q->slots, &q->capacity, (uint64_t)q->used + 1,
+                                             sizeof *q->slots, 4096) != IP_OK)
+        return NONE;
     return q->used++;
 }
 
@@ -75,8 +64,7 @@ ip_status ip__depth_queue_push(ip_depth_queue *q, const ip_queued_cell *cell, do
     if (s == NONE)
         return IP_ERR_NOMEM;
     uint32_t b = bucket_of(q, depth);
-    q->cells[s] = *cell;
-    q->next[s] = q->head[b];
+    q->slots[s] = (ip_depth_slot){*cell, q->head[b]};
     q->head[b] = s;
     q->first = b < q->first ? b : q->first;
     q->last = b > q->last ? b : q->last;
@@ -88,9 +76,9 @@ ip_status ip__depth_queue_push(ip_depth_queue *q, const ip_queued_cell *cell, do
 static void take(ip_depth_queue *q, uint32_t b, ip_queued_cell *cell)
 {
     uint32_t s = q->head[b];
-    *cell = q->cells[s];
-    q->head[b] = q->next[s];
-    q->next[s] = q->free;
+    *cell = q->slots[s].cell;
+    q->head[b] = q->slots[s].next;
+    q->slots[s].next = q->free;
     q->free = s;
     q->count--;
 }

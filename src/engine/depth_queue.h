@@ -21,10 +21,15 @@ typedef struct ip_queued_cell {
                         * predecessors (angles compare as their versines, without atan2) */
 } ip_queued_cell;
 
+typedef struct ip_depth_slot {
+    ip_queued_cell cell;
+    uint32_t next; /* the next slot in its bucket, or on the free list */
+} ip_depth_slot;
+
 typedef struct ip_depth_queue {
-    ip_queued_cell *cells;           /* slots */
-    uint32_t *next;                  /* per slot: the next in its bucket, or on the free list */
-    uint32_t capacity, used;         /* slots allocated; slots ever handed out */
+    ip_depth_slot *slots;
+    uint64_t capacity;               /* slots allocated */
+    uint32_t used;                   /* slots ever handed out */
     uint32_t free;                   /* the first free slot (UINT32_MAX: none) */
     uint32_t head[IP_DEPTH_BUCKETS]; /* per bucket: its newest slot (UINT32_MAX: empty) */
     uint32_t first, last;            /* no bucket outside [first, last] holds a cell */

@@ -202,7 +202,7 @@ static void clear_view(void *user, unsigned index)
 
 /* The tiles that some brick holding the isovalue (at a level the view uses) may show in
  * (ip__reach_tiles()). The others are settled from the start with no bound (clear_view()): no ray
- * of theirs can meet an active cell, so none is walked (ip__engine_cast_ray()) and no beam is
+ * of theirs can meet an active cell, so none is walked (ip__engine_retire()) and no beam is
  * tested for them; and no triangle can show there, so the coverage keeps no entries for them
  * (ip__coverage_reach()): they are neither cleared nor, in a fresh process, touched at all. */
 static void reach_view(ip_engine *e)
@@ -449,14 +449,13 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
     atomic_store(&e->step_stopped, 0);
     e->step_deadline = max_seconds > 0 ? ip_now_seconds() + max_seconds : 0;
     /* A small step shares its rays between the threads (each ray may propagate a large part
-     * of the surface): a batch of ceil(rays / threads), one thread per ray at most. Every
-     * worker runs: those left without rays help the others' propagations (ip__engine_help()). */
-    unsigned threads = e->threads, batch_threads = threads;
+     * of the surface): a batch of ceil(rays / threads), one ray when there are fewer rays than
+     * threads. Every worker runs: those left without rays help the others' propagations
+     * (ip__engine_help()). */
+    unsigned threads = e->threads;
     e->step_batch = RAY_BATCH;
-    if (max_rays && max_rays < (uint64_t)threads * RAY_BATCH) {
-        batch_threads = max_rays < threads ? (unsigned)max_rays : threads;
-        e->step_batch = (unsigned)((max_rays + batch_threads - 1) / batch_threads);
-    }
+    if (max_rays && max_rays < (uint64_t)threads * RAY_BATCH)
+        e->step_batch = (unsigned)((max_rays + threads - 1) / threads);
     e->working = threads;
     for (unsigned t = 0; t < threads; t++) {
         ip_engine_worker *w = &e->workers[t];

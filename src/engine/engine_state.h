@@ -98,8 +98,7 @@ struct ip_engine {
     uint32_t levels_used;                   /* levels 0 .. levels_used - 1 have a distance band */
     double lod_distance[IP_MAX_LEVELS + 1]; /* D[k]; D[levels_used] = infinity */
     double cell_reach[IP_MAX_LEVELS];       /* a level-k cell's extent along the view (world) */
-    /* With occlusion: bulk retirement of the rays of 8 x 8 pixel tiles (see ip__engine_retire()).
-     */
+    /* With occlusion: bulk retirement of the rays of 8 x 8 tiles (ip__engine_retire()) */
     ip_engine_tile *tiles;
     unsigned char *reached; /* per tile: some active brick may show in it (reach_view()) */
     size_t tile_capacity;
@@ -157,8 +156,9 @@ void ip__engine_leave_range(ip_engine *e, ip_engine_worker *w);
 
 /* retire.c */
 
-/* 1 when ray r may be retired without a walk (counted): tile_retires(), in the Z-order
- * levels, with occlusion. Otherwise 0, with *from where its walk may start (0: at the eye). */
+/* 1 when ray r may be retired without a walk (counted), with occlusion: tile_retires() in the
+ * Z-order levels, before them only a tile no active brick shows in. Otherwise 0, with *from
+ * where its walk may start (0: at the eye). */
 int ip__engine_retire(ip_engine_worker *w, const ip_order_ray *r, double *from);
 
 /* When the worker's iterator stands at an aligned block of BLOCK_CELLS positions of the Z-order

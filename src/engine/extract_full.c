@@ -22,7 +22,6 @@ static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip
     uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
     ip_status st = IP_OK;
     ip_cell_output out = {mesh, NULL, 0}; /* every triangle, none culled */
-    uint64_t culled = 0;
     for (uint32_t i = 0; i < per * per * per && st == IP_OK; i++) {
         if (!ip__range_active(ranges[2 * i], ranges[2 * i + 1], iso))
             continue;
@@ -42,7 +41,7 @@ static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip
                         !ip__clip_keeps_samples(clip, l, level, cell, far))
                         continue;
                     unsigned mc;
-                    int n = ip__extract_cell(s, &out, cell, iso, &mc, &culled, &st);
+                    int n = ip__extract_cell(s, &out, cell, iso, &mc, &c->culled, &st);
                     if (n < 0)
                         break;
                     if (mc != 0 && mc != 255)

@@ -34,10 +34,7 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     p->sin_foldback = sin(options->foldback_degrees * DEG);
     p->clip = (ip_clip){options->clip, options->clip_count};
     p->pixel_scale = 0.5 * camera->height / p->basis.tan_half_y;
-    for (int a = 0; a < 3; a++) {
-        p->to_x[a] = p->basis.right[a] * 0.5 * camera->width / p->basis.tan_half_x;
-        p->to_y[a] = -p->basis.up[a] * 0.5 * camera->height / p->basis.tan_half_y;
-    }
+    ip__image_axes_of(&p->basis, camera->width, camera->height, &p->axes);
     p->near_distance = near_distance;
     p->far_distance = far_distance;
     ip__depth_queue_init(&p->queue);
@@ -146,8 +143,7 @@ static int in_frustum(const ip_propagator *p, const double v[3], double depth, d
 {
     if (!(depth > 0.0))
         return 0;
-    *x = ip__vec3_dot(v, p->to_x) / depth + 0.5 * p->camera->width;
-    *y = ip__vec3_dot(v, p->to_y) / depth + 0.5 * p->camera->height;
+    ip__image_position(&p->axes, v, depth, x, y);
     *pixels = diagonal / depth * p->pixel_scale;
     double margin = 2.0 + *pixels;
     return *x >= p->window[0] - margin && *x <= p->window[2] + margin &&
@@ -166,14 +162,6 @@ static int hidden(const ip_propagator *p, const uint32_t cell[3], double pixels,
     unsigned k = 0;
     while (k < MAX_TEST_SHIFT && pixels * (double)(1u << k) < MIN_TEST_PIXELS)
         k++;
-    if (k == 0) {
-        double lo[3], hi[3];
-        for (int a = 0; a < 3; a++) {
-            lo[a] = p->sampler->world[a][cell[a]];
-            hi[a] = p->sampler->world[a][cell[a] + 1];
-        }
-        return ip__coverage_hides_seen(p->out.coverage, lo, hi, depth, x, y);
-    }
     double lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
         uint32_t first = cell[a] >> k << k, end = first + (1u << k),
@@ -182,7 +170,8 @@ static int hidden(const ip_propagator *p, const uint32_t cell[3], double pixels,
         lo[a] = p->sampler->world[a][first];
         hi[a] = p->sampler->world[a][end];
     }
-    return ip__coverage_hides(p->out.coverage, lo, hi);
+    return k == 0 ? ip__coverage_hides_seen(p->out.coverage, lo, hi, depth, x, y)
+                  : ip__coverage_hides(p->out.coverage, lo, hi);
 }
 
 /* 1 unless the clipping planes drop `cell`; only called when there are planes. */
@@ -270,12 +259,7 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
         double folded = faces ? foldback_limit(p, q.max_versine) : 0.0;
         /* The bitmap of the cell's brick, which holds most of its neighbours (it exists: the
          * cell was marked before it was queued). */
-        atomic_uint_fast64_t *home = NULL;
-        if (faces) {
-            uint32_t brick[3] = {q.cell[0] >> shift, q.cell[1] >> shift, q.cell[2] >> shift};
-            home = (atomic_uint_fast64_t *)ip__visited_bitmap(
-                visited, ip_brick_global_index(visited->layout, level, brick));
-        }
+        atomic_uint_fast64_t *home = faces ? ip__visited_cell_bitmap(visited, level, q.cell) : NULL;
         for (int f = 0; f < 6 && st == IP_OK; f++) {
             if (!(faces & (1u << f)))
                 continue;

@@ -45,8 +45,7 @@ typedef struct ip_propagator {
     double cutoff_versine;              /* 1 - cos(cut-off angle) */
     double cos_foldback, sin_foldback;  /* of the fold-back tolerance */
     double pixel_scale;                 /* pixels per unit of (size / depth) */
-    double to_x[3], to_y[3];            /* image x and y (pixels) are v . to_x / depth + centre
-                                           (v from the eye), as in the coverage */
+    ip_image_axes axes;                 /* image positions, as the coverage works them out */
     double near_distance, far_distance; /* the level's distance band from the eye */
     ip_clip clip;                       /* the options' planes: dropped cells are not entered */
     double window[4];     /* x0, y0, x1, y1 (pixels): propagation stays where cells may project

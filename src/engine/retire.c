@@ -137,8 +137,14 @@ int ip__engine_retire(ip_engine_worker *w, const ip_order_ray *r, double *from)
 {
     ip_engine *e = w->engine;
     *from = r->tested ? r->from : 0;
-    if (r->tested || !e->options.occlusion || r->level < e->tile_from ||
-        !tile_retires(w, r->x, r->y, r->level, from))
+    if (r->tested || !e->options.occlusion)
+        return 0;
+    /* Before the Z-order levels only a tile settled with no bound retires a ray: one no active
+     * brick shows in (clear_view()). */
+    if (r->level < e->tile_from
+            ? atomic_load_explicit(&pixel_tile(e, r->x, r->y)->depth, memory_order_relaxed) !=
+                  ip__float_bits(INFINITY)
+            : !tile_retires(w, r->x, r->y, r->level, from))
         return 0;
     w->counts.rays++;
     w->counts.retired++;

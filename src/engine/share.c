@@ -1,13 +1,15 @@
 /* Idle workers help the others' propagations: parts of long queues handed out during a step. */
 #include <string.h>
 #include "engine_state.h"
+#include "internal.h"
 
 int ip__engine_give_cells(void *user, uint32_t level, const ip_queued_cell *cells, unsigned count,
                           const double dir[3])
 {
     ip_engine *e = user;
+    IP_ASSERT(count <= IP_SHARE_CELLS);
     pthread_mutex_lock(&e->share_lock);
-    int room = e->shared_count < SHARED_MAX && count <= IP_SHARE_CELLS;
+    int room = e->shared_count < SHARED_MAX;
     if (room) {
         ip_shared_cells *c = &e->shared[e->shared_count++];
         c->level = level;

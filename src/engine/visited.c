@@ -40,8 +40,8 @@ void ip__visited_free(ip_visited *v)
     v->bitmaps = NULL;
 }
 
-/* The brick of a cell and the cell's bit inside it. */
-static uint64_t locate(const ip_visited *v, uint32_t level, const uint32_t cell[3], uint64_t *bit)
+/* The global index of the brick holding a cell. */
+static uint64_t brick_of(const ip_visited *v, uint32_t level, const uint32_t cell[3])
 {
     uint32_t brick[3];
     IP_ASSERT(level < v->layout->level_count);
@@ -49,7 +49,6 @@ static uint64_t locate(const ip_visited *v, uint32_t level, const uint32_t cell[
         IP_ASSERT(cell[a] < v->layout->levels[level].dims[a] - 1);
         brick[a] = cell[a] >> v->edge_shift;
     }
-    *bit = ip__visited_cell_bit(v, cell);
     return ip_brick_global_index(v->layout, level, brick);
 }
 
@@ -75,12 +74,8 @@ static atomic_uint_fast64_t *brick_bitmap(ip_visited *v, uint64_t g)
 
 int ip__visited_mark(ip_visited *v, uint32_t level, const uint32_t cell[3])
 {
-    uint64_t bit, g = locate(v, level, cell, &bit);
-    atomic_uint_fast64_t *m = brick_bitmap(v, g);
-    if (!m)
-        return -1;
-    uint_fast64_t mask = (uint_fast64_t)1 << (bit & 63);
-    return (atomic_fetch_or(&m[bit >> 6], mask) & mask) != 0;
+    atomic_uint_fast64_t *m = brick_bitmap(v, brick_of(v, level, cell));
+    return m ? ip__visited_mark_in(v, m, cell) : -1;
 }
 
 int ip__visited_mark_part(ip_visited *v, uint64_t brick, uint64_t part)
@@ -95,9 +90,11 @@ int ip__visited_mark_part(ip_visited *v, uint64_t brick, uint64_t part)
 
 int ip__visited_test(const ip_visited *v, uint32_t level, const uint32_t cell[3])
 {
-    uint64_t bit, g = locate(v, level, cell, &bit);
-    atomic_uint_fast64_t *m = atomic_load_explicit(&v->bitmaps[g], memory_order_acquire);
-    if (!m)
-        return 0;
-    return (atomic_load_explicit(&m[bit >> 6], memory_order_relaxed) >> (bit & 63)) & 1;
+    return ip__visited_test_in(v, ip__visited_cell_bitmap(v, level, cell), cell);
+}
+
+atomic_uint_fast64_t *ip__visited_cell_bitmap(const ip_visited *v, uint32_t level,
+                                              const uint32_t cell[3])
+{
+    return ip__visited_bitmap(v, brick_of(v, level, cell));
 }

@@ -33,6 +33,10 @@ int ip__visited_mark(ip_visited *v, uint32_t level, const uint32_t cell[3]);
 /* 1 when the cell is marked. */
 int ip__visited_test(const ip_visited *v, uint32_t level, const uint32_t cell[3]);
 
+/* The bitmap of the brick holding cell `cell` of `level` (ip__visited_bitmap()). */
+atomic_uint_fast64_t *ip__visited_cell_bitmap(const ip_visited *v, uint32_t level,
+                                              const uint32_t cell[3]);
+
 /* Settled parts: the beam tests' record of sub-blocks and cell groups every active cell of
  * which (that the clipping planes keep) is marked, so that later tests pass over them. Part
  * `part` of a brick is sub-block `part` (index within the brick, x fastest) below
@@ -42,10 +46,11 @@ int ip__visited_test(const ip_visited *v, uint32_t level, const uint32_t cell[3]
  * global index `brick`; 0, or -1 when out of memory. */
 int ip__visited_mark_part(ip_visited *v, uint64_t brick, uint64_t part);
 
-/* For tests of many cells of one brick: the bitmap of the brick of global index `brick`, NULL
- * while none of its cells is marked (a bitmap published after this call is not seen, so a
- * cell marked meanwhile may read as unmarked). */
-static inline const atomic_uint_fast64_t *ip__visited_bitmap(const ip_visited *v, uint64_t brick)
+/* For tests and marks of many cells of one brick (ip__visited_test_in(), ip__visited_mark_in()):
+ * the bitmap of the brick of global index `brick`, NULL while none of its cells is marked (a
+ * bitmap published after this call is not seen, so a cell marked meanwhile may read as
+ * unmarked). */
+static inline atomic_uint_fast64_t *ip__visited_bitmap(const ip_visited *v, uint64_t brick)
 {
     return atomic_load_explicit(&v->bitmaps[brick], memory_order_acquire);
 }

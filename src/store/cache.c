@@ -190,7 +190,7 @@ static void note_touch(ip_cache *c, uint64_t g, uint32_t level)
     }
 }
 
-/* The hit path: pin the slot's entry if it holds brick g. No lock. */
+/* The hit path: pin the slot's entry if it holds brick g, counted as a hit. No lock. */
 static int try_pin(ip_cache *c, uint64_t g, ip_brick *b)
 {
     entry *e = atomic_load_explicit(&c->slots[g].entry, memory_order_acquire);
@@ -215,6 +215,7 @@ static int try_pin(ip_cache *c, uint64_t g, ip_brick *b)
         atomic_fetch_sub(&c->prefetch_unused, 1);
     }
     fill_brick(e, b);
+    atomic_fetch_add_explicit(&c->hits[g % HIT_STRIPES].value, 1, memory_order_relaxed);
     return 1;
 }
 
@@ -600,7 +601,7 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
     uint32_t level, brick[3];
     ip_brick_coords(c->layout, g, &level, brick);
     note_touch(c, g, level);
-    if (ip__cache_pin_resident(c, g, b))
+    if (try_pin(c, g, b))
         return IP_OK;
     double t0 = ip_now_seconds(); /* from here on the caller waits for the brick */
     pthread_mutex_t *lock = &c->stripe_lock[g % STRIPES];
@@ -609,7 +610,6 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
     for (;;) {
         if (try_pin(c, g, b)) {
             pthread_mutex_unlock(lock);
-            atomic_fetch_add(&c->hits[g % HIT_STRIPES].value, 1);
             if (waited)
                 atomic_fetch_add(&c->waits, 1);
             add_wait(c, t0);
@@ -631,10 +631,7 @@ ip_status ip_cache_pin_brick(ip_cache *c, uint64_t g, ip_brick *b, ip_error *err
 
 int ip__cache_pin_resident(ip_cache *c, uint64_t g, ip_brick *b)
 {
-    if (g >= c->layout->brick_count || !try_pin(c, g, b))
-        return 0;
-    atomic_fetch_add_explicit(&c->hits[g % HIT_STRIPES].value, 1, memory_order_relaxed);
-    return 1;
+    return g < c->layout->brick_count && try_pin(c, g, b);
 }
 
 uint64_t ip__cache_tick_now(const ip_cache *c)

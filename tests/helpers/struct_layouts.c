@@ -182,6 +182,7 @@ static void engine(void)
     FIELD(ip_mesh, cells);
     FIELD(ip_mesh, triangle_count);
     FIELD(ip_mesh, capacity);
+    FIELD(ip_mesh, populated);
     FIELD(ip_mesh, with_cells);
 }
 

@@ -15,14 +15,12 @@ file_bytes=$(stat -c %s big.ibv)
 check "the brick file is larger than the slack under test" test "$file_bytes" -gt $((256 << 20))
 run_capture "$bin/isoinfo" --verify big.ibv --cache-mb 32 --stats stats.json
 check "reading every brick succeeds" test "$rc" = 0
-json=$(cat stats.json)
-value() { printf '%s' "$json" | sed "s/.*\"$1\": \([0-9.]*\).*/\1/"; }
-budget=$(value budget_bytes)
-summary=$(value summary_bytes)
-peak=$(value peak_rss_bytes)
-touched=$(value bricks_touched)
-total=$(value bricks_total)
-resident_peak=$(value resident_peak_bytes)
+budget=$(json_number budget_bytes stats.json)
+summary=$(json_number summary_bytes stats.json)
+peak=$(json_number peak_rss_bytes stats.json)
+touched=$(json_number bricks_touched stats.json)
+total=$(json_number bricks_total stats.json)
+resident_peak=$(json_number resident_peak_bytes stats.json)
 limit=$((budget + summary + (64 << 20)))
 echo "cache_memory: file $((file_bytes >> 20)) MiB, budget $((budget >> 20)) MiB, summaries $((summary >> 20)) MiB, peak RSS $((peak >> 20)) MiB, limit $((limit >> 20)) MiB"
 check "budget is 32 MiB" test "$budget" = $((32 << 20))

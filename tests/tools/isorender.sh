@@ -16,7 +16,7 @@ check "the PLY header" sh -c 'head -c 200 p.ply | grep -q "format binary_little_
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o p2.png --lod off \
     --mesh p.stl --stats p2.json --software --quiet
 check "--mesh .stl succeeds" test "$rc" = 0
-triangles=$(sed -n 's/.*"triangles": *\([0-9]*\).*/\1/p' p2.json | head -1)
+triangles=$(json_number triangles p2.json)
 check "the STL holds the run's $triangles triangles" test "$(stat -c %s p.stl)" = $((84 + 50 * triangles))
 expect_error 2 "p.off" "$bin/isorender" s.ibv --iso 100.5 --mesh p.off -o x.png
 check "an unknown mesh format writes nothing" sh -c '! test -e p.off && ! test -e x.png'
@@ -37,11 +37,11 @@ check "progress ends with every ray and 100 % final pixels" sh -c 'tail -1 p.csv
 check "a checkpoint each time the ray count doubles" test "$(grep -c . p.csv)" = 17
 # final_pixel_pct never decreases
 check "final pixels only grow" awk -F, 'NR > 2 && $6 + 0 < prev { exit 1 } { prev = $6 + 0 }' p.csv
-triangles=$(printf '%s' "$json" | sed 's/.*"triangles": \([0-9]*\).*/\1/')
+triangles=$(json_number triangles p.json)
 faces=$(head -c 400 p.ply | sed -n 's/^element face \([0-9]*\).*/\1/p')
 check "the PLY holds every triangle ($faces = $triangles)" test "$faces" = "$triangles"
 # overdraw: the visible triangles (owning a final pixel) are among the extracted ones
-visible=$(printf '%s' "$json" | sed 's/.*"visible_triangles": \([0-9]*\).*/\1/')
+visible=$(json_number visible_triangles p.json)
 check "0 < visible ($visible) <= triangles ($triangles)" test "$visible" -gt 0 -a "$visible" -le "$triangles"
 check "the last checkpoint's visible triangles are the stats'" sh -c \
     'tail -1 p.csv | cut -d, -f7 | grep -qx "$0"' "$visible"
@@ -52,12 +52,12 @@ run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o o.png
     --occlusion off --stats o.json --software --quiet
 check "occlusion off succeeds" test "$rc" = 0
 check "occlusion off says so" grep -q '"occlusion": false, "deferred_cells": 0, "retired_rays": 0,' o.json
-retired=$(printf '%s' "$json" | sed 's/.*"retired_rays": \([0-9]*\).*/\1/')
+retired=$(json_number retired_rays p.json)
 check "occlusion on retires rays in bulk (0 < $retired < 19200)" test "$retired" -gt 0 -a "$retired" -lt 19200
-walked=$(printf '%s' "$json" | sed 's/.*"ray_nodes": \([0-9]*\).*/\1/')
-walked_off=$(sed 's/.*"ray_nodes": \([0-9]*\).*/\1/' o.json)
+walked=$(json_number ray_nodes p.json)
+walked_off=$(json_number ray_nodes o.json)
 check "the rays walk fewer nodes with occlusion ($walked < $walked_off)" test "$walked" -lt "$walked_off"
-off=$(sed 's/.*"triangles": \([0-9]*\).*/\1/' o.json)
+off=$(json_number triangles o.json)
 check "occlusion on extracts no more ($triangles <= $off)" test "$triangles" -le "$off"
 check "occlusion on and off make the same picture" cmp -s p.png o.png
 expect_error 2 "--occlusion" "$bin/isorender" s.ibv --iso 1 --occlusion maybe -o x.png
@@ -79,14 +79,13 @@ cull_run() { # NAME OPTIONS...
     run_capture "$bin/isorender" s.ibv --iso 100.5 --size 64x48 --view -y --lod off --threads 1 \
         -o "$cull_name.png" --stats "$cull_name.json" --software --quiet "$@"
 }
-json_number() { sed "s/.*\"$2\": \([0-9]*\).*/\1/" "$1"; }
 cull_run c
 check "culling by default succeeds" test "$rc" = 0
 check "culling is on by default" grep -q '"cull": true' c.json
 cull_run c0 --cull off
 check "--cull off says so" grep -q '"cull": false, "culled_triangles": 0' c0.json
-kept=$(json_number c.json triangles) culled=$(json_number c.json culled_triangles)
-whole=$(json_number c0.json triangles)
+kept=$(json_number triangles c.json) culled=$(json_number culled_triangles c.json)
+whole=$(json_number triangles c0.json)
 check "some triangles are culled (0 < $culled)" test "$culled" -gt 0
 check "kept and culled add up to the triangles kept without ($kept + $culled = $whole)" \
     test $((kept + culled)) = "$whole"

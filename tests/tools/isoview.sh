@@ -138,21 +138,20 @@ check "the compact overlay does not cover the model ($hud_box, $model_box)" \
     apart $hud_box $model_box
 
 json=$(cat walk.json 2>/dev/null)
-field() { printf '%s' "$json" | sed -n "s/.*\"$1\": \([0-9.]*\).*/\1/p" | head -1; }
 for key in cache budget_bytes resident_peak_bytes hits misses evictions hit_rate bricks_touched \
            peak_rss_bytes file iso mode camera lod rays rays_total done triangles time \
            rendering_s extraction_wall_s passes fps frames mean; do
     check "stats has \"$key\"" sh -c 'printf "%s" "$0" | grep -q "\"$1\":"' "$json" "$key"
 done
 check "the last pass cast every ray" sh -c 'printf "%s" "$0" | grep -q "\"rays\": 76800, \"rays_total\": 76800, \"done\": true"' "$json"
-check "and made triangles ($(field triangles))" test "$(field triangles)" -gt 0
-check "five progressive passes ($(field passes))" test "$(field passes)" = 5
-check "frames were drawn ($(field frames))" test "$(field frames)" -gt 5
-peak=$(field resident_peak_bytes)
-budget=$(field budget_bytes)
+check "and made triangles ($(json_number triangles walk.json))" test "$(json_number triangles walk.json)" -gt 0
+check "five progressive passes ($(json_number passes walk.json))" test "$(json_number passes walk.json)" = 5
+check "frames were drawn ($(json_number frames walk.json))" test "$(json_number frames walk.json)" -gt 5
+peak=$(json_number resident_peak_bytes walk.json)
+budget=$(json_number budget_bytes walk.json)
 check "the cache stayed within its budget ($peak <= $budget)" test "$peak" -le "$budget"
-check "the budget was binding (evictions: $(field evictions))" test "$(field evictions)" -gt 0
-check "no load went over budget" test "$(field over_budget_pins)" = 0
+check "the budget was binding (evictions: $(json_number evictions walk.json))" test "$(json_number evictions walk.json)" -gt 0
+check "no load went over budget" test "$(json_number over_budget_pins walk.json)" = 0
 
 # pausing: a change of view keeps the surface shown (no new pass) until refinement resumes;
 # a change of isovalue resumes it, and the new isovalue's surface appears

@@ -37,6 +37,10 @@ check() {
 # under AddressSanitizer), under `timeout 300`; stdout in $out, stderr in $err, and in $rc the
 # status of COMMAND itself, kept in a file: xvfb-run's own status also reflects its clean-up,
 # which can fail when another test's server starts or stops at the same time.
+# json_number KEY FILE: the number after "KEY": in a JSON file (the last such on the first line
+# that holds one; the programs write their stats on one line).
+json_number() { sed -n "s/.*\"$1\": *\([-0-9.e+]*\).*/\1/p" "$2" | head -1; }
+
 in_xvfb() {
     ix_first=$1 ix_screen=$2
     shift 2

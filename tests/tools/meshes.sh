@@ -25,7 +25,7 @@ check "--weld is the default" cmp -s w.ply w2.ply
 render --full --no-weld --mesh u.ply -o u.png
 check "--no-weld succeeds" test "$rc" = 0
 t=$(topology u.ply)
-triangles=$(sed -n 's/.*"triangles": *\([0-9]*\).*/\1/p' w.json | head -1)
+triangles=$(json_number triangles w.json)
 check "--no-weld: 3 vertices for each of the $triangles triangles ($t)" \
     test "$(field vertices "$t")" = $((3 * triangles)) -a "$(field faces "$t")" = "$triangles"
 "$bin/tests/ply_triangles" w.ply >w.txt

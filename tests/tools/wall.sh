@@ -57,14 +57,11 @@ check "units add up to 2 passes x $regions regions ($(sum dyn.json units))" \
     test "$(sum dyn.json units)" = $((2 * regions))
 check "rays add up to the 115200 pixels ($(sum dyn.json rays))" test "$(sum dyn.json rays)" = 115200
 check "more regions than processes ($regions)" test "$regions" -gt 16
+# every share starts non-empty (more blocks of 4 regions than processes), so the first unit a
+# process takes is from its own share: each stole fewer units than it took
 over=$(grep '"rank": ' dyn.json | sed 's/.*"units": \([0-9]*\).*"stolen": \([0-9]*\).*/\1 \2/' |
-    awk '$2 > $1 { n++ } END { print n + 0 }')
-check "no process stole more units than it took ($over did)" test "$over" = 0
-# every share starts non-empty (more blocks of 4 regions than processes), so the first unit
-# taken is from its taker's own share: fewer units stolen than taken
-stolen=$(sum dyn.json stolen)
-check "fewer units stolen than taken ($stolen of $(sum dyn.json units))" \
-    test "$stolen" -lt "$(sum dyn.json units)"
+    awk '$2 >= $1 { n++ } END { print n + 0 }')
+check "every process stole fewer units than it took ($over did not)" test "$over" = 0
 busy=$(grep '"rank": ' dyn.json | grep -c '"units": [1-9]')
 check "every process took units ($busy of 4)" test "$busy" = 4
 

@@ -114,8 +114,7 @@ static int create_engine(viewer *v, ip_error *err)
     tool_view_options common;
     clip_options(v, &common);
     ip_engine_options eo;
-    /* every triangle unless --cull on: a paused viewer shows the mesh from other views */
-    tool_engine_options(&common, 1, &eo);
+    tool_engine_options(&common, &eo);
     ip_engine *engine;
     if (ip_engine_create(v->cache, &eo, &engine, err) != IP_OK)
         return -1;

@@ -85,6 +85,9 @@ int parse_args(int argc, char **argv, options *o)
     int rc = tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
                                           sizeof isoview_options / sizeof isoview_options[0], o,
                                           &o->file, argc, argv);
+    if (o->common.cull < 0) /* every triangle unless --cull on: a paused viewer shows the mesh
+                               from other views */
+        o->common.cull = 0;
     if (rc == 0 && o->common.iso_count > 1) /* isorender draws each; here one would be lost */
         return tool_usage_error("isoview",
                                 "--iso given %u times: isoview shows one surface (isorender "

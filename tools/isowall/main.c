@@ -610,7 +610,7 @@ static int open_run(wall_run *r)
                  setup_layout(r, &err) != 0;
     if (!failed) {
         ip_engine_options eo;
-        tool_engine_options(&r->o.common, 0, &eo);
+        tool_engine_options(&r->o.common, &eo);
         failed =
             ip_engine_create(r->cache, &eo, &r->engine, &err) != IP_OK ||
             ip_engine_begin(r->engine, &r->layout.camera, (float)r->o.common.iso, &err) != IP_OK;

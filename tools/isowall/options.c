@@ -120,6 +120,8 @@ int wall_parse_args(int argc, char **argv, wall_options *o)
     }
     if (!o->common.threads)
         o->common.threads = 1;
+    if (o->common.cull < 0) /* the wall's image only: culled unless --cull off */
+        o->common.cull = 1;
     o->common.width = (uint32_t)width;
     o->common.height = (uint32_t)height;
     return 0;
