@@ -104,6 +104,19 @@ static inline uint32_t ip__ceil_log2(uint64_t v)
     return r;
 }
 
+/* The index of the lowest set bit of m (not 0). */
+static inline unsigned ip__lowest_bit(unsigned m)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return (unsigned)__builtin_ctz(m);
+#else
+    unsigned i = 0;
+    while (!(m >> i & 1u))
+        i++;
+    return i;
+#endif
+}
+
 /* 1 on a little-endian host. */
 static inline int ip__host_little_endian(void)
 {

@@ -3,6 +3,7 @@
 
 #include "beam.h"
 #include "format.h"
+#include "internal.h"
 #include "vec3.h"
 
 /* The beam in the level's index space (cell (i, j, k) is the box [i, i+1] x ...): a box meets
@@ -102,6 +103,52 @@ static void unsettled(index_beam *w, const double lo[3], const double hi[3])
     w->limit = z < w->limit ? z : w->limit;
 }
 
+/* Bit i set when sample first + i (i < n) of brick b is at or above iso: a corner bit of
+ * ip__mc_case() (a NaN is below). */
+static unsigned row_at_or_above(const ip_brick *b, ip_type type, size_t first, unsigned n,
+                                float iso)
+{
+#define ROW_AS(T)                                        \
+    do {                                                 \
+        const T *p = (const T *)b->samples + first;      \
+        unsigned bits = 0;                               \
+        for (unsigned i = 0; i < n; i++)                 \
+            bits |= (unsigned)((float)p[i] >= iso) << i; \
+        return bits;                                     \
+    } while (0)
+    switch (type) {
+    case IP_UINT8: ROW_AS(uint8_t);
+    case IP_UINT16: ROW_AS(uint16_t);
+    case IP_INT16: ROW_AS(int16_t);
+    case IP_FLOAT32: ROW_AS(float);
+    }
+#undef ROW_AS
+    return 0.0f >= iso ? (1u << n) - 1 : 0; /* not a type: as ip__samples_gather() */
+}
+
+/* The active cells (ip__mc_case() neither 0 nor 255) among cells [g0, g1) of brick b, at most
+ * IP_CELL_GROUP a side: bit x - g0[0] of active[z - g0[2]][y - g0[1]]. Each sample is
+ * classified once, into a bit of its row along x, rather than once per cell it is a corner of:
+ * a cell is active where its 4 corner rows have, at its two bits, some set and not all. */
+static void group_active(const ip_brick *b, ip_type type, const uint32_t g0[3],
+                         const uint32_t g1[3], float iso,
+                         unsigned active[IP_CELL_GROUP][IP_CELL_GROUP])
+{
+    unsigned rows[IP_CELL_GROUP + 1][IP_CELL_GROUP + 1];
+    unsigned nx = g1[0] - g0[0], ny = g1[1] - g0[1], nz = g1[2] - g0[2];
+    size_t row = b->extent[0], slice = row * b->extent[1], first = ip__sample_index(b, g0);
+    for (unsigned z = 0; z <= nz; z++)
+        for (unsigned y = 0; y <= ny; y++)
+            rows[z][y] = row_at_or_above(b, type, first + y * row + z * slice, nx + 1, iso);
+    unsigned cells = (1u << nx) - 1;
+    for (unsigned z = 0; z < nz; z++)
+        for (unsigned y = 0; y < ny; y++) {
+            unsigned all = rows[z][y] & rows[z][y + 1] & rows[z + 1][y] & rows[z + 1][y + 1];
+            unsigned any = rows[z][y] | rows[z][y + 1] | rows[z + 1][y] | rows[z + 1][y + 1];
+            active[z][y] = (any | any >> 1) & ~(all & all >> 1) & cells;
+        }
+}
+
 /* The cells [lo, hi) of sub-block `sb` (index within its brick), by cell groups (cache.h):
  * those that are active and not visited lower the beam's limit (unsettled()). A cell group the
  * beam meets every active cell of which is visited is recorded as settled
@@ -126,8 +173,6 @@ static void settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi
         return;
     uint32_t per_group = (s->layout->brick_edge + IP_CELL_GROUP - 1) / IP_CELL_GROUP;
     int record_groups = s->layout->subblock_edge >= IP_CELL_GROUP;
-    ptrdiff_t corners[8];
-    ip__corner_offsets(brick, corners);
     size_t groups_x = ip_cell_groups(brick->extent[0]),
            groups_xy = groups_x * ip_cell_groups(brick->extent[1]);
     int whole = 1; /* no active cell of the sub-block unvisited so far */
@@ -165,17 +210,14 @@ static void settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi
                     continue;
                 }
                 int group_whole = 1;
+                unsigned active[IP_CELL_GROUP][IP_CELL_GROUP];
+                group_active(brick, s->layout->type, g0, g1, s->iso, active);
                 for (uint32_t z = g0[2]; z < g1[2]; z++)
                     for (uint32_t y = g0[1]; y < g1[1]; y++)
-                        for (uint32_t x = g0[0]; x < g1[0]; x++) {
-                            /* cheapest first: most cells here are extracted or inactive */
+                        for (unsigned left = active[z - g0[2]][y - g0[1]]; left; left &= left - 1) {
+                            uint32_t x = g0[0] + ip__lowest_bit(left);
                             uint32_t c[3] = {x, y, z}, c1[3] = {x + 1, y + 1, z + 1};
                             if (ip__visited_test_in(w->visited, marked, c))
-                                continue;
-                            float values[8];
-                            ip__cell_values(brick, s->layout->type, corners, c, values);
-                            unsigned mc = ip__mc_case(values, s->iso);
-                            if (mc == 0 || mc == 255)
                                 continue;
                             if (side != IP__CLIP_KEEPS_ALL &&
                                 !ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))

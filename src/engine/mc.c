@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "internal.h"
 #include "mc.h"
 #include "vec3.h"
 
@@ -20,19 +21,6 @@ unsigned ip__mc_crossed_faces(unsigned mc_case)
             faces |= 1u << f;
     }
     return faces;
-}
-
-/* The index of the lowest set bit of m (not 0). */
-static unsigned lowest_bit(unsigned m)
-{
-#if defined(__GNUC__) || defined(__clang__)
-    return (unsigned)__builtin_ctz(m);
-#else
-    unsigned i = 0;
-    while (!(m >> i & 1u))
-        i++;
-    return i;
-#endif
 }
 
 /* Where the surface crosses the edge from v0 (low corner) to v1, as a fraction of the edge.
@@ -138,7 +126,7 @@ unsigned ip__mc_cell_edge_points(const float values[8], unsigned mc_case, float 
 {
     unsigned crossed = ip__mc_edge_table[mc_case & 0xFFu];
     for (unsigned left = crossed; left; left &= left - 1) {
-        unsigned e = lowest_bit(left);
+        unsigned e = ip__lowest_bit(left);
         float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
                                 values[ip__mc_edge_corners[e][1]], iso);
         edge_position(e, t, lo, hi, points[e]);
@@ -154,7 +142,7 @@ unsigned ip__mc_cell_edge_normals(const float values[8], unsigned mc_case,
     const float inverse_size[3] = {1.0f / (hi[0] - lo[0]), 1.0f / (hi[1] - lo[1]),
                                    1.0f / (hi[2] - lo[2])};
     for (unsigned left = crossed; left; left &= left - 1) {
-        unsigned e = lowest_bit(left);
+        unsigned e = ip__lowest_bit(left);
         float t = edge_fraction(values[ip__mc_edge_corners[e][0]],
                                 values[ip__mc_edge_corners[e][1]], iso);
         edge_normal(values, gradients, iso, e, t, inverse_size, normals[e]);

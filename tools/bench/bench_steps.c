@@ -1,9 +1,10 @@
 /* bench_steps: the progressive engine driven as the viewer drives it, in many small steps of a
  * fixed number of rays, or as isorender's --progress drives it, in steps ending at 1, 2, 4, ...
  * rays, through the public API only (so the same source measures any build of the library).
- * Prints the wall time of each run (the view's ip_engine_begin() included), its steps and the
- * time per step, then the median run. A benchmark, not a test: the figures depend on the
- * machine and on what else runs on it.
+ * Prints the wall time of each run (the view's ip_engine_begin() included, and that call alone),
+ * its steps and the time per step, then the median of the warm runs. Run 0 is the process's
+ * first view, on an empty cache (REPEATS 0 runs only that one, e.g. to profile it). A
+ * benchmark, not a test: the figures depend on the machine and on what else runs on it.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,8 +14,8 @@
 static const char usage[] =
     "usage: bench_steps FILE.ibv ISO VIEW WIDTHxHEIGHT RAYS_PER_STEP THREADS REPEATS [MAX_RAYS]\n"
     "Casts the rays of the view RAYS_PER_STEP at a time (0: steps ending at 1, 2, 4, ... rays),\n"
-    "all of them or the first MAX_RAYS, REPEATS times on one engine after one untimed run that\n"
-    "warms the cache.\n";
+    "all of them or the first MAX_RAYS, REPEATS times on one engine after run 0, the first\n"
+    "view on an empty cache, which warms it.\n";
 
 static int compare_doubles(const void *a, const void *b)
 {
@@ -50,7 +51,7 @@ int main(int argc, char **argv)
     ip_engine *engine = NULL;
     uint32_t width, height;
     int repeats = atoi(argv[7]);
-    if (sscanf(argv[4], "%ux%u", &width, &height) != 2 || repeats < 1 || repeats > 1000) {
+    if (sscanf(argv[4], "%ux%u", &width, &height) != 2 || repeats < 0 || repeats > 1000) {
         fputs(usage, stderr);
         return 2;
     }
@@ -69,10 +70,11 @@ int main(int argc, char **argv)
     ip_layout_world_box(ip_store_layout(store), lo, hi);
     if (ip_camera_fit_axis(lo, hi, argv[3], 30.0, width, height, &camera, &err) != IP_OK)
         goto fail;
-    for (int r = 0; r <= repeats; r++) { /* run 0 warms the cache */
+    for (int r = 0; r <= repeats; r++) { /* run 0 fills the cache */
         double t0 = ip_now_seconds();    /* the view's set-up counts */
         if (ip_engine_begin(engine, &camera, iso, &err) != IP_OK)
             goto fail;
+        double begun = ip_now_seconds() - t0;
         uint64_t steps = 0, done = 0;
         while (!ip_engine_done(engine) && (!max_rays || done < max_rays)) {
             uint64_t n = step_rays(rays, done, max_rays);
@@ -83,17 +85,19 @@ int main(int argc, char **argv)
             steps++;
         }
         double seconds = ip_now_seconds() - t0;
-        if (r > 0) {
+        if (r > 0)
             times[r - 1] = seconds;
-            printf("run %d: %.4f s, %llu steps, %.2f us per step, %llu rays, %llu triangles\n", r,
-                   seconds, (unsigned long long)steps, seconds / (double)steps * 1e6,
-                   (unsigned long long)done,
-                   (unsigned long long)ip_engine_mesh(engine)->triangle_count);
-        }
+        printf("run %d: %.4f s (begin %.4f s), %llu steps, %.2f us per step, %llu rays, "
+               "%llu triangles\n",
+               r, seconds, begun, (unsigned long long)steps, seconds / (double)steps * 1e6,
+               (unsigned long long)done,
+               (unsigned long long)ip_engine_mesh(engine)->triangle_count);
     }
-    qsort(times, (size_t)repeats, sizeof times[0], compare_doubles);
-    printf("median %.4f s [%.4f-%.4f] of %d runs\n", times[(repeats - 1) / 2], times[0],
-           times[repeats - 1], repeats);
+    if (repeats > 0) {
+        qsort(times, (size_t)repeats, sizeof times[0], compare_doubles);
+        printf("median %.4f s [%.4f-%.4f] of %d runs\n", times[(repeats - 1) / 2], times[0],
+               times[repeats - 1], repeats);
+    }
     ip_engine_destroy(engine);
     ip_cache_destroy(cache);
     ip_store_close(store);
