@@ -796,6 +796,85 @@ static void check_reach_box(void)
     CHECK(memchr(reached, 0, sizeof reached) == NULL);
 }
 
+/* The tiles every brick holding `iso` may show in, brick by brick over each level's whole grid:
+ * what ip__reach_tiles() finds by the octree. */
+static void reach_every_brick(const ip_store *store, float iso, uint32_t levels,
+                              const ip_camera_basis *basis, const ip_camera *cam, uint32_t tx,
+                              uint32_t ty, unsigned char *reached, uint64_t *active)
+{
+    const ip_layout *l = ip_store_layout(store);
+    memset(reached, 0, (size_t)tx * ty);
+    for (uint32_t k = 0; k < levels; k++) {
+        const ip_level_layout *lv = &l->levels[k];
+        uint32_t b[3];
+        for (b[2] = 0; b[2] < lv->bricks[2]; b[2]++)
+            for (b[1] = 0; b[1] < lv->bricks[1]; b[1]++)
+                for (b[0] = 0; b[0] < lv->bricks[0]; b[0]++) {
+                    float range[2];
+                    ip_store_brick_range(store, ip_brick_global_index(l, k, b), range);
+                    if (!(range[0] < iso && range[1] >= iso))
+                        continue;
+                    ++*active;
+                    uint32_t origin[3], extent[3];
+                    ip_brick_extent(l, k, b, origin, extent);
+                    double lo[3], hi[3];
+                    for (int a = 0; a < 3; a++) {
+                        double scale = l->spacing[a] * (double)(1u << k);
+                        lo[a] = origin[a] * scale;
+                        hi[a] = (origin[a] + extent[a] - 1.0) * scale;
+                    }
+                    ip__reach_box(basis, cam, lo, hi, 3, tx, ty, reached);
+                }
+    }
+}
+
+/* ip__reach_tiles() walks the octree, passing over the nodes that do not hold the isovalue: it
+ * marks exactly the tiles that testing every brick marks, at every level count, for isovalues
+ * crossing few or many bricks or none, seen along the axes and from off them. */
+static void check_reach_tiles(scene *s)
+{
+    const ip_layout *l = ip_store_layout(s->store);
+    const float isos[] = {30.5f, 127.5f, 250.5f, 1000.0f};
+    const char *axes[] = {"-y", "+z", "+x", "-z"};
+    uint64_t cases = 0, with_active = 0, partial = 0;
+    for (size_t v = 0; v < sizeof axes / sizeof axes[0]; v++) {
+        ip_camera cam;
+        ip_error err;
+        REQUIRE(ip_camera_fit_axis(s->lo, s->hi, axes[v], 30.0, 150, 110, &cam, &err) == IP_OK);
+        if (v == 2) { /* off the axes, and near enough that the volume fills the image */
+            cam.eye[1] += 0.6 * (cam.eye[0] - cam.target[0]);
+            cam.eye[2] -= 0.3 * (cam.eye[0] - cam.target[0]);
+            for (int a = 0; a < 3; a++)
+                cam.eye[a] = cam.target[a] + 0.6 * (cam.eye[a] - cam.target[a]);
+        }
+        if (v == 3) /* far: a brick is a tile or two, and a node a few */
+            for (int a = 0; a < 3; a++)
+                cam.eye[a] = cam.target[a] + 4.0 * (cam.eye[a] - cam.target[a]);
+        ip_camera_basis basis;
+        ip_camera_basis_of(&cam, &basis);
+        const uint32_t tx = (150 + 7) / 8, ty = (110 + 7) / 8;
+        unsigned char walked[19 * 14], every[19 * 14];
+        REQUIRE(tx * ty == sizeof walked);
+        for (size_t i = 0; i < sizeof isos / sizeof isos[0]; i++)
+            for (uint32_t levels = 1; levels <= l->level_count; levels++) {
+                uint64_t active = 0;
+                memset(walked, 7, sizeof walked);
+                ip__reach_tiles(s->store, isos[i], levels, &basis, &cam, 3, tx, ty, walked);
+                reach_every_brick(s->store, isos[i], levels, &basis, &cam, tx, ty, every, &active);
+                CHECK_MSG(memcmp(walked, every, sizeof walked) == 0,
+                          "iso %g, %u levels, view %s: the octree walk marks other tiles",
+                          (double)isos[i], levels, axes[v]);
+                cases++;
+                with_active += active > 0;
+                partial += memchr(every, 0, sizeof every) && memchr(every, 1, sizeof every);
+            }
+    }
+    CHECK_MSG(l->level_count > 1 && with_active >= cases / 2 && partial > 0 && with_active < cases,
+              "%llu cases: %llu with active bricks, %llu with tiles both reached and not",
+              (unsigned long long)cases, (unsigned long long)with_active,
+              (unsigned long long)partial);
+}
+
 /* The full extraction of an isovalue at level 0 and its image under one camera, beside
  * buffers for the image of a progressive mesh to compare with it. */
 typedef struct reference {
@@ -1182,6 +1261,7 @@ int main(void)
     check_view(&s, "sphere", "-y", 127.5f, 120, 100);
     check_view(&s, "sphere", "+z", 90.5f, 100, 120);
     check_empty_space(&s, 200.5f);
+    check_reach_tiles(&s);
     close_scene(&s);
 
     make_volume(dir, IP_FIELD_GYROID, 36, IP_FLOAT32, 8, ibv, sizeof ibv);

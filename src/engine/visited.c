@@ -17,27 +17,35 @@ ip_status ip__visited_init(ip_visited *v, const ip_layout *layout)
     v->words_per_brick = (b * b * b + per * per * per + groups * groups * groups + 63) / 64;
     v->edge_shift = ip__ceil_log2(b);
     v->bitmaps = calloc(layout->brick_count, sizeof *v->bitmaps);
+    v->holders = malloc(layout->brick_count * sizeof *v->holders);
     atomic_init(&v->bytes, 0);
-    return v->bitmaps ? IP_OK : IP_ERR_NOMEM;
+    atomic_init(&v->holder_count, 0);
+    if (v->bitmaps && v->holders)
+        return IP_OK;
+    ip__visited_free(v);
+    return IP_ERR_NOMEM;
 }
 
 void ip__visited_clear(ip_visited *v)
 {
-    for (uint64_t g = 0; v->bitmaps && g < v->layout->brick_count; g++) {
-        atomic_uint_fast64_t *m = atomic_load(&v->bitmaps[g]);
-        if (m) {
-            free(m);
-            atomic_store(&v->bitmaps[g], NULL);
-        }
+    uint64_t n = atomic_load(&v->holder_count);
+    for (uint64_t i = 0; i < n; i++) {
+        uint64_t g = v->holders[i];
+        free(atomic_load(&v->bitmaps[g]));
+        atomic_store(&v->bitmaps[g], NULL);
     }
+    atomic_store(&v->holder_count, 0);
     atomic_store(&v->bytes, 0);
 }
 
 void ip__visited_free(ip_visited *v)
 {
-    ip__visited_clear(v);
+    if (v->bitmaps && v->holders)
+        ip__visited_clear(v);
     free(v->bitmaps);
+    free(v->holders);
     v->bitmaps = NULL;
+    v->holders = NULL;
 }
 
 /* The global index of the brick holding a cell. */
@@ -63,6 +71,7 @@ static atomic_uint_fast64_t *brick_bitmap(ip_visited *v, uint64_t g)
         atomic_uint_fast64_t *expected = NULL;
         if (atomic_compare_exchange_strong(&v->bitmaps[g], &expected, fresh)) {
             m = fresh;
+            v->holders[atomic_fetch_add(&v->holder_count, 1)] = g; /* each brick once */
             atomic_fetch_add(&v->bytes, v->words_per_brick * sizeof *fresh);
         } else {
             free(fresh); /* another thread published first */

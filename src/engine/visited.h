@@ -13,6 +13,9 @@
 typedef struct ip_visited {
     const ip_layout *layout;
     _Atomic(atomic_uint_fast64_t *) *bitmaps; /* one per brick of every level, or NULL */
+    uint64_t *holders; /* the bricks that have a bitmap, holders[0 .. holder_count) (in the
+                          order published; an entry is written just after its count is taken) */
+    atomic_uint_fast64_t holder_count;
     uint64_t words_per_brick;
     uint64_t cells_per_brick;     /* B^3: the cells' bits, then one per sub-block, then one */
     uint64_t subblocks_per_brick; /* per cell group (IP_CELL_GROUP^3 cells): see "Settled" */
@@ -23,7 +26,8 @@ typedef struct ip_visited {
 ip_status ip__visited_init(ip_visited *v, const ip_layout *layout);
 void ip__visited_free(ip_visited *v);
 
-/* Forgets every cell (frees the bitmaps). Not to be called while other threads use the set. */
+/* Forgets every cell (frees the bitmaps, visiting only the bricks that have one). Not to be
+ * called while other threads use the set. */
 void ip__visited_clear(ip_visited *v);
 
 /* Marks cell `cell` of `level`; returns 1 if it was already marked, 0 if this call marked it,
