@@ -103,27 +103,19 @@ static void unsettled(index_beam *w, const double lo[3], const double hi[3])
     w->limit = z < w->limit ? z : w->limit;
 }
 
-/* Bit i set when sample first + i (i < n) of brick b is at or above iso: a corner bit of
- * ip__mc_case() (a NaN is below). */
+/* Bit i set when sample first + i (i < n <= IP_CELL_GROUP + 1) of brick b is at or above iso:
+ * a corner bit of ip__mc_case() (a NaN is below). */
 static unsigned row_at_or_above(const ip_brick *b, ip_type type, size_t first, unsigned n,
                                 float iso)
 {
-#define ROW_AS(T)                                        \
-    do {                                                 \
-        const T *p = (const T *)b->samples + first;      \
-        unsigned bits = 0;                               \
-        for (unsigned i = 0; i < n; i++)                 \
-            bits |= (unsigned)((float)p[i] >= iso) << i; \
-        return bits;                                     \
-    } while (0)
-    switch (type) {
-    case IP_UINT8: ROW_AS(uint8_t);
-    case IP_UINT16: ROW_AS(uint16_t);
-    case IP_INT16: ROW_AS(int16_t);
-    case IP_FLOAT32: ROW_AS(float);
-    }
-#undef ROW_AS
-    return 0.0f >= iso ? (1u << n) - 1 : 0; /* not a type: as ip__samples_gather() */
+    _Static_assert(IP_CELL_GROUP == 4, "one offset per sample of a group's row");
+    static const ptrdiff_t along[IP_CELL_GROUP + 1] = {0, 1, 2, 3, 4};
+    float v[IP_CELL_GROUP + 1] = {0}; /* all written below: the compiler cannot tell */
+    ip__samples_gather(b->samples, type, first, along, (int)n, v);
+    unsigned bits = 0;
+    for (unsigned i = 0; i < n; i++)
+        bits |= (unsigned)(v[i] >= iso) << i;
+    return bits;
 }
 
 /* The active cells (ip__mc_case() neither 0 nor 255) among cells [g0, g1) of brick b, at most

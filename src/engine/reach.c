@@ -6,9 +6,10 @@
 #include "reach.h"
 #include "sampler.h"
 
-/* The tiles [t[0], t[1]] x [t[2], t[3]] (as whole numbers) holding a pixel centre within a pixel
- * of the bounding rectangle of the image of the world box [lo, hi]: every tile when a corner of
- * the box is not in front of the eye; none when t[0] > t[1] or t[2] > t[3]. */
+/* The tiles [t[0], t[1]] x [t[2], t[3]] (whole numbers, never NaN: fmax() and fmin() drop a NaN
+ * end) holding a pixel centre within a pixel of the bounding rectangle of the image of the
+ * world box [lo, hi]: every tile when a corner of the box is not in front of the eye; none when
+ * t[0] > t[1] or t[2] > t[3]. */
 static void box_tiles(const ip_camera_basis *basis, const ip_camera *camera, const double lo[3],
                       const double hi[3], unsigned shift, uint32_t tiles_x, uint32_t tiles_y,
                       double t[4])
@@ -41,7 +42,7 @@ void ip__reach_box(const ip_camera_basis *basis, const ip_camera *camera, const 
 {
     double t[4];
     box_tiles(basis, camera, lo, hi, shift, tiles_x, tiles_y, t);
-    if (!(t[0] <= t[1])) /* left or right of the image */
+    if (t[0] > t[1]) /* left or right of the image */
         return;
     for (double ty = t[2]; ty <= t[3]; ty++)
         memset(reached + (size_t)ty * tiles_x + (size_t)t[0], 1, (size_t)(t[1] - t[0]) + 1);
@@ -60,27 +61,9 @@ typedef struct reach_walk {
     unsigned char *reached;
 } reach_walk;
 
-/* Marks the tiles brick b of the walk's level may show in, if its range holds the isovalue. */
-static void reach_brick(const reach_walk *w, const uint32_t b[3])
-{
-    const ip_layout *l = w->layout;
-    float range[2];
-    ip_store_brick_range(w->store, ip_brick_global_index(l, w->level, b), range);
-    if (!ip__range_active(range[0], range[1], w->iso))
-        return;
-    uint32_t origin[3], extent[3];
-    ip_brick_extent(l, w->level, b, origin, extent);
-    double lo[3], hi[3];
-    for (int a = 0; a < 3; a++) {
-        double scale = l->spacing[a] * (double)(1u << w->level);
-        lo[a] = origin[a] * scale;
-        hi[a] = (origin[a] + extent[a] - 1.0) * scale;
-    }
-    ip__reach_box(w->basis, w->camera, lo, hi, w->shift, w->tiles_x, w->tiles_y, w->reached);
-}
-
-/* The world box of the walk's level that octree node `node` of `depth` (>= 1) spans: the boxes
- * of its bricks (ip__reach_tiles()) within one. */
+/* The world box of the walk's level that octree node `node` of `depth` spans (0: a brick, from
+ * its first sample to its last; above, the boxes of its bricks within one), cells of 2^level
+ * samples' spacing from sample 0, as the seeder sees them. */
 static void node_box(const reach_walk *w, uint32_t depth, const uint32_t node[3], double lo[3],
                      double hi[3])
 {
@@ -100,6 +83,18 @@ static void node_box(const reach_walk *w, uint32_t depth, const uint32_t node[3]
         hi[a] = (origin[a] + extent[a] - 1.0) * l->spacing[a] * (double)(1u << w->level);
 }
 
+/* Marks the tiles brick b of the walk's level may show in, if its range holds the isovalue. */
+static void reach_brick(const reach_walk *w, const uint32_t b[3])
+{
+    float range[2];
+    ip_store_brick_range(w->store, ip_brick_global_index(w->layout, w->level, b), range);
+    if (!ip__range_active(range[0], range[1], w->iso))
+        return;
+    double lo[3], hi[3];
+    node_box(w, 0, b, lo, hi);
+    ip__reach_box(w->basis, w->camera, lo, hi, w->shift, w->tiles_x, w->tiles_y, w->reached);
+}
+
 /* 1 when marking the bricks of node `node` of `depth` (>= 1) would mark no tile not marked yet:
  * the tiles of its box hold every tile of each brick's box, and they are all marked, or none of
  * them is in the image. */
@@ -110,8 +105,6 @@ static int reached_already(const reach_walk *w, uint32_t depth, const uint32_t n
     box_tiles(w->basis, w->camera, lo, hi, w->shift, w->tiles_x, w->tiles_y, t);
     if (t[0] > t[1] || t[2] > t[3])
         return 1;
-    if (!(t[0] <= t[1] && t[2] <= t[3]))
-        return 0; /* not a number */
     for (double ty = t[2]; ty <= t[3]; ty++) {
         const unsigned char *row = w->reached + (size_t)ty * w->tiles_x;
         for (double tx = t[0]; tx <= t[1]; tx++)

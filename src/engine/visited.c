@@ -18,7 +18,6 @@ ip_status ip__visited_init(ip_visited *v, const ip_layout *layout)
     v->edge_shift = ip__ceil_log2(b);
     v->bitmaps = calloc(layout->brick_count, sizeof *v->bitmaps);
     v->holders = malloc(layout->brick_count * sizeof *v->holders);
-    atomic_init(&v->bytes, 0);
     atomic_init(&v->holder_count, 0);
     if (v->bitmaps && v->holders)
         return IP_OK;
@@ -35,13 +34,11 @@ void ip__visited_clear(ip_visited *v)
         atomic_store(&v->bitmaps[g], NULL);
     }
     atomic_store(&v->holder_count, 0);
-    atomic_store(&v->bytes, 0);
 }
 
 void ip__visited_free(ip_visited *v)
 {
-    if (v->bitmaps && v->holders)
-        ip__visited_clear(v);
+    ip__visited_clear(v); /* nothing to visit when the arrays are missing: no holders yet */
     free(v->bitmaps);
     free(v->holders);
     v->bitmaps = NULL;
@@ -72,7 +69,6 @@ static atomic_uint_fast64_t *brick_bitmap(ip_visited *v, uint64_t g)
         if (atomic_compare_exchange_strong(&v->bitmaps[g], &expected, fresh)) {
             m = fresh;
             v->holders[atomic_fetch_add(&v->holder_count, 1)] = g; /* each brick once */
-            atomic_fetch_add(&v->bytes, v->words_per_brick * sizeof *fresh);
         } else {
             free(fresh); /* another thread published first */
             m = expected;

@@ -20,7 +20,6 @@ typedef struct ip_visited {
     uint64_t cells_per_brick;     /* B^3: the cells' bits, then one per sub-block, then one */
     uint64_t subblocks_per_brick; /* per cell group (IP_CELL_GROUP^3 cells): see "Settled" */
     unsigned edge_shift;          /* log2 of the brick edge (a power of two) */
-    atomic_uint_fast64_t bytes;   /* allocated bitmap bytes */
 } ip_visited;
 
 ip_status ip__visited_init(ip_visited *v, const ip_layout *layout);
