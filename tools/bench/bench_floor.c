@@ -1,0 +1,298 @@
+/* bench_floor: the floor under any exact view. The cells whose triangles own a pixel of the
+ * final image (the full extraction rasterised for the view) are what every exact method must
+ * at least triangulate; this times marching cubes with normals over exactly those cells, as
+ * an oracle that knew them would, with no rays, no propagation and no coverage: run 0 on an
+ * empty cache (the bricks decoded as the cells ask for them), then REPEATS runs warm. The
+ * cells are taken in id order (brick by brick, row by row), the kindest order for the caches,
+ * and split in THREADS contiguous parts, one per thread. Prints the counts, each run's time
+ * and the median of the warm runs. A benchmark, not a test (docs/performance.md, part 21).
+ */
+#include <inttypes.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "isoprop/isoprop.h"
+#include "isoprop/render.h"
+#include "propagate.h"
+#include "sampler.h"
+
+static const char usage[] =
+    "usage: bench_floor FILE.ibv ISO VIEW WIDTHxHEIGHT THREADS REPEATS\n"
+    "Triangulates only the cells whose triangles own a pixel of the final image of the view\n"
+    "(from the full extraction), on THREADS threads: once on an empty cache, then REPEATS\n"
+    "times warm.\n";
+
+#define MAX_THREADS 64
+
+typedef struct part {
+    ip_cache *cache;
+    const uint64_t *cells; /* level-0 linear indices */
+    size_t count;
+    uint32_t dims[3]; /* cells along each axis */
+    float iso;
+    ip_mesh mesh;
+    uint64_t triangles;
+    ip_status status;
+} part;
+
+static void *extract_part(void *arg)
+{
+    part *p = arg;
+    ip_sampler s;
+    p->status = ip__sampler_init(&s, p->cache, 0);
+    if (p->status != IP_OK)
+        return NULL;
+    ip_cell_output out = {&p->mesh, NULL, 0}; /* every triangle, no coverage */
+    uint64_t culled = 0;
+    p->triangles = 0;
+    for (size_t i = 0; i < p->count && p->status == IP_OK; i++) {
+        uint64_t l = p->cells[i];
+        uint32_t cell[3] = {(uint32_t)(l % p->dims[0]), (uint32_t)(l / p->dims[0] % p->dims[1]),
+                            (uint32_t)(l / p->dims[0] / p->dims[1])};
+        unsigned mc;
+        int n = ip__extract_cell(&s, &out, cell, p->iso, &mc, &culled, &p->status);
+        if (n > 0)
+            p->triangles += (uint64_t)n;
+    }
+    ip__sampler_free(&s);
+    return NULL;
+}
+
+/* One run over all cells on `threads` threads; returns its wall time, or -1 on a failure. */
+static double run(part *parts, unsigned threads, uint64_t *triangles)
+{
+    pthread_t id[MAX_THREADS];
+    double t0 = ip_now_seconds();
+    for (unsigned t = 1; t < threads; t++)
+        if (pthread_create(&id[t], NULL, extract_part, &parts[t]) != 0)
+            return -1;
+    extract_part(&parts[0]);
+    for (unsigned t = 1; t < threads; t++)
+        pthread_join(id[t], NULL);
+    double seconds = ip_now_seconds() - t0;
+    *triangles = 0;
+    for (unsigned t = 0; t < threads; t++) {
+        if (parts[t].status != IP_OK)
+            return -1;
+        *triangles += parts[t].triangles;
+        ip_mesh_clear(&parts[t].mesh);
+    }
+    return seconds;
+}
+
+static int compare_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The sorted, distinct level-0 cells of the triangles that own a pixel of `mesh`'s image, in
+ * *cells (malloc'd); their count, or -1 on a failure. */
+static long owning_cells(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
+                         const double hi[3], uint64_t **cells, uint64_t *owning_triangles)
+{
+    size_t pixels = (size_t)camera->width * camera->height;
+    uint32_t *owner = malloc(pixels * sizeof *owner);
+    unsigned char *owns = calloc(mesh->triangle_count ? mesh->triangle_count : 1, 1);
+    ip_error err;
+    if (!owner || !owns || ip_raster_mesh(mesh, camera, lo, hi, owner, NULL, &err) != IP_OK) {
+        free(owner);
+        free(owns);
+        return -1;
+    }
+    for (size_t i = 0; i < pixels; i++)
+        if (owner[i] != UINT32_MAX)
+            owns[owner[i]] = 1;
+    free(owner);
+    size_t n = 0;
+    *owning_triangles = 0;
+    uint64_t *list = malloc((mesh->triangle_count ? mesh->triangle_count : 1) * sizeof *list);
+    if (!list) {
+        free(owns);
+        return -1;
+    }
+    for (uint64_t t = 0; t < mesh->triangle_count; t++)
+        if (owns[t]) {
+            list[n++] = mesh->cells[t] & ((UINT64_C(1) << 58) - 1); /* level 0 */
+            ++*owning_triangles;
+        }
+    free(owns);
+    qsort(list, n, sizeof *list, compare_u64);
+    size_t distinct = 0;
+    for (size_t i = 0; i < n; i++)
+        if (distinct == 0 || list[i] != list[distinct - 1])
+            list[distinct++] = list[i];
+    *cells = list;
+    return (long)distinct;
+}
+
+/* Writes all of `bytes` to fd; 0 on a failure. */
+static int write_all(int fd, const void *data, size_t bytes)
+{
+    for (const char *p = data; bytes > 0;) {
+        ssize_t n = write(fd, p, bytes);
+        if (n <= 0)
+            return 0;
+        p += n;
+        bytes -= (size_t)n;
+    }
+    return 1;
+}
+
+/* Reads `bytes` from fd; 0 when it ends first. */
+static int read_all(int fd, void *data, size_t bytes)
+{
+    for (char *p = data; bytes > 0;) {
+        ssize_t n = read(fd, p, bytes);
+        if (n <= 0)
+            return 0;
+        p += n;
+        bytes -= (size_t)n;
+    }
+    return 1;
+}
+
+/* The child: the full extraction, its image's owning cells, sent down `fd` (count, then the
+ * cells). Returns the process's exit status. */
+static int child(ip_store *store, const ip_camera *camera, float iso, const double lo[3],
+                 const double hi[3], int fd)
+{
+    ip_error err;
+    ip_cache *cache;
+    ip_mesh full;
+    ip_mesh_init_with_cells(&full);
+    if (ip_cache_create(store, (uint64_t)512 << 20, &cache, &err) != IP_OK ||
+        ip_extract_full(cache, iso, 0, 0, &full, NULL, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: %s\n", err.message);
+        return 1;
+    }
+    uint64_t *cells, owning;
+    long count = owning_cells(&full, camera, lo, hi, &cells, &owning);
+    if (count < 0) {
+        fprintf(stderr, "bench_floor: out of memory\n");
+        return 1;
+    }
+    printf("full extraction: %" PRIu64 " triangles; %" PRIu64 " own a pixel, from %ld cells\n",
+           full.triangle_count, owning, count);
+    fflush(stdout);
+    uint64_t n = (uint64_t)count;
+    return write_all(fd, &n, sizeof n) && write_all(fd, cells, n * sizeof *cells) ? 0 : 1;
+}
+
+/* The owning cells, from a child process (child()), in *cells (malloc'd); their count, or -1
+ * with a message on standard error. */
+static long cells_from_child(ip_store *store, const ip_camera *camera, float iso,
+                             const double lo[3], const double hi[3], uint64_t **cells)
+{
+    int fds[2];
+    fflush(stdout);
+    if (pipe(fds) != 0)
+        return -1;
+    pid_t pid = fork();
+    if (pid < 0)
+        return -1;
+    if (pid == 0) {
+        close(fds[0]);
+        _exit(child(store, camera, iso, lo, hi, fds[1]));
+    }
+    close(fds[1]);
+    uint64_t n = 0;
+    int ok = read_all(fds[0], &n, sizeof n) && n < ((uint64_t)1 << 40) &&
+             (*cells = malloc((n ? n : 1) * sizeof **cells)) != NULL &&
+             read_all(fds[0], *cells, n * sizeof **cells);
+    close(fds[0]);
+    int status;
+    if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0 || !ok) {
+        fprintf(stderr, "bench_floor: finding the cells failed\n");
+        return -1;
+    }
+    return (long)n;
+}
+
+int main(int argc, char **argv)
+{
+    uint32_t width, height;
+    if (argc != 7 || sscanf(argv[4], "%" SCNu32 "x%" SCNu32, &width, &height) != 2) {
+        fputs(usage, stderr);
+        return 2;
+    }
+    float iso = strtof(argv[2], NULL);
+    unsigned threads = (unsigned)strtoul(argv[5], NULL, 10);
+    int repeats = atoi(argv[6]);
+    if (threads < 1 || threads > MAX_THREADS || repeats < 0) {
+        fputs(usage, stderr);
+        return 2;
+    }
+    ip_error err;
+    ip_store *store;
+    ip_cache *cache;
+    ip_camera camera;
+    double lo[3], hi[3];
+    if (ip_store_open(argv[1], &store, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: %s\n", err.message);
+        return 1;
+    }
+    const ip_layout *layout = ip_store_layout(store);
+    ip_layout_world_box(layout, lo, hi);
+    if (ip_camera_fit_axis(lo, hi, argv[3], 30.0, width, height, &camera, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: %s\n", err.message);
+        return 1;
+    }
+    /* the cells, found in a child process, so that run 0 finds this one as a fresh process
+     * would: no brick decoded, no memory ever used for them */
+    uint64_t *cells = NULL;
+    long count = cells_from_child(store, &camera, iso, lo, hi, &cells);
+    if (count < 0)
+        return 1;
+    if (ip_cache_create(store, (uint64_t)512 << 20, &cache, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: %s\n", err.message);
+        return 1;
+    }
+    part parts[MAX_THREADS];
+    for (unsigned t = 0; t < threads; t++) {
+        size_t first = (size_t)count * t / threads, end = (size_t)count * (t + 1) / threads;
+        parts[t] = (part){cache, cells + first, end - first, {0, 0, 0}, iso, {0}, 0, IP_OK};
+        for (int a = 0; a < 3; a++)
+            parts[t].dims[a] = layout->levels[0].dims[a] - 1;
+        ip_mesh_init(&parts[t].mesh);
+    }
+    double *times = malloc(((size_t)repeats + 1) * sizeof *times);
+    uint64_t triangles = 0;
+    for (int r = 0; r <= repeats; r++) {
+        times[r] = run(parts, threads, &triangles);
+        if (times[r] < 0) {
+            fprintf(stderr, "bench_floor: a brick could not be read\n");
+            return 1;
+        }
+        printf("run %d: %.4f s, %ld cells, %" PRIu64 " triangles", r, times[r], count, triangles);
+        if (r == 0) {
+            ip_cache_stats cs;
+            ip_cache_get_stats(cache, &cs);
+            printf(" (empty cache: %" PRIu64 " bricks decoded, %" PRIu64 " bytes)", cs.misses,
+                   cs.bytes_decompressed);
+        }
+        printf("\n");
+    }
+    if (repeats > 0) {
+        qsort(times + 1, (size_t)repeats, sizeof *times, compare_doubles);
+        printf("median %.4f s [%.4f-%.4f] of %d warm runs, %u threads\n",
+               times[1 + (repeats - 1) / 2], times[1], times[repeats], repeats, threads);
+    }
+    for (unsigned t = 0; t < threads; t++)
+        ip_mesh_free(&parts[t].mesh);
+    free(times);
+    free(cells);
+    ip_cache_destroy(cache);
+    ip_store_close(store);
+    return 0;
+}
