@@ -35,7 +35,7 @@ for i in $(seq "$runs"); do
                 --threads "$threads" $extra -o "$work/$name.png" \
                 --progress "$work/$name-$mode-$i.csv" --force --quiet
         done
-        "$build/bench_floor" "$file" "$iso" "$view" 1600x1200 "$threads" 5 >"$work/$name-floor-$i.txt"
+        "$build/bench_floor" "$file" "$iso" "$view" 1600x1200 "$threads" 20 >"$work/$name-floor-$i.txt"
     done
 done
 python3 - "$work" "$runs" "$threads" <<'PY'

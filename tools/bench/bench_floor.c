@@ -3,7 +3,7 @@
  * at least triangulate; this times marching cubes with normals over exactly those cells, as
  * an oracle that knew them would, with no rays, no propagation and no coverage: run 0 on an
  * empty cache (the bricks decoded as the cells ask for them), then REPEATS runs warm. The
- * cells are taken in id order (brick by brick, row by row), the kindest order for the caches,
+ * cells are taken brick by brick (in id order within a brick), the kindest order for the caches,
  * and split in THREADS contiguous parts, one per thread. Prints the counts, each run's time
  * and the median of the warm runs. A benchmark, not a test (docs/performance.md, part 21).
  */
@@ -30,9 +30,8 @@ static const char usage[] =
 
 typedef struct part {
     ip_cache *cache;
-    const uint64_t *cells; /* level-0 linear indices */
+    const uint32_t (*cells)[3]; /* level-0 cells */
     size_t count;
-    uint32_t dims[3]; /* cells along each axis */
     float iso;
     ip_mesh mesh;
     uint64_t triangles;
@@ -50,11 +49,8 @@ static void *extract_part(void *arg)
     uint64_t culled = 0;
     p->triangles = 0;
     for (size_t i = 0; i < p->count && p->status == IP_OK; i++) {
-        uint64_t l = p->cells[i];
-        uint32_t cell[3] = {(uint32_t)(l % p->dims[0]), (uint32_t)(l / p->dims[0] % p->dims[1]),
-                            (uint32_t)(l / p->dims[0] / p->dims[1])};
         unsigned mc;
-        int n = ip__extract_cell(&s, &out, cell, p->iso, &mc, &culled, &p->status);
+        int n = ip__extract_cell(&s, &out, p->cells[i], p->iso, &mc, &culled, &p->status);
         if (n > 0)
             p->triangles += (uint64_t)n;
     }
@@ -62,32 +58,48 @@ static void *extract_part(void *arg)
     return NULL;
 }
 
-/* One run over all cells on `threads` threads; returns its wall time, or -1 on a failure. */
-static double run(part *parts, unsigned threads, uint64_t *triangles)
+/* The threads, started once (as the engine's workers are) and held at barriers between
+ * runs, so that a run's time holds no thread start. */
+typedef struct crew {
+    part *parts;
+    unsigned threads;
+    pthread_barrier_t start, done;
+    int quit;
+} crew;
+
+typedef struct helper {
+    crew *crew;
+    unsigned index;
+} helper;
+
+static void *help(void *arg)
 {
-    pthread_t id[MAX_THREADS];
-    double t0 = ip_now_seconds();
-    for (unsigned t = 1; t < threads; t++)
-        if (pthread_create(&id[t], NULL, extract_part, &parts[t]) != 0)
-            return -1;
-    extract_part(&parts[0]);
-    for (unsigned t = 1; t < threads; t++)
-        pthread_join(id[t], NULL);
-    double seconds = ip_now_seconds() - t0;
-    *triangles = 0;
-    for (unsigned t = 0; t < threads; t++) {
-        if (parts[t].status != IP_OK)
-            return -1;
-        *triangles += parts[t].triangles;
-        ip_mesh_clear(&parts[t].mesh);
+    helper *h = arg;
+    for (;;) {
+        pthread_barrier_wait(&h->crew->start);
+        if (h->crew->quit)
+            return NULL;
+        extract_part(&h->crew->parts[h->index]);
+        pthread_barrier_wait(&h->crew->done);
     }
-    return seconds;
 }
 
-static int compare_u64(const void *a, const void *b)
+/* One run over all cells; returns its wall time, or -1 on a failure. */
+static double run(crew *c, uint64_t *triangles)
 {
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return x < y ? -1 : x > y;
+    double t0 = ip_now_seconds();
+    pthread_barrier_wait(&c->start);
+    extract_part(&c->parts[0]);
+    pthread_barrier_wait(&c->done);
+    double seconds = ip_now_seconds() - t0;
+    *triangles = 0;
+    for (unsigned t = 0; t < c->threads; t++) {
+        if (c->parts[t].status != IP_OK)
+            return -1;
+        *triangles += c->parts[t].triangles;
+        ip_mesh_clear(&c->parts[t].mesh);
+    }
+    return seconds;
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -96,10 +108,25 @@ static int compare_doubles(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* The sorted, distinct level-0 cells of the triangles that own a pixel of `mesh`'s image, in
- * *cells (malloc'd); their count, or -1 on a failure. */
-static long owning_cells(const ip_mesh *mesh, const ip_camera *camera, const double lo[3],
-                         const double hi[3], uint64_t **cells, uint64_t *owning_triangles)
+/* A cell and the brick holding it, for sorting brick by brick. */
+typedef struct cell_key {
+    uint64_t brick, linear;
+} cell_key;
+
+static int compare_keys(const void *a, const void *b)
+{
+    const cell_key *x = a, *y = b;
+    if (x->brick != y->brick)
+        return x->brick < y->brick ? -1 : 1;
+    return x->linear < y->linear ? -1 : x->linear > y->linear;
+}
+
+/* The distinct level-0 cells of the triangles that own a pixel of `mesh`'s image, brick by
+ * brick and in id order within a brick, in *cells (malloc'd); their count, or -1 on a
+ * failure. */
+static long owning_cells(const ip_mesh *mesh, const ip_layout *layout, const ip_camera *camera,
+                         const double lo[3], const double hi[3], uint64_t **cells,
+                         uint64_t *owning_triangles)
 {
     size_t pixels = (size_t)camera->width * camera->height;
     uint32_t *owner = malloc(pixels * sizeof *owner);
@@ -116,22 +143,34 @@ static long owning_cells(const ip_mesh *mesh, const ip_camera *camera, const dou
     free(owner);
     size_t n = 0;
     *owning_triangles = 0;
+    cell_key *keys = malloc((mesh->triangle_count ? mesh->triangle_count : 1) * sizeof *keys);
     uint64_t *list = malloc((mesh->triangle_count ? mesh->triangle_count : 1) * sizeof *list);
-    if (!list) {
+    if (!keys || !list) {
         free(owns);
+        free(keys);
+        free(list);
         return -1;
     }
+    const ip_level_layout *lv = &layout->levels[0];
+    uint64_t cx = lv->dims[0] - 1, cy = lv->dims[1] - 1;
+    unsigned shift = 0;
+    while ((1u << shift) < layout->brick_edge)
+        shift++;
     for (uint64_t t = 0; t < mesh->triangle_count; t++)
         if (owns[t]) {
-            list[n++] = mesh->cells[t] & ((UINT64_C(1) << 58) - 1); /* level 0 */
+            uint64_t l = mesh->cells[t] & ((UINT64_C(1) << 58) - 1); /* level 0 */
+            uint32_t b[3] = {(uint32_t)(l % cx) >> shift, (uint32_t)(l / cx % cy) >> shift,
+                             (uint32_t)(l / cx / cy) >> shift};
+            keys[n++] = (cell_key){ip_brick_global_index(layout, 0, b), l};
             ++*owning_triangles;
         }
     free(owns);
-    qsort(list, n, sizeof *list, compare_u64);
+    qsort(keys, n, sizeof *keys, compare_keys);
     size_t distinct = 0;
     for (size_t i = 0; i < n; i++)
-        if (distinct == 0 || list[i] != list[distinct - 1])
-            list[distinct++] = list[i];
+        if (distinct == 0 || keys[i].linear != list[distinct - 1])
+            list[distinct++] = keys[i].linear;
+    free(keys);
     *cells = list;
     return (long)distinct;
 }
@@ -177,7 +216,7 @@ static int child(ip_store *store, const ip_camera *camera, float iso, const doub
         return 1;
     }
     uint64_t *cells, owning;
-    long count = owning_cells(&full, camera, lo, hi, &cells, &owning);
+    long count = owning_cells(&full, ip_store_layout(store), camera, lo, hi, &cells, &owning);
     if (count < 0) {
         fprintf(stderr, "bench_floor: out of memory\n");
         return 1;
@@ -258,18 +297,42 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_floor: %s\n", err.message);
         return 1;
     }
+    /* the cells' coordinates, worked out before the clock starts */
+    uint32_t(*xyz)[3] = malloc(((size_t)count + 1) * sizeof *xyz);
+    if (!xyz) {
+        fprintf(stderr, "bench_floor: out of memory\n");
+        return 1;
+    }
+    uint64_t cx = layout->levels[0].dims[0] - 1, cy = layout->levels[0].dims[1] - 1;
+    for (long i = 0; i < count; i++) {
+        xyz[i][0] = (uint32_t)(cells[i] % cx);
+        xyz[i][1] = (uint32_t)(cells[i] / cx % cy);
+        xyz[i][2] = (uint32_t)(cells[i] / cx / cy);
+    }
+    free(cells);
     part parts[MAX_THREADS];
     for (unsigned t = 0; t < threads; t++) {
         size_t first = (size_t)count * t / threads, end = (size_t)count * (t + 1) / threads;
-        parts[t] = (part){cache, cells + first, end - first, {0, 0, 0}, iso, {0}, 0, IP_OK};
-        for (int a = 0; a < 3; a++)
-            parts[t].dims[a] = layout->levels[0].dims[a] - 1;
+        parts[t] =
+            (part){cache, (const uint32_t(*)[3])(xyz + first), end - first, iso, {0}, 0, IP_OK};
         ip_mesh_init(&parts[t].mesh);
+    }
+    crew c = {parts, threads, .quit = 0};
+    helper helpers[MAX_THREADS];
+    pthread_t id[MAX_THREADS];
+    pthread_barrier_init(&c.start, NULL, threads);
+    pthread_barrier_init(&c.done, NULL, threads);
+    for (unsigned t = 1; t < threads; t++) {
+        helpers[t] = (helper){&c, t};
+        if (pthread_create(&id[t], NULL, help, &helpers[t]) != 0) {
+            fprintf(stderr, "bench_floor: cannot start a thread\n");
+            return 1;
+        }
     }
     double *times = malloc(((size_t)repeats + 1) * sizeof *times);
     uint64_t triangles = 0;
     for (int r = 0; r <= repeats; r++) {
-        times[r] = run(parts, threads, &triangles);
+        times[r] = run(&c, &triangles);
         if (times[r] < 0) {
             fprintf(stderr, "bench_floor: a brick could not be read\n");
             return 1;
@@ -283,6 +346,12 @@ int main(int argc, char **argv)
         }
         printf("\n");
     }
+    c.quit = 1;
+    pthread_barrier_wait(&c.start);
+    for (unsigned t = 1; t < threads; t++)
+        pthread_join(id[t], NULL);
+    pthread_barrier_destroy(&c.start);
+    pthread_barrier_destroy(&c.done);
     if (repeats > 0) {
         qsort(times + 1, (size_t)repeats, sizeof *times, compare_doubles);
         printf("median %.4f s [%.4f-%.4f] of %d warm runs, %u threads\n",
@@ -291,7 +360,7 @@ int main(int argc, char **argv)
     for (unsigned t = 0; t < threads; t++)
         ip_mesh_free(&parts[t].mesh);
     free(times);
-    free(cells);
+    free(xyz);
     ip_cache_destroy(cache);
     ip_store_close(store);
     return 0;
