@@ -332,14 +332,20 @@ static void test_accessors(const char *ibv)
     free(work);
 }
 
+/* A small uint8 phantom, bricked as `name`.ibv in dir: both constant and stored bricks. */
+static void make_phantom(const char *dir, const char *name, char *ibv, size_t size)
+{
+    ip_gen_params p = {IP_FIELD_SHEPP_LOGAN, {40, 36, 33}, IP_UINT8, 0.0, 1};
+    make_volume(dir, &p, name, ibv, size);
+}
+
 /* The sub-block ranges as the store holds them (those of uniform bricks shared by value) are
  * the file's, bit for bit, for every brick; the store holds less than the summary section. */
 static void test_compact_summaries(const char *dir)
 {
-    ip_gen_params p = {IP_FIELD_SHEPP_LOGAN, {40, 36, 33}, IP_UINT8, 0.0, 1};
     char ibv[4400];
     ip_error err;
-    make_volume(dir, &p, "phantom", ibv, sizeof ibv);
+    make_phantom(dir, "phantom", ibv, sizeof ibv);
     size_t size;
     unsigned char *file = read_whole(ibv, &size);
     ip_store *s = NULL;
@@ -375,10 +381,9 @@ static void test_compact_summaries(const char *dir)
  * kernel cannot tell, and then throughout. */
 static void test_in_memory(const char *dir)
 {
-    ip_gen_params p = {IP_FIELD_SHEPP_LOGAN, {40, 36, 33}, IP_UINT8, 0.0, 1};
     char ibv[4400];
     ip_error err;
-    make_volume(dir, &p, "in_memory", ibv, sizeof ibv);
+    make_phantom(dir, "in_memory", ibv, sizeof ibv);
     size_t size;
     free(read_whole(ibv, &size));
     ip_store *s = NULL;
