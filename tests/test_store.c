@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <math.h>
 #include <sys/stat.h>
+#include <sys/vfs.h>
 #include <unistd.h>
 
 #include "check.h"
@@ -331,14 +332,20 @@ static void test_accessors(const char *ibv)
     free(work);
 }
 
+/* A small uint8 phantom, bricked as `name`.ibv in dir: both constant and stored bricks. */
+static void make_phantom(const char *dir, const char *name, char *ibv, size_t size)
+{
+    ip_gen_params p = {IP_FIELD_SHEPP_LOGAN, {40, 36, 33}, IP_UINT8, 0.0, 1};
+    make_volume(dir, &p, name, ibv, size);
+}
+
 /* The sub-block ranges as the store holds them (those of uniform bricks shared by value) are
  * the file's, bit for bit, for every brick; the store holds less than the summary section. */
 static void test_compact_summaries(const char *dir)
 {
-    ip_gen_params p = {IP_FIELD_SHEPP_LOGAN, {40, 36, 33}, IP_UINT8, 0.0, 1};
     char ibv[4400];
     ip_error err;
-    make_volume(dir, &p, "phantom", ibv, sizeof ibv);
+    make_phantom(dir, "phantom", ibv, sizeof ibv);
     size_t size;
     unsigned char *file = read_whole(ibv, &size);
     ip_store *s = NULL;
@@ -368,6 +375,52 @@ static void test_compact_summaries(const char *dir)
     free(file);
 }
 
+/* ip_store_brick_in_memory(): 1 for every brick once the file has just been read whole, 0 for
+ * a payload brick once the kernel has dropped the file's pages (unless the file system keeps
+ * files in memory), 1 for a constant brick whatever the page cache holds; -1 only where the
+ * kernel cannot tell, and then throughout. */
+static void test_in_memory(const char *dir)
+{
+    char ibv[4400];
+    ip_error err;
+    make_phantom(dir, "in_memory", ibv, sizeof ibv);
+    size_t size;
+    free(read_whole(ibv, &size));
+    ip_store *s = NULL;
+    REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
+    const ip_layout *l = ip_store_layout(s);
+    ip_brick_entry e;
+    uint64_t g = first_payload(s, &e), constant = UINT64_MAX;
+    for (uint64_t i = 0; i < l->brick_count && constant == UINT64_MAX; i++) {
+        ip_brick_entry c;
+        ip_store_brick_entry(s, i, &c);
+        if (c.encoding == IP_BRICK_CONSTANT)
+            constant = i;
+    }
+    REQUIRE(constant != UINT64_MAX);
+    int in = ip_store_brick_in_memory(s, g);
+    if (in < 0) {
+        printf("test_store: the kernel cannot tell what the page cache holds here\n");
+        ip_store_close(s);
+        return;
+    }
+    int all = 1;
+    for (uint64_t i = 0; i < l->brick_count; i++)
+        all &= ip_store_brick_in_memory(s, i) == 1;
+    CHECK(all);
+    int fd = open(ibv, O_RDONLY);
+    REQUIRE(fd >= 0);
+    struct statfs fs;
+    REQUIRE(fstatfs(fd, &fs) == 0);
+    int memory_fs = fs.f_type == 0x01021994 /* tmpfs */ || fs.f_type == 0x858458f6; /* ramfs */
+    REQUIRE(fdatasync(fd) == 0 && posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED) == 0);
+    close(fd);
+    in = ip_store_brick_in_memory(s, g);
+    CHECK_MSG(memory_fs ? in == 1 : in == 0, "brick %llu: %d", (unsigned long long)g, in);
+    CHECK(ip_store_brick_in_memory(s, constant) == 1);
+    ip_store_close(s);
+}
+
 int main(void)
 {
     const char *dir = test_tmp_dir("test_store");
@@ -380,5 +433,6 @@ int main(void)
     test_truncated_while_open(dir, ibv);
     test_rewritten_while_open(dir, ibv);
     test_compact_summaries(dir);
+    test_in_memory(dir);
     return test_summary("test_store");
 }

@@ -1,12 +1,17 @@
 #!/bin/bash
-# Cold views with reading ahead on and off, interleaved (docs/performance.md, part 13). Needs
-# root for drop_caches; writes its files to /tmp/pf/r.
-# usage: tools/bench_prefetch.sh BUILD RUNS FILE.ibv...: cold runs, prefetch on/off interleaved
+# Cold views with reading ahead on and off, interleaved (docs/performance.md, parts 13 and
+# 21). Needs root for drop_caches; writes its files to /tmp/pf/r. MODES (default "on off")
+# lists the --prefetch values compared, taken in turn, the order rotating from run to run.
+# usage: [MODES="on off always"] tools/bench_prefetch.sh BUILD RUNS FILE.ibv...
 B=$1; RUNS=$2; shift 2
+read -r -a modes <<<"${MODES:-on off}"
+
 mkdir -p /tmp/pf/r
 for f in "$@"; do
   for i in $(seq 1 $RUNS); do
-    if [ $((i % 2)) = 1 ]; then order="on off"; else order="off on"; fi
+    n=${#modes[@]}
+    order=""
+    for k in $(seq 0 $((n - 1))); do order="$order ${modes[$(((i + k) % n))]}"; done
     for pf in $order; do
       sync; echo 3 > /proc/sys/vm/drop_caches
       tag=$(basename $f .ibv)_${pf}_$i

@@ -564,7 +564,7 @@ void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t he
     o->lod = 1;
     o->pixel_error = 1.0;
     o->occlusion = 1;
-    o->prefetch = 1;
+    o->prefetch = IP_PREFETCH_ON;
     o->cull = -1;
     o->cache_bytes = ip_cache_default_budget();
 }
@@ -747,7 +747,13 @@ static int parse_occlusion(const char *p, const tool_option *opt, const char *co
 static int parse_prefetch(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     (void)opt;
-    return parse_on_off(p, v[0], &((tool_view_options *)base)->prefetch, "--prefetch");
+    static const char *const names[3] = {"off", "on", "always"}; /* IP_PREFETCH_OFF, _ON, ... */
+    for (int i = 0; i < 3; i++)
+        if (!strcmp(v[0], names[i])) {
+            ((tool_view_options *)base)->prefetch = i;
+            return 0;
+        }
+    return tool_usage_error(p, "--prefetch must be on, off or always");
 }
 
 static int parse_cull(const char *p, const tool_option *opt, const char *const *v, void *base)

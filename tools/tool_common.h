@@ -134,7 +134,7 @@ typedef struct tool_view_options {
     int lod;
     double pixel_error;
     int occlusion; /* --occlusion on|off */
-    int prefetch;  /* --prefetch on|off */
+    int prefetch;  /* --prefetch on|off|always: IP_PREFETCH_ON, _OFF, _ALWAYS */
     int cull;      /* --cull on|off; -1 when not given, until the program settles its default */
     unsigned clip_count;                    /* --clip SPEC, repeatable */
     ip_clip_plane clip[IP_MAX_CLIP_PLANES]; /* world units (tool_parse_clip()) */
@@ -152,8 +152,10 @@ typedef struct tool_view_options {
     "  --lod on|off        adaptive resolution: far regions from coarser levels (default on)\n"    \
     "  --pixel-error P     with --lod: coarsen where a cell projects to <= P pixels (default 1)\n" \
     "  --occlusion on|off  propagation skips cells that extracted surface hides (default on)\n"    \
-    "  --prefetch on|off   a background thread reads and decodes the bricks the next rays need\n"  \
-    "                      (default on)\n"                                                         \
+    "  --prefetch on|off|always\n"                                                                 \
+    "                      a background thread reads and decodes the bricks the next rays need;\n" \
+    "                      on (the default): only those the disk must deliver when the threads\n"  \
+    "                      take every core; always: every one\n"                                   \
     "  --cull on|off       with --occlusion: keep no triangle the image shows at no pixel\n"       \
     "                      centre (default: isorender and isowall on, unless --mesh or --aa;\n"    \
     "                      isoview off)\n"                                                         \

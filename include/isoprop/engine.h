@@ -47,14 +47,19 @@
  * front but what this view's image needs. Keep them (cull 0) for a mesh to be written out,
  * drawn with multisampling or from another view (docs/occlusion.md).
  *
- * Reading ahead (options.prefetch, on by default): one more thread per engine reads and
- * decodes into the cache, from the first step after ip_engine_begin() on and between steps,
- * the bricks that the next rays of the order will seed in (found from the summaries) and
- * their neighbours across brick faces, within the cache's budget and without evicting a
- * brick of the current view (docs/cache.md, "Prefetching"). The triangles do not depend on
- * it; only who reads a brick first and when. A brick that fails to load in the background is
- * read again by the worker that needs it, which reports the error as without reading ahead.
- * It stops at ip_engine_begin() (for the new view), ip_engine_cancel() and ip_engine_destroy().
+ * Reading ahead (options.prefetch, IP_PREFETCH_ON by default): one more thread per engine
+ * reads and decodes into the cache, from the first step after ip_engine_begin() on and between
+ * steps, the bricks that the next rays of the order will seed in (found from the summaries) and
+ * their neighbours across brick faces, within the cache's budget and without evicting a brick
+ * of the current view (docs/cache.md, "Prefetching"). When the workers have every core
+ * (threads >= ip_thread_count(0)) it reads ahead only the bricks the disk has to deliver: one
+ * whose payload the page cache holds (ip_store_brick_in_memory()) is left to the worker that
+ * needs it, which decodes it as fast, rather than decoded on a core the workers need, maybe
+ * for no ray. IP_PREFETCH_ALWAYS reads every planned brick ahead; IP_PREFETCH_OFF starts no
+ * reader. The triangles do not depend on it; only who reads a brick first and when. A brick
+ * that fails to load in the background is read again by the worker that needs it, which
+ * reports the error as without reading ahead. It stops at ip_engine_begin() (for the new view),
+ * ip_engine_cancel() and ip_engine_destroy().
  *
  * Threads: an engine is driven by one thread. ip_engine_create() starts its worker threads
  * (ip_thread_count(options.threads) in all, the driving thread counted), which sleep between
@@ -102,6 +107,11 @@ typedef struct ip_clip_plane {
     double offset;
 } ip_clip_plane;
 
+/* ip_engine_options.prefetch (see Reading ahead above). */
+#define IP_PREFETCH_OFF 0    /* no reader */
+#define IP_PREFETCH_ON 1     /* read ahead what the disk must deliver, all when a core is spare */
+#define IP_PREFETCH_ALWAYS 2 /* read every planned brick ahead */
+
 typedef struct ip_engine_options {
     double cutoff_degrees;   /* propagation cut-off angle around the seed's ray */
     double foldback_degrees; /* fold-back tolerance */
@@ -112,8 +122,9 @@ typedef struct ip_engine_options {
     int cell_ids;            /* keep each triangle's cell id in the mesh (8 bytes a triangle
                                  more; for comparing extractions) */
     int occlusion;           /* occlusion-aware propagation (see Occlusion above; default on) */
-    int prefetch;            /* a background reader loads the bricks the next rays need (see
-                                Reading ahead above; default on) */
+    int prefetch;            /* a background reader loads the bricks the next rays need:
+                                IP_PREFETCH_OFF, _ON (the default) or _ALWAYS (see Reading
+                                ahead above) */
     int cull;                /* with occlusion: triangles drawn at no pixel centre of the view's
                                 image are not kept (see Culling above; default on) */
     unsigned clip_count;     /* planes in use in clip (0: none, the default) */

@@ -30,7 +30,9 @@ def _engine_options(threads, cutoff, foldback, lod, pixel_error, occlusion, pref
     if foldback is not None:
         o.foldback_degrees = foldback
     o.threads, o.lod, o.pixel_error = threads, int(bool(lod)), pixel_error
-    o.occlusion, o.prefetch = int(bool(occlusion)), int(bool(prefetch))
+    # prefetch: True/False, or "always" (isorender --prefetch always)
+    o.occlusion = int(bool(occlusion))
+    o.prefetch = 2 if prefetch == "always" else int(bool(prefetch))
     o.cull = int(bool(cull))
     return o
 

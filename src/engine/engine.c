@@ -22,7 +22,7 @@ void ip_engine_options_default(ip_engine_options *o)
     o->pixel_error = 1.0;
     o->cell_ids = 0;
     o->occlusion = 1;
-    o->prefetch = 1;
+    o->prefetch = IP_PREFETCH_ON;
     o->cull = 1;
     o->clip_count = 0;
 }
@@ -45,6 +45,11 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     if (options->lod && !(options->pixel_error > 0 && isfinite(options->pixel_error)))
         return ip__fail(err, IP_ERR_ARGUMENT, "the pixel error %g must be positive",
                         options->pixel_error);
+    if (options->prefetch < IP_PREFETCH_OFF || options->prefetch > IP_PREFETCH_ALWAYS)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "prefetch %d: must be IP_PREFETCH_OFF, IP_PREFETCH_ON or "
+                        "IP_PREFETCH_ALWAYS (0, 1, 2)",
+                        options->prefetch);
     if (!ip__clip_valid(options->clip, options->clip_count))
         return ip__fail(err, IP_ERR_ARGUMENT,
                         "clipping planes: %u given (at most %d), each with a finite, non-zero "
@@ -77,8 +82,12 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
                        : IP_ERR_NOMEM;
     if (st == IP_OK)
         st = ip__pool_create(e->threads, &e->pool, NULL);
-    if (st == IP_OK && options->prefetch)
-        st = ip__prefetcher_create(cache, &e->prefetcher);
+    /* IP_PREFETCH_ON: the reader leaves the bricks already in memory to the workers when they
+     * have every core (ip__prefetcher_create()) */
+    if (st == IP_OK && options->prefetch != IP_PREFETCH_OFF)
+        st = ip__prefetcher_create(
+            cache, options->prefetch == IP_PREFETCH_ON && e->threads >= ip_thread_count(0),
+            &e->prefetcher);
     for (unsigned t = 0; st == IP_OK && t < e->threads; t++) {
         e->workers[t].engine = e;
         ip_mesh_init(&e->workers[t].mesh);

@@ -25,7 +25,8 @@ struct ip__prefetcher {
     ip_cache *cache;
     const ip_store *store;
     const ip_layout *layout;
-    uint64_t window; /* payload bytes asked of the kernel ahead of the brick being loaded */
+    uint64_t window;     /* payload bytes asked of the kernel ahead of the brick being loaded */
+    int leave_in_memory; /* bricks whose payload the page cache holds are left to the workers */
     pthread_t thread;
     int started;
     pthread_mutex_t lock;
@@ -193,6 +194,8 @@ static void load_next(ip__prefetcher *p)
     ip_brick_entry be;
     ip_store_brick_entry(p->store, g, &be);
     p->hinted_bytes -= be.stored_size; /* hint() has passed it: hinted > head */
+    if (p->leave_in_memory && ip_store_brick_in_memory(p->store, g) == 1)
+        return; /* no disk to wait for: a worker that needs it loads it as fast */
     ip__prefetch_outcome got = ip__cache_prefetch_brick(p->cache, g, p->below);
     if (got == IP__PREFETCH_FULL)
         p->finished = 1; /* the budget holds this view's bricks: stop until the next view */
@@ -236,11 +239,12 @@ static void *reader(void *arg)
     return NULL;
 }
 
-ip_status ip__prefetcher_create(ip_cache *cache, ip__prefetcher **out)
+ip_status ip__prefetcher_create(ip_cache *cache, int leave_in_memory, ip__prefetcher **out)
 {
     ip__prefetcher *p = calloc(1, sizeof *p);
     if (!p)
         return IP_ERR_NOMEM;
+    p->leave_in_memory = leave_in_memory;
     p->cache = cache;
     p->store = ip_cache_store(cache);
     p->layout = ip_store_layout(p->store);

@@ -61,9 +61,13 @@ typedef struct ip__prefetch_view {
     uint32_t region_x, region_y; /* the image pixel of the order's pixel (0, 0) */
 } ip__prefetch_view;
 
-/* Starts the reader thread (signals blocked), idle until ip__prefetcher_resume(). *out is the
- * caller's, released with ip__prefetcher_destroy(). @return IP_OK or IP_ERR_NOMEM. */
-ip_status ip__prefetcher_create(ip_cache *cache, ip__prefetcher **out);
+/* Starts the reader thread (signals blocked), idle until ip__prefetcher_resume(). With
+ * `leave_in_memory` it loads only the planned bricks whose payload the page cache does not
+ * hold (ip_store_brick_in_memory() is not 1), for when it would take a core from the workers:
+ * decoding such a brick costs a worker no more than it costs the reader, and the reader's
+ * would be lost when no ray needs the brick. *out is the caller's, released with
+ * ip__prefetcher_destroy(). @return IP_OK or IP_ERR_NOMEM. */
+ip_status ip__prefetcher_create(ip_cache *cache, int leave_in_memory, ip__prefetcher **out);
 
 /* Pauses, stops and joins the thread, frees everything; NULL is a no-op. */
 void ip__prefetcher_destroy(ip__prefetcher *p);

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/uio.h>
 #include <unistd.h>
 #include <xxhash.h>
 
@@ -470,6 +471,42 @@ void ip_store_prefetch_brick(const ip_store *s, uint64_t g)
     ip_store_brick_entry(s, g, &e);
     if (e.stored_size > 0)
         (void)posix_fadvise(s->fd, (off_t)e.offset, (off_t)e.stored_size, POSIX_FADV_WILLNEED);
+}
+
+/* Whether byte `offset` of the file is in the page cache: a read of it that may not wait for
+ * the disk (RWF_NOWAIT) gets it (1), is refused as it would wait (0), or fails otherwise:
+ * the kernel or the file system cannot tell (-1). */
+static int byte_in_memory(int fd, uint64_t offset)
+{
+#ifdef RWF_NOWAIT
+    char byte;
+    struct iovec v = {&byte, 1};
+    ssize_t n = preadv2(fd, &v, 1, (off_t)offset, RWF_NOWAIT);
+    if (n == 1)
+        return 1;
+    return n < 0 && errno == EAGAIN ? 0 : -1;
+#else
+    (void)fd;
+    (void)offset;
+    return -1;
+#endif
+}
+
+int ip_store_brick_in_memory(const ip_store *s, uint64_t g)
+{
+    ip_brick_entry e;
+    ip_store_brick_entry(s, g, &e);
+    if (e.stored_size == 0)
+        return 1; /* a constant brick: nothing to read */
+    /* its first, middle and last pages: the kernel reads a payload's pages together (a miss,
+     * a hint, its read-ahead), so these stand for the others */
+    uint64_t at[3] = {e.offset, e.offset + e.stored_size / 2, e.offset + e.stored_size - 1};
+    for (int i = 0; i < 3; i++) {
+        int in = byte_in_memory(s->fd, at[i]);
+        if (in != 1)
+            return in;
+    }
+    return 1;
 }
 
 static int same_range(const float *a, const float *b)

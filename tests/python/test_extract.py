@@ -92,6 +92,16 @@ class Extract(unittest.TestCase):
         self.assertTrue(mesh.stats["done"])
         self.assertEqual(mesh.stats["rays"], SIZE[0] * SIZE[1])
 
+    def test_prefetch_always_and_off_same_triangles(self):
+        """prefetch="always" (isorender --prefetch always) and prefetch=False extract the same
+        triangles on one thread; the statistics say whether a reader ran."""
+        always = self.f.extract(ISO, view="+x", size=SIZE, threads=1, prefetch="always")
+        off = self.f.extract(ISO, view="+x", size=SIZE, threads=1, prefetch=False)
+        self.assertTrue(always.stats["prefetch"])
+        self.assertFalse(off.stats["prefetch"])
+        self.assertEqual(always.faces.tolist(), off.faces.tolist())
+        self.assertEqual(always.vertices.tolist(), off.vertices.tolist())
+
     def test_cull_equals_isorender_cull_on(self):
         """cull=True keeps what isorender --mesh --cull on keeps, and fewer triangles than the
         default, which keeps them all; the counts add up."""

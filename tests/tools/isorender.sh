@@ -69,7 +69,13 @@ check "prefetch off succeeds" test "$rc" = 0
 check "prefetch off says so" grep -q '"prefetch": false' n.json
 check "prefetch off loads nothing ahead" grep -q '"prefetched": 0, "prefetch_hits": 0' n.json
 check "prefetch on and off make the same picture" cmp -s p.png n.png
-expect_error 2 "--prefetch" "$bin/isorender" s.ibv --iso 1 --prefetch maybe -o x.png
+run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o a.png \
+    --prefetch always --stats a.json --software --quiet
+check "prefetch always succeeds" test "$rc" = 0
+check "prefetch always says it is on" grep -q '"prefetch": true' a.json
+check "prefetch always and off make the same picture" cmp -s a.png n.png
+expect_error 2 "--prefetch must be on, off or always" "$bin/isorender" s.ibv --iso 1 \
+    --prefetch maybe -o x.png
 
 # culling: on by default, off when the mesh is written (unless asked for); the same picture
 # either way, and on one thread the culled and kept triangles add up to those kept without

@@ -1,0 +1,367 @@
+/* bench_floor: the floor under any exact view. The cells whose triangles own a pixel of the
+ * final image (the full extraction rasterised for the view) are what every exact method must
+ * at least triangulate; this times marching cubes with normals over exactly those cells, as
+ * an oracle that knew them would, with no rays, no propagation and no coverage: run 0 on an
+ * empty cache (the bricks decoded as the cells ask for them), then REPEATS runs warm. The
+ * cells are taken brick by brick (in id order within a brick), the kindest order for the caches,
+ * and split in THREADS contiguous parts, one per thread. Prints the counts, each run's time
+ * and the median of the warm runs. A benchmark, not a test (docs/performance.md, part 21).
+ */
+#include <inttypes.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "isoprop/isoprop.h"
+#include "isoprop/render.h"
+#include "propagate.h"
+#include "sampler.h"
+
+static const char usage[] =
+    "usage: bench_floor FILE.ibv ISO VIEW WIDTHxHEIGHT THREADS REPEATS\n"
+    "Triangulates only the cells whose triangles own a pixel of the final image of the view\n"
+    "(from the full extraction), on THREADS threads: once on an empty cache, then REPEATS\n"
+    "times warm.\n";
+
+#define MAX_THREADS 64
+
+typedef struct part {
+    ip_cache *cache;
+    const uint32_t (*cells)[3]; /* level-0 cells */
+    size_t count;
+    float iso;
+    ip_mesh mesh;
+    uint64_t triangles;
+    ip_status status;
+} part;
+
+static void *extract_part(void *arg)
+{
+    part *p = arg;
+    ip_sampler s;
+    p->status = ip__sampler_init(&s, p->cache, 0);
+    if (p->status != IP_OK)
+        return NULL;
+    ip_cell_output out = {&p->mesh, NULL, 0}; /* every triangle, no coverage */
+    uint64_t culled = 0;
+    p->triangles = 0;
+    for (size_t i = 0; i < p->count && p->status == IP_OK; i++) {
+        unsigned mc;
+        int n = ip__extract_cell(&s, &out, p->cells[i], p->iso, &mc, &culled, &p->status);
+        if (n > 0)
+            p->triangles += (uint64_t)n;
+    }
+    ip__sampler_free(&s);
+    return NULL;
+}
+
+/* The threads, started once (as the engine's workers are) and held at barriers between
+ * runs, so that a run's time holds no thread start. */
+typedef struct crew {
+    part *parts;
+    unsigned threads;
+    pthread_barrier_t start, done;
+    int quit;
+} crew;
+
+typedef struct helper {
+    crew *crew;
+    unsigned index;
+} helper;
+
+static void *help(void *arg)
+{
+    helper *h = arg;
+    for (;;) {
+        pthread_barrier_wait(&h->crew->start);
+        if (h->crew->quit)
+            return NULL;
+        extract_part(&h->crew->parts[h->index]);
+        pthread_barrier_wait(&h->crew->done);
+    }
+}
+
+/* One run over all cells; returns its wall time, or -1 on a failure. */
+static double run(crew *c, uint64_t *triangles)
+{
+    double t0 = ip_now_seconds();
+    pthread_barrier_wait(&c->start);
+    extract_part(&c->parts[0]);
+    pthread_barrier_wait(&c->done);
+    double seconds = ip_now_seconds() - t0;
+    *triangles = 0;
+    for (unsigned t = 0; t < c->threads; t++) {
+        if (c->parts[t].status != IP_OK)
+            return -1;
+        *triangles += c->parts[t].triangles;
+        ip_mesh_clear(&c->parts[t].mesh);
+    }
+    return seconds;
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* A cell and the brick holding it, for sorting brick by brick. */
+typedef struct cell_key {
+    uint64_t brick, linear;
+} cell_key;
+
+static int compare_keys(const void *a, const void *b)
+{
+    const cell_key *x = a, *y = b;
+    if (x->brick != y->brick)
+        return x->brick < y->brick ? -1 : 1;
+    return x->linear < y->linear ? -1 : x->linear > y->linear;
+}
+
+/* The distinct level-0 cells of the triangles that own a pixel of `mesh`'s image, brick by
+ * brick and in id order within a brick, in *cells (malloc'd); their count, or -1 on a
+ * failure. */
+static long owning_cells(const ip_mesh *mesh, const ip_layout *layout, const ip_camera *camera,
+                         const double lo[3], const double hi[3], uint64_t **cells,
+                         uint64_t *owning_triangles)
+{
+    size_t pixels = (size_t)camera->width * camera->height;
+    uint32_t *owner = malloc(pixels * sizeof *owner);
+    unsigned char *owns = calloc(mesh->triangle_count ? mesh->triangle_count : 1, 1);
+    ip_error err;
+    if (!owner || !owns || ip_raster_mesh(mesh, camera, lo, hi, owner, NULL, &err) != IP_OK) {
+        free(owner);
+        free(owns);
+        return -1;
+    }
+    for (size_t i = 0; i < pixels; i++)
+        if (owner[i] != UINT32_MAX)
+            owns[owner[i]] = 1;
+    free(owner);
+    size_t n = 0;
+    *owning_triangles = 0;
+    cell_key *keys = malloc((mesh->triangle_count ? mesh->triangle_count : 1) * sizeof *keys);
+    uint64_t *list = malloc((mesh->triangle_count ? mesh->triangle_count : 1) * sizeof *list);
+    if (!keys || !list) {
+        free(owns);
+        free(keys);
+        free(list);
+        return -1;
+    }
+    const ip_level_layout *lv = &layout->levels[0];
+    uint64_t cx = lv->dims[0] - 1, cy = lv->dims[1] - 1;
+    unsigned shift = 0;
+    while ((1u << shift) < layout->brick_edge)
+        shift++;
+    for (uint64_t t = 0; t < mesh->triangle_count; t++)
+        if (owns[t]) {
+            uint64_t l = mesh->cells[t] & ((UINT64_C(1) << 58) - 1); /* level 0 */
+            uint32_t b[3] = {(uint32_t)(l % cx) >> shift, (uint32_t)(l / cx % cy) >> shift,
+                             (uint32_t)(l / cx / cy) >> shift};
+            keys[n++] = (cell_key){ip_brick_global_index(layout, 0, b), l};
+            ++*owning_triangles;
+        }
+    free(owns);
+    qsort(keys, n, sizeof *keys, compare_keys);
+    size_t distinct = 0;
+    for (size_t i = 0; i < n; i++)
+        if (distinct == 0 || keys[i].linear != list[distinct - 1])
+            list[distinct++] = keys[i].linear;
+    free(keys);
+    *cells = list;
+    return (long)distinct;
+}
+
+/* Writes all of `bytes` to fd; 0 on a failure. */
+static int write_all(int fd, const void *data, size_t bytes)
+{
+    for (const char *p = data; bytes > 0;) {
+        ssize_t n = write(fd, p, bytes);
+        if (n <= 0)
+            return 0;
+        p += n;
+        bytes -= (size_t)n;
+    }
+    return 1;
+}
+
+/* Reads `bytes` from fd; 0 when it ends first. */
+static int read_all(int fd, void *data, size_t bytes)
+{
+    for (char *p = data; bytes > 0;) {
+        ssize_t n = read(fd, p, bytes);
+        if (n <= 0)
+            return 0;
+        p += n;
+        bytes -= (size_t)n;
+    }
+    return 1;
+}
+
+/* The child: the full extraction, its image's owning cells, sent down `fd` (count, then the
+ * cells). Returns the process's exit status. */
+static int child(ip_store *store, const ip_camera *camera, float iso, const double lo[3],
+                 const double hi[3], int fd)
+{
+    ip_error err;
+    ip_cache *cache;
+    ip_mesh full;
+    ip_mesh_init_with_cells(&full);
+    if (ip_cache_create(store, (uint64_t)512 << 20, &cache, &err) != IP_OK ||
+        ip_extract_full(cache, iso, 0, 0, &full, NULL, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: %s\n", err.message);
+        return 1;
+    }
+    uint64_t *cells, owning;
+    long count = owning_cells(&full, ip_store_layout(store), camera, lo, hi, &cells, &owning);
+    if (count < 0) {
+        fprintf(stderr, "bench_floor: out of memory\n");
+        return 1;
+    }
+    printf("full extraction: %" PRIu64 " triangles; %" PRIu64 " own a pixel, from %ld cells\n",
+           full.triangle_count, owning, count);
+    fflush(stdout);
+    uint64_t n = (uint64_t)count;
+    return write_all(fd, &n, sizeof n) && write_all(fd, cells, n * sizeof *cells) ? 0 : 1;
+}
+
+/* The owning cells, from a child process (child()), in *cells (malloc'd); their count, or -1
+ * with a message on standard error. */
+static long cells_from_child(ip_store *store, const ip_camera *camera, float iso,
+                             const double lo[3], const double hi[3], uint64_t **cells)
+{
+    int fds[2];
+    fflush(stdout);
+    if (pipe(fds) != 0)
+        return -1;
+    pid_t pid = fork();
+    if (pid < 0)
+        return -1;
+    if (pid == 0) {
+        close(fds[0]);
+        _exit(child(store, camera, iso, lo, hi, fds[1]));
+    }
+    close(fds[1]);
+    uint64_t n = 0;
+    int ok = read_all(fds[0], &n, sizeof n) && n < ((uint64_t)1 << 40) &&
+             (*cells = malloc((n ? n : 1) * sizeof **cells)) != NULL &&
+             read_all(fds[0], *cells, n * sizeof **cells);
+    close(fds[0]);
+    int status;
+    if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0 || !ok) {
+        fprintf(stderr, "bench_floor: finding the cells failed\n");
+        return -1;
+    }
+    return (long)n;
+}
+
+int main(int argc, char **argv)
+{
+    uint32_t width, height;
+    if (argc != 7 || sscanf(argv[4], "%" SCNu32 "x%" SCNu32, &width, &height) != 2) {
+        fputs(usage, stderr);
+        return 2;
+    }
+    float iso = strtof(argv[2], NULL);
+    unsigned threads = (unsigned)strtoul(argv[5], NULL, 10);
+    int repeats = atoi(argv[6]);
+    if (threads < 1 || threads > MAX_THREADS || repeats < 0) {
+        fputs(usage, stderr);
+        return 2;
+    }
+    ip_error err;
+    ip_store *store;
+    ip_cache *cache;
+    ip_camera camera;
+    double lo[3], hi[3];
+    if (ip_store_open(argv[1], &store, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: %s\n", err.message);
+        return 1;
+    }
+    const ip_layout *layout = ip_store_layout(store);
+    ip_layout_world_box(layout, lo, hi);
+    if (ip_camera_fit_axis(lo, hi, argv[3], 30.0, width, height, &camera, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: %s\n", err.message);
+        return 1;
+    }
+    /* the cells, found in a child process, so that run 0 finds this one as a fresh process
+     * would: no brick decoded, no memory ever used for them */
+    uint64_t *cells = NULL;
+    long count = cells_from_child(store, &camera, iso, lo, hi, &cells);
+    if (count < 0)
+        return 1;
+    if (ip_cache_create(store, (uint64_t)512 << 20, &cache, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: %s\n", err.message);
+        return 1;
+    }
+    /* the cells' coordinates, worked out before the clock starts */
+    uint32_t(*xyz)[3] = malloc(((size_t)count + 1) * sizeof *xyz);
+    if (!xyz) {
+        fprintf(stderr, "bench_floor: out of memory\n");
+        return 1;
+    }
+    uint64_t cx = layout->levels[0].dims[0] - 1, cy = layout->levels[0].dims[1] - 1;
+    for (long i = 0; i < count; i++) {
+        xyz[i][0] = (uint32_t)(cells[i] % cx);
+        xyz[i][1] = (uint32_t)(cells[i] / cx % cy);
+        xyz[i][2] = (uint32_t)(cells[i] / cx / cy);
+    }
+    free(cells);
+    part parts[MAX_THREADS];
+    for (unsigned t = 0; t < threads; t++) {
+        size_t first = (size_t)count * t / threads, end = (size_t)count * (t + 1) / threads;
+        parts[t] =
+            (part){cache, (const uint32_t(*)[3])(xyz + first), end - first, iso, {0}, 0, IP_OK};
+        ip_mesh_init(&parts[t].mesh);
+    }
+    crew c = {parts, threads, .quit = 0};
+    helper helpers[MAX_THREADS];
+    pthread_t id[MAX_THREADS];
+    pthread_barrier_init(&c.start, NULL, threads);
+    pthread_barrier_init(&c.done, NULL, threads);
+    for (unsigned t = 1; t < threads; t++) {
+        helpers[t] = (helper){&c, t};
+        if (pthread_create(&id[t], NULL, help, &helpers[t]) != 0) {
+            fprintf(stderr, "bench_floor: cannot start a thread\n");
+            return 1;
+        }
+    }
+    double *times = malloc(((size_t)repeats + 1) * sizeof *times);
+    uint64_t triangles = 0;
+    for (int r = 0; r <= repeats; r++) {
+        times[r] = run(&c, &triangles);
+        if (times[r] < 0) {
+            fprintf(stderr, "bench_floor: a brick could not be read\n");
+            return 1;
+        }
+        printf("run %d: %.4f s, %ld cells, %" PRIu64 " triangles", r, times[r], count, triangles);
+        if (r == 0) {
+            ip_cache_stats cs;
+            ip_cache_get_stats(cache, &cs);
+            printf(" (empty cache: %" PRIu64 " bricks decoded, %" PRIu64 " bytes)", cs.misses,
+                   cs.bytes_decompressed);
+        }
+        printf("\n");
+    }
+    c.quit = 1;
+    pthread_barrier_wait(&c.start);
+    for (unsigned t = 1; t < threads; t++)
+        pthread_join(id[t], NULL);
+    pthread_barrier_destroy(&c.start);
+    pthread_barrier_destroy(&c.done);
+    if (repeats > 0) {
+        qsort(times + 1, (size_t)repeats, sizeof *times, compare_doubles);
+        printf("median %.4f s [%.4f-%.4f] of %d warm runs, %u threads\n",
+               times[1 + (repeats - 1) / 2], times[1], times[repeats], repeats, threads);
+    }
+    for (unsigned t = 0; t < threads; t++)
+        ip_mesh_free(&parts[t].mesh);
+    free(times);
+    free(xyz);
+    ip_cache_destroy(cache);
+    ip_store_close(store);
+    return 0;
+}
