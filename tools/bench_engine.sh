@@ -7,8 +7,9 @@
 #      process, page cache warm) and warm, and the overdraw, beside
 #      isorender --full and VTK's vtkFlyingEdges3D / vtkMarchingCubes (filter Update() only)
 #      and VTK's rendering of the Flying Edges output at 1600x1200 offscreen; the targets as
-#      ratios to Flying Edges in the same run, and the overdraw's floor (the triangles that
-#      show at all, counted at 6400x4800);
+#      ratios to Flying Edges in the same run, the overdraw's floor (the triangles that
+#      show at all, counted at 6400x4800) and the marching cubes floor (bench_floor: only the
+#      cells that own a pixel of the final image, triangulated alone);
 #   2. out of core: the head upsampled 4x (2048x2048x936 uint16, 7.3 GiB), bricked once, viewed
 #      with a 512 MiB cache: time to first image and to 99.5 %, peak RSS, bricks touched, hit
 #      rate; beside it the peak memory of VTK Flying Edges on the same raw file (if it fits);
@@ -46,7 +47,7 @@ report_only=${REPORT:-0}
 py=/usr/bin/python3
 case $build in /*) ;; *) build=$root/$build ;; esac
 [ -f "$raw" ] || { echo "bench_engine: $raw is missing" >&2; exit 1; }
-for p in isobrick isorender isogen; do
+for p in isobrick isorender isogen bench_floor; do
     [ -x "$build/$p" ] || { echo "bench_engine: $build/$p is missing: run tools/setup.sh build" >&2; exit 1; }
 done
 
@@ -273,6 +274,9 @@ if measuring; then
             drop_caches
             iso_run "$name-full-cold-$i" "$head_ibv" $common --full
             iso_run "$name-full-warm-$i" "$head_ibv" $common --full --warm
+            # the floor: only the cells that own a pixel of the final image (part 21)
+            "$build/bench_floor" "$head_ibv" "$iso" "$view" 1600x1200 "$(getconf _NPROCESSORS_ONLN)" 20 \
+                >"$name-floor-$i.txt"
         done
         $py "$root/tools/bench_vtk.py" extract "$raw" 600.5 1224.5 >>vtk-extract.jsonl
         for s in "600.5 -y" "1224.5 -x"; do
@@ -357,6 +361,18 @@ for s in "skin 600.5 -y" "bone 1224.5 -x"; do
         "$(calc "round($v6400 / $v1600, 2)") (the floor without culling, which drops most of those holding no" \
         "pixel centre); the warm run kept $(calc "round($(med "$st") * $v1600 / $v6400, 2)")x" \
         "the triangles that show at all by 99.5 %."
+    echo
+    fw=$(for f in "$name"-floor-?.txt; do sed -n 's/^median \([0-9.]*\) s.*/\1/p' "$f"; done | sort -g)
+    f0=$(for f in "$name"-floor-?.txt; do sed -n 's/^run 0: \([0-9.]*\) s.*/\1/p' "$f"; done | sort -g)
+    fw_med=$(echo "$fw" | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')
+    f0_med=$(echo "$f0" | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')
+    echo "Marching cubes floor ($name, \`bench_floor\`): the $(sed -n 's/.* from \([0-9]*\) cells$/\1/p' "$name"-floor-1.txt)" \
+        "cells whose triangles own a pixel of the final image, triangulated alone (no rays, no" \
+        "propagation, no coverage), as an oracle that knew them would: warm $(printf %.4f "$fw_med") s" \
+        "[$(echo "$fw" | head -1)-$(echo "$fw" | tail -1)], $(calc "round($fw_med / $fe2, 2)")x Flying Edges again" \
+        "(the warm target: 0.15x); a fresh process's first run $(printf %.4f "$f0_med") s," \
+        "$(calc "round($f0_med / $fe, 2)")x Flying Edges' first call (the fresh target: 0.4x). Medians of" \
+        "$repeat processes, each a median of 20 warm runs."
     echo
     # bar chart data: name, 85 %, 99.5 %, all rays (warm), --full warm, FE, MC, FE + first render
     echo "$name $(med "$(h tstats 85 "$name"-warm-?.csv)") $(med "$(h tstats 99.5 "$name"-warm-?.csv)") $(med "$(h tstats 100 "$name"-warm-?.csv)") $(h jmed time.extraction_wall_s "$name"-full-warm-*.json) $fe2 $mc $(calc "$fe2 + $r1")" >>bars.dat

@@ -30,8 +30,10 @@ def _engine_options(threads, cutoff, foldback, lod, pixel_error, occlusion, pref
     if foldback is not None:
         o.foldback_degrees = foldback
     o.threads, o.lod, o.pixel_error = threads, int(bool(lod)), pixel_error
-    # prefetch: True/False, or "always" (isorender --prefetch always)
     o.occlusion = int(bool(occlusion))
+    # prefetch: True (on) or False (off), or "always" (isorender --prefetch always)
+    if isinstance(prefetch, str) and prefetch != "always":
+        raise ValueError('prefetch: True, False or "always", not %r' % prefetch)
     o.prefetch = 2 if prefetch == "always" else int(bool(prefetch))
     o.cull = int(bool(cull))
     return o
@@ -185,9 +187,9 @@ class File:
         on) or `camera` (a dict eye/target/up/fov or isorender's --camera text), until every
         pixel has had its ray, `rays` rays or `time_limit` seconds. full=True triangulates
         every active cell instead (isorender --full; the view does not matter). threads (0:
-        every core), cutoff and foldback (degrees), lod, pixel_error, occlusion, prefetch and
-        cull are isorender's options (cull off by default here: the mesh is the product, not an
-        image of it); cache_mb the brick cache's budget (the cache stays warm
+        every core), cutoff and foldback (degrees), lod, pixel_error, occlusion, prefetch (True,
+        False or "always") and cull are isorender's options (cull off by default here: the mesh
+        is the product, not an image of it); cache_mb the brick cache's budget (the cache stays warm
         between calls). on_step(step), if given, sees each step (as extract_steps() yields).
         Raises isoprop.Error for a file that cannot be read."""
         kw = dict(view=view, camera=camera, size=size, threads=threads, cutoff=cutoff,

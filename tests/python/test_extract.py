@@ -101,6 +101,8 @@ class Extract(unittest.TestCase):
         self.assertFalse(off.stats["prefetch"])
         self.assertEqual(always.faces.tolist(), off.faces.tolist())
         self.assertEqual(always.vertices.tolist(), off.vertices.tolist())
+        with self.assertRaises(ValueError):
+            self.f.extract(ISO, view="+x", size=SIZE, threads=1, prefetch="off")
 
     def test_cull_equals_isorender_cull_on(self):
         """cull=True keeps what isorender --mesh --cull on keeps, and fewer triangles than the
