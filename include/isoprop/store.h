@@ -84,12 +84,12 @@ IP_API ip_status ip_store_read_brick(const ip_store *store, uint64_t g, void *ds
  *  A hint: a later ip_store_read_brick() finds the bytes in memory instead of stalling. */
 IP_API void ip_store_prefetch_brick(const ip_store *store, uint64_t g);
 
-/*! ip_store_brick_in_memory() : whether brick `g`'s payload can be read without waiting for
- *  the disk: 1 when the kernel holds it in the page cache (or the brick has no payload), 0
- *  when a read would wait for the device, -1 when the kernel or the file system cannot tell
- *  (reads that may not wait, RWF_NOWAIT, are not supported). Probes a few bytes of the payload
- *  (a read of one byte each), reads nothing else and changes nothing. A hint: the answer may
- *  be stale the moment it is given. Thread-safe. */
+/*! ip_store_brick_in_memory() : whether brick `g`'s payload (g < the brick count) can be read
+ *  without waiting for the disk: 1 when the kernel holds it in the page cache (or the brick
+ *  has no payload), 0 when a read would wait for the device, -1 when the kernel or the file
+ *  system cannot tell (reads that may not wait, RWF_NOWAIT, are not supported). Probes a few
+ *  bytes of the payload (a read of one byte each), reads nothing else and changes nothing. A
+ *  hint: the answer may be stale the moment it is given. Thread-safe. */
 IP_API int ip_store_brick_in_memory(const ip_store *store, uint64_t g);
 
 /*! ip_store_check_summary() : recomputes the range and sub-block ranges of brick `g` from its

@@ -76,7 +76,7 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
         *culled += (uint64_t)n;
         return 0;
     }
-    if (ip__sampler_cell_normals(s, cell, values, *mc_case, iso, normals) < 0) {
+    if (ip__sampler_cell_normals(s, cell, values, *mc_case, iso, lo, hi, normals) < 0) {
         *st = s->status;
         return -1;
     }

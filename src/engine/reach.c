@@ -78,7 +78,8 @@ static void node_box(const reach_walk *w, uint32_t depth, const uint32_t node[3]
     ip_brick_extent(l, w->level, first, origin, extent);
     for (int a = 0; a < 3; a++)
         lo[a] = origin[a] * l->spacing[a] * (double)(1u << w->level);
-    ip_brick_extent(l, w->level, last, origin, extent);
+    if (depth > 0) /* a brick is its own first and last */
+        ip_brick_extent(l, w->level, last, origin, extent);
     for (int a = 0; a < 3; a++)
         hi[a] = (origin[a] + extent[a] - 1.0) * l->spacing[a] * (double)(1u << w->level);
 }

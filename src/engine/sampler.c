@@ -228,9 +228,10 @@ int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, floa
 }
 
 int ip__sampler_cell_normals(ip_sampler *s, const uint32_t cell[3], const float values[8],
-                             unsigned mc_case, float iso, float normals[12][3])
+                             unsigned mc_case, float iso, const float lo[3], const float hi[3],
+                             float normals[12][3])
 {
-    float outer[24], gradients[8][3], lo[3], hi[3];
+    float outer[24], gradients[8][3];
     const ip_brick *b = ip__sampler_cell_brick(s, cell);
     if (!b || !gradient_neighbours(s, cell, b, outer))
         return -1;
@@ -247,7 +248,6 @@ int ip__sampler_cell_normals(ip_sampler *s, const uint32_t cell[3], const float 
             float vh = h ? outer[3 * c + a] : across, vl = h ? across : outer[3 * c + a];
             gradients[c][a] = (float)((double)(vh - vl) * inverse[h][a]);
         }
-    ip__sampler_cell_box(s, cell, lo, hi);
     return (int)ip__mc_cell_edge_normals(values, mc_case, (const float(*)[3])gradients, iso, lo, hi,
                                          normals);
 }

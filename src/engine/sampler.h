@@ -107,11 +107,14 @@ void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float lo[
  * then, for an active case, the gradient normals at its edge crossings from those values, as
  * ip__mc_cell_edge_normals() gives them (the mask of crossed edges, or -1 after a failure).
  * The case first: most cells of an active sub-block are not active, and need neither the
- * gradient neighbours nor the divisions. The vertices are ip__mc_cell_edge_points()'. */
+ * gradient neighbours nor the divisions. The vertices are ip__mc_cell_edge_points()', and
+ * lo, hi the cell's box as ip__sampler_cell_box() gives it (both take it from the caller, who
+ * works it out once). */
 int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, float values[8],
                           unsigned *mc_case);
 int ip__sampler_cell_normals(ip_sampler *s, const uint32_t cell[3], const float values[8],
-                             unsigned mc_case, float iso, float normals[12][3]);
+                             unsigned mc_case, float iso, const float lo[3], const float hi[3],
+                             float normals[12][3]);
 
 /* 1 when the range [lo, hi] (over cell corners) may hold an active cell for `iso`: some corner
  * >= iso and some corner < iso. */

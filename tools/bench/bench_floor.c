@@ -17,6 +17,7 @@
 
 #include "isoprop/isoprop.h"
 #include "isoprop/render.h"
+#include "internal.h"
 #include "propagate.h"
 #include "sampler.h"
 
@@ -108,9 +109,10 @@ static int compare_doubles(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* A cell and the brick holding it, for sorting brick by brick. */
+/* A cell, the brick holding it and its id, for sorting brick by brick. */
 typedef struct cell_key {
-    uint64_t brick, linear;
+    uint64_t brick, id;
+    uint32_t xyz[3];
 } cell_key;
 
 static int compare_keys(const void *a, const void *b)
@@ -118,60 +120,62 @@ static int compare_keys(const void *a, const void *b)
     const cell_key *x = a, *y = b;
     if (x->brick != y->brick)
         return x->brick < y->brick ? -1 : 1;
-    return x->linear < y->linear ? -1 : x->linear > y->linear;
+    return x->id < y->id ? -1 : x->id > y->id;
 }
 
-/* The distinct level-0 cells of the triangles that own a pixel of `mesh`'s image, brick by
- * brick and in id order within a brick, in *cells (malloc'd); their count, or -1 on a
- * failure. */
+/* The distinct cells of the triangles that own a pixel of the image of `mesh` (level 0, with
+ * cell ids), brick by brick and in id order within a brick, in *cells (malloc'd); their count,
+ * or -1 on a failure. */
 static long owning_cells(const ip_mesh *mesh, const ip_layout *layout, const ip_camera *camera,
-                         const double lo[3], const double hi[3], uint64_t **cells,
+                         const double lo[3], const double hi[3], uint32_t (**cells)[3],
                          uint64_t *owning_triangles)
 {
-    size_t pixels = (size_t)camera->width * camera->height;
+    size_t pixels = (size_t)camera->width * camera->height, n = 0;
+    size_t triangles = mesh->triangle_count ? mesh->triangle_count : 1;
     uint32_t *owner = malloc(pixels * sizeof *owner);
-    unsigned char *owns = calloc(mesh->triangle_count ? mesh->triangle_count : 1, 1);
+    unsigned char *owns = calloc(triangles, 1);
+    cell_key *keys = malloc(triangles * sizeof *keys);
     ip_error err;
-    if (!owner || !owns || ip_raster_mesh(mesh, camera, lo, hi, owner, NULL, &err) != IP_OK) {
+    if (!owner || !owns || !keys ||
+        ip_raster_mesh(mesh, camera, lo, hi, owner, NULL, &err) != IP_OK) {
         free(owner);
         free(owns);
+        free(keys);
         return -1;
     }
     for (size_t i = 0; i < pixels; i++)
         if (owner[i] != UINT32_MAX)
             owns[owner[i]] = 1;
     free(owner);
-    size_t n = 0;
-    *owning_triangles = 0;
-    cell_key *keys = malloc((mesh->triangle_count ? mesh->triangle_count : 1) * sizeof *keys);
-    uint64_t *list = malloc((mesh->triangle_count ? mesh->triangle_count : 1) * sizeof *list);
-    if (!keys || !list) {
-        free(owns);
-        free(keys);
-        free(list);
-        return -1;
+    /* at level 0 a cell's id is its linear index among the level's cells (ip_cell_id()) */
+    uint64_t cx = layout->levels[0].dims[0] - 1, cy = layout->levels[0].dims[1] - 1;
+    uint32_t shift = ip__ceil_log2(layout->brick_edge);
+    for (uint64_t t = 0; t < mesh->triangle_count; t++) {
+        if (!owns[t])
+            continue;
+        uint64_t id = mesh->cells[t];
+        cell_key *k = &keys[n++];
+        *k = (cell_key){
+            0, id, {(uint32_t)(id % cx), (uint32_t)(id / cx % cy), (uint32_t)(id / cx / cy)}};
+        uint32_t b[3] = {k->xyz[0] >> shift, k->xyz[1] >> shift, k->xyz[2] >> shift};
+        k->brick = ip_brick_global_index(layout, 0, b);
     }
-    const ip_level_layout *lv = &layout->levels[0];
-    uint64_t cx = lv->dims[0] - 1, cy = lv->dims[1] - 1;
-    unsigned shift = 0;
-    while ((1u << shift) < layout->brick_edge)
-        shift++;
-    for (uint64_t t = 0; t < mesh->triangle_count; t++)
-        if (owns[t]) {
-            uint64_t l = mesh->cells[t] & ((UINT64_C(1) << 58) - 1); /* level 0 */
-            uint32_t b[3] = {(uint32_t)(l % cx) >> shift, (uint32_t)(l / cx % cy) >> shift,
-                             (uint32_t)(l / cx / cy) >> shift};
-            keys[n++] = (cell_key){ip_brick_global_index(layout, 0, b), l};
-            ++*owning_triangles;
-        }
     free(owns);
+    *owning_triangles = n;
     qsort(keys, n, sizeof *keys, compare_keys);
     size_t distinct = 0;
     for (size_t i = 0; i < n; i++)
-        if (distinct == 0 || keys[i].linear != list[distinct - 1])
-            list[distinct++] = keys[i].linear;
+        if (distinct == 0 || keys[i].id != keys[distinct - 1].id)
+            keys[distinct++] = keys[i];
+    uint32_t(*out)[3] = malloc((distinct ? distinct : 1) * sizeof *out);
+    if (!out) {
+        free(keys);
+        return -1;
+    }
+    for (size_t i = 0; i < distinct; i++)
+        memcpy(out[i], keys[i].xyz, sizeof out[i]);
     free(keys);
-    *cells = list;
+    *cells = out;
     return (long)distinct;
 }
 
@@ -215,7 +219,8 @@ static int child(ip_store *store, const ip_camera *camera, float iso, const doub
         fprintf(stderr, "bench_floor: %s\n", err.message);
         return 1;
     }
-    uint64_t *cells, owning;
+    uint32_t(*cells)[3];
+    uint64_t owning;
     long count = owning_cells(&full, ip_store_layout(store), camera, lo, hi, &cells, &owning);
     if (count < 0) {
         fprintf(stderr, "bench_floor: out of memory\n");
@@ -231,7 +236,7 @@ static int child(ip_store *store, const ip_camera *camera, float iso, const doub
 /* The owning cells, from a child process (child()), in *cells (malloc'd); their count, or -1
  * with a message on standard error. */
 static long cells_from_child(ip_store *store, const ip_camera *camera, float iso,
-                             const double lo[3], const double hi[3], uint64_t **cells)
+                             const double lo[3], const double hi[3], uint32_t (**cells)[3])
 {
     int fds[2];
     fflush(stdout);
@@ -289,7 +294,7 @@ int main(int argc, char **argv)
     }
     /* the cells, found in a child process, so that run 0 finds this one as a fresh process
      * would: no brick decoded, no memory ever used for them */
-    uint64_t *cells = NULL;
+    uint32_t(*cells)[3] = NULL;
     long count = cells_from_child(store, &camera, iso, lo, hi, &cells);
     if (count < 0)
         return 1;
@@ -297,24 +302,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_floor: %s\n", err.message);
         return 1;
     }
-    /* the cells' coordinates, worked out before the clock starts */
-    uint32_t(*xyz)[3] = malloc(((size_t)count + 1) * sizeof *xyz);
-    if (!xyz) {
-        fprintf(stderr, "bench_floor: out of memory\n");
-        return 1;
-    }
-    uint64_t cx = layout->levels[0].dims[0] - 1, cy = layout->levels[0].dims[1] - 1;
-    for (long i = 0; i < count; i++) {
-        xyz[i][0] = (uint32_t)(cells[i] % cx);
-        xyz[i][1] = (uint32_t)(cells[i] / cx % cy);
-        xyz[i][2] = (uint32_t)(cells[i] / cx / cy);
-    }
-    free(cells);
     part parts[MAX_THREADS];
     for (unsigned t = 0; t < threads; t++) {
         size_t first = (size_t)count * t / threads, end = (size_t)count * (t + 1) / threads;
         parts[t] =
-            (part){cache, (const uint32_t(*)[3])(xyz + first), end - first, iso, {0}, 0, IP_OK};
+            (part){cache, (const uint32_t(*)[3])(cells + first), end - first, iso, {0}, 0, IP_OK};
         ip_mesh_init(&parts[t].mesh);
     }
     crew c = {parts, threads, .quit = 0};
@@ -360,7 +352,7 @@ int main(int argc, char **argv)
     for (unsigned t = 0; t < threads; t++)
         ip_mesh_free(&parts[t].mesh);
     free(times);
-    free(xyz);
+    free(cells);
     ip_cache_destroy(cache);
     ip_store_close(store);
     return 0;
