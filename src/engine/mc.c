@@ -9,19 +9,7 @@
 
 /* The external definition of the inline one in isoprop/mc.h (C11 6.7.4). */
 extern unsigned ip__mc_case(const float corner_values[8], float iso);
-
-unsigned ip__mc_crossed_faces(unsigned mc_case)
-{
-    /* Corners of faces -x, +x, -y, +y, -z, +z: a face is crossed unless its corners agree. */
-    static const uint8_t face_corners[6] = {0x55, 0xAA, 0x33, 0xCC, 0x0F, 0xF0};
-    unsigned faces = 0;
-    for (unsigned f = 0; f < 6; f++) {
-        unsigned inside = mc_case & face_corners[f];
-        if (inside != 0 && inside != face_corners[f])
-            faces |= 1u << f;
-    }
-    return faces;
-}
+extern unsigned ip__mc_crossed_faces(unsigned mc_case);
 
 /* Where the surface crosses the edge from v0 (low corner) to v1, as a fraction of the edge.
  * Always measured from the low corner, so the cells sharing an edge compute the same bits. */

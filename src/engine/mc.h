@@ -90,8 +90,19 @@ inline unsigned ip__mc_case(const float corner_values[8], float iso)
 
 /*! ip__mc_crossed_faces() : a 6-bit mask of the faces of a cell of case `mc_case` that the surface
  *  crosses (bit f set when face f has a crossed edge): the neighbours across those faces are
- *  active too, which is what propagation follows. Only the low 8 bits of mc_case are used. */
-unsigned ip__mc_crossed_faces(unsigned mc_case);
+ *  active too, which is what propagation follows. Only the low 8 bits of mc_case are used. An
+ *  inline definition (propagation asks once per cell); src/engine/mc.c holds the external one. */
+inline unsigned ip__mc_crossed_faces(unsigned mc_case)
+{
+    /* Corners of faces -x, +x, -y, +y, -z, +z: a face is crossed unless its corners agree. */
+    static const uint8_t face_corners[6] = {0x55, 0xAA, 0x33, 0xCC, 0x0F, 0xF0};
+    unsigned faces = 0;
+    for (unsigned f = 0; f < 6; f++) {
+        unsigned inside = mc_case & face_corners[f];
+        faces |= (unsigned)(inside != 0 && inside != face_corners[f]) << f;
+    }
+    return faces;
+}
 
 /*! ip__mc_triangulate_cell() : the isosurface triangles of one cell.
  *  values      : the 8 corner samples, in the corner order above.

@@ -76,9 +76,17 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
         *culled += (uint64_t)n;
         return 0;
     }
-    if (ip__sampler_cell_normals(s, cell, values, *mc_case, iso, lo, hi, normals) < 0) {
+    int crossed = ip__sampler_cell_normals(s, cell, values, *mc_case, iso, lo, hi, normals);
+    if (crossed < 0) {
         *st = s->status;
         return -1;
+    }
+    /* each crossing's normal packed once: up to 4 triangles share it */
+    int16_t packed[12][3];
+    for (unsigned left = (unsigned)crossed; left; left &= left - 1) {
+        unsigned e = ip__lowest_bit(left);
+        for (int a = 0; a < 3; a++)
+            packed[e][a] = ip_normal_pack(normals[e][a]);
     }
     const ip_level_layout *lv = &s->layout->levels[s->level];
     uint64_t linear =
@@ -91,7 +99,7 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
         for (int k = 0; k < 3; k++)
             for (int a = 0; a < 3; a++) {
                 pos[9 * kept + 3 * k + a] = points[row[3 * t + k]][a];
-                nor[9 * kept + 3 * k + a] = ip_normal_pack(normals[row[3 * t + k]][a]);
+                nor[9 * kept + 3 * k + a] = packed[row[3 * t + k]][a];
             }
         kept++;
     }
@@ -113,10 +121,11 @@ static double versine(const double dir[3], const double v[3], double length)
 
 /* The versine below which an angle is smaller than (the angle of versine `max`) less the
  * fold-back tolerance: 1 - cos(m - f) = 1 - cos m cos f - sin m sin f. Negative (no angle
- * qualifies) when m <= f. */
+ * qualifies) when m <= f. (Comparisons, not fmax(), here and in the propagation loop: fmax()
+ * is a call on the x86-64 baseline, and gives the same for these values, NaN included.) */
 static double foldback_limit(const ip_propagator *p, double max)
 {
-    double cos_m = 1.0 - max, sin_m = sqrt(fmax(0.0, max * (2.0 - max)));
+    double cos_m = 1.0 - max, s2 = max * (2.0 - max), sin_m = sqrt(s2 > 0.0 ? s2 : 0.0);
     if (cos_m >= p->cos_foldback) /* m <= f */
         return -1.0;
     return 1.0 - cos_m * p->cos_foldback - sin_m * p->sin_foldback;
@@ -296,7 +305,9 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
             else if (!was)
                 st = ip__depth_queue_push(
                     &p->queue,
-                    &(ip_queued_cell){{n3[0], n3[1], n3[2]}, (float)fmax(q.max_versine, a)}, depth);
+                    &(ip_queued_cell){{n3[0], n3[1], n3[2]},
+                                      (float)(a > q.max_versine ? a : q.max_versine)},
+                    depth);
         }
         /* the farthest part of a long queue to a worker waiting for cells */
         if (p->share.hungry && extracted % SHARE_STRIDE == 0 &&

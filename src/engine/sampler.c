@@ -15,15 +15,20 @@ ip_status ip__sampler_init(ip_sampler *s, ip_cache *cache, uint32_t level)
     s->level = level;
     s->edge_shift = ip__ceil_log2(s->layout->brick_edge); /* a power of two */
     for (int a = 0; a < 3; a++) {
-        s->dims[a] = s->layout->levels[level].dims[a];
-        s->world[a] = malloc(s->dims[a] * sizeof(double));
-        if (!s->world[a]) {
+        uint32_t n = s->dims[a] = s->layout->levels[level].dims[a];
+        s->world[a] = malloc(n * sizeof(double));
+        s->inverse_span[a] = malloc(n * sizeof(double));
+        if (!s->world[a] || !s->inverse_span[a]) {
             ip__sampler_free(s);
             return IP_ERR_NOMEM;
         }
-        for (uint32_t i = 0; i < s->dims[a]; i++)
+        for (uint32_t i = 0; i < n; i++)
             s->world[a][i] =
                 ip_level_sample_index(s->layout->dims[a], level, i) * s->layout->spacing[a];
+        for (uint32_t i = 0; i < n; i++) {
+            double d = s->world[a][i + 1 < n ? i + 1 : i] - s->world[a][i > 0 ? i - 1 : 0];
+            s->inverse_span[a][i] = d > 0 ? 1.0 / d : 0.0;
+        }
     }
     return IP_OK;
 }
@@ -43,7 +48,9 @@ void ip__sampler_free(ip_sampler *s)
         ip__sampler_release(s);
     for (int a = 0; a < 3; a++) {
         free(s->world[a]);
+        free(s->inverse_span[a]);
         s->world[a] = NULL;
+        s->inverse_span[a] = NULL;
     }
 }
 
@@ -205,15 +212,6 @@ static int gradient_neighbours(ip_sampler *s, const uint32_t cell[3], const ip_b
     return 1;
 }
 
-/* World distance between the samples either side of sample i (clamped) along axis a, for a
- * central (or, at the volume's faces, one-sided) difference. */
-static double span(const ip_sampler *s, int a, int64_t i)
-{
-    int64_t last = s->dims[a] - 1;
-    int64_t l = i > 0 ? i - 1 : 0, h = i < last ? i + 1 : last;
-    return s->world[a][h] - s->world[a][l];
-}
-
 int ip__sampler_cell_case(ip_sampler *s, const uint32_t cell[3], float iso, float values[8],
                           unsigned *mc_case)
 {
@@ -237,10 +235,8 @@ int ip__sampler_cell_normals(ip_sampler *s, const uint32_t cell[3], const float 
         return -1;
     double inverse[2][3]; /* per axis, 1 / the span around the cell's low and high corners */
     for (int a = 0; a < 3; a++)
-        for (int h = 0; h < 2; h++) {
-            double d = span(s, a, (int64_t)cell[a] + h);
-            inverse[h][a] = d > 0 ? 1.0 / d : 0.0;
-        }
+        for (int h = 0; h < 2; h++)
+            inverse[h][a] = s->inverse_span[a][cell[a] + h];
     for (int c = 0; c < 8; c++)
         for (int a = 0; a < 3; a++) {
             int h = (c >> a) & 1;

@@ -20,6 +20,9 @@ typedef struct ip_sampler {
     uint32_t level;
     uint32_t dims[3]; /* the level's samples */
     double *world[3]; /* world coordinate of each level sample along each axis */
+    /* per axis and sample: 1 / the world distance between the samples either side of it
+     * (clamped at the volume's faces), 0 where that is 0: a central difference's factor */
+    double *inverse_span[3];
     ip_brick held[IP_SAMPLER_SLOTS];
     int used[IP_SAMPLER_SLOTS];
     unsigned next_victim;
