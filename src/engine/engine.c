@@ -435,9 +435,13 @@ static void work(void *user, unsigned index)
             w->status == IP_OK)
             w->status = IP_ERR_NOMEM;
     }
+    /* Out of rays: the triangles go to the mesh before helping, while the other workers may
+     * still propagate, rather than after, when the step waits for the last of them. */
+    if (w->mesh.triangle_count > 0 && flush_triangles(w) != IP_OK && w->status == IP_OK)
+        w->status = IP_ERR_NOMEM;
     ip__engine_help(e, w);
     publish_cells(e, w, &published);
-    if (flush_triangles(w) != IP_OK && w->status == IP_OK)
+    if (w->mesh.triangle_count > 0 && flush_triangles(w) != IP_OK && w->status == IP_OK)
         w->status = IP_ERR_NOMEM;
     if (w->status != IP_OK) /* the step fails: the other workers take no more rays */
         atomic_store(&e->step_stopped, 1);
