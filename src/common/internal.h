@@ -12,8 +12,10 @@
 
 #if defined(__GNUC__)
 #define IP_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#define IP_ALWAYS_INLINE inline __attribute__((always_inline))
 #else
 #define IP_PRINTF(a, b)
+#define IP_ALWAYS_INLINE inline
 #endif
 
 /* IP_ASSERT(cond): an internal invariant (a precondition of an internal function: an index in

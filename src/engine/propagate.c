@@ -76,17 +76,9 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
         *culled += (uint64_t)n;
         return 0;
     }
-    int crossed = ip__sampler_cell_normals(s, cell, values, *mc_case, iso, lo, hi, normals);
-    if (crossed < 0) {
+    if (ip__sampler_cell_normals(s, cell, values, *mc_case, iso, lo, hi, normals) < 0) {
         *st = s->status;
         return -1;
-    }
-    /* each crossing's normal packed once: up to 4 triangles share it */
-    int16_t packed[12][3];
-    for (unsigned left = (unsigned)crossed; left; left &= left - 1) {
-        unsigned e = ip__lowest_bit(left);
-        for (int a = 0; a < 3; a++)
-            packed[e][a] = ip_normal_pack(normals[e][a]);
     }
     const ip_level_layout *lv = &s->layout->levels[s->level];
     uint64_t linear =
@@ -99,7 +91,7 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
         for (int k = 0; k < 3; k++)
             for (int a = 0; a < 3; a++) {
                 pos[9 * kept + 3 * k + a] = points[row[3 * t + k]][a];
-                nor[9 * kept + 3 * k + a] = packed[row[3 * t + k]][a];
+                nor[9 * kept + 3 * k + a] = ip_normal_pack(normals[row[3 * t + k]][a]);
             }
         kept++;
     }
