@@ -383,10 +383,12 @@ static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
     to->culled += from->culled;
 }
 
-/* Moves the worker's triangles to the engine's mesh. */
+/* Moves the worker's triangles, if it holds any, to the engine's mesh. */
 static ip_status flush_triangles(ip_engine_worker *w)
 {
     ip_engine *e = w->engine;
+    if (w->mesh.triangle_count == 0)
+        return IP_OK; /* not even the lock to take */
     pthread_mutex_lock(&e->mesh_lock);
     ip_status st = ip_mesh_append_mesh(&e->mesh, &w->mesh, 0, w->mesh.triangle_count);
     pthread_mutex_unlock(&e->mesh_lock);
@@ -437,11 +439,11 @@ static void work(void *user, unsigned index)
     }
     /* Out of rays: the triangles go to the mesh before helping, while the other workers may
      * still propagate, rather than after, when the step waits for the last of them. */
-    if (w->mesh.triangle_count > 0 && flush_triangles(w) != IP_OK && w->status == IP_OK)
+    if (flush_triangles(w) != IP_OK && w->status == IP_OK)
         w->status = IP_ERR_NOMEM;
     ip__engine_help(e, w);
     publish_cells(e, w, &published);
-    if (w->mesh.triangle_count > 0 && flush_triangles(w) != IP_OK && w->status == IP_OK)
+    if (flush_triangles(w) != IP_OK && w->status == IP_OK)
         w->status = IP_ERR_NOMEM;
     if (w->status != IP_OK) /* the step fails: the other workers take no more rays */
         atomic_store(&e->step_stopped, 1);

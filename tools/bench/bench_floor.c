@@ -8,7 +8,6 @@
  * and the median of the warm runs. A benchmark, not a test (docs/performance.md, part 21).
  */
 #include <inttypes.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,6 +17,7 @@
 #include "isoprop/isoprop.h"
 #include "isoprop/render.h"
 #include "internal.h"
+#include "pool.h"
 #include "propagate.h"
 #include "sampler.h"
 
@@ -26,8 +26,6 @@ static const char usage[] =
     "Triangulates only the cells whose triangles own a pixel of the final image of the view\n"
     "(from the full extraction), on THREADS threads: once on an empty cache, then REPEATS\n"
     "times warm.\n";
-
-#define MAX_THREADS 64
 
 typedef struct part {
     ip_cache *cache;
@@ -39,13 +37,14 @@ typedef struct part {
     ip_status status;
 } part;
 
-static void *extract_part(void *arg)
+/* Job `index` of a run (ip__pool_run()): part `index` of `user`, the parts. */
+static void extract_part(void *user, unsigned index)
 {
-    part *p = arg;
+    part *p = (part *)user + index;
     ip_sampler s;
     p->status = ip__sampler_init(&s, p->cache, 0);
     if (p->status != IP_OK)
-        return NULL;
+        return;
     ip_cell_output out = {&p->mesh, NULL, 0}; /* every triangle, no coverage */
     uint64_t culled = 0;
     p->triangles = 0;
@@ -56,49 +55,22 @@ static void *extract_part(void *arg)
             p->triangles += (uint64_t)n;
     }
     ip__sampler_free(&s);
-    return NULL;
 }
 
-/* The threads, started once (as the engine's workers are) and held at barriers between
- * runs, so that a run's time holds no thread start. */
-typedef struct crew {
-    part *parts;
-    unsigned threads;
-    pthread_barrier_t start, done;
-    int quit;
-} crew;
-
-typedef struct helper {
-    crew *crew;
-    unsigned index;
-} helper;
-
-static void *help(void *arg)
-{
-    helper *h = arg;
-    for (;;) {
-        pthread_barrier_wait(&h->crew->start);
-        if (h->crew->quit)
-            return NULL;
-        extract_part(&h->crew->parts[h->index]);
-        pthread_barrier_wait(&h->crew->done);
-    }
-}
-
-/* One run over all cells; returns its wall time, or -1 on a failure. */
-static double run(crew *c, uint64_t *triangles)
+/* One run over all cells, a part per job on `pool` (the engine's kind of pool: its threads
+ * started once, so that a run's time holds no thread start); returns its wall time, or -1 on
+ * a failure. */
+static double run(ip__pool *pool, part *parts, unsigned threads, uint64_t *triangles)
 {
     double t0 = ip_now_seconds();
-    pthread_barrier_wait(&c->start);
-    extract_part(&c->parts[0]);
-    pthread_barrier_wait(&c->done);
+    ip__pool_run(pool, threads, extract_part, parts);
     double seconds = ip_now_seconds() - t0;
     *triangles = 0;
-    for (unsigned t = 0; t < c->threads; t++) {
-        if (c->parts[t].status != IP_OK)
+    for (unsigned t = 0; t < threads; t++) {
+        if (parts[t].status != IP_OK)
             return -1;
-        *triangles += c->parts[t].triangles;
-        ip_mesh_clear(&c->parts[t].mesh);
+        *triangles += parts[t].triangles;
+        ip_mesh_clear(&parts[t].mesh);
     }
     return seconds;
 }
@@ -179,36 +151,10 @@ static long owning_cells(const ip_mesh *mesh, const ip_layout *layout, const ip_
     return (long)distinct;
 }
 
-/* Writes all of `bytes` to fd; 0 on a failure. */
-static int write_all(int fd, const void *data, size_t bytes)
-{
-    for (const char *p = data; bytes > 0;) {
-        ssize_t n = write(fd, p, bytes);
-        if (n <= 0)
-            return 0;
-        p += n;
-        bytes -= (size_t)n;
-    }
-    return 1;
-}
-
-/* Reads `bytes` from fd; 0 when it ends first. */
-static int read_all(int fd, void *data, size_t bytes)
-{
-    for (char *p = data; bytes > 0;) {
-        ssize_t n = read(fd, p, bytes);
-        if (n <= 0)
-            return 0;
-        p += n;
-        bytes -= (size_t)n;
-    }
-    return 1;
-}
-
-/* The child: the full extraction, its image's owning cells, sent down `fd` (count, then the
+/* The child: the full extraction, its image's owning cells, sent down `to` (count, then the
  * cells). Returns the process's exit status. */
 static int child(ip_store *store, const ip_camera *camera, float iso, const double lo[3],
-                 const double hi[3], int fd)
+                 const double hi[3], FILE *to)
 {
     ip_error err;
     ip_cache *cache;
@@ -230,7 +176,9 @@ static int child(ip_store *store, const ip_camera *camera, float iso, const doub
            full.triangle_count, owning, count);
     fflush(stdout);
     uint64_t n = (uint64_t)count;
-    return write_all(fd, &n, sizeof n) && write_all(fd, cells, n * sizeof *cells) ? 0 : 1;
+    int sent = fwrite(&n, sizeof n, 1, to) == 1 &&
+               fwrite(cells, sizeof *cells, (size_t)n, to) == (size_t)n && fflush(to) == 0;
+    return sent ? 0 : 1;
 }
 
 /* The owning cells, from a child process (child()), in *cells (malloc'd); their count, or -1
@@ -247,14 +195,19 @@ static long cells_from_child(ip_store *store, const ip_camera *camera, float iso
         return -1;
     if (pid == 0) {
         close(fds[0]);
-        _exit(child(store, camera, iso, lo, hi, fds[1]));
+        FILE *to = fdopen(fds[1], "wb");
+        _exit(to ? child(store, camera, iso, lo, hi, to) : 1);
     }
     close(fds[1]);
+    FILE *from = fdopen(fds[0], "rb");
     uint64_t n = 0;
-    int ok = read_all(fds[0], &n, sizeof n) && n < ((uint64_t)1 << 40) &&
+    int ok = from && fread(&n, sizeof n, 1, from) == 1 && n < ((uint64_t)1 << 40) &&
              (*cells = malloc((n ? n : 1) * sizeof **cells)) != NULL &&
-             read_all(fds[0], *cells, n * sizeof **cells);
-    close(fds[0]);
+             fread(*cells, sizeof **cells, (size_t)n, from) == (size_t)n;
+    if (from)
+        fclose(from);
+    else
+        close(fds[0]);
     int status;
     if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0 || !ok) {
         fprintf(stderr, "bench_floor: finding the cells failed\n");
@@ -273,7 +226,7 @@ int main(int argc, char **argv)
     float iso = strtof(argv[2], NULL);
     unsigned threads = (unsigned)strtoul(argv[5], NULL, 10);
     int repeats = atoi(argv[6]);
-    if (threads < 1 || threads > MAX_THREADS || repeats < 0) {
+    if (threads < 1 || threads > IP_MAX_THREADS || repeats < 0) {
         fputs(usage, stderr);
         return 2;
     }
@@ -302,29 +255,22 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_floor: %s\n", err.message);
         return 1;
     }
-    part parts[MAX_THREADS];
+    part parts[IP_MAX_THREADS];
     for (unsigned t = 0; t < threads; t++) {
         size_t first = (size_t)count * t / threads, end = (size_t)count * (t + 1) / threads;
         parts[t] =
             (part){cache, (const uint32_t(*)[3])(cells + first), end - first, iso, {0}, 0, IP_OK};
         ip_mesh_init(&parts[t].mesh);
     }
-    crew c = {parts, threads, .quit = 0};
-    helper helpers[MAX_THREADS];
-    pthread_t id[MAX_THREADS];
-    pthread_barrier_init(&c.start, NULL, threads);
-    pthread_barrier_init(&c.done, NULL, threads);
-    for (unsigned t = 1; t < threads; t++) {
-        helpers[t] = (helper){&c, t};
-        if (pthread_create(&id[t], NULL, help, &helpers[t]) != 0) {
-            fprintf(stderr, "bench_floor: cannot start a thread\n");
-            return 1;
-        }
-    }
+    ip__pool *pool;
     double *times = malloc(((size_t)repeats + 1) * sizeof *times);
+    if (!times || ip__pool_create(threads, &pool, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: out of memory\n");
+        return 1;
+    }
     uint64_t triangles = 0;
     for (int r = 0; r <= repeats; r++) {
-        times[r] = run(&c, &triangles);
+        times[r] = run(pool, parts, threads, &triangles);
         if (times[r] < 0) {
             fprintf(stderr, "bench_floor: a brick could not be read\n");
             return 1;
@@ -338,12 +284,7 @@ int main(int argc, char **argv)
         }
         printf("\n");
     }
-    c.quit = 1;
-    pthread_barrier_wait(&c.start);
-    for (unsigned t = 1; t < threads; t++)
-        pthread_join(id[t], NULL);
-    pthread_barrier_destroy(&c.start);
-    pthread_barrier_destroy(&c.done);
+    ip__pool_destroy(pool);
     if (repeats > 0) {
         qsort(times + 1, (size_t)repeats, sizeof *times, compare_doubles);
         printf("median %.4f s [%.4f-%.4f] of %d warm runs, %u threads\n",
