@@ -1,6 +1,8 @@
 /* The thread pool: every job runs exactly once per run, runs can follow each other on one
  * pool, the helpers really run jobs at the same time as the caller (with signals blocked), a
- * pool of 1 runs on the caller, and a pool may be destroyed without ever running. */
+ * pool of 1 runs on the caller, and a pool may be destroyed without ever running. The spin
+ * before a sleep: it sees another thread's change, gives up when its time is out, and is off
+ * for a pool with more threads than the machine has cores. */
 #include <errno.h>
 #include <pthread.h>
 #include <signal.h>
@@ -113,6 +115,45 @@ static void check_concurrent(unsigned threads)
     ip__pool_destroy(pool);
 }
 
+/* Changes the word spun on, after a pause long enough for the spinner to be spinning. */
+static void *change_later(void *arg)
+{
+    struct timespec pause = {0, 2000000}; /* 2 ms */
+    nanosleep(&pause, NULL);
+    atomic_fetch_add((atomic_uint *)arg, 1);
+    return NULL;
+}
+
+static void check_spin(void)
+{
+    atomic_uint word;
+    atomic_init(&word, 7);
+    /* no time: one look */
+    CHECK(ip__spin_while(&word, 7, 0) == 0);
+    CHECK(ip__spin_while(&word, 6, 0) == 1);
+    CHECK(ip__spin_while(&word, 6, 1e-3) == 1);
+    /* unchanged: it returns once its time is out, not before */
+    double t0 = ip_now_seconds();
+    CHECK(ip__spin_while(&word, 7, 1e-3) == 0);
+    CHECK(ip_now_seconds() - t0 >= 1e-3);
+    /* another thread's change ends the spin (long before its 30 s) */
+    pthread_t other;
+    REQUIRE(pthread_create(&other, NULL, change_later, &word) == 0);
+    CHECK(ip__spin_while(&word, 7, 30.0) == 1);
+    CHECK(atomic_load(&word) == 8);
+    pthread_join(other, NULL);
+    /* pools spin up to as many threads as cores, and not beyond */
+    ip__pool *pool = NULL;
+    REQUIRE(ip__pool_create(ip_thread_count(0), &pool, NULL) == IP_OK);
+    CHECK(ip__pool_spin_seconds(pool) == IP_SPIN_SECONDS);
+    ip__pool_destroy(pool);
+    if (ip_thread_count(0) < IP_MAX_THREADS) {
+        REQUIRE(ip__pool_create(ip_thread_count(0) + 1, &pool, NULL) == IP_OK);
+        CHECK(ip__pool_spin_seconds(pool) == 0);
+        ip__pool_destroy(pool);
+    }
+}
+
 static void caller_job(void *user, unsigned index)
 {
     pthread_t *who = user;
@@ -175,5 +216,7 @@ int main(void)
     }
     ip__pool_destroy(NULL);
     CHECK(1);
+
+    check_spin();
     return test_summary("test_pool");
 }

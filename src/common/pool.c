@@ -6,7 +6,38 @@
 #include <stdlib.h>
 
 #include "internal.h"
+#include "isoprop/system.h"
 #include "pool.h"
+
+/* The processor's hint that this thread spins (it then leaves the loop without a pipeline
+ * flush, and lends the core to its other hardware thread). */
+static inline void relax(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#elif defined(__aarch64__)
+    __asm__ __volatile__("yield");
+#endif
+}
+
+int ip__spin_while(const atomic_uint *word, unsigned seen, double seconds)
+{
+    if (!(seconds > 0))
+        return atomic_load_explicit(word, memory_order_acquire) != seen;
+    double until = 0;
+    for (unsigned i = 1;; i++) {
+        if (atomic_load_explicit(word, memory_order_acquire) != seen)
+            return 1;
+        relax();
+        if (i % 64 == 0) { /* the clock now and then: it costs more than a pause */
+            double now = ip_now_seconds();
+            if (until == 0)
+                until = now + seconds;
+            else if (now >= until)
+                return 0;
+        }
+    }
+}
 
 struct ip__pool {
     pthread_mutex_t lock;
@@ -15,11 +46,13 @@ struct ip__pool {
     unsigned helpers;          /* helper threads started */
     pthread_t *tids;
     /* The current run, guarded by lock. */
-    unsigned long generation; /* runs started so far */
+    atomic_uint generation; /* runs started so far (read unlocked to spin on) */
     ip__pool_job fn;
     void *user;
-    unsigned jobs, next, done;
+    unsigned jobs, next;
+    atomic_uint done; /* (read unlocked to spin on) */
     int stop;
+    double spin; /* ip__pool_spin_seconds() */
 };
 
 /* Runs jobs of the current run until none is left to take; called and returns with the lock
@@ -33,7 +66,7 @@ static void take_jobs(ip__pool *p)
         pthread_mutex_unlock(&p->lock);
         fn(user, i);
         pthread_mutex_lock(&p->lock);
-        if (++p->done == p->jobs)
+        if (atomic_fetch_add(&p->done, 1) + 1 == p->jobs)
             pthread_cond_signal(&p->work_done);
     }
 }
@@ -41,14 +74,20 @@ static void take_jobs(ip__pool *p)
 static void *helper(void *arg)
 {
     ip__pool *p = arg;
-    unsigned long seen = 0; /* not p->generation: a run may start before this thread does */
+    unsigned seen = 0; /* not p->generation: a run may start before this thread does */
     pthread_mutex_lock(&p->lock);
     for (;;) {
-        while (!p->stop && p->generation == seen)
+        /* a short spin first: the next run often comes at once (an engine's steps) */
+        if (!p->stop && atomic_load(&p->generation) == seen) {
+            pthread_mutex_unlock(&p->lock);
+            ip__spin_while(&p->generation, seen, p->spin);
+            pthread_mutex_lock(&p->lock);
+        }
+        while (!p->stop && atomic_load(&p->generation) == seen)
             pthread_cond_wait(&p->work_ready, &p->lock);
         if (p->stop)
             break;
-        seen = p->generation;
+        seen = atomic_load(&p->generation);
         take_jobs(p);
     }
     pthread_mutex_unlock(&p->lock);
@@ -81,6 +120,7 @@ ip_status ip__pool_create(unsigned threads, ip__pool **out, ip_error *err)
     pthread_mutex_init(&p->lock, NULL);
     pthread_cond_init(&p->work_ready, NULL);
     pthread_cond_init(&p->work_done, NULL);
+    p->spin = threads <= ip_thread_count(0) ? IP_SPIN_SECONDS : 0;
     for (unsigned t = 0; t + 1 < threads; t++)
         if (ip__thread_start(&p->tids[p->helpers], helper, p) == 0)
             p->helpers++;
@@ -105,6 +145,11 @@ void ip__pool_destroy(ip__pool *p)
     free(p);
 }
 
+double ip__pool_spin_seconds(const ip__pool *p)
+{
+    return p->spin;
+}
+
 unsigned ip__pool_threads(const ip__pool *p)
 {
     return 1 + p->helpers;
@@ -124,11 +169,18 @@ void ip__pool_run(ip__pool *p, unsigned jobs, ip__pool_job fn, void *user)
     p->user = user;
     p->jobs = jobs;
     p->next = 0;
-    p->done = 0;
-    p->generation++;
+    atomic_store(&p->done, 0);
+    atomic_fetch_add(&p->generation, 1);
     pthread_cond_broadcast(&p->work_ready);
     take_jobs(p);
-    while (p->done < p->jobs)
+    unsigned done = atomic_load(&p->done);
+    if (done < jobs) { /* the helpers' last jobs: spin a little, then sleep */
+        pthread_mutex_unlock(&p->lock);
+        while (done < jobs && ip__spin_while(&p->done, done, p->spin))
+            done = atomic_load(&p->done);
+        pthread_mutex_lock(&p->lock);
+    }
+    while (atomic_load(&p->done) < p->jobs)
         pthread_cond_wait(&p->work_done, &p->lock);
     pthread_mutex_unlock(&p->lock);
 }

@@ -4,6 +4,7 @@
 #define ISOPROP_POOL_H
 
 #include <pthread.h>
+#include <stdatomic.h>
 
 #include "isoprop/status.h"
 
@@ -37,5 +38,20 @@ unsigned ip__pool_threads(const ip__pool *pool);
  * never runs on two threads at once but its thread varies. One run at a time per pool, never
  * from inside a job. jobs == 0 does nothing. */
 void ip__pool_run(ip__pool *pool, unsigned jobs, ip__pool_job fn, void *user);
+
+/* How long a thread about to sleep on a condition first spins on it (seconds). A sleeper
+ * runs again tens of microseconds after its wake-up (more on a virtual machine), as long as a
+ * small engine step's tail; a short spin takes the news at once, for at most this much CPU
+ * per wait. */
+#define IP_SPIN_SECONDS 50e-6
+
+/* How long the pool's threads, and work that waits on them, spin before sleeping (seconds):
+ * IP_SPIN_SECONDS, or 0 when the pool has more threads than the machine has cores (a spinner
+ * would hold the core that the thread it waits for needs). */
+double ip__pool_spin_seconds(const ip__pool *pool);
+
+/* Spins (with the processor's pause hint) while *word == seen, for up to `seconds`.
+ * @return 1 when the word changed, 0 when the time ran out (at once for seconds <= 0). */
+int ip__spin_while(const atomic_uint *word, unsigned seen, double seconds);
 
 #endif

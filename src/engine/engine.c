@@ -72,6 +72,7 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     pthread_mutex_init(&e->share_lock, NULL);
     pthread_cond_init(&e->share_wake, NULL);
     atomic_init(&e->hungry, 0);
+    atomic_init(&e->share_news, 0);
     ip_mesh_init(&e->mesh);
     e->mesh.with_cells = options->cell_ids != 0;
     e->workers = calloc(e->threads, sizeof *e->workers);

@@ -137,6 +137,7 @@ struct ip_engine {
     unsigned shared_count;
     unsigned working;
     atomic_int hungry;
+    atomic_uint share_news; /* bumped under share_lock when waiters should look again (spun on) */
 };
 
 /* handout.c */

@@ -2,6 +2,7 @@
 #include <string.h>
 #include "engine_state.h"
 #include "internal.h"
+#include "pool.h"
 
 int ip__engine_give_cells(void *user, uint32_t level, const ip_queued_cell *cells, unsigned count,
                           const double dir[3])
@@ -16,6 +17,7 @@ int ip__engine_give_cells(void *user, uint32_t level, const ip_queued_cell *cell
         c->count = count;
         memcpy(c->dir, dir, sizeof c->dir);
         memcpy(c->cells, cells, count * sizeof *cells);
+        atomic_fetch_add(&e->share_news, 1);
         pthread_cond_signal(&e->share_wake);
     }
     pthread_mutex_unlock(&e->share_lock);
@@ -42,9 +44,16 @@ void ip__engine_help(ip_engine *e, ip_engine_worker *w)
         if (e->working == 0)
             break;
         atomic_fetch_add(&e->hungry, 1);
-        pthread_cond_wait(&e->share_wake, &e->share_lock);
+        /* a short spin before sleeping: cells offered or the last worker done, soon after */
+        unsigned seen = atomic_load(&e->share_news);
+        pthread_mutex_unlock(&e->share_lock);
+        int news = ip__spin_while(&e->share_news, seen, ip__pool_spin_seconds(e->pool));
+        pthread_mutex_lock(&e->share_lock);
+        if (!news && e->shared_count == 0 && e->working > 0)
+            pthread_cond_wait(&e->share_wake, &e->share_lock);
         atomic_fetch_sub(&e->hungry, 1);
     }
+    atomic_fetch_add(&e->share_news, 1);
     pthread_cond_broadcast(&e->share_wake); /* the others may wait for working to reach 0 */
     pthread_mutex_unlock(&e->share_lock);
 }
