@@ -103,6 +103,10 @@ class Camera(ctypes.Structure):
 
 
 IP_MAX_CLIP_PLANES = 6  # engine.h
+# ip_engine_options.prefetch (engine.h)
+PREFETCH_OFF = 0  # IP_PREFETCH_OFF: no reader
+PREFETCH_ON = 1  # IP_PREFETCH_ON: the default
+PREFETCH_ALWAYS = 2  # IP_PREFETCH_ALWAYS: every planned brick read ahead
 
 
 class ClipPlane(ctypes.Structure):
@@ -151,4 +155,14 @@ MIRRORS = {
     "ip_engine_options": EngineOptions,
     "ip_engine_counts": EngineCounts,
     "ip_mesh": Mesh,
+}
+
+# Every mirrored constant, by its C name: what the layout test checks.
+CONSTANTS = {
+    "IP_PATH_MAX": PATH_MAX,
+    "IP_MAX_LEVELS": MAX_LEVELS,
+    "IP_MAX_CLIP_PLANES": IP_MAX_CLIP_PLANES,
+    "IP_PREFETCH_OFF": PREFETCH_OFF,
+    "IP_PREFETCH_ON": PREFETCH_ON,
+    "IP_PREFETCH_ALWAYS": PREFETCH_ALWAYS,
 }

@@ -34,7 +34,8 @@ def _engine_options(threads, cutoff, foldback, lod, pixel_error, occlusion, pref
     # prefetch: True (on) or False (off), or "always" (isorender --prefetch always)
     if isinstance(prefetch, str) and prefetch != "always":
         raise ValueError('prefetch: True, False or "always", not %r' % prefetch)
-    o.prefetch = 2 if prefetch == "always" else int(bool(prefetch))
+    o.prefetch = (S.PREFETCH_ALWAYS if prefetch == "always"
+                  else S.PREFETCH_ON if prefetch else S.PREFETCH_OFF)
     o.cull = int(bool(cull))
     return o
 

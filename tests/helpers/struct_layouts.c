@@ -1,7 +1,8 @@
 /* Prints the size and every field's offset of the public structs that the Python module
  * mirrors with ctypes (python/isoprop/_structs.py), one "STRUCT SIZE" line per struct and one
- * "STRUCT.FIELD OFFSET" line per field; tests/python/test_layouts.py compares them. Built
- * against the public headers alone. */
+ * "STRUCT.FIELD OFFSET" line per field, and the value of every constant it mirrors, one
+ * "#NAME VALUE" line each; tests/python/test_layouts.py compares them. Built against the
+ * public headers alone. */
 #include <stddef.h>
 #include <stdio.h>
 
@@ -9,6 +10,7 @@
 
 #define SIZE(type) printf("%s %zu\n", #type, sizeof(type))
 #define FIELD(type, field) printf("%s.%s %zu\n", #type, #field, offsetof(type, field))
+#define CONSTANT(name) printf("#%s %lld\n", #name, (long long)(name))
 
 static void error_and_input(void)
 {
@@ -186,6 +188,16 @@ static void engine(void)
     FIELD(ip_mesh, with_cells);
 }
 
+static void constants(void)
+{
+    CONSTANT(IP_PATH_MAX);
+    CONSTANT(IP_MAX_LEVELS);
+    CONSTANT(IP_MAX_CLIP_PLANES);
+    CONSTANT(IP_PREFETCH_OFF);
+    CONSTANT(IP_PREFETCH_ON);
+    CONSTANT(IP_PREFETCH_ALWAYS);
+}
+
 int main(void)
 {
     error_and_input();
@@ -193,5 +205,6 @@ int main(void)
     layout();
     cache();
     engine();
+    constants();
     return 0;
 }

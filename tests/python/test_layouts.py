@@ -1,5 +1,6 @@
 """The ctypes mirrors of python/isoprop/_structs.py against the C compiler: the size of every
-mirrored struct and the offset of every field, as tests/helpers/struct_layouts.c prints them."""
+mirrored struct, the offset of every field and the value of every mirrored constant, as
+tests/helpers/struct_layouts.c prints them."""
 import ctypes
 import os
 import subprocess
@@ -13,7 +14,9 @@ class Layouts(unittest.TestCase):
     def test_every_mirror_matches_the_headers(self):
         out = subprocess.run([os.path.join(support.BIN, "tests", "struct_layouts")], check=True,
                              capture_output=True, text=True).stdout
-        c = dict(line.split() for line in out.splitlines())
+        lines = dict(line.split() for line in out.splitlines())
+        c = {k: v for k, v in lines.items() if not k.startswith("#")}
+        constants = {k[1:]: int(v) for k, v in lines.items() if k.startswith("#")}
         checked = 0
         for name, mirror in _structs.MIRRORS.items():
             self.assertEqual(ctypes.sizeof(mirror), int(c[name]), "sizeof(%s)" % name)
@@ -24,6 +27,8 @@ class Layouts(unittest.TestCase):
         # every field the helper prints is mirrored (a new C field fails here too)
         self.assertEqual(checked, sum(1 for k in c if "." in k))
         self.assertEqual(set(_structs.MIRRORS), {k for k in c if "." not in k})
+        # every constant the helper prints is mirrored, with its value
+        self.assertEqual(_structs.CONSTANTS, constants)
 
 
 if __name__ == "__main__":
