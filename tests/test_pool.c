@@ -115,32 +115,54 @@ static void check_concurrent(unsigned threads)
     ip__pool_destroy(pool);
 }
 
-/* Changes the word spun on, after a pause long enough for the spinner to be spinning. */
+/* The word spun on, and the mutex its writer takes (none: NULL). */
+typedef struct spun {
+    atomic_uint word;
+    pthread_mutex_t *lock;
+} spun;
+
+/* Changes the word, under its mutex if it has one, after a pause long enough for the spinner
+ * to be spinning. */
 static void *change_later(void *arg)
 {
+    spun *s = arg;
     struct timespec pause = {0, 2000000}; /* 2 ms */
     nanosleep(&pause, NULL);
-    atomic_fetch_add((atomic_uint *)arg, 1);
+    if (s->lock)
+        pthread_mutex_lock(s->lock);
+    atomic_fetch_add(&s->word, 1);
+    if (s->lock)
+        pthread_mutex_unlock(s->lock);
     return NULL;
 }
 
 static void check_spin(void)
 {
-    atomic_uint word;
-    atomic_init(&word, 7);
+    spun s = {.lock = NULL};
+    atomic_init(&s.word, 7);
     /* no time: one look */
-    CHECK(ip__spin_while(&word, 7, 0) == 0);
-    CHECK(ip__spin_while(&word, 6, 0) == 1);
-    CHECK(ip__spin_while(&word, 6, 1e-3) == 1);
+    CHECK(ip__spin_while(&s.word, 7, 0, NULL) == 0);
+    CHECK(ip__spin_while(&s.word, 6, 0, NULL) == 1);
+    CHECK(ip__spin_while(&s.word, 6, 1e-3, NULL) == 1);
     /* unchanged: it returns once its time is out, not before */
     double t0 = ip_now_seconds();
-    CHECK(ip__spin_while(&word, 7, 1e-3) == 0);
+    CHECK(ip__spin_while(&s.word, 7, 1e-3, NULL) == 0);
     CHECK(ip_now_seconds() - t0 >= 1e-3);
     /* another thread's change ends the spin (long before its 30 s) */
     pthread_t other;
-    REQUIRE(pthread_create(&other, NULL, change_later, &word) == 0);
-    CHECK(ip__spin_while(&word, 7, 30.0) == 1);
-    CHECK(atomic_load(&word) == 8);
+    REQUIRE(pthread_create(&other, NULL, change_later, &s) == 0);
+    CHECK(ip__spin_while(&s.word, 7, 30.0, NULL) == 1);
+    CHECK(atomic_load(&s.word) == 8);
+    pthread_join(other, NULL);
+    /* with a mutex held: let go while spinning (the writer needs it), held again after */
+    pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+    s.lock = &lock;
+    pthread_mutex_lock(&lock);
+    REQUIRE(pthread_create(&other, NULL, change_later, &s) == 0);
+    CHECK(ip__spin_while(&s.word, 8, 30.0, &lock) == 1);
+    CHECK(atomic_load(&s.word) == 9);
+    CHECK(pthread_mutex_trylock(&lock) == EBUSY); /* this thread holds it */
+    pthread_mutex_unlock(&lock);
     pthread_join(other, NULL);
     /* pools spin up to as many threads as cores, and not beyond */
     ip__pool *pool = NULL;

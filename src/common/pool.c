@@ -20,7 +20,8 @@ static inline void relax(void)
 #endif
 }
 
-int ip__spin_while(const atomic_uint *word, unsigned seen, double seconds)
+/* ip__spin_while() without the mutex. */
+static int spin(const atomic_uint *word, unsigned seen, double seconds)
 {
     if (!(seconds > 0))
         return atomic_load_explicit(word, memory_order_acquire) != seen;
@@ -37,6 +38,16 @@ int ip__spin_while(const atomic_uint *word, unsigned seen, double seconds)
                 return 0;
         }
     }
+}
+
+int ip__spin_while(const atomic_uint *word, unsigned seen, double seconds, pthread_mutex_t *held)
+{
+    if (held)
+        pthread_mutex_unlock(held);
+    int changed = spin(word, seen, seconds);
+    if (held)
+        pthread_mutex_lock(held);
+    return changed;
 }
 
 struct ip__pool {
@@ -78,11 +89,8 @@ static void *helper(void *arg)
     pthread_mutex_lock(&p->lock);
     for (;;) {
         /* a short spin first: the next run often comes at once (an engine's steps) */
-        if (!p->stop && atomic_load(&p->generation) == seen) {
-            pthread_mutex_unlock(&p->lock);
-            ip__spin_while(&p->generation, seen, p->spin);
-            pthread_mutex_lock(&p->lock);
-        }
+        if (!p->stop && atomic_load(&p->generation) == seen)
+            ip__spin_while(&p->generation, seen, p->spin, &p->lock);
         while (!p->stop && atomic_load(&p->generation) == seen)
             pthread_cond_wait(&p->work_ready, &p->lock);
         if (p->stop)
@@ -173,13 +181,9 @@ void ip__pool_run(ip__pool *p, unsigned jobs, ip__pool_job fn, void *user)
     atomic_fetch_add(&p->generation, 1);
     pthread_cond_broadcast(&p->work_ready);
     take_jobs(p);
-    unsigned done = atomic_load(&p->done);
-    if (done < jobs) { /* the helpers' last jobs: spin a little, then sleep */
-        pthread_mutex_unlock(&p->lock);
-        while (done < jobs && ip__spin_while(&p->done, done, p->spin))
-            done = atomic_load(&p->done);
-        pthread_mutex_lock(&p->lock);
-    }
+    unsigned done = atomic_load(&p->done); /* the helpers' last jobs: spin a little, then sleep */
+    while (done < jobs && ip__spin_while(&p->done, done, p->spin, &p->lock))
+        done = atomic_load(&p->done);
     while (atomic_load(&p->done) < p->jobs)
         pthread_cond_wait(&p->work_done, &p->lock);
     pthread_mutex_unlock(&p->lock);

@@ -46,9 +46,8 @@ void ip__engine_help(ip_engine *e, ip_engine_worker *w)
         atomic_fetch_add(&e->hungry, 1);
         /* a short spin before sleeping: cells offered or the last worker done, soon after */
         unsigned seen = atomic_load(&e->share_news);
-        pthread_mutex_unlock(&e->share_lock);
-        int news = ip__spin_while(&e->share_news, seen, ip__pool_spin_seconds(e->pool));
-        pthread_mutex_lock(&e->share_lock);
+        int news =
+            ip__spin_while(&e->share_news, seen, ip__pool_spin_seconds(e->pool), &e->share_lock);
         if (!news && e->shared_count == 0 && e->working > 0)
             pthread_cond_wait(&e->share_wake, &e->share_lock);
         atomic_fetch_sub(&e->hungry, 1);
