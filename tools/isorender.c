@@ -1157,10 +1157,11 @@ static void json_counts(FILE *f, void *user)
     if (!r->o.full) {
         fprintf(f,
                 ", \"occlusion\": %s, \"deferred_cells\": %llu, \"retired_rays\": %llu, "
-                "\"ray_nodes\": %llu, \"prefetch\": %s, \"cull\": %s, \"culled_triangles\": %llu",
+                "\"ray_nodes\": %llu, \"prefetch\": %s, \"prefetch_mode\": \"%s\", \"cull\": %s, "
+                "\"culled_triangles\": %llu",
                 r->o.common.occlusion ? "true" : "false", (unsigned long long)r->totals.deferred,
                 (unsigned long long)r->totals.retired, (unsigned long long)r->totals.nodes,
-                r->o.common.prefetch ? "true" : "false",
+                r->o.common.prefetch ? "true" : "false", tool_prefetch_name(r->o.common.prefetch),
                 r->o.common.occlusion && r->o.common.cull ? "true" : "false",
                 (unsigned long long)r->totals.culled);
     }

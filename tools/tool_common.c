@@ -744,12 +744,19 @@ static int parse_occlusion(const char *p, const tool_option *opt, const char *co
     return parse_on_off(p, v[0], &((tool_view_options *)base)->occlusion, "--occlusion");
 }
 
+/* --prefetch's names, indexed by the modes IP_PREFETCH_OFF, _ON and _ALWAYS (0, 1, 2). */
+static const char *const prefetch_names[3] = {"off", "on", "always"};
+
+const char *tool_prefetch_name(int mode)
+{
+    return mode >= 0 && mode < 3 ? prefetch_names[mode] : "unknown";
+}
+
 static int parse_prefetch(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     (void)opt;
-    static const char *const names[3] = {"off", "on", "always"}; /* IP_PREFETCH_OFF, _ON, ... */
     for (int i = 0; i < 3; i++)
-        if (!strcmp(v[0], names[i])) {
+        if (!strcmp(v[0], prefetch_names[i])) {
             ((tool_view_options *)base)->prefetch = i;
             return 0;
         }

@@ -168,6 +168,10 @@ typedef struct tool_view_options {
  * default cache budget, an image of width x height. */
 void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t height);
 
+/* --prefetch's name of a mode ("off", "on" or "always"; "unknown" for another value): a
+ * static string. */
+const char *tool_prefetch_name(int mode);
+
 /* Parses a --clip SPEC (see TOOL_ENGINE_OPTIONS_HELP) into *plane; returns 0, or -1 when it
  * is not one (an unknown axis, a bad number, a zero normal). */
 int tool_parse_clip(const char *text, ip_clip_plane *plane);

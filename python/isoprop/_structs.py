@@ -107,6 +107,8 @@ IP_MAX_CLIP_PLANES = 6  # engine.h
 PREFETCH_OFF = 0  # IP_PREFETCH_OFF: no reader
 PREFETCH_ON = 1  # IP_PREFETCH_ON: the default
 PREFETCH_ALWAYS = 2  # IP_PREFETCH_ALWAYS: every planned brick read ahead
+# each mode's name, as isorender's --prefetch takes it and --stats writes it ("prefetch_mode")
+PREFETCH_NAMES = {PREFETCH_OFF: "off", PREFETCH_ON: "on", PREFETCH_ALWAYS: "always"}
 
 
 class ClipPlane(ctypes.Structure):

@@ -56,6 +56,7 @@ def run_stats(run, counts, cache):
         out.update({"occlusion": bool(run.options.occlusion), "deferred_cells": counts.deferred,
                     "retired_rays": counts.retired, "ray_nodes": counts.nodes,
                     "prefetch": bool(run.options.prefetch),
+                    "prefetch_mode": S.PREFETCH_NAMES[run.options.prefetch],
                     "cull": bool(run.options.occlusion and run.options.cull),
                     "culled_triangles": counts.culled})
     out["warnings"] = list(run.warnings)

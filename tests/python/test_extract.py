@@ -99,6 +99,8 @@ class Extract(unittest.TestCase):
         off = self.f.extract(ISO, view="+x", size=SIZE, threads=1, prefetch=False)
         self.assertTrue(always.stats["prefetch"])
         self.assertFalse(off.stats["prefetch"])
+        self.assertEqual(always.stats["prefetch_mode"], "always")
+        self.assertEqual(off.stats["prefetch_mode"], "off")
         self.assertEqual(always.faces.tolist(), off.faces.tolist())
         self.assertEqual(always.vertices.tolist(), off.vertices.tolist())
         with self.assertRaises(ValueError):

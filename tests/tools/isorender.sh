@@ -25,7 +25,7 @@ for key in cache budget_bytes resident_bytes resident_peak_bytes hits misses evi
            bytes_decompressed decode_seconds bricks_touched bricks_total hit_rate \
            peak_rss_bytes rays seeds cells triangles intersection_s propagation_s \
            extraction_s rendering_s visible_triangles overdraw occlusion deferred_cells \
-           retired_rays ray_nodes prefetch cull culled_triangles prefetched prefetch_hits \
+           retired_rays ray_nodes prefetch prefetch_mode cull culled_triangles prefetched prefetch_hits \
            bytes_read_disk wait_seconds; do
     check "stats has \"$key\"" sh -c 'printf "%s" "$0" | grep -q "\"$1\":"' "$json" "$key"
 done
@@ -66,13 +66,14 @@ expect_error 2 "--occlusion" "$bin/isorender" s.ibv --iso 1 --occlusion maybe -o
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o n.png \
     --prefetch off --stats n.json --software --quiet
 check "prefetch off succeeds" test "$rc" = 0
-check "prefetch off says so" grep -q '"prefetch": false' n.json
+check "prefetch off says so" grep -q '"prefetch": false, "prefetch_mode": "off"' n.json
+check "prefetch on by default, and says which" grep -q '"prefetch": true, "prefetch_mode": "on"' p.json
 check "prefetch off loads nothing ahead" grep -q '"prefetched": 0, "prefetch_hits": 0' n.json
 check "prefetch on and off make the same picture" cmp -s p.png n.png
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o a.png \
     --prefetch always --stats a.json --software --quiet
 check "prefetch always succeeds" test "$rc" = 0
-check "prefetch always says it is on" grep -q '"prefetch": true' a.json
+check "prefetch always says it is on, and always" grep -q '"prefetch": true, "prefetch_mode": "always"' a.json
 check "prefetch always and off make the same picture" cmp -s a.png n.png
 expect_error 2 "--prefetch must be on, off or always" "$bin/isorender" s.ibv --iso 1 \
     --prefetch maybe -o x.png
