@@ -635,13 +635,8 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
         }
         hits[at] = (child_hit){{ch[0], ch[1], ch[2]}, a, b, in, out, walk};
     }
-    double plo[3], phi[3];
-    ip__seeder_node_box(s, depth, node, plo, phi);
-    uint32_t in_lo[3], in_hi[3];
-    for (int k = 0; k < 3; k++) {
-        in_lo[k] = (uint32_t)plo[k];
-        in_hi[k] = (uint32_t)phi[k];
-    }
+    uint32_t in_lo[3], in_hi[3]; /* the node's cells: where its children's near passes look */
+    ip__seeder_node_cells(s, depth, node, in_lo, in_hi);
     for (int i = 0; i < count; i++) {
         int found =
             hits[i].walk ? walk_node(s, r, depth - 1, hits[i].node, hits[i].t0, hits[i].t1) : 0;

@@ -85,18 +85,25 @@ static inline int ip__seeder_active_child(const ip_seeder *s, uint32_t depth,
     return ip__seeder_node_active(s, depth - 1, ch);
 }
 
+/* ip__seeder_node_box() as level coordinates: the node's cells are [first, last). */
+static inline void ip__seeder_node_cells(const ip_seeder *s, uint32_t depth, const uint32_t node[3],
+                                         uint32_t first[3], uint32_t last[3])
+{
+    double lo[3], hi[3];
+    ip__seeder_node_box(s, depth, node, lo, hi);
+    for (int k = 0; k < 3; k++) {
+        first[k] = (uint32_t)lo[k];
+        last[k] = (uint32_t)hi[k];
+    }
+}
+
 /* 1 unless the clipping planes drop every cell of node `node` at `depth`. */
 static inline int ip__seeder_node_kept(const ip_seeder *s, uint32_t depth, const uint32_t node[3])
 {
     if (s->clip.count == 0)
         return 1;
-    double lo[3], hi[3];
-    ip__seeder_node_box(s, depth, node, lo, hi);
     uint32_t first[3], last[3];
-    for (int k = 0; k < 3; k++) {
-        first[k] = (uint32_t)lo[k];
-        last[k] = (uint32_t)hi[k];
-    }
+    ip__seeder_node_cells(s, depth, node, first, last);
     return ip__clip_keeps_samples(&s->clip, s->layout, s->level, first, last);
 }
 
