@@ -220,12 +220,11 @@ static int changes_cell(const index_ray *r, int k, double u0, double u1)
 
 /* The faces of the box [lo, hi] (index units, whole cells) inside the region of cells
  * [in_lo, in_hi) that the ray passes within s->reach of over [ta, tb] where it may leave cells
- * beyond them unentered: bit 2k is the low face along axis k, bit 2k + 1 the high one. The
- * ray enters the box through a face along
- * axis `in` and leaves it through one along `out` (-1: neither; it starts or ends inside, or
- * on the boundary of the caller's region). Beyond the face it crosses, a cell's only
- * neighbour is the cell it enters; a larger box's is left out only when the ray stays in one
- * of its cells while it runs within reach of that face. */
+ * beyond them unentered: bit 2k is the low face along axis k, bit 2k + 1 the high one. The ray
+ * enters the box through a face along axis `in` and leaves it through one along `out` (-1:
+ * neither; it starts or ends inside, or on the boundary of the caller's region). Beyond a face
+ * it crosses, a cell's only neighbour it comes near is the cell it enters; a larger box's face
+ * counts when the ray moves into another of the level's cells within reach of the crossing. */
 static unsigned near_faces(const ip_seeder *s, const index_ray *r, const double lo[3],
                            const double hi[3], const uint32_t in_lo[3], const uint32_t in_hi[3],
                            double ta, double tb, int in, int out)
