@@ -6,6 +6,7 @@
 #include "beam.h"
 #include "check.h"
 #include "isoprop/camera.h"
+#include "mc.h"
 #include "seed.h"
 #include "volumes.h"
 
@@ -30,6 +31,25 @@ static void view_setup(ip_cache *cache, const char *axis, ip_camera *camera, ip_
     REQUIRE(ip_camera_fit_axis(lo, hi, axis, 30.0, 160, 120, camera, &err) == IP_OK);
     ip_camera_basis_of(camera, basis);
     REQUIRE(ip__sampler_init(sampler, cache, 0) == IP_OK);
+}
+
+static int cell_order(const void *a, const void *b)
+{
+    return memcmp(a, b, 3 * sizeof(uint32_t));
+}
+
+/* 1 when two walks of a ray found the same: the same result and seed cell, and the same cells.
+ * Down the octree and over the bricks, the cells a ray passes close by (near_cells() in seed.c)
+ * come at other places in the list: the lists are compared as sets. */
+static int same_finds(int fa, unsigned na, int sa, uint32_t a[][3], int fb, unsigned nb, int sb,
+                      uint32_t b[][3])
+{
+    if (fa != fb || na != nb || (sa < 0) != (sb < 0) ||
+        (sa >= 0 && memcmp(a[sa], b[sb], sizeof a[0]) != 0))
+        return 0;
+    qsort(a, na, sizeof a[0], cell_order);
+    qsort(b, nb, sizeof b[0], cell_order);
+    return memcmp(a, b, na * sizeof a[0]) == 0;
 }
 
 /* Casts every pixel's ray through level 0 three times: without the group ranges, with them
@@ -64,8 +84,8 @@ static void check_view(ip_cache *cache, const char *axis, float iso)
             uint32_t c[IP_SEED_MAX_CELLS][3];
             unsigned nc;
             int sc, fc = ip__seed_find(&octree, camera.eye, dir, 0, INFINITY, c, &nc, &sc);
-            walks_differ += fc != fb || nc != nb || sc != sb || memcmp(c, b, nb * sizeof b[0]) != 0;
             differ += fa != fb || na != nb || sa != sb || memcmp(a, b, na * sizeof a[0]) != 0;
+            walks_differ += !same_finds(fc, nc, sc, c, fb, nb, sb, b);
             seeds += fa == 1;
             rays++;
         }
@@ -218,6 +238,75 @@ static void check_beams(ip_cache *cache, const char *axis, float iso)
     ip__sampler_free(&sampler);
 }
 
+/* A ray that runs beside a cell without entering it, within the ray's reach of one of the
+ * cell's triangles (IP_SEED_REACH_PIXELS): the cell must be among the cells the ray finds, as a
+ * near miss (a rasteriser's snapping may show that triangle at the pixel), down the octree and
+ * over the bricks alike; with no reach, it is not. For each of the first cells found whose edge
+ * along z at their high x and y is crossed, the ray runs along z, parallel to that edge, half
+ * the reach outside it diagonally, from half a cell before the cell. */
+static void check_near_passes(ip_cache *cache, float iso)
+{
+    const ip_layout *l = ip_store_layout(ip_cache_store(cache));
+    const uint32_t *d = l->levels[0].dims;
+    ip_sampler sampler;
+    REQUIRE(ip__sampler_init(&sampler, cache, 0) == IP_OK);
+    int edge = -1; /* the edge along z joining corners 3 (x1, y1, z0) and 7 (x1, y1, z1) */
+    for (int e = 0; e < 12; e++)
+        if (ip__mc_edge_corners[e][0] == 3 && ip__mc_edge_corners[e][1] == 7)
+            edge = e;
+    REQUIRE(edge >= 0);
+    const double pixel_angle = 0.01, eye_distance = 50.0;
+    unsigned cases = 0, found_near = 0, found_without = 0;
+    for (uint32_t z = 2; z + 3 < d[2] && cases < 40; z += 3)
+        for (uint32_t y = 2; y + 3 < d[1] && cases < 40; y++)
+            for (uint32_t x = 2; x + 3 < d[0] && cases < 40; x++) {
+                uint32_t c[3] = {x, y, z};
+                float values[8], lo[3], hi[3], points[12][3];
+                unsigned mc;
+                REQUIRE(ip__sampler_cell_case(&sampler, c, iso, values, &mc) == 1);
+                if (!(ip__mc_edge_table[mc] >> edge & 1u))
+                    continue;
+                ip__sampler_cell_box(&sampler, c, lo, hi);
+                ip__mc_cell_edge_points(values, mc, iso, lo, hi, points);
+                /* the reach there: thick x (eye distance to where the ray leaves the volume
+                 * plus a cell), as ip__seed_find() works it out */
+                double far = eye_distance + (double)(d[2] - 1 - z) + 1.5;
+                double reach = IP_SEED_REACH_PIXELS * pixel_angle * far, off = 0.5 * reach;
+                double eye[3] = {points[edge][0] + off, points[edge][1] + off,
+                                 lo[2] - eye_distance};
+                const double dir[3] = {0, 0, 1};
+                double t_min = eye_distance - 0.5;
+                cases++;
+                for (int way = 0; way < 3; way++) { /* bricks, octree, bricks without reach */
+                    ip_seeder s;
+                    ip__seeder_init(&s, &sampler, iso, pixel_angle);
+                    s.short_walk = way == 1 ? 0.0 : s.short_walk;
+                    s.thick = way == 2 ? 0.0 : s.thick;
+                    uint32_t cells[IP_SEED_MAX_CELLS][3];
+                    unsigned count;
+                    int seed;
+                    REQUIRE(ip__seed_find(&s, eye, dir, t_min, INFINITY, cells, &count, &seed) >=
+                            0);
+                    int has = 0;
+                    for (unsigned i = 0; i < count; i++)
+                        has |= memcmp(cells[i], c, sizeof c) == 0;
+                    CHECK_MSG(seed < 0 || memcmp(cells[seed], c, sizeof c) != 0,
+                              "cell %u %u %u: a ray beside it took it as its seed", x, y, z);
+                    if (way < 2)
+                        found_near += (unsigned)has;
+                    else
+                        found_without += (unsigned)has;
+                }
+            }
+    CHECK_MSG(cases >= 10, "only %u cells with the edge crossed", cases);
+    CHECK_MSG(found_near == 2 * cases, "%u of %u rays beside a cell found it", found_near,
+              2 * cases);
+    CHECK_MSG(found_without == 0, "%u rays found a cell they only pass beside with no reach",
+              found_without);
+    printf("test_seed: near passes: %u cells, each found by the rays beside them\n", cases);
+    ip__sampler_free(&sampler);
+}
+
 int main(void)
 {
     const char *dir = test_tmp_dir("test_seed");
@@ -234,6 +323,8 @@ int main(void)
     check_view(cache, "-z", -300.5f);
     check_beams(cache, "-y", 1000.5f);
     check_beams(cache, "+x", -300.5f);
+    check_near_passes(cache, 1000.5f);
+    check_near_passes(cache, -300.5f);
     ip_cache_destroy(cache);
     ip_store_close(store);
     return test_summary("test_seed");

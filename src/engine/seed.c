@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "format.h"
+#include "internal.h"
 #include "seed.h"
 #include "vec3.h"
 
@@ -60,6 +61,15 @@ static int clip(const index_ray *r, const double lo[3], const double hi[3], doub
 typedef struct dda {
     int32_t i[3], n[3], step[3];
     double t_max[3], t_delta[3], t, t_end;
+    int in_axis;    /* the axis of the face the ray entered the current cell through; -1 for the
+                    first cell (the ray enters the grid there, or starts inside it) */
+    double base[3]; /* the grid's first corner */
+    double edge;    /* its cells' edge */
+    int32_t back[3], front[3]; /* the index along each axis where the face behind (ahead of)
+                                  the ray is the grid's own: the first (last) cell it meets */
+    unsigned behind[3];        /* which face is behind the ray along each axis: 0 low, 1 high */
+    int parallel;              /* the ray runs parallel to some axis's faces */
+    int peek;                  /* the axis dda_exit() found the ray leaves along, or -1 */
 } dda;
 
 static void dda_init(dda *d, const index_ray *r, const double base[3], double edge,
@@ -91,19 +101,45 @@ static void dda_init(dda *d, const index_ray *r, const double base[3], double ed
     }
     d->t = t0;
     d->t_end = t1;
+    d->in_axis = -1;
+    d->parallel = 0;
+    d->peek = -1;
+    for (int k = 0; k < 3; k++) {
+        d->base[k] = base[k];
+        d->behind[k] = d->step[k] < 0;
+        d->back[k] = d->step[k] < 0 ? d->n[k] - 1 : 0;
+        d->front[k] = d->step[k] < 0 ? 0 : d->n[k] - 1;
+        d->parallel |= d->step[k] == 0;
+    }
+    d->edge = edge;
 }
 
-/* The current cell's exit parameter; advances to the next cell. Returns 0 when past the end. */
-static int dda_next(dda *d, double *exit_t)
+/* The axis of the face the ray leaves the current cell through, and there *exit_t; -1 when
+ * the stretch ends in the cell or on the grid's boundary (then *exit_t is its end). */
+static IP_ALWAYS_INLINE int dda_exit(dda *d, double *exit_t)
 {
     int k = d->t_max[0] < d->t_max[1] ? (d->t_max[0] < d->t_max[2] ? 0 : 2)
                                       : (d->t_max[1] < d->t_max[2] ? 1 : 2);
+    d->peek = k; /* dda_next() steps along it */
+    *exit_t = d->t_max[k] < d->t_end ? d->t_max[k] : d->t_end;
+    int steps = !(d->t_max[k] > d->t_end) && d->step[k] != 0;
+    return steps && d->i[k] + d->step[k] >= 0 && d->i[k] + d->step[k] < d->n[k] ? k : -1;
+}
+
+/* The current cell's exit parameter; advances to the next cell. Returns 0 when past the end. */
+static IP_ALWAYS_INLINE int dda_next(dda *d, double *exit_t)
+{
+    int k = d->peek >= 0                ? d->peek
+            : d->t_max[0] < d->t_max[1] ? (d->t_max[0] < d->t_max[2] ? 0 : 2)
+                                        : (d->t_max[1] < d->t_max[2] ? 1 : 2);
+    d->peek = -1;
     *exit_t = d->t_max[k] < d->t_end ? d->t_max[k] : d->t_end;
     if (d->t_max[k] > d->t_end || d->step[k] == 0)
         return 0;
     d->t = d->t_max[k];
     d->i[k] += d->step[k];
     d->t_max[k] += d->t_delta[k];
+    d->in_axis = k;
     return d->i[k] >= 0 && d->i[k] < d->n[k];
 }
 
@@ -119,8 +155,9 @@ static int active(const float *range, float iso)
  * the margin of its edge; 1: outside every triangle, within the margin of one; 0: none.
  * `mc` is the cell's case; `ro` the ray's origin in the cell's frame (corner 0 at the origin),
  * its direction and the basis across it are r's. */
-static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc, const float values[8],
-                         const float size[3], const double ro[3])
+static IP_ALWAYS_INLINE int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc,
+                                          const float values[8], const float size[3],
+                                          const double ro[3])
 {
     static const float zero[3] = {0, 0, 0};
     float points[12][3];
@@ -163,6 +200,234 @@ static int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc, co
     return best;
 }
 
+/* floor(x) for |x| < 2^62 (floor() is a call on the x86-64 baseline). */
+static inline int64_t floor_index(double x)
+{
+    int64_t i = (int64_t)x; /* toward zero */
+    return i - ((double)i > x);
+}
+
+/* 1 when the ray moves into another cell of the level between t = u0 and u1 across a plane
+ * along an axis other than k. */
+static int changes_cell(const index_ray *r, int k, double u0, double u1)
+{
+    for (int j = 0; j < 3; j++)
+        if (j != k && floor_index(r->origin[j] + u0 * r->dir[j]) !=
+                          floor_index(r->origin[j] + u1 * r->dir[j]))
+            return 1;
+    return 0;
+}
+
+/* The faces of the box [lo, hi] (index units, whole cells) inside the region of cells
+ * [in_lo, in_hi) that the ray passes within s->reach of over [ta, tb] where it may leave cells
+ * beyond them unentered: bit 2k is the low face along axis k, bit 2k + 1 the high one. The ray
+ * enters the box through a face along axis `in` and leaves it through one along `out` (-1:
+ * neither; it starts or ends inside, or on the boundary of the caller's region). Beyond a face
+ * it crosses, a cell's only neighbour it comes near is the cell it enters; a larger box's face
+ * counts when the ray moves into another of the level's cells within reach of the crossing. */
+static unsigned near_faces(const ip_seeder *s, const index_ray *r, const double lo[3],
+                           const double hi[3], const uint32_t in_lo[3], const uint32_t in_hi[3],
+                           double ta, double tb, int in, int out)
+{
+    unsigned m = 0;
+    for (int k = 0; k < 3; k++) { /* faces on the region's boundary lead out of it: not here */
+        double a = r->origin[k] + ta * r->dir[k], b = r->origin[k] + tb * r->dir[k];
+        double least = a < b ? a : b, most = a < b ? b : a;
+        m |= (unsigned)(least - lo[k] < s->reach[k] && lo[k] > (double)in_lo[k]) << 2 * k;
+        m |= (unsigned)(hi[k] - most < s->reach[k] && hi[k] < (double)in_hi[k]) << (2 * k + 1);
+    }
+    if (!m)
+        return 0;
+    int cell = hi[0] - lo[0] == 1.0 && hi[1] - lo[1] == 1.0 && hi[2] - lo[2] == 1.0;
+    /* within reach of a plane it crosses at t from t - within to t + within (as
+     * dda_near_faces()) */
+    if (in >= 0 && (cell || !changes_cell(r, in, ta - s->within[in], ta + s->within[in])))
+        m &= ~(1u << (2 * in + (r->dir[in] < 0)));
+    if (out >= 0 && (cell || !changes_cell(r, out, tb - s->within[out], tb + s->within[out])))
+        m &= ~(1u << (2 * out + (r->dir[out] > 0)));
+    return m;
+}
+
+/* The first plane the ray crosses after the current cell's exit along axis `out`: the least
+ * t_max of the other axes. */
+static IP_ALWAYS_INLINE double next_other(const dda *d, int out)
+{
+    double a = d->t_max[out == 0 ? 1 : 0], b = d->t_max[out == 2 ? 1 : 2];
+    return a < b ? a : b;
+}
+
+/* near_faces() of the DDA's current cell, within the DDA's grid (the caller's region), from
+ * the DDA's own crossings: the ray was last at the plane behind the cell along axis k at
+ * t_max[k] - t_delta[k] and reaches the plane ahead at t_max[k]. `in` and `out` as
+ * near_faces(). For a grid of the level's cells (`coarse` 0) the faces it crosses there are
+ * left out; for a coarser one they count when the ray moves into another of the level's cells
+ * within reach of them: `in_changes` and *out_changes say so for the planes it crosses at t_in
+ * and t_out (the latter set here: it is the next cell's in_changes). */
+static IP_ALWAYS_INLINE unsigned dda_near_faces(const ip_seeder *s, const index_ray *r,
+                                                const dda *d, int coarse, double before,
+                                                double t_in, double t_out, int in, int out,
+                                                int in_changes, int *out_changes)
+{
+    /* Along an axis the ray runs parallel to, t_max and t_delta are infinite: both tests
+     * fail there (NaN and infinity), and the position says instead. The ray comes within
+     * reach of a face it does not cross only where it crosses two planes within reach of
+     * each other: past the cell's first and last, most cells are told apart by the crossings
+     * just before and after theirs (`before`: where it entered the previous cell). */
+    unsigned m = 0;
+    int quiet = !d->parallel && in >= 0 && out >= 0 && t_in - before >= s->within_most &&
+                next_other(d, out) - t_out >= s->within_most;
+    for (int k = 0; k < 3 && !quiet; k++) {
+        unsigned near_behind = (unsigned)(t_in - (d->t_max[k] - d->t_delta[k]) < s->within[k]) &
+                               (unsigned)(d->i[k] != d->back[k]);
+        unsigned near_ahead =
+            (unsigned)(d->t_max[k] - t_out < s->within[k]) & (unsigned)(d->i[k] != d->front[k]);
+        m |= (near_behind << d->behind[k] | near_ahead << (1u - d->behind[k])) << 2 * k;
+    }
+    if (in >= 0) /* crossed there: the cell's neighbour is where the ray comes from */
+        m &= ~(1u << (2 * in + d->behind[in]));
+    if (out >= 0)
+        m &= ~(1u << (2 * out + 1 - d->behind[out]));
+    if (d->parallel && !quiet)
+        for (int k = 0; k < 3; k++) {
+            if (d->step[k] != 0)
+                continue;
+            double p = r->origin[k] - d->base[k] - d->edge * (double)d->i[k];
+            m |= ((unsigned)(p < s->reach[k] && d->i[k] != 0) |
+                  (unsigned)(d->edge - p < s->reach[k] && d->i[k] != d->n[k] - 1) << 1)
+                 << 2 * k;
+        }
+    if (coarse && in >= 0 && in_changes)
+        m |= 1u << (2 * in + d->behind[in]);
+    if (coarse && out >= 0) {
+        *out_changes = changes_cell(r, out, t_out - s->within[out], t_out + s->within[out]);
+        m |= (unsigned)*out_changes << (2 * out + 1 - d->behind[out]);
+    }
+    return m;
+}
+
+/* 1 when cell c is already among the ray's cells. */
+static int found_already(const ip_seeder *s, const int64_t c[3])
+{
+    for (unsigned i = 0; i < s->found_count; i++)
+        if (s->found[i][0] == c[0] && s->found[i][1] == c[1] && s->found[i][2] == c[2])
+            return 1;
+    return 0;
+}
+
+/* Tests cell c, which the ray passes within s->reach of without entering it: when it is
+ * active and the ray passes within the margin of one of its triangles (or inside one, by
+ * rounding), it is added as a near miss (extracted alone, never the seed). Returns -1 when
+ * its brick could not be read, else 0. */
+static int near_cell(ip_seeder *s, const index_ray *r, const int64_t c[3])
+{
+    const ip_layout *l = s->layout;
+    const ip_level_layout *lv = &l->levels[s->level];
+    uint32_t cell[3], brick[3], at[3];
+    for (int k = 0; k < 3; k++) {
+        if (c[k] < 0 || c[k] + 1 >= (int64_t)lv->dims[k])
+            return 0; /* beyond the volume */
+        cell[k] = (uint32_t)c[k];
+        brick[k] = cell[k] / l->brick_edge;
+        at[k] = (cell[k] - brick[k] * l->brick_edge) / l->subblock_edge;
+    }
+    uint32_t per = l->brick_edge / l->subblock_edge;
+    const float *ranges =
+        ip_store_subblock_ranges(s->store, ip_brick_global_index(l, s->level, brick));
+    if (!active(&ranges[2 * (at[0] + per * (at[1] + per * at[2]))], s->iso) ||
+        s->found_count + 1 >= IP_SEED_MAX_CELLS || found_already(s, c))
+        return 0;
+    uint32_t c1[3] = {cell[0] + 1, cell[1] + 1, cell[2] + 1};
+    if (s->clip.count && !ip__clip_keeps_samples(&s->clip, l, s->level, cell, c1))
+        return 0;
+    float values[8];
+    if (!ip__sampler_cell_values(s->sampler, cell, values))
+        return -1;
+    unsigned mc = ip__mc_case(values, s->iso);
+    if (mc == 0 || mc == 255)
+        return 0;
+    float origin[3], far[3], size[3];
+    double ro[3];
+    ip__sampler_cell_box(s->sampler, cell, origin, far);
+    for (int k = 0; k < 3; k++) {
+        ro[k] = r->world_origin[k] - (double)origin[k];
+        size[k] = far[k] - origin[k];
+    }
+    s->near_tested++;
+    if (classify_cell(s, r, mc, values, size, ro))
+        memcpy(s->found[s->found_count++], cell, sizeof cell);
+    return 0;
+}
+
+/* The cells the ray passes within s->reach of, over [ta, tb], while it runs through the box
+ * walk_lo .. walk_hi (index units, whole cells): those outside the box own_lo .. own_hi (whose
+ * cells are the caller's to walk, or inactive; empty when lo > hi) and inside the cells
+ * [in_lo, in_hi) (the region the caller walks) are tested by near_cell(). The ray enters the
+ * walked box through a face along axis `in` and leaves it along `out` (near_faces()).
+ * Returns -1 when a brick could not be read, else 0. */
+static int near_cells(ip_seeder *s, const index_ray *r, const double walk_lo[3],
+                      const double walk_hi[3], const double own_lo[3], const double own_hi[3],
+                      const uint32_t in_lo[3], const uint32_t in_hi[3], double ta, double tb,
+                      int in, int out)
+{
+    uint32_t n[3];
+    for (int k = 0; k < 3; k++)
+        n[k] = (uint32_t)(walk_hi[k] - walk_lo[k]);
+    dda d;
+    dda_init(&d, r, walk_lo, 1.0, n, ta, tb);
+    d.in_axis = in;
+    for (;;) {
+        double exit_t;
+        int leave = dda_exit(&d, &exit_t);
+        int64_t c[3];
+        double lo[3], hi[3];
+        for (int k = 0; k < 3; k++) {
+            c[k] = (int64_t)walk_lo[k] + d.i[k];
+            lo[k] = (double)c[k];
+            hi[k] = lo[k] + 1.0;
+        }
+        unsigned m =
+            near_faces(s, r, lo, hi, in_lo, in_hi, d.t, exit_t, d.in_axis, leave < 0 ? out : leave);
+        /* the neighbours across those faces, diagonal ones included: along each axis the
+         * cell's own row, and the row below or above where the ray passes near that face
+         * (near_faces() leaves out the faces on the region's boundary) */
+        if (m) {
+            int steps[3][3], count[3];
+            for (int k = 0; k < 3; k++) {
+                count[k] = 0;
+                steps[k][count[k]++] = 0;
+                if (m >> 2 * k & 1u)
+                    steps[k][count[k]++] = -1;
+                if (m >> (2 * k + 1) & 1u)
+                    steps[k][count[k]++] = 1;
+            }
+            for (int z = 0; z < count[2]; z++)
+                for (int y = 0; y < count[1]; y++)
+                    for (int x = 0; x < count[0]; x++) {
+                        int64_t nb[3] = {c[0] + steps[0][x], c[1] + steps[1][y],
+                                         c[2] + steps[2][z]};
+                        int outside = 0;
+                        for (int k = 0; k < 3; k++)
+                            outside |= (double)nb[k] < own_lo[k] || (double)nb[k] >= own_hi[k];
+                        if ((x | y | z) && outside && near_cell(s, r, nb) < 0)
+                            return -1;
+                    }
+        }
+        if (!dda_next(&d, &exit_t))
+            return 0;
+    }
+}
+
+/* near_cells() of the box lo .. hi itself (the caller walks its cells), when the ray passes
+ * near a face of it that it does not cross. */
+static int near_box(ip_seeder *s, const index_ray *r, const double lo[3], const double hi[3],
+                    const uint32_t in_lo[3], const uint32_t in_hi[3], double ta, double tb, int in,
+                    int out)
+{
+    if (!near_faces(s, r, lo, hi, in_lo, in_hi, ta, tb, in, out))
+        return 0;
+    return near_cells(s, r, lo, hi, lo, hi, in_lo, in_hi, ta, tb, in, out);
+}
+
 /* Tests the cells of one sub-block (cells [lo, hi) in level coordinates) along the ray; `side`
  * is where the sub-block lies against the clipping planes (ip__clip_keeps_box()), its cells
  * tested against them only when it straddles one. */
@@ -187,6 +452,7 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
     int group_active = 1;
     dda d;
     dda_init(&d, r, base, 1.0, n, t0, t1);
+    double before = -INFINITY; /* where the ray entered the previous cell */
     for (;;) {
         s->nodes++;
         uint32_t c[3] = {lo[0] + (uint32_t)d.i[0], lo[1] + (uint32_t)d.i[1],
@@ -203,6 +469,7 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
         }
         float values[8];
         unsigned mc = 0;
+        int kind = 0;
         uint32_t c1[3] = {c[0] + 1, c[1] + 1, c[2] + 1};
         if (group_active && (side == IP__CLIP_KEEPS_ALL ||
                              ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))) {
@@ -219,15 +486,27 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
                 size[k] = far[k] - origin[k];
             }
             s->cells_tested++;
-            int kind = classify_cell(s, r, mc, values, size, ro);
+            kind = classify_cell(s, r, mc, values, size, ro);
             if (kind >= 2 && s->seed_index < 0)
                 s->seed_index = (int)s->found_count; /* the first cell the ray is inside */
             if (kind && s->found_count < IP_SEED_MAX_CELLS)
                 memcpy(s->found[s->found_count++], c, sizeof c);
-            if (kind == 3)
-                return 1;
         }
+        /* the sub-block's cells beside this one that the ray passes close by (their brick
+         * is this one: the sampler finds it in its slot, and `brick` stays pinned) */
         double exit_t;
+        int leave = dda_exit(&d, &exit_t);
+        unsigned near = dda_near_faces(s, r, &d, 0, before, d.t, exit_t, d.in_axis, leave, 0, NULL);
+        before = d.t;
+        if (near) {
+            double clo[3] = {c[0], c[1], c[2]}, chi[3] = {c1[0], c1[1], c1[2]};
+            if (near_cells(s, r, clo, chi, clo, chi, lo, hi, d.t, exit_t, d.in_axis, leave) < 0)
+                return -1;
+        }
+        if (kind == 3) {
+            s->hit_t = exit_t;
+            return 1;
+        }
         if (!dda_next(&d, &exit_t))
             return 0;
     }
@@ -241,22 +520,44 @@ static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], dou
     const float *ranges = ip__seeder_brick(s, b, origin, extent, n);
     uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
     double base[3] = {origin[0], origin[1], origin[2]};
+    /* the brick's cells, the region its sub-blocks' near passes look into */
+    uint32_t cells_lo[3] = {origin[0], origin[1], origin[2]},
+             cells_hi[3] = {origin[0] + extent[0] - 1, origin[1] + extent[1] - 1,
+                            origin[2] + extent[2] - 1};
     dda d;
     dda_init(&d, r, base, se, n, t0, t1);
+    int changes = 0; /* the ray moves into another cell within reach of the last plane crossed */
+    double before = -INFINITY; /* where the ray entered the previous sub-block */
     for (;;) {
         s->nodes++;
         int32_t at[3] = {d.i[0], d.i[1], d.i[2]};
         double enter_t = d.t, exit_t;
+        int in = d.in_axis, out = dda_exit(&d, &exit_t);
+        /* the faces the ray passes close to, to the end of the sub-block (where it stops, if
+         * it does, is known after the walk) */
+        unsigned near =
+            dda_near_faces(s, r, &d, 1, before, enter_t, exit_t, in, out, changes, &changes);
+        before = enter_t;
         int more = dda_next(&d, &exit_t);
         uint32_t sb = (uint32_t)at[0] + per * ((uint32_t)at[1] + per * (uint32_t)at[2]);
-        if (active(&ranges[2 * sb], s->iso)) {
-            uint32_t lo[3], hi[3], sub[3] = {(uint32_t)at[0], (uint32_t)at[1], (uint32_t)at[2]};
+        uint32_t lo[3], hi[3], sub[3] = {(uint32_t)at[0], (uint32_t)at[1], (uint32_t)at[2]};
+        int found = 0, is_active = active(&ranges[2 * sb], s->iso);
+        if (is_active || near)
             ip__seeder_subblock_cells(s, origin, extent, sub, lo, hi);
+        if (is_active) {
             int side = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi);
-            int found = side ? walk_cells(s, r, lo, hi, side, enter_t, exit_t) : 0;
-            if (found)
-                return found;
+            found = side ? walk_cells(s, r, lo, hi, side, enter_t, exit_t) : 0;
         }
+        if (found < 0)
+            return found;
+        if (near || found) { /* where it stopped: up to there (near_box()) */
+            double blo[3] = {lo[0], lo[1], lo[2]}, bhi[3] = {hi[0], hi[1], hi[2]};
+            if (near_box(s, r, blo, bhi, cells_lo, cells_hi, enter_t, found ? s->hit_t : exit_t, in,
+                         found ? -1 : out) < 0)
+                return -1;
+        }
+        if (found)
+            return found;
         if (!more)
             return 0;
     }
@@ -265,6 +566,8 @@ static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], dou
 typedef struct child_hit {
     uint32_t node[3];
     double t0, t1;
+    int in, out; /* the axes of the faces the ray enters and leaves it through (near_faces()) */
+    int walk;    /* active and kept: walked; else only looked beside (near passes) */
 } child_hit;
 
 static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uint32_t node[3],
@@ -294,33 +597,55 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
             leave[k][h] = ta > tb ? ta : tb;
         }
     }
+    /* Every child the ray enters, active or not: beside an inactive one, the ray may pass
+     * close to an active sibling's cells (near_box()). */
+    const uint32_t *grid = s->grid[depth - 1];
     for (int c = 0; c < 8; c++) {
         uint32_t ch[3];
-        if (!ip__seeder_active_child(s, depth, node, c, ch) ||
-            !ip__seeder_node_kept(s, depth - 1, ch))
+        for (int k = 0; k < 3; k++)
+            ch[k] = 2 * node[k] + ((c >> k) & 1);
+        if (ch[0] >= grid[0] || ch[1] >= grid[1] || ch[2] >= grid[2])
             continue;
         double a = t0, b = t1;
-        int missed = 0;
+        int missed = 0, in = -1, out = -1;
         for (int k = 0; k < 3; k++) {
             int h = (c >> k) & 1;
             if (r->dir[k] == 0.0) {
                 missed |= !within[k][h];
                 continue;
             }
-            a = enter[k][h] > a ? enter[k][h] : a;
-            b = leave[k][h] < b ? leave[k][h] : b;
+            if (enter[k][h] > a) {
+                a = enter[k][h];
+                in = k;
+            }
+            if (leave[k][h] < b) {
+                b = leave[k][h];
+                out = k;
+            }
         }
         if (missed || !(a <= b))
             continue;
+        int walk =
+            ip__seeder_node_active(s, depth - 1, ch) && ip__seeder_node_kept(s, depth - 1, ch);
         int at = count++;
         while (at > 0 && hits[at - 1].t0 > a) { /* insertion sort: front to back */
             hits[at] = hits[at - 1];
             at--;
         }
-        hits[at] = (child_hit){{ch[0], ch[1], ch[2]}, a, b};
+        hits[at] = (child_hit){{ch[0], ch[1], ch[2]}, a, b, in, out, walk};
     }
+    uint32_t in_lo[3], in_hi[3]; /* the node's cells: where its children's near passes look */
+    ip__seeder_node_cells(s, depth, node, in_lo, in_hi);
     for (int i = 0; i < count; i++) {
-        int found = walk_node(s, r, depth - 1, hits[i].node, hits[i].t0, hits[i].t1);
+        int found =
+            hits[i].walk ? walk_node(s, r, depth - 1, hits[i].node, hits[i].t0, hits[i].t1) : 0;
+        if (found < 0)
+            return found;
+        double lo[3], hi[3];
+        ip__seeder_node_box(s, depth - 1, hits[i].node, lo, hi);
+        if (near_box(s, r, lo, hi, in_lo, in_hi, hits[i].t0, found ? s->hit_t : hits[i].t1,
+                     hits[i].in, found ? -1 : hits[i].out) < 0)
+            return -1;
         if (found)
             return found;
     }
@@ -337,16 +662,32 @@ static int walk_bricks(ip_seeder *s, const index_ray *r, double t0, double t1)
     const uint32_t *grid = s->grid[0];
     dda d;
     dda_init(&d, r, base, s->layout->brick_edge, grid, t0, t1);
+    const ip_level_layout *lv = &s->layout->levels[s->level];
+    static const uint32_t cells_lo[3] = {0, 0, 0};
+    uint32_t cells_hi[3] = {lv->dims[0] - 1, lv->dims[1] - 1, lv->dims[2] - 1};
+    int changes = 0;           /* as in walk_brick() */
+    double before = -INFINITY; /* where the ray entered the previous brick */
     for (;;) {
         s->nodes++;
         uint32_t b[3] = {(uint32_t)d.i[0], (uint32_t)d.i[1], (uint32_t)d.i[2]};
         double enter_t = d.t, exit_t;
+        int in = d.in_axis, out = dda_exit(&d, &exit_t);
+        unsigned near =
+            dda_near_faces(s, r, &d, 1, before, enter_t, exit_t, in, out, changes, &changes);
+        before = enter_t;
         int more = dda_next(&d, &exit_t);
-        if (ip__seeder_node_active(s, 0, b) && ip__seeder_node_kept(s, 0, b)) {
-            int found = walk_brick(s, r, b, enter_t, exit_t);
-            if (found)
-                return found;
-        }
+        int found = ip__seeder_node_active(s, 0, b) && ip__seeder_node_kept(s, 0, b)
+                        ? walk_brick(s, r, b, enter_t, exit_t)
+                        : 0;
+        if (found < 0)
+            return found;
+        double lo[3], hi[3];
+        ip__seeder_node_box(s, 0, b, lo, hi);
+        if ((near || found) && near_box(s, r, lo, hi, cells_lo, cells_hi, enter_t,
+                                        found ? s->hit_t : exit_t, in, found ? -1 : out) < 0)
+            return -1;
+        if (found)
+            return found;
         if (!more)
             return 0;
     }
@@ -363,6 +704,7 @@ void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_
     s->use_group_ranges = 1;
     s->short_walk = IP_SEED_SHORT_WALK;
     s->margin = IP_SEED_MARGIN_PIXELS * pixel_angle;
+    s->thick = IP_SEED_REACH_PIXELS * pixel_angle;
     for (int k = 0; k < 3; k++)
         s->scale[k] = s->layout->spacing[k] * (double)(1u << s->level);
     /* The node grid and the first node's range of every depth, so that a child's range is
@@ -471,11 +813,55 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
     across_basis(dir, r.u, r.w);
     double lo[3], hi[3], t0 = t_min, t1 = t_max;
     ip__seeder_node_box(s, depth, root, lo, hi);
-    if (!clip(&r, lo, hi, &t0, &t1))
+    /* The ray's reach (seed.h), from its farthest point within a cell of the volume. */
+    double wide_lo[3], wide_hi[3], w0 = t_min, w1 = t_max;
+    for (int k = 0; k < 3; k++) {
+        wide_lo[k] = lo[k] - 1.0;
+        wide_hi[k] = hi[k] + 1.0;
+    }
+    if (!clip(&r, wide_lo, wide_hi, &w0, &w1))
         return 0;
-    int found = (t1 - t0) * r.len <= s->short_walk * s->layout->brick_edge
+    s->within_most = 0.0;
+    for (int k = 0; k < 3; k++) {
+        s->reach[k] = s->thick * w1 / s->scale[k];
+        s->within[k] = r.dir[k] != 0.0 ? s->reach[k] / fabs(r.dir[k]) : 0.0;
+        s->within_most = s->within[k] > s->within_most ? s->within[k] : s->within_most;
+    }
+    int inside = clip(&r, lo, hi, &t0, &t1), found = 0;
+    /* Where the ray runs outside the volume, it may pass close to cells on its faces. */
+    static const double none_lo[3] = {INFINITY, INFINITY, INFINITY},
+                        none_hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    static const uint32_t cells_lo[3] = {0, 0, 0};
+    uint32_t cells_hi[3] = {lv->dims[0] - 1, lv->dims[1] - 1, lv->dims[2] - 1};
+    /* Entering squarely through a face, the ray is within reach of cells outside the one it
+     * enters only where it moves into another cell within reach of that face (as
+     * near_faces()); missing the volume, anywhere it passes within reach of it. */
+    int enter_axis = -1, leave_axis = -1;
+    if (inside)
+        for (int k = 0; k < 3; k++) {
+            if (r.dir[k] == 0.0)
+                continue;
+            double ta = ((r.dir[k] > 0 ? lo[k] : hi[k]) - r.origin[k]) * r.inv_dir[k];
+            double tb = ((r.dir[k] > 0 ? hi[k] : lo[k]) - r.origin[k]) * r.inv_dir[k];
+            enter_axis = ta == t0 ? k : enter_axis;
+            leave_axis = tb == t1 ? k : leave_axis;
+        }
+    int outside_before =
+        !inside || enter_axis < 0 ||
+        changes_cell(&r, enter_axis, t0 - s->within[enter_axis], t0 + s->within[enter_axis]);
+    double before = inside ? t0 : w1;
+    if (w0 < before && outside_before)
+        found = near_cells(s, &r, wide_lo, wide_hi, none_lo, none_hi, cells_lo, cells_hi, w0,
+                           before, -1, -1);
+    if (inside && found == 0)
+        found = (t1 - t0) * r.len <= s->short_walk * s->layout->brick_edge
                     ? walk_bricks(s, &r, t0, t1)
                     : walk_node(s, &r, depth, root, t0, t1);
+    if (inside && found == 0 && t1 < w1 &&
+        (leave_axis < 0 ||
+         changes_cell(&r, leave_axis, t1 - s->within[leave_axis], t1 + s->within[leave_axis])))
+        found = near_cells(s, &r, wide_lo, wide_hi, none_lo, none_hi, cells_lo, cells_hi, t1, w1,
+                           -1, -1);
     if (found < 0)
         return -1; /* a brick could not be read: the cells found so far may be wrong */
     *count = s->found_count;

@@ -30,8 +30,14 @@ typedef struct ip_seeder {
                           IP_SEED_SHORT_WALK; the same cells are found either way) */
     uint32_t (*found)[3]; /* the cells of the current ray (see ip__seed_find) */
     unsigned found_count;
-    int seed_index; /* position in found of the first cell the ray is inside, or -1 */
-    double margin;  /* IP_SEED_MARGIN_PIXELS as an angle, radians */
+    int seed_index;       /* position in found of the first cell the ray is inside, or -1 */
+    double margin;        /* IP_SEED_MARGIN_PIXELS as an angle, radians */
+    double thick;         /* IP_SEED_REACH_PIXELS as an angle, radians */
+    double reach[3];      /* the current ray's reach (IP_SEED_REACH_PIXELS), index units per axis */
+    double within[3];     /* reach / |the ray's direction| per axis: the reach in t units */
+    double within_most;   /* the largest of them */
+    uint64_t near_tested; /* active cells the rays passed close to, without entering, tested */
+    double hit_t;         /* where the ray leaves the cell it stopped in (walk_cells()) */
     /* Per octree depth of the level (0: the bricks): the node grid and the range of its
      * node (0, 0, 0), the others following x fastest. */
     uint32_t grid[IP_SEED_MAX_DEPTH + 1][3];
@@ -79,18 +85,25 @@ static inline int ip__seeder_active_child(const ip_seeder *s, uint32_t depth,
     return ip__seeder_node_active(s, depth - 1, ch);
 }
 
+/* ip__seeder_node_box() as level coordinates: the node's cells are [first, last). */
+static inline void ip__seeder_node_cells(const ip_seeder *s, uint32_t depth, const uint32_t node[3],
+                                         uint32_t first[3], uint32_t last[3])
+{
+    double lo[3], hi[3];
+    ip__seeder_node_box(s, depth, node, lo, hi);
+    for (int k = 0; k < 3; k++) {
+        first[k] = (uint32_t)lo[k];
+        last[k] = (uint32_t)hi[k];
+    }
+}
+
 /* 1 unless the clipping planes drop every cell of node `node` at `depth`. */
 static inline int ip__seeder_node_kept(const ip_seeder *s, uint32_t depth, const uint32_t node[3])
 {
     if (s->clip.count == 0)
         return 1;
-    double lo[3], hi[3];
-    ip__seeder_node_box(s, depth, node, lo, hi);
     uint32_t first[3], last[3];
-    for (int k = 0; k < 3; k++) {
-        first[k] = (uint32_t)lo[k];
-        last[k] = (uint32_t)hi[k];
-    }
+    ip__seeder_node_cells(s, depth, node, first, last);
     return ip__clip_keeps_samples(&s->clip, s->layout, s->level, first, last);
 }
 
@@ -132,6 +145,18 @@ static inline void ip__seeder_subblock_cells(const ip_seeder *s, const uint32_t 
 #define IP_SEED_MARGIN_PIXELS (1.0 / 64.0)
 #define IP_SEED_MAX_CELLS 64
 
+/* A ray also tests the active cells it passes within this distance of without entering them
+ * (its reach): the rasteriser's snapping moves a triangle's edge by up to sqrt(2) / 512 pixel
+ * (0.0028), so it may show at a pixel a triangle whose cell the pixel's ray runs just beside,
+ * a triangle no cell the ray enters holds. Those it passes within the margin of are near
+ * misses (extracted alone, never the seed). The reach is the angle it subtends at the image
+ * centre (where a pixel subtends the widest angle) times the ray's farthest distance within a
+ * cell of the volume, along each axis in index units (a box around the ray, wider than the
+ * round reach it stands for): 2.8 times the snapping anywhere along the ray. A cell a pixel
+ * may show that way lies within the snapping of its ray, inside the slack of a tile's beam
+ * (retire.c, 1/64 pixel): a retired ray's tile has it extracted already. */
+#define IP_SEED_REACH_PIXELS (1.0 / 128.0)
+
 /* `pixel_angle`: the angle one pixel subtends at the image centre (radians). */
 void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_angle);
 
@@ -141,7 +166,9 @@ void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_
  * the ray passes inside. Fills cells[0 .. *count) (room for IP_SEED_MAX_CELLS) with every cell
  * the ray passed inside or within the margin of, in order, up to the first it passes inside by
  * more than the margin (where it stops); *seed_index is the seed's position there, or -1.
- * The other cells are where a rasteriser may show a triangle at this pixel after rounding.
+ * The other cells are where a rasteriser may show a triangle at this pixel after rounding:
+ * among them the cells the ray passes beside within its reach (IP_SEED_REACH_PIXELS) without
+ * entering them, up to the cell it stops in, wherever they come in the list.
  * @return 1 when there is a seed, 0 when not (the cells are near misses only, possibly none),
  * -1 when a brick could not be read (see the sampler's status). */
 int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,

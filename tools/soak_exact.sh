@@ -1,0 +1,94 @@
+#!/bin/sh
+# Soaks the engine's guarantee: once every ray has been cast, the progressive image equals the
+# full extraction's (with adaptive resolution off: with it on, far regions come from coarser
+# levels, which --full does not use). Runs CASES random cases over generated volumes and the
+# sample volumes of ../shared/data (those present): a random volume, isovalue, side, azimuth,
+# elevation, zoom, image size, thread count and cut-off, occlusion and culling on or off. Each
+# case renders the progressive run and --full with the same options through the software
+# rasterizer and compares the two PNG files byte for byte. Prints a line per failing case (the
+# two command lines that reproduce it), a total, and exits 1 on any difference. Not a test:
+# the test suite checks fixed cases; this looks for the rare one, for as long as it is given.
+#
+#   tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
+#   defaults: build 200 1 (a temporary folder, removed at the end)
+set -eu
+build=${1:-build}
+cases=${2:-200}
+seed=${3:-1}
+for p in isogen isobrick isoinfo isorender; do
+    [ -x "$build/$p" ] || { echo "soak_exact: $build/$p is missing: run tools/setup.sh build" >&2; exit 2; }
+done
+case $cases$seed in *[!0-9]*) echo "soak_exact: CASES and SEED are whole numbers" >&2; exit 2 ;; esac
+if [ -n "${4:-}" ]; then
+    work=$4
+    mkdir -p "$work"
+else
+    work=$(mktemp -d)
+    trap 'rm -rf "$work"' EXIT
+fi
+data=$(dirname "$0")/../../shared/data
+
+# the volumes: NAME FILE.ibv LOW HIGH (the value range isoinfo reports)
+: >"$work/volumes"
+add_volume() { # add_volume NAME INPUT [isobrick options...]
+    name=$1 input=$2
+    shift 2
+    "$build/isobrick" "$input" -o "$work/$name.ibv" --force --quiet "$@"
+    range=$("$build/isoinfo" "$work/$name.ibv" | sed -n 's/^  value range *\([-0-9.e+]*\) \.\. \([-0-9.e+]*\)$/\1 \2/p')
+    echo "$name $work/$name.ibv $range" >>"$work/volumes"
+}
+"$build/isogen" gyroid --dims 96x80x72 --noise 0.02 -o "$work/" --force --quiet
+add_volume gyroid "$work/gyroid_96x80x72_uint16.raw" --brick-size 16
+"$build/isogen" marschner-lobb --dims 64x64x64 --type float32 -o "$work/" --force --quiet
+add_volume lobb "$work/marschner-lobb_64x64x64_float32.raw" --brick-size 8
+for f in neghip_66x66x66_uint8 tooth_103x94x161_uint8 engine_256x256x128_uint8 \
+    hydrogen_density_64x64x64_float32 ct_head_visible_woman_512x512x234_uint16; do
+    [ -f "$data/$f.raw" ] && add_volume "${f%%_*}" "$data/$f.raw"
+done
+volumes=$(grep -c . "$work/volumes")
+echo "soak_exact: $cases cases, seed $seed, over $volumes volumes: $(cut -d' ' -f1 "$work/volumes" | tr '\n' ' ')"
+
+failed=0
+i=0
+while [ "$i" -lt "$cases" ]; do
+    # one case's options, drawn from (seed, i)
+    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" 'BEGIN {
+        srand(s * 100003 + i)
+        split("+x -x +y -y +z -z", side, " ")
+        split("1 2 3", threads, " ")
+        volume = int(rand() * n) + 1
+        fraction = 0.03 + 0.6 * rand()
+        view = side[int(rand() * 6) + 1]
+        azimuth = rand() * 360 - 180
+        elevation = rand() * 160 - 80
+        zoom = rand() < 0.3 ? 1 + rand() * 3 : 1
+        big = rand() < 0.1 # one case in ten at 800x600 to 1600x1200
+        width = (big ? 800 : 64) + int(rand() * (big ? 800 : 500))
+        height = (big ? 600 : 48) + int(rand() * (big ? 600 : 400))
+        thread_count = threads[int(rand() * 3) + 1]
+        cutoff = rand() < 0.2 ? 0.5 + rand() * 8 : 1.81
+        occlusion = rand() < 0.8 ? "on" : "off"
+        cull = rand() < 0.6 ? "on" : "off"
+        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s\n", volume, fraction, view,
+            azimuth, elevation, zoom, width, height, thread_count, cutoff, occlusion, cull }')
+    line=$(sed -n "${1}p" "$work/volumes")
+    set -- $line "$@"
+    name=$1 ibv=$2 low=$3 high=$4 fraction=$6
+    iso=$(awk -v l="$low" -v h="$high" -v f="$fraction" 'BEGIN { printf "%.6g", l + f * (h - l) }')
+    opts="--iso $iso --view $7 --azimuth $8 --elevation $9 --zoom ${10} --size ${11} --threads ${12} --cutoff ${13} --lod off --occlusion ${14} --cull ${15} --software --force --quiet"
+    # shellcheck disable=SC2086 # opts is a list of words
+    if ! "$build/isorender" "$ibv" $opts -o "$work/p.png" 2>"$work/p.err" ||
+        ! "$build/isorender" "$ibv" $opts --full -o "$work/f.png" 2>"$work/f.err"; then
+        failed=$((failed + 1))
+        echo "case $i ($name): isorender failed: $(cat "$work/p.err" "$work/f.err" | head -1)"
+        echo "  $build/isorender $ibv $opts -o p.png"
+    elif ! cmp -s "$work/p.png" "$work/f.png"; then
+        failed=$((failed + 1))
+        echo "case $i ($name): the progressive image differs from the full extraction's"
+        echo "  $build/isorender $ibv $opts -o p.png"
+        echo "  $build/isorender $ibv $opts --full -o f.png"
+    fi
+    i=$((i + 1))
+done
+echo "soak_exact: $failed of $cases cases failed"
+[ "$failed" = 0 ]
