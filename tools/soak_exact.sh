@@ -9,8 +9,9 @@
 # two command lines that reproduce it), a total, and exits 1 on any difference. Not a test:
 # the test suite checks fixed cases; this looks for the rare one, for as long as it is given.
 #
-#   tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
-#   defaults: build 200 1 (a temporary folder, removed at the end)
+#   [SOAK_DATA=DIR] tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
+#   defaults: build 200 1 (a temporary folder, removed at the end); SOAK_DATA, the folder of
+#   the sample volumes: ../shared/data (empty: the generated volumes alone)
 set -eu
 build=${1:-build}
 cases=${2:-200}
@@ -26,7 +27,7 @@ else
     work=$(mktemp -d)
     trap 'rm -rf "$work"' EXIT
 fi
-data=$(dirname "$0")/../../shared/data
+data=${SOAK_DATA-$(dirname "$0")/../../shared/data}
 
 # the volumes: NAME FILE.ibv LOW HIGH (the value range isoinfo reports)
 : >"$work/volumes"
@@ -43,7 +44,7 @@ add_volume gyroid "$work/gyroid_96x80x72_uint16.raw" --brick-size 16
 add_volume lobb "$work/marschner-lobb_64x64x64_float32.raw" --brick-size 8
 for f in neghip_66x66x66_uint8 tooth_103x94x161_uint8 engine_256x256x128_uint8 \
     hydrogen_density_64x64x64_float32 ct_head_visible_woman_512x512x234_uint16; do
-    [ -f "$data/$f.raw" ] && add_volume "${f%%_*}" "$data/$f.raw"
+    if [ -n "$data" ] && [ -f "$data/$f.raw" ]; then add_volume "${f%%_*}" "$data/$f.raw"; fi
 done
 volumes=$(grep -c . "$work/volumes")
 echo "soak_exact: $cases cases, seed $seed, over $volumes volumes: $(cut -d' ' -f1 "$work/volumes" | tr '\n' ' ')"

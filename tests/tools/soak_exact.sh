@@ -1,0 +1,16 @@
+# The exact-image guarantee over random views (tools/soak_exact.sh): 24 cases on the generated
+# volumes, a fixed seed, each progressive image against --full's, byte for byte; a bad case
+# count is a usage error (exit 2).
+. "$(dirname "$0")/lib.sh"
+
+soak=$(cd "$(dirname "$0")/../../tools" && pwd)/soak_exact.sh
+run_capture env SOAK_DATA= sh "$soak" "$bin" 24 5 "$work/soak"
+check "24 random views: every progressive image equals the full extraction's ($rc)" \
+    test "$rc" = 0
+check "it says so" sh -c 'printf "%s" "$0" | grep -q "0 of 24 cases failed"' "$out"
+check "over the generated volumes alone" \
+    sh -c 'printf "%s" "$0" | grep -q "over 2 volumes: gyroid lobb"' "$out"
+run_capture env SOAK_DATA= sh "$soak" "$bin" 2x 5 "$work/soak"
+check "a bad case count exits 2 ($rc)" test "$rc" = 2
+
+finish
