@@ -51,8 +51,9 @@ static double stop_depth(const ip_engine *e, uint32_t x, uint32_t y)
  * are entered front to back (the boxes of disjoint nodes cut disjoint spans of the ray), so the
  * shortened walk meets exactly the cells of the full walk up to the stop, in the same order, and
  * extracts the same ones of them, near misses (the cells it passes within 1/64 pixel of a triangle
- * edge, extracted alone, those beside it within its reach included: seed.h) and seed alike. Rays may then find nothing where they would have found a
- * hidden seed; propagation from such a seed only ever saved other rays work. Each entry is backed
+ * edge, extracted alone, those beside it within its reach included: seed.h) and seed alike.
+ * Rays may then find nothing where they would have found a hidden seed; propagation from such a
+ * seed only ever saved other rays work. Each entry is backed
  * by a triangle already in a worker's mesh (one may rise when two threads lower it at once,
  * coverage.h), so a stale or risen read only stops the walk later. The edge of the solid margin
  * matters: the plain coverage entry also counts centres on a triangle's edge, where snapping may

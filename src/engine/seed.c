@@ -32,10 +32,14 @@ static void across_basis(const double d[3], double u[3], double w[3])
     ip__vec3_cross(d, u, w);
 }
 
-/* Clips the ray to the index box [lo, hi]; returns 0 when it misses it or only behind t0. */
-static int clip(const index_ray *r, const double lo[3], const double hi[3], double *t0, double *t1)
+/* Clips the ray to the index box [lo, hi]; returns 0 when it misses it or only behind t0.
+ * *in and *out (either may be NULL): the axis of the face the ray enters and leaves the box
+ * through, -1 where the stretch starts (ends) inside it, at the t0 (t1) it was given. */
+static int clip_axes(const index_ray *r, const double lo[3], const double hi[3], double *t0,
+                     double *t1, int *in, int *out)
 {
     double a = *t0, b = *t1;
+    int enter = -1, leave = -1;
     for (int k = 0; k < 3; k++) {
         if (r->dir[k] == 0.0) {
             if (r->origin[k] < lo[k] || r->origin[k] > hi[k])
@@ -49,12 +53,27 @@ static int clip(const index_ray *r, const double lo[3], const double hi[3], doub
             ta = tb;
             tb = t;
         }
-        a = ta > a ? ta : a;
-        b = tb < b ? tb : b;
+        if (ta > a) {
+            a = ta;
+            enter = k;
+        }
+        if (tb < b) {
+            b = tb;
+            leave = k;
+        }
     }
     *t0 = a;
     *t1 = b;
+    if (in)
+        *in = enter;
+    if (out)
+        *out = leave;
     return a <= b;
+}
+
+static int clip(const index_ray *r, const double lo[3], const double hi[3], double *t0, double *t1)
+{
+    return clip_axes(r, lo, hi, t0, t1, NULL, NULL);
 }
 
 /* A 3D DDA over a grid of `n` cells of edge `edge` (index units) starting at `base`. */
@@ -65,11 +84,8 @@ typedef struct dda {
                     first cell (the ray enters the grid there, or starts inside it) */
     double base[3]; /* the grid's first corner */
     double edge;    /* its cells' edge */
-    int32_t back[3], front[3]; /* the index along each axis where the face behind (ahead of)
-                                  the ray is the grid's own: the first (last) cell it meets */
-    unsigned behind[3];        /* which face is behind the ray along each axis: 0 low, 1 high */
-    int parallel;              /* the ray runs parallel to some axis's faces */
-    int peek;                  /* the axis dda_exit() found the ray leaves along, or -1 */
+    int parallel;   /* the ray runs parallel to some axis's faces */
+    int peek;       /* the axis dda_exit() found the ray leaves along, or -1 */
 } dda;
 
 static void dda_init(dda *d, const index_ray *r, const double base[3], double edge,
@@ -106,9 +122,6 @@ static void dda_init(dda *d, const index_ray *r, const double base[3], double ed
     d->peek = -1;
     for (int k = 0; k < 3; k++) {
         d->base[k] = base[k];
-        d->behind[k] = d->step[k] < 0;
-        d->back[k] = d->step[k] < 0 ? d->n[k] - 1 : 0;
-        d->front[k] = d->step[k] < 0 ? 0 : d->n[k] - 1;
         d->parallel |= d->step[k] == 0;
     }
     d->edge = edge;
@@ -153,14 +166,20 @@ static int active(const float *range, float iso)
  * for every central projection through the ray) and the ray's distance to its edges is
  * measured as an angle. 3: inside a triangle by at least the margin; 2: inside one, within
  * the margin of its edge; 1: outside every triangle, within the margin of one; 0: none.
- * `mc` is the cell's case; `ro` the ray's origin in the cell's frame (corner 0 at the origin),
- * its direction and the basis across it are r's. */
-static IP_ALWAYS_INLINE int classify_cell(const ip_seeder *s, const index_ray *r, unsigned mc,
-                                          const float values[8], const float size[3],
-                                          const double ro[3])
+ * `cell` (level coordinates), its case `mc` and corner values; the triangles are built in the
+ * cell's own frame (corner 0 at the origin), where the ray's origin is taken too. */
+static IP_ALWAYS_INLINE int classify_cell(const ip_seeder *s, const index_ray *r,
+                                          const uint32_t cell[3], unsigned mc,
+                                          const float values[8])
 {
     static const float zero[3] = {0, 0, 0};
-    float points[12][3];
+    float points[12][3], origin[3], far[3], size[3];
+    double ro[3];
+    ip__sampler_cell_box(s->sampler, cell, origin, far);
+    for (int k = 0; k < 3; k++) { /* the cell's frame keeps precision in large volumes */
+        ro[k] = r->world_origin[k] - (double)origin[k];
+        size[k] = far[k] - origin[k];
+    }
     unsigned crossed = ip__mc_cell_edge_points(values, mc, s->iso, zero, size, points);
     /* each crossing point projected once, though up to 4 triangles share it */
     double p[12][2];
@@ -218,14 +237,15 @@ static int changes_cell(const index_ray *r, int k, double u0, double u1)
     return 0;
 }
 
-/* The faces of the box [lo, hi] (index units, whole cells) inside the region of cells
+/* The faces of the box [lo, hi] (index units: one of the level's cells, or with `coarse` a
+ * larger box of whole cells) inside the region of cells
  * [in_lo, in_hi) that the ray passes within s->reach of over [ta, tb] where it may leave cells
  * beyond them unentered: bit 2k is the low face along axis k, bit 2k + 1 the high one. The ray
  * enters the box through a face along axis `in` and leaves it through one along `out` (-1:
  * neither; it starts or ends inside, or on the boundary of the caller's region). Beyond a face
  * it crosses, a cell's only neighbour it comes near is the cell it enters; a larger box's face
  * counts when the ray moves into another of the level's cells within reach of the crossing. */
-static unsigned near_faces(const ip_seeder *s, const index_ray *r, const double lo[3],
+static unsigned near_faces(const ip_seeder *s, const index_ray *r, int coarse, const double lo[3],
                            const double hi[3], const uint32_t in_lo[3], const uint32_t in_hi[3],
                            double ta, double tb, int in, int out)
 {
@@ -238,12 +258,11 @@ static unsigned near_faces(const ip_seeder *s, const index_ray *r, const double 
     }
     if (!m)
         return 0;
-    int cell = hi[0] - lo[0] == 1.0 && hi[1] - lo[1] == 1.0 && hi[2] - lo[2] == 1.0;
     /* within reach of a plane it crosses at t from t - within to t + within (as
      * dda_near_faces()) */
-    if (in >= 0 && (cell || !changes_cell(r, in, ta - s->within[in], ta + s->within[in])))
+    if (in >= 0 && (!coarse || !changes_cell(r, in, ta - s->within[in], ta + s->within[in])))
         m &= ~(1u << (2 * in + (r->dir[in] < 0)));
-    if (out >= 0 && (cell || !changes_cell(r, out, tb - s->within[out], tb + s->within[out])))
+    if (out >= 0 && (!coarse || !changes_cell(r, out, tb - s->within[out], tb + s->within[out])))
         m &= ~(1u << (2 * out + (r->dir[out] > 0)));
     return m;
 }
@@ -277,16 +296,18 @@ static IP_ALWAYS_INLINE unsigned dda_near_faces(const ip_seeder *s, const index_
     int quiet = !d->parallel && in >= 0 && out >= 0 && t_in - before >= s->within_most &&
                 next_other(d, out) - t_out >= s->within_most;
     for (int k = 0; k < 3 && !quiet; k++) {
+        unsigned behind = d->step[k] < 0; /* the face behind the ray: 0 low, 1 high */
+        int32_t first = behind ? d->n[k] - 1 : 0, last = behind ? 0 : d->n[k] - 1;
         unsigned near_behind = (unsigned)(t_in - (d->t_max[k] - d->t_delta[k]) < s->within[k]) &
-                               (unsigned)(d->i[k] != d->back[k]);
+                               (unsigned)(d->i[k] != first); /* not the grid's own face */
         unsigned near_ahead =
-            (unsigned)(d->t_max[k] - t_out < s->within[k]) & (unsigned)(d->i[k] != d->front[k]);
-        m |= (near_behind << d->behind[k] | near_ahead << (1u - d->behind[k])) << 2 * k;
+            (unsigned)(d->t_max[k] - t_out < s->within[k]) & (unsigned)(d->i[k] != last);
+        m |= (near_behind << behind | near_ahead << (1u - behind)) << 2 * k;
     }
     if (in >= 0) /* crossed there: the cell's neighbour is where the ray comes from */
-        m &= ~(1u << (2 * in + d->behind[in]));
+        m &= ~(1u << (2 * in + (d->step[in] < 0)));
     if (out >= 0)
-        m &= ~(1u << (2 * out + 1 - d->behind[out]));
+        m &= ~(1u << (2 * out + (d->step[out] > 0)));
     if (d->parallel && !quiet)
         for (int k = 0; k < 3; k++) {
             if (d->step[k] != 0)
@@ -297,10 +318,10 @@ static IP_ALWAYS_INLINE unsigned dda_near_faces(const ip_seeder *s, const index_
                  << 2 * k;
         }
     if (coarse && in >= 0 && in_changes)
-        m |= 1u << (2 * in + d->behind[in]);
+        m |= 1u << (2 * in + (d->step[in] < 0));
     if (coarse && out >= 0) {
         *out_changes = changes_cell(r, out, t_out - s->within[out], t_out + s->within[out]);
-        m |= (unsigned)*out_changes << (2 * out + 1 - d->behind[out]);
+        m |= (unsigned)*out_changes << (2 * out + (d->step[out] > 0));
     }
     return m;
 }
@@ -322,17 +343,17 @@ static int near_cell(ip_seeder *s, const index_ray *r, const int64_t c[3])
 {
     const ip_layout *l = s->layout;
     const ip_level_layout *lv = &l->levels[s->level];
-    uint32_t cell[3], brick[3], at[3];
+    uint32_t cell[3], brick[3], origin[3], extent[3], n[3], at[3];
     for (int k = 0; k < 3; k++) {
         if (c[k] < 0 || c[k] + 1 >= (int64_t)lv->dims[k])
             return 0; /* beyond the volume */
         cell[k] = (uint32_t)c[k];
         brick[k] = cell[k] / l->brick_edge;
-        at[k] = (cell[k] - brick[k] * l->brick_edge) / l->subblock_edge;
     }
+    const float *ranges = ip__seeder_brick(s, brick, origin, extent, n); /* its sub-block's: */
     uint32_t per = l->brick_edge / l->subblock_edge;
-    const float *ranges =
-        ip_store_subblock_ranges(s->store, ip_brick_global_index(l, s->level, brick));
+    for (int k = 0; k < 3; k++)
+        at[k] = (cell[k] - origin[k]) / l->subblock_edge;
     if (!active(&ranges[2 * (at[0] + per * (at[1] + per * at[2]))], s->iso) ||
         s->found_count + 1 >= IP_SEED_MAX_CELLS || found_already(s, c))
         return 0;
@@ -340,20 +361,13 @@ static int near_cell(ip_seeder *s, const index_ray *r, const int64_t c[3])
     if (s->clip.count && !ip__clip_keeps_samples(&s->clip, l, s->level, cell, c1))
         return 0;
     float values[8];
-    if (!ip__sampler_cell_values(s->sampler, cell, values))
+    unsigned mc;
+    if (ip__sampler_cell_case(s->sampler, cell, s->iso, values, &mc) < 0)
         return -1;
-    unsigned mc = ip__mc_case(values, s->iso);
     if (mc == 0 || mc == 255)
         return 0;
-    float origin[3], far[3], size[3];
-    double ro[3];
-    ip__sampler_cell_box(s->sampler, cell, origin, far);
-    for (int k = 0; k < 3; k++) {
-        ro[k] = r->world_origin[k] - (double)origin[k];
-        size[k] = far[k] - origin[k];
-    }
     s->near_tested++;
-    if (classify_cell(s, r, mc, values, size, ro))
+    if (classify_cell(s, r, cell, mc, values))
         memcpy(s->found[s->found_count++], cell, sizeof cell);
     return 0;
 }
@@ -385,8 +399,8 @@ static int near_cells(ip_seeder *s, const index_ray *r, const double walk_lo[3],
             lo[k] = (double)c[k];
             hi[k] = lo[k] + 1.0;
         }
-        unsigned m =
-            near_faces(s, r, lo, hi, in_lo, in_hi, d.t, exit_t, d.in_axis, leave < 0 ? out : leave);
+        unsigned m = near_faces(s, r, 0, lo, hi, in_lo, in_hi, d.t, exit_t, d.in_axis,
+                                leave < 0 ? out : leave);
         /* the neighbours across those faces, diagonal ones included: along each axis the
          * cell's own row, and the row below or above where the ray passes near that face
          * (near_faces() leaves out the faces on the region's boundary) */
@@ -417,13 +431,19 @@ static int near_cells(ip_seeder *s, const index_ray *r, const double walk_lo[3],
     }
 }
 
-/* near_cells() of the box lo .. hi itself (the caller walks its cells), when the ray passes
- * near a face of it that it does not cross. */
+/* After the walk of the box lo .. hi (whole cells), which the ray crossed over [ta, tb],
+ * entering it along `in` and leaving along `out`: near_cells() of the box when the ray passes
+ * near a face of it that it does not cross. Where the walk stopped (`found`), only up to the
+ * cell it stopped in (s->hit_t): beyond, the ray needs nothing. */
 static int near_box(ip_seeder *s, const index_ray *r, const double lo[3], const double hi[3],
                     const uint32_t in_lo[3], const uint32_t in_hi[3], double ta, double tb, int in,
-                    int out)
+                    int out, int found)
 {
-    if (!near_faces(s, r, lo, hi, in_lo, in_hi, ta, tb, in, out))
+    if (found) {
+        tb = s->hit_t;
+        out = -1;
+    }
+    if (!near_faces(s, r, 1, lo, hi, in_lo, in_hi, ta, tb, in, out))
         return 0;
     return near_cells(s, r, lo, hi, lo, hi, in_lo, in_hi, ta, tb, in, out);
 }
@@ -478,15 +498,8 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
             s->cells_read++;
         }
         if (mc != 0 && mc != 255) {
-            float origin[3], far[3], size[3];
-            double ro[3];
-            ip__sampler_cell_box(s->sampler, c, origin, far);
-            for (int k = 0; k < 3; k++) { /* the cell's frame keeps precision in large volumes */
-                ro[k] = r->world_origin[k] - (double)origin[k];
-                size[k] = far[k] - origin[k];
-            }
             s->cells_tested++;
-            kind = classify_cell(s, r, mc, values, size, ro);
+            kind = classify_cell(s, r, c, mc, values);
             if (kind >= 2 && s->seed_index < 0)
                 s->seed_index = (int)s->found_count; /* the first cell the ray is inside */
             if (kind && s->found_count < IP_SEED_MAX_CELLS)
@@ -550,10 +563,9 @@ static int walk_brick(ip_seeder *s, const index_ray *r, const uint32_t b[3], dou
         }
         if (found < 0)
             return found;
-        if (near || found) { /* where it stopped: up to there (near_box()) */
+        if (near || found) { /* where it stopped, to there only: near_box() looks again */
             double blo[3] = {lo[0], lo[1], lo[2]}, bhi[3] = {hi[0], hi[1], hi[2]};
-            if (near_box(s, r, blo, bhi, cells_lo, cells_hi, enter_t, found ? s->hit_t : exit_t, in,
-                         found ? -1 : out) < 0)
+            if (near_box(s, r, blo, bhi, cells_lo, cells_hi, enter_t, exit_t, in, out, found) < 0)
                 return -1;
         }
         if (found)
@@ -643,8 +655,8 @@ static int walk_node(ip_seeder *s, const index_ray *r, uint32_t depth, const uin
             return found;
         double lo[3], hi[3];
         ip__seeder_node_box(s, depth - 1, hits[i].node, lo, hi);
-        if (near_box(s, r, lo, hi, in_lo, in_hi, hits[i].t0, found ? s->hit_t : hits[i].t1,
-                     hits[i].in, found ? -1 : hits[i].out) < 0)
+        if (near_box(s, r, lo, hi, in_lo, in_hi, hits[i].t0, hits[i].t1, hits[i].in, hits[i].out,
+                     found) < 0)
             return -1;
         if (found)
             return found;
@@ -681,11 +693,12 @@ static int walk_bricks(ip_seeder *s, const index_ray *r, double t0, double t1)
                         : 0;
         if (found < 0)
             return found;
-        double lo[3], hi[3];
-        ip__seeder_node_box(s, 0, b, lo, hi);
-        if ((near || found) && near_box(s, r, lo, hi, cells_lo, cells_hi, enter_t,
-                                        found ? s->hit_t : exit_t, in, found ? -1 : out) < 0)
-            return -1;
+        if (near || found) { /* as in walk_brick() */
+            double lo[3], hi[3];
+            ip__seeder_node_box(s, 0, b, lo, hi);
+            if (near_box(s, r, lo, hi, cells_lo, cells_hi, enter_t, exit_t, in, out, found) < 0)
+                return -1;
+        }
         if (found)
             return found;
         if (!more)
@@ -827,7 +840,8 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
         s->within[k] = r.dir[k] != 0.0 ? s->reach[k] / fabs(r.dir[k]) : 0.0;
         s->within_most = s->within[k] > s->within_most ? s->within[k] : s->within_most;
     }
-    int inside = clip(&r, lo, hi, &t0, &t1), found = 0;
+    int enter_axis = -1, leave_axis = -1, found = 0; /* clip_axes() sets them when inside */
+    int inside = clip_axes(&r, lo, hi, &t0, &t1, &enter_axis, &leave_axis);
     /* Where the ray runs outside the volume, it may pass close to cells on its faces. */
     static const double none_lo[3] = {INFINITY, INFINITY, INFINITY},
                         none_hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -836,16 +850,6 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
     /* Entering squarely through a face, the ray is within reach of cells outside the one it
      * enters only where it moves into another cell within reach of that face (as
      * near_faces()); missing the volume, anywhere it passes within reach of it. */
-    int enter_axis = -1, leave_axis = -1;
-    if (inside)
-        for (int k = 0; k < 3; k++) {
-            if (r.dir[k] == 0.0)
-                continue;
-            double ta = ((r.dir[k] > 0 ? lo[k] : hi[k]) - r.origin[k]) * r.inv_dir[k];
-            double tb = ((r.dir[k] > 0 ? hi[k] : lo[k]) - r.origin[k]) * r.inv_dir[k];
-            enter_axis = ta == t0 ? k : enter_axis;
-            leave_axis = tb == t1 ? k : leave_axis;
-        }
     int outside_before =
         !inside || enter_axis < 0 ||
         changes_cell(&r, enter_axis, t0 - s->within[enter_axis], t0 + s->within[enter_axis]);
