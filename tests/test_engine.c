@@ -266,6 +266,83 @@ static void check_lod(const char *dir)
     close_scene(&s);
 }
 
+/* Adaptive resolution's guarantee: once every ray has been cast, the progressive mesh holds
+ * only triangles of the full extraction at the view's levels (ip_extract_full_lod(): each
+ * level's cells within its distance band), and its image is that extraction's, pixel for
+ * pixel, on 1 and 2 threads, with occlusion on and off. The long gyroid seen end-on and from
+ * an angle, at a pixel error of 1 and 2, uses 3 to 5 levels. */
+static void check_lod_exact(const char *dir)
+{
+    char ibv[4200];
+    snprintf(ibv, sizeof ibv, "%s/long.ibv", dir); /* made by check_lod() */
+    scene s;
+    open_scene(ibv, &s);
+    static const struct {
+        const char *axis;
+        double azimuth, elevation, pixel_error;
+        uint32_t w, h;
+    } views[] = {{"-z", 0, 0, 1, 64, 64}, {"-z", 35, 20, 2, 96, 72}, {"+z", -50, 10, 1, 80, 60}};
+    const uint32_t n = 96 * 72;
+    uint32_t *ia = malloc(n * 4), *ib = malloc(n * 4);
+    uint8_t *ca = malloc(n * 4), *cb = malloc(n * 4);
+    REQUIRE(ia && ib && ca && cb);
+    for (size_t v = 0; v < sizeof views / sizeof views[0]; v++) {
+        ip_error err;
+        ip_camera cam;
+        REQUIRE(ip_camera_fit_axis(s.lo, s.hi, views[v].axis, 30.0, views[v].w, views[v].h, &cam,
+                                   &err) == IP_OK);
+        ip_camera_orbit(&cam, views[v].azimuth, views[v].elevation);
+        ip_mesh full;
+        ip_mesh_init_with_cells(&full);
+        REQUIRE(ip_extract_full_lod(s.cache, 127.5f, &cam, views[v].pixel_error, 2, NULL, 0, &full,
+                                    NULL, &err) == IP_OK);
+        REQUIRE(ip_raster_mesh(&full, &cam, s.lo, s.hi, ib, cb, &err) == IP_OK);
+        uint32_t pixels = views[v].w * views[v].h, levels = 0;
+        size_t covered = 0;
+        for (uint32_t i = 0; i < pixels; i++)
+            covered += ib[i] != UINT32_MAX;
+        for (int threads = 1; threads <= 2; threads++)
+            for (int occlusion = 0; occlusion < 2; occlusion++) {
+                ip_engine *e;
+                ip_engine_options o;
+                ip_engine_options_default(&o);
+                o.pixel_error = views[v].pixel_error;
+                o.cell_ids = 1;
+                o.threads = (unsigned)threads;
+                o.occlusion = occlusion;
+                REQUIRE(ip_engine_create(s.cache, &o, &e, &err) == IP_OK);
+                ip_engine_counts t;
+                run_all_rays(e, &cam, 127.5f, &t);
+                while (levels < IP_MAX_LEVELS && isfinite(ip_engine_lod_distance(e, levels)))
+                    levels++;
+                const ip_mesh *part = ip_engine_mesh(e);
+                uint64_t missing = triangles_not_in(part, &full);
+                REQUIRE(ip_raster_mesh(part, &cam, s.lo, s.hi, ia, ca, &err) == IP_OK);
+                size_t differ = 0;
+                for (uint32_t i = 0; i < pixels; i++)
+                    differ += ia[i] == UINT32_MAX ? ib[i] != UINT32_MAX
+                                                  : memcmp(ca + 4 * i, cb + 4 * i, 4) != 0;
+                CHECK_MSG(missing == 0 && differ == 0,
+                          "lod view %zu, %d threads, occlusion %d: %llu triangles not in the "
+                          "full extraction at its levels, %zu pixels differ",
+                          v, threads, occlusion, (unsigned long long)missing, differ);
+                CHECK(part->triangle_count > 0 && part->triangle_count <= full.triangle_count);
+                ip_engine_destroy(e);
+            }
+        printf("test_engine: lod exact, view %zu: %u levels, %llu triangles in the full "
+               "extraction at them, %zu of %u pixels covered\n",
+               v, levels, (unsigned long long)full.triangle_count, covered, pixels);
+        CHECK_MSG(levels >= 3 && covered > pixels / 10, "lod view %zu: %u levels, %zu pixels", v,
+                  levels, covered);
+        ip_mesh_free(&full);
+    }
+    free(ia);
+    free(ib);
+    free(ca);
+    free(cb);
+    close_scene(&s);
+}
+
 typedef struct canceller {
     ip_engine *engine;
     atomic_int stop;
@@ -1283,6 +1360,7 @@ int main(void)
     close_scene(&s);
 
     check_lod(dir);
+    check_lod_exact(dir);
     check_coverage_box_test();
     check_cull_mask();
     check_coverage_indexed();

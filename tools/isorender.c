@@ -42,6 +42,8 @@ static const char usage[] =
     "  --rays N            stop after N rays (default: every pixel)\n"
     "  --time SECONDS      stop extracting after this long\n" TOOL_ENGINE_OPTIONS_HELP
     "  --full              triangulate every active cell instead (the baseline)\n"
+    "  --full-lod          every active cell at the view's adaptive resolution: each level's\n"
+    "                      cells within its distance band (what --lod on equals at the end)\n"
     "  --warm              extract once untimed first, so the timed run finds a warm cache\n"
     "  --cache-mb N        brick cache budget in MiB (default 512, or a quarter of RAM)\n"
     "  --threads N         threads for seeding, propagation and --full (default: all cores)\n"
@@ -127,6 +129,7 @@ typedef struct options {
     tool_view_options common;
     const char *file, *out, *mesh, *progress, *strip;
     int full, software, warm; /* --stats, --force and --quiet are in common */
+    int full_lod;             /* --full-lod: full becomes 2 */
     strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
     int weld, no_weld;
     uint64_t smooth;          /* --smooth N: Taubin iterations for the mesh file (0: none) */
@@ -196,6 +199,7 @@ static const tool_option isorender_options[] = {
     {"--mesh", NULL, 1, offsetof(options, mesh), NULL, NULL, NULL},
     {"--progress", NULL, 1, offsetof(options, progress), NULL, NULL, NULL},
     {"--full", NULL, 0, offsetof(options, full), NULL, NULL, NULL},
+    {"--full-lod", NULL, 0, offsetof(options, full_lod), NULL, NULL, NULL},
     {"--warm", NULL, 0, offsetof(options, warm), NULL, NULL, NULL},
     {"--software", NULL, 0, offsetof(options, software), NULL, NULL, NULL},
     {"--strip", NULL, 1, offsetof(options, strip), NULL, NULL, NULL},
@@ -706,6 +710,14 @@ static int parse_args(int argc, char **argv, options *o)
                                           &o->file, argc, argv);
     if (rc)
         return rc;
+    if (o->full && o->full_lod)
+        return tool_usage_error("isorender", "--full and --full-lod: one or the other");
+    if (o->full_lod && !o->common.lod)
+        return tool_usage_error("isorender",
+                                "--full-lod is the full extraction at adaptive resolution: not "
+                                "with --lod off (--full is that)");
+    if (o->full_lod)
+        o->full = 2;
     if (o->full && (o->common.rays || o->common.time_limit > 0))
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
     if (o->software && o->aa > 1)
@@ -843,20 +855,27 @@ static int extract_progressive(run *r, ip_error *err)
     return 0;
 }
 
+/* --full (level 0) or --full-lod (the view's levels, each in its band) into r->full_mesh. */
+static ip_status full_extraction(run *r, ip_engine_counts *counts, ip_error *err)
+{
+    const tool_view_options *c = &r->o.common;
+    if (r->o.full == 2)
+        return ip_extract_full_lod(r->cache, (float)c->iso, &r->camera, c->pixel_error, c->threads,
+                                   c->clip, c->clip_count, &r->full_mesh, counts, err);
+    return ip_extract_full_clipped(r->cache, (float)c->iso, 0, c->threads, c->clip, c->clip_count,
+                                   &r->full_mesh, counts, err);
+}
+
 static int extract_full(run *r, ip_error *err)
 {
     ip_mesh_init(&r->full_mesh);
     if (r->o.warm) {
-        if (ip_extract_full_clipped(r->cache, (float)r->o.common.iso, 0, r->o.common.threads,
-                                    r->o.common.clip, r->o.common.clip_count, &r->full_mesh, NULL,
-                                    err) != IP_OK)
+        if (full_extraction(r, NULL, err) != IP_OK)
             return -1;
         ip_mesh_clear(&r->full_mesh);
     }
     double start = ip_now_seconds();
-    if (ip_extract_full_clipped(r->cache, (float)r->o.common.iso, 0, r->o.common.threads,
-                                r->o.common.clip, r->o.common.clip_count, &r->full_mesh, &r->totals,
-                                err) != IP_OK)
+    if (full_extraction(r, &r->totals, err) != IP_OK)
         return -1;
     r->extraction_wall = ip_now_seconds() - start;
     r->mesh = &r->full_mesh;

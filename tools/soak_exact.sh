@@ -1,17 +1,20 @@
 #!/bin/sh
 # Soaks the engine's guarantee: once every ray has been cast, the progressive image equals the
-# full extraction's (with adaptive resolution off: with it on, far regions come from coarser
-# levels, which --full does not use). Runs CASES random cases over generated volumes and the
-# sample volumes of ../shared/data (those present): a random volume, isovalue, side, azimuth,
-# elevation, zoom, image size, thread count and cut-off, occlusion and culling on or off. Each
-# case renders the progressive run and --full with the same options through the software
+# full extraction's: --full with adaptive resolution off, --full-lod (each level's cells in its
+# distance band) with it on. Runs CASES random cases over generated volumes and the sample
+# volumes of ../shared/data (those present): a random volume, isovalue, side, azimuth,
+# elevation, zoom, image size, thread count and cut-off, occlusion and culling on or off, and
+# adaptive resolution on or off (with a pixel error of 1, 2 or 4). Each case renders the
+# progressive run and the full extraction with the same options through the software
 # rasterizer and compares the two PNG files byte for byte. Prints a line per failing case (the
 # two command lines that reproduce it), a total, and exits 1 on any difference. Not a test:
 # the test suite checks fixed cases; this looks for the rare one, for as long as it is given.
 #
-#   [SOAK_DATA=DIR] tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
+#   [SOAK_DATA=DIR] [SOAK_LOD=mixed|on|off] tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
 #   defaults: build 200 1 (a temporary folder, removed at the end); SOAK_DATA, the folder of
-#   the sample volumes: ../shared/data (empty: the generated volumes alone)
+#   the sample volumes: ../shared/data (empty: the generated volumes alone); SOAK_LOD, whether
+#   cases run with adaptive resolution: mixed (one in two, the default), on or off (every case;
+#   off draws the cases that this tool drew before it knew adaptive resolution)
 set -eu
 build=${1:-build}
 cases=${2:-200}
@@ -20,6 +23,8 @@ for p in isogen isobrick isoinfo isorender; do
     [ -x "$build/$p" ] || { echo "soak_exact: $build/$p is missing: run tools/setup.sh build" >&2; exit 2; }
 done
 case $cases$seed in *[!0-9]*) echo "soak_exact: CASES and SEED are whole numbers" >&2; exit 2 ;; esac
+lod_mode=${SOAK_LOD:-mixed}
+case $lod_mode in mixed | on | off) ;; *) echo "soak_exact: SOAK_LOD is mixed, on or off" >&2; exit 2 ;; esac
 if [ -n "${4:-}" ]; then
     work=$4
     mkdir -p "$work"
@@ -49,11 +54,12 @@ done
 volumes=$(grep -c . "$work/volumes")
 echo "soak_exact: $cases cases, seed $seed, over $volumes volumes: $(cut -d' ' -f1 "$work/volumes" | tr '\n' ' ')"
 
+: >"$work/cases"
 failed=0
 i=0
 while [ "$i" -lt "$cases" ]; do
     # one case's options, drawn from (seed, i)
-    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" 'BEGIN {
+    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" -v lod_mode="$lod_mode" 'BEGIN {
         srand(s * 100003 + i)
         split("+x -x +y -y +z -z", side, " ")
         split("1 2 3", threads, " ")
@@ -70,16 +76,26 @@ while [ "$i" -lt "$cases" ]; do
         cutoff = rand() < 0.2 ? 0.5 + rand() * 8 : 1.81
         occlusion = rand() < 0.8 ? "on" : "off"
         cull = rand() < 0.6 ? "on" : "off"
-        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s\n", volume, fraction, view,
-            azimuth, elevation, zoom, width, height, thread_count, cutoff, occlusion, cull }')
+        # drawn last, so that the draws above stay those of every earlier version of the tool
+        lod = lod_mode == "on" || (lod_mode == "mixed" && rand() < 0.5) ? "on" : "off"
+        pixel_error = lod == "on" ? 2 ^ int(rand() * 3) : 1
+        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s %s %d\n", volume, fraction, view,
+            azimuth, elevation, zoom, width, height, thread_count, cutoff, occlusion, cull, lod,
+            pixel_error }')
     line=$(sed -n "${1}p" "$work/volumes")
     set -- $line "$@"
     name=$1 ibv=$2 low=$3 high=$4 fraction=$6
     iso=$(awk -v l="$low" -v h="$high" -v f="$fraction" 'BEGIN { printf "%.6g", l + f * (h - l) }')
-    opts="--iso $iso --view $7 --azimuth $8 --elevation $9 --zoom ${10} --size ${11} --threads ${12} --cutoff ${13} --lod off --occlusion ${14} --cull ${15} --software --force --quiet"
+    opts="--iso $iso --view $7 --azimuth $8 --elevation $9 --zoom ${10} --size ${11} --threads ${12} --cutoff ${13} --lod ${16} --occlusion ${14} --cull ${15} --software --force --quiet"
+    full=--full
+    if [ "${16}" = on ]; then
+        opts="$opts --pixel-error ${17}"
+        full=--full-lod
+    fi
+    echo "$name $opts" >>"$work/cases" # what was run, for whoever reads WORK_DIR after
     # shellcheck disable=SC2086 # opts is a list of words
     if ! "$build/isorender" "$ibv" $opts -o "$work/p.png" 2>"$work/p.err" ||
-        ! "$build/isorender" "$ibv" $opts --full -o "$work/f.png" 2>"$work/f.err"; then
+        ! "$build/isorender" "$ibv" $opts $full -o "$work/f.png" 2>"$work/f.err"; then
         failed=$((failed + 1))
         echo "case $i ($name): isorender failed: $(cat "$work/p.err" "$work/f.err" | head -1)"
         echo "  $build/isorender $ibv $opts -o p.png"
@@ -87,7 +103,7 @@ while [ "$i" -lt "$cases" ]; do
         failed=$((failed + 1))
         echo "case $i ($name): the progressive image differs from the full extraction's"
         echo "  $build/isorender $ibv $opts -o p.png"
-        echo "  $build/isorender $ibv $opts --full -o f.png"
+        echo "  $build/isorender $ibv $opts $full -o f.png"
     fi
     i=$((i + 1))
 done

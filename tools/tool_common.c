@@ -1141,7 +1141,11 @@ void tool_write_run_json(FILE *f, const tool_run_json *j)
     fprintf(f,
             ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
             "\"renderer\": \"%s\"",
-            j->iso, j->full ? "full" : "progressive", c->width, c->height, j->renderer);
+            j->iso,
+            j->full == 2 ? "full-lod"
+            : j->full    ? "full"
+                         : "progressive",
+            c->width, c->height, j->renderer);
     fprintf(f,
             ", \"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"target\": [%.9g, %.9g, %.9g], "
             "\"up\": [%.9g, %.9g, %.9g], \"fov\": %.9g}",

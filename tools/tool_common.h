@@ -329,7 +329,7 @@ void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_
 typedef struct tool_run_json {
     const char *file;
     double iso;
-    int full; /* full extraction, else progressive */
+    int full; /* 1: full extraction, 2: at adaptive resolution (isorender --full-lod), else 0 */
     const ip_camera *camera;
     const char *renderer; /* "opengl", "software", "none" */
     const tool_view_options *options;

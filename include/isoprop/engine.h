@@ -248,6 +248,22 @@ IP_API ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t le
                                          unsigned clip_count, ip_mesh *mesh,
                                          ip_engine_counts *counts, ip_error *err);
 
+/*! ip_extract_full_lod() : the full extraction at the adaptive resolution of a view: for each
+ *  level that an engine with `lod` on and `pixel_error` (ip_engine_options) uses for `camera`,
+ *  the active cells whose centre lies within that level's distance band from the eye
+ *  ([ip_engine_lod_distance(k), ip_engine_lod_distance(k + 1)), world units), among those the
+ *  planes keep (as ip_extract_full_clipped()). Appended level by level, each in brick order,
+ *  so the result is the same for any number of threads; the reference that the progressive
+ *  image with adaptive resolution equals once every ray has been cast (isorender --full-lod).
+ *  With one level in use it is ip_extract_full_clipped() of level 0. Cells outside the view
+ *  are included: the bands are distances, not the frustum.
+ *  @return IP_OK, IP_ERR_ARGUMENT for a bad camera, pixel error or planes, or a brick read
+ *  error. */
+IP_API ip_status ip_extract_full_lod(ip_cache *cache, float iso, const ip_camera *camera,
+                                     double pixel_error, unsigned threads,
+                                     const ip_clip_plane *clip, unsigned clip_count, ip_mesh *mesh,
+                                     ip_engine_counts *counts, ip_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -59,6 +59,9 @@ _PROTOTYPES = {
     "ip_engine_totals": (None, [HANDLE, POINTER(S.EngineCounts)]),
     "ip_extract_full": (c_int, [HANDLE, c_float, c_uint32, c_uint, POINTER(S.Mesh),
                                 POINTER(S.EngineCounts), ERR]),
+    "ip_extract_full_lod": (c_int, [HANDLE, c_float, POINTER(S.Camera), c_double, c_uint,
+                                    c_void_p, c_uint, POINTER(S.Mesh), POINTER(S.EngineCounts),
+                                    ERR]),
     "ip_mesh_init": (None, [POINTER(S.Mesh)]),
     "ip_mesh_free": (None, [POINTER(S.Mesh)]),
 }

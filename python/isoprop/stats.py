@@ -34,8 +34,9 @@ def cache_stats(cache, summary_bytes):
 def run_stats(run, counts, cache):
     """The whole dict for `run` (a volume._Run) with totals `counts` (ip_engine_counts)."""
     c = run.camera
+    mode = "full-lod" if run.full == "lod" else "full" if run.full else "progressive"
     out = {"cache": cache_stats(cache, run.summary_bytes), "file": run.path, "iso": run.iso,
-           "mode": "full" if run.full else "progressive", "width": c.width, "height": c.height,
+           "mode": mode, "width": c.width, "height": c.height,
            "renderer": "none",
            "camera": {"eye": list(c.eye), "target": list(c.target), "up": list(c.up),
                       "fov": c.fov_y},

@@ -72,7 +72,7 @@ class _Run:
             warnings.warn(text, RuntimeWarning, stacklevel=4)
 
     def done(self):
-        return self.full or bool(self.engine and lib.ip_engine_done(self.engine))
+        return bool(self.full) or bool(self.engine and lib.ip_engine_done(self.engine))
 
     def destroy(self):
         if self.engine:
@@ -187,7 +187,10 @@ class File:
         `size` (width, height) pixels seen from `view` (+x -x +y -y +z -z: the side the eye is
         on) or `camera` (a dict eye/target/up/fov or isorender's --camera text), until every
         pixel has had its ray, `rays` rays or `time_limit` seconds. full=True triangulates
-        every active cell instead (isorender --full; the view does not matter). threads (0:
+        every active cell instead (isorender --full; the view does not matter); full="lod"
+        every active cell at the view's adaptive resolution, each level's cells within its
+        distance band (isorender --full-lod: what the progressive mesh with lod on draws once
+        every pixel has had its ray; needs lod on). threads (0:
         every core), cutoff and foldback (degrees), lod, pixel_error, occlusion, prefetch (True,
         False or "always") and cull are isorender's options (cull off by default here: the mesh
         is the product, not an image of it); cache_mb the brick cache's budget (the cache stays warm
@@ -196,10 +199,15 @@ class File:
         kw = dict(view=view, camera=camera, size=size, threads=threads, cutoff=cutoff,
                   foldback=foldback, lod=lod, pixel_error=pixel_error, occlusion=occlusion,
                   prefetch=prefetch, cull=cull, cache_mb=cache_mb)
+        if full not in (False, True, "lod"):
+            raise ValueError('full: False, True or "lod", not %r' % (full,))
         if full:
             if rays is not None or time_limit is not None or on_step is not None:
                 raise ValueError("full=True extracts everything: no rays, time_limit or on_step")
-            return self._extract_full(iso, **kw)
+            if full == "lod" and not lod:
+                raise ValueError('full="lod" is the full extraction at adaptive resolution: '
+                                 "not with lod=False (full=True is that)")
+            return self._extract_full(iso, full, **kw)
         run = self._begin(iso, **kw)
         try:
             for first, count, counts in self._steps(run, rays, time_limit, None):
@@ -293,17 +301,23 @@ class File:
             lib.ip_engine_totals(run.engine, ctypes.byref(counts))
         return run_stats(run, counts, self._cache)
 
-    def _extract_full(self, iso, view, camera, size, threads, cache_mb, **engine_kw):
+    def _extract_full(self, iso, full, view, camera, size, threads, cache_mb, **engine_kw):
         cam = self._camera(view, camera, size)
         options = _engine_options(threads, **engine_kw)
         cache = self._cache_for(cache_mb)
-        run = _Run(self, iso, True, cam, options)
+        run = _Run(self, iso, full, cam, options)
         mesh, counts, err = S.Mesh(), S.EngineCounts(), new_error()
         lib.ip_mesh_init(ctypes.byref(mesh))
         try:
             start = lib.ip_now_seconds()
-            st = lib.ip_extract_full(cache, float(iso), 0, threads, ctypes.byref(mesh),
-                                     ctypes.byref(counts), ctypes.byref(err))
+            if full == "lod":
+                st = lib.ip_extract_full_lod(cache, float(iso), ctypes.byref(cam),
+                                             options.pixel_error, threads, None, 0,
+                                             ctypes.byref(mesh), ctypes.byref(counts),
+                                             ctypes.byref(err))
+            else:
+                st = lib.ip_extract_full(cache, float(iso), 0, threads, ctypes.byref(mesh),
+                                         ctypes.byref(counts), ctypes.byref(err))
             run.wall_seconds = lib.ip_now_seconds() - start
             check(st, err)
             vertices, normals = copy_triangles(mesh, 0, mesh.triangle_count)

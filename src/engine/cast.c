@@ -64,7 +64,14 @@ static double stop_depth(const ip_engine *e, uint32_t x, uint32_t y)
  * already, and would only end the walk there (a cell hit squarely) or be passed over. Walking on
  * from `from` then finds what the full walk finds past it and at most more cells behind an
  * extracted one, all of the true surface: each is extracted or propagated from as a walk would
- * (the image stays exact: a pixel's own first-hit cell is either extracted already or found). */
+ * (the image stays exact: a pixel's own first-hit cell is either extracted already or found).
+ *
+ * With adaptive resolution the surface is that of each level's cells within its distance band
+ * (lod.h). The ray walks each level over the band widened by half a cell's diagonal, where
+ * every point of a band's cell lies, passing over the cells of other bands as the seeder is
+ * told (ip__seeder_band()), and each next level only up to where a walk stopped, the far side
+ * of the cell it stopped in: the nearest first-hit cell of any level lies within that, so the
+ * argument above holds for the levels together. */
 ip_status ip__engine_cast_ray(ip_engine_worker *w, uint32_t x, uint32_t y, double from)
 {
     ip_engine *e = w->engine;
@@ -73,15 +80,19 @@ ip_status ip__engine_cast_ray(ip_engine_worker *w, uint32_t x, uint32_t y, doubl
     w->counts.rays++;
     ip_camera_pixel_ray(&e->basis, &e->camera, x + 0.5, y + 0.5, dir);
     double z = stop_depth(e, x, y), cos = ip__vec3_dot(dir, e->basis.forward);
+    double nearest = INFINITY; /* where a level's walk stopped: beyond, no level need look */
     for (uint32_t k = 0; k < e->levels_used; k++) {
         ip_level_tools *lt = &w->level[k];
         unsigned count;
         int seed_index;
-        double t_max = e->lod_distance[k + 1], stop = (z + e->cell_reach[k]) / cos;
+        /* The level's band (lod.h) widened by its cells' radius: every point of a cell of the
+         * band lies within that distance range of the eye, and so at t within it. */
+        double widen = e->levels_used > 1 ? e->cell_radius[k] : 0.0;
+        double band_lo = e->lod_distance[k] - widen, band_hi = e->lod_distance[k + 1] + widen;
+        double t_max = band_hi, stop = (z + e->cell_reach[k]) / cos;
         t_max = stop < t_max ? stop : t_max;
-        if (t_max < e->lod_distance[k])
-            return IP_OK;
-        double t_min = from / cos > e->lod_distance[k] ? from / cos : e->lod_distance[k];
+        t_max = nearest < t_max ? nearest : t_max;
+        double t_min = from / cos > band_lo ? from / cos : band_lo;
         if (t_min > t_max)
             continue;
         uint64_t nodes = lt->seeder.nodes;
@@ -110,8 +121,8 @@ ip_status ip__engine_cast_ray(ip_engine_worker *w, uint32_t x, uint32_t y, doubl
                 return st;
             }
         }
-        if (found)
-            return IP_OK;
+        if (lt->seeder.stopped && lt->seeder.hit_t < nearest)
+            nearest = lt->seeder.hit_t;
     }
     return IP_OK;
 }

@@ -7,6 +7,7 @@
 
 #include "engine_state.h"
 #include "internal.h"
+#include "lod.h"
 #include "reach.h"
 #include "vec3.h"
 
@@ -133,32 +134,12 @@ void ip_engine_destroy(ip_engine *e)
     free(e);
 }
 
-/* D[k]: beyond it a level-k cell (2^k level-0 cells across, at the largest spacing)
- * projects to at most pixel_error pixels. Levels whose D lies beyond the volume's farthest
- * corner are not used. */
+/* The distance bands of the view's levels (lod.h). */
 static void set_lod_distances(ip_engine *e)
 {
     const ip_layout *l = ip_store_layout(ip_cache_store(e->cache));
-    double spacing = fmax(l->spacing[0], fmax(l->spacing[1], l->spacing[2]));
-    double pixels_per_radian = 0.5 * e->camera.height / e->basis.tan_half_y;
-    double far = 0;
-    for (int k = 0; k < 8; k++) {
-        double corner[3], v[3];
-        for (int a = 0; a < 3; a++)
-            corner[a] = (k >> a & 1) ? (l->dims[a] - 1) * l->spacing[a] : 0;
-        ip__vec3_sub(corner, e->camera.eye, v);
-        far = fmax(far, ip__vec3_length(v));
-    }
-    e->lod_distance[0] = 0;
-    e->levels_used = 1;
-    for (uint32_t k = 1; e->options.lod && k < l->level_count; k++) {
-        double d = (double)(1u << k) * spacing * pixels_per_radian / e->options.pixel_error;
-        if (d >= far)
-            break;
-        e->lod_distance[k] = d;
-        e->levels_used = k + 1;
-    }
-    e->lod_distance[e->levels_used] = INFINITY;
+    e->levels_used =
+        ip__lod_distances(l, &e->camera, e->options.lod, e->options.pixel_error, e->lod_distance);
 }
 
 double ip_engine_lod_distance(const ip_engine *e, uint32_t level)
@@ -250,6 +231,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     set_lod_distances(e);
     const ip_layout *layout = ip_store_layout(ip_cache_store(e->cache));
     for (uint32_t k = 0; k < e->levels_used; k++) {
+        e->cell_radius[k] = ip__lod_cell_radius(layout, k);
         e->cell_reach[k] = 0;
         for (int a = 0; a < 3; a++)
             e->cell_reach[k] += layout->spacing[a] * (double)(1u << k) * fabs(e->basis.forward[a]);
@@ -288,6 +270,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
             ip__sampler_release(&lt->sampler);
             lt->sampler.status = IP_OK;
             ip__seeder_init(&lt->seeder, &lt->sampler, iso, pixel_angle);
+            ip__seeder_band(&lt->seeder, e->lod_distance[k], e->lod_distance[k + 1]);
             lt->seeder.clip = (ip_clip){e->options.clip, e->options.clip_count};
             ip__propagator_free(&lt->propagator);
             if (ip__propagator_init(&lt->propagator, &lt->sampler, &e->visited, &w->mesh,

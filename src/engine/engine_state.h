@@ -98,6 +98,7 @@ struct ip_engine {
     uint32_t levels_used;                   /* levels 0 .. levels_used - 1 have a distance band */
     double lod_distance[IP_MAX_LEVELS + 1]; /* D[k]; D[levels_used] = infinity */
     double cell_reach[IP_MAX_LEVELS];       /* a level-k cell's extent along the view (world) */
+    double cell_radius[IP_MAX_LEVELS];      /* half a level-k cell's diagonal (world; lod.h) */
     /* With occlusion: bulk retirement of the rays of 8 x 8 tiles (ip__engine_retire()) */
     ip_engine_tile *tiles;
     unsigned char *reached; /* per tile: some active brick may show in it (reach_view()) */

@@ -1,4 +1,6 @@
-/* Full extraction: every active cell of a level, brick by brick, skipping by summaries. */
+/* Full extraction: every active cell of a level, brick by brick, skipping by summaries; and at
+ * a view's adaptive resolution, each level's cells of its distance band (lod.h). */
+#include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,12 +9,41 @@
 #include "clip.h"
 #include "internal.h"
 #include "isoprop/engine.h"
+#include "lod.h"
 #include "pool.h"
 #include "propagate.h"
 
-/* Triangulates the active cells of one brick that `clip` keeps, sub-block by sub-block. */
+/* The cells a full extraction takes by distance: with `banded`, those whose centre lies in
+ * [near, far) from `eye` (lod.h); else all. */
+typedef struct full_band {
+    int banded;
+    double near, far, radius; /* radius: half a cell's diagonal (ip__lod_cell_radius()) */
+    double eye[3];
+} full_band;
+
+/* 0 when no cell of the level's brick `brick` can lie in the band: its world box lies wholly
+ * nearer than near - radius or farther than far + radius from the eye. */
+static int brick_may_be_in_band(const ip_sampler *s, const full_band *band,
+                                const uint32_t origin[3], const uint32_t extent[3])
+{
+    if (!band->banded)
+        return 1;
+    double in2 = 0, out2 = 0; /* squared distances to the box's nearest and farthest points */
+    for (int a = 0; a < 3; a++) {
+        double lo = s->world[a][origin[a]], hi = s->world[a][origin[a] + extent[a] - 1];
+        double e = band->eye[a], d_in = e < lo ? lo - e : e > hi ? e - hi : 0.0;
+        double d_out = e - lo > hi - e ? e - lo : hi - e;
+        in2 += d_in * d_in;
+        out2 += d_out * d_out;
+    }
+    double lowest = band->near - band->radius, highest = band->far + band->radius;
+    return !(sqrt(in2) > highest || (lowest > 0 && sqrt(out2) < lowest));
+}
+
+/* Triangulates the active cells of one brick that `clip` keeps (and `band` takes),
+ * sub-block by sub-block. */
 static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip_clip *clip,
-                               uint64_t g, ip_engine_counts *c)
+                               const full_band *band, uint64_t g, ip_engine_counts *c)
 {
     const ip_layout *l = s->layout;
     const float *ranges = ip_store_subblock_ranges(ip_cache_store(s->cache), g);
@@ -22,6 +53,8 @@ static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip
     uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
     ip_status st = IP_OK;
     ip_cell_output out = {mesh, NULL, 0}; /* every triangle, none culled */
+    if (!brick_may_be_in_band(s, band, origin, extent))
+        return st;
     for (uint32_t i = 0; i < per * per * per && st == IP_OK; i++) {
         if (!ip__range_active(ranges[2 * i], ranges[2 * i + 1], iso))
             continue;
@@ -37,8 +70,10 @@ static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip
             for (uint32_t y = lo[1]; y < hi[1] && st == IP_OK; y++)
                 for (uint32_t x = lo[0]; x < hi[0]; x++) {
                     uint32_t cell[3] = {x, y, z}, far[3] = {x + 1, y + 1, z + 1};
-                    if (side == IP__CLIP_STRADDLES &&
-                        !ip__clip_keeps_samples(clip, l, level, cell, far))
+                    if ((side == IP__CLIP_STRADDLES &&
+                         !ip__clip_keeps_samples(clip, l, level, cell, far)) ||
+                        (band->banded && !ip__lod_in_band(ip__lod_cell_distance(s, cell, band->eye),
+                                                          band->near, band->far)))
                         continue;
                     unsigned mc;
                     int n = ip__extract_cell(s, &out, cell, iso, &mc, &c->culled, &st);
@@ -59,6 +94,7 @@ typedef struct full_worker {
     float iso;
     uint32_t level;
     ip_clip clip;
+    full_band band;
     atomic_uint_fast64_t *next; /* next level-local brick to take */
     ip_sampler sampler;
     ip_mesh mesh;
@@ -96,8 +132,8 @@ static void full_work(void *user, unsigned index)
         }
         w->brick_of[w->chunks] = i;
         w->start_of[w->chunks++] = w->mesh.triangle_count;
-        w->status =
-            extract_brick(&w->sampler, &w->mesh, w->iso, &w->clip, lv->first_brick + i, &w->counts);
+        w->status = extract_brick(&w->sampler, &w->mesh, w->iso, &w->clip, &w->band,
+                                  lv->first_brick + i, &w->counts);
         ip__sampler_release(&w->sampler); /* a brick at a time */
     }
     w->counts.extraction_seconds = ip_now_seconds() - start;
@@ -135,19 +171,24 @@ ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned t
     return ip_extract_full_clipped(cache, iso, level, threads, NULL, 0, mesh, counts, err);
 }
 
-ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t level, unsigned threads,
-                                  const ip_clip_plane *clip, unsigned clip_count, ip_mesh *mesh,
-                                  ip_engine_counts *counts, ip_error *err)
+static ip_status check_planes(const ip_clip_plane *clip, unsigned clip_count, ip_error *err)
 {
-    const ip_layout *l = ip_store_layout(ip_cache_store(cache));
+    if (ip__clip_valid(clip, clip_count))
+        return IP_OK;
+    return ip__fail(err, IP_ERR_ARGUMENT,
+                    "clipping planes: %u given (at most %d), each with a finite, non-zero "
+                    "normal and a finite offset",
+                    clip_count, IP_MAX_CLIP_PLANES);
+}
+
+/* The full extraction of one level's cells that the planes keep and `band` takes, appended
+ * to `mesh` in brick order; counts summed into *c. */
+static ip_status extract_level(ip_cache *cache, float iso, uint32_t level, unsigned threads,
+                               const ip_clip_plane *clip, unsigned clip_count,
+                               const full_band *band, ip_mesh *mesh, ip_engine_counts *total,
+                               ip_error *err)
+{
     const char *path = ip_store_path(ip_cache_store(cache));
-    if (level >= l->level_count)
-        return ip__fail(err, IP_ERR_ARGUMENT, "%s: level %u does not exist", path, level);
-    if (!ip__clip_valid(clip, clip_count))
-        return ip__fail(err, IP_ERR_ARGUMENT,
-                        "clipping planes: %u given (at most %d), each with a finite, non-zero "
-                        "normal and a finite offset",
-                        clip_count, IP_MAX_CLIP_PLANES);
     threads = ip_thread_count(threads);
     full_worker *w = calloc(threads, sizeof *w);
     if (!w)
@@ -156,8 +197,12 @@ ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t level, un
     atomic_init(&next, 0);
     ip_status st = IP_OK;
     for (unsigned t = 0; t < threads; t++) {
-        w[t] = (full_worker){
-            .cache = cache, .iso = iso, .level = level, .clip = {clip, clip_count}, .next = &next};
+        w[t] = (full_worker){.cache = cache,
+                             .iso = iso,
+                             .level = level,
+                             .clip = {clip, clip_count},
+                             .band = *band,
+                             .next = &next};
         ip_mesh_init(&w[t].mesh);
         w[t].mesh.with_cells = mesh->with_cells;
         if (ip__sampler_init(&w[t].sampler, cache, level) != IP_OK && st == IP_OK)
@@ -194,6 +239,57 @@ ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t level, un
         free(w[t].start_of);
     }
     free(w);
+    total->cells += c.cells;
+    total->triangles += c.triangles;
+    total->extraction_seconds += c.extraction_seconds;
+    return st;
+}
+
+ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t level, unsigned threads,
+                                  const ip_clip_plane *clip, unsigned clip_count, ip_mesh *mesh,
+                                  ip_engine_counts *counts, ip_error *err)
+{
+    const ip_layout *l = ip_store_layout(ip_cache_store(cache));
+    if (level >= l->level_count)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: level %u does not exist",
+                        ip_store_path(ip_cache_store(cache)), level);
+    if (check_planes(clip, clip_count, err) != IP_OK)
+        return IP_ERR_ARGUMENT;
+    static const full_band every = {0, 0.0, INFINITY, 0.0, {0, 0, 0}};
+    ip_engine_counts c;
+    memset(&c, 0, sizeof c);
+    ip_status st =
+        extract_level(cache, iso, level, threads, clip, clip_count, &every, mesh, &c, err);
+    if (counts)
+        *counts = c;
+    return st;
+}
+
+ip_status ip_extract_full_lod(ip_cache *cache, float iso, const ip_camera *camera,
+                              double pixel_error, unsigned threads, const ip_clip_plane *clip,
+                              unsigned clip_count, ip_mesh *mesh, ip_engine_counts *counts,
+                              ip_error *err)
+{
+    const ip_layout *l = ip_store_layout(ip_cache_store(cache));
+    if (!(pixel_error > 0 && isfinite(pixel_error)))
+        return ip__fail(err, IP_ERR_ARGUMENT, "pixel error %g: not a positive number", pixel_error);
+    if (ip_camera_check(camera, err) != IP_OK)
+        return IP_ERR_ARGUMENT;
+    if (check_planes(clip, clip_count, err) != IP_OK)
+        return IP_ERR_ARGUMENT;
+    double D[IP_MAX_LEVELS + 1];
+    uint32_t levels = ip__lod_distances(l, camera, 1, pixel_error, D);
+    ip_engine_counts c;
+    memset(&c, 0, sizeof c);
+    ip_status st = IP_OK;
+    for (uint32_t k = 0; k < levels && st == IP_OK; k++) {
+        full_band band = {levels > 1,
+                          D[k],
+                          D[k + 1],
+                          ip__lod_cell_radius(l, k),
+                          {camera->eye[0], camera->eye[1], camera->eye[2]}};
+        st = extract_level(cache, iso, k, threads, clip, clip_count, &band, mesh, &c, err);
+    }
     if (counts)
         *counts = c;
     return st;

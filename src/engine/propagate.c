@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "lod.h"
 #include "propagate.h"
 #include "vec3.h"
 
@@ -278,14 +279,16 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
             cell_centre(p->sampler, n3, centre, &diagonal);
             double v[3];
             ip__vec3_sub(centre, eye, v);
+            /* the distance as ip__lod_cell_distance() works it out, which the rays' band test
+             * uses: both must agree to the bit (lod.h) */
             double distance = ip__vec3_length(v), a = versine(dir, v, distance);
             if (a > p->cutoff_versine || a < folded)
                 continue;
             double depth = ip__vec3_dot(v, p->basis.forward), x, y, pixels;
             if (!in_frustum(p, v, depth, diagonal, &x, &y, &pixels))
                 continue;
-            if (distance < p->near_distance || distance >= p->far_distance)
-                continue; /* another level's band: the resolution boundary */
+            if (!ip__lod_in_band(distance, p->near_distance, p->far_distance))
+                continue; /* another level's band (lod.h): the resolution boundary */
             if (p->out.coverage && hidden(p, n3, pixels, depth, x, y)) {
                 counts->deferred++; /* left unmarked: a ray that seeds it extracts it */
                 continue;

@@ -5,6 +5,7 @@
 
 #include "format.h"
 #include "internal.h"
+#include "lod.h"
 #include "seed.h"
 #include "vec3.h"
 
@@ -326,6 +327,13 @@ static IP_ALWAYS_INLINE unsigned dda_near_faces(const ip_seeder *s, const index_
     return m;
 }
 
+/* 1 when `cell` lies in the seeder's distance band (lod.h), as propagation decides it. */
+static int in_band(const ip_seeder *s, const index_ray *r, const uint32_t cell[3])
+{
+    return ip__lod_in_band(ip__lod_cell_distance(s->sampler, cell, r->world_origin), s->band_near,
+                           s->band_far);
+}
+
 /* 1 when cell c is already among the ray's cells. */
 static int found_already(const ip_seeder *s, const int64_t c[3])
 {
@@ -358,7 +366,8 @@ static int near_cell(ip_seeder *s, const index_ray *r, const int64_t c[3])
         s->found_count + 1 >= IP_SEED_MAX_CELLS || found_already(s, c))
         return 0;
     uint32_t c1[3] = {cell[0] + 1, cell[1] + 1, cell[2] + 1};
-    if (s->clip.count && !ip__clip_keeps_samples(&s->clip, l, s->level, cell, c1))
+    if ((s->clip.count && !ip__clip_keeps_samples(&s->clip, l, s->level, cell, c1)) ||
+        (s->banded && !in_band(s, r, cell)))
         return 0;
     float values[8];
     unsigned mc;
@@ -491,8 +500,10 @@ static int walk_cells(ip_seeder *s, const index_ray *r, const uint32_t lo[3], co
         unsigned mc = 0;
         int kind = 0;
         uint32_t c1[3] = {c[0] + 1, c[1] + 1, c[2] + 1};
-        if (group_active && (side == IP__CLIP_KEEPS_ALL ||
-                             ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))) {
+        if (group_active &&
+            (side == IP__CLIP_KEEPS_ALL ||
+             ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1)) &&
+            (!s->banded || in_band(s, r, c))) {
             ip__cell_values(brick, s->layout->type, corners, c, values);
             mc = ip__mc_case(values, s->iso);
             s->cells_read++;
@@ -731,6 +742,14 @@ void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_
         s->ranges[depth] = ip_store_node_range(s->store, s->level, depth, origin);
     }
     s->first_brick = lv->first_brick;
+    ip__seeder_band(s, 0.0, INFINITY);
+}
+
+void ip__seeder_band(ip_seeder *s, double near, double far)
+{
+    s->band_near = near;
+    s->band_far = far;
+    s->banded = near > 0.0 || far < INFINITY;
 }
 
 /* The ray eye + t * dir in the index space of a level whose cells are `scale` world units. */
@@ -814,6 +833,7 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
     s->found = cells;
     s->found_count = 0;
     s->seed_index = -1;
+    s->stopped = 0;
     *count = 0;
     *seed_index = -1;
     const ip_level_layout *lv = &s->layout->levels[s->level];
@@ -868,6 +888,7 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
                            -1, -1);
     if (found < 0)
         return -1; /* a brick could not be read: the cells found so far may be wrong */
+    s->stopped = found == 1;
     *count = s->found_count;
     *seed_index = s->seed_index;
     return found || s->seed_index >= 0;

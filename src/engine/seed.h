@@ -38,6 +38,12 @@ typedef struct ip_seeder {
     double within_most;   /* the largest of them */
     uint64_t near_tested; /* active cells the rays passed close to, without entering, tested */
     double hit_t;         /* where the ray leaves the cell it stopped in (walk_cells()) */
+    int stopped;          /* 1 when the last ip__seed_find() stopped in a cell (at hit_t) */
+    /* With adaptive resolution (banded), only the cells of the level's distance band
+     * [band_near, band_far) are the view's (lod.h): the walk passes over the others as if
+     * they were inactive (ip__seeder_band()). */
+    int banded;
+    double band_near, band_far;
     /* Per octree depth of the level (0: the bricks): the node grid and the range of its
      * node (0, 0, 0), the others following x fastest. */
     uint32_t grid[IP_SEED_MAX_DEPTH + 1][3];
@@ -160,6 +166,10 @@ static inline void ip__seeder_subblock_cells(const ip_seeder *s, const uint32_t 
 /* `pixel_angle`: the angle one pixel subtends at the image centre (radians). */
 void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_angle);
 
+/* Restricts the walks to the cells of the level's distance band [near, far) (lod.h), as
+ * propagation is: 0 and +infinity (a view of one level) walk every cell. */
+void ip__seeder_band(ip_seeder *s, double near, double far);
+
 /* Casts the ray eye + t * dir (world units, dir of unit length, t_min <= t <= t_max) through
  * the octree of the seeder's level, front to back (a stretch of up to s->short_walk bricks
  * over the bricks by a DDA). The seed is the first cell with a triangle
@@ -170,7 +180,9 @@ void ip__seeder_init(ip_seeder *s, ip_sampler *sampler, float iso, double pixel_
  * among them the cells the ray passes beside within its reach (IP_SEED_REACH_PIXELS) without
  * entering them, up to the cell it stops in, wherever they come in the list.
  * @return 1 when there is a seed, 0 when not (the cells are near misses only, possibly none),
- * -1 when a brick could not be read (see the sampler's status). */
+ * -1 when a brick could not be read (see the sampler's status). s->stopped then says whether
+ * the walk stopped in a cell, and s->hit_t where the ray leaves that cell. Cells outside the
+ * seeder's band (ip__seeder_band()) are passed over, neither found nor stopped in. */
 int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
                   double t_max, uint32_t cells[][3], unsigned *count, int *seed_index);
 

@@ -84,6 +84,25 @@ class Extract(unittest.TestCase):
         self.assert_same_keys(mesh.stats, stats)
         self.assertEqual(mesh.stats["triangles"], len(mesh))
 
+    def test_full_lod_equals_isorender_full_lod(self):
+        """full="lod" is isorender --full-lod: the view's levels, each level's cells in its
+        distance band; at a 4-pixel error the phantom's far side comes from a coarser level,
+        so there are fewer triangles than in the full extraction."""
+        ply, stats = self.isorender("full-lod", "--full-lod", "--view", "+x", "--pixel-error", "4")
+        self.assertEqual(stats["mode"], "full-lod")
+        for threads in (1, 0):
+            mesh = self.f.extract(ISO, full="lod", view="+x", size=SIZE, threads=threads,
+                                  pixel_error=4)
+            self.assert_same_triangles(mesh, ply)
+        mesh = self.f.extract(ISO, full="lod", view="+x", size=SIZE, threads=1, pixel_error=4)
+        self.assert_same_keys(mesh.stats, stats)
+        whole = self.f.extract(ISO, full=True, size=SIZE)
+        self.assertLess(len(mesh), len(whole))
+        with self.assertRaises(ValueError):
+            self.f.extract(ISO, full="lod", lod=False, size=SIZE)
+        with self.assertRaises(ValueError):
+            self.f.extract(ISO, full="yes", size=SIZE)
+
     def test_progressive_equals_isorender_on_one_thread(self):
         ply, stats = self.isorender("progressive", "--view", "+x")
         mesh = self.f.extract(ISO, view="+x", size=SIZE, threads=1)

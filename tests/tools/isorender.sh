@@ -111,6 +111,23 @@ run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y -o f.png
 check "full render succeeds" test "$rc" = 0
 check "full and progressive images are identical" cmp -s p.png f.png
 
+# adaptive resolution: at a 4-pixel error the far side comes from coarser levels, and once
+# every ray has been cast the progressive image is the full extraction's at the view's levels
+for t in 1 2; do
+    run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y --azimuth 30 \
+        --pixel-error 4 --threads $t -o l$t.png --stats l$t.json --software --quiet
+    check "lod render on $t threads succeeds" test "$rc" = 0
+done
+run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --view -y --azimuth 30 \
+    --pixel-error 4 -o fl.png --stats fl.json --full-lod --software --quiet
+check "--full-lod succeeds" test "$rc" = 0
+check "--full-lod says so" grep -q '"mode": "full-lod"' fl.json
+check "lod uses a coarse level" sh -c '! grep -q "\"level\": 1, \"bricks_touched\": 0," fl.json'
+check "lod and --full-lod images are identical (1 thread)" cmp -s l1.png fl.png
+check "lod and --full-lod images are identical (2 threads)" cmp -s l2.png fl.png
+expect_error 2 "--full-lod" "$bin/isorender" s.ibv --iso 100.5 --full --full-lod -o x.png
+expect_error 2 "--full-lod" "$bin/isorender" s.ibv --iso 100.5 --full-lod --lod off -o x.png
+
 # limits: a ray budget
 run_capture "$bin/isorender" s.ibv --iso 100.5 --size 160x120 --rays 100 -o r.png --stats r.json --software --quiet --warm
 check "a ray budget stops early" grep -q '"rays": 100, "rays_total": 19200, "done": false' r.json

@@ -1,0 +1,49 @@
+/* Adaptive resolution: the distance bands of a view's pyramid levels. Internal.
+ *
+ * A view uses levels 0 .. levels - 1. A cell of level k belongs to the view's surface when
+ * the distance (world units) from the eye to its centre lies in [D[k], D[k + 1]), the band of
+ * level k, with D[0] = 0 and D[levels] = +infinity. Propagation, the rays' walks and the full
+ * extraction at adaptive resolution (ip_extract_full_lod()) all apply this one rule, the
+ * distance by ip__lod_cell_distance() (propagation's own arithmetic on the same centre) and
+ * the band by ip__lod_in_band(), so that they agree to the bit on every cell: the progressive
+ * image with adaptive resolution then equals that full extraction's once every ray has been
+ * cast. */
+#ifndef ISOPROP_LOD_H
+#define ISOPROP_LOD_H
+
+#include <stdint.h>
+
+#include "isoprop/camera.h"
+#include "isoprop/layout.h"
+#include "sampler.h"
+#include "vec3.h"
+
+/* Sets D[0 .. levels] for `camera` and returns `levels` (1 when `lod` is 0): D[k] is where a
+ * level-k cell (2^k level-0 cells across, at the largest spacing) projects to `pixel_error`
+ * pixels; levels whose D lies beyond the volume's farthest corner from the eye are not used. */
+uint32_t ip__lod_distances(const ip_layout *l, const ip_camera *camera, int lod, double pixel_error,
+                           double D[IP_MAX_LEVELS + 1]);
+
+/* Half the diagonal of a level-k cell at the layout's spacing (world units): no point of a
+ * level-k cell lies farther from its centre (the last cells along an axis are no larger). */
+double ip__lod_cell_radius(const ip_layout *l, uint32_t k);
+
+/* Distance (world units) from `eye` to the centre of `cell` of the sampler's level: the
+ * centre is the midpoint of the cell's world box, as propagation takes it. */
+static inline double ip__lod_cell_distance(const ip_sampler *s, const uint32_t cell[3],
+                                           const double eye[3])
+{
+    double centre[3], v[3];
+    for (int a = 0; a < 3; a++)
+        centre[a] = 0.5 * (s->world[a][cell[a]] + s->world[a][cell[a] + 1]);
+    ip__vec3_sub(centre, eye, v);
+    return ip__vec3_length(v);
+}
+
+/* 1 when a cell whose centre lies `distance` from the eye is in the band [near, far). */
+static inline int ip__lod_in_band(double distance, double near, double far)
+{
+    return !(distance < near || distance >= far);
+}
+
+#endif
