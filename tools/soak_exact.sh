@@ -3,18 +3,21 @@
 # full extraction's: --full with adaptive resolution off, --full-lod (each level's cells in its
 # distance band) with it on. Runs CASES random cases over generated volumes and the sample
 # volumes of ../shared/data (those present): a random volume, isovalue, side, azimuth,
-# elevation, zoom, image size, thread count and cut-off, occlusion and culling on or off, and
-# adaptive resolution on or off (with a pixel error of 1, 2 or 4). Each case renders the
+# elevation, zoom, image size, thread count and cut-off, occlusion and culling on or off,
+# adaptive resolution on or off (with a pixel error of 1, 2 or 4), and in one case of four one
+# or two clipping planes through the volume's middle (--clip). Each case renders the
 # progressive run and the full extraction with the same options through the software
 # rasterizer and compares the two PNG files byte for byte. Prints a line per failing case (the
 # two command lines that reproduce it), a total, and exits 1 on any difference. Not a test:
 # the test suite checks fixed cases; this looks for the rare one, for as long as it is given.
 #
-#   [SOAK_DATA=DIR] [SOAK_LOD=mixed|on|off] tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
+#   [SOAK_DATA=DIR] [SOAK_LOD=mixed|on|off] [SOAK_CLIP=on|off] tools/soak_exact.sh [BUILD_DIR]
+#       [CASES] [SEED] [WORK_DIR]
 #   defaults: build 200 1 (a temporary folder, removed at the end); SOAK_DATA, the folder of
 #   the sample volumes: ../shared/data (empty: the generated volumes alone); SOAK_LOD, whether
-#   cases run with adaptive resolution: mixed (one in two, the default), on or off (every case;
-#   off draws the cases that this tool drew before it knew adaptive resolution)
+#   cases run with adaptive resolution: mixed (one in two, the default), on or off (every
+#   case); SOAK_CLIP, whether one case in four has clipping planes (on, the default, or off).
+#   SOAK_LOD=off SOAK_CLIP=off draws the cases this tool drew before it knew either.
 set -eu
 build=${1:-build}
 cases=${2:-200}
@@ -25,6 +28,8 @@ done
 case $cases$seed in *[!0-9]*) echo "soak_exact: CASES and SEED are whole numbers" >&2; exit 2 ;; esac
 lod_mode=${SOAK_LOD:-mixed}
 case $lod_mode in mixed | on | off) ;; *) echo "soak_exact: SOAK_LOD is mixed, on or off" >&2; exit 2 ;; esac
+clip_mode=${SOAK_CLIP:-on}
+case $clip_mode in on | off) ;; *) echo "soak_exact: SOAK_CLIP is on or off" >&2; exit 2 ;; esac
 if [ -n "${4:-}" ]; then
     work=$4
     mkdir -p "$work"
@@ -34,14 +39,19 @@ else
 fi
 data=${SOAK_DATA-$(dirname "$0")/../../shared/data}
 
-# the volumes: NAME FILE.ibv LOW HIGH (the value range isoinfo reports)
+# the volumes: NAME FILE.ibv LOW HIGH X Y Z (the value range and the world box's size, as
+# isoinfo reports them: (samples - 1) x spacing along each axis)
 : >"$work/volumes"
 add_volume() { # add_volume NAME INPUT [isobrick options...]
     name=$1 input=$2
     shift 2
     "$build/isobrick" "$input" -o "$work/$name.ibv" --force --quiet "$@"
-    range=$("$build/isoinfo" "$work/$name.ibv" | sed -n 's/^  value range *\([-0-9.e+]*\) \.\. \([-0-9.e+]*\)$/\1 \2/p')
-    echo "$name $work/$name.ibv $range" >>"$work/volumes"
+    "$build/isoinfo" "$work/$name.ibv" >"$work/info"
+    range=$(sed -n 's/^  value range *\([-0-9.e+]*\) \.\. \([-0-9.e+]*\)$/\1 \2/p' "$work/info")
+    box=$(awk '/^  dims / { x = $2; y = $4; z = $6 }
+        /^  spacing / { gsub(",", ""); printf "%.9g %.9g %.9g", (x - 1) * $2, (y - 1) * $3, (z - 1) * $4 }' \
+        "$work/info")
+    echo "$name $work/$name.ibv $range $box" >>"$work/volumes"
 }
 "$build/isogen" gyroid --dims 96x80x72 --noise 0.02 -o "$work/" --force --quiet
 add_volume gyroid "$work/gyroid_96x80x72_uint16.raw" --brick-size 16
@@ -59,7 +69,7 @@ failed=0
 i=0
 while [ "$i" -lt "$cases" ]; do
     # one case's options, drawn from (seed, i)
-    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" -v lod_mode="$lod_mode" 'BEGIN {
+    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" -v lod_mode="$lod_mode" -v clip_mode="$clip_mode" -v box="$(cut -d' ' -f5-7 "$work/volumes" | tr '\n' ' ')" 'BEGIN {
         srand(s * 100003 + i)
         split("+x -x +y -y +z -z", side, " ")
         split("1 2 3", threads, " ")
@@ -79,14 +89,38 @@ while [ "$i" -lt "$cases" ]; do
         # drawn last, so that the draws above stay those of every earlier version of the tool
         lod = lod_mode == "on" || (lod_mode == "mixed" && rand() < 0.5) ? "on" : "off"
         pixel_error = lod == "on" ? 2 ^ int(rand() * 3) : 1
-        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s %s %d\n", volume, fraction, view,
+        # clipping planes, drawn after everything else: each through a point of the middle of
+        # the box of the volume (X Y Z), along an axis or in a random direction; "none" for none
+        split(box, b, " ")
+        planes = clip_mode == "on" && rand() < 0.25 ? 1 + int(rand() * 2) : 0
+        clip = ""
+        for (p = 0; p < planes; p++) {
+            if (rand() < 0.5) {
+                axis = int(rand() * 3)
+                nx = axis == 0; ny = axis == 1; nz = axis == 2
+                if (rand() < 0.5) { nx = -nx; ny = -ny; nz = -nz }
+            } else {
+                do { nx = 2 * rand() - 1; ny = 2 * rand() - 1; nz = 2 * rand() - 1
+                     l = sqrt(nx * nx + ny * ny + nz * nz) } while (l < 0.1 || l > 1)
+                nx /= l; ny /= l; nz /= l
+            }
+            px = b[3 * volume - 2] * (0.2 + 0.6 * rand())
+            py = b[3 * volume - 1] * (0.2 + 0.6 * rand())
+            pz = b[3 * volume] * (0.2 + 0.6 * rand())
+            clip = clip sprintf("%s%.4f,%.4f,%.4f,%.4f", p ? ":" : "", nx, ny, nz,
+                -(nx * px + ny * py + nz * pz))
+        }
+        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s %s %d %s\n", volume, fraction, view,
             azimuth, elevation, zoom, width, height, thread_count, cutoff, occlusion, cull, lod,
-            pixel_error }')
-    line=$(sed -n "${1}p" "$work/volumes")
+            pixel_error, planes ? clip : "none" }')
+    line=$(sed -n "${1}p" "$work/volumes" | cut -d' ' -f1-4)
     set -- $line "$@"
     name=$1 ibv=$2 low=$3 high=$4 fraction=$6
     iso=$(awk -v l="$low" -v h="$high" -v f="$fraction" 'BEGIN { printf "%.6g", l + f * (h - l) }')
     opts="--iso $iso --view $7 --azimuth $8 --elevation $9 --zoom ${10} --size ${11} --threads ${12} --cutoff ${13} --lod ${16} --occlusion ${14} --cull ${15} --software --force --quiet"
+    if [ "${18}" != none ]; then
+        for plane in $(echo "${18}" | tr ':' ' '); do opts="$opts --clip $plane"; done
+    fi
     full=--full
     if [ "${16}" = on ]; then
         opts="$opts --pixel-error ${17}"

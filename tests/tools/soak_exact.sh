@@ -1,7 +1,7 @@
 # The exact-image guarantee over random views (tools/soak_exact.sh): 24 cases on the generated
 # volumes, a fixed seed, each progressive image against the full extraction's, byte for byte
-# (--full's, or --full-lod's for the cases with adaptive resolution: about half); a bad case
-# count or SOAK_LOD is a usage error (exit 2).
+# (--full's, or --full-lod's for the cases with adaptive resolution: about half), some with
+# clipping planes; a bad case count, SOAK_LOD or SOAK_CLIP is a usage error (exit 2).
 . "$(dirname "$0")/lib.sh"
 
 soak=$(cd "$(dirname "$0")/../../tools" && pwd)/soak_exact.sh
@@ -13,9 +13,13 @@ check "over the generated volumes alone" \
     sh -c 'printf "%s" "$0" | grep -q "over 2 volumes: gyroid lobb"' "$out"
 lod_cases=$(grep -c -- "--lod on" "$work/soak/cases" || true)
 check "with adaptive resolution in $lod_cases of them" test "$lod_cases" -ge 6
+clip_cases=$(grep -c -- "--clip" "$work/soak/cases" || true)
+check "with clipping planes in $clip_cases of them" test "$clip_cases" -ge 2
 run_capture env SOAK_DATA= sh "$soak" "$bin" 2x 5 "$work/soak"
 check "a bad case count exits 2 ($rc)" test "$rc" = 2
 run_capture env SOAK_DATA= SOAK_LOD=maybe sh "$soak" "$bin" 2 5 "$work/soak"
 check "a bad SOAK_LOD exits 2 ($rc)" test "$rc" = 2
+run_capture env SOAK_DATA= SOAK_CLIP=maybe sh "$soak" "$bin" 2 5 "$work/soak"
+check "a bad SOAK_CLIP exits 2 ($rc)" test "$rc" = 2
 
 finish
