@@ -1399,11 +1399,17 @@ static void turntable_camera(const run *r, uint64_t f, ip_camera *camera)
 }
 
 /* The mesh of frame f: a progressive run from scratch for its camera (with --rays and --time
- * per frame), or the one full extraction, made for frame 0. */
+ * per frame), the one full extraction (--full), made for frame 0, or the full extraction at
+ * the frame's own levels (--full-lod: the bands follow the eye). */
 static int turntable_extract_one(run *r, ip_error *err)
 {
-    if (r->o.full)
+    if (r->o.full == 1)
         return r->mesh ? 0 : extract_full(r, err);
+    if (r->o.full == 2) {
+        ip_mesh_free(&r->full_mesh);
+        r->mesh = NULL;
+        return extract_full(r, err);
+    }
     if (create_engine(r, err) != 0)
         return -1;
     double start = ip_now_seconds();

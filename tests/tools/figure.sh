@@ -113,6 +113,17 @@ check "--turntable --full --force succeeds" test "$rc" = 0
 same "a full turntable's frame 0 is its azimuth's image" frames/frame_000.png y90.png
 same "and frame 1 is half a turn further" frames/frame_001.png ym90.png --level 1 --max-pct 0.1
 check "the folder keeps the older frames" test -e frames/frame_003.png
+# --full-lod: the levels follow the eye, so each frame has its own full extraction, and it is
+# the image of that frame's progressive run (a 4-pixel error: two levels in use)
+render --view -y --pixel-error 4 --full-lod --stats lod.json -o lod.png
+check "a 4-pixel error uses level 1" sh -c '! grep -q "\"level\": 1, \"bricks_touched\": 0," lod.json'
+run_capture render --view -y --turntable 3 --pixel-error 4 --full-lod -o lodfull
+check "--turntable --full-lod succeeds" test "$rc" = 0
+run_capture render --view -y --turntable 3 --pixel-error 4 -o lodprog
+for f in 0 1 2; do
+    check "--full-lod turntable frame $f is the progressive frame" \
+        cmp -s lodfull/frame_00$f.png lodprog/frame_00$f.png
+done
 : >afile
 expect_error 1 "not a folder" render --turntable 2 -o afile
 
