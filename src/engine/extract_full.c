@@ -21,8 +21,9 @@ typedef struct full_band {
     double eye[3];
 } full_band;
 
-/* 0 when no cell of the level's brick `brick` can lie in the band: its world box lies wholly
- * nearer than near - radius or farther than far + radius from the eye. */
+/* 0 when no cell of the brick whose samples start at `origin` (extent samples along each axis,
+ * the sampler's level) can lie in the band: its world box lies wholly nearer than
+ * near - radius or farther than far + radius from the eye. */
 static int brick_may_be_in_band(const ip_sampler *s, const full_band *band,
                                 const uint32_t origin[3], const uint32_t extent[3])
 {
@@ -182,7 +183,7 @@ static ip_status check_planes(const ip_clip_plane *clip, unsigned clip_count, ip
 }
 
 /* The full extraction of one level's cells that the planes keep and `band` takes, appended
- * to `mesh` in brick order; counts summed into *c. */
+ * to `mesh` in brick order; the cells, triangles and time added to *total. */
 static ip_status extract_level(ip_cache *cache, float iso, uint32_t level, unsigned threads,
                                const ip_clip_plane *clip, unsigned clip_count,
                                const full_band *band, ip_mesh *mesh, ip_engine_counts *total,
