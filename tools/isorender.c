@@ -129,7 +129,7 @@ typedef struct options {
     tool_view_options common;
     const char *file, *out, *mesh, *progress, *strip;
     int full, software, warm; /* --stats, --force and --quiet are in common */
-    int full_lod;             /* --full-lod: full becomes 2 */
+    int full_lod;             /* --full-lod: full becomes TOOL_FULL_LOD (--full: TOOL_FULL) */
     strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
     int weld, no_weld;
     uint64_t smooth;          /* --smooth N: Taubin iterations for the mesh file (0: none) */
@@ -717,7 +717,7 @@ static int parse_args(int argc, char **argv, options *o)
                                 "--full-lod is the full extraction at adaptive resolution: not "
                                 "with --lod off (--full is that)");
     if (o->full_lod)
-        o->full = 2;
+        o->full = TOOL_FULL_LOD;
     if (o->full && (o->common.rays || o->common.time_limit > 0))
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
     if (o->software && o->aa > 1)
@@ -859,7 +859,7 @@ static int extract_progressive(run *r, ip_error *err)
 static ip_status full_extraction(run *r, ip_engine_counts *counts, ip_error *err)
 {
     const tool_view_options *c = &r->o.common;
-    if (r->o.full == 2)
+    if (r->o.full == TOOL_FULL_LOD)
         return ip_extract_full_lod(r->cache, (float)c->iso, &r->camera, c->pixel_error, c->threads,
                                    c->clip, c->clip_count, &r->full_mesh, counts, err);
     return ip_extract_full_clipped(r->cache, (float)c->iso, 0, c->threads, c->clip, c->clip_count,
@@ -1403,9 +1403,9 @@ static void turntable_camera(const run *r, uint64_t f, ip_camera *camera)
  * the frame's own levels (--full-lod: the bands follow the eye). */
 static int turntable_extract_one(run *r, ip_error *err)
 {
-    if (r->o.full == 1)
+    if (r->o.full == TOOL_FULL)
         return r->mesh ? 0 : extract_full(r, err);
-    if (r->o.full == 2) {
+    if (r->o.full == TOOL_FULL_LOD) {
         ip_mesh_free(&r->full_mesh);
         r->mesh = NULL;
         return extract_full(r, err);

@@ -1142,9 +1142,9 @@ void tool_write_run_json(FILE *f, const tool_run_json *j)
             ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
             "\"renderer\": \"%s\"",
             j->iso,
-            j->full == 2 ? "full-lod"
-            : j->full    ? "full"
-                         : "progressive",
+            j->full == TOOL_FULL_LOD ? "full-lod"
+            : j->full == TOOL_FULL   ? "full"
+                                     : "progressive",
             c->width, c->height, j->renderer);
     fprintf(f,
             ", \"camera\": {\"eye\": [%.9g, %.9g, %.9g], \"target\": [%.9g, %.9g, %.9g], "

@@ -326,10 +326,18 @@ void tool_print_cache_table(FILE *out, const ip_cache_stats *s, uint64_t summary
 void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_bytes);
 
 /* What isorender and isoview write about a run in --stats (members after "cache"). */
+/* What a run extracts (tool_run_json.full, isorender's o.full): the progressive run, the full
+ * extraction (--full, a flag: 1) or the full extraction at adaptive resolution (--full-lod). */
+enum {
+    TOOL_PROGRESSIVE = 0,
+    TOOL_FULL = 1,
+    TOOL_FULL_LOD = 2
+};
+
 typedef struct tool_run_json {
     const char *file;
     double iso;
-    int full; /* 1: full extraction, 2: at adaptive resolution (isorender --full-lod), else 0 */
+    int full; /* TOOL_PROGRESSIVE, TOOL_FULL or TOOL_FULL_LOD */
     const ip_camera *camera;
     const char *renderer; /* "opengl", "software", "none" */
     const tool_view_options *options;

@@ -256,7 +256,10 @@ IP_API ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t le
  *  so the result is the same for any number of threads; the reference that the progressive
  *  image with adaptive resolution equals once every ray has been cast (isorender --full-lod).
  *  With one level in use it is ip_extract_full_clipped() of level 0. Cells outside the view
- *  are included: the bands are distances, not the frustum.
+ *  are included: the bands are distances, not the frustum. `camera` (its eye, field of view
+ *  and image height set the bands) and `clip` are the caller's, read during the call; the
+ *  triangles are appended to the caller's `mesh` (cell ids, which name the level, when it
+ *  keeps them). Threads as ip_extract_full() (0 = every core, joined before it returns).
  *  @return IP_OK, IP_ERR_ARGUMENT for a bad camera, pixel error or planes, or a brick read
  *  error. */
 IP_API ip_status ip_extract_full_lod(ip_cache *cache, float iso, const ip_camera *camera,

@@ -121,8 +121,7 @@ ip_status ip__engine_cast_ray(ip_engine_worker *w, uint32_t x, uint32_t y, doubl
                 return st;
             }
         }
-        if (lt->seeder.stopped && lt->seeder.hit_t < nearest)
-            nearest = lt->seeder.hit_t;
+        nearest = lt->seeder.hit_t < nearest ? lt->seeder.hit_t : nearest;
     }
     return IP_OK;
 }

@@ -4,10 +4,9 @@
  * the distance (world units) from the eye to its centre lies in [D[k], D[k + 1]), the band of
  * level k, with D[0] = 0 and D[levels] = +infinity. Propagation, the rays' walks and the full
  * extraction at adaptive resolution (ip_extract_full_lod()) all apply this one rule, the
- * distance by ip__lod_cell_distance() (propagation's own arithmetic on the same centre) and
- * the band by ip__lod_in_band(), so that they agree to the bit on every cell: the progressive
- * image with adaptive resolution then equals that full extraction's once every ray has been
- * cast. */
+ * centre by ip__sampler_cell_centre(), the distance by ip__lod_centre_distance() and the band
+ * by ip__lod_in_band(), so that they agree to the bit on every cell: the progressive image
+ * with adaptive resolution then equals that full extraction's once every ray has been cast. */
 #ifndef ISOPROP_LOD_H
 #define ISOPROP_LOD_H
 
@@ -28,16 +27,22 @@ uint32_t ip__lod_distances(const ip_layout *l, const ip_camera *camera, int lod,
  * level-k cell lies farther from its centre (the last cells along an axis are no larger). */
 double ip__lod_cell_radius(const ip_layout *l, uint32_t k);
 
-/* Distance (world units) from `eye` to the centre of `cell` of the sampler's level: the
- * centre is the midpoint of the cell's world box, as propagation takes it. */
+/* Distance (world units) from `eye` to `centre`, a cell's ip__sampler_cell_centre(); v is
+ * set to centre - eye. Propagation (which needs v too) and the rays both go through it. */
+static inline double ip__lod_centre_distance(const double centre[3], const double eye[3],
+                                             double v[3])
+{
+    ip__vec3_sub(centre, eye, v);
+    return ip__vec3_length(v);
+}
+
+/* Distance (world units) from `eye` to the centre of `cell` of the sampler's level. */
 static inline double ip__lod_cell_distance(const ip_sampler *s, const uint32_t cell[3],
                                            const double eye[3])
 {
     double centre[3], v[3];
-    for (int a = 0; a < 3; a++)
-        centre[a] = 0.5 * (s->world[a][cell[a]] + s->world[a][cell[a] + 1]);
-    ip__vec3_sub(centre, eye, v);
-    return ip__vec3_length(v);
+    ip__sampler_cell_centre(s, cell, centre);
+    return ip__lod_centre_distance(centre, eye, v);
 }
 
 /* 1 when a cell whose centre lies `distance` from the eye is in the band [near, far). */

@@ -124,14 +124,15 @@ static double foldback_limit(const ip_propagator *p, double max)
     return 1.0 - cos_m * p->cos_foldback - sin_m * p->sin_foldback;
 }
 
+/* The cell's centre (ip__sampler_cell_centre()) and the length of its diagonal. */
 static void cell_centre(const ip_sampler *s, const uint32_t cell[3], double centre[3],
                         double *diagonal)
 {
+    ip__sampler_cell_centre(s, cell, centre);
     double d2 = 0;
     for (int a = 0; a < 3; a++) {
-        double lo = s->world[a][cell[a]], hi = s->world[a][cell[a] + 1];
-        centre[a] = 0.5 * (lo + hi);
-        d2 += (hi - lo) * (hi - lo);
+        double side = s->world[a][cell[a] + 1] - s->world[a][cell[a]];
+        d2 += side * side;
     }
     *diagonal = sqrt(d2);
 }
@@ -277,11 +278,9 @@ ip_status ip__propagate_queued(ip_propagator *p, const ip_queued_cell *cells, un
                 (clipping && !cell_kept(p, n3)))
                 continue;
             cell_centre(p->sampler, n3, centre, &diagonal);
-            double v[3];
-            ip__vec3_sub(centre, eye, v);
-            /* the distance as ip__lod_cell_distance() works it out, which the rays' band test
-             * uses: both must agree to the bit (lod.h) */
-            double distance = ip__vec3_length(v), a = versine(dir, v, distance);
+            double v[3]; /* the distance as the rays' band test takes it (lod.h) */
+            double distance = ip__lod_centre_distance(centre, eye, v),
+                   a = versine(dir, v, distance);
             if (a > p->cutoff_versine || a < folded)
                 continue;
             double depth = ip__vec3_dot(v, p->basis.forward), x, y, pixels;

@@ -105,6 +105,15 @@ static inline void ip__cell_values(const ip_brick *b, ip_type type, const ptrdif
  * so that neighbouring cells get the same bits for their shared corners. */
 void ip__sampler_cell_box(const ip_sampler *s, const uint32_t cell[3], float lo[3], float hi[3]);
 
+/* The centre of `cell`'s world box, in double (world units): the point propagation orders
+ * cells by and the distance bands of adaptive resolution are decided at (lod.h). */
+static inline void ip__sampler_cell_centre(const ip_sampler *s, const uint32_t cell[3],
+                                           double centre[3])
+{
+    for (int a = 0; a < 3; a++)
+        centre[a] = 0.5 * (s->world[a][cell[a]] + s->world[a][cell[a] + 1]);
+}
+
 /* A cell in two parts, for a caller that may not need its normals (the gradients are most of
  * the work): its corner values and marching-cubes case (returns 1, or -1 after a failure);
  * then, for an active case, the gradient normals at its edge crossings from those values, as

@@ -309,7 +309,7 @@ static IP_ALWAYS_INLINE unsigned dda_near_faces(const ip_seeder *s, const index_
         m &= ~(1u << (2 * in + (d->step[in] < 0)));
     if (out >= 0)
         m &= ~(1u << (2 * out + (d->step[out] > 0)));
-    if (d->parallel && !quiet)
+    if (d->parallel) /* (never quiet) */
         for (int k = 0; k < 3; k++) {
             if (d->step[k] != 0)
                 continue;
@@ -833,7 +833,7 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
     s->found = cells;
     s->found_count = 0;
     s->seed_index = -1;
-    s->stopped = 0;
+    s->hit_t = INFINITY;
     *count = 0;
     *seed_index = -1;
     const ip_level_layout *lv = &s->layout->levels[s->level];
@@ -888,7 +888,6 @@ int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double
                            -1, -1);
     if (found < 0)
         return -1; /* a brick could not be read: the cells found so far may be wrong */
-    s->stopped = found == 1;
     *count = s->found_count;
     *seed_index = s->seed_index;
     return found || s->seed_index >= 0;

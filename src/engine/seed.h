@@ -37,8 +37,8 @@ typedef struct ip_seeder {
     double within[3];     /* reach / |the ray's direction| per axis: the reach in t units */
     double within_most;   /* the largest of them */
     uint64_t near_tested; /* active cells the rays passed close to, without entering, tested */
-    double hit_t;         /* where the ray leaves the cell it stopped in (walk_cells()) */
-    int stopped;          /* 1 when the last ip__seed_find() stopped in a cell (at hit_t) */
+    double hit_t;         /* where the ray leaves the cell it stopped in (walk_cells()); +infinity
+                     after an ip__seed_find() that stopped in none */
     /* With adaptive resolution (banded), only the cells of the level's distance band
      * [band_near, band_far) are the view's (lod.h): the walk passes over the others as if
      * they were inactive (ip__seeder_band()). */
@@ -180,9 +180,9 @@ void ip__seeder_band(ip_seeder *s, double near, double far);
  * among them the cells the ray passes beside within its reach (IP_SEED_REACH_PIXELS) without
  * entering them, up to the cell it stops in, wherever they come in the list.
  * @return 1 when there is a seed, 0 when not (the cells are near misses only, possibly none),
- * -1 when a brick could not be read (see the sampler's status). s->stopped then says whether
- * the walk stopped in a cell, and s->hit_t where the ray leaves that cell. Cells outside the
- * seeder's band (ip__seeder_band()) are passed over, neither found nor stopped in. */
+ * -1 when a brick could not be read (see the sampler's status). s->hit_t then says where the
+ * ray leaves the cell the walk stopped in (+infinity when it stopped in none). Cells outside
+ * the seeder's band (ip__seeder_band()) are passed over, neither found nor stopped in. */
 int ip__seed_find(ip_seeder *s, const double eye[3], const double dir[3], double t_min,
                   double t_max, uint32_t cells[][3], unsigned *count, int *seed_index);
 
