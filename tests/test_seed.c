@@ -6,6 +6,7 @@
 #include "beam.h"
 #include "check.h"
 #include "isoprop/camera.h"
+#include "lod.h"
 #include "mc.h"
 #include "seed.h"
 #include "volumes.h"
@@ -135,11 +136,11 @@ static void mark_active(ip_visited *v, ip_sampler *sampler, const ip_layout *l, 
 }
 
 /* The depth short of which `beam` is settled, found the slow way: the least nearest depth
- * (world units) of the active cells of level 0 not marked in v whose box is not wholly outside
- * one of the beam's planes (cells [i, i+1] x ... scaled by the spacing); +infinity when there
- * is none. */
+ * (world units) of the active cells of level 0 not marked in v, whose centre lies in the
+ * distance band [near, far) from the eye (lod.h) and whose box is not wholly outside one of the
+ * beam's planes (cells [i, i+1] x ... scaled by the spacing); +infinity when there is none. */
 static double settled_depth(const ip_beam *beam, const ip_visited *v, ip_sampler *sampler,
-                            const ip_layout *l, float iso)
+                            const ip_layout *l, float iso, double near_d, double far_d)
 {
     const uint32_t *d = l->levels[0].dims;
     double least = INFINITY;
@@ -160,7 +161,8 @@ static double settled_depth(const ip_beam *beam, const ip_visited *v, ip_sampler
                               n[2] * (n[2] >= 0 ? hi[2] : lo[2]) <
                           0;
                 }
-                if (!out && !ip__visited_test(v, 0, c) && cell_active(sampler, iso, c))
+                if (!out && !ip__visited_test(v, 0, c) && cell_active(sampler, iso, c) &&
+                    ip__lod_in_band(ip__lod_cell_distance(sampler, c, beam->eye), near_d, far_d))
                     least = near;
             }
     return least;
@@ -172,8 +174,10 @@ static double settled_depth(const ip_beam *beam, const ip_visited *v, ip_sampler
  * record, and some are recorded. Where a beam is not settled, the depth it is settled short
  * of is the nearest depth of the nearest cell that may spoil it (checked on every 4th tile
  * against settled_depth()), and a beam whose min_depth skips what lies nearer than that gives
- * the same depth. */
-static void check_beams(ip_cache *cache, const char *axis, float iso)
+ * the same depth. With `band` 1 or 2 the seeder keeps only the cells whose centres lie farther
+ * (1) or nearer (2) than the volume's centre (ip__seeder_band(), as adaptive resolution does):
+ * the cells outside the band are never the view's, and do not spoil a beam. */
+static void check_beams(ip_cache *cache, const char *axis, float iso, int band)
 {
     const ip_layout *l = ip_store_layout(ip_cache_store(cache));
     ip_camera camera;
@@ -182,6 +186,15 @@ static void check_beams(ip_cache *cache, const char *axis, float iso)
     view_setup(cache, axis, &camera, &basis, &sampler);
     ip_seeder seeder;
     ip__seeder_init(&seeder, &sampler, iso, 2.0 * basis.tan_half_y / camera.height);
+    double middle = 0.0;
+    for (int a = 0; a < 3; a++) {
+        double m = 0.5 * (l->levels[0].dims[a] - 1.0) * l->spacing[a] - camera.eye[a];
+        middle += m * m;
+    }
+    middle = sqrt(middle);
+    if (band)
+        ip__seeder_band(&seeder, band == 1 ? middle : 0.0, band == 1 ? INFINITY : middle);
+    double near_d = seeder.band_near, far_d = seeder.band_far;
     ip_visited kept, fresh;
     REQUIRE(ip__visited_init(&kept, l) == IP_OK);
     REQUIRE(ip__visited_init(&fresh, l) == IP_OK);
@@ -207,7 +220,7 @@ static void check_beams(ip_cache *cache, const char *axis, float iso)
                 tests++;
                 if (a || (tx + ty) % 4 != 0)
                     continue;
-                double want = settled_depth(&beam, &fresh, &sampler, l, iso);
+                double want = settled_depth(&beam, &fresh, &sampler, l, iso, near_d, far_d);
                 wrong += !(fabs(ta - want) <= 1e-9 * want);
                 deep++;
                 /* what lies wholly nearer than that depth less two cells is settled:
@@ -224,14 +237,14 @@ static void check_beams(ip_cache *cache, const char *axis, float iso)
             parts += ip__visited_part_in(&kept, m, part);
     }
     CHECK_MSG(differ == 0 && settled > tests / 4 && settled < tests && parts > 0,
-              "view %s, iso %g: %llu of %llu beam tests differ, %llu settled, %llu parts "
-              "recorded",
-              axis, (double)iso, (unsigned long long)differ, (unsigned long long)tests,
+              "view %s, iso %g, band %d: %llu of %llu beam tests differ, %llu settled, %llu "
+              "parts recorded",
+              axis, (double)iso, band, (unsigned long long)differ, (unsigned long long)tests,
               (unsigned long long)settled, (unsigned long long)parts);
     CHECK_MSG(wrong == 0 && floored == 0 && deep > 100,
-              "view %s, iso %g: of %llu beams not settled, %llu gave the wrong depth, %llu "
-              "another with min_depth",
-              axis, (double)iso, (unsigned long long)deep, (unsigned long long)wrong,
+              "view %s, iso %g, band %d: of %llu beams not settled, %llu gave the wrong depth, "
+              "%llu another with min_depth",
+              axis, (double)iso, band, (unsigned long long)deep, (unsigned long long)wrong,
               (unsigned long long)floored);
     ip__visited_free(&kept);
     ip__visited_free(&fresh);
@@ -321,8 +334,10 @@ int main(void)
     check_view(cache, "-y", 1000.5f);
     check_view(cache, "+x", -300.5f);
     check_view(cache, "-z", -300.5f);
-    check_beams(cache, "-y", 1000.5f);
-    check_beams(cache, "+x", -300.5f);
+    check_beams(cache, "-y", 1000.5f, 0);
+    check_beams(cache, "+x", -300.5f, 0);
+    check_beams(cache, "-y", 1000.5f, 1);
+    check_beams(cache, "+x", -300.5f, 2);
     check_near_passes(cache, 1000.5f);
     check_near_passes(cache, -300.5f);
     ip_cache_destroy(cache);

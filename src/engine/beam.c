@@ -4,6 +4,7 @@
 #include "beam.h"
 #include "format.h"
 #include "internal.h"
+#include "lod.h"
 #include "vec3.h"
 
 /* The beam in the level's index space (cell (i, j, k) is the box [i, i+1] x ...): a box meets
@@ -11,15 +12,16 @@
 typedef struct index_beam {
     ip_seeder *s;
     ip_visited *visited;
-    double normal[4][3]; /* the planes' normals with index coordinates: n[a] * scale[a] */
-    double offset[4];    /* - n . eye */
-    double forward[3];   /* forward[a] * scale[a] */
-    double limit;        /* max_depth + forward . eye, lowered below each box found unsettled */
-    double floor;        /* min_depth + forward . eye */
-    int flip;            /* bit a: forward[a] < 0 (the nearer half along axis a is the high) */
-    double eye[3];       /* the eye, in index coordinates */
-    double step[4][3];   /* along corner ray i, index units per unit of view depth */
-    double at_eye;       /* forward . eye (world) */
+    double normal[4][3];     /* the planes' normals with index coordinates: n[a] * scale[a] */
+    double offset[4];        /* - n . eye */
+    double forward[3];       /* forward[a] * scale[a] */
+    double limit;            /* max_depth + forward . eye, lowered below each box found unsettled */
+    double floor;            /* min_depth + forward . eye */
+    int flip;                /* bit a: forward[a] < 0 (the nearer half along axis a is the high) */
+    double eye[3];           /* the eye, in index coordinates */
+    double step[4][3];       /* along corner ray i, index units per unit of view depth */
+    double at_eye;           /* forward . eye (world) */
+    const double *world_eye; /* the eye (world units), for the seeder's distance band */
 } index_beam;
 
 void ip__beam_init(ip_beam *b, const double eye[3], const double forward[3],
@@ -92,6 +94,25 @@ static inline int meets(const index_beam *w, const double lo[3], const double hi
             return 0;
     }
     return 1;
+}
+
+/* 1 when no cell of the index box [lo, hi] can be the view's at the seeder's level: with
+ * adaptive resolution, every point of the box (the centres of its cells included) lies
+ * outside the level's distance band (lod.h), with a margin for rounding. */
+static int outside_band(const index_beam *w, const double lo[3], const double hi[3])
+{
+    const ip_seeder *s = w->s;
+    if (!s->banded)
+        return 0;
+    double near2 = 0, far2 = 0;
+    for (int a = 0; a < 3; a++) {
+        double e = w->eye[a], below = lo[a] - e, above = e - hi[a];
+        double n = below > 0 ? below : above > 0 ? above : 0;
+        double f = e - lo[a] > hi[a] - e ? e - lo[a] : hi[a] - e;
+        near2 += n * n * s->scale[a] * s->scale[a];
+        far2 += f * f * s->scale[a] * s->scale[a];
+    }
+    return sqrt(far2) * (1 + 1e-9) < s->band_near || sqrt(near2) * (1 - 1e-9) > s->band_far;
 }
 
 /* The index box [lo, hi], met by the beam, may hold an active cell that is not visited: the
@@ -214,6 +235,10 @@ static void settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi
                             if (side != IP__CLIP_KEEPS_ALL &&
                                 !ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))
                                 continue;
+                            if (s->banded &&
+                                !ip__lod_in_band(ip__lod_cell_distance(s->sampler, c, w->world_eye),
+                                                 s->band_near, s->band_far))
+                                continue; /* never the view's: as the rays and propagation */
                             whole = group_whole = 0;
                             double clo[3] = {x, y, z}, chi[3] = {x + 1.0, y + 1.0, z + 1.0};
                             if (meets(w, clo, chi))
@@ -264,7 +289,7 @@ static void settled_brick(index_beam *w, const uint32_t b[3], const double box_l
                 uint32_t lo[3], hi[3];
                 ip__seeder_subblock_cells(s, origin, extent, at, lo, hi);
                 double blo[3] = {lo[0], lo[1], lo[2]}, bhi[3] = {hi[0], hi[1], hi[2]};
-                if (!meets(w, blo, bhi))
+                if (!meets(w, blo, bhi) || outside_band(w, blo, bhi))
                     continue;
                 int side = ip__clip_keeps_samples(&s->clip, l, s->level, lo, hi);
                 if (side)
@@ -290,7 +315,7 @@ static void settled_node(index_beam *w, uint32_t depth, const uint32_t node[3])
             continue;
         double lo[3], hi[3];
         ip__seeder_node_box(s, depth - 1, ch, lo, hi);
-        if (!meets(w, lo, hi) || !ip__seeder_node_kept(s, depth - 1, ch))
+        if (!meets(w, lo, hi) || outside_band(w, lo, hi) || !ip__seeder_node_kept(s, depth - 1, ch))
             continue;
         settled_node(w, depth - 1, ch);
     }
@@ -303,6 +328,7 @@ int ip__beam_settled(ip_seeder *s, ip_visited *visited, const ip_beam *b, double
     w.visited = visited;
     double at_eye = ip__vec3_dot(b->forward, b->eye);
     w.at_eye = at_eye;
+    w.world_eye = b->eye;
     for (int i = 0; i < 4; i++) {
         double cosine = ip__vec3_dot(b->corner[i], b->forward);
         for (int a = 0; a < 3; a++)
@@ -331,7 +357,7 @@ int ip__beam_settled(ip_seeder *s, ip_visited *visited, const ip_beam *b, double
     static const uint32_t root[3] = {0, 0, 0};
     double lo[3], hi[3];
     ip__seeder_node_box(s, depth, root, lo, hi);
-    if (!meets(&w, lo, hi))
+    if (!meets(&w, lo, hi) || outside_band(&w, lo, hi))
         return 1;
     settled_node(&w, depth, root);
     if (w.limit == limit)

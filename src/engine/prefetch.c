@@ -11,6 +11,7 @@
 #include "cache_prefetch.h"
 #include "format.h"
 #include "internal.h"
+#include "lod.h"
 #include "pool.h"
 #include "prefetch.h"
 #include "sampler.h"
@@ -106,9 +107,13 @@ static unsigned ray_bricks(ip__prefetcher *p, uint32_t x, uint32_t y, uint64_t *
     unsigned n = 0;
     ip_camera_pixel_ray(&v->basis, &v->camera, (double)x + v->region_x + 0.5,
                         (double)y + v->region_y + 0.5, dir);
-    for (uint32_t k = 0; k < v->levels_used && n < IP__PREFETCH_RAY_BRICKS; k++)
-        n += ip__seed_ray_bricks(p->store, k, v->iso, &v->clip, v->camera.eye, dir, p->lod[k],
-                                 p->lod[k + 1], out + n, IP__PREFETCH_RAY_BRICKS - n);
+    for (uint32_t k = 0; k < v->levels_used && n < IP__PREFETCH_RAY_BRICKS; k++) {
+        /* the band widened as the rays walk it (cast.c): a cell of the band may reach past it */
+        double widen = v->levels_used > 1 ? ip__lod_cell_radius(p->layout, k) : 0.0;
+        n += ip__seed_ray_bricks(p->store, k, v->iso, &v->clip, v->camera.eye, dir,
+                                 p->lod[k] - widen, p->lod[k + 1] + widen, out + n,
+                                 IP__PREFETCH_RAY_BRICKS - n);
+    }
     return n;
 }
 
