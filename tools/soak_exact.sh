@@ -4,20 +4,24 @@
 # distance band) with it on. Runs CASES random cases over generated volumes and the sample
 # volumes of ../shared/data (those present): a random volume, isovalue, side, azimuth,
 # elevation, zoom, image size, thread count and cut-off, occlusion and culling on or off,
-# adaptive resolution on or off (with a pixel error of 1, 2 or 4), and in one case of four one
-# or two clipping planes through the volume's middle (--clip). Each case renders the
-# progressive run and the full extraction with the same options through the software
-# rasterizer and compares the two PNG files byte for byte. Prints a line per failing case (the
+# adaptive resolution on or off (with a pixel error of 1, 2 or 4), in one case of four one or
+# two clipping planes through the volume's middle (--clip), and in one case of four a second
+# isovalue (a second surface, each extracted by its own run), the first surface translucent in
+# half of those (--opacity). Each case renders the progressive run and the full extraction
+# with the same options through the software rasterizer and compares the two PNG files byte
+# for byte. Prints a line per failing case (the
 # two command lines that reproduce it), a total, and exits 1 on any difference. Not a test:
 # the test suite checks fixed cases; this looks for the rare one, for as long as it is given.
 #
-#   [SOAK_DATA=DIR] [SOAK_LOD=mixed|on|off] [SOAK_CLIP=on|off] tools/soak_exact.sh [BUILD_DIR]
-#       [CASES] [SEED] [WORK_DIR]
+#   [SOAK_DATA=DIR] [SOAK_LOD=mixed|on|off] [SOAK_CLIP=on|off] [SOAK_MULTI=on|off]
+#       tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
 #   defaults: build 200 1 (a temporary folder, removed at the end); SOAK_DATA, the folder of
 #   the sample volumes: ../shared/data (empty: the generated volumes alone); SOAK_LOD, whether
 #   cases run with adaptive resolution: mixed (one in two, the default), on or off (every
-#   case); SOAK_CLIP, whether one case in four has clipping planes (on, the default, or off).
-#   SOAK_LOD=off SOAK_CLIP=off draws the cases this tool drew before it knew either.
+#   case); SOAK_CLIP, whether one case in four has clipping planes (on, the default, or off);
+#   SOAK_MULTI, whether one case in four has a second surface (on, the default, or off).
+#   SOAK_LOD=off SOAK_CLIP=off SOAK_MULTI=off draws the cases this tool drew before it knew
+#   any of them; SOAK_MULTI=off alone, those it drew before it knew the second surface.
 set -eu
 build=${1:-build}
 cases=${2:-200}
@@ -30,6 +34,8 @@ lod_mode=${SOAK_LOD:-mixed}
 case $lod_mode in mixed | on | off) ;; *) echo "soak_exact: SOAK_LOD is mixed, on or off" >&2; exit 2 ;; esac
 clip_mode=${SOAK_CLIP:-on}
 case $clip_mode in on | off) ;; *) echo "soak_exact: SOAK_CLIP is on or off" >&2; exit 2 ;; esac
+multi_mode=${SOAK_MULTI:-on}
+case $multi_mode in on | off) ;; *) echo "soak_exact: SOAK_MULTI is on or off" >&2; exit 2 ;; esac
 if [ -n "${4:-}" ]; then
     work=$4
     mkdir -p "$work"
@@ -69,7 +75,7 @@ failed=0
 i=0
 while [ "$i" -lt "$cases" ]; do
     # one case's options, drawn from (seed, i)
-    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" -v lod_mode="$lod_mode" -v clip_mode="$clip_mode" -v box="$(cut -d' ' -f5-7 "$work/volumes" | tr '\n' ' ')" 'BEGIN {
+    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" -v lod_mode="$lod_mode" -v clip_mode="$clip_mode" -v multi_mode="$multi_mode" -v box="$(cut -d' ' -f5-7 "$work/volumes" | tr '\n' ' ')" 'BEGIN {
         srand(s * 100003 + i)
         split("+x -x +y -y +z -z", side, " ")
         split("1 2 3", threads, " ")
@@ -110,16 +116,25 @@ while [ "$i" -lt "$cases" ]; do
             clip = clip sprintf("%s%.4f,%.4f,%.4f,%.4f", p ? ":" : "", nx, ny, nz,
                 -(nx * px + ny * py + nz * pz))
         }
-        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s %s %d %s\n", volume, fraction, view,
-            azimuth, elevation, zoom, width, height, thread_count, cutoff, occlusion, cull, lod,
-            pixel_error, planes ? clip : "none" }')
+        # a second surface, drawn after the planes: the fraction of the range at its isovalue (-1:
+        # none), and the opacity of the first surface
+        second = multi_mode == "on" && rand() < 0.25 ? 0.03 + 0.6 * rand() : -1
+        opacity = second >= 0 && rand() < 0.5 ? 0.3 + 0.6 * rand() : 1
+        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s %s %d %s %.4f %.2f\n", volume,
+            fraction, view, azimuth, elevation, zoom, width, height, thread_count, cutoff,
+            occlusion, cull, lod, pixel_error, planes ? clip : "none", second, opacity }')
     line=$(sed -n "${1}p" "$work/volumes" | cut -d' ' -f1-4)
     set -- $line "$@"
-    name=$1 ibv=$2 low=$3 high=$4 fraction=$6
+    name=$1 ibv=$2 low=$3 high=$4 fraction=$6 second=${19} opacity=${20}
     iso=$(awk -v l="$low" -v h="$high" -v f="$fraction" 'BEGIN { printf "%.6g", l + f * (h - l) }')
     opts="--iso $iso --view $7 --azimuth $8 --elevation $9 --zoom ${10} --size ${11} --threads ${12} --cutoff ${13} --lod ${16} --occlusion ${14} --cull ${15} --software --force --quiet"
     if [ "${18}" != none ]; then
         for plane in $(echo "${18}" | tr ':' ' '); do opts="$opts --clip $plane"; done
+    fi
+    if [ "$second" != -1.0000 ]; then
+        iso2=$(awk -v l="$low" -v h="$high" -v f="$second" 'BEGIN { printf "%.6g", l + f * (h - l) }')
+        opts="$opts --iso $iso2"
+        [ "$opacity" = 1.00 ] || opts="$opts --opacity $opacity"
     fi
     full=--full
     if [ "${16}" = on ]; then
