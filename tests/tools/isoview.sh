@@ -218,6 +218,22 @@ check "--quiet prints nothing" test -z "$out"
 check "stats show rays" grep -q '"rays": [1-9]' at.json
 check "stats say lod" grep -q '"lod": true' at.json
 expect_error 1 "exists" "$bin/isoview" s.ibv --iso 1 --screenshot-at 1 at.png
+# with adaptive resolution (the default), f extracts at the view's resolution: the window shows
+# isorender --full-lod's image, which the finished progressive pass equals; at a pixel error of
+# 16 the coarse levels differ from level 0's full extraction in a few % of the pixels
+printf 'overlay off\nwait done\nscreenshot %s\nfull\nwait done\nscreenshot %s\nquit\n' \
+    lod-pass.png lod-full.png >lod.txt
+view s.ibv --iso 1000.5 --size 320x240 --pixel-error 16 --script lod.txt --stats lod.json --quiet
+check "f with adaptive resolution exits with 0 (got $rc: $err)" test "$rc" = 0
+"$bin/isorender" s.ibv --iso 1000.5 --size 320x240 --view -y --pixel-error 16 --full-lod \
+    -o r-lod.png --stats r-lod.json --quiet
+same_image "... f shows --full-lod's image" lod-full.png r-lod.png
+same_image "... as the finished pass does" lod-pass.png r-lod.png
+check "--full-lod uses a coarse level only" grep -q '"level": 0, "bricks_touched": 0,' r-lod.json
+check "the image differs from level 0's full extraction (the test can fail)" \
+    sh -c '! "$0" r-lod.png r-start.png --level 2 --max-pct 0.2 >/dev/null' "$compare"
+check "the statistics say full-lod" grep -q '"mode": "full-lod"' lod.json
+check "and the lod they used" grep -q '"pixel_error": 16' lod.json
 # --aa 4: a multisampled window (its screenshot differs from the one without at the edges)
 printf 'overlay off\nfull\nwait done\nscreenshot %s\nquit\n' aa1.png >aa1.txt
 printf 'overlay off\nfull\nwait done\nscreenshot %s\nquit\n' aa4.png >aa4.txt

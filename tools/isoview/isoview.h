@@ -96,6 +96,7 @@ typedef struct viewer {
     /* paused: no rays are cast; a change of view waits (restart stays set, the mesh shown stays
      * on screen) until resumed; a change of isovalue resumes */
     int paused, want_full, full_shown, help_on;
+    int full_mode; /* what full_mesh holds: TOOL_FULL, or TOOL_FULL_LOD with --lod on */
     /* the --clip planes apply (the key c toggles them); clip_changed: the engine must be made
      * again with the planes on or off before the next pass */
     int clip_on, clip_changed;

@@ -166,19 +166,28 @@ static int refine(viewer *v)
     return 0;
 }
 
-/* Extracts every active cell (blocking: the frame before shows that it is working). */
+/* Extracts every active cell (blocking: the frame before shows that it is working): at full
+ * resolution with --lod off, else at the view's adaptive resolution (each level's cells
+ * within its distance band, isorender --full-lod), what the progressive pass equals once
+ * every ray has been cast. */
 static int extract_full(viewer *v)
 {
     v->want_full = 0;
-    v->restart = 0; /* the full mesh serves every view, a change made while paused included */
+    v->restart = 0; /* the full mesh is the current view's, a change made while paused included */
     ip_mesh_clear(&v->full_mesh);
     memset(&v->full_counts, 0, sizeof v->full_counts);
     tool_view_options common; /* the clipping planes as they apply now */
     clip_options(v, &common);
+    v->full_mode = common.lod ? TOOL_FULL_LOD : TOOL_FULL;
     double start = ip_now_seconds();
-    if (ip_extract_full_clipped(v->cache, (float)v->iso, 0, common.threads, common.clip,
-                                common.clip_count, &v->full_mesh, &v->full_counts,
-                                &v->err) != IP_OK)
+    ip_status st =
+        common.lod
+            ? ip_extract_full_lod(v->cache, (float)v->iso, &v->camera, common.pixel_error,
+                                  common.threads, common.clip, common.clip_count, &v->full_mesh,
+                                  &v->full_counts, &v->err)
+            : ip_extract_full_clipped(v->cache, (float)v->iso, 0, common.threads, common.clip,
+                                      common.clip_count, &v->full_mesh, &v->full_counts, &v->err);
+    if (st != IP_OK)
         return -1;
     v->full_wall = ip_now_seconds() - start;
     v->pass_render = 0;
@@ -367,7 +376,7 @@ static void json_counts(FILE *f, void *user)
     clip_options(v, &common);
     const tool_run_json j = {v->o.file,
                              v->iso,
-                             full,
+                             full ? v->full_mode : TOOL_PROGRESSIVE,
                              &v->camera,
                              "opengl",
                              &common,
@@ -398,7 +407,10 @@ static void print_summary(const viewer *v)
     else
         ip_engine_totals(v->engine, &t);
     printf("%s: iso %g, %s, %ux%u\n", v->o.file, v->iso,
-           v->full_shown ? "full extraction" : "progressive", v->camera.width, v->camera.height);
+           !v->full_shown                  ? "progressive"
+           : v->full_mode == TOOL_FULL_LOD ? "full extraction at adaptive resolution"
+                                           : "full extraction",
+           v->camera.width, v->camera.height);
     printf("  rays          %llu of %llu\n", (unsigned long long)t.rays,
            (unsigned long long)v->camera.width * v->camera.height);
     printf("  triangles     %llu\n", (unsigned long long)t.triangles);
