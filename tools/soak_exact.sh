@@ -9,17 +9,21 @@
 # isovalue (a second surface, each extracted by its own run), the first surface translucent in
 # half of those (--opacity). Each case renders the progressive run and the full extraction
 # with the same options through the software rasterizer and compares the two PNG files byte
-# for byte. Prints a line per failing case (the
+# for byte. With SOAK_WALL=on, one case of six with one surface also renders the view with
+# isowall (the display wall's renderer: a random wall of 1 to 3 x 1 to 3 tiles on 2 or 3 MPI
+# processes, the image cut to whole tiles) and compares its image with the full extraction's. Prints a line per failing case (the
 # two command lines that reproduce it), a total, and exits 1 on any difference. Not a test:
 # the test suite checks fixed cases; this looks for the rare one, for as long as it is given.
 #
 #   [SOAK_DATA=DIR] [SOAK_LOD=mixed|on|off] [SOAK_CLIP=on|off] [SOAK_MULTI=on|off]
-#       tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
+#       [SOAK_WALL=on|off] tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
 #   defaults: build 200 1 (a temporary folder, removed at the end); SOAK_DATA, the folder of
 #   the sample volumes: ../shared/data (empty: the generated volumes alone); SOAK_LOD, whether
 #   cases run with adaptive resolution: mixed (one in two, the default), on or off (every
 #   case); SOAK_CLIP, whether one case in four has clipping planes (on, the default, or off);
-#   SOAK_MULTI, whether one case in four has a second surface (on, the default, or off).
+#   SOAK_MULTI, whether one case in four has a second surface (on, the default, or off);
+#   SOAK_WALL, whether some cases also run isowall (off, the default, or on: needs mpirun and
+#   BUILD/isowall). SOAK_WALL changes only the image size of the cases it picks.
 #   SOAK_LOD=off SOAK_CLIP=off SOAK_MULTI=off draws the cases this tool drew before it knew
 #   any of them; SOAK_MULTI=off alone, those it drew before it knew the second surface.
 set -eu
@@ -36,6 +40,12 @@ clip_mode=${SOAK_CLIP:-on}
 case $clip_mode in on | off) ;; *) echo "soak_exact: SOAK_CLIP is on or off" >&2; exit 2 ;; esac
 multi_mode=${SOAK_MULTI:-on}
 case $multi_mode in on | off) ;; *) echo "soak_exact: SOAK_MULTI is on or off" >&2; exit 2 ;; esac
+wall_mode=${SOAK_WALL:-off}
+case $wall_mode in on | off) ;; *) echo "soak_exact: SOAK_WALL is on or off" >&2; exit 2 ;; esac
+if [ "$wall_mode" = on ]; then
+    command -v mpirun >/dev/null 2>&1 || { echo "soak_exact: SOAK_WALL=on needs mpirun (OpenMPI)" >&2; exit 2; }
+    [ -x "$build/isowall" ] || { echo "soak_exact: SOAK_WALL=on needs $build/isowall (a build with MPI)" >&2; exit 2; }
+fi
 if [ -n "${4:-}" ]; then
     work=$4
     mkdir -p "$work"
@@ -75,7 +85,7 @@ failed=0
 i=0
 while [ "$i" -lt "$cases" ]; do
     # one case's options, drawn from (seed, i)
-    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" -v lod_mode="$lod_mode" -v clip_mode="$clip_mode" -v multi_mode="$multi_mode" -v box="$(cut -d' ' -f5-7 "$work/volumes" | tr '\n' ' ')" 'BEGIN {
+    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" -v lod_mode="$lod_mode" -v clip_mode="$clip_mode" -v multi_mode="$multi_mode" -v wall_mode="$wall_mode" -v box="$(cut -d' ' -f5-7 "$work/volumes" | tr '\n' ' ')" 'BEGIN {
         srand(s * 100003 + i)
         split("+x -x +y -y +z -z", side, " ")
         split("1 2 3", threads, " ")
@@ -120,16 +130,30 @@ while [ "$i" -lt "$cases" ]; do
         # none), and the opacity of the first surface
         second = multi_mode == "on" && rand() < 0.25 ? 0.03 + 0.6 * rand() : -1
         opacity = second >= 0 && rand() < 0.5 ? 0.3 + 0.6 * rand() : 1
-        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s %s %d %s %.4f %.2f\n", volume,
-            fraction, view, azimuth, elevation, zoom, width, height, thread_count, cutoff,
-            occlusion, cull, lod, pixel_error, planes ? clip : "none", second, opacity }')
+        # a display wall, drawn last (one surface only): tiles across and down, processes;
+        # the image is cut to whole tiles
+        wall = wall_mode == "on" && second < 0 && rand() < 1 / 6
+        columns = wall ? 1 + int(rand() * 3) : 1
+        rows = wall ? 1 + int(rand() * 3) : 1
+        processes = wall ? 2 + int(rand() * 2) : 0
+        if (wall) { width -= width % columns; height -= height % rows }
+        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s %s %d %s %.4f %.2f %d %d %d\n",
+            volume, fraction, view, azimuth, elevation, zoom, width, height, thread_count, cutoff,
+            occlusion, cull, lod, pixel_error, planes ? clip : "none", second, opacity, columns,
+            rows, processes }')
     line=$(sed -n "${1}p" "$work/volumes" | cut -d' ' -f1-4)
     set -- $line "$@"
     name=$1 ibv=$2 low=$3 high=$4 fraction=$6 second=${19} opacity=${20}
+    columns=${21} rows=${22} processes=${23}
     iso=$(awk -v l="$low" -v h="$high" -v f="$fraction" 'BEGIN { printf "%.6g", l + f * (h - l) }')
     opts="--iso $iso --view $7 --azimuth $8 --elevation $9 --zoom ${10} --size ${11} --threads ${12} --cutoff ${13} --lod ${16} --occlusion ${14} --cull ${15} --software --force --quiet"
+    # the view's options alone, for isowall
+    view="--iso $iso --view $7 --azimuth $8 --elevation $9 --zoom ${10} --cutoff ${13} --lod ${16} --occlusion ${14} --cull ${15}"
     if [ "${18}" != none ]; then
-        for plane in $(echo "${18}" | tr ':' ' '); do opts="$opts --clip $plane"; done
+        for plane in $(echo "${18}" | tr ':' ' '); do
+            opts="$opts --clip $plane"
+            view="$view --clip $plane"
+        done
     fi
     if [ "$second" != -1.0000 ]; then
         iso2=$(awk -v l="$low" -v h="$high" -v f="$second" 'BEGIN { printf "%.6g", l + f * (h - l) }')
@@ -139,9 +163,16 @@ while [ "$i" -lt "$cases" ]; do
     full=--full
     if [ "${16}" = on ]; then
         opts="$opts --pixel-error ${17}"
+        view="$view --pixel-error ${17}"
         full=--full-lod
     fi
-    echo "$name $opts" >>"$work/cases" # what was run, for whoever reads WORK_DIR after
+    wall=""
+    if [ "$processes" != 0 ]; then
+        size=${11}
+        wall="--wall ${columns}x${rows} --tile $((${size%x*} / columns))x$((${size#*x} / rows))"
+    fi
+    # what was run, for whoever reads WORK_DIR after
+    echo "$name $opts${wall:+ | isowall $wall on $processes processes}" >>"$work/cases"
     # shellcheck disable=SC2086 # opts is a list of words
     if ! "$build/isorender" "$ibv" $opts -o "$work/p.png" 2>"$work/p.err" ||
         ! "$build/isorender" "$ibv" $opts $full -o "$work/f.png" 2>"$work/f.err"; then
@@ -152,6 +183,17 @@ while [ "$i" -lt "$cases" ]; do
         failed=$((failed + 1))
         echo "case $i ($name): the progressive image differs from the full extraction's"
         echo "  $build/isorender $ibv $opts -o p.png"
+        echo "  $build/isorender $ibv $opts $full -o f.png"
+    elif [ -n "$wall" ] && ! timeout 300 mpirun --oversubscribe --allow-run-as-root -np "$processes" \
+        "$build/isowall" "$ibv" $view $wall --threads 1 --force --quiet -o "$work/w.png" \
+        >"$work/w.err" 2>&1; then
+        failed=$((failed + 1))
+        echo "case $i ($name): isowall failed: $(grep -v '^$' "$work/w.err" | head -1)"
+        echo "  mpirun -np $processes $build/isowall $ibv $view $wall --threads 1 -o w.png"
+    elif [ -n "$wall" ] && ! cmp -s "$work/w.png" "$work/f.png"; then
+        failed=$((failed + 1))
+        echo "case $i ($name): the display wall's image differs from the full extraction's"
+        echo "  mpirun -np $processes $build/isowall $ibv $view $wall --threads 1 -o w.png"
         echo "  $build/isorender $ibv $opts $full -o f.png"
     fi
     i=$((i + 1))
