@@ -5,27 +5,33 @@
 # volumes of ../shared/data (those present): a random volume, isovalue, side, azimuth,
 # elevation, zoom, image size, thread count and cut-off, occlusion and culling on or off,
 # adaptive resolution on or off (with a pixel error of 1, 2 or 4), in one case of four one or
-# two clipping planes through the volume's middle (--clip), and in one case of four a second
-# isovalue (a second surface, each extracted by its own run), the first surface translucent in
-# half of those (--opacity). Each case renders the progressive run and the full extraction
-# with the same options through the software rasterizer and compares the two PNG files byte
-# for byte. With SOAK_WALL=on, one case of six with one surface also renders the view with
-# isowall (the display wall's renderer: a random wall of 1 to 3 x 1 to 3 tiles on 2 or 3 MPI
-# processes, the image cut to whole tiles) and compares its image with the full extraction's. Prints a line per failing case (the
-# two command lines that reproduce it), a total, and exits 1 on any difference. Not a test:
-# the test suite checks fixed cases; this looks for the rare one, for as long as it is given.
+# two clipping planes through the volume's middle (--clip), in one case of four a second
+# isovalue (a second surface, each extracted by its own run; the first surface translucent in
+# half of those, --opacity), and in one case of four a brick cache of 1 MiB (--cache-mb 1, far
+# less than a view needs: bricks are evicted and read again while it is extracted). Each case
+# renders the progressive run and the full extraction with the same options through the
+# software rasterizer and compares the two PNG files byte for byte. With SOAK_WALL=on, one
+# case of six with one surface also renders the view with isowall (the display wall's
+# renderer: a random wall of 1 to 3 x 1 to 3 tiles on 2 or 3 MPI processes, the image cut to
+# whole tiles) and compares its image with the full extraction's. Prints a line per failing
+# case (the command lines that reproduce it), a total, and exits 1 on any difference. Not a
+# test: the test suite checks fixed cases; this looks for the rare one, for as long as it is
+# given.
 #
 #   [SOAK_DATA=DIR] [SOAK_LOD=mixed|on|off] [SOAK_CLIP=on|off] [SOAK_MULTI=on|off]
-#       [SOAK_WALL=on|off] tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED] [WORK_DIR]
+#       [SOAK_CACHE=on|off] [SOAK_WALL=on|off] tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED]
+#       [WORK_DIR]
 #   defaults: build 200 1 (a temporary folder, removed at the end); SOAK_DATA, the folder of
 #   the sample volumes: ../shared/data (empty: the generated volumes alone); SOAK_LOD, whether
 #   cases run with adaptive resolution: mixed (one in two, the default), on or off (every
 #   case); SOAK_CLIP, whether one case in four has clipping planes (on, the default, or off);
-#   SOAK_MULTI, whether one case in four has a second surface (on, the default, or off);
-#   SOAK_WALL, whether some cases also run isowall (off, the default, or on: needs mpirun and
-#   BUILD/isowall). SOAK_WALL changes only the image size of the cases it picks.
-#   SOAK_LOD=off SOAK_CLIP=off SOAK_MULTI=off draws the cases this tool drew before it knew
-#   any of them; SOAK_MULTI=off alone, those it drew before it knew the second surface.
+#   SOAK_MULTI, whether one case in four has a second surface, and SOAK_CACHE, whether one in
+#   four has a 1 MiB cache (each on, the default, or off); SOAK_WALL, whether some cases also
+#   run isowall (off, the default, or on: needs mpirun and BUILD/isowall; it changes only the
+#   image size of the cases it picks). Each later draw comes after the earlier ones: with
+#   SOAK_LOD=off SOAK_CLIP=off SOAK_MULTI=off SOAK_CACHE=off the cases are those this tool drew
+#   before it knew any of them; with SOAK_MULTI=off SOAK_CACHE=off, those it drew before the
+#   second surface; with SOAK_CACHE=off, those it drew before the small cache.
 set -eu
 build=${1:-build}
 cases=${2:-200}
@@ -40,6 +46,8 @@ clip_mode=${SOAK_CLIP:-on}
 case $clip_mode in on | off) ;; *) echo "soak_exact: SOAK_CLIP is on or off" >&2; exit 2 ;; esac
 multi_mode=${SOAK_MULTI:-on}
 case $multi_mode in on | off) ;; *) echo "soak_exact: SOAK_MULTI is on or off" >&2; exit 2 ;; esac
+cache_mode=${SOAK_CACHE:-on}
+case $cache_mode in on | off) ;; *) echo "soak_exact: SOAK_CACHE is on or off" >&2; exit 2 ;; esac
 wall_mode=${SOAK_WALL:-off}
 case $wall_mode in on | off) ;; *) echo "soak_exact: SOAK_WALL is on or off" >&2; exit 2 ;; esac
 if [ "$wall_mode" = on ]; then
@@ -85,7 +93,7 @@ failed=0
 i=0
 while [ "$i" -lt "$cases" ]; do
     # one case's options, drawn from (seed, i)
-    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" -v lod_mode="$lod_mode" -v clip_mode="$clip_mode" -v multi_mode="$multi_mode" -v wall_mode="$wall_mode" -v box="$(cut -d' ' -f5-7 "$work/volumes" | tr '\n' ' ')" 'BEGIN {
+    set -- $(awk -v s="$seed" -v i="$i" -v n="$volumes" -v lod_mode="$lod_mode" -v clip_mode="$clip_mode" -v multi_mode="$multi_mode" -v wall_mode="$wall_mode" -v cache_mode="$cache_mode" -v box="$(cut -d' ' -f5-7 "$work/volumes" | tr '\n' ' ')" 'BEGIN {
         srand(s * 100003 + i)
         split("+x -x +y -y +z -z", side, " ")
         split("1 2 3", threads, " ")
@@ -137,14 +145,16 @@ while [ "$i" -lt "$cases" ]; do
         rows = wall ? 1 + int(rand() * 3) : 1
         processes = wall ? 2 + int(rand() * 2) : 0
         if (wall) { width -= width % columns; height -= height % rows }
-        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s %s %d %s %.4f %.2f %d %d %d\n",
+        # a brick cache of 1 MiB, drawn last
+        small = cache_mode == "on" && rand() < 0.25
+        printf "%d %.4f %s %.1f %.1f %.2f %dx%d %s %.2f %s %s %s %d %s %.4f %.2f %d %d %d %d\n",
             volume, fraction, view, azimuth, elevation, zoom, width, height, thread_count, cutoff,
             occlusion, cull, lod, pixel_error, planes ? clip : "none", second, opacity, columns,
-            rows, processes }')
+            rows, processes, small }')
     line=$(sed -n "${1}p" "$work/volumes" | cut -d' ' -f1-4)
     set -- $line "$@"
     name=$1 ibv=$2 low=$3 high=$4 fraction=$6 second=${19} opacity=${20}
-    columns=${21} rows=${22} processes=${23}
+    columns=${21} rows=${22} processes=${23} small=${24}
     iso=$(awk -v l="$low" -v h="$high" -v f="$fraction" 'BEGIN { printf "%.6g", l + f * (h - l) }')
     opts="--iso $iso --view $7 --azimuth $8 --elevation $9 --zoom ${10} --size ${11} --threads ${12} --cutoff ${13} --lod ${16} --occlusion ${14} --cull ${15} --software --force --quiet"
     # the view's options alone, for isowall
@@ -165,6 +175,10 @@ while [ "$i" -lt "$cases" ]; do
         opts="$opts --pixel-error ${17}"
         view="$view --pixel-error ${17}"
         full=--full-lod
+    fi
+    if [ "$small" = 1 ]; then
+        opts="$opts --cache-mb 1"
+        view="$view --cache-mb 1"
     fi
     wall=""
     if [ "$processes" != 0 ]; then
