@@ -858,12 +858,8 @@ static int extract_progressive(run *r, ip_error *err)
 /* --full (level 0) or --full-lod (the view's levels, each in its band) into r->full_mesh. */
 static ip_status full_extraction(run *r, ip_engine_counts *counts, ip_error *err)
 {
-    const tool_view_options *c = &r->o.common;
-    if (r->o.full == TOOL_FULL_LOD)
-        return ip_extract_full_lod(r->cache, (float)c->iso, &r->camera, c->pixel_error, c->threads,
-                                   c->clip, c->clip_count, &r->full_mesh, counts, err);
-    return ip_extract_full_clipped(r->cache, (float)c->iso, 0, c->threads, c->clip, c->clip_count,
-                                   &r->full_mesh, counts, err);
+    return tool_full_extraction(r->cache, r->o.common.iso, r->o.full, &r->camera, &r->o.common,
+                                &r->full_mesh, counts, err);
 }
 
 static int extract_full(run *r, ip_error *err)

@@ -1131,6 +1131,17 @@ static void write_clip_json(FILE *f, const tool_view_options *o)
     fprintf(f, "]");
 }
 
+ip_status tool_full_extraction(ip_cache *cache, double iso, int mode, const ip_camera *camera,
+                               const tool_view_options *o, ip_mesh *mesh, ip_engine_counts *counts,
+                               ip_error *err)
+{
+    if (mode == TOOL_FULL_LOD)
+        return ip_extract_full_lod(cache, (float)iso, camera, o->pixel_error, o->threads, o->clip,
+                                   o->clip_count, mesh, counts, err);
+    return ip_extract_full_clipped(cache, (float)iso, 0, o->threads, o->clip, o->clip_count, mesh,
+                                   counts, err);
+}
+
 void tool_write_run_json(FILE *f, const tool_run_json *j)
 {
     const ip_camera *c = j->camera;

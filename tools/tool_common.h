@@ -325,7 +325,6 @@ void tool_print_cache_table(FILE *out, const ip_cache_stats *s, uint64_t summary
 /* Writes the "cache" object's members (without braces) as JSON. */
 void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_bytes);
 
-/* What isorender and isoview write about a run in --stats (members after "cache"). */
 /* What a run extracts (tool_run_json.full, isorender's o.full): the progressive run, the full
  * extraction (--full, a flag: 1) or the full extraction at adaptive resolution (--full-lod). */
 enum {
@@ -334,6 +333,16 @@ enum {
     TOOL_FULL_LOD = 2
 };
 
+/* The full extraction `mode` asks for, of isovalue `iso` with o's threads and clipping planes:
+ * TOOL_FULL every active cell of level 0 (ip_extract_full_clipped()), TOOL_FULL_LOD those of
+ * the levels o's pixel error gives `camera`, each within its distance band
+ * (ip_extract_full_lod()). Triangles are appended to the caller's `mesh`; `counts` (may be
+ * NULL) as those functions set it. */
+ip_status tool_full_extraction(ip_cache *cache, double iso, int mode, const ip_camera *camera,
+                               const tool_view_options *o, ip_mesh *mesh, ip_engine_counts *counts,
+                               ip_error *err);
+
+/* What isorender and isoview write about a run in --stats (members after "cache"). */
 typedef struct tool_run_json {
     const char *file;
     double iso;

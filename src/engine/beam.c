@@ -97,22 +97,20 @@ static inline int meets(const index_beam *w, const double lo[3], const double hi
 }
 
 /* 1 when no cell of the index box [lo, hi] can be the view's at the seeder's level: with
- * adaptive resolution, every point of the box (the centres of its cells included) lies
- * outside the level's distance band (lod.h), with a margin for rounding. */
+ * adaptive resolution, every point of the box (scaled to world units: the centres of its cells
+ * included) lies outside the level's distance band (lod.h), by a margin for rounding. */
 static int outside_band(const index_beam *w, const double lo[3], const double hi[3])
 {
     const ip_seeder *s = w->s;
     if (!s->banded)
         return 0;
-    double near2 = 0, far2 = 0;
+    double wlo[3], whi[3];
     for (int a = 0; a < 3; a++) {
-        double e = w->eye[a], below = lo[a] - e, above = e - hi[a];
-        double n = below > 0 ? below : above > 0 ? above : 0;
-        double f = e - lo[a] > hi[a] - e ? e - lo[a] : hi[a] - e;
-        near2 += n * n * s->scale[a] * s->scale[a];
-        far2 += f * f * s->scale[a] * s->scale[a];
+        wlo[a] = lo[a] * s->scale[a];
+        whi[a] = hi[a] * s->scale[a];
     }
-    return sqrt(far2) * (1 + 1e-9) < s->band_near || sqrt(near2) * (1 - 1e-9) > s->band_far;
+    return ip__lod_box_outside(wlo, whi, w->world_eye, s->band_near * (1 - 1e-9),
+                               s->band_far * (1 + 1e-9));
 }
 
 /* The index box [lo, hi], met by the beam, may hold an active cell that is not visited: the
@@ -235,9 +233,8 @@ static void settled_cells(index_beam *w, const uint32_t lo[3], const uint32_t hi
                             if (side != IP__CLIP_KEEPS_ALL &&
                                 !ip__clip_keeps_samples(&s->clip, s->layout, s->level, c, c1))
                                 continue;
-                            if (s->banded &&
-                                !ip__lod_in_band(ip__lod_cell_distance(s->sampler, c, w->world_eye),
-                                                 s->band_near, s->band_far))
+                            if (s->banded && !ip__lod_cell_in_band(s->sampler, c, w->world_eye,
+                                                                   s->band_near, s->band_far))
                                 continue; /* never the view's: as the rays and propagation */
                             whole = group_whole = 0;
                             double clo[3] = {x, y, z}, chi[3] = {x + 1.0, y + 1.0, z + 1.0};

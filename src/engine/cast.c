@@ -85,10 +85,10 @@ ip_status ip__engine_cast_ray(ip_engine_worker *w, uint32_t x, uint32_t y, doubl
         ip_level_tools *lt = &w->level[k];
         unsigned count;
         int seed_index;
-        /* The level's band (lod.h) widened by its cells' radius: every point of a cell of the
-         * band lies within that distance range of the eye, and so at t within it. */
-        double widen = e->levels_used > 1 ? e->cell_radius[k] : 0.0;
-        double band_lo = e->lod_distance[k] - widen, band_hi = e->lod_distance[k + 1] + widen;
+        /* The level's band (lod.h) widened by ip__lod_band_widening(): every point of a cell
+         * of the band lies within that distance range of the eye, and so at t within it. */
+        double band_lo = e->lod_distance[k] - e->band_widening[k],
+               band_hi = e->lod_distance[k + 1] + e->band_widening[k];
         double t_max = band_hi, stop = (z + e->cell_reach[k]) / cos;
         t_max = stop < t_max ? stop : t_max;
         t_max = nearest < t_max ? nearest : t_max;

@@ -167,12 +167,19 @@ static void begin_prefetch(ip_engine *e)
 {
     if (!e->prefetcher)
         return;
-    ip__prefetch_view view = {e->camera,       e->basis,
-                              e->iso,          e->levels_used,
-                              e->lod_distance, e->order,
-                              e->order_cells,  &e->next_position,
-                              &e->cancel,      {e->options.clip, e->options.clip_count},
-                              e->region_x,     e->region_y};
+    ip__prefetch_view view = {e->camera,
+                              e->basis,
+                              e->iso,
+                              e->levels_used,
+                              e->lod_distance,
+                              e->band_widening,
+                              e->order,
+                              e->order_cells,
+                              &e->next_position,
+                              &e->cancel,
+                              {e->options.clip, e->options.clip_count},
+                              e->region_x,
+                              e->region_y};
     ip__prefetcher_begin(e->prefetcher, &view);
 }
 /* One worker's share of the occlusion state to start over (a job of the engine's pool): its
@@ -231,7 +238,7 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
     set_lod_distances(e);
     const ip_layout *layout = ip_store_layout(ip_cache_store(e->cache));
     for (uint32_t k = 0; k < e->levels_used; k++) {
-        e->cell_radius[k] = ip__lod_cell_radius(layout, k);
+        e->band_widening[k] = ip__lod_band_widening(layout, k, e->levels_used);
         e->cell_reach[k] = 0;
         for (int a = 0; a < 3; a++)
             e->cell_reach[k] += layout->spacing[a] * (double)(1u << k) * fabs(e->basis.forward[a]);

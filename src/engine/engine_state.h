@@ -98,7 +98,8 @@ struct ip_engine {
     uint32_t levels_used;                   /* levels 0 .. levels_used - 1 have a distance band */
     double lod_distance[IP_MAX_LEVELS + 1]; /* D[k]; D[levels_used] = infinity */
     double cell_reach[IP_MAX_LEVELS];       /* a level-k cell's extent along the view (world) */
-    double cell_radius[IP_MAX_LEVELS];      /* half a level-k cell's diagonal (world; lod.h) */
+    double band_widening[IP_MAX_LEVELS];    /* how far a level-k cell may reach past its band
+                                               (world; ip__lod_band_widening()) */
     /* With occlusion: bulk retirement of the rays of 8 x 8 tiles (ip__engine_retire()) */
     ip_engine_tile *tiles;
     unsigned char *reached; /* per tile: some active brick may show in it (reach_view()) */

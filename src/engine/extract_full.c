@@ -17,28 +17,25 @@
  * [near, far) from `eye` (lod.h); else all. */
 typedef struct full_band {
     int banded;
-    double near, far, radius; /* radius: half a cell's diagonal (ip__lod_cell_radius()) */
+    double near, far, widen; /* widen: ip__lod_band_widening() */
     double eye[3];
 } full_band;
 
 /* 0 when no cell of the brick whose samples start at `origin` (extent samples along each axis,
  * the sampler's level) can lie in the band: its world box lies wholly nearer than
- * near - radius or farther than far + radius from the eye. */
+ * near - widen or farther than far + widen from the eye. */
 static int brick_may_be_in_band(const ip_sampler *s, const full_band *band,
                                 const uint32_t origin[3], const uint32_t extent[3])
 {
     if (!band->banded)
         return 1;
-    double in2 = 0, out2 = 0; /* squared distances to the box's nearest and farthest points */
+    double lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
-        double lo = s->world[a][origin[a]], hi = s->world[a][origin[a] + extent[a] - 1];
-        double e = band->eye[a], d_in = e < lo ? lo - e : e > hi ? e - hi : 0.0;
-        double d_out = e - lo > hi - e ? e - lo : hi - e;
-        in2 += d_in * d_in;
-        out2 += d_out * d_out;
+        lo[a] = s->world[a][origin[a]];
+        hi[a] = s->world[a][origin[a] + extent[a] - 1];
     }
-    double lowest = band->near - band->radius, highest = band->far + band->radius;
-    return !(sqrt(in2) > highest || (lowest > 0 && sqrt(out2) < lowest));
+    return !ip__lod_box_outside(lo, hi, band->eye, band->near - band->widen,
+                                band->far + band->widen);
 }
 
 /* Triangulates the active cells of one brick that `clip` keeps (and `band` takes),
@@ -73,8 +70,8 @@ static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip
                     uint32_t cell[3] = {x, y, z}, far[3] = {x + 1, y + 1, z + 1};
                     if ((side == IP__CLIP_STRADDLES &&
                          !ip__clip_keeps_samples(clip, l, level, cell, far)) ||
-                        (band->banded && !ip__lod_in_band(ip__lod_cell_distance(s, cell, band->eye),
-                                                          band->near, band->far)))
+                        (band->banded &&
+                         !ip__lod_cell_in_band(s, cell, band->eye, band->near, band->far)))
                         continue;
                     unsigned mc;
                     int n = ip__extract_cell(s, &out, cell, iso, &mc, &c->culled, &st);
@@ -287,7 +284,7 @@ ip_status ip_extract_full_lod(ip_cache *cache, float iso, const ip_camera *camer
         full_band band = {levels > 1,
                           D[k],
                           D[k + 1],
-                          ip__lod_cell_radius(l, k),
+                          ip__lod_band_widening(l, k, levels),
                           {camera->eye[0], camera->eye[1], camera->eye[2]}};
         st = extract_level(cache, iso, k, threads, clip, clip_count, &band, mesh, &c, err);
     }

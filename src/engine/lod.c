@@ -31,6 +31,19 @@ uint32_t ip__lod_distances(const ip_layout *l, const ip_camera *camera, int lod,
     return levels;
 }
 
+int ip__lod_box_outside(const double lo[3], const double hi[3], const double eye[3], double near,
+                        double far)
+{
+    double near2 = 0, far2 = 0; /* squared distances to the box's nearest and farthest points */
+    for (int a = 0; a < 3; a++) {
+        double e = eye[a], in = e < lo[a] ? lo[a] - e : e > hi[a] ? e - hi[a] : 0.0;
+        double out = e - lo[a] > hi[a] - e ? e - lo[a] : hi[a] - e;
+        near2 += in * in;
+        far2 += out * out;
+    }
+    return sqrt(far2) < near || sqrt(near2) > far;
+}
+
 double ip__lod_cell_radius(const ip_layout *l, uint32_t k)
 {
     double d2 = 0;

@@ -27,6 +27,20 @@ uint32_t ip__lod_distances(const ip_layout *l, const ip_camera *camera, int lod,
  * level-k cell lies farther from its centre (the last cells along an axis are no larger). */
 double ip__lod_cell_radius(const ip_layout *l, uint32_t k);
 
+/* How far past level k's band (world units) a cell of the band may reach, for a view that
+ * uses `levels` levels: ip__lod_cell_radius() with more than one, 0 with one (its band holds
+ * every distance). What the rays walk and the reads ahead plan is the band widened by it. */
+static inline double ip__lod_band_widening(const ip_layout *l, uint32_t k, uint32_t levels)
+{
+    return levels > 1 ? ip__lod_cell_radius(l, k) : 0.0;
+}
+
+/* 1 when every point of the world box [lo, hi] lies nearer than `near` to `eye`, or every
+ * point farther than `far` (world units): then no cell centre in the box lies in [near, far).
+ * Callers pass the band widened by whatever margin their box or their rounding needs. */
+int ip__lod_box_outside(const double lo[3], const double hi[3], const double eye[3], double near,
+                        double far);
+
 /* Distance (world units) from `eye` to `centre`, a cell's ip__sampler_cell_centre(); v is
  * set to centre - eye. Propagation (which needs v too) and the rays both go through it. */
 static inline double ip__lod_centre_distance(const double centre[3], const double eye[3],
@@ -49,6 +63,15 @@ static inline double ip__lod_cell_distance(const ip_sampler *s, const uint32_t c
 static inline int ip__lod_in_band(double distance, double near, double far)
 {
     return !(distance < near || distance >= far);
+}
+
+/* 1 when `cell` of the sampler's level is in the band [near, far) from `eye`: the rule itself,
+ * as the rays, the beams and the full extraction apply it (propagation, which needs the
+ * centre's offset too, goes through ip__lod_centre_distance() and ip__lod_in_band()). */
+static inline int ip__lod_cell_in_band(const ip_sampler *s, const uint32_t cell[3],
+                                       const double eye[3], double near, double far)
+{
+    return ip__lod_in_band(ip__lod_cell_distance(s, cell, eye), near, far);
 }
 
 #endif

@@ -11,7 +11,6 @@
 #include "cache_prefetch.h"
 #include "format.h"
 #include "internal.h"
-#include "lod.h"
 #include "pool.h"
 #include "prefetch.h"
 #include "sampler.h"
@@ -38,6 +37,7 @@ struct ip__prefetcher {
     /* The view and the plan: the reader's own between resume and pause. */
     ip__prefetch_view view;
     double lod[IP_MAX_LEVELS + 1];
+    double widen[IP_MAX_LEVELS];
     ip_ray_order order; /* where the plan has got to */
     uint32_t plan_last_level;
     int plan_done, finished;
@@ -109,9 +109,8 @@ static unsigned ray_bricks(ip__prefetcher *p, uint32_t x, uint32_t y, uint64_t *
                         (double)y + v->region_y + 0.5, dir);
     for (uint32_t k = 0; k < v->levels_used && n < IP__PREFETCH_RAY_BRICKS; k++) {
         /* the band widened as the rays walk it (cast.c): a cell of the band may reach past it */
-        double widen = v->levels_used > 1 ? ip__lod_cell_radius(p->layout, k) : 0.0;
         n += ip__seed_ray_bricks(p->store, k, v->iso, &v->clip, v->camera.eye, dir,
-                                 p->lod[k] - widen, p->lod[k + 1] + widen, out + n,
+                                 p->lod[k] - p->widen[k], p->lod[k + 1] + p->widen[k], out + n,
                                  IP__PREFETCH_RAY_BRICKS - n);
     }
     return n;
@@ -308,7 +307,9 @@ void ip__prefetcher_begin(ip__prefetcher *p, const ip__prefetch_view *view)
 {
     p->view = *view;
     memcpy(p->lod, view->lod_distance, (view->levels_used + 1) * sizeof *p->lod);
+    memcpy(p->widen, view->band_widening, view->levels_used * sizeof *p->widen);
     p->view.lod_distance = p->lod;
+    p->view.band_widening = p->widen;
     p->order = view->order;
     uint32_t last = ip__ray_order_last_level(&p->order);
     p->plan_last_level =

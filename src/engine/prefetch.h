@@ -52,8 +52,9 @@ typedef struct ip__prefetch_view {
     ip_camera_basis basis;
     float iso;
     uint32_t levels_used;
-    const double *lod_distance; /* D[0 .. levels_used], copied */
-    ip_ray_order order;         /* the view's order at position 0 */
+    const double *lod_distance;  /* D[0 .. levels_used], copied */
+    const double *band_widening; /* per level, as the rays widen its band (lod.h), copied */
+    ip_ray_order order;          /* the view's order at position 0 */
     uint64_t order_cells;
     const atomic_uint_fast64_t *claimed; /* the first position no worker has claimed */
     const atomic_int *cancel;            /* the engine's cancel flag */

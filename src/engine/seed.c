@@ -330,8 +330,7 @@ static IP_ALWAYS_INLINE unsigned dda_near_faces(const ip_seeder *s, const index_
 /* 1 when `cell` lies in the seeder's distance band (lod.h), as propagation decides it. */
 static int in_band(const ip_seeder *s, const index_ray *r, const uint32_t cell[3])
 {
-    return ip__lod_in_band(ip__lod_cell_distance(s->sampler, cell, r->world_origin), s->band_near,
-                           s->band_far);
+    return ip__lod_cell_in_band(s->sampler, cell, r->world_origin, s->band_near, s->band_far);
 }
 
 /* 1 when cell c is already among the ray's cells. */

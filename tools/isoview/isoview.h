@@ -95,8 +95,10 @@ typedef struct viewer {
     double draw_seconds;           /* the last frame, from the end of its slice to its swap */
     /* paused: no rays are cast; a change of view waits (restart stays set, the mesh shown stays
      * on screen) until resumed; a change of isovalue resumes */
-    int paused, want_full, full_shown, help_on;
-    int full_mode; /* what full_mesh holds: TOOL_FULL, or TOOL_FULL_LOD with --lod on */
+    int paused, want_full, help_on;
+    /* the full extraction is shown instead of the pass (0: not): TOOL_FULL, or TOOL_FULL_LOD
+     * with --lod on (what full_mesh holds) */
+    int full_shown;
     /* the --clip planes apply (the key c toggles them); clip_changed: the engine must be made
      * again with the planes on or off before the next pass */
     int clip_on, clip_changed;

@@ -178,23 +178,17 @@ static int extract_full(viewer *v)
     memset(&v->full_counts, 0, sizeof v->full_counts);
     tool_view_options common; /* the clipping planes as they apply now */
     clip_options(v, &common);
-    v->full_mode = common.lod ? TOOL_FULL_LOD : TOOL_FULL;
+    int mode = common.lod ? TOOL_FULL_LOD : TOOL_FULL;
     double start = ip_now_seconds();
-    ip_status st =
-        common.lod
-            ? ip_extract_full_lod(v->cache, (float)v->iso, &v->camera, common.pixel_error,
-                                  common.threads, common.clip, common.clip_count, &v->full_mesh,
-                                  &v->full_counts, &v->err)
-            : ip_extract_full_clipped(v->cache, (float)v->iso, 0, common.threads, common.clip,
-                                      common.clip_count, &v->full_mesh, &v->full_counts, &v->err);
-    if (st != IP_OK)
+    if (tool_full_extraction(v->cache, v->iso, mode, &v->camera, &common, &v->full_mesh,
+                             &v->full_counts, &v->err) != IP_OK)
         return -1;
     v->full_wall = ip_now_seconds() - start;
     v->pass_render = 0;
     ip_renderer_clear_mesh(v->renderer);
     if (ip_renderer_upload(v->renderer, &v->full_mesh, 0, &v->err) != IP_OK)
         return -1;
-    v->full_shown = 1;
+    v->full_shown = mode;
     v->overdraw_state = 0;
     return 0;
 }
@@ -376,7 +370,7 @@ static void json_counts(FILE *f, void *user)
     clip_options(v, &common);
     const tool_run_json j = {v->o.file,
                              v->iso,
-                             full ? v->full_mode : TOOL_PROGRESSIVE,
+                             full, /* TOOL_PROGRESSIVE when not shown */
                              &v->camera,
                              "opengl",
                              &common,
@@ -407,9 +401,9 @@ static void print_summary(const viewer *v)
     else
         ip_engine_totals(v->engine, &t);
     printf("%s: iso %g, %s, %ux%u\n", v->o.file, v->iso,
-           !v->full_shown                  ? "progressive"
-           : v->full_mode == TOOL_FULL_LOD ? "full extraction at adaptive resolution"
-                                           : "full extraction",
+           !v->full_shown                   ? "progressive"
+           : v->full_shown == TOOL_FULL_LOD ? "full extraction at adaptive resolution"
+                                            : "full extraction",
            v->camera.width, v->camera.height);
     printf("  rays          %llu of %llu\n", (unsigned long long)t.rays,
            (unsigned long long)v->camera.width * v->camera.height);
