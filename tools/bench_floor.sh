@@ -2,8 +2,10 @@
 # The floor under the 99.5 % targets, beside the engine and Flying Edges in one run: per round,
 # VTK's Flying Edges (first Update() in its process and again), isorender to 99.5 % final
 # pixels from a fresh process and warm (--warm), and bench_floor (marching cubes over only the
-# cells that own a pixel of the final image: its run 0 in a fresh process, and warm), for the
-# skin (600.5, -y) and the bone (1224.5, -x) at 1600x1200. Rounds interleave; prints the
+# cells that own a pixel of the final image: its run 0 in a fresh process, and warm; then the
+# same over the cells the engine extracts by the warm run's 99.5 % checkpoint, the walked
+# floor; and those cells through the engine's own extraction with the coverage, warm), for
+# the skin (600.5, -y) and the bone (1224.5, -x) at 1600x1200. Rounds interleave; prints the
 # medians with [min-max]. The page cache is left as it is (warm: run once beforehand).
 #
 #   tools/bench_floor.sh BUILD FILE.ibv RAW [RUNS] [THREADS]
@@ -13,7 +15,7 @@
 # the engine's and the floor's; VTK uses every core. Needs python3-vtk9, as bench_engine.sh.
 set -eu
 if [ $# -lt 3 ]; then
-    sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
 build=$1 file=$2 raw=$3 runs=${4:-5} threads=${5:-2}
@@ -36,6 +38,11 @@ for i in $(seq "$runs"); do
                 --progress "$work/$name-$mode-$i.csv" --force --quiet
         done
         "$build/bench_floor" "$file" "$iso" "$view" 1600x1200 "$threads" 20 >"$work/$name-floor-$i.txt"
+        rays=$(awk -F, 'NR > 1 && $6 >= 99.5 { print $2; exit }' "$work/$name-warm-$i.csv")
+        "$build/bench_floor" "$file" "$iso" "$view" 1600x1200 "$threads" 20 "$rays" \
+            >"$work/$name-walked-$i.txt"
+        "$build/bench_floor" "$file" "$iso" "$view" 1600x1200 "$threads" 20 "$rays" cover \
+            >"$work/$name-cover-$i.txt"
     done
 done
 python3 - "$work" "$runs" "$threads" <<'PY'
@@ -47,8 +54,17 @@ def at(path, pct, key='time_s'):
     rows = list(csv.DictReader(open(path)))
     return next(float(r[key]) for r in rows if float(r['final_pixel_pct']) >= pct)
 print('| %s threads | Flying Edges first / again | 99.5 %% fresh | 99.5 %% warm | floor fresh '
-      '(run 0) | floor warm | floor warm / FE again | cells owning a pixel | cells extracted by 99.5 %% |' % threads)
-print('| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |')
+      '(run 0) | floor warm | floor warm / FE again | walked floor fresh | walked floor warm | '
+      'walked warm / FE again | walked + coverage warm | cells owning a pixel | cells extracted '
+      'by 99.5 %% |' % threads)
+print('| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |')
+def floor(name, kind):
+    r0, rw = [], []
+    for i in range(1, runs + 1):
+        text = open('%s/%s-%s-%d.txt' % (work, name, kind, i)).read()
+        r0.append(float(re.search(r'run 0: ([0-9.]+) s', text).group(1)))
+        rw.append(float(re.search(r'median ([0-9.]+) s', text).group(1)))
+    return r0, rw
 for name, iso in (('skin', 600.5), ('bone', 1224.5)):
     fe = {1: [], 2: []}
     for i in range(1, runs + 1):
@@ -58,15 +74,15 @@ for name, iso in (('skin', 600.5), ('bone', 1224.5)):
                 fe[j['call']].append(j['update_s'])
     fresh = [at('%s/%s-fresh-%d.csv' % (work, name, i), 99.5) for i in range(1, runs + 1)]
     warm = [at('%s/%s-warm-%d.csv' % (work, name, i), 99.5) for i in range(1, runs + 1)]
-    f0, fw, cells = [], [], None
-    for i in range(1, runs + 1):
-        text = open('%s/%s-floor-%d.txt' % (work, name, i)).read()
-        f0.append(float(re.search(r'run 0: ([0-9.]+) s', text).group(1)))
-        fw.append(float(re.search(r'median ([0-9.]+) s', text).group(1)))
-        cells = re.search(r'from (\d+) cells', text).group(1)
+    f0, fw = floor(name, 'floor')
+    w0, ww = floor(name, 'walked')
+    c0, cw = floor(name, 'cover')
+    cells = re.search(r'from (\d+) cells', open('%s/%s-floor-1.txt' % (work, name)).read()).group(1)
     extracted = statistics.median(
         [at('%s/%s-warm-%d.csv' % (work, name, i), 99.5, 'cells') for i in range(1, runs + 1)])
-    print('| %s | %.4f / %.4f | %s | %s | %s | %s | %.2f | %s | %d |' % (
-        name, statistics.median(fe[1]), statistics.median(fe[2]), cell(fresh), cell(warm),
-        cell(f0), cell(fw), statistics.median(fw) / statistics.median(fe[2]), cells, extracted))
+    fe2 = statistics.median(fe[2])
+    print('| %s | %.4f / %.4f | %s | %s | %s | %s | %.2f | %s | %s | %.2f | %s | %s | %d |' % (
+        name, statistics.median(fe[1]), fe2, cell(fresh), cell(warm), cell(f0), cell(fw),
+        statistics.median(fw) / fe2, cell(w0), cell(ww), statistics.median(ww) / fe2, cell(cw),
+        cells, extracted))
 PY
