@@ -8,8 +8,9 @@
 #      isorender --full and VTK's vtkFlyingEdges3D / vtkMarchingCubes (filter Update() only)
 #      and VTK's rendering of the Flying Edges output at 1600x1200 offscreen; the targets as
 #      ratios to Flying Edges in the same run, the overdraw's floor (the triangles that
-#      show at all, counted at 6400x4800) and the marching cubes floor (bench_floor: only the
-#      cells that own a pixel of the final image, triangulated alone);
+#      show at all, counted at 6400x4800), the marching cubes floor (bench_floor: only the
+#      cells that own a pixel of the final image, triangulated alone) and the walked floor
+#      (bench_floor RAYS: the cells the engine extracts by the warm 99.5 %, triangulated alone);
 #   2. out of core: the head upsampled 4x (2048x2048x936 uint16, 7.3 GiB), bricked once, viewed
 #      with a 512 MiB cache: time to first image and to 99.5 %, peak RSS, bricks touched, hit
 #      rate; beside it the peak memory of VTK Flying Edges on the same raw file (if it fits);
@@ -277,6 +278,10 @@ if measuring; then
             # the floor: only the cells that own a pixel of the final image (part 21)
             "$build/bench_floor" "$head_ibv" "$iso" "$view" 1600x1200 "$(getconf _NPROCESSORS_ONLN)" 20 \
                 >"$name-floor-$i.txt"
+            # the walked floor: the cells the engine extracts by the warm 99.5 % (part 27)
+            rays=$(awk -F, 'NR > 1 && $6 >= 99.5 { print $2; exit }' "$name-warm-$i.csv")
+            "$build/bench_floor" "$head_ibv" "$iso" "$view" 1600x1200 "$(getconf _NPROCESSORS_ONLN)" 20 \
+                "${rays:-0}" >"$name-walked-$i.txt"
         done
         $py "$root/tools/bench_vtk.py" extract "$raw" 600.5 1224.5 >>vtk-extract.jsonl
         for s in "600.5 -y" "1224.5 -x"; do
@@ -373,6 +378,18 @@ for s in "skin 600.5 -y" "bone 1224.5 -x"; do
         "(the warm target: 0.15x); a fresh process's first run $(printf %.4f "$f0_med") s," \
         "$(calc "round($f0_med / $fe, 2)")x Flying Edges' first call (the fresh target: 0.4x). Medians of" \
         "$repeat processes, each a median of 20 warm runs."
+    if [ -s "$name-walked-1.txt" ]; then
+        ww=$(for f in "$name"-walked-?.txt; do sed -n 's/^median \([0-9.]*\) s.*/\1/p' "$f"; done | sort -g)
+        w0=$(for f in "$name"-walked-?.txt; do sed -n 's/^run 0: \([0-9.]*\) s.*/\1/p' "$f"; done | sort -g)
+        ww_med=$(echo "$ww" | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')
+        w0_med=$(echo "$w0" | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')
+        echo
+        echo "Walked floor ($name, \`bench_floor ... RAYS\`, part 27): the$(sed -n 's/^engine, [0-9]* rays: \([0-9]*\) cells.*/ \1/p' "$name"-walked-1.txt)" \
+            "cells the engine extracts by the warm run's 99.5 % checkpoint, triangulated alone (normals only" \
+            "for those owning a pixel): warm $(printf %.4f "$ww_med") s [$(echo "$ww" | head -1)-$(echo "$ww" | tail -1)]," \
+            "$(calc "round($ww_med / $fe2, 2)")x Flying Edges again; a fresh process's first run" \
+            "$(printf %.4f "$w0_med") s, $(calc "round($w0_med / $fe, 2)")x Flying Edges' first call."
+    fi
     echo
     # bar chart data: name, 85 %, 99.5 %, all rays (warm), --full warm, FE, MC, FE + first render
     echo "$name $(med "$(h tstats 85 "$name"-warm-?.csv)") $(med "$(h tstats 99.5 "$name"-warm-?.csv)") $(med "$(h tstats 100 "$name"-warm-?.csv)") $(h jmed time.extraction_wall_s "$name"-full-warm-*.json) $fe2 $mc $(calc "$fe2 + $r1")" >>bars.dat
