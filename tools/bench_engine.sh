@@ -281,7 +281,7 @@ if measuring; then
             # the walked floor: the cells the engine extracts by the warm 99.5 % (part 27)
             rays=$(awk -F, 'NR > 1 && $6 >= 99.5 { print $2; exit }' "$name-warm-$i.csv")
             "$build/bench_floor" "$head_ibv" "$iso" "$view" 1600x1200 "$(getconf _NPROCESSORS_ONLN)" 20 \
-                "${rays:-0}" >"$name-walked-$i.txt"
+                "$rays" >"$name-walked-$i.txt"
         done
         $py "$root/tools/bench_vtk.py" extract "$raw" 600.5 1224.5 >>vtk-extract.jsonl
         for s in "600.5 -y" "1224.5 -x"; do

@@ -53,9 +53,9 @@ static double stop_depth(const ip_engine *e, uint32_t x, uint32_t y)
  * extracts the same ones of them, near misses (the cells it passes within 1/64 pixel of a triangle
  * edge, extracted alone, those beside it within its reach included: seed.h) and seed alike.
  * Rays may then find nothing where they would have found a hidden seed; propagation from such a
- * seed only ever saved other rays work. Each entry is backed
- * by a triangle already in a worker's mesh (one may rise when two threads lower it at once,
- * coverage.h), so a stale or risen read only stops the walk later. The edge of the solid margin
+ * seed only ever saved other rays work. Each entry is backed by a triangle already in a
+ * worker's mesh (one may rise when two threads lower it at once, coverage.h), so a stale or
+ * risen read only stops the walk later. The edge of the solid margin
  * matters: the plain coverage entry also counts centres on a triangle's edge, where snapping may
  * uncover a silhouette and show the surface behind, which this ray must then still find.
  *

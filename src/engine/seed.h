@@ -37,8 +37,9 @@ typedef struct ip_seeder {
     double within[3];     /* reach / |the ray's direction| per axis: the reach in t units */
     double within_most;   /* the largest of them */
     uint64_t near_tested; /* active cells the rays passed close to, without entering, tested */
-    double hit_t;         /* where the ray leaves the cell it stopped in (walk_cells()); +infinity
-                     after an ip__seed_find() that stopped in none */
+    /* where the ray leaves the cell it stopped in (walk_cells()); +infinity after an
+     * ip__seed_find() that stopped in none */
+    double hit_t;
     /* With adaptive resolution (banded), only the cells of the level's distance band
      * [band_near, band_far) are the view's (lod.h): the walk passes over the others as if
      * they were inactive (ip__seeder_band()). */

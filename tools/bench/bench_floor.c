@@ -206,18 +206,25 @@ static long walked_cells(ip_cache *cache, const ip_layout *layout, const ip_came
     o.cull = 0;
     o.cell_ids = 1;
     ip_engine *engine;
-    if (ip_engine_create(cache, &o, &engine, &err) != IP_OK ||
-        ip_engine_begin(engine, camera, iso, &err) != IP_OK ||
+    if (ip_engine_create(cache, &o, &engine, &err) != IP_OK) {
+        fprintf(stderr, "bench_floor: %s\n", err.message);
+        return -1;
+    }
+    if (ip_engine_begin(engine, camera, iso, &err) != IP_OK ||
         ip_engine_step(engine, rays, 0, NULL, &err) != IP_OK) {
         fprintf(stderr, "bench_floor: %s\n", err.message);
+        ip_engine_destroy(engine);
         return -1;
     }
     const ip_mesh *mesh = ip_engine_mesh(engine);
     size_t n = 0;
     cell_key *keys = malloc((mesh->triangle_count ? mesh->triangle_count : 1) * sizeof *keys);
+    if (!keys)
+        fprintf(stderr, "bench_floor: out of memory\n");
     for (uint64_t t = 0; keys && t < mesh->triangle_count; t++) {
         if (mesh->cells[t] >> 58 != 0) {
-            fprintf(stderr, "bench_floor: the view uses a coarser level (run with --lod off)\n");
+            fprintf(stderr, "bench_floor: the view uses coarser levels (adaptive resolution): "
+                            "the walked floor is for views of level 0 alone\n");
             free(keys);
             keys = NULL;
             break;
@@ -326,7 +333,15 @@ int main(int argc, char **argv)
     float iso = strtof(argv[2], NULL);
     unsigned threads = (unsigned)strtoul(argv[5], NULL, 10);
     int repeats = atoi(argv[6]);
-    uint64_t rays = argc >= 8 ? strtoull(argv[7], NULL, 10) : 0;
+    uint64_t rays = 0;
+    if (argc >= 8) { /* RAYS: a positive count */
+        char *end;
+        rays = strtoull(argv[7], &end, 10);
+        if (end == argv[7] || *end || rays == 0 || argv[7][0] == '-') {
+            fputs(usage, stderr);
+            return 2;
+        }
+    }
     if (threads < 1 || threads > IP_MAX_THREADS || repeats < 0) {
         fputs(usage, stderr);
         return 2;
@@ -365,8 +380,12 @@ int main(int argc, char **argv)
     part parts[IP_MAX_THREADS];
     for (unsigned t = 0; t < threads; t++) {
         size_t first = (size_t)count * t / threads, end = (size_t)count * (t + 1) / threads;
-        parts[t] = (part){cache, cells + first, end - first, cover ? &coverage : NULL, iso, {0}, 0,
-                          0,     IP_OK};
+        parts[t] = (part){.cache = cache,
+                          .cells = cells + first,
+                          .count = end - first,
+                          .coverage = cover ? &coverage : NULL,
+                          .iso = iso,
+                          .status = IP_OK};
         ip_mesh_init(&parts[t].mesh);
     }
     ip__pool *pool;
@@ -386,7 +405,7 @@ int main(int argc, char **argv)
         for (unsigned t = 0; t < threads; t++)
             points += parts[t].points;
         printf("run %d: %.4f s, %ld cells, %" PRIu64 " triangles", r, times[r], count, triangles);
-        if (rays > 0)
+        if (rays > 0 && !cover)
             printf(", %" PRIu64 " cells edge points only", points);
         if (r == 0) {
             ip_cache_stats cs;
