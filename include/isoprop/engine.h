@@ -223,6 +223,19 @@ IP_API double ip_engine_lod_distance(const ip_engine *engine, uint32_t level);
 /*! ip_engine_totals() : counts and times since ip_engine_begin(). */
 IP_API void ip_engine_totals(const ip_engine *engine, ip_engine_counts *counts);
 
+/* The engine's memory, bytes, besides the brick cache it reads through (ip_cache_get_stats()). */
+typedef struct ip_engine_memory {
+    uint64_t mesh;     /* the mesh's arrays as allocated (ip_engine_mesh(); kept between views) */
+    uint64_t workers;  /* the workers' triangle buffers and propagation queues */
+    uint64_t visited;  /* the visited cells' bitmaps (one per brick the view reached) and index */
+    uint64_t coverage; /* with occlusion: the coverage buffers and screen tiles */
+    uint64_t total;    /* the sum */
+} ip_engine_memory;
+
+/*! ip_engine_memory_of() : what the engine holds now (*memory is the caller's); not during a
+ *  step. */
+IP_API void ip_engine_memory_of(const ip_engine *engine, ip_engine_memory *memory);
+
 /*! ip_engine_add_rendering_time() : adds the caller's rendering time to the totals. */
 IP_API void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
 

@@ -508,3 +508,30 @@ void ip_engine_add_rendering_time(ip_engine *e, double seconds)
 {
     e->totals.rendering_seconds += seconds;
 }
+
+/* The bytes of a mesh's arrays as allocated. */
+static uint64_t mesh_bytes(const ip_mesh *m)
+{
+    return m->capacity * (9 * sizeof(float) + 9 * sizeof(int16_t) +
+                          (m->with_cells ? sizeof(uint64_t) : 0));
+}
+
+void ip_engine_memory_of(const ip_engine *e, ip_engine_memory *m)
+{
+    memset(m, 0, sizeof *m);
+    m->mesh = mesh_bytes(&e->mesh);
+    for (unsigned t = 0; t < e->threads; t++) {
+        const ip_engine_worker *w = &e->workers[t];
+        m->workers += mesh_bytes(&w->mesh);
+        for (uint32_t k = 0; k < IP_MAX_LEVELS; k++)
+            if (w->level[k].ready)
+                m->workers += w->level[k].propagator.queue.capacity * sizeof(ip_depth_slot);
+    }
+    const ip_visited *v = &e->visited;
+    uint64_t bricks = v->layout ? v->layout->brick_count : 0;
+    m->visited = atomic_load(&((ip_visited *)v)->holder_count) * v->words_per_brick * 8 +
+                 bricks * (sizeof *v->bitmaps + sizeof *v->holders);
+    m->coverage = e->coverage.capacity * 2 * sizeof(atomic_uint) +
+                  e->tile_capacity * (sizeof *e->tiles + 1);
+    m->total = m->mesh + m->workers + m->visited + m->coverage;
+}

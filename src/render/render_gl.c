@@ -463,6 +463,12 @@ void ip_renderer_clear_mesh(ip_renderer *r)
     r->triangle_count = 0;
 }
 
+uint64_t ip_renderer_memory(const ip_renderer *r)
+{
+    uint64_t stream = r->stream_array ? (uint64_t)STREAM_TRIANGLES * (POSITION_BYTES + NORMAL_BYTES) : 0;
+    return r->triangle_capacity * (POSITION_BYTES + NORMAL_BYTES) + stream;
+}
+
 uint64_t ip_renderer_triangle_count(const ip_renderer *r)
 {
     return r->triangle_count;

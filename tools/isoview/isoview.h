@@ -9,6 +9,7 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "isoprop/cache.h"
@@ -22,7 +23,17 @@ typedef struct options {
     const char *file, *script, *screenshot_path;
     double screenshot_at, exit_after;
     int aa; /* --aa N: samples a pixel of the window (1: no multisampling) */
+    int renderer; /* --renderer: RENDERER_AUTO, _OPENGL or _SOFTWARE */
 } options;
+
+/* --renderer: OpenGL draws the mesh; software draws it with the library's exact rasterizer
+ * into a canvas shown as a texture; auto takes software where OpenGL is itself a software
+ * driver (llvmpipe, softpipe). */
+enum {
+    RENDERER_AUTO,
+    RENDERER_OPENGL,
+    RENDERER_SOFTWARE
+};
 
 typedef enum command_kind {
     COMMAND_CAMERA,
@@ -38,12 +49,13 @@ typedef enum command_kind {
     COMMAND_HELP,
     COMMAND_CLIP,
     COMMAND_SCREENSHOT,
+    COMMAND_DRAG,
     COMMAND_QUIT
 } command_kind;
 
 typedef struct command {
     command_kind kind;
-    double a, b;
+    double a, b, c;
     char *text; /* camera, view, screenshot: owned */
 } command;
 
@@ -64,6 +76,29 @@ typedef struct overlay {
     int quads_size;       /* bytes */
 } overlay;
 
+/* The software renderer's window side: the canvas's image as a texture over the window. */
+typedef struct display {
+    GLuint program, array, texture;
+    GLint height_at;
+    uint32_t width, height; /* of the texture (0: none yet) */
+} display;
+
+/* One pass's course, for --stats: when its frames came and what they had drawn. */
+typedef struct pass_record {
+    double start;                      /* seconds since the window opened: the change */
+    double first_frame, complete;      /* seconds after start (complete < 0: never) */
+    double final_85, final_995;        /* seconds after start to 85 % / 99.5 % of the final
+                                          pixels (< 0: not measured) */
+    uint64_t frames, triangles, rays;  /* frames drawn, and the pass's mesh at its end */
+    int moving;                        /* it began during a drag */
+} pass_record;
+
+/* A frame of a pass: seconds after the pass's start, and the triangles it had drawn. */
+typedef struct frame_mark {
+    double time;
+    uint64_t triangles;
+} frame_mark;
+
 /* Frames per second, for the overlay (a short window) and the stats (whole seconds). */
 typedef struct frame_clock {
     double first, last; /* times of the first and last frame, seconds */
@@ -82,7 +117,12 @@ typedef struct viewer {
     ip_cache *cache;
     ip_engine *engine;
     GLFWwindow *window;
-    ip_renderer *renderer;
+    ip_renderer *renderer; /* OpenGL (NULL with the software renderer) */
+    ip_canvas *canvas;     /* the software renderer (NULL with OpenGL) */
+    display screen;        /* the canvas's image in the window */
+    const ip_mesh *canvas_mesh; /* the mesh the canvas holds a prefix of (NULL: start over) */
+    ip_camera canvas_camera;    /* the camera it was begun with */
+    char gl_renderer[96];       /* GL_RENDERER */
     overlay text;
     double lo[3], hi[3];
     float value_min, value_max;
@@ -123,6 +163,17 @@ typedef struct viewer {
     uint32_t screenshot_number;
     double start;
     frame_clock clock;
+    /* the course of each pass (--stats "views"): frame times and the triangles drawn by them */
+    pass_record *records;
+    size_t record_count, record_capacity;
+    frame_mark *marks; /* this pass's frames */
+    size_t frame_count, frame_capacity;
+    int pass_recorded;         /* this pass's record is complete */
+    /* a drag from a script (COMMAND_DRAG): degrees a second left to turn, until drag_end */
+    double drag_rate[2], drag_end, drag_last;
+    uint64_t moving_frames; /* frames drawn during a drag (the mouse's or a script's) */
+    double moving_seconds;  /* and the seconds they took */
+    int renderer_note;      /* the software renderer took over from one that failed */
     int quit, failed;
     ip_error err;
 } viewer;
@@ -171,6 +222,33 @@ void clip_options(const viewer *v, tool_view_options *o);
 void show_message(viewer *v, const char *fmt, ...);
 /* Routes the window's keyboard and mouse to the viewer (the window's user pointer). */
 void controls_install(GLFWwindow *window);
+
+/* record.c */
+/* Starts the record of a new pass (the one before ends unfinished if it was not complete).
+ * Returns 0, or -1 with the error in v->err. */
+int record_begin(viewer *v);
+/* Notes a frame shown at `end` (ip_now_seconds()); the pass's record is complete with the
+ * first frame that shows complete refinement (its final pixels then measured). */
+void record_frame(viewer *v, double end);
+/* Ends the record of the pass shown (unfinished unless complete), at exit. */
+void record_end(viewer *v);
+void record_free(viewer *v);
+/* Writes --stats' "views" (each pass's record) and "views_median" (over the passes that did
+ * not begin during a drag), each after ", ". */
+void record_json(FILE *f, const viewer *v);
+
+/* display.c */
+/* Builds the texture and program that show the canvas (the window's context current).
+ * Returns 0, or -1 with the error in *err. */
+int display_create(display *d, ip_error *err);
+void display_destroy(display *d);
+/* Sends rows [rows[0], rows[1]) of the canvas's image (all of it after a change of size) to
+ * the texture and draws it over the window. Returns 0, or -1 with the error in *err. */
+int display_show(display *d, const uint8_t *rgba, uint32_t width, uint32_t height,
+                 const uint32_t rows[2], ip_error *err);
+/* Reads the window's back buffer as drawn (overlay included), top row first. Returns 0, or -1
+ * with the error in *err. */
+int display_read(uint32_t width, uint32_t height, uint8_t *rgba, ip_error *err);
 
 /* overlay.c */
 /* Builds the overlay's program and buffers (the window's context current). Returns 0, or -1

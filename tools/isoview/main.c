@@ -134,8 +134,12 @@ static int begin_pass(viewer *v)
     v->overdraw_state = 0;
     v->passes++;
     v->pass_wall = v->pass_render = 0;
-    ip_renderer_clear_mesh(v->renderer);
+    if (v->renderer)
+        ip_renderer_clear_mesh(v->renderer);
+    v->canvas_mesh = NULL; /* the canvas starts over */
     v->uploaded = 0;
+    if (record_begin(v) != 0)
+        return -1;
     if (ip_engine_begin(v->engine, &v->camera, (float)v->iso, &v->err) != IP_OK)
         return -1;
     return 0;
@@ -160,7 +164,7 @@ static int refine(viewer *v)
     if (st != IP_OK && st != IP_ERR_CANCELLED)
         return -1;
     const ip_mesh *mesh = ip_engine_mesh(v->engine);
-    if (ip_renderer_upload(v->renderer, mesh, v->uploaded, &v->err) != IP_OK)
+    if (v->renderer && ip_renderer_upload(v->renderer, mesh, v->uploaded, &v->err) != IP_OK)
         return -1;
     v->uploaded = mesh->triangle_count;
     return 0;
@@ -185,18 +189,50 @@ static int extract_full(viewer *v)
         return -1;
     v->full_wall = ip_now_seconds() - start;
     v->pass_render = 0;
-    ip_renderer_clear_mesh(v->renderer);
-    if (ip_renderer_upload(v->renderer, &v->full_mesh, 0, &v->err) != IP_OK)
-        return -1;
+    v->canvas_mesh = NULL;
+    if (v->renderer) {
+        ip_renderer_clear_mesh(v->renderer);
+        if (ip_renderer_upload(v->renderer, &v->full_mesh, 0, &v->err) != IP_OK)
+            return -1;
+    }
     v->full_shown = mode;
     v->overdraw_state = 0;
     return 0;
 }
 
+static int same_camera(const ip_camera *a, const ip_camera *b)
+{
+    for (int i = 0; i < 3; i++)
+        if (a->eye[i] != b->eye[i] || a->target[i] != b->target[i] || a->up[i] != b->up[i])
+            return 0;
+    return a->fov_y == b->fov_y && a->width == b->width && a->height == b->height;
+}
+
+/* The software renderer: the canvas draws the triangles of the mesh shown that it does not
+ * hold yet (all of them after a change of view, mesh or size) and shows the changed rows. */
+static int draw_software(viewer *v)
+{
+    const ip_mesh *mesh = v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine);
+    if (v->canvas_mesh != mesh || !same_camera(&v->canvas_camera, &v->camera) ||
+        ip_canvas_triangle_count(v->canvas) > mesh->triangle_count) {
+        v->canvas_mesh = NULL;
+        if (ip_canvas_begin(v->canvas, &v->camera, NULL, v->lo, v->hi, &v->err) != IP_OK)
+            return -1;
+        v->canvas_mesh = mesh;
+        v->canvas_camera = v->camera;
+    }
+    if (ip_canvas_add(v->canvas, mesh, ip_canvas_triangle_count(v->canvas), &v->err) != IP_OK)
+        return -1;
+    uint32_t rows[2];
+    const uint8_t *rgba = ip_canvas_shade(v->canvas, rows);
+    return display_show(&v->screen, rgba, v->camera.width, v->camera.height, rows, &v->err);
+}
+
 static int draw_frame(viewer *v, int working_on_full)
 {
     double start = ip_now_seconds();
-    if (ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) != IP_OK)
+    if (v->canvas ? draw_software(v) != 0
+                  : ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) != IP_OK)
         return -1;
     overlay_draw_frame(v, working_on_full);
     double seconds = ip_now_seconds() - start;
@@ -225,7 +261,8 @@ static int save_screenshot(viewer *v)
     int rc = -1;
     if (!rgba)
         set_error(&err, IP_ERR_NOMEM, "out of memory for a screenshot");
-    else if (ip_renderer_read_rgba(v->renderer, rgba, &err) == IP_OK &&
+    else if ((v->canvas ? display_read(v->camera.width, v->camera.height, rgba, &err) == 0
+                        : ip_renderer_read_rgba(v->renderer, rgba, &err) == IP_OK) &&
              ip_png_write(path, rgba, v->camera.width, v->camera.height,
                           automatic ? 0 : v->o.common.force, &err) == IP_OK)
         rc = 0;
@@ -252,7 +289,8 @@ static int follow_size(viewer *v)
     if (width <= 0 || height <= 0)
         return 0;
     if ((uint32_t)width != v->camera.width || (uint32_t)height != v->camera.height) {
-        if (ip_renderer_resize(v->renderer, (uint32_t)width, (uint32_t)height, &v->err) != IP_OK)
+        if (v->renderer &&
+            ip_renderer_resize(v->renderer, (uint32_t)width, (uint32_t)height, &v->err) != IP_OK)
             return -1;
         v->camera.width = (uint32_t)width;
         v->camera.height = (uint32_t)height;
@@ -261,16 +299,34 @@ static int follow_size(viewer *v)
     return 1;
 }
 
+/* A script's drag: the part of its turn due since the last frame. */
+static void follow_drag(viewer *v, double t)
+{
+    if (v->drag_end <= 0)
+        return;
+    double until = t < v->drag_end ? t : v->drag_end;
+    double dt = until - v->drag_last;
+    if (dt > 0) {
+        ip_camera_orbit(&v->camera, v->drag_rate[0] * dt, v->drag_rate[1] * dt);
+        change_view(v);
+    }
+    v->drag_last = until;
+    if (t >= v->drag_end)
+        v->drag_end = 0;
+}
+
 /* One frame: input, script, timers, extraction slice, drawing, screenshot, swap.
  * Returns 0, or -1 after an error in v->err. */
 static int frame(viewer *v)
 {
+    double frame_start = ip_now_seconds();
     glfwPollEvents();
     double t = ip_now_seconds() - v->start;
     if (glfwWindowShouldClose(v->window) || (v->o.exit_after >= 0 && t >= v->o.exit_after)) {
         v->quit = 1;
         return 0;
     }
+    follow_drag(v, t);
     run_script(v, t);
     if (v->quit)
         return 0;
@@ -309,7 +365,12 @@ static int frame(viewer *v)
     glfwSwapBuffers(v->window);
     double end = ip_now_seconds();
     v->draw_seconds = end - drawn;
+    if (v->drag_end > 0 || v->drag_button >= 0) {
+        v->moving_frames++;
+        v->moving_seconds += end - frame_start;
+    }
     frame_done(&v->clock, end);
+    record_frame(v, end);
     return 0;
 }
 
@@ -347,13 +408,59 @@ static int open_window(viewer *v)
     glfwGetFramebufferSize(v->window, &width, &height);
     v->camera.width = width > 0 ? (uint32_t)width : v->o.common.width;
     v->camera.height = height > 0 ? (uint32_t)height : v->o.common.height;
-    if (ip_renderer_create_current(v->camera.width, v->camera.height, 0, &v->renderer, &v->err) !=
-            IP_OK ||
-        overlay_create(&v->text, &v->err) != 0) {
+    const char *name = (const char *)glGetString(GL_RENDERER);
+    snprintf(v->gl_renderer, sizeof v->gl_renderer, "%s", name ? name : "unknown");
+    int software = v->o.renderer == RENDERER_SOFTWARE ||
+                   (v->o.renderer == RENDERER_AUTO && v->o.aa <= 1 &&
+                    (strstr(v->gl_renderer, "llvmpipe") || strstr(v->gl_renderer, "softpipe") ||
+                     strstr(v->gl_renderer, "Software Rasterizer")));
+    if (!software &&
+        ip_renderer_create_current(v->camera.width, v->camera.height, 0, &v->renderer, &v->err) !=
+            IP_OK) {
+        if (v->o.renderer == RENDERER_OPENGL) {
+            fprintf(stderr, "isoview: the OpenGL renderer cannot start: %s\n", v->err.message);
+            return -1;
+        }
+        fprintf(stderr, "isoview: note: the OpenGL renderer cannot start (%s); drawing in "
+                        "software\n", v->err.message);
+        software = 1;
+        v->renderer_note = 1;
+    }
+    if (software && (ip_canvas_create(v->o.common.threads, &v->canvas, &v->err) != IP_OK ||
+                     display_create(&v->screen, &v->err) != 0)) {
+        fprintf(stderr, "isoview: the software renderer cannot start: %s\n", v->err.message);
+        return -1;
+    }
+    if (overlay_create(&v->text, &v->err) != 0) {
         fprintf(stderr, "isoview: %s\n", v->err.message);
         return -1;
     }
     return 0;
+}
+
+/* --stats' "memory": what the viewer holds besides the process's code, in bytes. */
+static void memory_json(FILE *f, const viewer *v)
+{
+    ip_cache_stats s;
+    ip_cache_get_stats(v->cache, &s);
+    ip_engine_memory e;
+    ip_engine_memory_of(v->engine, &e);
+    uint64_t full = v->full_mesh.capacity * (9 * sizeof(float) + 9 * sizeof(int16_t));
+    uint64_t gpu = v->renderer ? ip_renderer_memory(v->renderer) : 0;
+    uint64_t canvas = v->canvas ? ip_canvas_memory(v->canvas) + 4ull * v->screen.width * v->screen.height : 0;
+    uint64_t summaries = ip_store_summary_memory(v->store);
+    fprintf(f,
+            ", \"memory\": {\"cache_bytes\": %llu, \"cache_peak_bytes\": %llu, "
+            "\"summaries_bytes\": %llu, \"engine_mesh_bytes\": %llu, "
+            "\"engine_workers_bytes\": %llu, \"visited_bytes\": %llu, \"coverage_bytes\": %llu, "
+            "\"full_mesh_bytes\": %llu, \"gpu_mesh_bytes\": %llu, \"canvas_bytes\": %llu, "
+            "\"rss_bytes\": %llu, \"rss_peak_bytes\": %llu}",
+            (unsigned long long)s.resident_bytes, (unsigned long long)s.resident_peak_bytes,
+            (unsigned long long)summaries, (unsigned long long)e.mesh,
+            (unsigned long long)e.workers, (unsigned long long)e.visited,
+            (unsigned long long)e.coverage, (unsigned long long)full, (unsigned long long)gpu,
+            (unsigned long long)canvas, (unsigned long long)ip_rss_bytes(),
+            (unsigned long long)ip_peak_rss_bytes());
 }
 
 static void json_counts(FILE *f, void *user)
@@ -372,7 +479,7 @@ static void json_counts(FILE *f, void *user)
                              v->iso,
                              full, /* TOOL_PROGRESSIVE when not shown */
                              &v->camera,
-                             "opengl",
+                             v->canvas ? "software" : "opengl",
                              &common,
                              0,
                              done,
@@ -391,6 +498,11 @@ static void json_counts(FILE *f, void *user)
             (unsigned long long)v->passes, (unsigned long long)k->frames,
             k->frames ? k->last - k->first : 0.0, mean, k->seconds ? k->slowest : mean,
             k->seconds ? k->fastest : mean);
+    fprintf(f, ", \"fps_moving\": %.3f, \"gl_renderer\": ",
+            v->moving_seconds > 0 ? (double)v->moving_frames / v->moving_seconds : 0.0);
+    tool_json_string(f, v->gl_renderer);
+    record_json(f, v);
+    memory_json(f, v);
 }
 
 static void print_summary(const viewer *v)
@@ -414,6 +526,7 @@ static void print_summary(const viewer *v)
 
 static int finish(viewer *v)
 {
+    record_end(v);
     ip_cache_stats s;
     ip_cache_get_stats(v->cache, &s);
     uint64_t summary = ip_store_summary_memory(v->store);
@@ -528,6 +641,8 @@ int main(int argc, char **argv)
                 v->o.file);
     free(v->screenshot_pending);
     overlay_destroy(&v->text);
+    display_destroy(&v->screen);
+    ip_canvas_destroy(v->canvas);
     ip_renderer_destroy(v->renderer);
     if (v->window)
         glfwDestroyWindow(v->window);
@@ -535,6 +650,7 @@ int main(int argc, char **argv)
     ip_engine_destroy(v->engine);
     ip_mesh_free(&v->full_mesh);
     free_commands(v);
+    record_free(v);
     ip_cache_destroy(v->cache);
     ip_store_close(v->store);
     free(v);

@@ -20,6 +20,10 @@ static const char usage[] =
     "                      (default: all cores)\n"
     "  --aa N              anti-aliasing: N samples a pixel of the window (1 to 16; default\n"
     "                      1, off: the image isorender draws)\n"
+    "  --renderer auto|opengl|software\n"
+    "                      draw the mesh with OpenGL, or with the exact software rasterizer\n"
+    "                      shown as a texture, drawing only what is new; auto (the default):\n"
+    "                      software where OpenGL is itself software (llvmpipe, softpipe)\n"
     "  --stats OUT.json    on exit: counts, times, fps and the cache statistics as JSON\n"
     "  --script FILE       run the commands of FILE (see docs/isoview.md)\n"
     "  --screenshot-at SECONDS OUT.png\n"
@@ -68,7 +72,23 @@ static int parse_aa(const char *p, const tool_option *opt, const char *const *v,
     return rc;
 }
 
+static int parse_renderer(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (!strcmp(v[0], "auto"))
+        o->renderer = RENDERER_AUTO;
+    else if (!strcmp(v[0], "opengl"))
+        o->renderer = RENDERER_OPENGL;
+    else if (!strcmp(v[0], "software"))
+        o->renderer = RENDERER_SOFTWARE;
+    else
+        return tool_usage_error(p, "--renderer '%s': must be auto, opengl or software", v[0]);
+    return 0;
+}
+
 static const tool_option isoview_options[] = {
+    {"--renderer", NULL, 1, 0, parse_renderer, NULL, NULL},
     {"--script", NULL, 1, offsetof(options, script), NULL, NULL, NULL},
     {"--screenshot-at", NULL, 2, 0, parse_screenshot_at, NULL, NULL},
     {"--exit-after", NULL, 1, 0, parse_exit_after, NULL, NULL},
@@ -82,12 +102,15 @@ int parse_args(int argc, char **argv, options *o)
     o->screenshot_at = -1;
     o->exit_after = -1;
     o->aa = 1;
+    o->renderer = RENDERER_AUTO;
     int rc = tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
                                           sizeof isoview_options / sizeof isoview_options[0], o,
                                           &o->file, argc, argv);
     if (o->common.cull < 0) /* every triangle unless --cull on: a paused viewer shows the mesh
                                from other views */
         o->common.cull = 0;
+    if (rc == 0 && o->aa > 1 && o->renderer == RENDERER_SOFTWARE)
+        return tool_usage_error("isoview", "--aa is OpenGL's: --renderer software draws without it");
     if (rc == 0 && o->common.iso_count > 1) /* isorender draws each; here one would be lost */
         return tool_usage_error("isoview",
                                 "--iso given %u times: isoview shows one surface (isorender "
