@@ -197,7 +197,7 @@ void record_json(FILE *f, const viewer *v)
             if (column[k])
                 column[k][i] = r->moving ? -1 : at[k];
         }
-        fprintf(f, "\"frames\": %llu, \"triangles\": %llu, \"rays\": %llu, \"moving\": %s}",
+        fprintf(f, "\"view_frames\": %llu, \"view_triangles\": %llu, \"view_rays\": %llu, \"moving\": %s}",
                 (unsigned long long)r->frames, (unsigned long long)r->triangles,
                 (unsigned long long)r->rays, r->moving ? "true" : "false");
     }
