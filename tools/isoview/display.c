@@ -6,33 +6,11 @@
 
 #include "isoview.h"
 
-/* One triangle over the window; each fragment fetches its pixel, the texture's row 0 (the
- * canvas's top row) at the top. */
-static const char *const display_vertex_source =
-    "#version 330 core\n"
-    "void main() {\n"
-    "    vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID >> 1) * 4 - 1));\n"
-    "    gl_Position = vec4(p, 0.0, 1.0);\n"
-    "}\n";
-
-static const char *const display_fragment_source =
-    "#version 330 core\n"
-    "uniform sampler2D image;\n"
-    "uniform int height;\n"
-    "out vec4 colour;\n"
-    "void main() {\n"
-    "    ivec2 p = ivec2(gl_FragCoord.xy);\n"
-    "    colour = texelFetch(image, ivec2(p.x, height - 1 - p.y), 0);\n"
-    "}\n";
-
 int display_create(display *d, ip_error *err)
 {
     memset(d, 0, sizeof *d);
-    if (ip_gl_program(display_vertex_source, display_fragment_source, &d->program, err) != IP_OK)
-        return -1;
-    d->height_at = glGetUniformLocation(d->program, "height");
-    glGenVertexArrays(1, &d->array);
     glGenTextures(1, &d->texture);
+    glGenFramebuffers(1, &d->framebuffer);
     if (glGetError() != GL_NO_ERROR) {
         set_error(err, IP_ERR_UNSUPPORTED, "display: an OpenGL error while setting up");
         return -1;
@@ -42,45 +20,69 @@ int display_create(display *d, ip_error *err)
 
 void display_destroy(display *d)
 {
-    if (d->program) {
-        glDeleteProgram(d->program);
-        glDeleteVertexArrays(1, &d->array);
+    if (d->texture) {
+        glDeleteFramebuffers(1, &d->framebuffer);
         glDeleteTextures(1, &d->texture);
     }
+    free(d->rows);
     memset(d, 0, sizeof *d);
+}
+
+/* The texture of a new size, bottom row first as OpenGL's images are, attached to the read
+ * framebuffer. Returns 0, or -1 with the error in *err. */
+static int resize(display *d, uint32_t width, uint32_t height, ip_error *err)
+{
+    uint8_t *rows = realloc(d->rows, (size_t)width * height * 4);
+    if (!rows) {
+        set_error(err, IP_ERR_NOMEM, "display: out of memory for a %ux%u image", width, height);
+        return -1;
+    }
+    d->rows = rows;
+    glBindTexture(GL_TEXTURE_2D, d->texture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, (GLsizei)width, (GLsizei)height, 0, GL_RGBA,
+                 GL_UNSIGNED_BYTE, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, d->framebuffer);
+    glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, d->texture,
+                           0);
+    if (glCheckFramebufferStatus(GL_READ_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        set_error(err, IP_ERR_UNSUPPORTED, "display: the image's framebuffer is incomplete");
+        return -1;
+    }
+    d->width = width;
+    d->height = height;
+    return 0;
 }
 
 int display_show(display *d, const uint8_t *rgba, uint32_t width, uint32_t height,
                  const uint32_t rows[2], ip_error *err)
 {
-    glBindTexture(GL_TEXTURE_2D, d->texture);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    if (width != d->width || height != d->height) { /* a new size: the whole image */
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, (GLsizei)width, (GLsizei)height, 0, GL_RGBA,
-                     GL_UNSIGNED_BYTE, rgba);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        d->width = width;
-        d->height = height;
-    } else if (rows[1] > rows[0]) { /* the rows that changed */
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, (GLint)rows[0], (GLsizei)width,
-                        (GLsizei)(rows[1] - rows[0]), GL_RGBA, GL_UNSIGNED_BYTE,
-                        rgba + (size_t)rows[0] * width * 4);
+    uint32_t first = rows[0], last = rows[1];
+    if (width != d->width || height != d->height) {
+        if (resize(d, width, height, err) != 0)
+            return -1;
+        first = 0, last = height; /* the whole image */
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glViewport(0, 0, (GLsizei)width, (GLsizei)height);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
+    if (last > first) {
+        /* the changed rows, turned bottom first, so that the copy to the window is a plain one
+         * (a software driver then copies memory instead of running a shader per pixel) */
+        size_t row = (size_t)width * 4;
+        for (uint32_t y = first; y < last; y++)
+            memcpy(d->rows + (size_t)(last - 1 - y) * row, rgba + (size_t)y * row, row);
+        glBindTexture(GL_TEXTURE_2D, d->texture);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, (GLint)(height - last), (GLsizei)width,
+                        (GLsizei)(last - first), GL_RGBA, GL_UNSIGNED_BYTE, d->rows);
+        glBindTexture(GL_TEXTURE_2D, 0);
+    }
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, d->framebuffer);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
-    glUseProgram(d->program);
-    glUniform1i(d->height_at, (GLint)height);
-    glActiveTexture(GL_TEXTURE0);
-    glBindVertexArray(d->array);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glBindVertexArray(0);
-    glUseProgram(0);
-    glBindTexture(GL_TEXTURE_2D, 0);
+    glBlitFramebuffer(0, 0, (GLint)width, (GLint)height, 0, 0, (GLint)width, (GLint)height,
+                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (glGetError() != GL_NO_ERROR) {
         set_error(err, IP_ERR_UNSUPPORTED, "display: an OpenGL error while showing the image");
         return -1;

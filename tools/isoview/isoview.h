@@ -78,9 +78,9 @@ typedef struct overlay {
 
 /* The software renderer's window side: the canvas's image as a texture over the window. */
 typedef struct display {
-    GLuint program, array, texture;
-    GLint height_at;
-    uint32_t width, height; /* of the texture (0: none yet) */
+    GLuint texture, framebuffer; /* the image, bottom row first, and a framebuffer to read it */
+    uint8_t *rows;               /* the rows sent, turned bottom first */
+    uint32_t width, height;      /* of the texture (0: none yet) */
 } display;
 
 /* One pass's course, for --stats: when its frames came and what they had drawn. */

@@ -1,9 +1,10 @@
 /* isoview: the interactive viewer. The isosurface refines progressively in a window while it
  * stays responsive: each frame casts rays for a time slice (ip_engine_step() on the render
  * thread, whose workers use every core), uploads the triangles added since the last frame and
- * draws. The slice is FRAME_BUDGET_SECONDS, or as long as the previous frame took to draw when
- * that was longer (software OpenGL drawing a large mesh), up to MAX_SLICE_SECONDS, so that
- * drawing never starves refinement. Any change of view or isovalue restarts the progressive
+ * draws. The slice is FRAME_BUDGET_SECONDS, or DRAW_SHARE times as long as the previous frame
+ * took to draw and show when that was longer (software OpenGL drawing a large mesh, or the
+ * copy of a large window), up to MAX_SLICE_SECONDS, so that drawing never starves
+ * refinement. Any change of view or isovalue restarts the progressive
  * order at once; as extraction is time-sliced, the work in flight is at most one slice.
  *
  * The other parts: options.c (the command line), script.c (--script), controls.c (mouse and
@@ -21,6 +22,8 @@
 
 #define FRAME_BUDGET_SECONDS 0.012 /* ray casting per frame: keeps 30+ fps while refining */
 #define MAX_SLICE_SECONDS 0.25     /* the longest slice: bounds the delay of input */
+#define DRAW_SHARE 2.0             /* the slice is at least this many times the last frame's
+                                      drawing, so drawing never starves refinement */
 #define FPS_WINDOW_SECONDS 0.5     /* the overlay's fps is averaged over this long */
 
 static char glfw_error[512];
@@ -150,9 +153,11 @@ static int refine(viewer *v)
 {
     if (v->paused || v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v))
         return 0;
-    double slice = v->draw_seconds < FRAME_BUDGET_SECONDS ? FRAME_BUDGET_SECONDS
-                   : v->draw_seconds > MAX_SLICE_SECONDS  ? MAX_SLICE_SECONDS
-                                                          : v->draw_seconds;
+    /* drawing (and showing the frame) takes at most a third of a frame */
+    double drawing = DRAW_SHARE * v->draw_seconds;
+    double slice = drawing < FRAME_BUDGET_SECONDS ? FRAME_BUDGET_SECONDS
+                   : drawing > MAX_SLICE_SECONDS  ? MAX_SLICE_SECONDS
+                                                  : drawing;
     if (v->o.common.time_limit > 0 && slice > v->o.common.time_limit - v->pass_wall)
         slice = v->o.common.time_limit - v->pass_wall;
     ip_engine_counts t;

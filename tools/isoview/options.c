@@ -106,9 +106,11 @@ int parse_args(int argc, char **argv, options *o)
     int rc = tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
                                           sizeof isoview_options / sizeof isoview_options[0], o,
                                           &o->file, argc, argv);
-    if (o->common.cull < 0) /* every triangle unless --cull on: a paused viewer shows the mesh
-                               from other views */
-        o->common.cull = 0;
+    /* on, as isorender: the mesh holds what the window shows (a paused viewer moved around
+     * the surface then shows pinholes until it resumes), unless --aa, whose samples off the
+     * pixel centres need every triangle */
+    if (o->common.cull < 0)
+        o->common.cull = o->aa <= 1;
     if (rc == 0 && o->aa > 1 && o->renderer == RENDERER_SOFTWARE)
         return tool_usage_error("isoview", "--aa is OpenGL's: --renderer software draws without it");
     if (rc == 0 && o->common.iso_count > 1) /* isorender draws each; here one would be lost */
