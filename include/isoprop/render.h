@@ -310,6 +310,18 @@ IP_API uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
 IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera,
                                   const double lo[3], const double hi[3], ip_error *err);
 
+/*! ip_renderer_draw_added() : draws only the uploaded triangles [first, count) over the image
+ *  drawn last, whose colour and depth the framebuffer still holds (a renderer's own, or a
+ *  caller's framebuffer object: not a window's, whose back buffer a swap may leave undefined);
+ *  `camera` must be the one of that image. The image is then the one ip_renderer_draw() gives
+ *  of every uploaded triangle (drawn in order, the nearest wins, the earlier on equal depth),
+ *  at the cost of the new triangles only: for a mesh that grows while the view stays. `first`
+ *  0 is ip_renderer_draw().
+ *  @return as ip_renderer_draw(), and IP_ERR_ARGUMENT when first is past the uploaded count. */
+IP_API ip_status ip_renderer_draw_added(ip_renderer *renderer, const ip_camera *camera,
+                                        const double lo[3], const double hi[3], uint64_t first,
+                                        ip_error *err);
+
 /*! ip_renderer_draw_mesh() : draws the background and the triangles of `mesh`, in order,
  *  like ip_renderer_draw() would after uploading exactly `mesh` (the same image), but
  *  streams them through one GPU buffer of 65,536 triangles, so that neither the GPU nor the

@@ -523,12 +523,13 @@ static void use_mesh_program(const ip_renderer *r, const ip_camera *camera, doub
     glUniform1f(r->opacity_at, 1.0f);
 }
 
+/* Draws the uploaded triangles [first, triangle_count). */
 static void draw_mesh(const ip_renderer *r, const ip_camera *camera, double near_plane,
-                      double far_plane)
+                      double far_plane, uint64_t first)
 {
     use_mesh_program(r, camera, near_plane, far_plane);
     glBindVertexArray(r->mesh_array);
-    glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * r->triangle_count));
+    glDrawArrays(GL_TRIANGLES, (GLint)(3 * first), (GLsizei)(3 * (r->triangle_count - first)));
     glBindVertexArray(0);
     glUseProgram(0);
 }
@@ -566,7 +567,34 @@ ip_status ip_renderer_draw(ip_renderer *r, const ip_camera *camera, const double
     if (st != IP_OK)
         return st;
     if (r->triangle_count)
-        draw_mesh(r, camera, near_plane, far_plane);
+        draw_mesh(r, camera, near_plane, far_plane, 0);
+    return check_gl("drawing", err);
+}
+
+ip_status ip_renderer_draw_added(ip_renderer *r, const ip_camera *camera, const double lo[3],
+                                 const double hi[3], uint64_t first, ip_error *err)
+{
+    if (first == 0)
+        return ip_renderer_draw(r, camera, lo, hi, err);
+    ip_status st = ip_camera_check(camera, err);
+    if (st == IP_OK)
+        st = ip_render_check_box(lo, hi, err);
+    if (st != IP_OK)
+        return st;
+    if (first > r->triangle_count)
+        return ip__fail(err, IP_ERR_ARGUMENT, "renderer: triangles from %llu drawn, but %llu uploaded",
+                        (unsigned long long)first, (unsigned long long)r->triangle_count);
+    if (camera->width != r->width || camera->height != r->height)
+        return ip__fail(err, IP_ERR_ARGUMENT, "renderer: camera is %ux%u, the image %ux%u",
+                        camera->width, camera->height, r->width, r->height);
+    st = make_current(r, err);
+    if (st != IP_OK)
+        return st;
+    double near_plane, far_plane;
+    ip_camera_depth_range(camera, lo, hi, &near_plane, &far_plane);
+    set_draw_state(r);
+    if (first < r->triangle_count)
+        draw_mesh(r, camera, near_plane, far_plane, first);
     return check_gl("drawing", err);
 }
 

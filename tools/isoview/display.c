@@ -1,14 +1,17 @@
-/* isoview's software display: the canvas's image (the exact software rasterizer, drawing only
- * what is new) shown in the window as a texture, for machines whose OpenGL is itself software
- * (llvmpipe), where drawing the whole mesh every frame would set the pace. */
+/* isoview's image between frames: a framebuffer object that keeps the picture from one frame to
+ * the next (a window's back buffer is undefined after a swap), so that a frame draws only what
+ * is new, and is copied to the window before the overlay. The software renderer sends the
+ * canvas's changed rows into its texture; the OpenGL renderer draws into it, with a depth
+ * buffer of its own. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "isoview.h"
 
-int display_create(display *d, ip_error *err)
+int display_create(display *d, int with_depth, ip_error *err)
 {
     memset(d, 0, sizeof *d);
+    d->with_depth = with_depth;
     glGenTextures(1, &d->texture);
     glGenFramebuffers(1, &d->framebuffer);
     if (glGetError() != GL_NO_ERROR) {
@@ -23,17 +26,18 @@ void display_destroy(display *d)
     if (d->texture) {
         glDeleteFramebuffers(1, &d->framebuffer);
         glDeleteTextures(1, &d->texture);
+        glDeleteRenderbuffers(1, &d->depth);
     }
     free(d->rows);
     memset(d, 0, sizeof *d);
 }
 
-/* The texture of a new size, bottom row first as OpenGL's images are, attached to the read
- * framebuffer. Returns 0, or -1 with the error in *err. */
-static int resize(display *d, uint32_t width, uint32_t height, ip_error *err)
+int display_size(display *d, uint32_t width, uint32_t height, ip_error *err)
 {
-    uint8_t *rows = realloc(d->rows, (size_t)width * height * 4);
-    if (!rows) {
+    if (width == d->width && height == d->height)
+        return 0;
+    uint8_t *rows = d->with_depth ? d->rows : realloc(d->rows, (size_t)width * height * 4);
+    if (!d->with_depth && !rows) {
         set_error(err, IP_ERR_NOMEM, "display: out of memory for a %ux%u image", width, height);
         return -1;
     }
@@ -43,10 +47,21 @@ static int resize(display *d, uint32_t width, uint32_t height, ip_error *err)
                  GL_UNSIGNED_BYTE, NULL);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, d->framebuffer);
-    glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, d->texture,
-                           0);
-    if (glCheckFramebufferStatus(GL_READ_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, d->framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, d->texture, 0);
+    if (d->with_depth) {
+        if (!d->depth)
+            glGenRenderbuffers(1, &d->depth);
+        glBindRenderbuffer(GL_RENDERBUFFER, d->depth);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, (GLsizei)width,
+                              (GLsizei)height);
+        glBindRenderbuffer(GL_RENDERBUFFER, 0);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, d->depth);
+    }
+    GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
         set_error(err, IP_ERR_UNSUPPORTED, "display: the image's framebuffer is incomplete");
         return -1;
     }
@@ -60,11 +75,11 @@ int display_show(display *d, const uint8_t *rgba, uint32_t width, uint32_t heigh
 {
     uint32_t first = rows[0], last = rows[1];
     if (width != d->width || height != d->height) {
-        if (resize(d, width, height, err) != 0)
+        if (display_size(d, width, height, err) != 0)
             return -1;
         first = 0, last = height; /* the whole image */
     }
-    if (last > first) {
+    if (rgba && last > first) {
         /* the changed rows, turned bottom first, so that the copy to the window is a plain one
          * (a software driver then copies memory instead of running a shader per pixel) */
         size_t row = (size_t)width * 4;

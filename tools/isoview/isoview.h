@@ -78,8 +78,10 @@ typedef struct overlay {
 
 /* The software renderer's window side: the canvas's image as a texture over the window. */
 typedef struct display {
-    GLuint texture, framebuffer; /* the image, bottom row first, and a framebuffer to read it */
-    uint8_t *rows;               /* the rows sent, turned bottom first */
+    GLuint texture, framebuffer; /* the image, bottom row first, and its framebuffer */
+    GLuint depth;                /* with_depth: the OpenGL renderer's depth buffer */
+    int with_depth;              /* for the OpenGL renderer (display_create()) */
+    uint8_t *rows;               /* the rows sent, turned bottom first (software) */
     uint32_t width, height;      /* of the texture (0: none yet) */
 } display;
 
@@ -120,8 +122,12 @@ typedef struct viewer {
     ip_renderer *renderer; /* OpenGL (NULL with the software renderer) */
     ip_canvas *canvas;     /* the software renderer (NULL with OpenGL) */
     display screen;        /* the canvas's image in the window */
-    const ip_mesh *canvas_mesh; /* the mesh the canvas holds a prefix of (NULL: start over) */
-    ip_camera canvas_camera;    /* the camera it was begun with */
+    /* the image kept between frames: the mesh it holds a prefix of (NULL: start over), the
+     * camera it was drawn for and (OpenGL) the triangles drawn into it */
+    const ip_mesh *canvas_mesh;
+    ip_camera canvas_camera;
+    uint64_t gl_drawn;
+    int keep_image; /* OpenGL draws into the kept image (not with --aa) */
     char gl_renderer[96];       /* GL_RENDERER */
     overlay text;
     double lo[3], hi[3];
@@ -238,12 +244,16 @@ void record_free(viewer *v);
 void record_json(FILE *f, const viewer *v);
 
 /* display.c */
-/* Builds the texture and program that show the canvas (the window's context current).
+/* Builds the kept image's texture and framebuffer, with a depth buffer for the OpenGL
+ * renderer (the window's context current).
  * Returns 0, or -1 with the error in *err. */
-int display_create(display *d, ip_error *err);
+int display_create(display *d, int with_depth, ip_error *err);
 void display_destroy(display *d);
-/* Sends rows [rows[0], rows[1]) of the canvas's image (all of it after a change of size) to
- * the texture and draws it over the window. Returns 0, or -1 with the error in *err. */
+/* Gives the image (and its depth buffer) width x height pixels; 0, or -1 with the error. */
+int display_size(display *d, uint32_t width, uint32_t height, ip_error *err);
+/* Sends rows [rows[0], rows[1]) of the canvas's image (all of it after a change of size; none
+ * when rgba is NULL, the OpenGL renderer having drawn into the image) to the texture and
+ * copies the image to the window. Returns 0, or -1 with the error in *err. */
 int display_show(display *d, const uint8_t *rgba, uint32_t width, uint32_t height,
                  const uint32_t rows[2], ip_error *err);
 /* Reads the window's back buffer as drawn (overlay included), top row first. Returns 0, or -1

@@ -233,11 +233,36 @@ static int draw_software(viewer *v)
     return display_show(&v->screen, rgba, v->camera.width, v->camera.height, rows, &v->err);
 }
 
+/* OpenGL into the kept image: only the triangles uploaded since the last frame, unless the
+ * view, the mesh shown or the size changed; then the image is copied to the window. */
+static int draw_opengl(viewer *v)
+{
+    const ip_mesh *mesh = v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine);
+    uint64_t first = v->gl_drawn;
+    if (v->canvas_mesh != mesh || !same_camera(&v->canvas_camera, &v->camera) ||
+        ip_renderer_triangle_count(v->renderer) < first)
+        first = 0;
+    v->canvas_mesh = NULL;
+    if (display_size(&v->screen, v->camera.width, v->camera.height, &v->err) != 0 ||
+        ip_renderer_draw_added(v->renderer, &v->camera, v->lo, v->hi, first, &v->err) != IP_OK)
+        return -1;
+    v->canvas_mesh = mesh;
+    v->canvas_camera = v->camera;
+    v->gl_drawn = ip_renderer_triangle_count(v->renderer);
+    const uint32_t none[2] = {0, 0};
+    return display_show(&v->screen, NULL, v->camera.width, v->camera.height, none, &v->err);
+}
+
 static int draw_frame(viewer *v, int working_on_full)
 {
     double start = ip_now_seconds();
-    if (v->canvas ? draw_software(v) != 0
-                  : ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) != IP_OK)
+    int rc = v->canvas       ? draw_software(v)
+             : v->keep_image ? draw_opengl(v)
+                             : (ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) ==
+                                        IP_OK
+                                    ? 0
+                                    : -1);
+    if (rc != 0)
         return -1;
     overlay_draw_frame(v, working_on_full);
     double seconds = ip_now_seconds() - start;
@@ -266,8 +291,9 @@ static int save_screenshot(viewer *v)
     int rc = -1;
     if (!rgba)
         set_error(&err, IP_ERR_NOMEM, "out of memory for a screenshot");
-    else if ((v->canvas ? display_read(v->camera.width, v->camera.height, rgba, &err) == 0
-                        : ip_renderer_read_rgba(v->renderer, rgba, &err) == IP_OK) &&
+    else if ((v->canvas || v->keep_image
+                  ? display_read(v->camera.width, v->camera.height, rgba, &err) == 0
+                  : ip_renderer_read_rgba(v->renderer, rgba, &err) == IP_OK) &&
              ip_png_write(path, rgba, v->camera.width, v->camera.height,
                           automatic ? 0 : v->o.common.force, &err) == IP_OK)
         rc = 0;
@@ -419,9 +445,15 @@ static int open_window(viewer *v)
                    (v->o.renderer == RENDERER_AUTO && v->o.aa <= 1 &&
                     (strstr(v->gl_renderer, "llvmpipe") || strstr(v->gl_renderer, "softpipe") ||
                      strstr(v->gl_renderer, "Software Rasterizer")));
-    if (!software &&
-        ip_renderer_create_current(v->camera.width, v->camera.height, 0, &v->renderer, &v->err) !=
-            IP_OK) {
+    /* OpenGL draws into a kept image (only what is new each frame), but with --aa into the
+     * window's multisampled framebuffer, every triangle each frame */
+    v->keep_image = !software && v->o.aa <= 1;
+    if (!software && (display_create(&v->screen, v->keep_image, &v->err) != 0 ||
+                      (v->keep_image &&
+                       display_size(&v->screen, v->camera.width, v->camera.height, &v->err) != 0) ||
+                      ip_renderer_create_current(v->camera.width, v->camera.height,
+                                                 v->keep_image ? v->screen.framebuffer : 0,
+                                                 &v->renderer, &v->err) != IP_OK)) {
         if (v->o.renderer == RENDERER_OPENGL) {
             fprintf(stderr, "isoview: the OpenGL renderer cannot start: %s\n", v->err.message);
             return -1;
@@ -430,9 +462,13 @@ static int open_window(viewer *v)
                         "software\n", v->err.message);
         software = 1;
         v->renderer_note = 1;
+        v->keep_image = 0;
+        ip_renderer_destroy(v->renderer);
+        v->renderer = NULL;
+        display_destroy(&v->screen);
     }
     if (software && (ip_canvas_create(v->o.common.threads, &v->canvas, &v->err) != IP_OK ||
-                     display_create(&v->screen, &v->err) != 0)) {
+                     display_create(&v->screen, 0, &v->err) != 0)) {
         fprintf(stderr, "isoview: the software renderer cannot start: %s\n", v->err.message);
         return -1;
     }
