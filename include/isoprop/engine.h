@@ -47,6 +47,22 @@
  * front but what this view's image needs. Keep them (cull 0) for a mesh to be written out,
  * drawn with multisampling or from another view (docs/occlusion.md).
  *
+ * Reuse (options.reuse, with occlusion; off by default): consecutive views of an orbit share
+ * most of their surface. ip_engine_begin() at the isovalue of the view before (the engine's
+ * planes and options unchanged, and that view's steps all successful) then keeps, of the mesh,
+ * the cells that belong to the new view's surface and may show in it: each cell whose level's
+ * distance band for the new view holds its centre (the rule of ip_extract_full_lod()), one of
+ * whose triangles may be drawn at a pixel centre of the new image, and that the others kept do
+ * not certainly hide. They stay in the mesh, first and in their order, are marked extracted,
+ * and their triangles are recorded in the coverage, so rays meeting them end there and their
+ * tiles retire in bulk: the pass extracts what became visible. With culling, a cell keeps all
+ * its triangles when one of them may show (whole cells), so a cell kept is never missing a
+ * triangle the new view needs. Every kept triangle belongs to the new view's full extraction
+ * at adaptive resolution and every cell of it is whole, so the image once every ray has been
+ * cast is the one without reuse. The mesh stays within the cells that may show in the current
+ * view: hidden cells and those outside the image are dropped. The mesh then keeps cell ids
+ * (with_cells), 8 bytes a triangle.
+ *
  * Reading ahead (options.prefetch, IP_PREFETCH_ON by default): one more thread per engine
  * reads and decodes into the cache, from the first step after ip_engine_begin() on and between
  * steps, the bricks that the next rays of the order will seed in (found from the summaries) and
@@ -131,6 +147,8 @@ typedef struct ip_engine_options {
     ip_clip_plane clip[IP_MAX_CLIP_PLANES]; /* the surface is kept where every plane keeps it:
                                                the exact-image guarantee holds for the kept
                                                cells (ip_extract_full_clipped()) */
+    int reuse; /* with occlusion: a view keeps what stays valid of the view before it at the
+                  same isovalue (see Reuse above; default off) */
 } ip_engine_options;
 
 /* Counters and times, per step or in total. Times are wall seconds, split as the paper does.
@@ -153,6 +171,8 @@ typedef struct ip_engine_counts {
     uint64_t nodes;    /* octree nodes (bricks included), sub-blocks and cells the rays' walks
                           entered: the seeding work, independent of the clock */
     uint64_t culled;   /* with options.cull: triangles made and not kept, not in `triangles` */
+    uint64_t kept;     /* with options.reuse: triangles kept from the view before, counted in
+                          `triangles` (their cells in `cells`) */
 } ip_engine_counts;
 
 typedef struct ip_engine ip_engine;

@@ -26,6 +26,7 @@ void ip_engine_options_default(ip_engine_options *o)
     o->prefetch = IP_PREFETCH_ON;
     o->cull = 1;
     o->clip_count = 0;
+    o->reuse = 0;
 }
 
 /* The brick file an engine extracts from, which its messages name. */
@@ -75,7 +76,7 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     atomic_init(&e->hungry, 0);
     atomic_init(&e->share_news, 0);
     ip_mesh_init(&e->mesh);
-    e->mesh.with_cells = options->cell_ids != 0;
+    e->mesh.with_cells = options->cell_ids != 0 || options->reuse != 0;
     e->workers = calloc(e->threads, sizeof *e->workers);
     e->leftovers = calloc(e->threads, sizeof *e->leftovers);
     e->shared = malloc(SHARED_MAX * sizeof *e->shared);
@@ -219,8 +220,13 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: the isovalue must be finite", path_of(e->cache));
     if (e->prefetcher) /* it reads the view about to change */
         ip__prefetcher_pause(e->prefetcher);
+    /* the view before's mesh stays for reuse (reuse.c) until the new view is set up */
+    int keep = e->options.reuse && e->options.occlusion && e->begun && e->reusable &&
+               iso == e->iso && e->mesh.with_cells;
+    e->reusable = 0;
     ip__visited_clear(&e->visited);
-    ip_mesh_clear(&e->mesh);
+    if (!keep)
+        ip_mesh_clear(&e->mesh);
     e->shared_count = 0; /* what a cancelled or failed step left */
     e->camera = *camera;
     ip_camera_basis_of(&e->camera, &e->basis);
@@ -289,8 +295,13 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
                 lt->propagator.share = (ip_share){&e->hungry, ip__engine_give_cells, e};
         }
     }
+    if (keep && ip__engine_keep(e) != IP_OK) {
+        ip_mesh_clear(&e->mesh);
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
+    }
     atomic_store(&e->cancel, 0);
     e->begun = 1;
+    e->reusable = 1;
     begin_prefetch(e);
     return IP_OK;
 }
@@ -314,6 +325,7 @@ ip_status ip_engine_set_region(ip_engine *e, uint32_t x, uint32_t y, uint32_t wi
                         (unsigned long long)pixels);
     if (e->prefetcher) /* it reads the order about to change */
         ip__prefetcher_pause(e->prefetcher);
+    e->reusable = 0; /* a region's mesh is not the view's */
     start_order(e, width, height);
     /* the positions of rays [first_ray, first_ray + ray_count) of the region's order */
     ip_ray_order walk = e->order;
@@ -372,6 +384,7 @@ static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
     to->retired += from->retired;
     to->nodes += from->nodes;
     to->culled += from->culled;
+    to->kept += from->kept;
 }
 
 /* Moves the worker's triangles, if it holds any, to the engine's mesh. */
@@ -491,6 +504,8 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
     add_counts(&e->totals, &c);
     if (counts)
         *counts = c;
+    if (st != IP_OK)
+        e->reusable = 0;
     return st;
 }
 

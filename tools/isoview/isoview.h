@@ -24,6 +24,7 @@ typedef struct options {
     double screenshot_at, exit_after;
     int aa; /* --aa N: samples a pixel of the window (1: no multisampling) */
     int renderer; /* --renderer: RENDERER_AUTO, _OPENGL or _SOFTWARE */
+    int reuse;    /* --reuse on|off: the engine's reuse across views */
 } options;
 
 /* --renderer: OpenGL draws the mesh; software draws it with the library's exact rasterizer
@@ -92,6 +93,7 @@ typedef struct pass_record {
     double final_85, final_995;        /* seconds after start to 85 % / 99.5 % of the final
                                           pixels (< 0: not measured) */
     uint64_t frames, triangles, rays;  /* frames drawn, and the pass's mesh at its end */
+    uint64_t kept;                     /* triangles kept from the view before (--reuse) */
     int moving;                        /* it began during a drag */
 } pass_record;
 

@@ -118,6 +118,7 @@ static int create_engine(viewer *v, ip_error *err)
     clip_options(v, &common);
     ip_engine_options eo;
     tool_engine_options(&common, &eo);
+    eo.reuse = v->o.reuse;
     ip_engine *engine;
     if (ip_engine_create(v->cache, &eo, &engine, err) != IP_OK)
         return -1;

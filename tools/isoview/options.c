@@ -24,6 +24,9 @@ static const char usage[] =
     "                      draw the mesh with OpenGL, or with the exact software rasterizer\n"
     "                      shown as a texture, drawing only what is new; auto (the default):\n"
     "                      software where OpenGL is itself software (llvmpipe, softpipe)\n"
+    "  --reuse on|off      a new view keeps the cells of the view before that stay valid and\n"
+    "                      may show, and extracts what became visible (default off: slower\n"
+    "                      here, see docs/isoview.md)\n"
     "  --stats OUT.json    on exit: counts, times, fps and the cache statistics as JSON\n"
     "  --script FILE       run the commands of FILE (see docs/isoview.md)\n"
     "  --screenshot-at SECONDS OUT.png\n"
@@ -87,7 +90,18 @@ static int parse_renderer(const char *p, const tool_option *opt, const char *con
     return 0;
 }
 
+static int parse_reuse(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (strcmp(v[0], "on") && strcmp(v[0], "off"))
+        return tool_usage_error(p, "--reuse '%s': must be on or off", v[0]);
+    o->reuse = !strcmp(v[0], "on");
+    return 0;
+}
+
 static const tool_option isoview_options[] = {
+    {"--reuse", NULL, 1, 0, parse_reuse, NULL, NULL},
     {"--renderer", NULL, 1, 0, parse_renderer, NULL, NULL},
     {"--script", NULL, 1, offsetof(options, script), NULL, NULL, NULL},
     {"--screenshot-at", NULL, 2, 0, parse_screenshot_at, NULL, NULL},
@@ -103,6 +117,7 @@ int parse_args(int argc, char **argv, options *o)
     o->exit_after = -1;
     o->aa = 1;
     o->renderer = RENDERER_AUTO;
+    o->reuse = 0;
     int rc = tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
                                           sizeof isoview_options / sizeof isoview_options[0], o,
                                           &o->file, argc, argv);

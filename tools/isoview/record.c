@@ -37,6 +37,7 @@ static void record_abandon(viewer *v)
     ip_engine_totals(v->engine, &t);
     r->triangles = t.triangles;
     r->rays = t.rays;
+    r->kept = t.kept;
     v->pass_recorded = 1;
 }
 
@@ -137,6 +138,7 @@ void record_frame(viewer *v, double end)
             ip_engine_totals(v->engine, &c);
         r->triangles = c.triangles;
         r->rays = c.rays;
+        r->kept = c.kept;
         if (v->frame_count == r->frames) /* every frame of the pass is in the log */
             measure_final(v, r);
         v->pass_recorded = 1;
@@ -197,9 +199,12 @@ void record_json(FILE *f, const viewer *v)
             if (column[k])
                 column[k][i] = r->moving ? -1 : at[k];
         }
-        fprintf(f, "\"view_frames\": %llu, \"view_triangles\": %llu, \"view_rays\": %llu, \"moving\": %s}",
+        fprintf(f,
+                "\"view_frames\": %llu, \"view_triangles\": %llu, \"view_kept\": %llu, "
+                "\"view_rays\": %llu, \"moving\": %s}",
                 (unsigned long long)r->frames, (unsigned long long)r->triangles,
-                (unsigned long long)r->rays, r->moving ? "true" : "false");
+                (unsigned long long)r->kept, (unsigned long long)r->rays,
+                r->moving ? "true" : "false");
     }
     fprintf(f, "], \"views_median\": {");
     const char *keys[4] = {"first_frame_s", "final_85_s", "final_995_s", "complete_s"};
