@@ -124,6 +124,23 @@ done
 check "five passes recorded" test "$(grep -o '"start_s"' walk.json | wc -l)" = 5
 check "the last pass completed, its final pixels measured" \
     sh -c 'tr "{" "\n" <walk.json | grep "\"start_s\"" | tail -1 | grep -q "\"final_995_s\": [0-9]"'
+# a drag (the script's, as the mouse's): coarse passes while the view moves, then the fine pass
+# at the camera where it stopped, the image isorender draws there (its --azimuth turns the
+# other way)
+printf 'wait done\ndrag 30 0 0.6\nwait done\noverlay off\nscreenshot drag.png\nquit\n' >drag.txt
+view s.ibv --iso 1000.5 --size 320x240 --script drag.txt --stats drag.json --exit-after 90
+check "the drag exits with 0 (got $rc: $err)" test "$rc" = 0
+"$bin/isorender" s.ibv --iso 1000.5 --size 320x240 --view -y --azimuth -30 -o r-drag.png --quiet
+same_image "after a drag, the fine pass's image at the camera it stopped at" drag.png r-drag.png
+check "passes ran while the view moved" grep -q '"moving": true' drag.json
+check "and the last one did not" \
+    sh -c 'tr "{" "\n" <drag.json | grep "\"start_s\"" | tail -1 | grep -q "\"moving\": false"'
+check "frames were counted while it moved" sh -c '! grep -q "\"fps_moving\": 0.000" drag.json'
+expect_error 2 "--drag-pixel-error '-1'" "$bin/isoview" s.ibv --iso 1 --drag-pixel-error -1
+printf 'drag 30 0\n' >baddrag.txt
+expect_error 1 "baddrag.txt:1: bad arguments to 'drag'" "$bin/isoview" s.ibv --iso 1 \
+    --script baddrag.txt
+
 # the same walk with the other renderer draws the same pictures
 for r in opengl software; do
     grep -q "\"renderer\": \"$r\"" walk.json && continue

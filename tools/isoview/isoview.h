@@ -25,6 +25,7 @@ typedef struct options {
     int aa; /* --aa N: samples a pixel of the window (1: no multisampling) */
     int renderer; /* --renderer: RENDERER_AUTO, _OPENGL or _SOFTWARE */
     int reuse;    /* --reuse on|off: the engine's reuse across views */
+    double drag_pixel_error; /* --drag-pixel-error P: the coarse pass while moving (0: none) */
 } options;
 
 /* --renderer: OpenGL draws the mesh; software draws it with the library's exact rasterizer
@@ -119,7 +120,8 @@ typedef struct viewer {
     options o;
     ip_store *store;
     ip_cache *cache;
-    ip_engine *engine;
+    ip_engine *engine; /* the one in use: fine, or coarse while the view moves */
+    ip_engine *fine, *coarse; /* coarse: --drag-pixel-error's (NULL: none) */
     GLFWwindow *window;
     ip_renderer *renderer; /* OpenGL (NULL with the software renderer) */
     ip_canvas *canvas;     /* the software renderer (NULL with OpenGL) */
@@ -179,6 +181,7 @@ typedef struct viewer {
     int pass_recorded;         /* this pass's record is complete */
     /* a drag from a script (COMMAND_DRAG): degrees a second left to turn, until drag_end */
     double drag_rate[2], drag_end, drag_last;
+    double last_motion; /* when the mouse (or a script's drag) last moved the view */
     uint64_t moving_frames; /* frames drawn during a drag (the mouse's or a script's) */
     double moving_seconds;  /* and the seconds they took */
     int renderer_note;      /* the software renderer took over from one that failed */
@@ -191,7 +194,8 @@ typedef struct viewer {
 void set_error(ip_error *err, ip_status code, const char *fmt, ...);
 /* 1 once this pass has cast its --rays, 2 once it has extracted for its --time, else 0. */
 int pass_limit_reached(const viewer *v);
-/* 1 once nothing more will be extracted until the next change, or while paused. */
+/* 1 once nothing more will be extracted until the next change, or while paused; never while
+ * the coarse pass of a moving view is shown (the fine one follows). */
 int refinement_complete(const viewer *v);
 /* Saves the next frame to `path` ("" for the next free isoview-NNN.png). */
 void request_screenshot(viewer *v, const char *path);

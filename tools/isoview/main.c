@@ -25,6 +25,7 @@
 #define DRAW_SHARE 2.0             /* the slice is at least this many times the last frame's
                                       drawing, so drawing never starves refinement */
 #define FPS_WINDOW_SECONDS 0.5     /* the overlay's fps is averaged over this long */
+#define MOTION_SECONDS 0.15        /* the view moves while the mouse moved it this recently */
 
 static char glfw_error[512];
 
@@ -57,6 +58,8 @@ int refinement_complete(const viewer *v)
 {
     if (v->paused && !v->want_full)
         return 1;
+    if (v->engine == v->coarse && v->coarse && !v->full_shown)
+        return 0; /* the fine pass follows once the view stops */
     return !v->restart && !v->want_full &&
            (v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v));
 }
@@ -119,16 +122,43 @@ static int create_engine(viewer *v, ip_error *err)
     ip_engine_options eo;
     tool_engine_options(&common, &eo);
     eo.reuse = v->o.reuse;
-    ip_engine *engine;
-    if (ip_engine_create(v->cache, &eo, &engine, err) != IP_OK)
+    ip_engine *fine, *coarse = NULL;
+    if (ip_engine_create(v->cache, &eo, &fine, err) != IP_OK)
         return -1;
-    tool_signals_cancel_engine(NULL); /* no handler uses the old one from here */
-    ip_engine_destroy(v->engine);
-    v->engine = engine;
+    /* the coarse pass while the view moves: adaptive resolution at a larger pixel error */
+    if (eo.lod && v->o.drag_pixel_error > eo.pixel_error) {
+        eo.pixel_error = v->o.drag_pixel_error;
+        eo.prefetch = IP_PREFETCH_OFF; /* its few bricks are read on demand */
+        eo.reuse = 0;
+        if (ip_engine_create(v->cache, &eo, &coarse, err) != IP_OK) {
+            ip_engine_destroy(fine);
+            return -1;
+        }
+    }
+    tool_signals_cancel_engine(NULL); /* no handler uses the old ones from here */
+    ip_engine_destroy(v->fine);
+    ip_engine_destroy(v->coarse);
+    v->engine = v->fine = fine;
+    v->coarse = coarse;
     tool_signals_cancel_engine(v->engine);
     v->clip_changed = 0;
     v->restart = 1;
     return 0;
+}
+
+/* The engine for the next pass: the coarse one while the view moves (a script's drag, or the
+ * mouse's drag or wheel within the last MOTION_SECONDS), the fine one otherwise; a change
+ * starts the pass again. */
+static void choose_engine(viewer *v)
+{
+    int moving = v->drag_end > 0 || ip_now_seconds() - v->last_motion < MOTION_SECONDS;
+    ip_engine *want = moving && v->coarse ? v->coarse : v->fine;
+    if (want == v->engine)
+        return;
+    tool_signals_cancel_engine(NULL);
+    v->engine = want;
+    tool_signals_cancel_engine(want);
+    v->restart = 1;
 }
 
 static int begin_pass(viewer *v)
@@ -154,8 +184,9 @@ static int refine(viewer *v)
 {
     if (v->paused || v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v))
         return 0;
-    /* drawing (and showing the frame) takes at most a third of a frame */
-    double drawing = DRAW_SHARE * v->draw_seconds;
+    /* drawing (and showing the frame) takes at most a third of a frame, half while the view
+     * moves (each frame then draws a new view whole) */
+    double drawing = (v->engine == v->coarse ? 1.0 : DRAW_SHARE) * v->draw_seconds;
     double slice = drawing < FRAME_BUDGET_SECONDS ? FRAME_BUDGET_SECONDS
                    : drawing > MAX_SLICE_SECONDS  ? MAX_SLICE_SECONDS
                                                   : drawing;
@@ -341,6 +372,7 @@ static void follow_drag(viewer *v, double t)
     if (dt > 0) {
         ip_camera_orbit(&v->camera, v->drag_rate[0] * dt, v->drag_rate[1] * dt);
         change_view(v);
+        v->last_motion = ip_now_seconds();
     }
     v->drag_last = until;
     if (t >= v->drag_end)
@@ -376,6 +408,8 @@ static int frame(viewer *v)
     }
     if (v->clip_changed && create_engine(v, &v->err) != 0)
         return -1;
+    if (!v->full_shown)
+        choose_engine(v);
     /* paused, a change of view keeps the mesh shown until refinement resumes */
     if (v->restart && !v->paused && begin_pass(v) != 0)
         return -1;
@@ -397,7 +431,7 @@ static int frame(viewer *v)
     glfwSwapBuffers(v->window);
     double end = ip_now_seconds();
     v->draw_seconds = end - drawn;
-    if (v->drag_end > 0 || v->drag_button >= 0) {
+    if (v->drag_end > 0 || end - v->last_motion < MOTION_SECONDS) {
         v->moving_frames++;
         v->moving_seconds += end - frame_start;
     }
@@ -485,8 +519,13 @@ static void memory_json(FILE *f, const viewer *v)
 {
     ip_cache_stats s;
     ip_cache_get_stats(v->cache, &s);
-    ip_engine_memory e;
-    ip_engine_memory_of(v->engine, &e);
+    ip_engine_memory e, c;
+    ip_engine_memory_of(v->fine, &e);
+    if (v->coarse) { /* the coarse pass's engine counts with the fine one's */
+        ip_engine_memory_of(v->coarse, &c);
+        e.mesh += c.mesh, e.workers += c.workers, e.visited += c.visited;
+        e.coverage += c.coverage;
+    }
     uint64_t full = v->full_mesh.capacity * (9 * sizeof(float) + 9 * sizeof(int16_t));
     uint64_t gpu = v->renderer ? ip_renderer_memory(v->renderer) : 0;
     uint64_t canvas = v->canvas ? ip_canvas_memory(v->canvas) + 4ull * v->screen.width * v->screen.height : 0;
@@ -689,7 +728,8 @@ int main(int argc, char **argv)
     if (v->window)
         glfwDestroyWindow(v->window);
     glfwTerminate();
-    ip_engine_destroy(v->engine);
+    ip_engine_destroy(v->fine);
+    ip_engine_destroy(v->coarse);
     ip_mesh_free(&v->full_mesh);
     free_commands(v);
     record_free(v);

@@ -27,6 +27,10 @@ static const char usage[] =
     "  --reuse on|off      a new view keeps the cells of the view before that stay valid and\n"
     "                      may show, and extracts what became visible (default off: slower\n"
     "                      here, see docs/isoview.md)\n"
+    "  --drag-pixel-error P\n"
+    "                      while the view moves (a drag), passes at this coarser pixel error\n"
+    "                      (adaptive resolution); refinement resumes at --pixel-error when\n"
+    "                      the motion stops (default 4; 0: off)\n"
     "  --stats OUT.json    on exit: counts, times, fps and the cache statistics as JSON\n"
     "  --script FILE       run the commands of FILE (see docs/isoview.md)\n"
     "  --screenshot-at SECONDS OUT.png\n"
@@ -100,7 +104,21 @@ static int parse_reuse(const char *p, const tool_option *opt, const char *const 
     return 0;
 }
 
+static int parse_drag_pixel_error(const char *p, const tool_option *opt, const char *const *v,
+                                  void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (tool_parse_double(v[0], &o->drag_pixel_error) != 0 || !(o->drag_pixel_error >= 0) ||
+        o->drag_pixel_error > 1024)
+        return tool_usage_error(p, "--drag-pixel-error '%s': must be 0 (off) or a pixel error up "
+                                   "to 1024",
+                                v[0]);
+    return 0;
+}
+
 static const tool_option isoview_options[] = {
+    {"--drag-pixel-error", NULL, 1, 0, parse_drag_pixel_error, NULL, NULL},
     {"--reuse", NULL, 1, 0, parse_reuse, NULL, NULL},
     {"--renderer", NULL, 1, 0, parse_renderer, NULL, NULL},
     {"--script", NULL, 1, offsetof(options, script), NULL, NULL, NULL},
@@ -118,6 +136,7 @@ int parse_args(int argc, char **argv, options *o)
     o->aa = 1;
     o->renderer = RENDERER_AUTO;
     o->reuse = 0;
+    o->drag_pixel_error = 4;
     int rc = tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
                                           sizeof isoview_options / sizeof isoview_options[0], o,
                                           &o->file, argc, argv);

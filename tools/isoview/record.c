@@ -52,7 +52,7 @@ int record_begin(viewer *v)
     memset(r, 0, sizeof *r);
     r->start = ip_now_seconds() - v->start;
     r->first_frame = r->complete = r->final_85 = r->final_995 = -1;
-    r->moving = v->drag_end > 0;
+    r->moving = v->engine == v->coarse && v->coarse;
     v->frame_count = 0;
     v->pass_recorded = 0;
     return 0;
