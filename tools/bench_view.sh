@@ -14,12 +14,14 @@
 # The orbit: 24 steps, each `orbit 15 0` (a full turn in all), `zoom 1.08` in the first 12 and
 # `zoom 1/1.08` in the last 12 (in to 2.5x and back out), then `wait done`; the skin (600.5) in a
 # 1280x960 window seen from -y. The drag: `drag 90 0 3` (a quarter turn over 3 seconds, a step
-# every frame, as a mouse drag), warm. Environment: SCALES ("4 6"), CACHE_MB ("256 512": per
-# scale), RENDERER (auto), REPEAT (1: runs of each kind, medians reported), SIZE (1280x960).
+# every frame, as a mouse drag), warm. Then (LONG=1, the default) 100 views of an orbit on the
+# first volume, its resident size sampled every second. Environment: SCALES ("4 6"), CACHE_MB
+# ("256 512": per scale), RENDERER (auto), REPEAT (1: runs of each kind, medians reported), SIZE
+# (1280x960), LONG (1).
 # Each isoview writes --stats, read with python3. Not a test.
 set -eu
 if [ $# -lt 1 ]; then
-    sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -147,6 +149,48 @@ for k in $scales; do
     # shellcheck disable=SC2086
     drag_row "x$k" $drag
 done
+# Memory over a long orbit: 100 steps of `orbit 15 0` (four turns and more), the first scale's
+# volume and cache, the process's resident size sampled every second from /proc.
+if [ "${LONG:-1}" = 1 ]; then
+    set -- $scales
+    k=$1
+    set -- $caches
+    cache=$1
+    { for i in $(seq 100); do printf 'orbit 15 0\nwait done\n'; done; echo quit; } >"$tmp/long.txt"
+    xvfb-run -a -s "-screen 0 1600x1200x24" "$build/isoview" "$dir/x$k.ibv" --iso 600.5 \
+        --size "$size" --cache-mb "$cache" --renderer "$renderer" --script "$tmp/long.txt" \
+        --stats "$tmp/long.json" --force --quiet --exit-after 1800 &
+    runner=$!
+    : >"$tmp/rss.txt"
+    while kill -0 "$runner" 2>/dev/null; do
+        pid=$(pgrep -n -f "isoview $dir/x$k.ibv" || true)
+        [ -n "$pid" ] && awk '/VmRSS/ { print $2 }' "/proc/$pid/status" 2>/dev/null >>"$tmp/rss.txt"
+        sleep 1
+    done
+    wait "$runner" || true
+    echo
+    echo "Memory over 100 views (x$k, \`--cache-mb $cache\`, \`orbit 15 0\` + \`wait done\` each):" \
+        "resident size (MiB) by tenths of the run, and the statistics' peak and breakdown at the end."
+    echo
+    python3 - "$tmp/rss.txt" "$tmp/long.json" <<'EOF'
+import json, sys
+rss = [int(x) / 1024 for x in open(sys.argv[1]) if x.strip()]
+d = json.load(open(sys.argv[2]))
+m = d["memory"]
+tenths = [max(rss[len(rss) * i // 10:max(len(rss) * (i + 1) // 10, len(rss) * i // 10 + 1)]) for i in range(10)] if rss else []
+print("| tenth | " + " | ".join(str(i + 1) for i in range(len(tenths))) + " |")
+print("| --- |" + " ---: |" * len(tenths))
+print("| peak RSS in it (MiB) | " + " | ".join(f"{v:.0f}" for v in tenths) + " |")
+print()
+print("| at the end (MiB) | cache (peak) | summaries | engine mesh | workers | visited | coverage | canvas | GPU mesh | RSS (peak) |")
+print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+f = lambda k: m[k] / 1048576
+print(f"| {len(d['views'])} views | {f('cache_bytes'):.0f} ({f('cache_peak_bytes'):.0f}) | {f('summaries_bytes'):.0f} | "
+      f"{f('engine_mesh_bytes'):.0f} | {f('engine_workers_bytes'):.0f} | {f('visited_bytes'):.0f} | "
+      f"{f('coverage_bytes'):.0f} | {f('canvas_bytes'):.0f} | {f('gpu_mesh_bytes'):.0f} | "
+      f"{f('rss_bytes'):.0f} ({f('rss_peak_bytes'):.0f}) |")
+EOF
+fi
 echo
 echo "($cold_note. Mean per view: the wall time from the first frame to the last over the" \
     "25 views, the opening view and the 24 steps; the medians are over the same 25.)"

@@ -225,6 +225,16 @@ IP_API ip_status ip_engine_set_region(ip_engine *engine, uint32_t x, uint32_t y,
                                       uint32_t height, uint64_t first_ray, uint64_t ray_count,
                                       ip_error *err);
 
+/*! ip_engine_read_ahead() : once the view is done (ip_engine_done()), lets the background
+ *  reader (options.prefetch) read into the cache the bricks that the first rays of `camera`'s
+ *  view would seed in, and their neighbours, as it does for a view begun (see Reading ahead
+ *  above), within the budget, evicting the least recently used bricks: for a viewer
+ *  that predicts the next view of an orbit or a zoom from the last motions. It reads until the
+ *  next ip_engine_begin(), which stops it; `camera` is copied. Nothing else changes: the mesh
+ *  and the view stay. A no-op without the reader.
+ *  @return IP_OK, or IP_ERR_ARGUMENT (a bad camera, or a view not done). */
+IP_API ip_status ip_engine_read_ahead(ip_engine *engine, const ip_camera *camera, ip_error *err);
+
 /*! ip_engine_done() : 1 once every pixel has had its ray (after ip_engine_set_region(): once
  *  the region's rays have). */
 IP_API int ip_engine_done(const ip_engine *engine);

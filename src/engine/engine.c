@@ -65,6 +65,7 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     e->threads = ip_thread_count(options->threads);
     atomic_init(&e->cancel, 0);
     atomic_init(&e->next_position, 0);
+    atomic_init(&e->ahead_claimed, 0);
     atomic_init(&e->rays_taken, 0);
     atomic_init(&e->leftovers_waiting, 0);
     atomic_init(&e->step_rays_left, 0);
@@ -180,8 +181,53 @@ static void begin_prefetch(ip_engine *e)
                               &e->cancel,
                               {e->options.clip, e->options.clip_count},
                               e->region_x,
-                              e->region_y};
+                              e->region_y,
+                              0};
     ip__prefetcher_begin(e->prefetcher, &view);
+}
+
+ip_status ip_engine_read_ahead(ip_engine *e, const ip_camera *camera, ip_error *err)
+{
+    ip_status st = ip_camera_check(camera, err);
+    if (st != IP_OK)
+        return st;
+    if (!e->begun || !ip_engine_done(e))
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "ip_engine_read_ahead(): the engine's view is not done yet");
+    if (!e->prefetcher)
+        return IP_OK;
+    /* the predicted view's bands and order, as ip_engine_begin() would set them */
+    const ip_layout *layout = ip_store_layout(ip_cache_store(e->cache));
+    double distance[IP_MAX_LEVELS + 1], widening[IP_MAX_LEVELS];
+    uint32_t levels =
+        ip__lod_distances(layout, camera, e->options.lod, e->options.pixel_error, distance);
+    for (uint32_t k = 0; k < levels; k++)
+        widening[k] = ip__lod_band_widening(layout, k, levels);
+    ip_ray_order order; /* as start_order() makes it */
+    ip__ray_order_init(&order, camera->width, camera->height);
+    uint32_t last = ip__ray_order_last_level(&order);
+    ip__ray_order_set_local_from(&order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
+    ip_camera_basis basis;
+    ip_camera_basis_of(camera, &basis);
+    atomic_store(&e->ahead_claimed, 0); /* no worker walks it: the reader plans its first rays */
+    ip__prefetch_view view = {*camera,
+                              basis,
+                              e->iso,
+                              levels,
+                              distance,
+                              widening,
+                              order,
+                              ip__ray_order_cells(&order),
+                              &e->ahead_claimed,
+                              &e->cancel,
+                              {e->options.clip, e->options.clip_count},
+                              0,
+                              0,
+                              1}; /* the workers are idle: every planned brick */
+    ip__prefetcher_pause(e->prefetcher);
+    ip__prefetcher_begin(e->prefetcher, &view);
+    ip__prefetcher_resume(e->prefetcher);
+    return IP_OK;
 }
 /* One worker's share of the occlusion state to start over (a job of the engine's pool): its
  * part of the coverage buffer and of the tiles. */

@@ -117,6 +117,7 @@ struct ip_engine {
     ip_ray_order order; /* the view's order, copied into each worker's iterator */
     uint64_t order_cells;
     atomic_uint_fast64_t next_position; /* the first position no worker has claimed */
+    atomic_uint_fast64_t ahead_claimed; /* ip_engine_read_ahead(): 0, no worker walks it */
     atomic_uint_fast64_t rays_taken;    /* pixels handed out since begin (or set_region) */
     uint64_t ray_target;                /* the pixels of the order to cast: done at rays_taken */
     atomic_uint cells_done;             /* cells extracted since begin, as workers publish them */

@@ -25,6 +25,7 @@ typedef struct options {
     int aa; /* --aa N: samples a pixel of the window (1: no multisampling) */
     int renderer; /* --renderer: RENDERER_AUTO, _OPENGL or _SOFTWARE */
     int reuse;    /* --reuse on|off: the engine's reuse across views */
+    int read_ahead; /* --read-ahead on|off: the next view of a motion read ahead */
     double drag_pixel_error; /* --drag-pixel-error P: the coarse pass while moving (0: none) */
 } options;
 
@@ -182,6 +183,10 @@ typedef struct viewer {
     /* a drag from a script (COMMAND_DRAG): degrees a second left to turn, until drag_end */
     double drag_rate[2], drag_end, drag_last;
     double last_motion; /* when the mouse (or a script's drag) last moved the view */
+    /* the cameras of the last two fine passes begun, for reading the next view ahead */
+    ip_camera pass_camera[2];
+    uint64_t fine_passes;
+    uint64_t read_aheads; /* views read ahead (ip_engine_read_ahead()) */
     uint64_t moving_frames; /* frames drawn during a drag (the mouse's or a script's) */
     double moving_seconds;  /* and the seconds they took */
     int renderer_note;      /* the software renderer took over from one that failed */

@@ -11,6 +11,7 @@
  * keyboard), overlay.c (the heads-up text). docs/isoview.md documents the controls, the
  * options and the script format.
  */
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -174,9 +175,57 @@ static int begin_pass(viewer *v)
     v->uploaded = 0;
     if (record_begin(v) != 0)
         return -1;
+    if (v->engine == v->fine) { /* the last two, for read_ahead() */
+        v->pass_camera[0] = v->pass_camera[1];
+        v->pass_camera[1] = v->camera;
+        v->fine_passes++;
+    }
     if (ip_engine_begin(v->engine, &v->camera, (float)v->iso, &v->err) != IP_OK)
         return -1;
     return 0;
+}
+
+static int same_camera(const ip_camera *a, const ip_camera *b)
+{
+    for (int i = 0; i < 3; i++)
+        if (a->eye[i] != b->eye[i] || a->target[i] != b->target[i] || a->up[i] != b->up[i])
+            return 0;
+    return a->fov_y == b->fov_y && a->width == b->width && a->height == b->height;
+}
+
+/* Once a fine pass is done: the next view, if the motion that led from the view before to this
+ * one goes on (an orbit's or a zoom's step again), is read ahead into the cache. */
+static void read_ahead(viewer *v)
+{
+    if (!v->o.read_ahead || v->fine_passes < 2 || v->engine != v->fine || v->paused ||
+        v->full_shown)
+        return;
+    const ip_camera *a = &v->pass_camera[0], *b = &v->pass_camera[1];
+    if (!same_camera(b, &v->camera) || same_camera(a, b) || a->width != b->width ||
+        a->height != b->height)
+        return;
+    ip_camera next = *b;
+    double da[3], db[3], la = 0, lb = 0, ln = 0;
+    for (int i = 0; i < 3; i++) {
+        da[i] = a->eye[i] - a->target[i];
+        db[i] = b->eye[i] - b->target[i];
+        la += da[i] * da[i];
+        lb += db[i] * db[i];
+    }
+    la = sqrt(la), lb = sqrt(lb);
+    double d[3];
+    for (int i = 0; i < 3; i++) { /* the step again: the offset turned as much, scaled as much */
+        next.target[i] = 2 * b->target[i] - a->target[i];
+        next.up[i] = 2 * b->up[i] - a->up[i];
+        d[i] = 2 * db[i] / lb - da[i] / la;
+        ln += d[i] * d[i];
+    }
+    ln = sqrt(ln);
+    for (int i = 0; i < 3; i++)
+        next.eye[i] = next.target[i] + d[i] / ln * lb * (lb / la);
+    if (ip_camera_check(&next, NULL) == IP_OK &&
+        ip_engine_read_ahead(v->engine, &next, NULL) == IP_OK)
+        v->read_aheads++;
 }
 
 /* One frame's slice of ray casting, then the new triangles to the GPU. */
@@ -204,6 +253,8 @@ static int refine(viewer *v)
     if (v->renderer && ip_renderer_upload(v->renderer, mesh, v->uploaded, &v->err) != IP_OK)
         return -1;
     v->uploaded = mesh->triangle_count;
+    if (ip_engine_done(v->engine))
+        read_ahead(v);
     return 0;
 }
 
@@ -237,13 +288,6 @@ static int extract_full(viewer *v)
     return 0;
 }
 
-static int same_camera(const ip_camera *a, const ip_camera *b)
-{
-    for (int i = 0; i < 3; i++)
-        if (a->eye[i] != b->eye[i] || a->target[i] != b->target[i] || a->up[i] != b->up[i])
-            return 0;
-    return a->fov_y == b->fov_y && a->width == b->width && a->height == b->height;
-}
 
 /* The software renderer: the canvas draws the triangles of the mesh shown that it does not
  * hold yet (all of them after a change of view, mesh or size) and shows the changed rows. */
@@ -579,6 +623,7 @@ static void json_counts(FILE *f, void *user)
             (unsigned long long)v->passes, (unsigned long long)k->frames,
             k->frames ? k->last - k->first : 0.0, mean, k->seconds ? k->slowest : mean,
             k->seconds ? k->fastest : mean);
+    fprintf(f, ", \"read_aheads\": %llu", (unsigned long long)v->read_aheads);
     fprintf(f, ", \"fps_moving\": %.3f, \"gl_renderer\": ",
             v->moving_seconds > 0 ? (double)v->moving_frames / v->moving_seconds : 0.0);
     tool_json_string(f, v->gl_renderer);

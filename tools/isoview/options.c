@@ -27,6 +27,9 @@ static const char usage[] =
     "  --reuse on|off      a new view keeps the cells of the view before that stay valid and\n"
     "                      may show, and extracts what became visible (default off: slower\n"
     "                      here, see docs/isoview.md)\n"
+    "  --read-ahead on|off once a view is done, read the next one of the same motion (an\n"
+    "                      orbit's or a zoom's step again) ahead into the cache (with\n"
+    "                      --prefetch on; default off: no gain measured, docs/isoview.md)\n"
     "  --drag-pixel-error P\n"
     "                      while the view moves (a drag), passes at this coarser pixel error\n"
     "                      (adaptive resolution); refinement resumes at --pixel-error when\n"
@@ -94,13 +97,13 @@ static int parse_renderer(const char *p, const tool_option *opt, const char *con
     return 0;
 }
 
-static int parse_reuse(const char *p, const tool_option *opt, const char *const *v, void *base)
+/* --reuse on|off and --read-ahead on|off */
+static int parse_switch(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     options *o = base;
-    (void)opt;
     if (strcmp(v[0], "on") && strcmp(v[0], "off"))
-        return tool_usage_error(p, "--reuse '%s': must be on or off", v[0]);
-    o->reuse = !strcmp(v[0], "on");
+        return tool_usage_error(p, "%s '%s': must be on or off", opt->name, v[0]);
+    *(!strcmp(opt->name, "--reuse") ? &o->reuse : &o->read_ahead) = !strcmp(v[0], "on");
     return 0;
 }
 
@@ -119,7 +122,8 @@ static int parse_drag_pixel_error(const char *p, const tool_option *opt, const c
 
 static const tool_option isoview_options[] = {
     {"--drag-pixel-error", NULL, 1, 0, parse_drag_pixel_error, NULL, NULL},
-    {"--reuse", NULL, 1, 0, parse_reuse, NULL, NULL},
+    {"--reuse", NULL, 1, 0, parse_switch, NULL, NULL},
+    {"--read-ahead", NULL, 1, 0, parse_switch, NULL, NULL},
     {"--renderer", NULL, 1, 0, parse_renderer, NULL, NULL},
     {"--script", NULL, 1, offsetof(options, script), NULL, NULL, NULL},
     {"--screenshot-at", NULL, 2, 0, parse_screenshot_at, NULL, NULL},
@@ -136,6 +140,7 @@ int parse_args(int argc, char **argv, options *o)
     o->aa = 1;
     o->renderer = RENDERER_AUTO;
     o->reuse = 0;
+    o->read_ahead = 0;
     o->drag_pixel_error = 4;
     int rc = tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
                                           sizeof isoview_options / sizeof isoview_options[0], o,
