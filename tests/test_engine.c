@@ -9,6 +9,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "coverage.h"
@@ -416,6 +417,60 @@ static void check_reuse_exact(const char *dir)
     free(ca);
     free(cb);
     close_scene(&s);
+}
+
+/* ip_engine_read_ahead(): refused before the view is done; once it is, the reader loads bricks
+ * of the predicted view (the other side of the volume) into the cache, and the next begin stops
+ * it; the mesh of the view done stays. */
+static void check_read_ahead(const char *dir)
+{
+    char ibv[4200];
+    snprintf(ibv, sizeof ibv, "%s/long.ibv", dir); /* made by check_lod() */
+    ip_error err;
+    ip_store *store;
+    ip_cache *cache;
+    REQUIRE(ip_store_open(ibv, &store, &err) == IP_OK);
+    REQUIRE(ip_cache_create(store, 256ull << 20, &cache, &err) == IP_OK);
+    double lo[3], hi[3];
+    ip_layout_world_box(ip_store_layout(store), lo, hi);
+    ip_engine_options o;
+    ip_engine_options_default(&o);
+    o.threads = 1;
+    o.prefetch = IP_PREFETCH_ON;
+    o.lod = 0; /* level 0 alone: the far side's bricks are not those of the near side */
+    ip_engine *e;
+    REQUIRE(ip_engine_create(cache, &o, &e, &err) == IP_OK);
+    ip_camera a, b;
+    REQUIRE(ip_camera_fit_axis(lo, hi, "-x", 30.0, 96, 72, &a, &err) == IP_OK);
+    REQUIRE(ip_camera_fit_axis(lo, hi, "+x", 30.0, 96, 72, &b, &err) == IP_OK);
+    REQUIRE(ip_engine_begin(e, &a, 127.5f, &err) == IP_OK);
+    CHECK(ip_engine_read_ahead(e, &b, &err) == IP_ERR_ARGUMENT); /* not done yet */
+    while (!ip_engine_done(e))
+        REQUIRE(ip_engine_step(e, 0, 0, NULL, &err) == IP_OK);
+    uint64_t triangles = ip_engine_mesh(e)->triangle_count;
+    ip_cache_stats before, after;
+    ip_cache_get_stats(cache, &before);
+    REQUIRE(ip_engine_read_ahead(e, &b, &err) == IP_OK);
+    for (int i = 0; i < 200; i++) { /* up to 2 s for the reader */
+        ip_cache_get_stats(cache, &after);
+        if (after.prefetched > before.prefetched)
+            break;
+        usleep(10000);
+    }
+    CHECK_MSG(after.prefetched > before.prefetched,
+              "read ahead: %llu bricks loaded ahead (%llu of %llu touched before)",
+              (unsigned long long)(after.prefetched - before.prefetched),
+              (unsigned long long)before.bricks_touched, (unsigned long long)before.bricks_total);
+    CHECK(ip_engine_mesh(e)->triangle_count == triangles);
+    ip_camera bad = b;
+    bad.fov_y = 0;
+    CHECK(ip_engine_read_ahead(e, &bad, &err) == IP_ERR_ARGUMENT);
+    ip_engine_counts t;
+    run_all_rays(e, &b, 127.5f, &t); /* begin stops the reader; the view as ever */
+    CHECK(t.rays == 96 * 72);
+    ip_engine_destroy(e);
+    ip_cache_destroy(cache);
+    ip_store_close(store);
 }
 
 typedef struct canceller {
@@ -1437,6 +1492,7 @@ int main(void)
     check_lod(dir);
     check_lod_exact(dir);
     check_reuse_exact(dir);
+    check_read_ahead(dir);
     check_coverage_box_test();
     check_cull_mask();
     check_coverage_indexed();
