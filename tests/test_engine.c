@@ -404,8 +404,10 @@ static void check_reuse_exact(const char *dir)
             }
             printf("test_engine: reuse, %d threads, cull %d: %llu of 7 views kept triangles\n",
                    threads, cull, (unsigned long long)kept_views);
-            CHECK_MSG(kept_views >= 5, "reuse, %d threads, cull %d: %llu of 7 views kept "
-                      "triangles", threads, cull, (unsigned long long)kept_views);
+            CHECK_MSG(kept_views >= 5,
+                      "reuse, %d threads, cull %d: %llu of 7 views kept "
+                      "triangles",
+                      threads, cull, (unsigned long long)kept_views);
             /* another isovalue keeps nothing */
             ip_engine_counts t;
             run_all_rays(e, &cam, 100.5f, &t);

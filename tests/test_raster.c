@@ -715,8 +715,8 @@ static void test_canvas(void)
                 REQUIRE(ip_canvas_add(canvas, &part, cuts[k - 1], &err) == IP_OK);
                 CHECK(ip_canvas_triangle_count(canvas) == cuts[k]);
                 got = ip_canvas_shade(canvas, rows);
-                REQUIRE(ip_raster_mesh_shaded(&part, &c, &shading, box_lo, box_hi, want_index,
-                                              want, &err) == IP_OK);
+                REQUIRE(ip_raster_mesh_shaded(&part, &c, &shading, box_lo, box_hi, want_index, want,
+                                              &err) == IP_OK);
                 CHECK_MSG(!memcmp(got, want, 4 * pixels), "%u threads, %llu triangles",
                           thread_counts[t], (unsigned long long)cuts[k]);
                 CHECK(!memcmp(ip_canvas_triangle_index(canvas), want_index,

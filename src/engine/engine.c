@@ -573,8 +573,8 @@ void ip_engine_add_rendering_time(ip_engine *e, double seconds)
 /* The bytes of a mesh's arrays as allocated. */
 static uint64_t mesh_bytes(const ip_mesh *m)
 {
-    return m->capacity * (9 * sizeof(float) + 9 * sizeof(int16_t) +
-                          (m->with_cells ? sizeof(uint64_t) : 0));
+    return m->capacity *
+           (9 * sizeof(float) + 9 * sizeof(int16_t) + (m->with_cells ? sizeof(uint64_t) : 0));
 }
 
 void ip_engine_memory_of(const ip_engine *e, ip_engine_memory *m)
@@ -592,7 +592,7 @@ void ip_engine_memory_of(const ip_engine *e, ip_engine_memory *m)
     uint64_t bricks = v->layout ? v->layout->brick_count : 0;
     m->visited = atomic_load(&((ip_visited *)v)->holder_count) * v->words_per_brick * 8 +
                  bricks * (sizeof *v->bitmaps + sizeof *v->holders);
-    m->coverage = e->coverage.capacity * 2 * sizeof(atomic_uint) +
-                  e->tile_capacity * (sizeof *e->tiles + 1);
+    m->coverage =
+        e->coverage.capacity * 2 * sizeof(atomic_uint) + e->tile_capacity * (sizeof *e->tiles + 1);
     m->total = m->mesh + m->workers + m->visited + m->coverage;
 }

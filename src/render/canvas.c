@@ -108,9 +108,9 @@ static ip_raster_target band_target(ip_canvas *c, unsigned b)
     uint32_t y0, y1;
     band_of(c, b, &y0, &y1);
     size_t at = (size_t)y0 * c->width;
-    ip_raster_target t = {c->width,           y1 - y0,       0,
-                          y0,                 c->inverse_depth + at, c->index + at,
-                          c->normal + 3 * at, c->dirty + at};
+    ip_raster_target t = {
+        c->width,           y1 - y0,      0, y0, c->inverse_depth + at, c->index + at,
+        c->normal + 3 * at, c->dirty + at};
     return t;
 }
 
@@ -173,8 +173,8 @@ static void draw_all(void *user, unsigned job)
 {
     ip_canvas *c = user;
     (void)job;
-    ip_raster_target t = {c->width,   c->height, 0,         0,
-                          c->inverse_depth, c->index, c->normal, c->dirty};
+    ip_raster_target t = {c->width,         c->height, 0,         0,
+                          c->inverse_depth, c->index,  c->normal, c->dirty};
     ip__raster_range(&t, &c->view, c->mesh, c->first, c->count, (uint32_t)c->first);
 }
 
@@ -272,6 +272,6 @@ uint64_t ip_canvas_triangle_count(const ip_canvas *c)
 
 size_t ip_canvas_memory(const ip_canvas *c)
 {
-    return c->capacity * (sizeof *c->inverse_depth + sizeof *c->index + 3 * sizeof *c->normal +
-                          1 + 4);
+    return c->capacity *
+           (sizeof *c->inverse_depth + sizeof *c->index + 3 * sizeof *c->normal + 1 + 4);
 }

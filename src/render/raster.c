@@ -69,14 +69,14 @@ void ip__raster_background(const ip_shading *s, uint32_t row, uint32_t height, u
     double t = (row + 0.5) / height;
     for (int i = 0; i < 3; i++)
         out[i] = ip__raster_unorm8(s->background_top[i] +
-                           t * (s->background_bottom[i] - (double)s->background_top[i]));
+                                   t * (s->background_bottom[i] - (double)s->background_top[i]));
     out[3] = 255;
 }
 
 /* The shaded colour of a surface of colour `colour`, before rounding. n: the interpolated
  * normal (any length); v: the unit vector toward the eye. */
 void ip__raster_shade(const ip_shading *s, const float colour[3], const float n[3],
-                        const double v[3], double out[3])
+                      const double v[3], double out[3])
 {
     const double normal[3] = {n[0], n[1], n[2]};
     double len = ip__vec3_length(normal);
@@ -88,7 +88,8 @@ void ip__raster_shade(const ip_shading *s, const float colour[3], const float n[
         out[i] = colour[i] * light + highlight;
 }
 
-void ip__raster_setup_view(ip_raster_view *v, const ip_camera *c, const double lo[3], const double hi[3])
+void ip__raster_setup_view(ip_raster_view *v, const ip_camera *c, const double lo[3],
+                           const double hi[3])
 {
     ip_camera_basis_of(c, &v->basis);
     memcpy(v->eye, c->eye, sizeof v->eye);
@@ -224,7 +225,8 @@ static void write_fragment(ip_raster_target *t, size_t pixel, const screen_verte
             (float)((q[0] * v[0].n[k] + q[1] * v[1].n[k] + q[2] * v[2].n[k]) / inverse_depth);
 }
 
-static void scan_triangle(ip_raster_target *t, const screen_vertex v[3], int64_t area, uint32_t index)
+static void scan_triangle(ip_raster_target *t, const screen_vertex v[3], int64_t area,
+                          uint32_t index)
 {
     int64_t min_x = v[0].x, max_x = v[0].x, min_y = v[0].y, max_y = v[0].y;
     for (int i = 1; i < 3; i++) {
@@ -288,8 +290,8 @@ static void raster_triangle(ip_raster_target *t, const ip_raster_view *view, con
 
 /* Clips the triangle where it leaves the view volume or the guard band, then rasterizes the
  * pieces. Returns without work when the triangle lies outside one plane entirely. */
-static void clip_and_raster(ip_raster_target *t, const ip_raster_view *view, const view_vertex tri[3],
-                            uint32_t index)
+static void clip_and_raster(ip_raster_target *t, const ip_raster_view *view,
+                            const view_vertex tri[3], uint32_t index)
 {
     unsigned outside_all = (1u << PLANE_COUNT) - 1, outside_any = 0;
     for (int i = 0; i < 3; i++) {
@@ -368,7 +370,8 @@ static void shade_surfaces_pixel(const surface_targets *st, const ip_surface *su
         double a = surfaces[i].opacity;
         ip__raster_shade(s, surfaces[i].colour, t->normal + 3 * pixel, ray, value);
         for (int k = 0; k < 3; k++)
-            out[k] = ip__raster_unorm8(a * fmin(1.0, fmax(0.0, value[k])) + (1.0 - a) * (out[k] / 255.0));
+            out[k] = ip__raster_unorm8(a * fmin(1.0, fmax(0.0, value[k])) +
+                                       (1.0 - a) * (out[k] / 255.0));
     }
 }
 

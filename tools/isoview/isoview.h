@@ -22,10 +22,10 @@ typedef struct options {
     tool_view_options common; /* with --stats, --force and --quiet */
     const char *file, *script, *screenshot_path;
     double screenshot_at, exit_after;
-    int aa; /* --aa N: samples a pixel of the window (1: no multisampling) */
-    int renderer; /* --renderer: RENDERER_AUTO, _OPENGL or _SOFTWARE */
-    int reuse;    /* --reuse on|off: the engine's reuse across views */
-    int read_ahead; /* --read-ahead on|off: the next view of a motion read ahead */
+    int aa;                  /* --aa N: samples a pixel of the window (1: no multisampling) */
+    int renderer;            /* --renderer: RENDERER_AUTO, _OPENGL or _SOFTWARE */
+    int reuse;               /* --reuse on|off: the engine's reuse across views */
+    int read_ahead;          /* --read-ahead on|off: the next view of a motion read ahead */
     double drag_pixel_error; /* --drag-pixel-error P: the coarse pass while moving (0: none) */
 } options;
 
@@ -90,13 +90,13 @@ typedef struct display {
 
 /* One pass's course, for --stats: when its frames came and what they had drawn. */
 typedef struct pass_record {
-    double start;                      /* seconds since the window opened: the change */
-    double first_frame, complete;      /* seconds after start (complete < 0: never) */
-    double final_85, final_995;        /* seconds after start to 85 % / 99.5 % of the final
+    double start;                     /* seconds since the window opened: the change */
+    double first_frame, complete;     /* seconds after start (complete < 0: never) */
+    double final_85, final_995;       /* seconds after start to 85 % / 99.5 % of the final
                                           pixels (< 0: not measured) */
-    uint64_t frames, triangles, rays;  /* frames drawn, and the pass's mesh at its end */
-    uint64_t kept;                     /* triangles kept from the view before (--reuse) */
-    int moving;                        /* it began during a drag */
+    uint64_t frames, triangles, rays; /* frames drawn, and the pass's mesh at its end */
+    uint64_t kept;                    /* triangles kept from the view before (--reuse) */
+    int moving;                       /* it began during a drag */
 } pass_record;
 
 /* A frame of a pass: seconds after the pass's start, and the triangles it had drawn. */
@@ -121,7 +121,7 @@ typedef struct viewer {
     options o;
     ip_store *store;
     ip_cache *cache;
-    ip_engine *engine; /* the one in use: fine, or coarse while the view moves */
+    ip_engine *engine;        /* the one in use: fine, or coarse while the view moves */
     ip_engine *fine, *coarse; /* coarse: --drag-pixel-error's (NULL: none) */
     GLFWwindow *window;
     ip_renderer *renderer; /* OpenGL (NULL with the software renderer) */
@@ -132,8 +132,8 @@ typedef struct viewer {
     const ip_mesh *canvas_mesh;
     ip_camera canvas_camera;
     uint64_t gl_drawn;
-    int keep_image; /* OpenGL draws into the kept image (not with --aa) */
-    char gl_renderer[96];       /* GL_RENDERER */
+    int keep_image;       /* OpenGL draws into the kept image (not with --aa) */
+    char gl_renderer[96]; /* GL_RENDERER */
     overlay text;
     double lo[3], hi[3];
     float value_min, value_max;
@@ -179,14 +179,14 @@ typedef struct viewer {
     size_t record_count, record_capacity;
     frame_mark *marks; /* this pass's frames */
     size_t frame_count, frame_capacity;
-    int pass_recorded;         /* this pass's record is complete */
+    int pass_recorded; /* this pass's record is complete */
     /* a drag from a script (COMMAND_DRAG): degrees a second left to turn, until drag_end */
     double drag_rate[2], drag_end, drag_last;
     double last_motion; /* when the mouse (or a script's drag) last moved the view */
     /* the cameras of the last two fine passes begun, for reading the next view ahead */
     ip_camera pass_camera[2];
     uint64_t fine_passes;
-    uint64_t read_aheads; /* views read ahead (ip_engine_read_ahead()) */
+    uint64_t read_aheads;   /* views read ahead (ip_engine_read_ahead()) */
     uint64_t moving_frames; /* frames drawn during a drag (the mouse's or a script's) */
     double moving_seconds;  /* and the seconds they took */
     int renderer_note;      /* the software renderer took over from one that failed */

@@ -23,10 +23,11 @@
 
 #define FRAME_BUDGET_SECONDS 0.012 /* ray casting per frame: keeps 30+ fps while refining */
 #define MAX_SLICE_SECONDS 0.25     /* the longest slice: bounds the delay of input */
-#define DRAW_SHARE 2.0             /* the slice is at least this many times the last frame's
+#define DRAW_SHARE \
+    2.0                        /* the slice is at least this many times the last frame's
                                       drawing, so drawing never starves refinement */
-#define FPS_WINDOW_SECONDS 0.5     /* the overlay's fps is averaged over this long */
-#define MOTION_SECONDS 0.15        /* the view moves while the mouse moved it this recently */
+#define FPS_WINDOW_SECONDS 0.5 /* the overlay's fps is averaged over this long */
+#define MOTION_SECONDS 0.15    /* the view moves while the mouse moved it this recently */
 
 static char glfw_error[512];
 
@@ -288,7 +289,6 @@ static int extract_full(viewer *v)
     return 0;
 }
 
-
 /* The software renderer: the canvas draws the triangles of the mesh shown that it does not
  * hold yet (all of them after a change of view, mesh or size) and shows the changed rows. */
 static int draw_software(viewer *v)
@@ -332,12 +332,11 @@ static int draw_opengl(viewer *v)
 static int draw_frame(viewer *v, int working_on_full)
 {
     double start = ip_now_seconds();
-    int rc = v->canvas       ? draw_software(v)
-             : v->keep_image ? draw_opengl(v)
-                             : (ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) ==
-                                        IP_OK
-                                    ? 0
-                                    : -1);
+    int rc =
+        v->canvas ? draw_software(v)
+        : v->keep_image
+            ? draw_opengl(v)
+            : (ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) == IP_OK ? 0 : -1);
     if (rc != 0)
         return -1;
     overlay_draw_frame(v, working_on_full);
@@ -537,8 +536,10 @@ static int open_window(viewer *v)
             fprintf(stderr, "isoview: the OpenGL renderer cannot start: %s\n", v->err.message);
             return -1;
         }
-        fprintf(stderr, "isoview: note: the OpenGL renderer cannot start (%s); drawing in "
-                        "software\n", v->err.message);
+        fprintf(stderr,
+                "isoview: note: the OpenGL renderer cannot start (%s); drawing in "
+                "software\n",
+                v->err.message);
         software = 1;
         v->renderer_note = 1;
         v->keep_image = 0;
@@ -572,7 +573,8 @@ static void memory_json(FILE *f, const viewer *v)
     }
     uint64_t full = v->full_mesh.capacity * (9 * sizeof(float) + 9 * sizeof(int16_t));
     uint64_t gpu = v->renderer ? ip_renderer_memory(v->renderer) : 0;
-    uint64_t canvas = v->canvas ? ip_canvas_memory(v->canvas) + 4ull * v->screen.width * v->screen.height : 0;
+    uint64_t canvas =
+        v->canvas ? ip_canvas_memory(v->canvas) + 4ull * v->screen.width * v->screen.height : 0;
     uint64_t summaries = ip_store_summary_memory(v->store);
     fprintf(f,
             ", \"memory\": {\"cache_bytes\": %llu, \"cache_peak_bytes\": %llu, "

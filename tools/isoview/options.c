@@ -114,8 +114,9 @@ static int parse_drag_pixel_error(const char *p, const tool_option *opt, const c
     (void)opt;
     if (tool_parse_double(v[0], &o->drag_pixel_error) != 0 || !(o->drag_pixel_error >= 0) ||
         o->drag_pixel_error > 1024)
-        return tool_usage_error(p, "--drag-pixel-error '%s': must be 0 (off) or a pixel error up "
-                                   "to 1024",
+        return tool_usage_error(p,
+                                "--drag-pixel-error '%s': must be 0 (off) or a pixel error up "
+                                "to 1024",
                                 v[0]);
     return 0;
 }
@@ -151,7 +152,8 @@ int parse_args(int argc, char **argv, options *o)
     if (o->common.cull < 0)
         o->common.cull = o->aa <= 1;
     if (rc == 0 && o->aa > 1 && o->renderer == RENDERER_SOFTWARE)
-        return tool_usage_error("isoview", "--aa is OpenGL's: --renderer software draws without it");
+        return tool_usage_error("isoview",
+                                "--aa is OpenGL's: --renderer software draws without it");
     if (rc == 0 && o->common.iso_count > 1) /* isorender draws each; here one would be lost */
         return tool_usage_error("isoview",
                                 "--iso given %u times: isoview shows one surface (isorender "

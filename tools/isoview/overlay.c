@@ -185,7 +185,8 @@ static void measure_overdraw(viewer *v, const ip_mesh *mesh)
     uint8_t *owns = calloc(mesh->triangle_count / 8 + 1, 1);
     v->overdraw_state = -1;
     if (ids && owns &&
-        (from_canvas || ip_raster_mesh(mesh, &v->camera, v->lo, v->hi, index, NULL, NULL) == IP_OK)) {
+        (from_canvas ||
+         ip_raster_mesh(mesh, &v->camera, v->lo, v->hi, index, NULL, NULL) == IP_OK)) {
         uint64_t visible = 0;
         for (size_t p = 0; p < n; p++) {
             uint32_t i = ids[p];
