@@ -23,6 +23,9 @@
 
 #define FRAME_BUDGET_SECONDS 0.012 /* ray casting per frame: keeps 30+ fps while refining */
 #define MAX_SLICE_SECONDS 0.25     /* the longest slice: bounds the delay of input */
+#define SOFTWARE_SLICE_SECONDS \
+    0.04 /* the software renderer's slice while refining: 20 frames
+                                       a second, each copying the whole window */
 #define DRAW_SHARE \
     2.0                        /* the slice is at least this many times the last frame's
                                       drawing, so drawing never starves refinement */
@@ -235,11 +238,15 @@ static int refine(viewer *v)
     if (v->paused || v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v))
         return 0;
     /* drawing (and showing the frame) takes at most a third of a frame, half while the view
-     * moves (each frame then draws a new view whole) */
+     * moves (each frame then draws a new view whole); the software renderer's frames after a
+     * pass's first come at most every SOFTWARE_SLICE_SECONDS, as each copies the window */
     double drawing = (v->engine == v->coarse ? 1.0 : DRAW_SHARE) * v->draw_seconds;
-    double slice = drawing < FRAME_BUDGET_SECONDS ? FRAME_BUDGET_SECONDS
-                   : drawing > MAX_SLICE_SECONDS  ? MAX_SLICE_SECONDS
-                                                  : drawing;
+    double least = v->canvas && v->frame_count > 0 && v->engine != v->coarse
+                       ? SOFTWARE_SLICE_SECONDS
+                       : FRAME_BUDGET_SECONDS;
+    double slice = drawing < least               ? least
+                   : drawing > MAX_SLICE_SECONDS ? MAX_SLICE_SECONDS
+                                                 : drawing;
     if (v->o.common.time_limit > 0 && slice > v->o.common.time_limit - v->pass_wall)
         slice = v->o.common.time_limit - v->pass_wall;
     ip_engine_counts t;
