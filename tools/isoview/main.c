@@ -251,9 +251,14 @@ static int refine(viewer *v)
         slice = v->o.common.time_limit - v->pass_wall;
     ip_engine_counts t;
     ip_engine_totals(v->engine, &t);
+    uint64_t rays = v->o.common.rays ? v->o.common.rays - t.rays : 0;
+    /* a pass's first frame: a ray a thread, whose propagations alone take longer than a slice
+     * on a large volume (a step checks its time between batches of rays), then the picture */
+    uint64_t first = ip_thread_count(v->o.common.threads);
+    if (v->frame_count == 0 && (!rays || rays > first))
+        rays = first;
     double start = ip_now_seconds();
-    ip_status st = ip_engine_step(v->engine, v->o.common.rays ? v->o.common.rays - t.rays : 0,
-                                  slice, NULL, &v->err);
+    ip_status st = ip_engine_step(v->engine, rays, slice, NULL, &v->err);
     v->pass_wall += ip_now_seconds() - start;
     if (st != IP_OK && st != IP_ERR_CANCELLED)
         return -1;
