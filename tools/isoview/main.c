@@ -253,9 +253,10 @@ static int refine(viewer *v)
     ip_engine_totals(v->engine, &t);
     uint64_t rays = v->o.common.rays ? v->o.common.rays - t.rays : 0;
     /* a pass's first frame: a ray a thread, whose propagations alone take longer than a slice
-     * on a large volume (a step checks its time between batches of rays), then the picture */
+     * on a large volume (a step checks its time between batches of rays), then the picture;
+     * not for a moving view's coarse pass, each frame of which is a pass's first */
     uint64_t first = ip_thread_count(v->o.common.threads);
-    if (v->frame_count == 0 && (!rays || rays > first))
+    if (v->frame_count == 0 && v->engine != v->coarse && (!rays || rays > first))
         rays = first;
     double start = ip_now_seconds();
     ip_status st = ip_engine_step(v->engine, rays, slice, NULL, &v->err);
