@@ -9,6 +9,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "coverage.h"
@@ -341,6 +342,137 @@ static void check_lod_exact(const char *dir)
     free(ca);
     free(cb);
     close_scene(&s);
+}
+
+/* Reuse across views (engine.h, "Reuse"): an orbit with zooms that change the levels' bands,
+ * each view's image once every ray has been cast is the full extraction's at its levels, pixel
+ * for pixel, its triangles all of that extraction, while later views keep triangles of the
+ * ones before; on 1 and 2 threads, culling on and off. */
+static void check_reuse_exact(const char *dir)
+{
+    char ibv[4200];
+    snprintf(ibv, sizeof ibv, "%s/long.ibv", dir); /* made by check_lod() */
+    scene s;
+    open_scene(ibv, &s);
+    const uint32_t w = 96, h = 72, n = w * h;
+    uint32_t *ia = malloc(n * 4), *ib = malloc(n * 4);
+    uint8_t *ca = malloc(n * 4), *cb = malloc(n * 4);
+    REQUIRE(ia && ib && ca && cb);
+    for (int threads = 1; threads <= 2; threads++)
+        for (int cull = 0; cull < 2; cull++) {
+            ip_error err;
+            ip_engine *e;
+            ip_engine_options o;
+            ip_engine_options_default(&o);
+            o.threads = (unsigned)threads;
+            o.cull = cull;
+            o.reuse = 1;
+            REQUIRE(ip_engine_create(s.cache, &o, &e, &err) == IP_OK);
+            ip_camera cam;
+            REQUIRE(ip_camera_fit_axis(s.lo, s.hi, "-z", 30.0, w, h, &cam, &err) == IP_OK);
+            ip_camera_orbit(&cam, 20, 25);
+            uint64_t kept_views = 0;
+            for (int step = 0; step < 8; step++) {
+                if (step > 0) {
+                    ip_camera_orbit(&cam, 15, step % 3 == 0 ? -5 : 0);
+                    double zoom = step < 5 ? 1.25 : 0.8; /* in, then out again */
+                    for (int a = 0; a < 3; a++)
+                        cam.eye[a] = cam.target[a] + (cam.eye[a] - cam.target[a]) / zoom;
+                }
+                ip_engine_counts t;
+                run_all_rays(e, &cam, 127.5f, &t);
+                kept_views += t.kept > 0;
+                ip_mesh full;
+                ip_mesh_init_with_cells(&full);
+                REQUIRE(ip_extract_full_lod(s.cache, 127.5f, &cam, 1.0, 2, NULL, 0, &full, NULL,
+                                            &err) == IP_OK);
+                REQUIRE(ip_raster_mesh(&full, &cam, s.lo, s.hi, ib, cb, &err) == IP_OK);
+                const ip_mesh *part = ip_engine_mesh(e);
+                uint64_t missing = triangles_not_in(part, &full);
+                REQUIRE(ip_raster_mesh(part, &cam, s.lo, s.hi, ia, ca, &err) == IP_OK);
+                size_t differ = 0;
+                for (uint32_t i = 0; i < n; i++)
+                    differ += ia[i] == UINT32_MAX ? ib[i] != UINT32_MAX
+                                                  : memcmp(ca + 4 * i, cb + 4 * i, 4) != 0;
+                CHECK_MSG(missing == 0 && differ == 0,
+                          "reuse, %d threads, cull %d, view %d: %llu triangles not in the full "
+                          "extraction at its levels, %zu pixels differ (%llu kept)",
+                          threads, cull, step, (unsigned long long)missing, differ,
+                          (unsigned long long)t.kept);
+                CHECK(t.triangles == part->triangle_count);
+                ip_mesh_free(&full);
+            }
+            printf("test_engine: reuse, %d threads, cull %d: %llu of 7 views kept triangles\n",
+                   threads, cull, (unsigned long long)kept_views);
+            CHECK_MSG(kept_views >= 5,
+                      "reuse, %d threads, cull %d: %llu of 7 views kept "
+                      "triangles",
+                      threads, cull, (unsigned long long)kept_views);
+            /* another isovalue keeps nothing */
+            ip_engine_counts t;
+            run_all_rays(e, &cam, 100.5f, &t);
+            CHECK(t.kept == 0);
+            ip_engine_destroy(e);
+        }
+    free(ia);
+    free(ib);
+    free(ca);
+    free(cb);
+    close_scene(&s);
+}
+
+/* ip_engine_read_ahead(): refused before the view is done; once it is, the reader loads bricks
+ * of the predicted view (the other side of the volume) into the cache, and the next begin stops
+ * it; the mesh of the view done stays. */
+static void check_read_ahead(const char *dir)
+{
+    char ibv[4200];
+    snprintf(ibv, sizeof ibv, "%s/long.ibv", dir); /* made by check_lod() */
+    ip_error err;
+    ip_store *store;
+    ip_cache *cache;
+    REQUIRE(ip_store_open(ibv, &store, &err) == IP_OK);
+    REQUIRE(ip_cache_create(store, 256ull << 20, &cache, &err) == IP_OK);
+    double lo[3], hi[3];
+    ip_layout_world_box(ip_store_layout(store), lo, hi);
+    ip_engine_options o;
+    ip_engine_options_default(&o);
+    o.threads = 1;
+    o.prefetch = IP_PREFETCH_ON;
+    o.lod = 0; /* level 0 alone: the far side's bricks are not those of the near side */
+    ip_engine *e;
+    REQUIRE(ip_engine_create(cache, &o, &e, &err) == IP_OK);
+    ip_camera a, b;
+    REQUIRE(ip_camera_fit_axis(lo, hi, "-x", 30.0, 96, 72, &a, &err) == IP_OK);
+    REQUIRE(ip_camera_fit_axis(lo, hi, "+x", 30.0, 96, 72, &b, &err) == IP_OK);
+    REQUIRE(ip_engine_begin(e, &a, 127.5f, &err) == IP_OK);
+    CHECK(ip_engine_read_ahead(e, &b, &err) == IP_ERR_ARGUMENT); /* not done yet */
+    while (!ip_engine_done(e))
+        REQUIRE(ip_engine_step(e, 0, 0, NULL, &err) == IP_OK);
+    uint64_t triangles = ip_engine_mesh(e)->triangle_count;
+    ip_cache_stats before, after;
+    ip_cache_get_stats(cache, &before);
+    REQUIRE(ip_engine_read_ahead(e, &b, &err) == IP_OK);
+    for (int i = 0; i < 200; i++) { /* up to 2 s for the reader */
+        ip_cache_get_stats(cache, &after);
+        if (after.prefetched > before.prefetched)
+            break;
+        usleep(10000);
+    }
+    CHECK_MSG(after.prefetched > before.prefetched,
+              "read ahead: %llu bricks loaded ahead (%llu of %llu touched before)",
+              (unsigned long long)(after.prefetched - before.prefetched),
+              (unsigned long long)before.bricks_touched, (unsigned long long)before.bricks_total);
+    CHECK(ip_engine_mesh(e)->triangle_count == triangles);
+    ip_camera bad = b;
+    bad.fov_y = 0;
+    CHECK(ip_engine_read_ahead(e, &bad, &err) == IP_ERR_ARGUMENT);
+    ip_engine_counts t;
+    run_all_rays(e, &b, 127.5f, &t); /* begin stops the reader; the view as ever */
+    CHECK(t.rays == 96 * 72);
+    ip_engine_destroy(e);
+    ip_cache_destroy(cache);
+    ip_store_close(store);
 }
 
 typedef struct canceller {
@@ -1361,6 +1493,8 @@ int main(void)
 
     check_lod(dir);
     check_lod_exact(dir);
+    check_reuse_exact(dir);
+    check_read_ahead(dir);
     check_coverage_box_test();
     check_cull_mask();
     check_coverage_indexed();

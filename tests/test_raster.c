@@ -656,6 +656,102 @@ static void test_png(void)
     CHECK(stat(path, &after) != 0);
 }
 
+/* A mesh of `count` random triangles in front of the camera (some crossing the near plane and
+ * the image's sides), with random normals: overlaps, ties and clipping for the canvas. */
+static void random_mesh(ip_mesh *m, const ip_camera *c, uint64_t count, uint64_t seed)
+{
+    for (uint64_t i = 0; i < count; i++) {
+        float p[9], n[9];
+        double depth = 2.0 + (double)(test_xorshift(&seed) % 1600) / 100.0;
+        double cx = (double)(test_xorshift(&seed) % (c->width + 20)) - 10;
+        double cy = (double)(test_xorshift(&seed) % (c->height + 20)) - 10;
+        for (int k = 0; k < 3; k++) {
+            double dx = (double)(test_xorshift(&seed) % 2400) / 100.0 - 12;
+            double dy = (double)(test_xorshift(&seed) % 2400) / 100.0 - 12;
+            double dz = i % 7 == 0 ? (double)(test_xorshift(&seed) % 1000) / 100.0 - 9 : 0;
+            point_at(c, cx + dx, cy + dy, depth + dz, p + 3 * k);
+            for (int a = 0; a < 3; a++)
+                n[3 * k + a] = (float)((double)(test_xorshift(&seed) % 2001) / 1000.0 - 1.0);
+        }
+        REQUIRE(ip_mesh_append_float_normals(m, p, n, NULL, 1) == IP_OK);
+    }
+}
+
+/* The canvas: a mesh added in pieces gives ip_raster_mesh_shaded()'s image and triangle ids
+ * exactly, at every piece, on one thread or several; each shading reports rows that hold
+ * every pixel it changed. */
+static void test_canvas(void)
+{
+    ip_shading shading;
+    ip_shading_default(&shading);
+    shading.surface[0] = 0.5f; /* not the default, to see that it is the one used */
+    const uint32_t sizes[2][2] = {{W, H}, {53, 61}};
+    const unsigned thread_counts[3] = {1, 2, 3};
+    for (int z = 0; z < 2; z++) {
+        ip_camera c = front_camera(sizes[z][0], sizes[z][1]);
+        ip_mesh m;
+        ip_mesh_init(&m);
+        random_mesh(&m, &c, 700, 0x9e3779b97f4a7c15ull + (uint64_t)z);
+        size_t pixels = (size_t)c.width * c.height;
+        uint8_t *want = malloc(4 * pixels), *before = malloc(4 * pixels);
+        uint32_t *want_index = malloc(pixels * sizeof *want_index);
+        REQUIRE(want && before && want_index);
+        for (int t = 0; t < 3; t++) {
+            ip_canvas *canvas;
+            ip_error err;
+            REQUIRE(ip_canvas_create(thread_counts[t], &canvas, &err) == IP_OK);
+            CHECK(ip_canvas_shade(canvas, NULL) == NULL);
+            CHECK(ip_canvas_add(canvas, &m, 0, &err) == IP_ERR_ARGUMENT);
+            REQUIRE(ip_canvas_begin(canvas, &c, &shading, box_lo, box_hi, &err) == IP_OK);
+            const uint64_t cuts[] = {0, 1, 6, 69, 70, 400, 700};
+            uint32_t rows[2];
+            const uint8_t *got = ip_canvas_shade(canvas, rows);
+            CHECK(rows[0] == 0 && rows[1] == c.height);
+            for (size_t k = 1; k < sizeof cuts / sizeof cuts[0]; k++) {
+                memcpy(before, got, 4 * pixels);
+                ip_mesh part = m;
+                part.triangle_count = cuts[k]; /* the mesh's first triangles */
+                CHECK(ip_canvas_add(canvas, &part, cuts[k - 1] + 1, &err) == IP_ERR_ARGUMENT);
+                REQUIRE(ip_canvas_add(canvas, &part, cuts[k - 1], &err) == IP_OK);
+                CHECK(ip_canvas_triangle_count(canvas) == cuts[k]);
+                got = ip_canvas_shade(canvas, rows);
+                REQUIRE(ip_raster_mesh_shaded(&part, &c, &shading, box_lo, box_hi, want_index, want,
+                                              &err) == IP_OK);
+                CHECK_MSG(!memcmp(got, want, 4 * pixels), "%u threads, %llu triangles",
+                          thread_counts[t], (unsigned long long)cuts[k]);
+                CHECK(!memcmp(ip_canvas_triangle_index(canvas), want_index,
+                              pixels * sizeof *want_index));
+                size_t outside = 0;
+                for (size_t p = 0; p < pixels; p++)
+                    if (memcmp(got + 4 * p, before + 4 * p, 4) &&
+                        (p / c.width < rows[0] || p / c.width >= rows[1]))
+                        outside++;
+                CHECK_MSG(outside == 0, "%zu changed pixels outside rows %u .. %u", outside,
+                          rows[0], rows[1]);
+            }
+            ip_canvas_shade(canvas, rows); /* nothing changed since */
+            CHECK(rows[0] == 0 && rows[1] == 0);
+            CHECK(ip_canvas_memory(canvas) >= pixels * 29);
+            /* a new image of another size, default shading: buffers reused or grown */
+            ip_camera small = front_camera(20, 10);
+            REQUIRE(ip_canvas_begin(canvas, &small, NULL, box_lo, box_hi, &err) == IP_OK);
+            REQUIRE(ip_canvas_add(canvas, &m, 0, &err) == IP_OK);
+            uint8_t small_want[20 * 10 * 4];
+            REQUIRE(ip_raster_mesh(&m, &small, box_lo, box_hi, NULL, small_want, &err) == IP_OK);
+            CHECK(!memcmp(ip_canvas_shade(canvas, NULL), small_want, sizeof small_want));
+            ip_camera bad = small;
+            bad.fov_y = 0;
+            CHECK(ip_canvas_begin(canvas, &bad, NULL, box_lo, box_hi, &err) == IP_ERR_ARGUMENT);
+            ip_canvas_destroy(canvas);
+        }
+        free(want);
+        free(before);
+        free(want_index);
+        ip_mesh_free(&m);
+    }
+    ip_canvas_destroy(NULL);
+}
+
 int main(void)
 {
     test_single_triangle();
@@ -669,5 +765,6 @@ int main(void)
     test_clipping();
     test_bad_arguments();
     test_png();
+    test_canvas();
     return test_summary("test_raster");
 }

@@ -230,6 +230,24 @@ static void test_incremental_upload(ip_renderer *r, const ip_mesh *m)
     draw_and_read(fresh, &c, parts);
     CHECK(memcmp(once, parts, bytes) == 0);
 
+    /* drawing only what each upload added over the image drawn before gives the same image */
+    ip_renderer *added = NULL;
+    REQUIRE(ip_renderer_create_headless(320, 240, &added, NULL) == IP_OK);
+    for (int k = 0; k < 3; k++) {
+        ip_mesh prefix = *m;
+        prefix.triangle_count = cuts[k + 1];
+        REQUIRE(ip_renderer_upload(added, &prefix, cuts[k], NULL) == IP_OK);
+        ip_error why;
+        CHECK_MSG(ip_renderer_draw_added(added, &c, scene_lo, scene_hi, cuts[k], &why) == IP_OK,
+                  "%s", why.message);
+    }
+    REQUIRE(ip_renderer_read_rgba(added, again, NULL) == IP_OK);
+    CHECK(memcmp(once, again, bytes) == 0);
+    ip_error why;
+    CHECK(ip_renderer_draw_added(added, &c, scene_lo, scene_hi, m->triangle_count + 1, &why) ==
+          IP_ERR_ARGUMENT);
+    ip_renderer_destroy(added);
+
     /* nothing to append, then a first triangle past the end */
     ip_error err;
     CHECK(ip_renderer_upload(fresh, &partial, partial.triangle_count, &err) == IP_OK);

@@ -157,8 +157,7 @@ typedef struct tool_view_options {
     "                      on (the default): only those the disk must deliver when the threads\n"  \
     "                      take every core; always: every one\n"                                   \
     "  --cull on|off       with --occlusion: keep no triangle the image shows at no pixel\n"       \
-    "                      centre (default: isorender and isowall on, unless --mesh or --aa;\n"    \
-    "                      isoview off)\n"                                                         \
+    "                      centre (default on, unless --mesh (isorender) or --aa)\n"               \
     "  --clip SPEC         keep one side of a plane, world units (repeatable, up to 6):\n"         \
     "                      x=40 keeps x >= 40, -x=40 keeps x <= 40 (y, z alike),\n"                \
     "                      A,B,C,D keeps A*x + B*y + C*z + D >= 0\n"

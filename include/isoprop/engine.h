@@ -47,6 +47,22 @@
  * front but what this view's image needs. Keep them (cull 0) for a mesh to be written out,
  * drawn with multisampling or from another view (docs/occlusion.md).
  *
+ * Reuse (options.reuse, with occlusion; off by default): consecutive views of an orbit share
+ * most of their surface. ip_engine_begin() at the isovalue of the view before (the engine's
+ * planes and options unchanged, and that view's steps all successful) then keeps, of the mesh,
+ * the cells that belong to the new view's surface and may show in it: each cell whose level's
+ * distance band for the new view holds its centre (the rule of ip_extract_full_lod()), one of
+ * whose triangles may be drawn at a pixel centre of the new image, and that the others kept do
+ * not certainly hide. They stay in the mesh, first and in their order, are marked extracted,
+ * and their triangles are recorded in the coverage, so rays meeting them end there and their
+ * tiles retire in bulk: the pass extracts what became visible. With culling, a cell keeps all
+ * its triangles when one of them may show (whole cells), so a cell kept is never missing a
+ * triangle the new view needs. Every kept triangle belongs to the new view's full extraction
+ * at adaptive resolution and every cell of it is whole, so the image once every ray has been
+ * cast is the one without reuse. The mesh stays within the cells that may show in the current
+ * view: hidden cells and those outside the image are dropped. The mesh then keeps cell ids
+ * (with_cells), 8 bytes a triangle.
+ *
  * Reading ahead (options.prefetch, IP_PREFETCH_ON by default): one more thread per engine
  * reads and decodes into the cache, from the first step after ip_engine_begin() on and between
  * steps, the bricks that the next rays of the order will seed in (found from the summaries) and
@@ -131,6 +147,8 @@ typedef struct ip_engine_options {
     ip_clip_plane clip[IP_MAX_CLIP_PLANES]; /* the surface is kept where every plane keeps it:
                                                the exact-image guarantee holds for the kept
                                                cells (ip_extract_full_clipped()) */
+    int reuse; /* with occlusion: a view keeps what stays valid of the view before it at the
+                  same isovalue (see Reuse above; default off) */
 } ip_engine_options;
 
 /* Counters and times, per step or in total. Times are wall seconds, split as the paper does.
@@ -153,6 +171,8 @@ typedef struct ip_engine_counts {
     uint64_t nodes;    /* octree nodes (bricks included), sub-blocks and cells the rays' walks
                           entered: the seeding work, independent of the clock */
     uint64_t culled;   /* with options.cull: triangles made and not kept, not in `triangles` */
+    uint64_t kept;     /* with options.reuse: triangles kept from the view before, counted in
+                          `triangles` (their cells in `cells`) */
 } ip_engine_counts;
 
 typedef struct ip_engine ip_engine;
@@ -205,6 +225,16 @@ IP_API ip_status ip_engine_set_region(ip_engine *engine, uint32_t x, uint32_t y,
                                       uint32_t height, uint64_t first_ray, uint64_t ray_count,
                                       ip_error *err);
 
+/*! ip_engine_read_ahead() : once the view is done (ip_engine_done()), lets the background
+ *  reader (options.prefetch) read into the cache the bricks that the first rays of `camera`'s
+ *  view would seed in, and their neighbours, as it does for a view begun (see Reading ahead
+ *  above), within the budget, evicting the least recently used bricks: for a viewer
+ *  that predicts the next view of an orbit or a zoom from the last motions. It reads until the
+ *  next ip_engine_begin(), which stops it; `camera` is copied. Nothing else changes: the mesh
+ *  and the view stay. A no-op without the reader.
+ *  @return IP_OK, or IP_ERR_ARGUMENT (a bad camera, or a view not done). */
+IP_API ip_status ip_engine_read_ahead(ip_engine *engine, const ip_camera *camera, ip_error *err);
+
 /*! ip_engine_done() : 1 once every pixel has had its ray (after ip_engine_set_region(): once
  *  the region's rays have). */
 IP_API int ip_engine_done(const ip_engine *engine);
@@ -222,6 +252,19 @@ IP_API double ip_engine_lod_distance(const ip_engine *engine, uint32_t level);
 
 /*! ip_engine_totals() : counts and times since ip_engine_begin(). */
 IP_API void ip_engine_totals(const ip_engine *engine, ip_engine_counts *counts);
+
+/* The engine's memory, bytes, besides the brick cache it reads through (ip_cache_get_stats()). */
+typedef struct ip_engine_memory {
+    uint64_t mesh;     /* the mesh's arrays as allocated (ip_engine_mesh(); kept between views) */
+    uint64_t workers;  /* the workers' triangle buffers and propagation queues */
+    uint64_t visited;  /* the visited cells' bitmaps (one per brick the view reached) and index */
+    uint64_t coverage; /* with occlusion: the coverage buffers and screen tiles */
+    uint64_t total;    /* the sum */
+} ip_engine_memory;
+
+/*! ip_engine_memory_of() : what the engine holds now (*memory is the caller's); not during a
+ *  step. */
+IP_API void ip_engine_memory_of(const ip_engine *engine, ip_engine_memory *memory);
 
 /*! ip_engine_add_rendering_time() : adds the caller's rendering time to the totals. */
 IP_API void ip_engine_add_rendering_time(ip_engine *engine, double seconds);

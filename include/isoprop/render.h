@@ -149,6 +149,61 @@ IP_API ip_status ip_raster_mesh_part(const ip_mesh *mesh, const ip_camera *camer
                                      uint32_t height, double *inverse_depth, uint8_t *rgba,
                                      ip_error *err);
 
+/* The canvas: ip_raster_mesh_shaded()'s image of a mesh that grows frame after frame, kept
+ * between frames, so that a frame draws only the triangles added since the last one and
+ * shades only the pixels they changed (an interactive viewer on a machine without a GPU).
+ * After ip_canvas_begin() and ip_canvas_add() calls that added triangles [0, n) of a mesh in
+ * any number of pieces, the image and the triangle ids are exactly those ip_raster_mesh_shaded()
+ * gives for the mesh's first n triangles: the nearest triangle wins, the lower index on equal
+ * depth, which is also the one drawn first. Rows are drawn in bands on the canvas's threads.
+ * A canvas is used by one thread at a time. */
+typedef struct ip_canvas ip_canvas;
+
+/*! ip_canvas_create() : an empty canvas drawing on `threads` threads (0: every core; the
+ *  calling thread counts, the others are started here and sleep between calls). *out is the
+ *  caller's, released with ip_canvas_destroy(). @return IP_OK or IP_ERR_NOMEM. */
+IP_API ip_status ip_canvas_create(unsigned threads, ip_canvas **out, ip_error *err);
+
+/*! ip_canvas_destroy() : stops the canvas's threads and frees it (NULL is a no-op). */
+IP_API void ip_canvas_destroy(ip_canvas *canvas);
+
+/*! ip_canvas_begin() : starts a new image of camera->width x camera->height pixels seen by
+ *  `camera`, near and far planes from the box [lo, hi] (world units) as ip_raster_mesh(), with
+ *  `shading` (copied; NULL: ip_shading_default()): every pixel the background, no triangle.
+ *  The buffers grow to the size (about 29 bytes a pixel) and are kept for later images.
+ *  @return IP_OK, IP_ERR_ARGUMENT (a bad camera, box or shading, a side over 65536) or
+ *  IP_ERR_NOMEM (the canvas then holds no image until the next successful begin). */
+IP_API ip_status ip_canvas_begin(ip_canvas *canvas, const ip_camera *camera,
+                                 const ip_shading *shading, const double lo[3], const double hi[3],
+                                 ip_error *err);
+
+/*! ip_canvas_add() : draws triangles [first, mesh->triangle_count) of `mesh`, numbered as in
+ *  the mesh; `first` must be the number of triangles the canvas holds
+ *  (ip_canvas_triangle_count()), so that the pieces added since begin are one mesh's first
+ *  triangles, in order. `mesh` is read during the call only.
+ *  @return IP_OK or IP_ERR_ARGUMENT (no begin, another `first`, UINT32_MAX triangles or
+ *  more). */
+IP_API ip_status ip_canvas_add(ip_canvas *canvas, const ip_mesh *mesh, uint64_t first,
+                               ip_error *err);
+
+/*! ip_canvas_shade() : shades the pixels changed since the last call (every pixel after
+ *  begin) and returns the image: width * height * 4 bytes (RGBA, top row first), owned by the
+ *  canvas, valid until the next begin or destroy. `rows` (may be NULL) receives the rows
+ *  [rows[0], rows[1]) that hold every pixel changed by this call ({0, 0}: none), the part a
+ *  caller showing the image in a texture has to send again. NULL before the first begin. */
+IP_API const uint8_t *ip_canvas_shade(ip_canvas *canvas, uint32_t rows[2]);
+
+/*! ip_canvas_triangle_index() : width * height entries, top row first: the index of the
+ *  triangle each pixel shows, UINT32_MAX where none; owned by the canvas, current after each
+ *  add. NULL before the first begin. */
+IP_API const uint32_t *ip_canvas_triangle_index(const ip_canvas *canvas);
+
+/*! ip_canvas_triangle_count() : the triangles added since begin. */
+IP_API uint64_t ip_canvas_triangle_count(const ip_canvas *canvas);
+
+/*! ip_canvas_memory() : the bytes of the canvas's image buffers. */
+IP_API size_t ip_canvas_memory(const ip_canvas *canvas);
+
 /*! ip_png_write() : writes an image given as width * height * 4 bytes (RGBA, top row first)
  *  as an 8-bit PNG: RGB when every alpha is 255, RGBA otherwise. The file appears only once
  *  complete (atomic); an existing `path` is replaced only when `force` is non-zero, and
@@ -237,6 +292,11 @@ IP_API ip_status ip_renderer_upload(ip_renderer *renderer, const ip_mesh *mesh,
 /*! ip_renderer_clear_mesh() : forgets every uploaded triangle, keeping the GPU buffers. */
 IP_API void ip_renderer_clear_mesh(ip_renderer *renderer);
 
+/*! ip_renderer_memory() : the bytes of the mesh buffers the renderer holds on the GPU (for
+ *  a software OpenGL driver, in the process's memory): those of ip_renderer_upload() (grown
+ *  geometrically) and of ip_renderer_draw_mesh()'s streaming, once used. */
+IP_API uint64_t ip_renderer_memory(const ip_renderer *renderer);
+
 /*! ip_renderer_triangle_count() : the number of triangles uploaded and not cleared. */
 IP_API uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
 
@@ -249,6 +309,18 @@ IP_API uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
  *  (an OpenGL error, named in the message). */
 IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera,
                                   const double lo[3], const double hi[3], ip_error *err);
+
+/*! ip_renderer_draw_added() : draws only the uploaded triangles [first, count) over the image
+ *  drawn last, whose colour and depth the framebuffer still holds (a renderer's own, or a
+ *  caller's framebuffer object: not a window's, whose back buffer a swap may leave undefined);
+ *  `camera` must be the one of that image. The image is then the one ip_renderer_draw() gives
+ *  of every uploaded triangle (drawn in order, the nearest wins, the earlier on equal depth),
+ *  at the cost of the new triangles only: for a mesh that grows while the view stays. `first`
+ *  0 is ip_renderer_draw().
+ *  @return as ip_renderer_draw(), and IP_ERR_ARGUMENT when first is past the uploaded count. */
+IP_API ip_status ip_renderer_draw_added(ip_renderer *renderer, const ip_camera *camera,
+                                        const double lo[3], const double hi[3], uint64_t first,
+                                        ip_error *err);
 
 /*! ip_renderer_draw_mesh() : draws the background and the triangles of `mesh`, in order,
  *  like ip_renderer_draw() would after uploading exactly `mesh` (the same image), but

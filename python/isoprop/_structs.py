@@ -121,7 +121,8 @@ class EngineOptions(ctypes.Structure):
     _fields_ = [("cutoff_degrees", c_double), ("foldback_degrees", c_double),
                 ("threads", c_uint), ("lod", c_int), ("pixel_error", c_double),
                 ("cell_ids", c_int), ("occlusion", c_int), ("prefetch", c_int),
-                ("cull", c_int), ("clip_count", c_uint), ("clip", ClipPlane * IP_MAX_CLIP_PLANES)]
+                ("cull", c_int), ("clip_count", c_uint), ("clip", ClipPlane * IP_MAX_CLIP_PLANES),
+                ("reuse", c_int)]
 
 
 class EngineCounts(ctypes.Structure):
@@ -130,7 +131,8 @@ class EngineCounts(ctypes.Structure):
                 ("triangles", c_uint64), ("intersection_seconds", c_double),
                 ("propagation_seconds", c_double), ("extraction_seconds", c_double),
                 ("rendering_seconds", c_double), ("deferred", c_uint64),
-                ("retired", c_uint64), ("nodes", c_uint64), ("culled", c_uint64)]
+                ("retired", c_uint64), ("nodes", c_uint64), ("culled", c_uint64),
+                ("kept", c_uint64)]
 
 
 class Mesh(ctypes.Structure):

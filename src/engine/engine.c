@@ -26,6 +26,7 @@ void ip_engine_options_default(ip_engine_options *o)
     o->prefetch = IP_PREFETCH_ON;
     o->cull = 1;
     o->clip_count = 0;
+    o->reuse = 0;
 }
 
 /* The brick file an engine extracts from, which its messages name. */
@@ -64,6 +65,7 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     e->threads = ip_thread_count(options->threads);
     atomic_init(&e->cancel, 0);
     atomic_init(&e->next_position, 0);
+    atomic_init(&e->ahead_claimed, 0);
     atomic_init(&e->rays_taken, 0);
     atomic_init(&e->leftovers_waiting, 0);
     atomic_init(&e->step_rays_left, 0);
@@ -75,7 +77,7 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     atomic_init(&e->hungry, 0);
     atomic_init(&e->share_news, 0);
     ip_mesh_init(&e->mesh);
-    e->mesh.with_cells = options->cell_ids != 0;
+    e->mesh.with_cells = options->cell_ids != 0 || options->reuse != 0;
     e->workers = calloc(e->threads, sizeof *e->workers);
     e->leftovers = calloc(e->threads, sizeof *e->leftovers);
     e->shared = malloc(SHARED_MAX * sizeof *e->shared);
@@ -179,8 +181,53 @@ static void begin_prefetch(ip_engine *e)
                               &e->cancel,
                               {e->options.clip, e->options.clip_count},
                               e->region_x,
-                              e->region_y};
+                              e->region_y,
+                              0};
     ip__prefetcher_begin(e->prefetcher, &view);
+}
+
+ip_status ip_engine_read_ahead(ip_engine *e, const ip_camera *camera, ip_error *err)
+{
+    ip_status st = ip_camera_check(camera, err);
+    if (st != IP_OK)
+        return st;
+    if (!e->begun || !ip_engine_done(e))
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "ip_engine_read_ahead(): the engine's view is not done yet");
+    if (!e->prefetcher)
+        return IP_OK;
+    /* the predicted view's bands and order, as ip_engine_begin() would set them */
+    const ip_layout *layout = ip_store_layout(ip_cache_store(e->cache));
+    double distance[IP_MAX_LEVELS + 1], widening[IP_MAX_LEVELS];
+    uint32_t levels =
+        ip__lod_distances(layout, camera, e->options.lod, e->options.pixel_error, distance);
+    for (uint32_t k = 0; k < levels; k++)
+        widening[k] = ip__lod_band_widening(layout, k, levels);
+    ip_ray_order order; /* as start_order() makes it */
+    ip__ray_order_init(&order, camera->width, camera->height);
+    uint32_t last = ip__ray_order_last_level(&order);
+    ip__ray_order_set_local_from(&order, last > LOCAL_LEVELS ? last - LOCAL_LEVELS : 0);
+    ip_camera_basis basis;
+    ip_camera_basis_of(camera, &basis);
+    atomic_store(&e->ahead_claimed, 0); /* no worker walks it: the reader plans its first rays */
+    ip__prefetch_view view = {*camera,
+                              basis,
+                              e->iso,
+                              levels,
+                              distance,
+                              widening,
+                              order,
+                              ip__ray_order_cells(&order),
+                              &e->ahead_claimed,
+                              &e->cancel,
+                              {e->options.clip, e->options.clip_count},
+                              0,
+                              0,
+                              1}; /* the workers are idle: every planned brick */
+    ip__prefetcher_pause(e->prefetcher);
+    ip__prefetcher_begin(e->prefetcher, &view);
+    ip__prefetcher_resume(e->prefetcher);
+    return IP_OK;
 }
 /* One worker's share of the occlusion state to start over (a job of the engine's pool): its
  * part of the coverage buffer and of the tiles. */
@@ -219,8 +266,13 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: the isovalue must be finite", path_of(e->cache));
     if (e->prefetcher) /* it reads the view about to change */
         ip__prefetcher_pause(e->prefetcher);
+    /* the view before's mesh stays for reuse (reuse.c) until the new view is set up */
+    int keep = e->options.reuse && e->options.occlusion && e->begun && e->reusable &&
+               iso == e->iso && e->mesh.with_cells;
+    e->reusable = 0;
     ip__visited_clear(&e->visited);
-    ip_mesh_clear(&e->mesh);
+    if (!keep)
+        ip_mesh_clear(&e->mesh);
     e->shared_count = 0; /* what a cancelled or failed step left */
     e->camera = *camera;
     ip_camera_basis_of(&e->camera, &e->basis);
@@ -289,8 +341,13 @@ ip_status ip_engine_begin(ip_engine *e, const ip_camera *camera, float iso, ip_e
                 lt->propagator.share = (ip_share){&e->hungry, ip__engine_give_cells, e};
         }
     }
+    if (keep && ip__engine_keep(e) != IP_OK) {
+        ip_mesh_clear(&e->mesh);
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path_of(e->cache));
+    }
     atomic_store(&e->cancel, 0);
     e->begun = 1;
+    e->reusable = 1;
     begin_prefetch(e);
     return IP_OK;
 }
@@ -314,6 +371,7 @@ ip_status ip_engine_set_region(ip_engine *e, uint32_t x, uint32_t y, uint32_t wi
                         (unsigned long long)pixels);
     if (e->prefetcher) /* it reads the order about to change */
         ip__prefetcher_pause(e->prefetcher);
+    e->reusable = 0; /* a region's mesh is not the view's */
     start_order(e, width, height);
     /* the positions of rays [first_ray, first_ray + ray_count) of the region's order */
     ip_ray_order walk = e->order;
@@ -372,6 +430,7 @@ static void add_counts(ip_engine_counts *to, const ip_engine_counts *from)
     to->retired += from->retired;
     to->nodes += from->nodes;
     to->culled += from->culled;
+    to->kept += from->kept;
 }
 
 /* Moves the worker's triangles, if it holds any, to the engine's mesh. */
@@ -491,6 +550,8 @@ ip_status ip_engine_step(ip_engine *e, uint64_t max_rays, double max_seconds,
     add_counts(&e->totals, &c);
     if (counts)
         *counts = c;
+    if (st != IP_OK)
+        e->reusable = 0;
     return st;
 }
 
@@ -507,4 +568,31 @@ void ip_engine_totals(const ip_engine *e, ip_engine_counts *counts)
 void ip_engine_add_rendering_time(ip_engine *e, double seconds)
 {
     e->totals.rendering_seconds += seconds;
+}
+
+/* The bytes of a mesh's arrays as allocated. */
+static uint64_t mesh_bytes(const ip_mesh *m)
+{
+    return m->capacity *
+           (9 * sizeof(float) + 9 * sizeof(int16_t) + (m->with_cells ? sizeof(uint64_t) : 0));
+}
+
+void ip_engine_memory_of(const ip_engine *e, ip_engine_memory *m)
+{
+    memset(m, 0, sizeof *m);
+    m->mesh = mesh_bytes(&e->mesh);
+    for (unsigned t = 0; t < e->threads; t++) {
+        const ip_engine_worker *w = &e->workers[t];
+        m->workers += mesh_bytes(&w->mesh);
+        for (uint32_t k = 0; k < IP_MAX_LEVELS; k++)
+            if (w->level[k].ready)
+                m->workers += w->level[k].propagator.queue.capacity * sizeof(ip_depth_slot);
+    }
+    const ip_visited *v = &e->visited;
+    uint64_t bricks = v->layout ? v->layout->brick_count : 0;
+    m->visited = atomic_load(&((ip_visited *)v)->holder_count) * v->words_per_brick * 8 +
+                 bricks * (sizeof *v->bitmaps + sizeof *v->holders);
+    m->coverage =
+        e->coverage.capacity * 2 * sizeof(atomic_uint) + e->tile_capacity * (sizeof *e->tiles + 1);
+    m->total = m->mesh + m->workers + m->visited + m->coverage;
 }

@@ -95,6 +95,8 @@ struct ip_engine {
     ip_camera_basis basis;
     float iso;
     int begun;
+    int reusable; /* with options.reuse: the mesh is that of the view begun last, every step of
+                     it successful, no region set (reuse.c) */
     uint32_t levels_used;                   /* levels 0 .. levels_used - 1 have a distance band */
     double lod_distance[IP_MAX_LEVELS + 1]; /* D[k]; D[levels_used] = infinity */
     double cell_reach[IP_MAX_LEVELS];       /* a level-k cell's extent along the view (world) */
@@ -115,6 +117,7 @@ struct ip_engine {
     ip_ray_order order; /* the view's order, copied into each worker's iterator */
     uint64_t order_cells;
     atomic_uint_fast64_t next_position; /* the first position no worker has claimed */
+    atomic_uint_fast64_t ahead_claimed; /* ip_engine_read_ahead(): 0, no worker walks it */
     atomic_uint_fast64_t rays_taken;    /* pixels handed out since begin (or set_region) */
     uint64_t ray_target;                /* the pixels of the order to cast: done at rays_taken */
     atomic_uint cells_done;             /* cells extracted since begin, as workers publish them */
@@ -182,6 +185,14 @@ int ip__engine_take_block(ip_engine *e, ip_engine_worker *w, ip_order_ray *rays,
  * it nearly hit before it, propagating from each not extracted yet. Why the image stays exact
  * with the stop and the start: cast.c. */
 ip_status ip__engine_cast_ray(ip_engine_worker *w, uint32_t x, uint32_t y, double from);
+
+/* reuse.c */
+
+/* With options.reuse, at ip_engine_begin() of a view at the isovalue of the one before, once the
+ * view, its bands, the coverage and the workers' samplers are set up: keeps the mesh's cells that
+ * belong to the new view (engine.h, "Reuse"), marks them extracted and records them in the
+ * coverage; adds them to the totals. @return IP_OK or IP_ERR_NOMEM. */
+ip_status ip__engine_keep(ip_engine *e);
 
 /* share.c */
 

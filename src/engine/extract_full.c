@@ -50,7 +50,7 @@ static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip
     ip_brick_extent(l, level, brick, origin, extent);
     uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
     ip_status st = IP_OK;
-    ip_cell_output out = {mesh, NULL, 0}; /* every triangle, none culled */
+    ip_cell_output out = {mesh, NULL, 0, 0}; /* every triangle, none culled */
     if (!brick_may_be_in_band(s, band, origin, extent))
         return st;
     for (uint32_t i = 0; i < per * per * per && st == IP_OK; i++) {

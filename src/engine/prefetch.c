@@ -198,7 +198,7 @@ static void load_next(ip__prefetcher *p)
     ip_brick_entry be;
     ip_store_brick_entry(p->store, g, &be);
     p->hinted_bytes -= be.stored_size; /* hint() has passed it: hinted > head */
-    if (p->leave_in_memory && ip_store_brick_in_memory(p->store, g) == 1)
+    if (p->leave_in_memory && !p->view.load_all && ip_store_brick_in_memory(p->store, g) == 1)
         return; /* no disk to wait for: a worker that needs it loads it as fast */
     ip__prefetch_outcome got = ip__cache_prefetch_brick(p->cache, g, p->below);
     if (got == IP__PREFETCH_FULL)

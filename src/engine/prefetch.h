@@ -60,6 +60,8 @@ typedef struct ip__prefetch_view {
     const atomic_int *cancel;            /* the engine's cancel flag */
     ip_clip clip; /* the engine's planes: bricks wholly beyond one are not read ahead */
     uint32_t region_x, region_y; /* the image pixel of the order's pixel (0, 0) */
+    int load_all; /* load every planned brick, those the page cache holds too: the workers are
+                     idle (ip_engine_read_ahead()) */
 } ip__prefetch_view;
 
 /* Starts the reader thread (signals blocked), idle until ip__prefetcher_resume(). With

@@ -23,7 +23,7 @@ ip_status ip__propagator_init(ip_propagator *p, ip_sampler *sampler, ip_visited 
     memset(p, 0, sizeof *p);
     p->sampler = sampler;
     p->visited = visited;
-    p->out = (ip_cell_output){mesh, coverage, coverage && options->cull};
+    p->out = (ip_cell_output){mesh, coverage, coverage && options->cull, options->reuse};
     p->camera = camera;
     p->window[0] = p->window[1] = 0;
     p->window[2] = camera->width;
@@ -71,7 +71,7 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
         out->coverage
             ? ip__coverage_add_indexed(out->coverage, (const float(*)[3])points, row, (unsigned)n)
             : 0;
-    if (!out->cull)
+    if (!out->cull || (out->whole_cells && (shows & ((1u << n) - 1))))
         shows = ~0u;
     if (!(shows & ((1u << n) - 1))) {
         *culled += (uint64_t)n;

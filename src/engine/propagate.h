@@ -33,6 +33,8 @@ typedef struct ip_cell_output {
     ip_mesh *mesh;
     ip_coverage *coverage;
     int cull;
+    int whole_cells; /* with cull: a cell keeps all its triangles when one of them may show, so
+                        that every cell in the mesh is whole (the engine's reuse) */
 } ip_cell_output;
 
 typedef struct ip_propagator {

@@ -5,6 +5,7 @@
 
 #include "internal.h"
 #include "isoprop/render.h"
+#include "raster_core.h"
 #include "vec3.h"
 
 /* Vertices snap to 1/256 pixel, as GPUs do; edge functions are then exact 64-bit integers, so
@@ -57,25 +58,25 @@ ip_status ip_shading_check(const ip_shading *s, ip_error *err)
     return IP_OK;
 }
 
-static uint8_t to_unorm8(double v)
+uint8_t ip__raster_unorm8(double v)
 {
     v = v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v;
     return (uint8_t)floor(v * 255.0 + 0.5);
 }
 
-static void shade_background(const ip_shading *s, uint32_t row, uint32_t height, uint8_t out[4])
+void ip__raster_background(const ip_shading *s, uint32_t row, uint32_t height, uint8_t out[4])
 {
     double t = (row + 0.5) / height;
     for (int i = 0; i < 3; i++)
-        out[i] = to_unorm8(s->background_top[i] +
-                           t * (s->background_bottom[i] - (double)s->background_top[i]));
+        out[i] = ip__raster_unorm8(s->background_top[i] +
+                                   t * (s->background_bottom[i] - (double)s->background_top[i]));
     out[3] = 255;
 }
 
 /* The shaded colour of a surface of colour `colour`, before rounding. n: the interpolated
  * normal (any length); v: the unit vector toward the eye. */
-static void shade_value(const ip_shading *s, const float colour[3], const float n[3],
-                        const double v[3], double out[3])
+void ip__raster_shade(const ip_shading *s, const float colour[3], const float n[3],
+                      const double v[3], double out[3])
 {
     const double normal[3] = {n[0], n[1], n[2]};
     double len = ip__vec3_length(normal);
@@ -87,30 +88,8 @@ static void shade_value(const ip_shading *s, const float colour[3], const float 
         out[i] = colour[i] * light + highlight;
 }
 
-/* A vertex in view space: x right, y up, z the depth along the view direction (world units);
- * the normal stays in world space. */
-typedef struct view_vertex {
-    double p[3];
-    double n[3];
-} view_vertex;
-
-typedef struct raster_view {
-    ip_camera_basis basis;
-    double eye[3];
-    double near_plane, far_plane;
-    double guard_x, guard_y; /* the guard band as bounds on x / z and y / z */
-    double width, height;
-} raster_view;
-
-typedef struct raster_target {
-    uint32_t width, height; /* of the part drawn */
-    uint32_t x, y;          /* its top-left pixel in the camera's image */
-    double *inverse_depth;  /* 1 / view depth of the nearest surface; 0 where empty */
-    uint32_t *index;
-    float *normal; /* 3 per pixel, or NULL when no image is wanted */
-} raster_target;
-
-static void setup_view(raster_view *v, const ip_camera *c, const double lo[3], const double hi[3])
+void ip__raster_setup_view(ip_raster_view *v, const ip_camera *c, const double lo[3],
+                           const double hi[3])
 {
     ip_camera_basis_of(c, &v->basis);
     memcpy(v->eye, c->eye, sizeof v->eye);
@@ -122,7 +101,7 @@ static void setup_view(raster_view *v, const ip_camera *c, const double lo[3], c
     v->guard_y = GUARD_PIXELS / side * v->basis.tan_half_y;
 }
 
-static void to_view(const raster_view *v, const float *p, const int16_t *n, view_vertex *out)
+static void to_view(const ip_raster_view *v, const float *p, const int16_t *n, view_vertex *out)
 {
     double d[3] = {p[0] - v->eye[0], p[1] - v->eye[1], p[2] - v->eye[2]};
     const double *r = v->basis.right, *u = v->basis.up, *f = v->basis.forward;
@@ -134,7 +113,7 @@ static void to_view(const raster_view *v, const float *p, const int16_t *n, view
 }
 
 /* Signed distance-like value of a vertex to clip plane k; inside when >= 0. */
-static double plane_value(const raster_view *v, int k, const view_vertex *a)
+static double plane_value(const ip_raster_view *v, int k, const view_vertex *a)
 {
     const double *p = a->p;
     switch (k) {
@@ -166,7 +145,7 @@ static view_vertex crossing(const view_vertex *a, double da, const view_vertex *
 }
 
 /* Sutherland-Hodgman against one plane; returns the new vertex count. */
-static int clip_polygon(const raster_view *v, int k, const view_vertex *in, int count,
+static int clip_polygon(const ip_raster_view *v, int k, const view_vertex *in, int count,
                         view_vertex *out)
 {
     int n = 0;
@@ -187,7 +166,7 @@ typedef struct screen_vertex {
     const double *n;
 } screen_vertex;
 
-static void to_screen(const raster_view *v, const view_vertex *a, screen_vertex *s)
+static void to_screen(const ip_raster_view *v, const view_vertex *a, screen_vertex *s)
 {
     double iz = 1.0 / a->p[2];
     double px = (a->p[0] * iz / v->basis.tan_half_x + 1.0) * 0.5 * v->width;
@@ -225,7 +204,7 @@ static edge make_edge(const screen_vertex *a, const screen_vertex *b, int64_t px
     return e;
 }
 
-static void write_fragment(raster_target *t, size_t pixel, const screen_vertex v[3],
+static void write_fragment(ip_raster_target *t, size_t pixel, const screen_vertex v[3],
                            const int64_t w[3], double inverse_area, uint32_t index)
 {
     double q[3], inverse_depth = 0;
@@ -237,6 +216,8 @@ static void write_fragment(raster_target *t, size_t pixel, const screen_vertex v
         return;
     t->inverse_depth[pixel] = inverse_depth;
     t->index[pixel] = index;
+    if (t->dirty)
+        t->dirty[pixel] = 1;
     if (!t->normal)
         return;
     for (int k = 0; k < 3; k++)
@@ -244,7 +225,8 @@ static void write_fragment(raster_target *t, size_t pixel, const screen_vertex v
             (float)((q[0] * v[0].n[k] + q[1] * v[1].n[k] + q[2] * v[2].n[k]) / inverse_depth);
 }
 
-static void scan_triangle(raster_target *t, const screen_vertex v[3], int64_t area, uint32_t index)
+static void scan_triangle(ip_raster_target *t, const screen_vertex v[3], int64_t area,
+                          uint32_t index)
 {
     int64_t min_x = v[0].x, max_x = v[0].x, min_y = v[0].y, max_y = v[0].y;
     for (int i = 1; i < 3; i++) {
@@ -287,7 +269,7 @@ static void scan_triangle(raster_target *t, const screen_vertex v[3], int64_t ar
     }
 }
 
-static void raster_triangle(raster_target *t, const raster_view *view, const view_vertex *a,
+static void raster_triangle(ip_raster_target *t, const ip_raster_view *view, const view_vertex *a,
                             const view_vertex *b, const view_vertex *c, uint32_t index)
 {
     screen_vertex v[3];
@@ -308,8 +290,8 @@ static void raster_triangle(raster_target *t, const raster_view *view, const vie
 
 /* Clips the triangle where it leaves the view volume or the guard band, then rasterizes the
  * pieces. Returns without work when the triangle lies outside one plane entirely. */
-static void clip_and_raster(raster_target *t, const raster_view *view, const view_vertex tri[3],
-                            uint32_t index)
+static void clip_and_raster(ip_raster_target *t, const ip_raster_view *view,
+                            const view_vertex tri[3], uint32_t index)
 {
     unsigned outside_all = (1u << PLANE_COUNT) - 1, outside_any = 0;
     for (int i = 0; i < 3; i++) {
@@ -345,8 +327,8 @@ static void clip_and_raster(raster_target *t, const raster_view *view, const vie
  * translucent one; first[i] is surface i's first triangle number in its target. One mesh is
  * one opaque surface. */
 typedef struct surface_targets {
-    raster_target opaque;
-    raster_target layer[IP_MAX_SURFACES]; /* of the translucent surfaces */
+    ip_raster_target opaque;
+    ip_raster_target layer[IP_MAX_SURFACES]; /* of the translucent surfaces */
     uint32_t first[IP_MAX_SURFACES];
 } surface_targets;
 
@@ -372,23 +354,24 @@ static void shade_surfaces_pixel(const surface_targets *st, const ip_surface *su
                                  size_t count, const ip_shading *s, const double ray[3],
                                  size_t pixel, uint8_t out[4])
 {
-    const raster_target *o = &st->opaque;
+    const ip_raster_target *o = &st->opaque;
     double value[3];
     if (o->index[pixel] != UINT32_MAX) {
         const ip_surface *f = &surfaces[opaque_surface_of(st, surfaces, count, o->index[pixel])];
-        shade_value(s, f->colour, o->normal + 3 * pixel, ray, value);
+        ip__raster_shade(s, f->colour, o->normal + 3 * pixel, ray, value);
         for (int k = 0; k < 3; k++)
-            out[k] = to_unorm8(value[k]);
+            out[k] = ip__raster_unorm8(value[k]);
     }
     for (size_t i = 0; i < count; i++) {
-        const raster_target *t = &st->layer[i];
+        const ip_raster_target *t = &st->layer[i];
         if (is_opaque(&surfaces[i]) || t->index[pixel] == UINT32_MAX ||
             t->inverse_depth[pixel] < o->inverse_depth[pixel])
             continue;
         double a = surfaces[i].opacity;
-        shade_value(s, surfaces[i].colour, t->normal + 3 * pixel, ray, value);
+        ip__raster_shade(s, surfaces[i].colour, t->normal + 3 * pixel, ray, value);
         for (int k = 0; k < 3; k++)
-            out[k] = to_unorm8(a * fmin(1.0, fmax(0.0, value[k])) + (1.0 - a) * (out[k] / 255.0));
+            out[k] = ip__raster_unorm8(a * fmin(1.0, fmax(0.0, value[k])) +
+                                       (1.0 - a) * (out[k] / 255.0));
     }
 }
 
@@ -420,12 +403,12 @@ static ip_shading shading_or_default(const ip_shading *shading)
 static void shade_image(const surface_targets *st, const ip_surface *surfaces, size_t count,
                         const ip_camera *camera, const ip_shading *s, uint8_t *rgba)
 {
-    const raster_target *t = &st->opaque;
+    const ip_raster_target *t = &st->opaque;
     ip_camera_basis basis;
     ip_camera_basis_of(camera, &basis);
     for (uint32_t y = 0; y < t->height; y++) {
         uint8_t background[4];
-        shade_background(s, t->y + y, camera->height, background);
+        ip__raster_background(s, t->y + y, camera->height, background);
         for (uint32_t x = 0; x < t->width; x++) {
             size_t pixel = (size_t)y * t->width + x;
             uint8_t *out = rgba + 4 * pixel;
@@ -470,7 +453,7 @@ static ip_status check_arguments(const ip_mesh *mesh, const ip_camera *camera, c
 
 /* The working buffers of the part [x, x + width) x [y, y + height) of the image; the caller's
  * triangle_index and inverse_depth (either may be NULL) are used where given. */
-static ip_status allocate_target(raster_target *t, uint32_t x, uint32_t y, uint32_t width,
+static ip_status allocate_target(ip_raster_target *t, uint32_t x, uint32_t y, uint32_t width,
                                  uint32_t height, uint32_t *triangle_index, double *inverse_depth,
                                  int with_normals, ip_error *err)
 {
@@ -493,7 +476,7 @@ static ip_status allocate_target(raster_target *t, uint32_t x, uint32_t y, uint3
     return IP_OK;
 }
 
-static void free_target(raster_target *t, const uint32_t *triangle_index,
+static void free_target(ip_raster_target *t, const uint32_t *triangle_index,
                         const double *inverse_depth)
 {
     if (t->inverse_depth != inverse_depth)
@@ -503,16 +486,22 @@ static void free_target(raster_target *t, const uint32_t *triangle_index,
     free(t->normal);
 }
 
-/* Rasterizes every triangle of `mesh` into t, numbered from `first_index` on. */
-static void raster_triangles(raster_target *t, const raster_view *view, const ip_mesh *mesh,
-                             uint32_t first_index)
+void ip__raster_range(ip_raster_target *t, const ip_raster_view *view, const ip_mesh *mesh,
+                      uint64_t first, uint64_t count, uint32_t first_index)
 {
-    for (uint64_t i = 0; i < mesh->triangle_count; i++) {
+    for (uint64_t i = first; i < first + count; i++) {
         view_vertex tri[3];
         for (int k = 0; k < 3; k++)
             to_view(view, mesh->positions + 9 * i + 3 * k, mesh->normals + 9 * i + 3 * k, &tri[k]);
-        clip_and_raster(t, view, tri, first_index + (uint32_t)i);
+        clip_and_raster(t, view, tri, first_index + (uint32_t)(i - first));
     }
+}
+
+/* Rasterizes every triangle of `mesh` into t, numbered from `first_index` on. */
+static void raster_triangles(ip_raster_target *t, const ip_raster_view *view, const ip_mesh *mesh,
+                             uint32_t first_index)
+{
+    ip__raster_range(t, view, mesh, 0, mesh->triangle_count, first_index);
 }
 
 static ip_status raster_part(const ip_mesh *mesh, const ip_camera *camera,
@@ -567,13 +556,13 @@ static ip_status raster_part(const ip_mesh *mesh, const ip_camera *camera,
     if (st != IP_OK)
         return st;
     surface_targets targets; /* the mesh as one opaque surface */
-    raster_target *target = &targets.opaque;
+    ip_raster_target *target = &targets.opaque;
     targets.first[0] = 0;
     st = allocate_target(target, x, y, width, height, triangle_index, inverse_depth, rgba != NULL,
                          err);
     if (st == IP_OK) {
-        raster_view view;
-        setup_view(&view, camera, lo, hi);
+        ip_raster_view view;
+        ip__raster_setup_view(&view, camera, lo, hi);
         raster_triangles(target, &view, mesh, 0);
         if (rgba) {
             ip_shading s = shading_or_default(shading);
@@ -637,8 +626,8 @@ ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count, const ip_
     surface_targets *targets = calloc(1, sizeof *targets);
     if (!targets)
         return ip__fail(err, IP_ERR_NOMEM, "raster: out of memory");
-    raster_view view;
-    setup_view(&view, camera, lo, hi);
+    ip_raster_view view;
+    ip__raster_setup_view(&view, camera, lo, hi);
     st = allocate_target(&targets->opaque, 0, 0, camera->width, camera->height, NULL, NULL, 1, err);
     uint32_t next = 0;
     for (size_t i = 0; st == IP_OK && i < count; i++) {

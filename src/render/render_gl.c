@@ -463,6 +463,13 @@ void ip_renderer_clear_mesh(ip_renderer *r)
     r->triangle_count = 0;
 }
 
+uint64_t ip_renderer_memory(const ip_renderer *r)
+{
+    uint64_t stream =
+        r->stream_array ? (uint64_t)STREAM_TRIANGLES * (POSITION_BYTES + NORMAL_BYTES) : 0;
+    return r->triangle_capacity * (POSITION_BYTES + NORMAL_BYTES) + stream;
+}
+
 uint64_t ip_renderer_triangle_count(const ip_renderer *r)
 {
     return r->triangle_count;
@@ -517,20 +524,21 @@ static void use_mesh_program(const ip_renderer *r, const ip_camera *camera, doub
     glUniform1f(r->opacity_at, 1.0f);
 }
 
+/* Draws the uploaded triangles [first, triangle_count). */
 static void draw_mesh(const ip_renderer *r, const ip_camera *camera, double near_plane,
-                      double far_plane)
+                      double far_plane, uint64_t first)
 {
     use_mesh_program(r, camera, near_plane, far_plane);
     glBindVertexArray(r->mesh_array);
-    glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * r->triangle_count));
+    glDrawArrays(GL_TRIANGLES, (GLint)(3 * first), (GLsizei)(3 * (r->triangle_count - first)));
     glBindVertexArray(0);
     glUseProgram(0);
 }
 
-/* Checks the view and makes the context current; then clears the depth and draws the
- * background. */
+/* Checks the view and makes the context current; then, with `clear`, clears the depth and draws
+ * the background (else the image drawn last stays). */
 static ip_status begin_image(ip_renderer *r, const ip_camera *camera, const double lo[3],
-                             const double hi[3], double *near_plane, double *far_plane,
+                             const double hi[3], int clear, double *near_plane, double *far_plane,
                              ip_error *err)
 {
     ip_status st = ip_camera_check(camera, err);
@@ -546,21 +554,33 @@ static ip_status begin_image(ip_renderer *r, const ip_camera *camera, const doub
         return st;
     ip_camera_depth_range(camera, lo, hi, near_plane, far_plane);
     set_draw_state(r);
-    glClearDepth(1.0);
-    glClear(GL_DEPTH_BUFFER_BIT);
-    draw_background(r);
+    if (clear) {
+        glClearDepth(1.0);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        draw_background(r);
+    }
     return IP_OK;
 }
 
 ip_status ip_renderer_draw(ip_renderer *r, const ip_camera *camera, const double lo[3],
                            const double hi[3], ip_error *err)
 {
+    return ip_renderer_draw_added(r, camera, lo, hi, 0, err);
+}
+
+ip_status ip_renderer_draw_added(ip_renderer *r, const ip_camera *camera, const double lo[3],
+                                 const double hi[3], uint64_t first, ip_error *err)
+{
+    if (first > r->triangle_count)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "renderer: triangles from %llu drawn, but %llu uploaded",
+                        (unsigned long long)first, (unsigned long long)r->triangle_count);
     double near_plane, far_plane;
-    ip_status st = begin_image(r, camera, lo, hi, &near_plane, &far_plane, err);
+    ip_status st = begin_image(r, camera, lo, hi, first == 0, &near_plane, &far_plane, err);
     if (st != IP_OK)
         return st;
-    if (r->triangle_count)
-        draw_mesh(r, camera, near_plane, far_plane);
+    if (first < r->triangle_count)
+        draw_mesh(r, camera, near_plane, far_plane, first);
     return check_gl("drawing", err);
 }
 
@@ -602,7 +622,7 @@ ip_status ip_renderer_draw_mesh(ip_renderer *r, const ip_mesh *m, const ip_camer
                                 const double lo[3], const double hi[3], ip_error *err)
 {
     double near_plane, far_plane;
-    ip_status st = begin_image(r, camera, lo, hi, &near_plane, &far_plane, err);
+    ip_status st = begin_image(r, camera, lo, hi, 1, &near_plane, &far_plane, err);
     if (st == IP_OK)
         st = make_stream_buffers(r, err);
     if (st != IP_OK || m->triangle_count == 0)
@@ -660,7 +680,7 @@ ip_status ip_renderer_draw_surfaces(ip_renderer *r, const ip_surface *surfaces, 
     ip_status st = ip_surfaces_check(surfaces, count, err);
     double near_plane, far_plane;
     if (st == IP_OK)
-        st = begin_image(r, camera, lo, hi, &near_plane, &far_plane, err);
+        st = begin_image(r, camera, lo, hi, 1, &near_plane, &far_plane, err);
     if (st == IP_OK)
         st = make_stream_buffers(r, err);
     if (st != IP_OK)

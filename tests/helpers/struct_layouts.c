@@ -162,6 +162,7 @@ static void engine(void)
     FIELD(ip_engine_options, cull);
     FIELD(ip_engine_options, clip_count);
     FIELD(ip_engine_options, clip);
+    FIELD(ip_engine_options, reuse);
     SIZE(ip_clip_plane);
     FIELD(ip_clip_plane, normal);
     FIELD(ip_clip_plane, offset);
@@ -178,6 +179,7 @@ static void engine(void)
     FIELD(ip_engine_counts, retired);
     FIELD(ip_engine_counts, nodes);
     FIELD(ip_engine_counts, culled);
+    FIELD(ip_engine_counts, kept);
     SIZE(ip_mesh);
     FIELD(ip_mesh, positions);
     FIELD(ip_mesh, normals);

@@ -111,6 +111,53 @@ same_image "the window shows isorender's image at the start" start.png r-start.p
 same_image "... after orbit, zoom and isovalue changes, at a given camera" camera.png r-camera.png
 same_image "... with the full extraction" full.png r-camera.png
 same_image "... back at --view -y" view.png r-start.png
+# the renderer: auto takes the software one where OpenGL is itself software (llvmpipe here)
+if grep -q '"gl_renderer": "[^"]*llvmpipe' walk.json; then
+    check "auto draws in software on llvmpipe" grep -q '"renderer": "software"' walk.json
+fi
+# each pass's course and the memory held (docs/isoview.md, "Statistics")
+for key in views views_median first_frame_s final_85_s final_995_s complete_s view_frames \
+           fps_moving memory engine_mesh_bytes visited_bytes coverage_bytes canvas_bytes \
+           gpu_mesh_bytes rss_peak_bytes; do
+    check "stats has \"$key\"" grep -q "\"$key\":" walk.json
+done
+check "five passes recorded" test "$(grep -o '"start_s"' walk.json | wc -l)" = 5
+check "the last pass completed, its final pixels measured" \
+    sh -c 'tr "{" "\n" <walk.json | grep "\"start_s\"" | tail -1 | grep -q "\"final_995_s\": [0-9]"'
+# a drag (the script's, as the mouse's): coarse passes while the view moves, then the fine pass
+# at the camera where it stopped, the image isorender draws there (its --azimuth turns the
+# other way)
+printf 'wait done\ndrag 30 0 0.6\nwait done\noverlay off\nscreenshot drag.png\nquit\n' >drag.txt
+view s.ibv --iso 1000.5 --size 320x240 --script drag.txt --stats drag.json --exit-after 90
+check "the drag exits with 0 (got $rc: $err)" test "$rc" = 0
+"$bin/isorender" s.ibv --iso 1000.5 --size 320x240 --view -y --azimuth -30 -o r-drag.png --quiet
+same_image "after a drag, the fine pass's image at the camera it stopped at" drag.png r-drag.png
+check "passes ran while the view moved" grep -q '"moving": true' drag.json
+check "and the last one did not" \
+    sh -c 'tr "{" "\n" <drag.json | grep "\"start_s\"" | tail -1 | grep -q "\"moving\": false"'
+check "frames were counted while it moved" sh -c '! grep -q "\"fps_moving\": 0.000" drag.json'
+expect_error 2 "--drag-pixel-error '-1'" "$bin/isoview" s.ibv --iso 1 --drag-pixel-error -1
+printf 'drag 30 0\n' >baddrag.txt
+expect_error 1 "baddrag.txt:1: bad arguments to 'drag'" "$bin/isoview" s.ibv --iso 1 \
+    --script baddrag.txt
+
+# the same walk with the other renderer draws the same pictures
+for r in opengl software; do
+    grep -q "\"renderer\": \"$r\"" walk.json && continue
+    sed "s/screenshot \([a-z]*\).png/screenshot $r-\1.png/" walk.txt >walk-$r.txt
+    view s.ibv --iso 1000.5 --size 320x240 --lod off --cache-mb 1 --script walk-$r.txt \
+        --stats walk-$r.json --exit-after 90 --renderer $r
+    check "the walk with --renderer $r exits with 0 (got $rc: $err)" test "$rc" = 0
+    check "its statistics say $r" grep -q "\"renderer\": \"$r\"" walk-$r.json
+    same_image "$r: the start" $r-start.png r-start.png
+    same_image "$r: at a given camera" $r-camera.png r-camera.png
+    same_image "$r: the full extraction" $r-full.png r-camera.png
+    same_image "$r: back at --view -y" $r-view.png r-start.png
+done
+expect_error 2 "--renderer 'gpu': must be auto, opengl or software" "$bin/isoview" s.ibv --iso 1 \
+    --renderer gpu
+expect_error 2 "--aa is OpenGL's" "$bin/isoview" s.ibv --iso 1 --renderer software --aa 4
+
 hud=$(pct_differ hud.png start.png)
 check "the overlay is drawn (${hud:-?} % of the pixels differ)" \
     awk -v p="${hud:-0}" 'BEGIN { exit !(p >= 1 && p <= 60) }'

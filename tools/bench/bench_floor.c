@@ -64,7 +64,7 @@ static void extract_part(void *user, unsigned index)
     p->status = ip__sampler_init(&s, p->cache, 0);
     if (p->status != IP_OK)
         return;
-    ip_cell_output out = {&p->mesh, p->coverage, p->coverage != NULL}; /* no coverage: all */
+    ip_cell_output out = {&p->mesh, p->coverage, p->coverage != NULL, 0}; /* no coverage: all */
     uint64_t culled = 0;
     p->triangles = p->points = 0;
     for (size_t i = 0; i < p->count && p->status == IP_OK; i++) {

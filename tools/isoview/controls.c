@@ -189,6 +189,7 @@ static void on_cursor(GLFWwindow *window, double x, double y)
         ip_camera_pan(&v->camera, -dx * pixel, dy * pixel);
     }
     change_view(v);
+    v->last_motion = ip_now_seconds(); /* the coarse pass while it moves (main.c) */
 }
 
 static void on_scroll(GLFWwindow *window, double dx, double dy)
@@ -198,6 +199,7 @@ static void on_scroll(GLFWwindow *window, double dx, double dy)
     if (dy != 0) {
         zoom_view(v, pow(WHEEL_ZOOM, dy));
         change_view(v);
+        v->last_motion = ip_now_seconds();
     }
 }
 

@@ -9,6 +9,7 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "isoprop/cache.h"
@@ -21,8 +22,21 @@ typedef struct options {
     tool_view_options common; /* with --stats, --force and --quiet */
     const char *file, *script, *screenshot_path;
     double screenshot_at, exit_after;
-    int aa; /* --aa N: samples a pixel of the window (1: no multisampling) */
+    int aa;                  /* --aa N: samples a pixel of the window (1: no multisampling) */
+    int renderer;            /* --renderer: RENDERER_AUTO, _OPENGL or _SOFTWARE */
+    int reuse;               /* --reuse on|off: the engine's reuse across views */
+    int read_ahead;          /* --read-ahead on|off: the next view of a motion read ahead */
+    double drag_pixel_error; /* --drag-pixel-error P: the coarse pass while moving (0: none) */
 } options;
+
+/* --renderer: OpenGL draws the mesh; software draws it with the library's exact rasterizer
+ * into a canvas shown as a texture; auto takes software where OpenGL is itself a software
+ * driver (llvmpipe, softpipe). */
+enum {
+    RENDERER_AUTO,
+    RENDERER_OPENGL,
+    RENDERER_SOFTWARE
+};
 
 typedef enum command_kind {
     COMMAND_CAMERA,
@@ -38,12 +52,13 @@ typedef enum command_kind {
     COMMAND_HELP,
     COMMAND_CLIP,
     COMMAND_SCREENSHOT,
+    COMMAND_DRAG,
     COMMAND_QUIT
 } command_kind;
 
 typedef struct command {
     command_kind kind;
-    double a, b;
+    double a, b, c;
     char *text; /* camera, view, screenshot: owned */
 } command;
 
@@ -64,6 +79,32 @@ typedef struct overlay {
     int quads_size;       /* bytes */
 } overlay;
 
+/* The software renderer's window side: the canvas's image as a texture over the window. */
+typedef struct display {
+    GLuint texture, framebuffer; /* the image, bottom row first, and its framebuffer */
+    GLuint depth;                /* with_depth: the OpenGL renderer's depth buffer */
+    int with_depth;              /* for the OpenGL renderer (display_create()) */
+    uint8_t *rows;               /* the rows sent, turned bottom first (software) */
+    uint32_t width, height;      /* of the texture (0: none yet) */
+} display;
+
+/* One pass's course, for --stats: when its frames came and what they had drawn. */
+typedef struct pass_record {
+    double start;                     /* seconds since the window opened: the change */
+    double first_frame, complete;     /* seconds after start (complete < 0: never) */
+    double final_85, final_995;       /* seconds after start to 85 % / 99.5 % of the final
+                                          pixels (< 0: not measured) */
+    uint64_t frames, triangles, rays; /* frames drawn, and the pass's mesh at its end */
+    uint64_t kept;                    /* triangles kept from the view before (--reuse) */
+    int moving;                       /* it began during a drag */
+} pass_record;
+
+/* A frame of a pass: seconds after the pass's start, and the triangles it had drawn. */
+typedef struct frame_mark {
+    double time;
+    uint64_t triangles;
+} frame_mark;
+
 /* Frames per second, for the overlay (a short window) and the stats (whole seconds). */
 typedef struct frame_clock {
     double first, last; /* times of the first and last frame, seconds */
@@ -80,9 +121,19 @@ typedef struct viewer {
     options o;
     ip_store *store;
     ip_cache *cache;
-    ip_engine *engine;
+    ip_engine *engine;        /* the one in use: fine, or coarse while the view moves */
+    ip_engine *fine, *coarse; /* coarse: --drag-pixel-error's (NULL: none) */
     GLFWwindow *window;
-    ip_renderer *renderer;
+    ip_renderer *renderer; /* OpenGL (NULL with the software renderer) */
+    ip_canvas *canvas;     /* the software renderer (NULL with OpenGL) */
+    display screen;        /* the canvas's image in the window */
+    /* the image kept between frames: the mesh it holds a prefix of (NULL: start over), the
+     * camera it was drawn for and (OpenGL) the triangles drawn into it */
+    const ip_mesh *canvas_mesh;
+    ip_camera canvas_camera;
+    uint64_t gl_drawn;
+    int keep_image;       /* OpenGL draws into the kept image (not with --aa) */
+    char gl_renderer[96]; /* GL_RENDERER */
     overlay text;
     double lo[3], hi[3];
     float value_min, value_max;
@@ -123,6 +174,22 @@ typedef struct viewer {
     uint32_t screenshot_number;
     double start;
     frame_clock clock;
+    /* the course of each pass (--stats "views"): frame times and the triangles drawn by them */
+    pass_record *records;
+    size_t record_count, record_capacity;
+    frame_mark *marks; /* this pass's frames */
+    size_t frame_count, frame_capacity;
+    int pass_recorded; /* this pass's record is complete */
+    /* a drag from a script (COMMAND_DRAG): degrees a second left to turn, until drag_end */
+    double drag_rate[2], drag_end, drag_last;
+    double last_motion; /* when the mouse (or a script's drag) last moved the view */
+    /* the cameras of the last two fine passes begun, for reading the next view ahead */
+    ip_camera pass_camera[2];
+    uint64_t fine_passes;
+    uint64_t read_aheads;   /* views read ahead (ip_engine_read_ahead()) */
+    uint64_t moving_frames; /* frames drawn during a drag (the mouse's or a script's) */
+    double moving_seconds;  /* and the seconds they took */
+    int renderer_note;      /* the software renderer took over from one that failed */
     int quit, failed;
     ip_error err;
 } viewer;
@@ -132,7 +199,8 @@ typedef struct viewer {
 void set_error(ip_error *err, ip_status code, const char *fmt, ...);
 /* 1 once this pass has cast its --rays, 2 once it has extracted for its --time, else 0. */
 int pass_limit_reached(const viewer *v);
-/* 1 once nothing more will be extracted until the next change, or while paused. */
+/* 1 once nothing more will be extracted until the next change, or while paused; never while
+ * the coarse pass of a moving view is shown (the fine one follows). */
 int refinement_complete(const viewer *v);
 /* Saves the next frame to `path` ("" for the next free isoview-NNN.png). */
 void request_screenshot(viewer *v, const char *path);
@@ -171,6 +239,37 @@ void clip_options(const viewer *v, tool_view_options *o);
 void show_message(viewer *v, const char *fmt, ...);
 /* Routes the window's keyboard and mouse to the viewer (the window's user pointer). */
 void controls_install(GLFWwindow *window);
+
+/* record.c */
+/* Starts the record of a new pass (the one before ends unfinished if it was not complete).
+ * Returns 0, or -1 with the error in v->err. */
+int record_begin(viewer *v);
+/* Notes a frame shown at `end` (ip_now_seconds()); the pass's record is complete with the
+ * first frame that shows complete refinement (its final pixels then measured). */
+void record_frame(viewer *v, double end);
+/* Ends the record of the pass shown (unfinished unless complete), at exit. */
+void record_end(viewer *v);
+void record_free(viewer *v);
+/* Writes --stats' "views" (each pass's record) and "views_median" (over the passes that did
+ * not begin during a drag), each after ", ". */
+void record_json(FILE *f, const viewer *v);
+
+/* display.c */
+/* Builds the kept image's texture and framebuffer, with a depth buffer for the OpenGL
+ * renderer (the window's context current).
+ * Returns 0, or -1 with the error in *err. */
+int display_create(display *d, int with_depth, ip_error *err);
+void display_destroy(display *d);
+/* Gives the image (and its depth buffer) width x height pixels; 0, or -1 with the error. */
+int display_size(display *d, uint32_t width, uint32_t height, ip_error *err);
+/* Sends rows [rows[0], rows[1]) of the canvas's image (all of it after a change of size; none
+ * when rgba is NULL, the OpenGL renderer having drawn into the image) to the texture and
+ * copies the image to the window. Returns 0, or -1 with the error in *err. */
+int display_show(display *d, const uint8_t *rgba, uint32_t width, uint32_t height,
+                 const uint32_t rows[2], ip_error *err);
+/* Reads the window's back buffer as drawn (overlay included), top row first. Returns 0, or -1
+ * with the error in *err. */
+int display_read(uint32_t width, uint32_t height, uint8_t *rgba, ip_error *err);
 
 /* overlay.c */
 /* Builds the overlay's program and buffers (the window's context current). Returns 0, or -1

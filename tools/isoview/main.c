@@ -1,15 +1,17 @@
 /* isoview: the interactive viewer. The isosurface refines progressively in a window while it
  * stays responsive: each frame casts rays for a time slice (ip_engine_step() on the render
  * thread, whose workers use every core), uploads the triangles added since the last frame and
- * draws. The slice is FRAME_BUDGET_SECONDS, or as long as the previous frame took to draw when
- * that was longer (software OpenGL drawing a large mesh), up to MAX_SLICE_SECONDS, so that
- * drawing never starves refinement. Any change of view or isovalue restarts the progressive
+ * draws. The slice is FRAME_BUDGET_SECONDS, or DRAW_SHARE times as long as the previous frame
+ * took to draw and show when that was longer (software OpenGL drawing a large mesh, or the
+ * copy of a large window), up to MAX_SLICE_SECONDS, so that drawing never starves
+ * refinement. Any change of view or isovalue restarts the progressive
  * order at once; as extraction is time-sliced, the work in flight is at most one slice.
  *
  * The other parts: options.c (the command line), script.c (--script), controls.c (mouse and
  * keyboard), overlay.c (the heads-up text). docs/isoview.md documents the controls, the
  * options and the script format.
  */
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,7 +23,14 @@
 
 #define FRAME_BUDGET_SECONDS 0.012 /* ray casting per frame: keeps 30+ fps while refining */
 #define MAX_SLICE_SECONDS 0.25     /* the longest slice: bounds the delay of input */
-#define FPS_WINDOW_SECONDS 0.5     /* the overlay's fps is averaged over this long */
+#define SOFTWARE_SLICE_SECONDS \
+    0.04 /* the software renderer's slice while refining: 20 frames
+                                       a second, each copying the whole window */
+#define DRAW_SHARE \
+    2.0                        /* the slice is at least this many times the last frame's
+                                      drawing, so drawing never starves refinement */
+#define FPS_WINDOW_SECONDS 0.5 /* the overlay's fps is averaged over this long */
+#define MOTION_SECONDS 0.15    /* the view moves while the mouse moved it this recently */
 
 static char glfw_error[512];
 
@@ -54,6 +63,8 @@ int refinement_complete(const viewer *v)
 {
     if (v->paused && !v->want_full)
         return 1;
+    if (v->engine == v->coarse && v->coarse && !v->full_shown)
+        return 0; /* the fine pass follows once the view stops */
     return !v->restart && !v->want_full &&
            (v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v));
 }
@@ -115,16 +126,44 @@ static int create_engine(viewer *v, ip_error *err)
     clip_options(v, &common);
     ip_engine_options eo;
     tool_engine_options(&common, &eo);
-    ip_engine *engine;
-    if (ip_engine_create(v->cache, &eo, &engine, err) != IP_OK)
+    eo.reuse = v->o.reuse;
+    ip_engine *fine, *coarse = NULL;
+    if (ip_engine_create(v->cache, &eo, &fine, err) != IP_OK)
         return -1;
-    tool_signals_cancel_engine(NULL); /* no handler uses the old one from here */
-    ip_engine_destroy(v->engine);
-    v->engine = engine;
+    /* the coarse pass while the view moves: adaptive resolution at a larger pixel error */
+    if (eo.lod && v->o.drag_pixel_error > eo.pixel_error) {
+        eo.pixel_error = v->o.drag_pixel_error;
+        eo.prefetch = IP_PREFETCH_OFF; /* its few bricks are read on demand */
+        eo.reuse = 0;
+        if (ip_engine_create(v->cache, &eo, &coarse, err) != IP_OK) {
+            ip_engine_destroy(fine);
+            return -1;
+        }
+    }
+    tool_signals_cancel_engine(NULL); /* no handler uses the old ones from here */
+    ip_engine_destroy(v->fine);
+    ip_engine_destroy(v->coarse);
+    v->engine = v->fine = fine;
+    v->coarse = coarse;
     tool_signals_cancel_engine(v->engine);
     v->clip_changed = 0;
     v->restart = 1;
     return 0;
+}
+
+/* The engine for the next pass: the coarse one while the view moves (a script's drag, or the
+ * mouse's drag or wheel within the last MOTION_SECONDS), the fine one otherwise; a change
+ * starts the pass again. */
+static void choose_engine(viewer *v)
+{
+    int moving = v->drag_end > 0 || ip_now_seconds() - v->last_motion < MOTION_SECONDS;
+    ip_engine *want = moving && v->coarse ? v->coarse : v->fine;
+    if (want == v->engine)
+        return;
+    tool_signals_cancel_engine(NULL);
+    v->engine = want;
+    tool_signals_cancel_engine(want);
+    v->restart = 1;
 }
 
 static int begin_pass(viewer *v)
@@ -134,11 +173,63 @@ static int begin_pass(viewer *v)
     v->overdraw_state = 0;
     v->passes++;
     v->pass_wall = v->pass_render = 0;
-    ip_renderer_clear_mesh(v->renderer);
+    if (v->renderer)
+        ip_renderer_clear_mesh(v->renderer);
+    v->canvas_mesh = NULL; /* the canvas starts over */
     v->uploaded = 0;
+    if (record_begin(v) != 0)
+        return -1;
+    if (v->engine == v->fine) { /* the last two, for read_ahead() */
+        v->pass_camera[0] = v->pass_camera[1];
+        v->pass_camera[1] = v->camera;
+        v->fine_passes++;
+    }
     if (ip_engine_begin(v->engine, &v->camera, (float)v->iso, &v->err) != IP_OK)
         return -1;
     return 0;
+}
+
+static int same_camera(const ip_camera *a, const ip_camera *b)
+{
+    for (int i = 0; i < 3; i++)
+        if (a->eye[i] != b->eye[i] || a->target[i] != b->target[i] || a->up[i] != b->up[i])
+            return 0;
+    return a->fov_y == b->fov_y && a->width == b->width && a->height == b->height;
+}
+
+/* Once a fine pass is done: the next view, if the motion that led from the view before to this
+ * one goes on (an orbit's or a zoom's step again), is read ahead into the cache. */
+static void read_ahead(viewer *v)
+{
+    if (!v->o.read_ahead || v->fine_passes < 2 || v->engine != v->fine || v->paused ||
+        v->full_shown)
+        return;
+    const ip_camera *a = &v->pass_camera[0], *b = &v->pass_camera[1];
+    if (!same_camera(b, &v->camera) || same_camera(a, b) || a->width != b->width ||
+        a->height != b->height)
+        return;
+    ip_camera next = *b;
+    double da[3], db[3], la = 0, lb = 0, ln = 0;
+    for (int i = 0; i < 3; i++) {
+        da[i] = a->eye[i] - a->target[i];
+        db[i] = b->eye[i] - b->target[i];
+        la += da[i] * da[i];
+        lb += db[i] * db[i];
+    }
+    la = sqrt(la), lb = sqrt(lb);
+    double d[3];
+    for (int i = 0; i < 3; i++) { /* the step again: the offset turned as much, scaled as much */
+        next.target[i] = 2 * b->target[i] - a->target[i];
+        next.up[i] = 2 * b->up[i] - a->up[i];
+        d[i] = 2 * db[i] / lb - da[i] / la;
+        ln += d[i] * d[i];
+    }
+    ln = sqrt(ln);
+    for (int i = 0; i < 3; i++)
+        next.eye[i] = next.target[i] + d[i] / ln * lb * (lb / la);
+    if (ip_camera_check(&next, NULL) == IP_OK &&
+        ip_engine_read_ahead(v->engine, &next, NULL) == IP_OK)
+        v->read_aheads++;
 }
 
 /* One frame's slice of ray casting, then the new triangles to the GPU. */
@@ -146,23 +237,38 @@ static int refine(viewer *v)
 {
     if (v->paused || v->full_shown || ip_engine_done(v->engine) || pass_limit_reached(v))
         return 0;
-    double slice = v->draw_seconds < FRAME_BUDGET_SECONDS ? FRAME_BUDGET_SECONDS
-                   : v->draw_seconds > MAX_SLICE_SECONDS  ? MAX_SLICE_SECONDS
-                                                          : v->draw_seconds;
+    /* drawing (and showing the frame) takes at most a third of a frame, half while the view
+     * moves (each frame then draws a new view whole); the software renderer's frames after a
+     * pass's first come at most every SOFTWARE_SLICE_SECONDS, as each copies the window */
+    double drawing = (v->engine == v->coarse ? 1.0 : DRAW_SHARE) * v->draw_seconds;
+    double least = v->canvas && v->frame_count > 0 && v->engine != v->coarse
+                       ? SOFTWARE_SLICE_SECONDS
+                       : FRAME_BUDGET_SECONDS;
+    double slice = drawing < least               ? least
+                   : drawing > MAX_SLICE_SECONDS ? MAX_SLICE_SECONDS
+                                                 : drawing;
     if (v->o.common.time_limit > 0 && slice > v->o.common.time_limit - v->pass_wall)
         slice = v->o.common.time_limit - v->pass_wall;
     ip_engine_counts t;
     ip_engine_totals(v->engine, &t);
+    uint64_t rays = v->o.common.rays ? v->o.common.rays - t.rays : 0;
+    /* a pass's first frame: a ray a thread, whose propagations alone take longer than a slice
+     * on a large volume (a step checks its time between batches of rays), then the picture;
+     * not for a moving view's coarse pass, each frame of which is a pass's first */
+    uint64_t first = ip_thread_count(v->o.common.threads);
+    if (v->frame_count == 0 && v->engine != v->coarse && (!rays || rays > first))
+        rays = first;
     double start = ip_now_seconds();
-    ip_status st = ip_engine_step(v->engine, v->o.common.rays ? v->o.common.rays - t.rays : 0,
-                                  slice, NULL, &v->err);
+    ip_status st = ip_engine_step(v->engine, rays, slice, NULL, &v->err);
     v->pass_wall += ip_now_seconds() - start;
     if (st != IP_OK && st != IP_ERR_CANCELLED)
         return -1;
     const ip_mesh *mesh = ip_engine_mesh(v->engine);
-    if (ip_renderer_upload(v->renderer, mesh, v->uploaded, &v->err) != IP_OK)
+    if (v->renderer && ip_renderer_upload(v->renderer, mesh, v->uploaded, &v->err) != IP_OK)
         return -1;
     v->uploaded = mesh->triangle_count;
+    if (ip_engine_done(v->engine))
+        read_ahead(v);
     return 0;
 }
 
@@ -185,18 +291,66 @@ static int extract_full(viewer *v)
         return -1;
     v->full_wall = ip_now_seconds() - start;
     v->pass_render = 0;
-    ip_renderer_clear_mesh(v->renderer);
-    if (ip_renderer_upload(v->renderer, &v->full_mesh, 0, &v->err) != IP_OK)
-        return -1;
+    v->canvas_mesh = NULL;
+    if (v->renderer) {
+        ip_renderer_clear_mesh(v->renderer);
+        if (ip_renderer_upload(v->renderer, &v->full_mesh, 0, &v->err) != IP_OK)
+            return -1;
+    }
     v->full_shown = mode;
     v->overdraw_state = 0;
     return 0;
 }
 
+/* The software renderer: the canvas draws the triangles of the mesh shown that it does not
+ * hold yet (all of them after a change of view, mesh or size) and shows the changed rows. */
+static int draw_software(viewer *v)
+{
+    const ip_mesh *mesh = v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine);
+    if (v->canvas_mesh != mesh || !same_camera(&v->canvas_camera, &v->camera) ||
+        ip_canvas_triangle_count(v->canvas) > mesh->triangle_count) {
+        v->canvas_mesh = NULL;
+        if (ip_canvas_begin(v->canvas, &v->camera, NULL, v->lo, v->hi, &v->err) != IP_OK)
+            return -1;
+        v->canvas_mesh = mesh;
+        v->canvas_camera = v->camera;
+    }
+    if (ip_canvas_add(v->canvas, mesh, ip_canvas_triangle_count(v->canvas), &v->err) != IP_OK)
+        return -1;
+    uint32_t rows[2];
+    const uint8_t *rgba = ip_canvas_shade(v->canvas, rows);
+    return display_show(&v->screen, rgba, v->camera.width, v->camera.height, rows, &v->err);
+}
+
+/* OpenGL into the kept image: only the triangles uploaded since the last frame, unless the
+ * view, the mesh shown or the size changed; then the image is copied to the window. */
+static int draw_opengl(viewer *v)
+{
+    const ip_mesh *mesh = v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine);
+    uint64_t first = v->gl_drawn;
+    if (v->canvas_mesh != mesh || !same_camera(&v->canvas_camera, &v->camera) ||
+        ip_renderer_triangle_count(v->renderer) < first)
+        first = 0;
+    v->canvas_mesh = NULL;
+    if (display_size(&v->screen, v->camera.width, v->camera.height, &v->err) != 0 ||
+        ip_renderer_draw_added(v->renderer, &v->camera, v->lo, v->hi, first, &v->err) != IP_OK)
+        return -1;
+    v->canvas_mesh = mesh;
+    v->canvas_camera = v->camera;
+    v->gl_drawn = ip_renderer_triangle_count(v->renderer);
+    const uint32_t none[2] = {0, 0};
+    return display_show(&v->screen, NULL, v->camera.width, v->camera.height, none, &v->err);
+}
+
 static int draw_frame(viewer *v, int working_on_full)
 {
     double start = ip_now_seconds();
-    if (ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) != IP_OK)
+    int rc =
+        v->canvas ? draw_software(v)
+        : v->keep_image
+            ? draw_opengl(v)
+            : (ip_renderer_draw(v->renderer, &v->camera, v->lo, v->hi, &v->err) == IP_OK ? 0 : -1);
+    if (rc != 0)
         return -1;
     overlay_draw_frame(v, working_on_full);
     double seconds = ip_now_seconds() - start;
@@ -225,7 +379,9 @@ static int save_screenshot(viewer *v)
     int rc = -1;
     if (!rgba)
         set_error(&err, IP_ERR_NOMEM, "out of memory for a screenshot");
-    else if (ip_renderer_read_rgba(v->renderer, rgba, &err) == IP_OK &&
+    else if ((v->canvas || v->keep_image
+                  ? display_read(v->camera.width, v->camera.height, rgba, &err) == 0
+                  : ip_renderer_read_rgba(v->renderer, rgba, &err) == IP_OK) &&
              ip_png_write(path, rgba, v->camera.width, v->camera.height,
                           automatic ? 0 : v->o.common.force, &err) == IP_OK)
         rc = 0;
@@ -252,7 +408,8 @@ static int follow_size(viewer *v)
     if (width <= 0 || height <= 0)
         return 0;
     if ((uint32_t)width != v->camera.width || (uint32_t)height != v->camera.height) {
-        if (ip_renderer_resize(v->renderer, (uint32_t)width, (uint32_t)height, &v->err) != IP_OK)
+        if (v->renderer &&
+            ip_renderer_resize(v->renderer, (uint32_t)width, (uint32_t)height, &v->err) != IP_OK)
             return -1;
         v->camera.width = (uint32_t)width;
         v->camera.height = (uint32_t)height;
@@ -261,16 +418,35 @@ static int follow_size(viewer *v)
     return 1;
 }
 
+/* A script's drag: the part of its turn due since the last frame. */
+static void follow_drag(viewer *v, double t)
+{
+    if (v->drag_end <= 0)
+        return;
+    double until = t < v->drag_end ? t : v->drag_end;
+    double dt = until - v->drag_last;
+    if (dt > 0) {
+        ip_camera_orbit(&v->camera, v->drag_rate[0] * dt, v->drag_rate[1] * dt);
+        change_view(v);
+        v->last_motion = ip_now_seconds();
+    }
+    v->drag_last = until;
+    if (t >= v->drag_end)
+        v->drag_end = 0;
+}
+
 /* One frame: input, script, timers, extraction slice, drawing, screenshot, swap.
  * Returns 0, or -1 after an error in v->err. */
 static int frame(viewer *v)
 {
+    double frame_start = ip_now_seconds();
     glfwPollEvents();
     double t = ip_now_seconds() - v->start;
     if (glfwWindowShouldClose(v->window) || (v->o.exit_after >= 0 && t >= v->o.exit_after)) {
         v->quit = 1;
         return 0;
     }
+    follow_drag(v, t);
     run_script(v, t);
     if (v->quit)
         return 0;
@@ -288,6 +464,8 @@ static int frame(viewer *v)
     }
     if (v->clip_changed && create_engine(v, &v->err) != 0)
         return -1;
+    if (!v->full_shown)
+        choose_engine(v);
     /* paused, a change of view keeps the mesh shown until refinement resumes */
     if (v->restart && !v->paused && begin_pass(v) != 0)
         return -1;
@@ -309,7 +487,12 @@ static int frame(viewer *v)
     glfwSwapBuffers(v->window);
     double end = ip_now_seconds();
     v->draw_seconds = end - drawn;
+    if (v->drag_end > 0 || end - v->last_motion < MOTION_SECONDS) {
+        v->moving_frames++;
+        v->moving_seconds += end - frame_start;
+    }
     frame_done(&v->clock, end);
+    record_frame(v, end);
     return 0;
 }
 
@@ -347,13 +530,77 @@ static int open_window(viewer *v)
     glfwGetFramebufferSize(v->window, &width, &height);
     v->camera.width = width > 0 ? (uint32_t)width : v->o.common.width;
     v->camera.height = height > 0 ? (uint32_t)height : v->o.common.height;
-    if (ip_renderer_create_current(v->camera.width, v->camera.height, 0, &v->renderer, &v->err) !=
-            IP_OK ||
-        overlay_create(&v->text, &v->err) != 0) {
+    const char *name = (const char *)glGetString(GL_RENDERER);
+    snprintf(v->gl_renderer, sizeof v->gl_renderer, "%s", name ? name : "unknown");
+    int software = v->o.renderer == RENDERER_SOFTWARE ||
+                   (v->o.renderer == RENDERER_AUTO && v->o.aa <= 1 &&
+                    (strstr(v->gl_renderer, "llvmpipe") || strstr(v->gl_renderer, "softpipe") ||
+                     strstr(v->gl_renderer, "Software Rasterizer")));
+    /* OpenGL draws into a kept image (only what is new each frame), but with --aa into the
+     * window's multisampled framebuffer, every triangle each frame */
+    v->keep_image = !software && v->o.aa <= 1;
+    if (!software && (display_create(&v->screen, v->keep_image, &v->err) != 0 ||
+                      (v->keep_image &&
+                       display_size(&v->screen, v->camera.width, v->camera.height, &v->err) != 0) ||
+                      ip_renderer_create_current(v->camera.width, v->camera.height,
+                                                 v->keep_image ? v->screen.framebuffer : 0,
+                                                 &v->renderer, &v->err) != IP_OK)) {
+        if (v->o.renderer == RENDERER_OPENGL) {
+            fprintf(stderr, "isoview: the OpenGL renderer cannot start: %s\n", v->err.message);
+            return -1;
+        }
+        fprintf(stderr,
+                "isoview: note: the OpenGL renderer cannot start (%s); drawing in "
+                "software\n",
+                v->err.message);
+        software = 1;
+        v->renderer_note = 1;
+        v->keep_image = 0;
+        ip_renderer_destroy(v->renderer);
+        v->renderer = NULL;
+        display_destroy(&v->screen);
+    }
+    if (software && (ip_canvas_create(v->o.common.threads, &v->canvas, &v->err) != IP_OK ||
+                     display_create(&v->screen, 0, &v->err) != 0)) {
+        fprintf(stderr, "isoview: the software renderer cannot start: %s\n", v->err.message);
+        return -1;
+    }
+    if (overlay_create(&v->text, &v->err) != 0) {
         fprintf(stderr, "isoview: %s\n", v->err.message);
         return -1;
     }
     return 0;
+}
+
+/* --stats' "memory": what the viewer holds besides the process's code, in bytes. */
+static void memory_json(FILE *f, const viewer *v)
+{
+    ip_cache_stats s;
+    ip_cache_get_stats(v->cache, &s);
+    ip_engine_memory e, c;
+    ip_engine_memory_of(v->fine, &e);
+    if (v->coarse) { /* the coarse pass's engine counts with the fine one's */
+        ip_engine_memory_of(v->coarse, &c);
+        e.mesh += c.mesh, e.workers += c.workers, e.visited += c.visited;
+        e.coverage += c.coverage;
+    }
+    uint64_t full = v->full_mesh.capacity * (9 * sizeof(float) + 9 * sizeof(int16_t));
+    uint64_t gpu = v->renderer ? ip_renderer_memory(v->renderer) : 0;
+    uint64_t canvas =
+        v->canvas ? ip_canvas_memory(v->canvas) + 4ull * v->screen.width * v->screen.height : 0;
+    uint64_t summaries = ip_store_summary_memory(v->store);
+    fprintf(f,
+            ", \"memory\": {\"cache_bytes\": %llu, \"cache_peak_bytes\": %llu, "
+            "\"summaries_bytes\": %llu, \"engine_mesh_bytes\": %llu, "
+            "\"engine_workers_bytes\": %llu, \"visited_bytes\": %llu, \"coverage_bytes\": %llu, "
+            "\"full_mesh_bytes\": %llu, \"gpu_mesh_bytes\": %llu, \"canvas_bytes\": %llu, "
+            "\"rss_bytes\": %llu, \"rss_peak_bytes\": %llu}",
+            (unsigned long long)s.resident_bytes, (unsigned long long)s.resident_peak_bytes,
+            (unsigned long long)summaries, (unsigned long long)e.mesh,
+            (unsigned long long)e.workers, (unsigned long long)e.visited,
+            (unsigned long long)e.coverage, (unsigned long long)full, (unsigned long long)gpu,
+            (unsigned long long)canvas, (unsigned long long)ip_rss_bytes(),
+            (unsigned long long)ip_peak_rss_bytes());
 }
 
 static void json_counts(FILE *f, void *user)
@@ -372,7 +619,7 @@ static void json_counts(FILE *f, void *user)
                              v->iso,
                              full, /* TOOL_PROGRESSIVE when not shown */
                              &v->camera,
-                             "opengl",
+                             v->canvas ? "software" : "opengl",
                              &common,
                              0,
                              done,
@@ -391,6 +638,12 @@ static void json_counts(FILE *f, void *user)
             (unsigned long long)v->passes, (unsigned long long)k->frames,
             k->frames ? k->last - k->first : 0.0, mean, k->seconds ? k->slowest : mean,
             k->seconds ? k->fastest : mean);
+    fprintf(f, ", \"read_aheads\": %llu", (unsigned long long)v->read_aheads);
+    fprintf(f, ", \"fps_moving\": %.3f, \"gl_renderer\": ",
+            v->moving_seconds > 0 ? (double)v->moving_frames / v->moving_seconds : 0.0);
+    tool_json_string(f, v->gl_renderer);
+    record_json(f, v);
+    memory_json(f, v);
 }
 
 static void print_summary(const viewer *v)
@@ -414,6 +667,7 @@ static void print_summary(const viewer *v)
 
 static int finish(viewer *v)
 {
+    record_end(v);
     ip_cache_stats s;
     ip_cache_get_stats(v->cache, &s);
     uint64_t summary = ip_store_summary_memory(v->store);
@@ -528,13 +782,17 @@ int main(int argc, char **argv)
                 v->o.file);
     free(v->screenshot_pending);
     overlay_destroy(&v->text);
+    display_destroy(&v->screen);
+    ip_canvas_destroy(v->canvas);
     ip_renderer_destroy(v->renderer);
     if (v->window)
         glfwDestroyWindow(v->window);
     glfwTerminate();
-    ip_engine_destroy(v->engine);
+    ip_engine_destroy(v->fine);
+    ip_engine_destroy(v->coarse);
     ip_mesh_free(&v->full_mesh);
     free_commands(v);
+    record_free(v);
     ip_cache_destroy(v->cache);
     ip_store_close(v->store);
     free(v);

@@ -20,6 +20,20 @@ static const char usage[] =
     "                      (default: all cores)\n"
     "  --aa N              anti-aliasing: N samples a pixel of the window (1 to 16; default\n"
     "                      1, off: the image isorender draws)\n"
+    "  --renderer auto|opengl|software\n"
+    "                      draw the mesh with OpenGL, or with the exact software rasterizer\n"
+    "                      shown as a texture, drawing only what is new; auto (the default):\n"
+    "                      software where OpenGL is itself software (llvmpipe, softpipe)\n"
+    "  --reuse on|off      a new view keeps the cells of the view before that stay valid and\n"
+    "                      may show, and extracts what became visible (default off: slower\n"
+    "                      here, see docs/isoview.md)\n"
+    "  --read-ahead on|off once a view is done, read the next one of the same motion (an\n"
+    "                      orbit's or a zoom's step again) ahead into the cache (with\n"
+    "                      --prefetch on; default off: no gain measured, docs/isoview.md)\n"
+    "  --drag-pixel-error P\n"
+    "                      while the view moves (a drag), passes at this coarser pixel error\n"
+    "                      (adaptive resolution); refinement resumes at --pixel-error when\n"
+    "                      the motion stops (default 4; 0: off)\n"
     "  --stats OUT.json    on exit: counts, times, fps and the cache statistics as JSON\n"
     "  --script FILE       run the commands of FILE (see docs/isoview.md)\n"
     "  --screenshot-at SECONDS OUT.png\n"
@@ -68,7 +82,50 @@ static int parse_aa(const char *p, const tool_option *opt, const char *const *v,
     return rc;
 }
 
+static int parse_renderer(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (!strcmp(v[0], "auto"))
+        o->renderer = RENDERER_AUTO;
+    else if (!strcmp(v[0], "opengl"))
+        o->renderer = RENDERER_OPENGL;
+    else if (!strcmp(v[0], "software"))
+        o->renderer = RENDERER_SOFTWARE;
+    else
+        return tool_usage_error(p, "--renderer '%s': must be auto, opengl or software", v[0]);
+    return 0;
+}
+
+/* --reuse on|off and --read-ahead on|off */
+static int parse_switch(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    if (strcmp(v[0], "on") && strcmp(v[0], "off"))
+        return tool_usage_error(p, "%s '%s': must be on or off", opt->name, v[0]);
+    *(!strcmp(opt->name, "--reuse") ? &o->reuse : &o->read_ahead) = !strcmp(v[0], "on");
+    return 0;
+}
+
+static int parse_drag_pixel_error(const char *p, const tool_option *opt, const char *const *v,
+                                  void *base)
+{
+    options *o = base;
+    (void)opt;
+    if (tool_parse_double(v[0], &o->drag_pixel_error) != 0 || !(o->drag_pixel_error >= 0) ||
+        o->drag_pixel_error > 1024)
+        return tool_usage_error(p,
+                                "--drag-pixel-error '%s': must be 0 (off) or a pixel error up "
+                                "to 1024",
+                                v[0]);
+    return 0;
+}
+
 static const tool_option isoview_options[] = {
+    {"--drag-pixel-error", NULL, 1, 0, parse_drag_pixel_error, NULL, NULL},
+    {"--reuse", NULL, 1, 0, parse_switch, NULL, NULL},
+    {"--read-ahead", NULL, 1, 0, parse_switch, NULL, NULL},
+    {"--renderer", NULL, 1, 0, parse_renderer, NULL, NULL},
     {"--script", NULL, 1, offsetof(options, script), NULL, NULL, NULL},
     {"--screenshot-at", NULL, 2, 0, parse_screenshot_at, NULL, NULL},
     {"--exit-after", NULL, 1, 0, parse_exit_after, NULL, NULL},
@@ -82,12 +139,21 @@ int parse_args(int argc, char **argv, options *o)
     o->screenshot_at = -1;
     o->exit_after = -1;
     o->aa = 1;
+    o->renderer = RENDERER_AUTO;
+    o->reuse = 0;
+    o->read_ahead = 0;
+    o->drag_pixel_error = 4;
     int rc = tool_parse_view_command_line("isoview", usage, &o->common, isoview_options,
                                           sizeof isoview_options / sizeof isoview_options[0], o,
                                           &o->file, argc, argv);
-    if (o->common.cull < 0) /* every triangle unless --cull on: a paused viewer shows the mesh
-                               from other views */
-        o->common.cull = 0;
+    /* on, as isorender: the mesh holds what the window shows (a paused viewer moved around
+     * the surface then shows pinholes until it resumes), unless --aa, whose samples off the
+     * pixel centres need every triangle */
+    if (o->common.cull < 0)
+        o->common.cull = o->aa <= 1;
+    if (rc == 0 && o->aa > 1 && o->renderer == RENDERER_SOFTWARE)
+        return tool_usage_error("isoview",
+                                "--aa is OpenGL's: --renderer software draws without it");
     if (rc == 0 && o->common.iso_count > 1) /* isorender draws each; here one would be lost */
         return tool_usage_error("isoview",
                                 "--iso given %u times: isoview shows one surface (isorender "

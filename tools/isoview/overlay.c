@@ -177,14 +177,19 @@ static void overlay_draw(overlay *t, const char *text, int corner, float margin,
 static void measure_overdraw(viewer *v, const ip_mesh *mesh)
 {
     size_t n = (size_t)v->camera.width * v->camera.height;
-    uint32_t *index = malloc(n * sizeof *index);
+    /* the software renderer's canvas holds the ids already when it has drawn the whole mesh */
+    int from_canvas = v->canvas && v->canvas_mesh == mesh &&
+                      ip_canvas_triangle_count(v->canvas) == mesh->triangle_count;
+    uint32_t *index = from_canvas ? NULL : malloc(n * sizeof *index);
+    const uint32_t *ids = from_canvas ? ip_canvas_triangle_index(v->canvas) : index;
     uint8_t *owns = calloc(mesh->triangle_count / 8 + 1, 1);
     v->overdraw_state = -1;
-    if (index && owns &&
-        ip_raster_mesh(mesh, &v->camera, v->lo, v->hi, index, NULL, NULL) == IP_OK) {
+    if (ids && owns &&
+        (from_canvas ||
+         ip_raster_mesh(mesh, &v->camera, v->lo, v->hi, index, NULL, NULL) == IP_OK)) {
         uint64_t visible = 0;
         for (size_t p = 0; p < n; p++) {
-            uint32_t i = index[p];
+            uint32_t i = ids[p];
             if (i != UINT32_MAX && !(owns[i / 8] & (1u << (i % 8)))) {
                 owns[i / 8] |= (uint8_t)(1u << (i % 8));
                 visible++;
@@ -295,7 +300,9 @@ static void hud_text(viewer *v, char *text, size_t size, int working_on_full)
 {
     int n = v->overlay_mode == OVERLAY_DETAILED ? detailed_text(v, text, size, working_on_full)
                                                 : compact_text(v, text, size, working_on_full);
-    if (n > 0 && (size_t)n < size && v->message[0] && ip_now_seconds() < v->message_until)
+    /* a frame saved as a screenshot shows no passing message (a "saved" line of the one before) */
+    if (n > 0 && (size_t)n < size && v->message[0] && ip_now_seconds() < v->message_until &&
+        !v->screenshot_pending)
         snprintf(text + n, size - (size_t)n, "\n%s", v->message);
     else if (n > 0 && (size_t)n < size && !v->help_on && v->overlay_mode == OVERLAY_DETAILED)
         snprintf(text + n, size - (size_t)n, "\nh: help");

@@ -6,6 +6,8 @@
  *     view AXIS                               +x -x +y -y +z -z, as --view
  *     iso V                                   set the isovalue
  *     orbit DX_DEGREES DY_DEGREES             orbit around the target, as a mouse drag does
+ *     drag DX DY SECONDS                      orbit by DX, DY degrees smoothly over SECONDS,
+ *                                             frame by frame, as a mouse drag does (waits)
  *     zoom FACTOR                             move toward the target: distance / FACTOR
  *     wait SECONDS                            let frames run for that long
  *     wait done                               until every ray has been cast (or the full
@@ -55,8 +57,9 @@ static int parse_command(viewer *v, char *line, command *c, ip_error *err)
     char *word = strtok_r(line, " \t", &save);
     char *arg1 = strtok_r(NULL, " \t", &save);
     char *arg2 = strtok_r(NULL, " \t", &save);
+    char *arg3 = arg2 ? strtok_r(NULL, " \t", &save) : NULL;
     char *extra = strtok_r(NULL, " \t", &save);
-    int args = !!arg1 + !!arg2;
+    int args = !!arg1 + !!arg2 + !!arg3;
     memset(c, 0, sizeof *c);
     if (extra)
         goto too_many;
@@ -82,6 +85,11 @@ static int parse_command(viewer *v, char *line, command *c, ip_error *err)
         if (args != 2 || tool_parse_double(arg1, &c->a) != 0 || tool_parse_double(arg2, &c->b))
             goto arguments;
         c->kind = COMMAND_ORBIT;
+    } else if (!strcmp(word, "drag")) {
+        if (args != 3 || tool_parse_double(arg1, &c->a) != 0 || tool_parse_double(arg2, &c->b) ||
+            tool_parse_double(arg3, &c->c) || !(c->c > 0))
+            goto arguments;
+        c->kind = COMMAND_DRAG;
     } else if (!strcmp(word, "zoom")) {
         if (args != 1 || tool_parse_double(arg1, &c->a) != 0 || c->a <= 0)
             goto arguments;
@@ -242,6 +250,13 @@ void run_script(viewer *v, double t)
         case COMMAND_ORBIT:
             ip_camera_orbit(&v->camera, c->a, c->b);
             change_view(v);
+            break;
+        case COMMAND_DRAG:
+            v->drag_rate[0] = c->a / c->c;
+            v->drag_rate[1] = c->b / c->c;
+            v->drag_last = t;
+            v->drag_end = t + c->c;
+            v->wait_until = t + c->c;
             break;
         case COMMAND_ZOOM:
             zoom_view(v, c->a);
