@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "array.h"
+#include "dicom_check.h"
 #include "dicom_gdcm.h"
 #include "input_source.h"
 #include "internal.h"
@@ -289,7 +290,9 @@ static ip_status read_slice(const dicom_series *s, dicom_slice *slice, ip_error 
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading its header", path);
     if ((st = check_magic(path, err)) != IP_OK)
         goto done;
-    if (ip__dicom_read_header(path, h, why, sizeof why) != 0) {
+    /* the structure first: the DICOM library stops the process on some malformed files */
+    if (ip__dicom_check_file(path, why, sizeof why) != 0 ||
+        ip__dicom_read_header(path, h, why, sizeof why) != 0) {
         st = ip__fail(err, IP_ERR_INPUT, "%s: %s", path, why);
         goto done;
     }
@@ -599,7 +602,9 @@ static ip_status dicom_read_plane(void *state, uint32_t z, void *dst, ip_error *
     char path[IP_PATH_MAX], why[160];
     ip_dicom_image image;
     slice_path(&src->series, slice, path);
-    if (ip__dicom_decode(path, dst, (size_t)src->plane_bytes, &image, why, sizeof why) != 0)
+    /* checked again: the file may have changed since it was described */
+    if (ip__dicom_check_file(path, why, sizeof why) != 0 ||
+        ip__dicom_decode(path, dst, (size_t)src->plane_bytes, &image, why, sizeof why) != 0)
         return ip__fail(err, IP_ERR_INPUT, "%s: %s", path, why);
     if (image.columns != slice->columns || image.rows != slice->rows || image.frames != 1 ||
         image.samples_per_pixel != 1 || image.bytes != src->plane_bytes ||
