@@ -292,6 +292,17 @@ IP_API ip_status ip_renderer_upload(ip_renderer *renderer, const ip_mesh *mesh,
 /*! ip_renderer_clear_mesh() : forgets every uploaded triangle, keeping the GPU buffers. */
 IP_API void ip_renderer_clear_mesh(ip_renderer *renderer);
 
+/*! ip_renderer_driver() : OpenGL's GL_RENDERER for the renderer's context (read once, owned by
+ *  the renderer), "unknown" where it cannot be read. A headless renderer makes its context
+ *  current on the calling thread. */
+IP_API const char *ip_renderer_driver(ip_renderer *renderer);
+
+/*! ip_gl_driver_is_software() : 1 when `gl_renderer` (OpenGL's GL_RENDERER: ip_renderer_driver(),
+ *  or a window's) names a software driver (Mesa's llvmpipe, softpipe, swrast), on which the
+ *  software rasterizer draws a large mesh faster and in less memory; else 0 (NULL too).
+ *  Thread-safe. */
+IP_API int ip_gl_driver_is_software(const char *gl_renderer);
+
 /*! ip_renderer_memory() : the bytes of the mesh buffers the renderer holds on the GPU (for
  *  a software OpenGL driver, in the process's memory): those of ip_renderer_upload() (grown
  *  geometrically) and of ip_renderer_draw_mesh()'s streaming, once used. */

@@ -1,6 +1,7 @@
 /* The OpenGL 3.3 core renderer: mesh buffers on the GPU, shaders, drawing and read-back. */
 #include <epoxy/gl.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,6 +35,7 @@ struct ip_renderer {
     GLuint stream_positions,
         stream_normals; /* and buffers of STREAM_TRIANGLES, made on first use */
     ip_shading shading;
+    char driver[128]; /* GL_RENDERER, read once */
 };
 
 /* The formulas are those of render.h and raster.c, in world space: v points to the eye. */
@@ -461,6 +463,21 @@ ip_status ip_renderer_upload(ip_renderer *r, const ip_mesh *m, uint64_t first, i
 void ip_renderer_clear_mesh(ip_renderer *r)
 {
     r->triangle_count = 0;
+}
+
+const char *ip_renderer_driver(ip_renderer *r)
+{
+    if (!r->driver[0] && make_current(r, NULL) == IP_OK) {
+        const char *name = (const char *)glGetString(GL_RENDERER);
+        snprintf(r->driver, sizeof r->driver, "%s", name ? name : "unknown");
+    }
+    return r->driver[0] ? r->driver : "unknown";
+}
+
+int ip_gl_driver_is_software(const char *name)
+{
+    return name && (strstr(name, "llvmpipe") || strstr(name, "softpipe") ||
+                    strstr(name, "Software Rasterizer") || strstr(name, "swrast"));
 }
 
 uint64_t ip_renderer_memory(const ip_renderer *r)

@@ -19,12 +19,18 @@ expect_error 2 "--aa '-4' is not a sample count (1 to 16)" render --aa -4 -o x.p
 expect_error 2 "--aa is OpenGL's" render --aa 4 --software -o x.png
 check "a refused run writes nothing" test ! -e x.png
 
-render --size 120x90 --aa 1 -o one.png --stats one.json
+render --size 120x90 --aa 1 --renderer opengl -o one.png --stats one.json
 if ! grep -q '"renderer": "opengl"' one.json; then
     echo "antialias: no headless OpenGL here; --aa is not tested further"
     finish
 fi
-render --size 120x90 --aa 4 -o four.png
+render --size 120x90 --aa 4 -o four.png --stats four.json
+check "--aa draws with OpenGL, --renderer auto or not" grep -q '"renderer": "opengl"' four.json
+# auto (the default) without --aa: software where OpenGL is itself software (llvmpipe), which
+# the window tests see (tests/tools/isoview.sh); here one of the two, the image alike
+render --size 120x90 -o auto.png --stats auto.json
+check "auto draws with one of the renderers" grep -q '"renderer": "\(software\|opengl\)"' auto.json
+check "auto's image is --aa 1's" "$compare" auto.png one.png --level 3 --max-pct 2
 render --size 480x360 --aa 1 -o big.png
 render --size 120x90 --software -o sw.png
 

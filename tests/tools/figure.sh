@@ -79,7 +79,8 @@ check "the default surface is ivory ($ivory)" sh -c 'set -- $0; [ "$1" -gt "$2" 
 
 # OpenGL draws the same colours as the software rasterizer (where OpenGL is available)
 "$bin/isorender" c.ibv --iso 60 --size 120x90 --quiet --full --color '0.2,0.5,0.9' \
-    --background '#ffe0c0:#102030' --azimuth 30 --elevation 20 -o gl.png --stats gl.json
+    --background '#ffe0c0:#102030' --azimuth 30 --elevation 20 -o gl.png --stats gl.json \
+    --renderer opengl
 render --full --color '0.2,0.5,0.9' --background '#ffe0c0:#102030' --azimuth 30 --elevation 20 \
     -o sw.png
 if grep -q '"renderer": "opengl"' gl.json; then

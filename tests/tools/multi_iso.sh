@@ -146,7 +146,7 @@ same "the turntable's first frame is the image" frames/frame_000.png plain.png
 
 # OpenGL draws the same (where OpenGL is available)
 "$bin/isorender" s.ibv --size 120x90 --quiet --azimuth 20 --elevation 15 --iso 60 --iso 180 \
-    --color "$outer" --color "$inner" --opacity 0.4 -o gl.png --stats gl.json
+    --color "$outer" --color "$inner" --opacity 0.4 -o gl.png --stats gl.json --renderer opengl
 if grep -q '"renderer": "opengl"' gl.json; then
     same "OpenGL and software agree" gl.png glass.png --level 3 --max-pct 2
 else

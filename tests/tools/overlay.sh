@@ -38,7 +38,7 @@ inside() {
 for renderer in --software opengl; do
     case $renderer in
     opengl)
-        render --camera $camera --stats gl.json -o probe.png
+        render --camera $camera --stats gl.json --renderer opengl -o probe.png
         if ! grep -q '"renderer": "opengl"' gl.json; then
             echo "overlay: no headless OpenGL here; the overlays are tested in software only"
             continue

@@ -532,10 +532,9 @@ static int open_window(viewer *v)
     v->camera.height = height > 0 ? (uint32_t)height : v->o.common.height;
     const char *name = (const char *)glGetString(GL_RENDERER);
     snprintf(v->gl_renderer, sizeof v->gl_renderer, "%s", name ? name : "unknown");
-    int software = v->o.renderer == RENDERER_SOFTWARE ||
-                   (v->o.renderer == RENDERER_AUTO && v->o.aa <= 1 &&
-                    (strstr(v->gl_renderer, "llvmpipe") || strstr(v->gl_renderer, "softpipe") ||
-                     strstr(v->gl_renderer, "Software Rasterizer")));
+    int software =
+        v->o.renderer == RENDERER_SOFTWARE || (v->o.renderer == RENDERER_AUTO && v->o.aa <= 1 &&
+                                               ip_gl_driver_is_software(v->gl_renderer));
     /* OpenGL draws into a kept image (only what is new each frame), but with --aa into the
      * window's multisampled framebuffer, every triangle each frame */
     v->keep_image = !software && v->o.aa <= 1;
