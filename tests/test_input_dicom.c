@@ -316,6 +316,37 @@ static void test_malformed(void)
     REQUIRE(patched == 1);
     REQUIRE(fseek(f, 0, SEEK_SET) == 0 && fwrite(bytes, 1, size, f) == size && fclose(f) == 0);
     expect_refused(dir, IP_ERR_INPUT, "short/IM0003.dcm", "its Pixel Data holds 112 bytes");
+    /* one slice's High Bit unlike its neighbours' (15 -> 11: the same Bits Stored, 16, no
+     * longer held) and, in another series, one with 12 bits stored (High Bit 11) among slices
+     * of 16: each refused, naming the file */
+    const struct {
+        const char *name, *text;
+        unsigned tag, value;
+    } layouts[] = {{"highbit", "High Bit 11 does not hold 16 bits stored", 0x0102, 11},
+                   {"stored", "a different bit layout (Bits Stored, High Bit)", 0, 12}};
+    for (size_t c = 0; c < 2; c++) {
+        write_case(fresh_folder(dir, layouts[c].name), &s, volume, 99, NULL, 0);
+        snprintf(path, sizeof path, "%s/IM0002.dcm", dir);
+        f = fopen(path, "r+b");
+        REQUIRE(f != NULL);
+        size = fread(bytes, 1, sizeof bytes, f);
+        patched = 0;
+        for (size_t i = 132; i + 10 <= size; i++) {
+            /* (0028,0101) Bits Stored and (0028,0102) High Bit, US, 2 bytes */
+            int stored = !memcmp(bytes + i, "\x28\x00\x01\x01US\x02\x00", 8);
+            int high = !memcmp(bytes + i, "\x28\x00\x02\x01US\x02\x00", 8);
+            if (layouts[c].tag ? high : stored || high) {
+                unsigned v = layouts[c].tag || stored ? layouts[c].value : layouts[c].value - 1;
+                bytes[i + 8] = (unsigned char)v, bytes[i + 9] = 0;
+                patched++;
+            }
+        }
+        REQUIRE(patched == (layouts[c].tag ? 1u : 2u));
+        REQUIRE(fseek(f, 0, SEEK_SET) == 0 && fwrite(bytes, 1, size, f) == size && fclose(f) == 0);
+        char name[64];
+        snprintf(name, sizeof name, "%s/IM0002.dcm", layouts[c].name);
+        expect_refused(dir, IP_ERR_INPUT, name, layouts[c].text);
+    }
     free(volume);
 }
 

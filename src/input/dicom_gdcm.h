@@ -26,6 +26,7 @@ typedef enum ip_dicom_field {
     IP_DICOM_PIXEL_SPACING,        /* (0028,0030) row spacing (y) \ column spacing (x), mm */
     IP_DICOM_BITS_ALLOCATED,       /* (0028,0100) */
     IP_DICOM_BITS_STORED,          /* (0028,0101) */
+    IP_DICOM_HIGH_BIT,             /* (0028,0102) */
     IP_DICOM_PIXEL_REPRESENTATION, /* (0028,0103) 0 unsigned, 1 two's complement */
     IP_DICOM_RESCALE_INTERCEPT,    /* (0028,1052) */
     IP_DICOM_RESCALE_SLOPE,        /* (0028,1053) */

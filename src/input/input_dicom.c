@@ -34,6 +34,7 @@ typedef struct dicom_slice {
     char series[IP_DICOM_VALUE_MAX];
     uint32_t columns, rows;
     ip_type type;
+    uint32_t bits_stored, high_bit; /* where the samples' bits lie in each pixel */
     int has_pixel_spacing;
     double pixel_spacing[2]; /* between rows (y), between columns (x); mm */
     double position[3], orientation[6];
@@ -154,6 +155,7 @@ static const char *const field_names[IP_DICOM_FIELD_COUNT] = {
     [IP_DICOM_PIXEL_SPACING] = "Pixel Spacing (0028,0030)",
     [IP_DICOM_BITS_ALLOCATED] = "Bits Allocated (0028,0100)",
     [IP_DICOM_BITS_STORED] = "Bits Stored (0028,0101)",
+    [IP_DICOM_HIGH_BIT] = "High Bit (0028,0102)",
     [IP_DICOM_PIXEL_REPRESENTATION] = "Pixel Representation (0028,0103)",
     [IP_DICOM_RESCALE_INTERCEPT] = "Rescale Intercept (0028,1052)",
     [IP_DICOM_RESCALE_SLOPE] = "Rescale Slope (0028,1053)",
@@ -239,13 +241,17 @@ static ip_status check_pixels(const char *path, const ip_dicom_header *h, ip_err
     return IP_OK;
 }
 
-/* 8-bit unsigned, 16-bit unsigned or signed. */
-static ip_status read_type(const char *path, const ip_dicom_header *h, ip_type *out, ip_error *err)
+/* 8-bit unsigned, 16-bit unsigned or signed, and where the bits lie (Bits Stored, High Bit). */
+static ip_status read_type(const char *path, const ip_dicom_header *h, dicom_slice *slice,
+                           ip_error *err)
 {
-    uint32_t bits, stored, representation;
+    uint32_t bits, stored, representation, high;
+    ip_type *out = &slice->type;
     ip_status st;
     if ((st = field_count(path, h, IP_DICOM_BITS_ALLOCATED, NAN, &bits, err)) != IP_OK ||
         (st = field_count(path, h, IP_DICOM_BITS_STORED, bits, &stored, err)) != IP_OK ||
+        (st = field_count(path, h, IP_DICOM_HIGH_BIT, stored ? stored - 1.0 : 0, &high, err)) !=
+            IP_OK ||
         (st = field_count(path, h, IP_DICOM_PIXEL_REPRESENTATION, 0, &representation, err)) !=
             IP_OK)
         return st;
@@ -261,6 +267,12 @@ static ip_status read_type(const char *path, const ip_dicom_header *h, ip_type *
     if (stored == 0 || stored > bits)
         return ip__fail(err, IP_ERR_INPUT, "%s: %u bits stored in %u-bit samples", path, stored,
                         bits);
+    if (high >= bits || high + 1 < stored)
+        return ip__fail(err, IP_ERR_INPUT,
+                        "%s: High Bit %u does not hold %u bits stored in %u-bit samples", path,
+                        high, stored, bits);
+    slice->bits_stored = stored;
+    slice->high_bit = high;
     return IP_OK;
 }
 
@@ -299,7 +311,7 @@ static ip_status read_slice(const dicom_series *s, dicom_slice *slice, ip_error 
     snprintf(slice->series, sizeof slice->series, "%s", h->value[IP_DICOM_SERIES_UID]);
     slice->has_pixel_spacing = h->value[IP_DICOM_PIXEL_SPACING][0] != '\0';
     if ((st = check_syntax(path, h, err)) != IP_OK || (st = check_pixels(path, h, err)) != IP_OK ||
-        (st = read_type(path, h, &slice->type, err)) != IP_OK ||
+        (st = read_type(path, h, slice, err)) != IP_OK ||
         (st = field_count(path, h, IP_DICOM_COLUMNS, NAN, &slice->columns, err)) != IP_OK ||
         (st = field_count(path, h, IP_DICOM_ROWS, NAN, &slice->rows, err)) != IP_OK ||
         (slice->has_pixel_spacing &&
@@ -358,6 +370,8 @@ static const char *difference(const dicom_slice *first, const dicom_slice *slice
         return "a different size (rows, columns)";
     if (slice->type != first->type)
         return "a different sample type";
+    if (slice->bits_stored != first->bits_stored || slice->high_bit != first->high_bit)
+        return "a different bit layout (Bits Stored, High Bit)";
     if (slice->has_pixel_spacing != first->has_pixel_spacing ||
         (first->has_pixel_spacing &&
          !same_numbers(slice->pixel_spacing, first->pixel_spacing, 2, 1e-4)))
@@ -369,7 +383,8 @@ static const char *difference(const dicom_slice *first, const dicom_slice *slice
     return NULL;
 }
 
-/* Slices alike: size, type, pixel spacing, orientation, rescale (one volume, one rescale). */
+/* Slices alike: size, type, bit layout, pixel spacing, orientation, rescale (one volume, one
+ * rescale). */
 static ip_status check_alike(const dicom_series *s, ip_error *err)
 {
     const dicom_slice *first = &s->slices[0];
