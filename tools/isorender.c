@@ -134,7 +134,7 @@ typedef struct options {
     tool_view_options common;
     const char *file, *out, *mesh, *progress, *strip;
     int full, software, warm; /* --stats, --force and --quiet are in common */
-    int renderer;             /* --renderer: RENDERER_AUTO, _OPENGL, _SOFTWARE (--software) */
+    int renderer;             /* --renderer: TOOL_RENDERER_AUTO, _OPENGL, _SOFTWARE (--software) */
     int full_lod;             /* --full-lod: full becomes TOOL_FULL_LOD (--full: TOOL_FULL) */
     strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
     int weld, no_weld;
@@ -198,8 +198,7 @@ typedef struct run {
 
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
                           void *base);
-static tool_option_parse parse_color, parse_turntable, parse_aa, parse_smooth, parse_opacity,
-    parse_renderer;
+static tool_option_parse parse_color, parse_turntable, parse_aa, parse_smooth, parse_opacity;
 
 static const tool_option isorender_options[] = {
     {"-o", NULL, 1, offsetof(options, out), NULL, NULL, NULL},
@@ -209,7 +208,7 @@ static const tool_option isorender_options[] = {
     {"--full-lod", NULL, 0, offsetof(options, full_lod), NULL, NULL, NULL},
     {"--warm", NULL, 0, offsetof(options, warm), NULL, NULL, NULL},
     {"--software", NULL, 0, offsetof(options, software), NULL, NULL, NULL},
-    {"--renderer", NULL, 1, 0, parse_renderer, NULL, NULL},
+    {"--renderer", NULL, 1, offsetof(options, renderer), tool_option_renderer, NULL, NULL},
     {"--strip", NULL, 1, offsetof(options, strip), NULL, NULL, NULL},
     {"--strip-at", NULL, 1, offsetof(options, strip_at), parse_strip_at, NULL, NULL},
     {"--weld", NULL, 0, offsetof(options, weld), NULL, NULL, NULL},
@@ -422,30 +421,6 @@ static ip_status draw_image(const run *r, ip_renderer *gl, const uint64_t *prefi
 
 /* Parses --strip-at's "P,P,..." (each a number with an optional '%'). Returns 0, or 2 after a
  * usage error. */
-/* --renderer: which draws the image (auto: software where OpenGL is itself software). */
-enum {
-    RENDERER_AUTO,
-    RENDERER_OPENGL,
-    RENDERER_SOFTWARE
-};
-
-static int parse_renderer(const char *program, const tool_option *option, const char *const *values,
-                          void *base)
-{
-    options *o = base;
-    (void)option;
-    if (!strcmp(values[0], "auto"))
-        o->renderer = RENDERER_AUTO;
-    else if (!strcmp(values[0], "opengl"))
-        o->renderer = RENDERER_OPENGL;
-    else if (!strcmp(values[0], "software"))
-        o->renderer = RENDERER_SOFTWARE;
-    else
-        return tool_usage_error(program, "--renderer '%s': must be auto, opengl or software",
-                                values[0]);
-    return 0;
-}
-
 static int parse_strip_at(const char *program, const tool_option *option, const char *const *values,
                           void *base)
 {
@@ -752,9 +727,9 @@ static int parse_args(int argc, char **argv, options *o)
         o->full = TOOL_FULL_LOD;
     if (o->full && (o->common.rays || o->common.time_limit > 0))
         return tool_usage_error("isorender", "--full extracts everything: no --rays or --time");
-    if (o->software && o->renderer == RENDERER_OPENGL)
+    if (o->software && o->renderer == TOOL_RENDERER_OPENGL)
         return tool_usage_error("isorender", "--software and --renderer opengl: one or the other");
-    if (o->renderer == RENDERER_SOFTWARE)
+    if (o->renderer == TOOL_RENDERER_SOFTWARE)
         o->software = 1;
     if (o->software && o->aa > 1)
         return tool_usage_error("isorender", "--aa is OpenGL's: --software draws without it");
@@ -1126,7 +1101,7 @@ static int render_image(run *r, uint8_t *rgba, ip_renderer **keep, ip_error *err
             fprintf(stderr, "isorender: no headless OpenGL (%s); rendering in software\n",
                     why.message);
         /* auto: OpenGL that is itself software draws slower than the exact rasterizer */
-        if (gl && r->o.renderer == RENDERER_AUTO && r->o.aa <= 1 &&
+        if (gl && r->o.renderer == TOOL_RENDERER_AUTO && r->o.aa <= 1 &&
             ip_gl_driver_is_software(ip_renderer_driver(gl))) {
             ip_renderer_destroy(gl);
             gl = NULL;

@@ -732,6 +732,22 @@ static int parse_on_off(const char *p, const char *value, int *out, const char *
     return 0;
 }
 
+int tool_option_on_off(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    return parse_on_off(p, v[0], (int *)(void *)((char *)base + opt->offset), opt->name);
+}
+
+int tool_option_renderer(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    static const char *const names[3] = {"auto", "opengl", "software"};
+    for (int i = 0; i < 3; i++)
+        if (!strcmp(v[0], names[i])) {
+            *(int *)(void *)((char *)base + opt->offset) = i; /* TOOL_RENDERER_* */
+            return 0;
+        }
+    return tool_usage_error(p, "--renderer '%s': must be auto, opengl or software", v[0]);
+}
+
 static int parse_lod(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     (void)opt;

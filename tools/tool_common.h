@@ -216,6 +216,19 @@ struct tool_option {
  * a bad value is "NAME 'VALUE' PROBLEM" (option->problem). */
 tool_option_parse tool_option_number, tool_option_positive;
 
+/* An on|off switch into the int at base + offset (1 or 0); a bad value is "NAME must be on or
+ * off". */
+tool_option_parse tool_option_on_off;
+
+/* --renderer auto|opengl|software (isorender, isoview) into the int at base + offset: */
+enum {
+    TOOL_RENDERER_AUTO, /* software where OpenGL is itself software (ip_gl_driver_is_software()) */
+    TOOL_RENDERER_OPENGL,  /* OpenGL */
+    TOOL_RENDERER_SOFTWARE /* the exact software rasterizer */
+};
+/* A bad value is "--renderer 'VALUE': must be auto, opengl or software". */
+tool_option_parse tool_option_renderer;
+
 /* Parses --cache-mb N (tool_parse_cache_mb()) into the uint64_t (bytes) at base + offset; a
  * bad value is "bad --cache-mb 'VALUE'". */
 tool_option_parse tool_option_cache_mb;

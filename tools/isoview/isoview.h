@@ -23,20 +23,11 @@ typedef struct options {
     const char *file, *script, *screenshot_path;
     double screenshot_at, exit_after;
     int aa;                  /* --aa N: samples a pixel of the window (1: no multisampling) */
-    int renderer;            /* --renderer: RENDERER_AUTO, _OPENGL or _SOFTWARE */
+    int renderer;            /* --renderer: TOOL_RENDERER_AUTO, _OPENGL or _SOFTWARE */
     int reuse;               /* --reuse on|off: the engine's reuse across views */
     int read_ahead;          /* --read-ahead on|off: the next view of a motion read ahead */
     double drag_pixel_error; /* --drag-pixel-error P: the coarse pass while moving (0: none) */
 } options;
-
-/* --renderer: OpenGL draws the mesh; software draws it with the library's exact rasterizer
- * into a canvas shown as a texture; auto takes software where OpenGL is itself a software
- * driver (llvmpipe, softpipe). */
-enum {
-    RENDERER_AUTO,
-    RENDERER_OPENGL,
-    RENDERER_SOFTWARE
-};
 
 typedef enum command_kind {
     COMMAND_CAMERA,
@@ -189,7 +180,6 @@ typedef struct viewer {
     uint64_t read_aheads;   /* views read ahead (ip_engine_read_ahead()) */
     uint64_t moving_frames; /* frames drawn during a drag (the mouse's or a script's) */
     double moving_seconds;  /* and the seconds they took */
-    int renderer_note;      /* the software renderer took over from one that failed */
     int quit, failed;
     ip_error err;
 } viewer;
@@ -202,6 +192,8 @@ int pass_limit_reached(const viewer *v);
 /* 1 once nothing more will be extracted until the next change, or while paused; never while
  * the coarse pass of a moving view is shown (the fine one follows). */
 int refinement_complete(const viewer *v);
+/* The mesh on the screen: the full extraction when shown, else the pass's. */
+const ip_mesh *shown_mesh(const viewer *v);
 /* Saves the next frame to `path` ("" for the next free isoview-NNN.png). */
 void request_screenshot(viewer *v, const char *path);
 

@@ -304,11 +304,23 @@ static int extract_full(viewer *v)
 
 /* The software renderer: the canvas draws the triangles of the mesh shown that it does not
  * hold yet (all of them after a change of view, mesh or size) and shows the changed rows. */
+const ip_mesh *shown_mesh(const viewer *v)
+{
+    return v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine);
+}
+
+/* Whether the kept image must be drawn again whole for `mesh`: another mesh, another view or
+ * size, or fewer triangles than the `held` it was drawn with (a pass begun again). */
+static int image_stale(const viewer *v, const ip_mesh *mesh, uint64_t held)
+{
+    return v->canvas_mesh != mesh || !same_camera(&v->canvas_camera, &v->camera) ||
+           held > mesh->triangle_count;
+}
+
 static int draw_software(viewer *v)
 {
-    const ip_mesh *mesh = v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine);
-    if (v->canvas_mesh != mesh || !same_camera(&v->canvas_camera, &v->camera) ||
-        ip_canvas_triangle_count(v->canvas) > mesh->triangle_count) {
+    const ip_mesh *mesh = shown_mesh(v);
+    if (image_stale(v, mesh, ip_canvas_triangle_count(v->canvas))) {
         v->canvas_mesh = NULL;
         if (ip_canvas_begin(v->canvas, &v->camera, NULL, v->lo, v->hi, &v->err) != IP_OK)
             return -1;
@@ -326,11 +338,8 @@ static int draw_software(viewer *v)
  * view, the mesh shown or the size changed; then the image is copied to the window. */
 static int draw_opengl(viewer *v)
 {
-    const ip_mesh *mesh = v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine);
-    uint64_t first = v->gl_drawn;
-    if (v->canvas_mesh != mesh || !same_camera(&v->canvas_camera, &v->camera) ||
-        ip_renderer_triangle_count(v->renderer) < first)
-        first = 0;
+    const ip_mesh *mesh = shown_mesh(v);
+    uint64_t first = image_stale(v, mesh, v->gl_drawn) ? 0 : v->gl_drawn;
     v->canvas_mesh = NULL;
     if (display_size(&v->screen, v->camera.width, v->camera.height, &v->err) != 0 ||
         ip_renderer_draw_added(v->renderer, &v->camera, v->lo, v->hi, first, &v->err) != IP_OK)
@@ -532,9 +541,9 @@ static int open_window(viewer *v)
     v->camera.height = height > 0 ? (uint32_t)height : v->o.common.height;
     const char *name = (const char *)glGetString(GL_RENDERER);
     snprintf(v->gl_renderer, sizeof v->gl_renderer, "%s", name ? name : "unknown");
-    int software =
-        v->o.renderer == RENDERER_SOFTWARE || (v->o.renderer == RENDERER_AUTO && v->o.aa <= 1 &&
-                                               ip_gl_driver_is_software(v->gl_renderer));
+    int software = v->o.renderer == TOOL_RENDERER_SOFTWARE ||
+                   (v->o.renderer == TOOL_RENDERER_AUTO && v->o.aa <= 1 &&
+                    ip_gl_driver_is_software(v->gl_renderer));
     /* OpenGL draws into a kept image (only what is new each frame), but with --aa into the
      * window's multisampled framebuffer, every triangle each frame */
     v->keep_image = !software && v->o.aa <= 1;
@@ -544,7 +553,7 @@ static int open_window(viewer *v)
                       ip_renderer_create_current(v->camera.width, v->camera.height,
                                                  v->keep_image ? v->screen.framebuffer : 0,
                                                  &v->renderer, &v->err) != IP_OK)) {
-        if (v->o.renderer == RENDERER_OPENGL) {
+        if (v->o.renderer == TOOL_RENDERER_OPENGL) {
             fprintf(stderr, "isoview: the OpenGL renderer cannot start: %s\n", v->err.message);
             return -1;
         }
@@ -553,7 +562,6 @@ static int open_window(viewer *v)
                 "software\n",
                 v->err.message);
         software = 1;
-        v->renderer_note = 1;
         v->keep_image = 0;
         ip_renderer_destroy(v->renderer);
         v->renderer = NULL;

@@ -82,31 +82,6 @@ static int parse_aa(const char *p, const tool_option *opt, const char *const *v,
     return rc;
 }
 
-static int parse_renderer(const char *p, const tool_option *opt, const char *const *v, void *base)
-{
-    options *o = base;
-    (void)opt;
-    if (!strcmp(v[0], "auto"))
-        o->renderer = RENDERER_AUTO;
-    else if (!strcmp(v[0], "opengl"))
-        o->renderer = RENDERER_OPENGL;
-    else if (!strcmp(v[0], "software"))
-        o->renderer = RENDERER_SOFTWARE;
-    else
-        return tool_usage_error(p, "--renderer '%s': must be auto, opengl or software", v[0]);
-    return 0;
-}
-
-/* --reuse on|off and --read-ahead on|off */
-static int parse_switch(const char *p, const tool_option *opt, const char *const *v, void *base)
-{
-    options *o = base;
-    if (strcmp(v[0], "on") && strcmp(v[0], "off"))
-        return tool_usage_error(p, "%s '%s': must be on or off", opt->name, v[0]);
-    *(!strcmp(opt->name, "--reuse") ? &o->reuse : &o->read_ahead) = !strcmp(v[0], "on");
-    return 0;
-}
-
 static int parse_drag_pixel_error(const char *p, const tool_option *opt, const char *const *v,
                                   void *base)
 {
@@ -123,9 +98,9 @@ static int parse_drag_pixel_error(const char *p, const tool_option *opt, const c
 
 static const tool_option isoview_options[] = {
     {"--drag-pixel-error", NULL, 1, 0, parse_drag_pixel_error, NULL, NULL},
-    {"--reuse", NULL, 1, 0, parse_switch, NULL, NULL},
-    {"--read-ahead", NULL, 1, 0, parse_switch, NULL, NULL},
-    {"--renderer", NULL, 1, 0, parse_renderer, NULL, NULL},
+    {"--reuse", NULL, 1, offsetof(options, reuse), tool_option_on_off, NULL, NULL},
+    {"--read-ahead", NULL, 1, offsetof(options, read_ahead), tool_option_on_off, NULL, NULL},
+    {"--renderer", NULL, 1, offsetof(options, renderer), tool_option_renderer, NULL, NULL},
     {"--script", NULL, 1, offsetof(options, script), NULL, NULL, NULL},
     {"--screenshot-at", NULL, 2, 0, parse_screenshot_at, NULL, NULL},
     {"--exit-after", NULL, 1, 0, parse_exit_after, NULL, NULL},
@@ -139,7 +114,7 @@ int parse_args(int argc, char **argv, options *o)
     o->screenshot_at = -1;
     o->exit_after = -1;
     o->aa = 1;
-    o->renderer = RENDERER_AUTO;
+    o->renderer = TOOL_RENDERER_AUTO;
     o->reuse = 0;
     o->read_ahead = 0;
     o->drag_pixel_error = 4;
@@ -151,7 +126,7 @@ int parse_args(int argc, char **argv, options *o)
      * pixel centres need every triangle */
     if (o->common.cull < 0)
         o->common.cull = o->aa <= 1;
-    if (rc == 0 && o->aa > 1 && o->renderer == RENDERER_SOFTWARE)
+    if (rc == 0 && o->aa > 1 && o->renderer == TOOL_RENDERER_SOFTWARE)
         return tool_usage_error("isoview",
                                 "--aa is OpenGL's: --renderer software draws without it");
     if (rc == 0 && o->common.iso_count > 1) /* isorender draws each; here one would be lost */

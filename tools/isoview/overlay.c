@@ -206,7 +206,7 @@ static const char *overdraw_text(viewer *v, char *text, size_t size)
 {
     int finished = v->full_shown || ip_engine_done(v->engine);
     if (finished && v->overdraw_state == 0)
-        measure_overdraw(v, v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine));
+        measure_overdraw(v, shown_mesh(v));
     if (!finished || v->overdraw_state != 1)
         return "-";
     snprintf(text, size, "%.2f", v->overdraw);

@@ -101,7 +101,7 @@ static void final_times(viewer *v, pass_record *r, const uint32_t *index)
  * shown (OpenGL), measured only for --stats. */
 static void measure_final(viewer *v, pass_record *r)
 {
-    const ip_mesh *mesh = v->full_shown ? &v->full_mesh : ip_engine_mesh(v->engine);
+    const ip_mesh *mesh = shown_mesh(v);
     if (v->canvas && v->canvas_mesh == mesh &&
         ip_canvas_triangle_count(v->canvas) == mesh->triangle_count) {
         final_times(v, r, ip_canvas_triangle_index(v->canvas));
