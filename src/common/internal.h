@@ -8,6 +8,7 @@
 
 #include "isoprop/status.h"
 #include "isoprop/system.h"
+#include "isoprop/version.h"
 #include "isoprop/volume.h"
 
 #if defined(__GNUC__)
@@ -17,6 +18,13 @@
 #define IP_PRINTF(a, b)
 #define IP_ALWAYS_INLINE inline
 #endif
+
+/* The version as a string literal, "MAJOR.MINOR.PATCH", from isoprop/version.h. */
+#define IP__STRINGIFY_(x) #x
+#define IP__STRINGIFY(x) IP__STRINGIFY_(x)
+#define IP__VERSION_STRING          \
+    IP__STRINGIFY(IP_VERSION_MAJOR) \
+    "." IP__STRINGIFY(IP_VERSION_MINOR) "." IP__STRINGIFY(IP_VERSION_PATCH)
 
 /* IP_ASSERT(cond): an internal invariant (a precondition of an internal function: an index in
  * range, a size, a pointer that is not NULL), never a check of input, which gets an ip_status.

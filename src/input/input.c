@@ -71,6 +71,19 @@ ip_status ip__input_open_regular(const char *path, int *fd, ip_error *err)
     return IP_OK;
 }
 
+/* Describes `path` with the input component's TIFF reader (tiff != 0) or DICOM reader. */
+static ip_status describe_by_component(int tiff, const char *path,
+                                       const ip_input_overrides *overrides, ip_input_desc *desc,
+                                       ip_text_found *found, ip_error *err)
+{
+    const ip__input_formats *formats;
+    ip_status st = ip__input_formats_load(path, &formats, err);
+    if (st != IP_OK)
+        return st;
+    return (tiff ? formats->tiff_describe : formats->dicom_describe)(path, overrides, desc, found,
+                                                                     err);
+}
+
 /* ---- folders: a DICOM series or numbered TIFF files ---- */
 
 /* The alphabetically first visible regular file of the folder `path` into out; IP_ERR_INPUT
@@ -114,12 +127,13 @@ static ip_status describe_folder(const char *path, const ip_input_overrides *ove
         return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", first);
     ssize_t got = pread(fd, head, sizeof head, 0);
     close(fd);
-    if (got == (ssize_t)sizeof head && memcmp(head + 128, "DICM", 4) == 0)
-        return ip__dicom_describe(path, overrides, desc, found, err);
-    if (got >= 4 &&
+    int dicom = got == (ssize_t)sizeof head && memcmp(head + 128, "DICM", 4) == 0;
+    int tiff =
+        got >= 4 &&
         ((head[0] == 'I' && head[1] == 'I' && (head[2] == 42 || head[2] == 43) && head[3] == 0) ||
-         (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && (head[3] == 42 || head[3] == 43))))
-        return ip__tiff_describe(path, overrides, desc, found, err);
+         (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && (head[3] == 42 || head[3] == 43)));
+    if (dicom || tiff)
+        return describe_by_component(tiff, path, overrides, desc, found, err);
     return ip__fail(err, IP_ERR_INPUT,
                     "%s: a folder of neither DICOM nor TIFF files (its first file %s is "
                     "neither)",
@@ -325,7 +339,7 @@ static ip_status check_data_file(ip_input_desc *desc, int data_at_end, uint64_t 
 {
     char label[2 * IP_PATH_MAX + 16];
     struct stat st;
-    if (ip__plane_source_of(desc->encoding))
+    if (ip__encoding_is_planes(desc->encoding))
         return IP_OK; /* a plane source checks each plane's file as it reads it */
     data_label(desc, label, sizeof label);
     /* O_NONBLOCK: naming a FIFO must fail below, not hang waiting for a writer. */
@@ -391,7 +405,7 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
     switch (kind_of(path)) {
     case INPUT_NRRD: format = &ip__nrrd_format; break;
     case INPUT_MHD: format = &ip__mhd_format; break;
-    case INPUT_TIFF: describe = ip__tiff_describe; break;
+    case INPUT_TIFF: return describe_by_component(1, path, overrides, desc, found, err);
     case INPUT_NIFTI: describe = ip__nifti_describe; break;
     case INPUT_RAW: break;
     }

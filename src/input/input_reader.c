@@ -117,7 +117,10 @@ ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_err
         ip_input_close(r);
         return status;
     }
-    r->source = ip__plane_source_of(desc->encoding);
+    if ((status = ip__plane_source_of(desc, &r->source, err)) != IP_OK) {
+        ip_input_close(r);
+        return status;
+    }
     if (r->source) {
         if ((status = r->source->open(&r->desc, &r->source_state, err)) != IP_OK) {
             ip_input_close(r);
@@ -419,15 +422,22 @@ ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t coun
     return IP_OK;
 }
 
-const ip__plane_source *ip__plane_source_of(ip_encoding encoding)
+int ip__encoding_is_planes(ip_encoding encoding)
 {
-    switch (encoding) {
-    case IP_ENCODING_TIFF: return &ip__tiff_source;
-    case IP_ENCODING_DICOM: return &ip__dicom_source;
-    case IP_ENCODING_RAW:
-    case IP_ENCODING_GZIP: break;
-    }
-    return NULL;
+    return encoding == IP_ENCODING_TIFF || encoding == IP_ENCODING_DICOM;
+}
+
+ip_status ip__plane_source_of(const ip_input_desc *desc, const ip__plane_source **out,
+                              ip_error *err)
+{
+    const ip__input_formats *formats;
+    *out = NULL;
+    if (!ip__encoding_is_planes(desc->encoding))
+        return IP_OK;
+    ip_status st = ip__input_formats_load(desc->path, &formats, err);
+    if (st == IP_OK)
+        *out = desc->encoding == IP_ENCODING_TIFF ? formats->tiff_source : formats->dicom_source;
+    return st;
 }
 
 /* ---- positioned reads (internal, input_positioned.h) ---- */

@@ -1,13 +1,15 @@
 /* Internal to the input module: the formats with binary headers (TIFF, NIfTI, DICOM), each
  * described by one function, and the plane sources of the encodings that are not one byte
  * stream (TIFF pages or files, DICOM files), which the reader drives one plane at a time.
- * Not part of the public API. */
+ * TIFF and DICOM live in the input component (src/input_formats/, libisoprop_input), found
+ * through ip__input_formats_load(). Not part of the public API. */
 #ifndef ISOPROP_INPUT_SOURCE_H
 #define ISOPROP_INPUT_SOURCE_H
 
 #include <stdint.h>
 
 #include "isoprop/input.h"
+#include "isoprop/version.h"
 #include "text_header.h"
 
 /* A binary-header format's describe function: fills `desc` (holding the defaults and `path`)
@@ -17,11 +19,7 @@
 typedef ip_status (*ip__describe_fn)(const char *path, const ip_input_overrides *overrides,
                                      ip_input_desc *desc, ip_text_found *found, ip_error *err);
 
-ip_status ip__tiff_describe(const char *path, const ip_input_overrides *overrides,
-                            ip_input_desc *desc, ip_text_found *found, ip_error *err);
 ip_status ip__nifti_describe(const char *path, const ip_input_overrides *overrides,
-                             ip_input_desc *desc, ip_text_found *found, ip_error *err);
-ip_status ip__dicom_describe(const char *path, const ip_input_overrides *overrides,
                              ip_input_desc *desc, ip_text_found *found, ip_error *err);
 
 /* A source of z-planes for IP_ENCODING_TIFF and IP_ENCODING_DICOM. The reader calls open once,
@@ -39,15 +37,38 @@ typedef struct ip__plane_source {
     void (*close)(void *state);
 } ip__plane_source;
 
-extern const ip__plane_source ip__tiff_source;
-extern const ip__plane_source ip__dicom_source;
+/* The input component's readers, as the component hands them to the core
+ * (ip_input_formats_table(), include/isoprop/input_formats.h). */
+typedef struct ip__input_formats {
+    uint32_t abi; /* IP__INPUT_FORMATS_ABI of the component's build */
+    ip__describe_fn tiff_describe, dicom_describe;
+    const ip__plane_source *tiff_source, *dicom_source;
+} ip__input_formats;
+
+/* The table's layout and the version of the structs it passes (ip_input_desc, ...): the core
+ * takes only a component of its own version. Raise the last part when ip__input_formats or
+ * ip__plane_source change. */
+#define IP__INPUT_FORMATS_ABI \
+    ((uint32_t)(IP_VERSION_MAJOR * 1000000 + IP_VERSION_MINOR * 10000 + IP_VERSION_PATCH * 100 + 1))
+
+/*! ip__input_formats_load() : the input component's readers, which `path` (a TIFF file or a
+ *  DICOM or TIFF folder) needs: the ones linked in (the static library, the component itself),
+ *  else libisoprop_input.so.MAJOR loaded from the folder of libisoprop.so, else from the
+ *  loader's path. IP_ERR_UNSUPPORTED naming `path` and the component when it cannot be loaded
+ *  or is of another version. Thread-safe. */
+ip_status ip__input_formats_load(const char *path, const ip__input_formats **out, ip_error *err);
+
+/*! ip__encoding_is_planes() : 1 for the encodings read through a plane source (TIFF, DICOM). */
+int ip__encoding_is_planes(ip_encoding encoding);
 
 /*! ip__input_open_regular() : opens `path` read-only without waiting (O_NONBLOCK: a FIFO is
  *  refused, never waited on) and checks that it is a regular file; *fd is the caller's to
  *  close. IP_ERR_IO when it cannot be opened, IP_ERR_INPUT when it is not a regular file. */
 ip_status ip__input_open_regular(const char *path, int *fd, ip_error *err);
 
-/*! ip__plane_source_of() : the plane source of an encoding; NULL for raw and gzip data. */
-const ip__plane_source *ip__plane_source_of(ip_encoding encoding);
+/*! ip__plane_source_of() : the plane source of desc's encoding into *out (loading the input
+ *  component, ip__input_formats_load()); NULL for raw and gzip data. */
+ip_status ip__plane_source_of(const ip_input_desc *desc, const ip__plane_source **out,
+                              ip_error *err);
 
 #endif

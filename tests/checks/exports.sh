@@ -2,8 +2,9 @@
 # A shared library exports exactly its public API: every function declared with IP_API in its
 # public headers, and nothing else (no internal ip__ symbol, nothing without the ip_ prefix, no
 # function of another library's headers).
-#   exports.sh LIBRARY.so HEADER...   (libisoprop.so: include/isoprop/*.h but render.h;
-#                                      libisoprop_render.so: render.h)
+#   exports.sh LIBRARY.so HEADER...   (libisoprop.so: include/isoprop/*.h but render.h and
+#                                      input_formats.h; libisoprop_render.so: render.h;
+#                                      libisoprop_input.so: input_formats.h)
 set -u
 lib=$1
 shift

@@ -2,7 +2,9 @@
 # prefixes; docs/examples/extract.c built with pkg-config against the core component alone
 # (no render.h, no libisoprop_render) and with CMake's find_package(isoprop) (shared, static,
 # and the render component); its triangles equal isorender's, byte for byte; nothing
-# graphical is linked; the installed programs and .pc files work from a moved prefix.
+# graphical is linked; the installed programs and .pc files work from a moved prefix; the
+# core links no image-format library, and the installed programs read TIFF through the input
+# component beside it, or fail naming it when it is missing.
 # Under the sanitizers (IP_SANITIZE) the library's objects need the sanitizer runtime, so the
 # embedder's programs are built with the same compiler (IP_CC) and -fsanitize flags.
 . "$(dirname "$0")/lib.sh"
@@ -40,6 +42,9 @@ check "libisoprop.so has a SONAME" sh -c "readelf -d '$core_lib/libisoprop.so' |
 check "libisoprop.so links nothing graphical" links_nothing_graphical "$core_lib/libisoprop.so"
 check "the example links nothing graphical" links_nothing_graphical extract
 check "the example uses the installed libisoprop" sh -c "ldd extract | grep -q '$core_lib/libisoprop.so'"
+check "core: libisoprop.so links no image-format library" \
+    sh -c "! ldd '$core_lib/libisoprop.so' | grep -Eq 'libtiff|libgdcm|libstdc\+\+'"
+check "core: no libisoprop_input" test -z "$(find "$core" -name 'libisoprop_input*')"
 
 # --- a volume, and the example against isorender ---
 "$bin/isogen" sphere --dims 48x40x36 --type uint8 -o "$work/" --quiet
@@ -66,7 +71,9 @@ run_capture "$cmake" --install "$bin" --prefix "$full"
 check "cmake --install succeeds ($err)" test "$rc" = 0
 for f in include/isoprop/render.h lib/cmake/isoprop/isopropConfig.cmake \
          lib/cmake/isoprop/isopropConfigVersion.cmake lib/pkgconfig/isoprop.pc \
-         lib/pkgconfig/isoprop-render.pc lib/libisoprop.a lib/libisoprop_render.a bin/isorender; do
+         lib/pkgconfig/isoprop-render.pc lib/libisoprop.a lib/libisoprop_render.a bin/isorender \
+         lib/libisoprop_input.so.0 lib/pkgconfig/isoprop-input.pc include/isoprop/input_formats.h \
+         lib/cmake/isoprop/isopropInputTargets.cmake; do
     check "installed $f" test -e "$full/$f"
 done
 check "libisoprop_render.so links EGL and libpng (what the check above looks for)" \
@@ -141,5 +148,20 @@ run_capture "$cc" "${flags[@]}" project/draw.c -o draw_pc $(moved_pc --cflags --
     -Wl,-rpath,"$(moved_pc --variable=libdir isoprop)"
 check "draw builds with pkg-config isoprop-render from the moved prefix ($err)" test "$rc" = 0
 check "... and runs" ./draw_pc drawn_pc.png
+
+# --- the input component, loaded by libisoprop.so from its own folder ---
+mkdir formats
+"$bin/isogen" sphere --dims 24x20x12 --type uint8 -o "$work/" --quiet
+"$bin/tests/make_formats" sphere_24x20x12_uint8.raw formats 1,1,1 >/dev/null
+run_capture "$work/moved/bin/isobrick" formats/stack.tif -o tif.ibv --quiet
+check "the installed isobrick reads a TIFF through libisoprop_input ($err)" test "$rc" = 0
+check "... which the programs do not link" \
+    sh -c "! ldd '$work/moved/bin/isobrick' | grep -q libisoprop_input"
+rm "$work"/moved/lib/libisoprop_input.so*
+expect_error 1 "formats/stack.tif: TIFF and DICOM need the input component libisoprop_input.so.0" \
+    "$work/moved/bin/isobrick" formats/stack.tif -o tif2.ibv --quiet
+check "... and writes nothing" test ! -e tif2.ibv
+run_capture "$work/moved/bin/isobrick" sphere_24x20x12_uint8.raw -o raw.ibv --quiet
+check "without it, raw volumes still brick ($err)" test "$rc" = 0
 
 finish

@@ -18,7 +18,7 @@
 #include <tiffio.h>
 #include <unistd.h>
 
-#include "input_source.h"
+#include "readers.h"
 #include "internal.h"
 
 /* ---- one open TIFF file ---- */

@@ -15,7 +15,7 @@
 #include "array.h"
 #include "dicom_check.h"
 #include "dicom_gdcm.h"
-#include "input_source.h"
+#include "readers.h"
 #include "internal.h"
 
 /* Slices closer together than this share a position (mm, and a fraction of the median
