@@ -2,7 +2,7 @@
 # Out of core for real: the Visible Woman head upsampled 4x (2048x2048x936 uint16, 7.3 GiB)
 # and 6x (3072x3072x1404 uint16, 24.7 GiB, more than this machine's RAM), each bricked once
 # with a capped working memory and viewed cold with a 512 MiB brick cache. Prints Markdown
-# tables (results in docs/performance.md, part 14):
+# tables (results in docs/benchmarks.md):
 #
 #   1. bricking: seconds, MB/s of raw input, peak RSS against --mem-mb, compression ratio,
 #      beside `lz4 -1` on one core over the same raw file (both from a cold page cache);

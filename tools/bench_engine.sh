@@ -1,6 +1,6 @@
 #!/bin/sh
 # The engine's performance against its peers, in one run on one machine (results in
-# docs/performance.md). Prints one Markdown table per part:
+# docs/benchmarks.md). Prints one Markdown table per part:
 #
 #   1. the paper's case: the Visible Woman head, skin 600.5 (-y) and bone 1224.5 (-x), 1600x1200,
 #      cut-off 1.81: time to 85 % and 99.5 % final pixels and to all rays, cold, fresh (a new

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Occlusion-aware propagation against the paper's propagation (isorender --occlusion on|off)
-# on the Visible Woman head at 1600x1200 (results in docs/performance.md, "Occlusion").
+# on the Visible Woman head at 1600x1200 (results in docs/notes/performance-notebook.md, part 6).
 # Prints a Markdown table per case: medians over REPEAT interleaved runs of the time to 85 %
 # and 99.5 % final pixels and to all rays, warm (isorender --warm) and fresh (a new process,
 # the brick file in the page cache), with the triangles extracted by then and the overdraw

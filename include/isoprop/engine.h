@@ -1,98 +1,58 @@
 /* isoprop: progressive view-dependent isosurface extraction (Liu, Finkelstein, Li).
  *
  * ip_engine_begin() fixes a view and an isovalue; each ip_engine_step() casts the next rays of
- * the progressive order (centre first, then the centres of quadrants, ...; the three finest
- * levels, most of the rays, in Z-order, for the caches: see ray_order.h). A ray walks the
- * min/max octree front to back, from the root through bricks and sub-blocks to cells, entering
- * only nodes whose range holds the isovalue, and stops at the first cell whose marching-cubes
- * triangles it really hits: the seed. (Cells it passes within 1/64 pixel of a triangle edge on
- * the way, where rounding could decide either way, are extracted too, alone.) Unless already extracted, the seed's surface is
- * propagated breadth-first into face neighbours that share a sign change, while they stay
- * within the cut-off angle of the seed's ray, do not fold back (the angle to the ray must not
- * drop below the largest angle among their predecessors by more than a tolerance) and lie in
- * the view frustum. Extracted cells are triangulated with marching cubes and appended to the
- * engine's mesh. Once every pixel has had its ray, the image of the mesh equals the image of
- * the full isosurface.
+ * the progressive order (centre first, then the centres of quadrants, ...). A ray walks the
+ * min/max octree front to back and stops at the first cell whose marching-cubes triangles it
+ * hits, its seed; the seed's surface is propagated into neighbouring cells within the cut-off
+ * angle of the ray, without folding back, and appended to the engine's mesh. Once every pixel
+ * has had its ray, the image of the mesh equals the image of the full isosurface
+ * (ip_extract_full(); with adaptive resolution, ip_extract_full_lod()). docs/design.md describes
+ * the method and the data flow, and gives the argument for the exact image as statements E1-E14,
+ * which the options below cite.
  *
- * Ray seeding reads only the summaries until it reaches a candidate cell; bricks are pinned
- * through the cache as seeding descends into them and as propagation crosses their faces.
+ * Adaptive resolution (options.lod, on by default; the paper's section 2.3): far regions come
+ * from the coarse levels of the brick file and never load fine bricks; each level serves a band
+ * of distances from the eye (ip_engine_lod_distance()). The image is exact against
+ * ip_extract_full_lod() (docs/design.md, E13), with sub-pixel cracks where the bands meet.
  *
- * Adaptive resolution (the paper's section 2.3, on by default): with D[k] the distance from
- * the eye beyond which a cell of pyramid level k (a meta-cell of 2^k level-0 cells) projects
- * to at most `pixel_error` pixels, the part of a ray between D[k] and D[k+1] is seeded in level
- * k's octree and bricks, and propagation stays within its level's distance band. Far regions
- * are extracted from the coarse levels of the brick file and never load fine bricks. Cracks at
- * the band boundaries are sub-pixel, as in the paper; the exact-image guarantee above holds
- * with lod off (or wherever every D[k >= 1] lies beyond the volume).
+ * Occlusion (options.occlusion, on by default): a coverage depth buffer of the surface extracted
+ * so far, 8 bytes a pixel, lets propagation pass over hidden cells, rays stop where nothing
+ * further can show, and the rays of 8 x 8 pixel tiles retire without a walk (`deferred`,
+ * `retired`). The image once every ray has been cast is unchanged (E5, E7-E12); what changes is
+ * how much hidden surface is extracted (docs/occlusion.md).
  *
- * Occlusion (options.occlusion, on by default): the engine keeps a coverage depth buffer of
- * the image, the nearest depth of the triangles extracted so far at each pixel centre, and
- * propagation does not queue a cell whose box that surface hides at every pixel centre the box
- * may cover (it stays unvisited). Such a cell cannot show in the final image, and since every
- * pixel's ray still extracts its own first-hit cell, the guarantee above is unchanged; what
- * changes is how much hidden surface is extracted (docs/occlusion.md). The buffer also keeps,
- * per pixel, the depth of surface that holds the pixel centre by 1/128 pixel or more, which the
- * rasterizer draws there whatever its rounding: a ray stops its walk where cells lie wholly
- * behind that depth (nothing there can show at its pixel), and the rays of an 8 x 8 pixel tile
- * whose pixels are all so covered are retired without a walk once a test of the tile's beam
- * against the octree finds every active cell those walks could enter extracted already
- * (`retired`), as are at once those of a tile the image of no brick holding the isovalue
- * reaches; the guarantee above is unchanged (the arguments are in cast.c and retire.c). 8
- * bytes a pixel.
+ * Culling (options.cull, on by default, with occlusion): triangles drawn at no pixel centre of
+ * the image are not kept in the mesh but counted in `culled`. The image is the same, every step
+ * (E6); the mesh is what this view's image needs. Keep them (cull 0) for a mesh to be written
+ * out, drawn with multisampling or from another view (docs/occlusion.md).
  *
- * Culling (options.cull, on by default, with occlusion): a triangle no pixel centre of the
- * image lies within 1/64 pixel of is drawn at no pixel of it (a rasterizer samples pixel
- * centres, and snaps vertices by far less), so it is not kept in the mesh and is counted in
- * `culled` instead. The image is the same, every step; the mesh is not the surface's whole
- * front but what this view's image needs. Keep them (cull 0) for a mesh to be written out,
- * drawn with multisampling or from another view (docs/occlusion.md).
+ * Reuse (options.reuse, with occlusion; off by default): ip_engine_begin() at the isovalue of the
+ * view before (the engine's planes and options unchanged, and that view's steps all successful)
+ * keeps, of the mesh, the whole cells that belong to the new view's surface and may show in it,
+ * first and in their order, and the pass extracts what became visible; the image once every ray
+ * has been cast is the one without reuse (E14). Hidden cells and those outside the image are
+ * dropped. The mesh then keeps cell ids (with_cells), 8 bytes a triangle.
  *
- * Reuse (options.reuse, with occlusion; off by default): consecutive views of an orbit share
- * most of their surface. ip_engine_begin() at the isovalue of the view before (the engine's
- * planes and options unchanged, and that view's steps all successful) then keeps, of the mesh,
- * the cells that belong to the new view's surface and may show in it: each cell whose level's
- * distance band for the new view holds its centre (the rule of ip_extract_full_lod()), one of
- * whose triangles may be drawn at a pixel centre of the new image, and that the others kept do
- * not certainly hide. They stay in the mesh, first and in their order, are marked extracted,
- * and their triangles are recorded in the coverage, so rays meeting them end there and their
- * tiles retire in bulk: the pass extracts what became visible. With culling, a cell keeps all
- * its triangles when one of them may show (whole cells), so a cell kept is never missing a
- * triangle the new view needs. Every kept triangle belongs to the new view's full extraction
- * at adaptive resolution and every cell of it is whole, so the image once every ray has been
- * cast is the one without reuse. The mesh stays within the cells that may show in the current
- * view: hidden cells and those outside the image are dropped. The mesh then keeps cell ids
- * (with_cells), 8 bytes a triangle.
- *
- * Reading ahead (options.prefetch, IP_PREFETCH_ON by default): one more thread per engine
- * reads and decodes into the cache, from the first step after ip_engine_begin() on and between
- * steps, the bricks that the next rays of the order will seed in (found from the summaries) and
- * their neighbours across brick faces, within the cache's budget and without evicting a brick
- * of the current view (docs/cache.md, "Prefetching"). When the workers have every core
- * (threads >= ip_thread_count(0)) it reads ahead only the bricks the disk has to deliver: one
- * whose payload the page cache holds (ip_store_brick_in_memory()) is left to the worker that
- * needs it, which decodes it as fast, rather than decoded on a core the workers need, maybe
- * for no ray. IP_PREFETCH_ALWAYS reads every planned brick ahead; IP_PREFETCH_OFF starts no
- * reader. The triangles do not depend on it; only who reads a brick first and when. A brick
- * that fails to load in the background is read again by the worker that needs it, which
- * reports the error as without reading ahead. It stops at ip_engine_begin() (for the new view),
- * ip_engine_cancel() and ip_engine_destroy().
+ * Reading ahead (options.prefetch, IP_PREFETCH_ON by default): one more thread per engine reads
+ * and decodes into the cache, from the first step after ip_engine_begin() on and between steps,
+ * the bricks that the next rays of the order will seed in and their neighbours, within the
+ * cache's budget and without evicting a brick of the current view (docs/cache.md,
+ * "Prefetching"). When the workers have every core (threads >= ip_thread_count(0)) it reads
+ * ahead only the bricks the disk has to deliver (not those whose payload the page cache holds,
+ * ip_store_brick_in_memory()). IP_PREFETCH_ALWAYS reads every planned brick ahead;
+ * IP_PREFETCH_OFF starts no reader. The triangles do not depend on it. A brick that fails to
+ * load in the background is read again by the worker that needs it, which reports the error as
+ * without reading ahead. It stops at ip_engine_begin() (for the new view), ip_engine_cancel()
+ * and ip_engine_destroy().
  *
  * Threads: an engine is driven by one thread. ip_engine_create() starts its worker threads
  * (ip_thread_count(options.threads) in all, the driving thread counted), which sleep between
- * steps; ip_engine_step() wakes them, works as one of them and returns when all have stopped.
- * They share the progressive ray sequence (handed out without a lock in ranges that each
- * worker walks on its own: short ones first, so that the order holds nearly exactly, longer
- * ones later; what a step's budget or deadline leaves of a range is cast first by the next
- * step, so every pixel has one ray and one thread casts exactly the sequential order), the
- * visited set (an atomic bit per cell) and the cache, and keep their own triangle buffers,
- * moved to the mesh every few thousand triangles and at the end of the step. A worker left
- * without rays in a step takes cells from the queue of a long propagation of another, so that
- * a step of fewer rays than threads keeps every thread busy; a step returns once every cell
- * queued in it is extracted. Which thread extracts a cell varies from run to
- * run, so the triangles' order and, where propagations meet, which cells are extracted may
- * vary; what every pixel finally shows does not (each pixel's own ray extracts its seed).
- * With several threads the times are summed over the threads. ip_engine_cancel() may be
- * called from any thread.
+ * steps; ip_engine_step() wakes them, works as one of them and returns when all have stopped and
+ * every cell queued in the step is extracted. Every pixel has one ray, and one thread casts
+ * exactly the sequential order. With several threads the triangles' order and, where
+ * propagations meet, which cells are extracted may vary from run to run; what every pixel
+ * finally shows does not (E4). The times are then summed over the threads. ip_engine_cancel()
+ * may be called from any thread.
  */
 #ifndef ISOPROP_ENGINE_H
 #define ISOPROP_ENGINE_H

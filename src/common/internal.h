@@ -137,7 +137,7 @@ static inline int ip__host_little_endian(void)
 /* Maps the whole pages inside [p, p + bytes) into the process, writable, in one system call
  * (MADV_POPULATE_WRITE), for memory about to be written: first touches of fresh memory then find
  * their pages present instead of taking a page fault each, which costs several times more in a
- * virtual machine (docs/performance.md, part 6). Contents are unchanged. Best effort: does
+ * virtual machine (docs/notes/performance-notebook.md, part 7). Contents are unchanged. Best effort: does
  * nothing where the kernel (before Linux 5.14) or the range does not allow it. */
 void ip__memory_populate(void *p, size_t bytes);
 

@@ -40,7 +40,7 @@ ip_status ip_mesh_reserve(ip_mesh *m, uint64_t triangles)
     /* Growth by half (not doubling) keeps the slack small for meshes of millions of triangles.
      * glibc moves a block it has mapped by remapping its pages; one it keeps on its heap (as it
      * does for large blocks once a large mapped block has been freed) is copied, which
-     * docs/performance.md part 23 measured at no cost worth arrays mapped by hand. */
+     * docs/notes/performance-notebook.md part 23 measured at no cost worth arrays mapped by hand. */
     uint64_t cap =
         ip__array_capacity(m->capacity, triangles, 1024, 9 * sizeof(float), IP_ARRAY_HALF);
     /* Moved arrays hold their triangles; what was populated past them may not have moved. */

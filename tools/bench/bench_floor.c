@@ -5,7 +5,7 @@
  * empty cache (the bricks decoded as the cells ask for them), then REPEATS runs warm. The
  * cells are taken brick by brick (in id order within a brick), the kindest order for the caches,
  * and split in THREADS contiguous parts, one per thread. Prints the counts, each run's time
- * and the median of the warm runs. A benchmark, not a test (docs/performance.md, part 21).
+ * and the median of the warm runs. A benchmark, not a test (docs/benchmarks.md).
  *
  * With RAYS, the cells are instead those the engine extracts in its first RAYS rays (one
  * thread, no read-ahead, every triangle kept): the floor under the paper's propagation, which

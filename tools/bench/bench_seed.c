@@ -2,7 +2,7 @@
  * thread, the bricks already decoded), with the cell-group ranges used and not, and prints
  * the time and the cells read and tested per ray of each, and what decoding the bricks cost
  * (the first, untimed pass); fails when the two find different cells. Run by hand
- * (docs/performance.md, part 6), never by the tests.
+ * (docs/notes/performance-notebook.md, part 8), never by the tests.
  *
  *   bench_seed FILE.ibv ISO VIEW [WxH] [REPEAT]    e.g. bench_seed head.ibv 600.5 -y 1600x1200 3
  */
