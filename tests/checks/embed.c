@@ -1,7 +1,9 @@
 /* An embedder's program: the whole chain through the public API alone (isoprop/isoprop.h,
  * linked with libisoprop.so, no internal header on its include path). Generates a sphere,
  * bricks it, opens it with a small cache, extracts the isosurface progressively until every
- * ray has been cast, and fully; both must find the sphere. Argument: a scratch folder. */
+ * ray has been cast, and fully; both must find the sphere. Argument: a scratch folder. Only
+ * the stable tier of the API (the build defines IP_EXPERIMENTAL for everything else). */
+#undef IP_EXPERIMENTAL
 #include <stdio.h>
 #include <string.h>
 
