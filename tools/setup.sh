@@ -18,7 +18,7 @@ cd "$root"
 jobs=$(nproc 2>/dev/null || echo 2)
 
 # Debian packages: compiler and build tools, the libraries, clang for the sanitizer and fuzzer
-# builds and clang-format for tools/check_format.sh, and the lz4/zstd programs the benchmark
+# builds and clang-format for tools/dev/check_format.sh, and the lz4/zstd programs the benchmark
 # compares against; GLFW and stb_easy_font for the viewer, and a virtual X server (xvfb-run) for
 # its test; python3 and numpy for the Python module (docs/python.md), which every build puts in
 # build/python; GDCM for DICOM series input and libtiff for TIFF input; help2man for the man

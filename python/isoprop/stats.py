@@ -1,6 +1,6 @@
 """The statistics of an extraction, as a dict with the keys of isorender's --stats JSON
-(tools/isorender.c, tools/tool_common.c). Left out, since they need the run's image: the
-renderer's work (final_pixel_pct, visible_triangles, overdraw); "renderer" is "none" and the
+(tools/isorender/stats.c, tools/common/report.c). Left out, since they need the run's image:
+the renderer's work (final_pixel_pct, visible_triangles, overdraw); "renderer" is "none" and the
 rendering times are 0."""
 import ctypes
 

@@ -1,4 +1,4 @@
-/* corrupt: exact, fast mutations of brick files, for tools/fault_inject.sh.
+/* corrupt: exact, fast mutations of brick files, for tools/dev/fault_inject.sh.
  *
  *   corrupt info FILE
  *       prints the file's sections, one per line ("header 0 256", "data OFFSET SIZE",

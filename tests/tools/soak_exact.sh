@@ -1,11 +1,11 @@
-# The exact-image guarantee over random views (tools/soak_exact.sh): 24 cases on the generated
+# The exact-image guarantee over random views (tools/dev/soak_exact.sh): 24 cases on the generated
 # volumes, a fixed seed, each progressive image against the full extraction's, byte for byte
 # (--full's, or --full-lod's for the cases with adaptive resolution: about half), some with
 # clipping planes, some with a second surface, some with a 1 MiB brick cache; a bad case count,
 # SOAK_LOD, SOAK_CLIP, SOAK_MULTI or SOAK_CACHE is a usage error (exit 2).
 . "$(dirname "$0")/lib.sh"
 
-soak=$(cd "$(dirname "$0")/../../tools" && pwd)/soak_exact.sh
+soak=$(cd "$(dirname "$0")/../../tools/dev" && pwd)/soak_exact.sh
 run_capture env SOAK_DATA= sh "$soak" "$bin" 24 5 "$work/soak"
 check "24 random views: every progressive image equals the full extraction's ($rc)" \
     test "$rc" = 0

@@ -112,10 +112,10 @@ expect_error 2 "--size is isorender's" "$bin/isowall" g.ibv --iso 0.5 --wall 3x2
     --size 16x16
 expect_error 2 "larger than 65536" "$bin/isowall" g.ibv --iso 0.5 --wall 200x1 --tile 400x8
 
-# random views (tools/soak_exact.sh with SOAK_WALL=on): 12 cases on the generated volumes, 3 of
+# random views (tools/dev/soak_exact.sh with SOAK_WALL=on): 12 cases on the generated volumes, 3 of
 # them also on a display wall of random tiles and processes (2 with adaptive resolution, 1 with
 # two clipping planes), whose image must equal the full extraction's byte for byte
-soak=$(cd "$(dirname "$0")/../../tools" && pwd)/soak_exact.sh
+soak=$(cd "$(dirname "$0")/../../tools/dev" && pwd)/soak_exact.sh
 run_capture env SOAK_DATA= SOAK_WALL=on sh "$soak" "$bin" 12 13 "$work/soak"
 check "12 random views, 3 on a wall: every image equals the full extraction's ($rc)" \
     test "$rc" = 0

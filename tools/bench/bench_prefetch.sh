@@ -3,7 +3,7 @@
 # parts 13 and 21). Needs root for drop_caches; writes its files to /tmp/pf/r. MODES (default
 # "on off") lists the --prefetch values compared, taken in turn, the order rotating from run to
 # run.
-# usage: [MODES="on off always"] tools/bench_prefetch.sh BUILD RUNS FILE.ibv...
+# usage: [MODES="on off always"] tools/bench/bench_prefetch.sh BUILD RUNS FILE.ibv...
 B=$1; RUNS=$2; shift 2
 read -r -a modes <<<"${MODES:-on off}"
 

@@ -5,21 +5,21 @@
 # the sample volumes of ../shared/data (those present) and on generated ones. For refactors that
 # must not change a triangle. Prints one line per case and a total; exits 1 on any difference.
 #
-#   tools/check_identical.sh [--quick] OLD NEW [WORK_DIR]
+#   tools/dev/check_identical.sh [--quick] OLD NEW [WORK_DIR]
 #
 # OLD and NEW are build folders (holding isogen, isobrick, isorender) or git revisions: a
 # revision is checked out into WORK_DIR and built there first. NEW defaults to the current
 # build folder `build`. WORK_DIR (default: a temporary folder, removed at the end) receives the
 # outputs; nothing is written elsewhere. --quick: fewer cases (one view, one brick edge).
 #
-#   tools/check_identical.sh HEAD~1 build          # this change against the commit before it
+#   tools/dev/check_identical.sh HEAD~1 build          # this change against the commit before it
 set -eu
 quick=0
 [ "${1:-}" = --quick ] && { quick=1; shift; }
-[ $# -ge 1 ] || { echo "usage: tools/check_identical.sh [--quick] OLD [NEW] [WORK_DIR]" >&2; exit 2; }
+[ $# -ge 1 ] || { echo "usage: tools/dev/check_identical.sh [--quick] OLD [NEW] [WORK_DIR]" >&2; exit 2; }
 old=$1
 new=${2:-build}
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 data=${IP_SHARED_DATA:-$root/../shared/data}
 keep=0
 if [ -n "${3:-}" ]; then

@@ -3,7 +3,7 @@
 # and random and sequential runs under several budgets; then `lz4 -b1` on the raw input, for
 # LZ4's own figure on the whole file. Prints Markdown. Not a test: numbers depend on the machine.
 #
-#   tools/bench_cache.sh [BRICK_FILE_OR_RAW] [BUILD_DIR] [bench_cache options...]
+#   tools/bench/bench_cache.sh [BRICK_FILE_OR_RAW] [BUILD_DIR] [bench_cache options...]
 #
 # Defaults: ../shared/data/ct_head_visible_woman_512x512x234_uint16.raw and build. A raw input
 # is bricked first (isobrick, default options) into a temporary .ibv; a .ibv is used as it is

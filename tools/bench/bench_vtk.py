@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The VTK side of tools/bench_engine.sh: isosurface extraction of a raw volume with VTK's
+"""The VTK side of tools/bench/bench_engine.sh: isosurface extraction of a raw volume with VTK's
 vtkFlyingEdges3D and vtkMarchingCubes (only the filter's Update() is timed), VTK's own rendering
 of the result offscreen, and the peak memory of Flying Edges on a large volume.
 

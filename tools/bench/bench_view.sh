@@ -1,7 +1,7 @@
 #!/bin/sh
 # The viewer on volumes far larger than its cache: isoview driven by a script under a virtual X
-# server, on the Visible Woman head upsampled 4x and 6x (the brick files tools/bench_big.sh makes
-# in DIR: x4.ibv, x6.ibv), cold (page cache dropped first) and warm. Prints a Markdown table
+# server, on the Visible Woman head upsampled 4x and 6x (the brick files tools/bench/bench_big.sh
+# makes in DIR: x4.ibv, x6.ibv), cold (page cache dropped first) and warm. Prints a Markdown table
 # (results in docs/isoview.md, "Viewing a volume far larger than the cache"):
 #
 #   per view (the median over the orbit's 25 views, the opening one and 24 steps): time to the first frame after the change,
@@ -9,7 +9,7 @@
 #   time per view to complete (the orbit's wall time / 24); frames a second while refining and
 #   while dragging; peak RSS; against the targets.
 #
-#   tools/bench_view.sh DIR [BUILD_DIR]
+#   tools/bench/bench_view.sh DIR [BUILD_DIR]
 #
 # The orbit: 24 steps, each `orbit 15 0` (a full turn in all), `zoom 1.08` in the first 12 and
 # `zoom 1/1.08` in the last 12 (in to 2.5x and back out), then `wait done`; the skin (600.5) in a
@@ -24,7 +24,7 @@ if [ $# -lt 1 ]; then
     sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 dir=$(cd "$1" && pwd)
 build=${2:-build}
 case $build in /*) ;; *) build=$root/$build ;; esac
@@ -116,7 +116,7 @@ for k in $scales; do
     cache=$1
     [ $# -gt 1 ] && shift
     ibv=$dir/x$k.ibv
-    [ -f "$ibv" ] || { echo "bench_view: $ibv is missing: run tools/bench_big.sh $dir first" >&2; exit 1; }
+    [ -f "$ibv" ] || { echo "bench_view: $ibv is missing: run tools/bench/bench_big.sh $dir first" >&2; exit 1; }
     case $k in 4) ts=1.0 tm=640 ;; 6) ts=1.5 tm=1024 ;; *) ts=1.5 tm=1024 ;; esac
     cold="" warm=""
     for r in $(seq "$repeat"); do

@@ -6,7 +6,7 @@
 # the brick file in the page cache), with the triangles extracted by then and the overdraw
 # (triangles extracted / triangles owning a pixel of the final image).
 #
-#   tools/bench_occlusion.sh [BUILD_DIR] [WORK_DIR]
+#   tools/bench/bench_occlusion.sh [BUILD_DIR] [WORK_DIR]
 #   defaults: build, /tmp/bench_occlusion; environment: RAW (the 512x512x234 head), REPEAT (5),
 #   CASES ("skin bone")
 #
@@ -14,7 +14,7 @@
 # at ip_engine_begin); "t [p]" is the first checkpoint at or past the share and the one before
 # it (the share was reached between the two). Not a test: it only measures and prints.
 set -eu
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-build}
 work=${2:-/tmp/bench_occlusion}
 raw=${RAW:-$root/../shared/data/ct_head_visible_woman_512x512x234_uint16.raw}

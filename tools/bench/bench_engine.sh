@@ -18,7 +18,7 @@
 #   4. threads: --threads 1 against every core, progressive (all rays) and --full;
 #   5. profiles (perf record) of the engine: progressive, --full, and the out-of-core view.
 #
-#   tools/bench_engine.sh [BUILD_DIR] [WORK_DIR]
+#   tools/bench/bench_engine.sh [BUILD_DIR] [WORK_DIR]
 #   defaults: build, /tmp/bench_engine (raw CSV/JSON/PNG/perf files are kept there)
 #   environment: RAW (the 512x512x234 head), BIG_DIR (where the x4 volume and its brick file
 #   are, or are made: /work/big), REPEAT (runs per measurement, median reported: 5),
@@ -31,7 +31,7 @@
 # times come from isorender's --progress CSV (checkpoints at doubling ray counts, clock started
 # at ip_engine_begin) and --stats JSON. Not a test: it only measures and prints.
 set -eu
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-build}
 work=${2:-/tmp/bench_engine}
 raw=${RAW:-$root/../shared/data/ct_head_visible_woman_512x512x234_uint16.raw}
@@ -283,9 +283,9 @@ if measuring; then
             "$build/bench_floor" "$head_ibv" "$iso" "$view" 1600x1200 "$(getconf _NPROCESSORS_ONLN)" 20 \
                 "$rays" >"$name-walked-$i.txt"
         done
-        $py "$root/tools/bench_vtk.py" extract "$raw" 600.5 1224.5 >>vtk-extract.jsonl
+        $py "$root/tools/bench/bench_vtk.py" extract "$raw" 600.5 1224.5 >>vtk-extract.jsonl
         for s in "600.5 -y" "1224.5 -x"; do
-            xvfb-run -a -s "-screen 0 1920x1200x24" $py "$root/tools/bench_vtk.py" render "$raw" $s 1600x1200 >>vtk-render.jsonl
+            xvfb-run -a -s "-screen 0 1920x1200x24" $py "$root/tools/bench/bench_vtk.py" render "$raw" $s 1600x1200 >>vtk-render.jsonl
         done
         i=$((i + 1))
     done
@@ -518,7 +518,7 @@ if [ "$bytes" = 0 ]; then
 elif [ "$estimate" -gt $((18 << 30)) ] || [ "$estimate" -gt $((avail - (2 << 30))) ]; then
     echo "| skipped | the estimate exceeds 18 GiB or what is available less 2 GiB |"
 else
-    measuring && /usr/bin/time -f "%e %M" -o vtk-big.time $py "$root/tools/bench_vtk.py" memory "$big_raw" 600.5 >vtk-big.json
+    measuring && /usr/bin/time -f "%e %M" -o vtk-big.time $py "$root/tools/bench/bench_vtk.py" memory "$big_raw" 600.5 >vtk-big.json
     echo "| read (numpy.fromfile) | $(printf %.1f "$(h get vtk-big.json read_s)") s |"
     echo "| Flying Edges Update() | $(printf %.2f "$(h get vtk-big.json update_s)") s |"
     echo "| triangles | $(fmt_k "$(h get vtk-big.json triangles)") K |"

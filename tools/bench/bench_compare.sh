@@ -4,9 +4,9 @@
 # warm, new fresh, new warm, ...); prints the medians with [min-max] and the triangles
 # extracted by 99.5 %. The page cache is left as it is (run once beforehand to warm it).
 #
-#   tools/bench_compare.sh OLD_BUILD NEW_BUILD FILE.ibv ISO VIEW [RUNS] [WxH]
+#   tools/bench/bench_compare.sh OLD_BUILD NEW_BUILD FILE.ibv ISO VIEW [RUNS] [WxH]
 #
-# e.g. tools/bench_compare.sh /tmp/old/build build head.ibv 600.5 -y 5 1600x1200
+# e.g. tools/bench/bench_compare.sh /tmp/old/build build head.ibv 600.5 -y 5 1600x1200
 # Uses the software rasterizer (--software); what is timed is the engine's own clock.
 set -eu
 if [ $# -lt 5 ]; then

@@ -5,7 +5,7 @@
 # or, where the corruption cannot matter to that run, in the very same image as the intact
 # file.
 #
-#   tools/fault_inject.sh [--build DIR] [--work DIR] [--quick] [--jobs N] [--timeout S]
+#   tools/dev/fault_inject.sh [--build DIR] [--work DIR] [--quick] [--jobs N] [--timeout S]
 #                         [--size WxH] [--renderer software|gl] [--volumes LIST]
 #                         [--seed N] [--no-changing] [--keep]
 #
@@ -58,7 +58,7 @@
 set -u
 
 script=$(readlink -f "$0")
-repo=$(dirname "$(dirname "$script")")
+repo=$(dirname "$(dirname "$(dirname "$script")")")
 
 # ---------------------------------------------------------------------------------------
 # One corrupted file through its five runs (run by xargs, several at once).
@@ -158,7 +158,7 @@ fi
 # ---------------------------------------------------------------------------------------
 # The driver.
 usage() {
-    sed -n '/^#   tools\/fault_inject.sh/,/^#   --keep/p' "$script" | sed 's/^# \{0,1\}//' >&2
+    sed -n '/^#   tools\/dev\/fault_inject.sh/,/^#   --keep/p' "$script" | sed 's/^# \{0,1\}//' >&2
     exit 2
 }
 

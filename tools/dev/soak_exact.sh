@@ -19,7 +19,7 @@
 # given.
 #
 #   [SOAK_DATA=DIR] [SOAK_LOD=mixed|on|off] [SOAK_CLIP=on|off] [SOAK_MULTI=on|off]
-#       [SOAK_CACHE=on|off] [SOAK_WALL=on|off] tools/soak_exact.sh [BUILD_DIR] [CASES] [SEED]
+#       [SOAK_CACHE=on|off] [SOAK_WALL=on|off] tools/dev/soak_exact.sh [BUILD_DIR] [CASES] [SEED]
 #       [WORK_DIR]
 #   defaults: build 200 1 (a temporary folder, removed at the end); SOAK_DATA, the folder of
 #   the sample volumes: ../shared/data (empty: the generated volumes alone); SOAK_LOD, whether
@@ -61,7 +61,7 @@ else
     work=$(mktemp -d)
     trap 'rm -rf "$work"' EXIT
 fi
-data=${SOAK_DATA-$(dirname "$0")/../../shared/data}
+data=${SOAK_DATA-$(dirname "$0")/../../../shared/data}
 
 # the volumes: NAME FILE.ibv LOW HIGH X Y Z (the value range and the world box's size, as
 # isoinfo reports them: (samples - 1) x spacing along each axis)

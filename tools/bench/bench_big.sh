@@ -10,7 +10,7 @@
 #      pixels, all rays, peak RSS, bricks touched, bytes read from the disk, per volume;
 #   3. the targets.
 #
-#   tools/bench_big.sh DIR [BUILD_DIR]
+#   tools/bench/bench_big.sh DIR [BUILD_DIR]
 #
 # DIR holds the big files: each raw volume and brick file is made there once (isogen
 # --upsample K, isobrick --mem-mb) when missing, and reused afterwards; the script removes
@@ -31,7 +31,7 @@ if [ $# -lt 1 ]; then
     sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 dir=$1
 build=${2:-build}
 case $build in /*) ;; *) build=$root/$build ;; esac

@@ -2,7 +2,7 @@
 # Bricking benchmark: for each volume in the data folder, the brick file against whole-file
 # lz4 -1 and zstd -1. Prints one Markdown table. Not a test: numbers depend on the machine.
 #
-#   tools/bench_brick.sh [--speed-only] [DATA_DIR] [BUILD_DIR] [EXTRA.raw ...]
+#   tools/bench/bench_brick.sh [--speed-only] [DATA_DIR] [BUILD_DIR] [EXTRA.raw ...]
 #                                                  (defaults: ../shared/data, build)
 #
 # Every input is read once first so that all columns are measured from the page cache.

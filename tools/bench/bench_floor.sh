@@ -8,9 +8,9 @@
 # the skin (600.5, -y) and the bone (1224.5, -x) at 1600x1200. Rounds interleave; prints the
 # medians with [min-max]. The page cache is left as it is (warm: run once beforehand).
 #
-#   tools/bench_floor.sh BUILD FILE.ibv RAW [RUNS] [THREADS]
+#   tools/bench/bench_floor.sh BUILD FILE.ibv RAW [RUNS] [THREADS]
 #
-# e.g. tools/bench_floor.sh build /tmp/head.ibv ../shared/data/ct_head_visible_woman_512x512x234_uint16.raw 5
+# e.g. tools/bench/bench_floor.sh build /tmp/head.ibv ../shared/data/ct_head_visible_woman_512x512x234_uint16.raw 5
 # RAW is the volume FILE.ibv was bricked from (bench_vtk.py reads it). THREADS (default 2) is
 # the engine's and the floor's; VTK uses every core. Needs python3-vtk9, as bench_engine.sh.
 set -eu
@@ -19,7 +19,7 @@ if [ $# -lt 3 ]; then
     exit 2
 fi
 build=$1 file=$2 raw=$3 runs=${4:-5} threads=${5:-2}
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 for p in isorender bench_floor; do
     [ -x "$build/$p" ] || { echo "bench_floor: $build/$p is missing" >&2; exit 1; }
 done
@@ -27,7 +27,8 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 surfaces="skin:600.5:-y bone:1224.5:-x"
 for i in $(seq "$runs"); do
-    /usr/bin/python3 "$root/tools/bench_vtk.py" extract "$raw" 600.5 1224.5 >"$work/vtk-$i.jsonl"
+    /usr/bin/python3 "$root/tools/bench/bench_vtk.py" extract "$raw" 600.5 1224.5 \
+        >"$work/vtk-$i.jsonl"
     for s in $surfaces; do
         IFS=: read -r name iso view <<<"$s"
         for mode in fresh warm; do

@@ -8,7 +8,7 @@
 # compare the CPU-busy seconds (busy_s), not the wall time. Prints Markdown tables; the JSON
 # of every run stays in WORK_DIR.
 #
-#   tools/bench_wall.sh WORK_DIR [BUILD_DIR] [RAW_FILE]
+#   tools/bench/bench_wall.sh WORK_DIR [BUILD_DIR] [RAW_FILE]
 #   defaults: build ../shared/data/ct_head_visible_woman_512x512x234_uint16.raw
 #   IP_WALL_TILE (default 1280x1024): the tile of the bad case; IP_WALL_REPEATS (default 5):
 #   runs of each case, the one of median balance shown, with the range of balance;
@@ -16,7 +16,7 @@
 #   core:overload-allowed, see docs/scale-out.md); IP_WALL_BIG_PROCESSES (default 4): the
 #   processes of the 31-Mpixel run
 set -eu
-work=${1:?usage: tools/bench_wall.sh WORK_DIR [BUILD_DIR] [RAW_FILE]}
+work=${1:?usage: tools/bench/bench_wall.sh WORK_DIR [BUILD_DIR] [RAW_FILE]}
 build=${2:-build}
 raw=${3:-../shared/data/ct_head_visible_woman_512x512x234_uint16.raw}
 tile=${IP_WALL_TILE:-1280x1024}

@@ -5,11 +5,11 @@
 # clang-format reports it. Changes nothing. clang-format is Debian's package clang-format
 # (tools/setup.sh installs it).
 #
-#   tools/check_format.sh            check the whole tree
-#   tools/check_format.sh FILE...    check these files only
-#   tools/check_format.sh --summary  one line per file that would change, with its line count
+#   tools/dev/check_format.sh            check the whole tree
+#   tools/dev/check_format.sh FILE...    check these files only
+#   tools/dev/check_format.sh --summary  one line per file that would change, with its line count
 set -eu
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 cd "$root"
 command -v clang-format >/dev/null 2>&1 || {
     echo "check_format: clang-format is missing (apt-get install clang-format)" >&2

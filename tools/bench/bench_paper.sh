@@ -10,7 +10,7 @@
 # from the first round (they differ between rounds by a few triangles at most, on several
 # threads), and OUT_DIR keeps the first round's CSV and JSON files and its warm images.
 #
-#   [ROUNDS=N] tools/bench_paper.sh [RAW_FILE] [BUILD_DIR] [OUT_DIR]
+#   [ROUNDS=N] tools/bench/bench_paper.sh [RAW_FILE] [BUILD_DIR] [OUT_DIR]
 #   defaults: ../shared/data/ct_head_visible_woman_512x512x234_uint16.raw build docs/results
 set -eu
 raw=${1:-../shared/data/ct_head_visible_woman_512x512x234_uint16.raw}
