@@ -50,7 +50,7 @@ typedef struct ip_input_desc {
                                    Offset/TransformMatrix/AnatomicalOrientation, NIfTI sform or
                                    qform, DICOM image position/orientation); identity when the
                                    file says nothing or its axes are not orthonormal */
-    uint64_t reserved[32]; /* zero: room for later fields at the same size (status.h) */
+    uint64_t reserved[32];      /* zero: room for later fields at the same size (status.h) */
 } ip_input_desc;
 
 /* Values given on the command line; each applies only where its has_ flag is set, and wins

@@ -35,12 +35,12 @@ extern "C" {
 
 /* The shading parameters shared by both renderers; colours are 0..1 per channel. */
 typedef struct ip_shading {
-    uint32_t size; /* bytes of the struct as the caller compiled it (IP_SIZED); see status.h */
-    float surface[3];           /* the surface colour (a light bone/ivory) */
-    float ambient;              /* light a surface gets when seen edge-on */
-    float diffuse;              /* Lambert weight of the headlight */
-    float specular;             /* weight of the white highlight */
-    float shininess;            /* exponent of the highlight */
+    uint32_t size;    /* bytes of the struct as the caller compiled it (IP_SIZED); see status.h */
+    float surface[3]; /* the surface colour (a light bone/ivory) */
+    float ambient;    /* light a surface gets when seen edge-on */
+    float diffuse;    /* Lambert weight of the headlight */
+    float specular;   /* weight of the white highlight */
+    float shininess;  /* exponent of the highlight */
     float background_top[3];    /* background colour of the top image row */
     float background_bottom[3]; /* background colour of the bottom image row */
 } ip_shading;

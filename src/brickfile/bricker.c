@@ -200,8 +200,8 @@ ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_bricker_
     ip_status st = take_options(given, &taken, err);
     if (st != IP_OK)
         return st;
-    st = ip__layout_init(&l, input->dims, input->type, input->spacing,
-                                   options->brick_edge, options->subblock_edge, err);
+    st = ip__layout_init(&l, input->dims, input->type, input->spacing, options->brick_edge,
+                         options->subblock_edge, err);
     if (st == IP_OK) {
         unsigned threads = thread_count(options);
         *bytes = memory_for(&l, threads, plan_overlap(&l, threads, options->memory_limit));
@@ -1141,8 +1141,7 @@ static ip_status check_request(const ip_input_desc *in, const char *out_path, ip
 }
 
 ip_status ip_bricker_run(const ip_input_desc *input, const char *out_path,
-                         const ip_bricker_options *given, ip_bricker_report *report,
-                         ip_error *err)
+                         const ip_bricker_options *given, ip_bricker_report *report, ip_error *err)
 {
     double start = ip_now_seconds();
     if (!input || !out_path || !given)

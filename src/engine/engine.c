@@ -92,8 +92,8 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *given, ip_e
     e->leftovers = calloc(e->threads, sizeof *e->leftovers);
     e->shared = malloc(SHARED_MAX * sizeof *e->shared);
     st = e->workers && e->leftovers && e->shared
-                       ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
-                       : IP_ERR_NOMEM;
+             ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
+             : IP_ERR_NOMEM;
     if (st == IP_OK)
         st = ip__pool_create(e->threads, &e->pool, NULL);
     /* IP_PREFETCH_ON: the reader leaves the bricks already in memory to the workers when they

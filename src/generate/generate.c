@@ -283,8 +283,8 @@ static ip_status take_params(const ip_gen_params *given, ip_gen_params *params, 
     if (!given)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: no parameters", what);
     memset(params, 0, sizeof *params);
-    ip_status st = ip__sized_in(params, sizeof *params, given, IP__SIZE_UPTO(ip_gen_params, seed),
-                                what, err);
+    ip_status st =
+        ip__sized_in(params, sizeof *params, given, IP__SIZE_UPTO(ip_gen_params, seed), what, err);
     if (st != IP_OK)
         return st;
     if ((unsigned)params->field >= FIELD_COUNT)

@@ -422,8 +422,8 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
     return describe_from_name(path, overrides, desc, found, err);
 }
 
-ip_status ip_input_describe(const char *path, const ip_input_overrides *given,
-                            ip_input_desc *out, ip_error *err)
+ip_status ip_input_describe(const char *path, const ip_input_overrides *given, ip_input_desc *out,
+                            ip_error *err)
 {
     ip_text_found found;
     ip_input_desc desc;

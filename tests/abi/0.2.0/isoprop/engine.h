@@ -125,14 +125,14 @@ typedef struct ip_engine_counts {
     double propagation_seconds;  /* queue, neighbour and criteria work */
     double extraction_seconds;   /* marching cubes: samples, gradients, triangles */
     double rendering_seconds;    /* reported by the caller, ip_engine_add_rendering_time() */
-    uint64_t deferred; /* with occlusion: neighbours propagation left because surface already
+    uint64_t deferred;    /* with occlusion: neighbours propagation left because surface already
                           extracted hid them (a cell may count more than once) */
-    uint64_t retired;  /* with occlusion: rays (counted in rays) retired with their screen tile,
+    uint64_t retired;     /* with occlusion: rays (counted in rays) retired with their screen tile,
                           without a walk (see Occlusion above) */
-    uint64_t nodes;    /* octree nodes (bricks included), sub-blocks and cells the rays' walks
+    uint64_t nodes;       /* octree nodes (bricks included), sub-blocks and cells the rays' walks
                           entered: the seeding work, independent of the clock */
-    uint64_t culled;   /* with options.cull: triangles made and not kept, not in `triangles` */
-    uint64_t kept;     /* with options.reuse: triangles kept from the view before, counted in
+    uint64_t culled;      /* with options.cull: triangles made and not kept, not in `triangles` */
+    uint64_t kept;        /* with options.reuse: triangles kept from the view before, counted in
                           `triangles` (their cells in `cells`) */
     uint64_t reserved[8]; /* zero: room for later fields at the same size (status.h) */
 } ip_engine_counts;
