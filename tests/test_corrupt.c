@@ -55,7 +55,7 @@ static const char *const run_names[4] = {"progressive, 1 thread", "progressive, 
 static void make_volume(const char *dir, ip_field field, const uint32_t dims[3], ip_type type,
                         uint32_t edge, uint32_t subblock, char *ibv, size_t size)
 {
-    ip_gen_params p = {field, {dims[0], dims[1], dims[2]}, type, 0.02, 7};
+    ip_gen_params p = {sizeof(ip_gen_params), field, {dims[0], dims[1], dims[2]}, type, 0.02, 7};
     char raw[4400];
     test_generate_raw(dir, ip_field_name(field), &p, raw, sizeof raw);
     snprintf(ibv, size, "%s/%s.b%u.ibv", dir, ip_field_name(field), edge);

@@ -53,7 +53,7 @@ static void close_scene(scene *s)
 static void make_volume(const char *dir, ip_field field, uint32_t n, ip_type type, uint32_t edge,
                         char *ibv, size_t size)
 {
-    ip_gen_params p = {field, {n, n + 3, n - 5}, type, 0.0, 1};
+    ip_gen_params p = {sizeof(ip_gen_params), field, {n, n + 3, n - 5}, type, 0.0, 1};
     char name[256], raw[4096];
     ip_error err;
     REQUIRE(ip_raw_file_name(name, sizeof name, ip_field_name(field), p.dims, type) == IP_OK);
@@ -195,7 +195,7 @@ static void check_view(scene *s, const char *what, const char *axis, float iso, 
 static void check_lod(const char *dir)
 {
     char raw[4200], ibv[4200];
-    ip_gen_params p = {IP_FIELD_GYROID, {24, 24, 512}, IP_UINT8, 0.0, 1};
+    ip_gen_params p = {sizeof(ip_gen_params), IP_FIELD_GYROID, {24, 24, 512}, IP_UINT8, 0.0, 1};
     ip_error err;
     snprintf(raw, sizeof raw, "%s/long_24x24x512_uint8.raw", dir);
     snprintf(ibv, sizeof ibv, "%s/long.ibv", dir);

@@ -103,7 +103,7 @@ static void store_le(unsigned char *dst, ip_type type, size_t i, double v)
 
 static ip_gen_params params_of(ip_field field, uint32_t nx, uint32_t ny, uint32_t nz, ip_type type)
 {
-    ip_gen_params p = {field, {nx, ny, nz}, type, 0.0, 1};
+    ip_gen_params p = {sizeof(ip_gen_params), field, {nx, ny, nz}, type, 0.0, 1};
     return p;
 }
 

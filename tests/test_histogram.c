@@ -143,7 +143,7 @@ static uint64_t check_volume(const char *dir, const char *stem, const ip_gen_par
 
 static void check_errors_and_default(const char *dir)
 {
-    ip_gen_params p = {IP_FIELD_GYROID, {40, 37, 33}, IP_UINT16, 0.0, 1};
+    ip_gen_params p = {sizeof(ip_gen_params), IP_FIELD_GYROID, {40, 37, 33}, IP_UINT16, 0.0, 1};
     char raw_path[4400], ibv[4400];
     test_generate_raw(dir, "levels", &p, raw_path, sizeof raw_path);
     snprintf(ibv, sizeof ibv, "%s/levels.ibv", dir);
@@ -176,14 +176,17 @@ static void check_errors_and_default(const char *dir)
 int main(void)
 {
     const char *dir = test_tmp_dir("test_histogram");
-    ip_gen_params gyroid = {IP_FIELD_GYROID, {21, 18, 19}, IP_UINT16, 0.02, 7};
+    ip_gen_params gyroid = {
+        sizeof(ip_gen_params), IP_FIELD_GYROID, {21, 18, 19}, IP_UINT16, 0.02, 7};
     check_volume(dir, "gyroid", &gyroid);
-    ip_gen_params sphere = {IP_FIELD_SPHERE, {26, 23, 17}, IP_UINT8, 0.0, 1};
+    ip_gen_params sphere = {sizeof(ip_gen_params), IP_FIELD_SPHERE, {26, 23, 17}, IP_UINT8, 0.0, 1};
     uint64_t constant = check_volume(dir, "sphere", &sphere);
     CHECK_MSG(constant > 0, "the sphere has no constant brick: that path is not tested");
-    ip_gen_params phantom = {IP_FIELD_SHEPP_LOGAN, {19, 22, 20}, IP_INT16, 0.01, 3};
+    ip_gen_params phantom = {
+        sizeof(ip_gen_params), IP_FIELD_SHEPP_LOGAN, {19, 22, 20}, IP_INT16, 0.01, 3};
     check_volume(dir, "phantom", &phantom);
-    ip_gen_params lobb = {IP_FIELD_MARSCHNER_LOBB, {17, 20, 18}, IP_FLOAT32, 0.0, 1};
+    ip_gen_params lobb = {
+        sizeof(ip_gen_params), IP_FIELD_MARSCHNER_LOBB, {17, 20, 18}, IP_FLOAT32, 0.0, 1};
     check_volume(dir, "lobb", &lobb);
     check_errors_and_default(dir);
     return test_summary("test_histogram");

@@ -184,7 +184,7 @@ static int same_triangles(const ip_mesh *soup, const ip_indexed_mesh *w)
  * `ibv`. */
 static void make_volume(const char *dir, ip_field field, char *ibv, size_t size)
 {
-    ip_gen_params p = {field, {37, 41, 34}, IP_FLOAT32, 0.0, 1};
+    ip_gen_params p = {sizeof(ip_gen_params), field, {37, 41, 34}, IP_FLOAT32, 0.0, 1};
     char name[256], raw[4400];
     ip_error err;
     REQUIRE(ip_raw_file_name(name, sizeof name, ip_field_name(field), p.dims, p.type) == IP_OK);

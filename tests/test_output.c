@@ -172,7 +172,7 @@ static void test_output_write(void)
     ip_mesh mesh;
     ip_mesh_init(&mesh);
     CHECK(ip_mesh_write_ply(&mesh, f, 1, &err) == IP_ERR_ARGUMENT);
-    ip_gen_params params = {IP_FIELD_SPHERE, {4, 4, 4}, IP_UINT8, 0.0, 1};
+    ip_gen_params params = {sizeof(ip_gen_params), IP_FIELD_SPHERE, {4, 4, 4}, IP_UINT8, 0.0, 1};
     CHECK(ip_generate_write(&params, f, 1, &err) == IP_ERR_ARGUMENT);
     CHECK(lstat(f, &st) == 0 && S_ISFIFO(st.st_mode));
     CHECK(!temporaries_left());
@@ -183,7 +183,7 @@ static void test_output_is_input(void)
 {
     char raw[4096], spelled[4096], ibv[4096], header[4096], data[4096];
     ip_error err;
-    ip_gen_params params = {IP_FIELD_SPHERE, {8, 6, 5}, IP_UINT8, 0.0, 1};
+    ip_gen_params params = {sizeof(ip_gen_params), IP_FIELD_SPHERE, {8, 6, 5}, IP_UINT8, 0.0, 1};
     at(raw, "sphere_8x6x5_uint8.raw");
     REQUIRE(ip_generate_write(&params, raw, 0, &err) == IP_OK);
     ip_input_desc desc;

@@ -35,7 +35,7 @@ typedef struct run_result {
 /* A gyroid in bricks of 8 cells: many bricks, and a surface across the whole picture. */
 static void make_scene(const char *dir, scene *s)
 {
-    ip_gen_params p = {IP_FIELD_GYROID, {41, 37, 33}, IP_UINT16, 0.0, 1};
+    ip_gen_params p = {sizeof(ip_gen_params), IP_FIELD_GYROID, {41, 37, 33}, IP_UINT16, 0.0, 1};
     char raw[4400];
     ip_store *store;
     ip_error err;

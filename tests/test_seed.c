@@ -14,7 +14,8 @@
 /* The Shepp-Logan phantom (int16, with noise) bricked with B = 16, S = 8 into dir. */
 static void brick_phantom(const char *dir, char *ibv, size_t size)
 {
-    ip_gen_params params = {IP_FIELD_SHEPP_LOGAN, {67, 58, 49}, IP_INT16, 0.01, 7};
+    ip_gen_params params = {
+        sizeof(ip_gen_params), IP_FIELD_SHEPP_LOGAN, {67, 58, 49}, IP_INT16, 0.01, 7};
     char raw[4400];
     test_generate_raw(dir, "phantom", &params, raw, sizeof raw);
     snprintf(ibv, size, "%s/phantom.ibv", dir);

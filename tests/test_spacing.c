@@ -64,7 +64,7 @@ static void test_refused_by_the_library(const char *dir)
 {
     char raw[4096], ibv[4096];
     ip_error err;
-    ip_gen_params params = {IP_FIELD_SPHERE, {6, 5, 4}, IP_UINT8, 0.0, 1};
+    ip_gen_params params = {sizeof(ip_gen_params), IP_FIELD_SPHERE, {6, 5, 4}, IP_UINT8, 0.0, 1};
     snprintf(raw, sizeof raw, "%s/sphere_6x5x4_uint8.raw", dir);
     snprintf(ibv, sizeof ibv, "%s/tiny.ibv", dir);
     REQUIRE(ip_generate_write(&params, raw, 0, &err) == IP_OK);

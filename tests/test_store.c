@@ -39,7 +39,7 @@ static void make_volume(const char *dir, const ip_gen_params *p, const char *ste
 /* A gyroid: many payloads, several levels. */
 static void make_file(const char *dir, char *ibv, size_t size)
 {
-    ip_gen_params p = {IP_FIELD_GYROID, {21, 18, 19}, IP_UINT16, 0.0, 1};
+    ip_gen_params p = {sizeof(ip_gen_params), IP_FIELD_GYROID, {21, 18, 19}, IP_UINT16, 0.0, 1};
     make_volume(dir, &p, "gyroid", ibv, size);
 }
 
@@ -335,7 +335,7 @@ static void test_accessors(const char *ibv)
 /* A small uint8 phantom, bricked as `name`.ibv in dir: both constant and stored bricks. */
 static void make_phantom(const char *dir, const char *name, char *ibv, size_t size)
 {
-    ip_gen_params p = {IP_FIELD_SHEPP_LOGAN, {40, 36, 33}, IP_UINT8, 0.0, 1};
+    ip_gen_params p = {sizeof(ip_gen_params), IP_FIELD_SHEPP_LOGAN, {40, 36, 33}, IP_UINT8, 0.0, 1};
     make_volume(dir, &p, name, ibv, size);
 }
 

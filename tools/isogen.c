@@ -212,7 +212,7 @@ static void report(const options *o, const char *path, const uint32_t dims[3], i
 
 static int run_generate(const options *o, ip_field field)
 {
-    ip_gen_params params = {field, {128, 128, 128}, IP_UINT16, 0.0, 1};
+    ip_gen_params params = {sizeof(ip_gen_params), field, {128, 128, 128}, IP_UINT16, 0.0, 1};
     char name[IP_PATH_MAX], path[IP_PATH_MAX];
     ip_error err;
     if (o->has_dims)

@@ -30,6 +30,7 @@ typedef int (*ip_progress_fn)(void *user, uint64_t done_bytes, uint64_t total_by
 #define IP_LZ4_HC_DEFAULT 9
 
 typedef struct ip_bricker_options {
+    uint32_t size; /* bytes of the struct as the caller compiled it (IP_SIZED); see status.h */
     uint32_t brick_edge;     /* B, cells per brick edge; default IP_DEFAULT_BRICK_EDGE */
     uint32_t subblock_edge;  /* s, cells per sub-block edge; default IP_DEFAULT_SUBBLOCK_EDGE */
     int lz4_level;           /* IP_LZ4_FAST (default) or an LZ4HC level 1..12 */
@@ -61,6 +62,7 @@ typedef struct ip_bricker_report {
      * plan had room for a second chunk of level-0 planes); seconds_read then counts only the
      * reading the encoding did not hide. */
     int read_overlap;
+    uint64_t reserved[8]; /* zero: room for later fields at the same size (status.h) */
 } ip_bricker_report;
 
 /*! ip_bricker_options_default() : fills `options` with the defaults above. */

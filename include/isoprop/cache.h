@@ -97,6 +97,7 @@ typedef struct ip_cache_stats {
     uint64_t bricks_touched, bricks_total;
     uint32_t levels;
     ip_cache_level_stats level[32];
+    uint64_t reserved[8]; /* zero: room for later fields at the same size (status.h) */
 } ip_cache_stats;
 
 /*! ip_cache_default_budget() : 512 MiB, or a quarter of the machine's RAM if smaller; bytes. */
@@ -110,6 +111,19 @@ IP_API ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, i
 
 /*! ip_cache_destroy() : frees every brick; no brick may still be pinned. NULL is allowed. */
 IP_API void ip_cache_destroy(ip_cache *cache);
+
+/*! ip_cache_get_stats() : a snapshot of the counters (consistent per counter, not across them
+ *  while other threads work). */
+IP_API void ip_cache_get_stats(const ip_cache *cache, ip_cache_stats *stats);
+
+/*! ip_cache_store() : the store the cache reads from. */
+IP_API const ip_store *ip_cache_store(const ip_cache *cache);
+
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same. */
+#ifdef IP_EXPERIMENTAL
 
 /*! ip_cache_pin_brick() : pins global brick `g` and fills *brick. On a miss the brick is read
  *  from the file, its checksum verified and decoded; a bad brick is reported (IP_ERR_CHECKSUM,
@@ -128,12 +142,7 @@ IP_API void ip_cache_unpin_brick(ip_cache *cache, const ip_brick *brick);
  *  Thread-safe. @return the decoded bytes freed. */
 IP_API uint64_t ip_cache_trim(ip_cache *cache, uint64_t keep_bytes);
 
-/*! ip_cache_get_stats() : a snapshot of the counters (consistent per counter, not across them
- *  while other threads work). */
-IP_API void ip_cache_get_stats(const ip_cache *cache, ip_cache_stats *stats);
-
-/*! ip_cache_store() : the store the cache reads from. */
-IP_API const ip_store *ip_cache_store(const ip_cache *cache);
+#endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus
 }

@@ -89,6 +89,7 @@ typedef struct ip_clip_plane {
 #define IP_PREFETCH_ALWAYS 2 /* read every planned brick ahead */
 
 typedef struct ip_engine_options {
+    uint32_t size; /* bytes of the struct as the caller compiled it (IP_SIZED); see status.h */
     double cutoff_degrees;   /* propagation cut-off angle around the seed's ray */
     double foldback_degrees; /* fold-back tolerance */
     unsigned threads;        /* worker threads for seeding and propagation; 0 = every core */
@@ -124,15 +125,16 @@ typedef struct ip_engine_counts {
     double propagation_seconds;  /* queue, neighbour and criteria work */
     double extraction_seconds;   /* marching cubes: samples, gradients, triangles */
     double rendering_seconds;    /* reported by the caller, ip_engine_add_rendering_time() */
-    uint64_t deferred; /* with occlusion: neighbours propagation left because surface already
+    uint64_t deferred;    /* with occlusion: neighbours propagation left because surface already
                           extracted hid them (a cell may count more than once) */
-    uint64_t retired;  /* with occlusion: rays (counted in rays) retired with their screen tile,
+    uint64_t retired;     /* with occlusion: rays (counted in rays) retired with their screen tile,
                           without a walk (see Occlusion above) */
-    uint64_t nodes;    /* octree nodes (bricks included), sub-blocks and cells the rays' walks
+    uint64_t nodes;       /* octree nodes (bricks included), sub-blocks and cells the rays' walks
                           entered: the seeding work, independent of the clock */
-    uint64_t culled;   /* with options.cull: triangles made and not kept, not in `triangles` */
-    uint64_t kept;     /* with options.reuse: triangles kept from the view before, counted in
+    uint64_t culled;      /* with options.cull: triangles made and not kept, not in `triangles` */
+    uint64_t kept;        /* with options.reuse: triangles kept from the view before, counted in
                           `triangles` (their cells in `cells`) */
+    uint64_t reserved[8]; /* zero: room for later fields at the same size (status.h) */
 } ip_engine_counts;
 
 typedef struct ip_engine ip_engine;
@@ -167,6 +169,58 @@ IP_API ip_status ip_engine_begin(ip_engine *engine, const ip_camera *camera, flo
 IP_API ip_status ip_engine_step(ip_engine *engine, uint64_t max_rays, double max_seconds,
                                 ip_engine_counts *counts, ip_error *err);
 
+/*! ip_engine_done() : 1 once every pixel has had its ray (after ip_engine_set_region(): once
+ *  the region's rays have). */
+IP_API int ip_engine_done(const ip_engine *engine);
+
+/*! ip_engine_cancel() : asks a running or later step to stop at the next ray (any thread). */
+IP_API void ip_engine_cancel(ip_engine *engine);
+
+/*! ip_engine_mesh() : the triangles extracted since ip_engine_begin(), in extraction order;
+ *  owned by the engine, valid until the next begin, step or destroy. */
+IP_API const ip_mesh *ip_engine_mesh(const ip_engine *engine);
+
+/*! ip_engine_totals() : counts and times since ip_engine_begin(). */
+IP_API void ip_engine_totals(const ip_engine *engine, ip_engine_counts *counts);
+
+/* The engine's memory, bytes, besides the brick cache it reads through (ip_cache_get_stats()). */
+typedef struct ip_engine_memory {
+    uint64_t mesh;     /* the mesh's arrays as allocated (ip_engine_mesh(); kept between views) */
+    uint64_t workers;  /* the workers' triangle buffers and propagation queues */
+    uint64_t visited;  /* the visited cells' bitmaps (one per brick the view reached) and index */
+    uint64_t coverage; /* with occlusion: the coverage buffers and screen tiles */
+    uint64_t total;    /* the sum */
+    uint64_t reserved[8]; /* zero: room for later fields at the same size (status.h) */
+} ip_engine_memory;
+
+/*! ip_extract_full() : triangulates every active cell of level `level`, brick by brick, skipping
+ *  bricks and sub-blocks whose summary range excludes `iso`; the oracle and the baseline.
+ *  Cell ids are kept when `mesh` keeps them (mesh->with_cells).
+ *  Triangles equal those of the progressive engine for the same cells. Runs on `threads`
+ *  threads (0 = every core; the calling thread and threads started for the call and joined
+ *  before it returns) and appends to `mesh` in brick order, so the result is the same
+ *  for any number of threads. Times are summed over threads.
+ *  @return IP_OK or a brick read error. */
+IP_API ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,
+                                 ip_mesh *mesh, ip_engine_counts *counts, ip_error *err);
+
+/*! ip_extract_full_clipped() : ip_extract_full() of the cells the `clip_count` planes `clip`
+ *  keep (the rule of ip_clip_plane; the engine with the same planes extracts among the same
+ *  cells), also skipping bricks and sub-blocks that lie wholly beyond a plane. `clip` is the
+ *  caller's, read during the call; NULL with a count of 0 is ip_extract_full().
+ *  @return IP_OK, IP_ERR_ARGUMENT for bad planes (as ip_engine_create()) or a brick read
+ *  error. */
+IP_API ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t level,
+                                         unsigned threads, const ip_clip_plane *clip,
+                                         unsigned clip_count, ip_mesh *mesh,
+                                         ip_engine_counts *counts, ip_error *err);
+
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same. */
+#ifdef IP_EXPERIMENTAL
+
 /*! ip_engine_set_region() : restricts the next steps to rays [first_ray, first_ray +
  *  ray_count) of the progressive order of the rectangle of width x height pixels whose top-left
  *  pixel is (x, y) in the image of ip_engine_begin()'s camera (the rectangle's own order: its
@@ -195,32 +249,9 @@ IP_API ip_status ip_engine_set_region(ip_engine *engine, uint32_t x, uint32_t y,
  *  @return IP_OK, or IP_ERR_ARGUMENT (a bad camera, or a view not done). */
 IP_API ip_status ip_engine_read_ahead(ip_engine *engine, const ip_camera *camera, ip_error *err);
 
-/*! ip_engine_done() : 1 once every pixel has had its ray (after ip_engine_set_region(): once
- *  the region's rays have). */
-IP_API int ip_engine_done(const ip_engine *engine);
-
-/*! ip_engine_cancel() : asks a running or later step to stop at the next ray (any thread). */
-IP_API void ip_engine_cancel(ip_engine *engine);
-
-/*! ip_engine_mesh() : the triangles extracted since ip_engine_begin(), in extraction order;
- *  owned by the engine, valid until the next begin, step or destroy. */
-IP_API const ip_mesh *ip_engine_mesh(const ip_engine *engine);
-
 /*! ip_engine_lod_distance() : D[level] of the current view, world units (0 for level 0;
  *  infinity for levels that are never used). Valid after ip_engine_begin(). */
 IP_API double ip_engine_lod_distance(const ip_engine *engine, uint32_t level);
-
-/*! ip_engine_totals() : counts and times since ip_engine_begin(). */
-IP_API void ip_engine_totals(const ip_engine *engine, ip_engine_counts *counts);
-
-/* The engine's memory, bytes, besides the brick cache it reads through (ip_cache_get_stats()). */
-typedef struct ip_engine_memory {
-    uint64_t mesh;     /* the mesh's arrays as allocated (ip_engine_mesh(); kept between views) */
-    uint64_t workers;  /* the workers' triangle buffers and propagation queues */
-    uint64_t visited;  /* the visited cells' bitmaps (one per brick the view reached) and index */
-    uint64_t coverage; /* with occlusion: the coverage buffers and screen tiles */
-    uint64_t total;    /* the sum */
-} ip_engine_memory;
 
 /*! ip_engine_memory_of() : what the engine holds now (*memory is the caller's); not during a
  *  step. */
@@ -228,28 +259,6 @@ IP_API void ip_engine_memory_of(const ip_engine *engine, ip_engine_memory *memor
 
 /*! ip_engine_add_rendering_time() : adds the caller's rendering time to the totals. */
 IP_API void ip_engine_add_rendering_time(ip_engine *engine, double seconds);
-
-/*! ip_extract_full() : triangulates every active cell of level `level`, brick by brick, skipping
- *  bricks and sub-blocks whose summary range excludes `iso`; the oracle and the baseline.
- *  Cell ids are kept when `mesh` keeps them (mesh->with_cells).
- *  Triangles equal those of the progressive engine for the same cells. Runs on `threads`
- *  threads (0 = every core; the calling thread and threads started for the call and joined
- *  before it returns) and appends to `mesh` in brick order, so the result is the same
- *  for any number of threads. Times are summed over threads.
- *  @return IP_OK or a brick read error. */
-IP_API ip_status ip_extract_full(ip_cache *cache, float iso, uint32_t level, unsigned threads,
-                                 ip_mesh *mesh, ip_engine_counts *counts, ip_error *err);
-
-/*! ip_extract_full_clipped() : ip_extract_full() of the cells the `clip_count` planes `clip`
- *  keep (the rule of ip_clip_plane; the engine with the same planes extracts among the same
- *  cells), also skipping bricks and sub-blocks that lie wholly beyond a plane. `clip` is the
- *  caller's, read during the call; NULL with a count of 0 is ip_extract_full().
- *  @return IP_OK, IP_ERR_ARGUMENT for bad planes (as ip_engine_create()) or a brick read
- *  error. */
-IP_API ip_status ip_extract_full_clipped(ip_cache *cache, float iso, uint32_t level,
-                                         unsigned threads, const ip_clip_plane *clip,
-                                         unsigned clip_count, ip_mesh *mesh,
-                                         ip_engine_counts *counts, ip_error *err);
 
 /*! ip_extract_full_lod() : the full extraction at the adaptive resolution of a view: for each
  *  level that an engine with `lod` on and `pixel_error` (ip_engine_options) uses for `camera`,
@@ -269,6 +278,8 @@ IP_API ip_status ip_extract_full_lod(ip_cache *cache, float iso, const ip_camera
                                      double pixel_error, unsigned threads,
                                      const ip_clip_plane *clip, unsigned clip_count, ip_mesh *mesh,
                                      ip_engine_counts *counts, ip_error *err);
+
+#endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus
 }

@@ -34,6 +34,7 @@ typedef enum ip_field {
 } ip_field;
 
 typedef struct ip_gen_params {
+    uint32_t size; /* bytes of the struct as the caller compiled it (IP_SIZED); see status.h */
     ip_field field;
     uint32_t dims[3]; /* samples along x, y, z; each >= 2 */
     ip_type type;

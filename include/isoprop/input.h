@@ -50,6 +50,7 @@ typedef struct ip_input_desc {
                                    Offset/TransformMatrix/AnatomicalOrientation, NIfTI sform or
                                    qform, DICOM image position/orientation); identity when the
                                    file says nothing or its axes are not orthonormal */
+    uint64_t reserved[32];      /* zero: room for later fields at the same size (status.h) */
 } ip_input_desc;
 
 /* Values given on the command line; each applies only where its has_ flag is set, and wins
@@ -59,6 +60,7 @@ typedef struct ip_input_desc {
  * in for a header value this library cannot use. Where the data start, their encoding and
  * their data file always come from the header. */
 typedef struct ip_input_overrides {
+    uint32_t size; /* bytes of the struct as the caller compiled it (IP_SIZED); see status.h */
     int has_dims;
     uint32_t dims[3];
     int has_type;

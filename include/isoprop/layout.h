@@ -92,6 +92,16 @@ typedef struct ip_brick_entry {
     uint64_t checksum;    /* XXH64 (seed 0) of the payload; 0 for a constant brick */
 } ip_brick_entry;
 
+/*! ip_layout_world_box() : the volume's world-space box: lo = 0, hi = (dims - 1) * spacing
+ *  along each axis (world units). */
+IP_API void ip_layout_world_box(const ip_layout *layout, double lo[3], double hi[3]);
+
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same. */
+#ifdef IP_EXPERIMENTAL
+
 /*! ip_layout_subblocks_per_brick() : (B / s)^3. */
 IP_API uint32_t ip_layout_subblocks_per_brick(const ip_layout *layout);
 
@@ -112,9 +122,7 @@ IP_API uint64_t ip_brick_global_index(const ip_layout *layout, uint32_t level,
 IP_API void ip_brick_coords(const ip_layout *layout, uint64_t global, uint32_t *level,
                             uint32_t brick[3]);
 
-/*! ip_layout_world_box() : the volume's world-space box: lo = 0, hi = (dims - 1) * spacing
- *  along each axis (world units). */
-IP_API void ip_layout_world_box(const ip_layout *layout, double lo[3], double hi[3]);
+#endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus
 }

@@ -25,6 +25,12 @@
 extern "C" {
 #endif
 
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same. */
+#ifdef IP_EXPERIMENTAL
+
 /*! ip_output_check() : whether `path` may be written as an output now: IP_OK when nothing
  *  exists there, or when a regular file (or a symbolic link to one: the link is replaced, not
  *  its target) exists and `force` is set. Touches nothing. Reentrant.
@@ -52,6 +58,8 @@ IP_API ip_status ip_output_not_input(const char *output_path, const char *input_
  *  IP_ERR_IO, with err->message naming the path. */
 IP_API ip_status ip_output_write(const char *path, const void *data, size_t size, int force,
                                  ip_error *err);
+
+#endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus
 }

@@ -35,11 +35,12 @@ extern "C" {
 
 /* The shading parameters shared by both renderers; colours are 0..1 per channel. */
 typedef struct ip_shading {
-    float surface[3];           /* the surface colour (a light bone/ivory) */
-    float ambient;              /* light a surface gets when seen edge-on */
-    float diffuse;              /* Lambert weight of the headlight */
-    float specular;             /* weight of the white highlight */
-    float shininess;            /* exponent of the highlight */
+    uint32_t size;    /* bytes of the struct as the caller compiled it (IP_SIZED); see status.h */
+    float surface[3]; /* the surface colour (a light bone/ivory) */
+    float ambient;    /* light a surface gets when seen edge-on */
+    float diffuse;    /* Lambert weight of the headlight */
+    float specular;   /* weight of the white highlight */
+    float shininess;  /* exponent of the highlight */
     float background_top[3];    /* background colour of the top image row */
     float background_bottom[3]; /* background colour of the bottom image row */
 } ip_shading;
@@ -52,11 +53,6 @@ IP_API void ip_shading_default(ip_shading *shading);
  *  ambient, diffuse and specular finite and >= 0; shininess finite and > 0.
  *  @return IP_OK or IP_ERR_ARGUMENT with a message. Thread-safe. */
 IP_API ip_status ip_shading_check(const ip_shading *shading, ip_error *err);
-
-/*! ip_render_check_box() : validates the world box [lo, hi] (world units) that both
- *  renderers take for their near and far planes: finite, lo <= hi on every axis.
- *  @return IP_OK or IP_ERR_ARGUMENT with a message. Thread-safe. */
-IP_API ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_error *err);
 
 /*! ip_raster_mesh() : renders `mesh` in software, the reference for the GPU renderer.
  *  `camera` gives the image size (width x height pixels) and the view; near and far planes
@@ -102,6 +98,126 @@ typedef struct ip_surface {
 
 /* The most surfaces one image takes. */
 #define IP_MAX_SURFACES 16
+
+/* The canvas: ip_raster_mesh_shaded()'s image of a mesh that grows frame after frame, kept
+ * between frames, so that a frame draws only the triangles added since the last one and
+ * shades only the pixels they changed (an interactive viewer on a machine without a GPU).
+ * After ip_canvas_begin() and ip_canvas_add() calls that added triangles [0, n) of a mesh in
+ * any number of pieces, the image and the triangle ids are exactly those ip_raster_mesh_shaded()
+ * gives for the mesh's first n triangles: the nearest triangle wins, the lower index on equal
+ * depth, which is also the one drawn first. Rows are drawn in bands on the canvas's threads.
+ * A canvas is used by one thread at a time. */
+typedef struct ip_canvas ip_canvas;
+
+/*! ip_png_write() : writes an image given as width * height * 4 bytes (RGBA, top row first)
+ *  as an 8-bit PNG: RGB when every alpha is 255, RGBA otherwise. The file appears only once
+ *  complete (atomic); an existing `path` is replaced only when `force` is non-zero, and
+ *  only when it is a regular file (isoprop/output.h).
+ *  Reentrant. @return IP_OK, IP_ERR_EXISTS, IP_ERR_ARGUMENT (an empty image, or a path that
+ *  is not a regular file), IP_ERR_NOMEM or IP_ERR_IO. */
+IP_API ip_status ip_png_write(const char *path, const uint8_t *rgba, uint32_t width,
+                              uint32_t height, int force, ip_error *err);
+
+/* A headless OpenGL 3.3 core context: EGL on Mesa's surfaceless platform (no window, no
+ * display server; llvmpipe where no GPU is present). It has no default framebuffer: draw into
+ * a framebuffer object. The EGL display is process-wide and, once initialised, is left
+ * initialised, because terminating it would destroy every other context on it. */
+typedef struct ip_gl_context ip_gl_context;
+
+/* The GPU renderer: holds the mesh in GPU buffers and draws it with the shading above.
+ * A renderer is not thread-safe. A headless renderer makes its own context current on the
+ * calling thread at each call, so it may move between threads provided the thread that used
+ * it last calls ip_renderer_release() first; a renderer on the caller's context needs that
+ * context current at every call. OpenGL state the calls change, which a caller sharing the
+ * context must set again for its own drawing: the bound framebuffers, renderbuffer, vertex
+ * array, program and buffers (array, copy, pixel pack: 0 afterwards); the viewport; depth
+ * test (on, GL_LESS, writes on); face culling, blending, scissor test, depth clamp and sRGB
+ * conversion (off); multisampling (on); polygon mode (fill); colour mask (all on); pack
+ * alignment and row layout (1, tight). */
+typedef struct ip_renderer ip_renderer;
+
+/*! ip_renderer_create_headless() : a renderer with its own headless context and an
+ *  off-screen framebuffer of width x height pixels (RGBA8 colour, 24-bit depth).
+ *  @return IP_OK, IP_ERR_ARGUMENT (a size of 0 or over the GL limit), IP_ERR_UNSUPPORTED
+ *  (no headless OpenGL 3.3 core here) or IP_ERR_NOMEM; *out is NULL on failure. */
+IP_API ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip_renderer **out,
+                                             ip_error *err);
+
+/*! ip_renderer_resize() : changes the image size (pixels). A headless renderer reallocates
+ *  its off-screen framebuffer; otherwise the caller has resized its framebuffer already.
+ *  @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM (the old size remains). */
+IP_API ip_status ip_renderer_resize(ip_renderer *renderer, uint32_t width, uint32_t height,
+                                    ip_error *err);
+
+/*! ip_renderer_upload() : appends the triangles [first_triangle, mesh->triangle_count) of
+ *  `mesh` to the renderer's GPU buffers. The buffers grow geometrically, copying what they
+ *  hold on the GPU, so what was uploaded before is never sent again. The caller keeps `mesh`
+ *  (it is read during the call only) and decides what to append: passing the count uploaded
+ *  so far appends exactly the triangles added since.
+ *  @return IP_OK, IP_ERR_ARGUMENT (first_triangle > mesh->triangle_count) or IP_ERR_NOMEM
+ *  (GPU memory; nothing of this call is kept). */
+IP_API ip_status ip_renderer_upload(ip_renderer *renderer, const ip_mesh *mesh,
+                                    uint64_t first_triangle, ip_error *err);
+
+/*! ip_renderer_clear_mesh() : forgets every uploaded triangle, keeping the GPU buffers. */
+IP_API void ip_renderer_clear_mesh(ip_renderer *renderer);
+
+/*! ip_renderer_triangle_count() : the number of triangles uploaded and not cleared. */
+IP_API uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
+
+/*! ip_renderer_draw() : draws the background and the uploaded triangles in upload order,
+ *  seen by `camera` (whose width and height must be the renderer's), with near and far planes
+ *  from ip_camera_depth_range(camera, lo, hi) for the volume's world box [lo, hi].
+ *  The image is complete when the call returns from the caller's point of view (OpenGL may
+ *  still be working: ip_renderer_read_rgba() waits for it).
+ *  @return IP_OK, IP_ERR_ARGUMENT (bad camera or box, size mismatch) or IP_ERR_UNSUPPORTED
+ *  (an OpenGL error, named in the message). */
+IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera,
+                                  const double lo[3], const double hi[3], ip_error *err);
+
+/*! ip_renderer_set_shading() : the shading of later draws (NULL: ip_shading_default(),
+ *  which a new renderer starts with); copied. Needs no context.
+ *  @return IP_OK or IP_ERR_ARGUMENT (ip_shading_check() fails; the shading stays). */
+IP_API ip_status ip_renderer_set_shading(ip_renderer *renderer, const ip_shading *shading,
+                                         ip_error *err);
+
+/*! ip_renderer_read_rgba() : copies the image drawn last into `rgba` (width * height * 4
+ *  bytes, caller-owned), top row first, waiting for OpenGL to finish.
+ *  @return IP_OK or IP_ERR_UNSUPPORTED (an OpenGL error). */
+IP_API ip_status ip_renderer_read_rgba(ip_renderer *renderer, uint8_t *rgba, ip_error *err);
+
+/*! ip_renderer_destroy() : frees the GPU objects and, for a headless renderer, its context
+ *  (NULL is a no-op). A renderer on the caller's context needs that context current. */
+IP_API void ip_renderer_destroy(ip_renderer *renderer);
+
+/* ---- figure overlays: an axis triad and a scale bar, drawn into a finished image ----
+ *
+ * Both draw into an RGBA image as the renderers give it (width * height * 4 bytes, top row
+ * first; the camera's width and height), after rendering, so they look the same whichever
+ * renderer drew it, with or without anti-aliasing. Each draws only inside a box in one corner,
+ * which it reports as {x0, y0, x1, y1} (pixels; x0, y0 included, x1, y1 excluded): the triad
+ * in the bottom-left corner, the scale bar in the bottom-right; an overlay that would not fit
+ * whole in the image is refused, never cut. Their sizes follow the
+ * image's smaller side s: text (stb_easy_font's, scaled by round(s / 240), 1 to 4), the
+ * triad's arms 8 % of s (at least 16 pixels). Lines are anti-aliased, text is not. */
+
+/* A scale bar: a round length and what it spans in the image at the target's depth. */
+typedef struct ip_scale_bar {
+    double length;     /* world units (the spacing's): 1, 2 or 5 times a power of ten */
+    double pixel_size; /* world units one pixel spans at the depth of the camera's target */
+    double pixels;     /* length / pixel_size: the bar's length in the image, pixels */
+} ip_scale_bar;
+
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same. */
+#ifdef IP_EXPERIMENTAL
+
+/*! ip_render_check_box() : validates the world box [lo, hi] (world units) that both
+ *  renderers take for their near and far planes: finite, lo <= hi on every axis.
+ *  @return IP_OK or IP_ERR_ARGUMENT with a message. Thread-safe. */
+IP_API ip_status ip_render_check_box(const double lo[3], const double hi[3], ip_error *err);
 
 /*! ip_surfaces_check() : validates surfaces for a several-surface image: 1 to
  *  IP_MAX_SURFACES of them, each with a mesh, colour channels in [0, 1] and an opacity in
@@ -149,16 +265,6 @@ IP_API ip_status ip_raster_mesh_part(const ip_mesh *mesh, const ip_camera *camer
                                      uint32_t height, double *inverse_depth, uint8_t *rgba,
                                      ip_error *err);
 
-/* The canvas: ip_raster_mesh_shaded()'s image of a mesh that grows frame after frame, kept
- * between frames, so that a frame draws only the triangles added since the last one and
- * shades only the pixels they changed (an interactive viewer on a machine without a GPU).
- * After ip_canvas_begin() and ip_canvas_add() calls that added triangles [0, n) of a mesh in
- * any number of pieces, the image and the triangle ids are exactly those ip_raster_mesh_shaded()
- * gives for the mesh's first n triangles: the nearest triangle wins, the lower index on equal
- * depth, which is also the one drawn first. Rows are drawn in bands on the canvas's threads.
- * A canvas is used by one thread at a time. */
-typedef struct ip_canvas ip_canvas;
-
 /*! ip_canvas_create() : an empty canvas drawing on `threads` threads (0: every core; the
  *  calling thread counts, the others are started here and sleep between calls). *out is the
  *  caller's, released with ip_canvas_destroy(). @return IP_OK or IP_ERR_NOMEM. */
@@ -204,21 +310,6 @@ IP_API uint64_t ip_canvas_triangle_count(const ip_canvas *canvas);
 /*! ip_canvas_memory() : the bytes of the canvas's image buffers. */
 IP_API size_t ip_canvas_memory(const ip_canvas *canvas);
 
-/*! ip_png_write() : writes an image given as width * height * 4 bytes (RGBA, top row first)
- *  as an 8-bit PNG: RGB when every alpha is 255, RGBA otherwise. The file appears only once
- *  complete (atomic); an existing `path` is replaced only when `force` is non-zero, and
- *  only when it is a regular file (isoprop/output.h).
- *  Reentrant. @return IP_OK, IP_ERR_EXISTS, IP_ERR_ARGUMENT (an empty image, or a path that
- *  is not a regular file), IP_ERR_NOMEM or IP_ERR_IO. */
-IP_API ip_status ip_png_write(const char *path, const uint8_t *rgba, uint32_t width,
-                              uint32_t height, int force, ip_error *err);
-
-/* A headless OpenGL 3.3 core context: EGL on Mesa's surfaceless platform (no window, no
- * display server; llvmpipe where no GPU is present). It has no default framebuffer: draw into
- * a framebuffer object. The EGL display is process-wide and, once initialised, is left
- * initialised, because terminating it would destroy every other context on it. */
-typedef struct ip_gl_context ip_gl_context;
-
 /*! ip_gl_context_create_headless() : creates the context and makes it current on the calling
  *  thread. @return IP_OK, IP_ERR_UNSUPPORTED (no EGL, no surfaceless platform, no OpenGL 3.3
  *  core: the message says which) or IP_ERR_NOMEM; *out is NULL on failure. */
@@ -245,25 +336,6 @@ IP_API void ip_gl_context_destroy(ip_gl_context *context);
 IP_API ip_status ip_gl_program(const char *vertex_source, const char *fragment_source,
                                unsigned *program, ip_error *err);
 
-/* The GPU renderer: holds the mesh in GPU buffers and draws it with the shading above.
- * A renderer is not thread-safe. A headless renderer makes its own context current on the
- * calling thread at each call, so it may move between threads provided the thread that used
- * it last calls ip_renderer_release() first; a renderer on the caller's context needs that
- * context current at every call. OpenGL state the calls change, which a caller sharing the
- * context must set again for its own drawing: the bound framebuffers, renderbuffer, vertex
- * array, program and buffers (array, copy, pixel pack: 0 afterwards); the viewport; depth
- * test (on, GL_LESS, writes on); face culling, blending, scissor test, depth clamp and sRGB
- * conversion (off); multisampling (on); polygon mode (fill); colour mask (all on); pack
- * alignment and row layout (1, tight). */
-typedef struct ip_renderer ip_renderer;
-
-/*! ip_renderer_create_headless() : a renderer with its own headless context and an
- *  off-screen framebuffer of width x height pixels (RGBA8 colour, 24-bit depth).
- *  @return IP_OK, IP_ERR_ARGUMENT (a size of 0 or over the GL limit), IP_ERR_UNSUPPORTED
- *  (no headless OpenGL 3.3 core here) or IP_ERR_NOMEM; *out is NULL on failure. */
-IP_API ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip_renderer **out,
-                                             ip_error *err);
-
 /*! ip_renderer_create_current() : a renderer on the OpenGL 3.3 core (or later) context that
  *  is current on the calling thread (for example a window's), drawing into `framebuffer` (0:
  *  the default framebuffer) of width x height pixels. The caller keeps the context current
@@ -272,25 +344,6 @@ IP_API ip_status ip_renderer_create_headless(uint32_t width, uint32_t height, ip
  *  core) or IP_ERR_NOMEM. */
 IP_API ip_status ip_renderer_create_current(uint32_t width, uint32_t height, uint32_t framebuffer,
                                             ip_renderer **out, ip_error *err);
-
-/*! ip_renderer_resize() : changes the image size (pixels). A headless renderer reallocates
- *  its off-screen framebuffer; otherwise the caller has resized its framebuffer already.
- *  @return IP_OK, IP_ERR_ARGUMENT or IP_ERR_NOMEM (the old size remains). */
-IP_API ip_status ip_renderer_resize(ip_renderer *renderer, uint32_t width, uint32_t height,
-                                    ip_error *err);
-
-/*! ip_renderer_upload() : appends the triangles [first_triangle, mesh->triangle_count) of
- *  `mesh` to the renderer's GPU buffers. The buffers grow geometrically, copying what they
- *  hold on the GPU, so what was uploaded before is never sent again. The caller keeps `mesh`
- *  (it is read during the call only) and decides what to append: passing the count uploaded
- *  so far appends exactly the triangles added since.
- *  @return IP_OK, IP_ERR_ARGUMENT (first_triangle > mesh->triangle_count) or IP_ERR_NOMEM
- *  (GPU memory; nothing of this call is kept). */
-IP_API ip_status ip_renderer_upload(ip_renderer *renderer, const ip_mesh *mesh,
-                                    uint64_t first_triangle, ip_error *err);
-
-/*! ip_renderer_clear_mesh() : forgets every uploaded triangle, keeping the GPU buffers. */
-IP_API void ip_renderer_clear_mesh(ip_renderer *renderer);
 
 /*! ip_renderer_driver() : OpenGL's GL_RENDERER for the renderer's context (read once, owned by
  *  the renderer), "unknown" where it cannot be read. A headless renderer makes its context
@@ -307,19 +360,6 @@ IP_API int ip_gl_driver_is_software(const char *gl_renderer);
  *  a software OpenGL driver, in the process's memory): those of ip_renderer_upload() (grown
  *  geometrically) and of ip_renderer_draw_mesh()'s streaming, once used. */
 IP_API uint64_t ip_renderer_memory(const ip_renderer *renderer);
-
-/*! ip_renderer_triangle_count() : the number of triangles uploaded and not cleared. */
-IP_API uint64_t ip_renderer_triangle_count(const ip_renderer *renderer);
-
-/*! ip_renderer_draw() : draws the background and the uploaded triangles in upload order,
- *  seen by `camera` (whose width and height must be the renderer's), with near and far planes
- *  from ip_camera_depth_range(camera, lo, hi) for the volume's world box [lo, hi].
- *  The image is complete when the call returns from the caller's point of view (OpenGL may
- *  still be working: ip_renderer_read_rgba() waits for it).
- *  @return IP_OK, IP_ERR_ARGUMENT (bad camera or box, size mismatch) or IP_ERR_UNSUPPORTED
- *  (an OpenGL error, named in the message). */
-IP_API ip_status ip_renderer_draw(ip_renderer *renderer, const ip_camera *camera,
-                                  const double lo[3], const double hi[3], ip_error *err);
 
 /*! ip_renderer_draw_added() : draws only the uploaded triangles [first, count) over the image
  *  drawn last, whose colour and depth the framebuffer still holds (a renderer's own, or a
@@ -356,12 +396,6 @@ IP_API ip_status ip_renderer_draw_surfaces(ip_renderer *renderer, const ip_surfa
                                            size_t count, const ip_camera *camera,
                                            const double lo[3], const double hi[3], ip_error *err);
 
-/*! ip_renderer_set_shading() : the shading of later draws (NULL: ip_shading_default(),
- *  which a new renderer starts with); copied. Needs no context.
- *  @return IP_OK or IP_ERR_ARGUMENT (ip_shading_check() fails; the shading stays). */
-IP_API ip_status ip_renderer_set_shading(ip_renderer *renderer, const ip_shading *shading,
-                                         ip_error *err);
-
 /*! ip_renderer_set_samples() : anti-aliasing of a headless renderer: each pixel of later
  *  draws keeps `samples` coverage and depth samples (OpenGL multisampling; 1: none, the
  *  default), averaged when the image is read, so silhouettes get intermediate colours while
@@ -372,30 +406,10 @@ IP_API ip_status ip_renderer_set_shading(ip_renderer *renderer, const ip_shading
  *  the limit; the setting stays), IP_ERR_UNSUPPORTED or IP_ERR_NOMEM. */
 IP_API ip_status ip_renderer_set_samples(ip_renderer *renderer, uint32_t samples, ip_error *err);
 
-/*! ip_renderer_read_rgba() : copies the image drawn last into `rgba` (width * height * 4
- *  bytes, caller-owned), top row first, waiting for OpenGL to finish.
- *  @return IP_OK or IP_ERR_UNSUPPORTED (an OpenGL error). */
-IP_API ip_status ip_renderer_read_rgba(ip_renderer *renderer, uint8_t *rgba, ip_error *err);
-
 /*! ip_renderer_release() : makes a headless renderer's context no longer current on the
  *  calling thread, so that another thread may use the renderer; a no-op for a renderer on the
  *  caller's context. */
 IP_API void ip_renderer_release(ip_renderer *renderer);
-
-/*! ip_renderer_destroy() : frees the GPU objects and, for a headless renderer, its context
- *  (NULL is a no-op). A renderer on the caller's context needs that context current. */
-IP_API void ip_renderer_destroy(ip_renderer *renderer);
-
-/* ---- figure overlays: an axis triad and a scale bar, drawn into a finished image ----
- *
- * Both draw into an RGBA image as the renderers give it (width * height * 4 bytes, top row
- * first; the camera's width and height), after rendering, so they look the same whichever
- * renderer drew it, with or without anti-aliasing. Each draws only inside a box in one corner,
- * which it reports as {x0, y0, x1, y1} (pixels; x0, y0 included, x1, y1 excluded): the triad
- * in the bottom-left corner, the scale bar in the bottom-right; an overlay that would not fit
- * whole in the image is refused, never cut. Their sizes follow the
- * image's smaller side s: text (stb_easy_font's, scaled by round(s / 240), 1 to 4), the
- * triad's arms 8 % of s (at least 16 pixels). Lines are anti-aliased, text is not. */
 
 /*! ip_overlay_text_width() : the width in pixels of one line of `text` as
  *  ip_overlay_draw_text() draws it at `scale` (1 to 16); 0 for NULL text or another scale.
@@ -414,13 +428,6 @@ IP_API uint32_t ip_overlay_text_width(const char *text, int scale);
 IP_API ip_status ip_overlay_draw_text(uint8_t *rgba, uint32_t width, uint32_t height, int left,
                                       int top, const char *text, int scale, const uint8_t ink[3],
                                       const uint8_t shadow[3], ip_error *err);
-
-/* A scale bar: a round length and what it spans in the image at the target's depth. */
-typedef struct ip_scale_bar {
-    double length;     /* world units (the spacing's): 1, 2 or 5 times a power of ten */
-    double pixel_size; /* world units one pixel spans at the depth of the camera's target */
-    double pixels;     /* length / pixel_size: the bar's length in the image, pixels */
-} ip_scale_bar;
 
 /*! ip_scale_bar_choose() : the longest length of 1, 2 or 5 times a power of ten world units
  *  whose bar spans at most `max_pixels` (> 0) pixels at the depth of the camera's target,
@@ -478,6 +485,8 @@ IP_API ip_status ip_overlay_draw_axes(uint8_t *rgba, const ip_camera *camera,
 IP_API ip_status ip_overlay_draw_scale_bar(uint8_t *rgba, const ip_camera *camera,
                                            const ip_scale_bar *bar, const char *unit,
                                            uint32_t box[4], uint32_t bar_box[4], ip_error *err);
+
+#endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus
 }

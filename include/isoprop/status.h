@@ -16,6 +16,24 @@
 #define IP_API
 #endif
 
+/* Structs that may grow (docs/api.md, "Stability").
+ * - The option structs the caller fills (ip_engine_options, ip_bricker_options,
+ *   ip_input_overrides, ip_gen_params, ip_shading) start with `uint32_t size`: the bytes of the
+ *   struct as the caller's program was compiled. The library reads only that many bytes: the
+ *   fields added after the caller was compiled keep their defaults, and a struct from a later
+ *   version is taken when the fields this library does not know are zero (else
+ *   IP_ERR_UNSUPPORTED). A size of 0, as a zero-initialised struct has, stands for the struct as
+ *   version 0.2.0 declared it, so that `{0}` keeps working; the ip_*_default() functions and
+ *   IP_SIZED() set the size. Initialise each such struct one of these ways before filling it.
+ * - The structs the library fills (ip_input_desc, ip_bricker_report, ip_engine_counts,
+ *   ip_engine_memory, ip_cache_stats) keep their size within a major version: they end with
+ *   `reserved` words, zero, from which later fields are taken. */
+#if !defined(__cplusplus)
+/* IP_SIZED(type): a zero-initialised `type` that says its size, e.g.
+ * `ip_input_overrides overrides = IP_SIZED(ip_input_overrides);`. */
+#define IP_SIZED(type) ((type){.size = (uint32_t)sizeof(type)})
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif

@@ -42,6 +42,33 @@ IP_API const ip_layout *ip_store_layout(const ip_store *store);
 /*! ip_store_path() : the path the store was opened with. */
 IP_API const char *ip_store_path(const ip_store *store);
 
+/*! ip_store_summary_memory() : bytes the store holds in memory for the summaries (directory,
+ *  brick, sub-block and node ranges; the sub-block ranges of constant bricks are shared, so
+ *  this is usually well under the file's summary section). */
+IP_API uint64_t ip_store_summary_memory(const ip_store *store);
+
+/*! ip_store_check_summary() : recomputes the range and sub-block ranges of brick `g` from its
+ *  decoded `samples` (as ip_store_read_brick() or the cache give them) and compares them with
+ *  the summary section. @return IP_OK, or IP_ERR_CORRUPT naming the brick. */
+IP_API ip_status ip_store_check_summary(const ip_store *store, uint64_t g, const void *samples,
+                                        ip_error *err);
+
+/*! ip_store_verify_brick() : ip_store_read_brick() (same buffers), then recomputes the brick's range and
+ *  sub-block ranges from the decoded samples and compares them with the summary section.
+ *  @return IP_OK, or IP_ERR_CHECKSUM / IP_ERR_CORRUPT naming the brick. */
+IP_API ip_status ip_store_verify_brick(const ip_store *store, uint64_t g, void *dst, void *work,
+                                       ip_error *err);
+
+/*! ip_store_verify_octree() : recomputes every octree node from the brick ranges and compares.
+ *  @return IP_OK or IP_ERR_CORRUPT naming the first wrong node. */
+IP_API ip_status ip_store_verify_octree(const ip_store *store, ip_error *err);
+
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same. */
+#ifdef IP_EXPERIMENTAL
+
 /*! ip_store_brick_entry() : directory entry of global brick `g` (< brick_count). */
 IP_API void ip_store_brick_entry(const ip_store *store, uint64_t g, ip_brick_entry *entry);
 
@@ -56,11 +83,6 @@ IP_API const float *ip_store_subblock_ranges(const ip_store *store, uint64_t g);
  *  `level`; depth 0 is the brick itself. Owned by the store. */
 IP_API const float *ip_store_node_range(const ip_store *store, uint32_t level, uint32_t depth,
                                         const uint32_t node[3]);
-
-/*! ip_store_summary_memory() : bytes the store holds in memory for the summaries (directory,
- *  brick, sub-block and node ranges; the sub-block ranges of constant bricks are shared, so
- *  this is usually well under the file's summary section). */
-IP_API uint64_t ip_store_summary_memory(const ip_store *store);
 
 /*! ip_store_brick_samples() : number of samples of brick `g` (its extent's product). */
 IP_API uint64_t ip_store_brick_samples(const ip_store *store, uint64_t g);
@@ -92,21 +114,7 @@ IP_API void ip_store_prefetch_brick(const ip_store *store, uint64_t g);
  *  hint: the answer may be stale the moment it is given. Thread-safe. */
 IP_API int ip_store_brick_in_memory(const ip_store *store, uint64_t g);
 
-/*! ip_store_check_summary() : recomputes the range and sub-block ranges of brick `g` from its
- *  decoded `samples` (as ip_store_read_brick() or the cache give them) and compares them with
- *  the summary section. @return IP_OK, or IP_ERR_CORRUPT naming the brick. */
-IP_API ip_status ip_store_check_summary(const ip_store *store, uint64_t g, const void *samples,
-                                        ip_error *err);
-
-/*! ip_store_verify_brick() : ip_store_read_brick() (same buffers), then recomputes the brick's range and
- *  sub-block ranges from the decoded samples and compares them with the summary section.
- *  @return IP_OK, or IP_ERR_CHECKSUM / IP_ERR_CORRUPT naming the brick. */
-IP_API ip_status ip_store_verify_brick(const ip_store *store, uint64_t g, void *dst, void *work,
-                                       ip_error *err);
-
-/*! ip_store_verify_octree() : recomputes every octree node from the brick ranges and compares.
- *  @return IP_OK or IP_ERR_CORRUPT naming the first wrong node. */
-IP_API ip_status ip_store_verify_octree(const ip_store *store, ip_error *err);
+#endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus
 }

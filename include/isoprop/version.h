@@ -13,10 +13,10 @@ extern "C" {
 #endif
 
 #define IP_VERSION_MAJOR 0
-#define IP_VERSION_MINOR 1
+#define IP_VERSION_MINOR 2
 #define IP_VERSION_PATCH 0
 
-/*! ip_version() : the version of the library linked in, as "MAJOR.MINOR.PATCH" (e.g. "0.1.0");
+/*! ip_version() : the version of the library linked in, as "MAJOR.MINOR.PATCH" (e.g. "0.2.0");
  *  a constant string, never NULL; thread-safe. */
 IP_API const char *ip_version(void);
 

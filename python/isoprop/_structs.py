@@ -28,12 +28,12 @@ class InputDesc(ctypes.Structure):
                 ("data_offset", c_uint64), ("dims", c_uint32 * 3), ("type", c_int),
                 ("big_endian", c_int), ("spacing", c_double * 3), ("encoding", c_int),
                 ("stream_skip", c_uint64), ("has_rescale", c_int), ("rescale_slope", c_double),
-                ("rescale_intercept", c_double), ("orientation", Orientation)]
+                ("rescale_intercept", c_double), ("orientation", Orientation), ("reserved", c_uint64 * 32)]
 
 
 class InputOverrides(ctypes.Structure):
     """ip_input_overrides (input.h)"""
-    _fields_ = [("has_dims", c_int), ("dims", c_uint32 * 3), ("has_type", c_int),
+    _fields_ = [("size", c_uint32), ("has_dims", c_int), ("dims", c_uint32 * 3), ("has_type", c_int),
                 ("type", c_int), ("has_endian", c_int), ("big_endian", c_int),
                 ("has_spacing", c_int), ("spacing", c_double * 3)]
 
@@ -44,7 +44,7 @@ PROGRESS_FN = ctypes.CFUNCTYPE(c_int, c_void_p, c_uint64, c_uint64)
 
 class BrickerOptions(ctypes.Structure):
     """ip_bricker_options (bricker.h)"""
-    _fields_ = [("brick_edge", c_uint32), ("subblock_edge", c_uint32), ("lz4_level", c_int),
+    _fields_ = [("size", c_uint32), ("brick_edge", c_uint32), ("subblock_edge", c_uint32), ("lz4_level", c_int),
                 ("threads", c_uint), ("memory_limit", c_uint64), ("force", c_int),
                 ("progress", PROGRESS_FN), ("progress_user", c_void_p)]
 
@@ -56,7 +56,7 @@ class BrickerReport(ctypes.Structure):
                 ("bricks_raw", c_uint64), ("levels", c_uint32), ("threads", c_uint),
                 ("seconds", c_double), ("memory_planned", c_uint64), ("peak_rss", c_uint64),
                 ("seconds_read", c_double), ("seconds_encode", c_double),
-                ("seconds_write", c_double), ("bytes_direct", c_uint64), ("read_overlap", c_int)]
+                ("seconds_write", c_double), ("bytes_direct", c_uint64), ("read_overlap", c_int), ("reserved", c_uint64 * 8)]
 
 
 class LevelLayout(ctypes.Structure):
@@ -93,7 +93,7 @@ class CacheStats(ctypes.Structure):
                 ("prefetch_hits", c_uint64), ("bytes_read_disk", c_uint64),
                 ("wait_seconds", c_double), ("bricks_touched", c_uint64),
                 ("bricks_total", c_uint64), ("levels", c_uint32),
-                ("level", CacheLevelStats * 32)]
+                ("level", CacheLevelStats * 32), ("reserved", c_uint64 * 8)]
 
 
 class Camera(ctypes.Structure):
@@ -118,7 +118,7 @@ class ClipPlane(ctypes.Structure):
 
 class EngineOptions(ctypes.Structure):
     """ip_engine_options (engine.h)"""
-    _fields_ = [("cutoff_degrees", c_double), ("foldback_degrees", c_double),
+    _fields_ = [("size", c_uint32), ("cutoff_degrees", c_double), ("foldback_degrees", c_double),
                 ("threads", c_uint), ("lod", c_int), ("pixel_error", c_double),
                 ("cell_ids", c_int), ("occlusion", c_int), ("prefetch", c_int),
                 ("cull", c_int), ("clip_count", c_uint), ("clip", ClipPlane * IP_MAX_CLIP_PLANES),
@@ -132,7 +132,7 @@ class EngineCounts(ctypes.Structure):
                 ("propagation_seconds", c_double), ("extraction_seconds", c_double),
                 ("rendering_seconds", c_double), ("deferred", c_uint64),
                 ("retired", c_uint64), ("nodes", c_uint64), ("culled", c_uint64),
-                ("kept", c_uint64)]
+                ("kept", c_uint64), ("reserved", c_uint64 * 8)]
 
 
 class Mesh(ctypes.Structure):

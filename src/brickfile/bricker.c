@@ -20,6 +20,7 @@
 #include "input_positioned.h"
 #include "isoprop/output.h"
 #include "pool.h"
+#include "sized.h"
 #include "summary.h"
 
 /* One pyramid level's slab: the B+1 planes of the brick layer being filled, kept in a ring
@@ -175,17 +176,32 @@ static int plan_overlap(const ip_layout *l, unsigned threads, uint64_t limit)
 void ip_bricker_options_default(ip_bricker_options *options)
 {
     memset(options, 0, sizeof *options);
+    options->size = sizeof *options;
     options->brick_edge = IP_DEFAULT_BRICK_EDGE;
     options->subblock_edge = IP_DEFAULT_SUBBLOCK_EDGE;
     options->lz4_level = IP_LZ4_FAST;
 }
 
-ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_bricker_options *options,
+/* The caller's options (a sized struct, status.h) as this library's, into *taken. */
+static ip_status take_options(const ip_bricker_options *given, ip_bricker_options *taken,
+                              ip_error *err)
+{
+    ip_bricker_options_default(taken);
+    return ip__sized_in(taken, sizeof *taken, given,
+                        IP__SIZE_UPTO(ip_bricker_options, progress_user), "bricker options", err);
+}
+
+ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_bricker_options *given,
                                    uint64_t *bytes, ip_error *err)
 {
     ip_layout l;
-    ip_status st = ip__layout_init(&l, input->dims, input->type, input->spacing,
-                                   options->brick_edge, options->subblock_edge, err);
+    ip_bricker_options taken;
+    const ip_bricker_options *options = &taken;
+    ip_status st = take_options(given, &taken, err);
+    if (st != IP_OK)
+        return st;
+    st = ip__layout_init(&l, input->dims, input->type, input->spacing, options->brick_edge,
+                         options->subblock_edge, err);
     if (st == IP_OK) {
         unsigned threads = thread_count(options);
         *bytes = memory_for(&l, threads, plan_overlap(&l, threads, options->memory_limit));
@@ -1125,15 +1141,18 @@ static ip_status check_request(const ip_input_desc *in, const char *out_path, ip
 }
 
 ip_status ip_bricker_run(const ip_input_desc *input, const char *out_path,
-                         const ip_bricker_options *options, ip_bricker_report *report,
-                         ip_error *err)
+                         const ip_bricker_options *given, ip_bricker_report *report, ip_error *err)
 {
     double start = ip_now_seconds();
-    if (!input || !out_path || !options)
+    if (!input || !out_path || !given)
         return ip__fail(err, IP_ERR_ARGUMENT,
                         "ip_bricker_run: input, out_path and options "
                         "are required");
-    ip_status st = check_request(input, out_path, err);
+    ip_bricker_options taken;
+    const ip_bricker_options *options = &taken;
+    ip_status st = take_options(given, &taken, err);
+    if (st == IP_OK)
+        st = check_request(input, out_path, err);
     if (st != IP_OK)
         return st;
     bricker b;

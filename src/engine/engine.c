@@ -9,6 +9,7 @@
 #include "internal.h"
 #include "lod.h"
 #include "reach.h"
+#include "sized.h"
 #include "vec3.h"
 
 #define LOCAL_LEVELS 3        /* ray order: the finest levels cast in Z-order (start_order()) */
@@ -16,6 +17,8 @@
 
 void ip_engine_options_default(ip_engine_options *o)
 {
+    memset(o, 0, sizeof *o);
+    o->size = sizeof *o;
     o->cutoff_degrees = IP_DEFAULT_CUTOFF_DEGREES;
     o->foldback_degrees = IP_DEFAULT_FOLDBACK_DEGREES;
     o->threads = 0;
@@ -35,9 +38,16 @@ static const char *path_of(const ip_cache *cache)
     return ip_store_path(ip_cache_store(cache));
 }
 
-ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip_engine **out,
+ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *given, ip_engine **out,
                            ip_error *err)
 {
+    ip_engine_options taken;
+    ip_engine_options_default(&taken);
+    ip_status st = ip__sized_in(&taken, sizeof taken, given,
+                                IP__SIZE_UPTO(ip_engine_options, reuse), "engine options", err);
+    if (st != IP_OK)
+        return st;
+    const ip_engine_options *options = &taken;
     if (!(options->cutoff_degrees > 0 && options->cutoff_degrees <= 180) ||
         !(options->foldback_degrees >= 0 && options->foldback_degrees <= 180))
         return ip__fail(err, IP_ERR_ARGUMENT,
@@ -81,9 +91,9 @@ ip_status ip_engine_create(ip_cache *cache, const ip_engine_options *options, ip
     e->workers = calloc(e->threads, sizeof *e->workers);
     e->leftovers = calloc(e->threads, sizeof *e->leftovers);
     e->shared = malloc(SHARED_MAX * sizeof *e->shared);
-    ip_status st = e->workers && e->leftovers && e->shared
-                       ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
-                       : IP_ERR_NOMEM;
+    st = e->workers && e->leftovers && e->shared
+             ? ip__visited_init(&e->visited, ip_store_layout(ip_cache_store(cache)))
+             : IP_ERR_NOMEM;
     if (st == IP_OK)
         st = ip__pool_create(e->threads, &e->pool, NULL);
     /* IP_PREFETCH_ON: the reader leaves the bricks already in memory to the workers when they

@@ -10,6 +10,7 @@
 #include "internal.h"
 #include "isoprop/generate.h"
 #include "pool.h"
+#include "sized.h"
 
 #define GEN_PI 3.14159265358979323846
 /* Whole gyroid periods across each axis's [-1, 1] span. */
@@ -274,11 +275,18 @@ static void store_sample(void *dst, size_t i, ip_type type, double v)
     }
 }
 
-/* Validates params; messages start with `what` (the output path, or "generate"). */
-static ip_status check_params(const ip_gen_params *params, const char *what, ip_error *err)
+/* Takes the caller's params (a sized struct, status.h) into *params and validates them;
+ * messages start with `what` (the output path, or "generate"). */
+static ip_status take_params(const ip_gen_params *given, ip_gen_params *params, const char *what,
+                             ip_error *err)
 {
-    if (!params)
+    if (!given)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: no parameters", what);
+    memset(params, 0, sizeof *params);
+    ip_status st =
+        ip__sized_in(params, sizeof *params, given, IP__SIZE_UPTO(ip_gen_params, seed), what, err);
+    if (st != IP_OK)
+        return st;
     if ((unsigned)params->field >= FIELD_COUNT)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: unknown field %d", what, (int)params->field);
     if (ip_type_size(params->type) == 0)
@@ -332,9 +340,11 @@ static void generate_rows(const ip_gen_params *params, uint32_t z, uint32_t y_fi
     }
 }
 
-ip_status ip_generate_plane(const ip_gen_params *params, uint32_t z, void *dst, ip_error *err)
+ip_status ip_generate_plane(const ip_gen_params *given, uint32_t z, void *dst, ip_error *err)
 {
-    ip_status st = check_params(params, "generate", err);
+    ip_gen_params taken;
+    const ip_gen_params *params = &taken;
+    ip_status st = take_params(given, &taken, "generate", err);
     if (st != IP_OK)
         return st;
     if (z >= params->dims[2])
@@ -423,13 +433,15 @@ static ip_status write_planes(const ip_gen_params *params, ip_atomic_file *out, 
     return st;
 }
 
-ip_status ip_generate_write(const ip_gen_params *params, const char *path, int force, ip_error *err)
+ip_status ip_generate_write(const ip_gen_params *given, const char *path, int force, ip_error *err)
 {
     size_t plane_bytes = 0;
     ip_atomic_file out;
+    ip_gen_params taken;
+    const ip_gen_params *params = &taken;
     if (!path)
         return ip__fail(err, IP_ERR_ARGUMENT, "generate: no output path");
-    ip_status st = check_params(params, path, err);
+    ip_status st = take_params(given, &taken, path, err);
     if (st != IP_OK)
         return st;
     st = plane_size(params->dims, params->type, path, &plane_bytes, err);

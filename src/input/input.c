@@ -15,6 +15,7 @@
 #include "input_headers.h"
 #include "input_source.h"
 #include "internal.h"
+#include "sized.h"
 #include "isoprop/input.h"
 
 /* Dims at or above this are refused, as ip_dims_parse() refuses them, so that every volume
@@ -421,8 +422,8 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
     return describe_from_name(path, overrides, desc, found, err);
 }
 
-ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
-                            ip_input_desc *out, ip_error *err)
+ip_status ip_input_describe(const char *path, const ip_input_overrides *given, ip_input_desc *out,
+                            ip_error *err)
 {
     ip_text_found found;
     ip_input_desc desc;
@@ -432,6 +433,15 @@ ip_status ip_input_describe(const char *path, const ip_input_overrides *override
         return ip__fail(err, IP_ERR_ARGUMENT, "ip_input_describe: path and out are required");
     if (path[0] == '\0' || strlen(path) >= IP_PATH_MAX)
         return ip__fail(err, IP_ERR_ARGUMENT, "%.64s: path is empty or too long", path);
+    ip_input_overrides taken = {0};
+    const ip_input_overrides *overrides = NULL;
+    if (given) {
+        if ((status = ip__sized_in(&taken, sizeof taken, given,
+                                   IP__SIZE_UPTO(ip_input_overrides, spacing), "input overrides",
+                                   err)) != IP_OK)
+            return status;
+        overrides = &taken;
+    }
     memset(&found, 0, sizeof found);
     set_defaults(&desc, path);
     if ((status = read_layout(path, overrides, &desc, &found, err)) != IP_OK ||

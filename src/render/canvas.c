@@ -133,8 +133,9 @@ ip_status ip_canvas_begin(ip_canvas *c, const ip_camera *camera, const ip_shadin
     ip_status st = ip_camera_check(camera, err);
     if (st == IP_OK)
         st = ip_render_check_box(lo, hi, err);
-    if (st == IP_OK && shading)
-        st = ip_shading_check(shading, err);
+    ip_shading taken;
+    if (st == IP_OK)
+        st = ip__shading_take(shading, &taken, err);
     if (st != IP_OK)
         return st;
     if (camera->width > 65536 || camera->height > 65536)
@@ -149,10 +150,7 @@ ip_status ip_canvas_begin(ip_canvas *c, const ip_camera *camera, const ip_shadin
     c->camera = *camera;
     ip_camera_basis_of(camera, &c->basis);
     ip__raster_setup_view(&c->view, camera, lo, hi);
-    if (shading)
-        c->shading = *shading;
-    else
-        ip_shading_default(&c->shading);
+    c->shading = taken;
     c->triangles = 0;
     ip__pool_run(c->pool, c->bands, clear_band, c);
     c->begun = 1;

@@ -6,6 +6,7 @@
 #include "internal.h"
 #include "isoprop/render.h"
 #include "raster_core.h"
+#include "sized.h"
 #include "vec3.h"
 
 /* Vertices snap to 1/256 pixel, as GPUs do; edge functions are then exact 64-bit integers, so
@@ -33,6 +34,7 @@ void ip_shading_default(ip_shading *s)
         .background_bottom = {0.08f, 0.09f, 0.13f},
     };
     *s = defaults;
+    s->size = sizeof *s;
 }
 
 /* Whether every channel of the colour is in [0, 1] (NaN is not). */
@@ -44,7 +46,14 @@ static int is_unit_colour(const float c[3])
     return 1;
 }
 
-ip_status ip_shading_check(const ip_shading *s, ip_error *err)
+ip_status ip_shading_check(const ip_shading *given, ip_error *err)
+{
+    ip_shading taken;
+    return ip__shading_take(given, &taken, err);
+}
+
+/* The checks of ip_shading_check() on the library's own copy. */
+static ip_status check_shading(const ip_shading *s, ip_error *err)
 {
     if (!is_unit_colour(s->surface) || !is_unit_colour(s->background_top) ||
         !is_unit_colour(s->background_bottom))
@@ -56,6 +65,16 @@ ip_status ip_shading_check(const ip_shading *s, ip_error *err)
                         "shading: ambient, diffuse and specular must be finite and >= 0, "
                         "shininess finite and > 0");
     return IP_OK;
+}
+
+ip_status ip__shading_take(const ip_shading *given, ip_shading *taken, ip_error *err)
+{
+    ip_shading_default(taken);
+    if (!given)
+        return IP_OK;
+    ip_status st = ip__sized_in(taken, sizeof *taken, given,
+                                IP__SIZE_UPTO(ip_shading, background_bottom), "shading", err);
+    return st == IP_OK ? check_shading(taken, err) : st;
 }
 
 uint8_t ip__raster_unorm8(double v)
@@ -387,17 +406,6 @@ static int is_covered(const surface_targets *st, const ip_surface *surfaces, siz
     return 0;
 }
 
-/* `shading`, or ip_shading_default() when NULL. */
-static ip_shading shading_or_default(const ip_shading *shading)
-{
-    ip_shading s;
-    if (shading)
-        s = *shading;
-    else
-        ip_shading_default(&s);
-    return s;
-}
-
 /* Shades the part of the image the targets hold into rgba (its width * height * 4 bytes): each
  * pixel the background of its row of the whole image, then the surfaces that show there. */
 static void shade_image(const surface_targets *st, const ip_surface *surfaces, size_t count,
@@ -552,7 +560,8 @@ static ip_status raster_part(const ip_mesh *mesh, const ip_camera *camera,
                              uint32_t *triangle_index, double *inverse_depth, uint8_t *rgba,
                              ip_error *err)
 {
-    ip_status st = shading ? ip_shading_check(shading, err) : IP_OK;
+    ip_shading s;
+    ip_status st = ip__shading_take(shading, &s, err);
     if (st != IP_OK)
         return st;
     surface_targets targets; /* the mesh as one opaque surface */
@@ -565,7 +574,6 @@ static ip_status raster_part(const ip_mesh *mesh, const ip_camera *camera,
         ip__raster_setup_view(&view, camera, lo, hi);
         raster_triangles(target, &view, mesh, 0);
         if (rgba) {
-            ip_shading s = shading_or_default(shading);
             ip_surface one = {mesh, {0, 0, 0}, 1.0f};
             memcpy(one.colour, s.surface, sizeof one.colour);
             shade_image(&targets, &one, 1, camera, &s, rgba);
@@ -597,12 +605,9 @@ ip_status ip_surfaces_check(const ip_surface *surfaces, size_t count, ip_error *
 }
 
 static ip_status check_surfaces(const ip_surface *surfaces, size_t count, const ip_camera *camera,
-                                const ip_shading *shading, const double lo[3], const double hi[3],
-                                ip_error *err)
+                                const double lo[3], const double hi[3], ip_error *err)
 {
     ip_status st = ip_surfaces_check(surfaces, count, err);
-    if (st == IP_OK && shading)
-        st = ip_shading_check(shading, err);
     uint64_t opaque = 0;
     for (size_t i = 0; st == IP_OK && i < count; i++) {
         st = check_arguments(surfaces[i].mesh, camera, lo, hi, err);
@@ -618,7 +623,10 @@ ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count, const ip_
                              const ip_shading *shading, const double lo[3], const double hi[3],
                              uint8_t *rgba, ip_error *err)
 {
-    ip_status st = check_surfaces(surfaces, count, camera, shading, lo, hi, err);
+    ip_shading s;
+    ip_status st = ip__shading_take(shading, &s, err);
+    if (st == IP_OK)
+        st = check_surfaces(surfaces, count, camera, lo, hi, err);
     if (st != IP_OK)
         return st;
     if (!rgba)
@@ -643,10 +651,8 @@ ip_status ip_raster_surfaces(const ip_surface *surfaces, size_t count, const ip_
         if (st == IP_OK)
             raster_triangles(&targets->layer[i], &view, f->mesh, 0);
     }
-    if (st == IP_OK) {
-        ip_shading s = shading_or_default(shading);
+    if (st == IP_OK)
         shade_image(targets, surfaces, count, camera, &s, rgba);
-    }
     free_target(&targets->opaque, NULL, NULL);
     for (size_t i = 0; i < count; i++)
         free_target(&targets->layer[i], NULL, NULL);

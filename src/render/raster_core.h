@@ -46,6 +46,10 @@ void ip__raster_range(ip_raster_target *t, const ip_raster_view *view, const ip_
 /* A channel value in [0, 1] (clamped) as 8 bits, round(255 * v). */
 uint8_t ip__raster_unorm8(double v);
 
+/* The caller's shading (a sized struct: include/isoprop/status.h; NULL: ip_shading_default())
+ * as the library's own, checked as ip_shading_check() does. */
+ip_status ip__shading_take(const ip_shading *given, ip_shading *taken, ip_error *err);
+
 /* The background of image row `row` of `height` rows. */
 void ip__raster_background(const ip_shading *s, uint32_t row, uint32_t height, uint8_t out[4]);
 

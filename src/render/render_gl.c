@@ -7,6 +7,7 @@
 
 #include "internal.h"
 #include "isoprop/render.h"
+#include "raster_core.h"
 
 enum {
     POSITION_BYTES = 9 * sizeof(float), /* a triangle's positions */
@@ -728,13 +729,10 @@ static void flip_rows(uint8_t *rgba, uint32_t width, uint32_t height)
 
 ip_status ip_renderer_set_shading(ip_renderer *r, const ip_shading *shading, ip_error *err)
 {
-    if (!shading) {
-        ip_shading_default(&r->shading);
-        return IP_OK;
-    }
-    ip_status st = ip_shading_check(shading, err);
+    ip_shading taken;
+    ip_status st = ip__shading_take(shading, &taken, err);
     if (st == IP_OK)
-        r->shading = *shading;
+        r->shading = taken;
     return st;
 }
 

@@ -1,7 +1,9 @@
 /* An embedder's program: the whole chain through the public API alone (isoprop/isoprop.h,
  * linked with libisoprop.so, no internal header on its include path). Generates a sphere,
  * bricks it, opens it with a small cache, extracts the isosurface progressively until every
- * ray has been cast, and fully; both must find the sphere. Argument: a scratch folder. */
+ * ray has been cast, and fully; both must find the sphere. Argument: a scratch folder. Only
+ * the stable tier of the API (the build defines IP_EXPERIMENTAL for everything else). */
+#undef IP_EXPERIMENTAL
 #include <stdio.h>
 #include <string.h>
 
@@ -23,7 +25,7 @@ int main(int argc, char **argv)
     snprintf(raw, sizeof raw, "%s/sphere_48x40x32_uint8.raw", argv[1]);
     snprintf(ibv, sizeof ibv, "%s/sphere.ibv", argv[1]);
     ip_error err;
-    ip_gen_params g = {IP_FIELD_SPHERE, {48, 40, 32}, IP_UINT8, 0.0, 1};
+    ip_gen_params g = {sizeof(ip_gen_params), IP_FIELD_SPHERE, {48, 40, 32}, IP_UINT8, 0.0, 1};
     if (ip_generate_write(&g, raw, 1, &err) != IP_OK)
         return fail("generate", &err);
     ip_input_desc in;

@@ -31,11 +31,13 @@ static void error_and_input(void)
     FIELD(ip_input_desc, rescale_slope);
     FIELD(ip_input_desc, rescale_intercept);
     FIELD(ip_input_desc, orientation);
+    FIELD(ip_input_desc, reserved);
     SIZE(ip_orientation);
     FIELD(ip_orientation, origin);
     FIELD(ip_orientation, directions);
     FIELD(ip_orientation, space);
     SIZE(ip_input_overrides);
+    FIELD(ip_input_overrides, size);
     FIELD(ip_input_overrides, has_dims);
     FIELD(ip_input_overrides, dims);
     FIELD(ip_input_overrides, has_type);
@@ -49,6 +51,7 @@ static void error_and_input(void)
 static void bricker(void)
 {
     SIZE(ip_bricker_options);
+    FIELD(ip_bricker_options, size);
     FIELD(ip_bricker_options, brick_edge);
     FIELD(ip_bricker_options, subblock_edge);
     FIELD(ip_bricker_options, lz4_level);
@@ -74,6 +77,7 @@ static void bricker(void)
     FIELD(ip_bricker_report, seconds_write);
     FIELD(ip_bricker_report, bytes_direct);
     FIELD(ip_bricker_report, read_overlap);
+    FIELD(ip_bricker_report, reserved);
 }
 
 static void layout(void)
@@ -139,6 +143,7 @@ static void cache(void)
     FIELD(ip_cache_stats, bricks_total);
     FIELD(ip_cache_stats, levels);
     FIELD(ip_cache_stats, level);
+    FIELD(ip_cache_stats, reserved);
 }
 
 static void engine(void)
@@ -151,6 +156,7 @@ static void engine(void)
     FIELD(ip_camera, width);
     FIELD(ip_camera, height);
     SIZE(ip_engine_options);
+    FIELD(ip_engine_options, size);
     FIELD(ip_engine_options, cutoff_degrees);
     FIELD(ip_engine_options, foldback_degrees);
     FIELD(ip_engine_options, threads);
@@ -180,6 +186,7 @@ static void engine(void)
     FIELD(ip_engine_counts, nodes);
     FIELD(ip_engine_counts, culled);
     FIELD(ip_engine_counts, kept);
+    FIELD(ip_engine_counts, reserved);
     SIZE(ip_mesh);
     FIELD(ip_mesh, positions);
     FIELD(ip_mesh, normals);

@@ -107,7 +107,7 @@ cat >project/CMakeLists.txt <<EOF
 cmake_minimum_required(VERSION 3.18)
 project(uses_isoprop C)
 set(CMAKE_C_STANDARD 11)
-find_package(isoprop 0.1 REQUIRED COMPONENTS render)
+find_package(isoprop 0.2 REQUIRED COMPONENTS render)
 add_executable(extract_shared extract.c)
 target_link_libraries(extract_shared PRIVATE isoprop::isoprop)
 add_executable(extract_static extract.c)
@@ -118,7 +118,7 @@ EOF
 cmake_flags="${flags[*]}"
 run_capture "$cmake" -S project -B project/build -DCMAKE_PREFIX_PATH="$full" \
     -DCMAKE_C_COMPILER="$cc" -DCMAKE_C_FLAGS="$cmake_flags" -DCMAKE_BUILD_TYPE=Release
-check "find_package(isoprop 0.1 COMPONENTS render) configures ($err)" test "$rc" = 0
+check "find_package(isoprop 0.2 COMPONENTS render) configures ($err)" test "$rc" = 0
 run_capture "$cmake" --build project/build
 check "the CMake project builds ($out $err)" test "$rc" = 0
 for program in extract_shared extract_static; do

@@ -1,0 +1,124 @@
+/* isoprop: reading input volumes (headerless raw, NRRD, MetaImage, TIFF, NIfTI, DICOM) plane
+ * by plane.
+ *
+ * ip_input_describe() works out where the samples are and how they are laid out, from a file
+ * name of the form NAME_XxYxZ_TYPE.raw, from a NRRD header (.nrrd attached, .nhdr detached;
+ * raw or gzip encoding), a MetaImage header (.mhd with its data file), a TIFF file or a folder
+ * of TIFF files, a NIfTI-1/2 file (.nii, .nii.gz) or a folder holding a DICOM series, and from
+ * explicit overrides. A reader then streams z-planes in order with bounded memory.
+ */
+#ifndef ISOPROP_INPUT_H
+#define ISOPROP_INPUT_H
+
+#include <stdint.h>
+
+#include "isoprop/orientation.h"
+#include "isoprop/status.h"
+#include "isoprop/volume.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* How the samples are stored. */
+typedef enum ip_encoding {
+    IP_ENCODING_RAW = 0,  /* plain samples from data_offset on */
+    IP_ENCODING_GZIP = 1, /* a gzip (or zlib) stream from data_offset on */
+    IP_ENCODING_TIFF = 2, /* one TIFF page a plane: a multi-page file or a folder of files */
+    IP_ENCODING_DICOM = 3 /* one DICOM file a plane: a folder holding one series */
+} ip_encoding;
+
+/* Where a volume's samples are and how to read them. */
+typedef struct ip_input_desc {
+    char path[IP_PATH_MAX];      /* the file the user named (header or raw) */
+    char data_path[IP_PATH_MAX]; /* the file that holds the samples */
+    uint64_t data_offset;        /* byte offset of the first sample in data_path */
+    uint32_t dims[3];            /* samples along x, y, z; each >= 2 */
+    ip_type type;
+    int big_endian;    /* 1 when the stored samples are big-endian */
+    double spacing[3]; /* world units between samples; default 1,1,1 */
+    ip_encoding encoding;
+    uint64_t stream_skip; /* gzip: bytes of the inflated stream before the first sample (a
+                             header inside the stream, as in .nii.gz); 0 otherwise */
+    int has_rescale;      /* 1 when the file says its values stand for stored x rescale_slope
+                             + rescale_intercept (NIfTI scl_slope/scl_inter, DICOM rescale);
+                             reported, never applied: samples keep their stored values */
+    double rescale_slope;
+    double rescale_intercept;
+    ip_orientation orientation; /* origin, axis directions and space in the file's physical
+                                   space (NRRD space origin/directions/space, MetaImage
+                                   Offset/TransformMatrix/AnatomicalOrientation, NIfTI sform or
+                                   qform, DICOM image position/orientation); identity when the
+                                   file says nothing or its axes are not orthonormal */
+    uint64_t reserved[32];      /* zero: room for later fields at the same size (status.h) */
+} ip_input_desc;
+
+/* Values given on the command line; each applies only where its has_ flag is set, and wins
+ * over the file name and over any header. A header field that an override replaces is not
+ * read at all (has_dims covers NRRD dimension/sizes and MetaImage NDims/DimSize, has_spacing
+ * covers spacings/space directions and ElementSpacing/ElementSize), so an override can stand
+ * in for a header value this library cannot use. Where the data start, their encoding and
+ * their data file always come from the header. */
+typedef struct ip_input_overrides {
+    uint32_t size; /* bytes of the struct as the caller compiled it (IP_SIZED); see status.h */
+    int has_dims;
+    uint32_t dims[3];
+    int has_type;
+    ip_type type;
+    int has_endian;
+    int big_endian;
+    int has_spacing;
+    double spacing[3];
+} ip_input_overrides;
+
+/*! ip_input_describe() : fills *out for the volume at `path`.
+ *  `overrides` may be NULL. The extension picks the format: .nrrd/.nhdr NRRD, .mhd/.mha
+ *  MetaImage, .tif/.tiff TIFF, .nii/.nii.gz NIfTI; a folder holds a DICOM series or numbered
+ *  TIFF files (told apart by the first file's content); anything else is headerless raw
+ *  (little-endian, spacing 1,1,1, dims and type from a base name NAME_XxYxZ_TYPE.raw or from
+ *  the overrides). Checks everything that can be
+ *  checked before reading samples: a dimension under 2 (or at or above 2^31), an unknown
+ *  type, an unreadable or malformed header, a header or data file that is not a regular file
+ *  (a FIFO or a device is refused at once, never waited on), a missing data file, a size past
+ *  2^63 bytes, (raw encoding) a data size that does not equal dims x type size, and a spacing
+ *  outside the bounds of ip_spacing_check(); the length of gzip data is checked by the
+ *  reader. Reentrant; *out is untouched on failure.
+ *  @return IP_OK, or IP_ERR_INPUT / IP_ERR_IO with err->message naming the file and the
+ *  problem in one line; IP_ERR_UNSUPPORTED for a spacing outside the renderable range, or a
+ *  valid TIFF or NIfTI file this library does not read (a sample type, a compression, 4D
+ *  images, .hdr/.img pairs: docs/input.md);
+ *  IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an override type that is not
+ *  an ip_type; IP_ERR_NOMEM when an allocation fails. */
+IP_API ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
+                                   ip_input_desc *out, ip_error *err);
+
+/* A sequential plane reader. Not thread-safe; one owner at a time. */
+typedef struct ip_input_reader ip_input_reader;
+
+/*! ip_input_open() : opens a reader positioned at plane z = 0. *out is owned by the caller
+ *  and released with ip_input_close(). Gzip streams use a fixed 256 KiB input buffer and
+ *  inflate straight into the caller's planes. @return IP_OK, IP_ERR_IO or IP_ERR_NOMEM;
+ *  IP_ERR_INPUT when the data file is no longer a regular file, when gzip data end within
+ *  the stream_skip bytes before the samples, or when a TIFF file no longer reads; IP_ERR_ARGUMENT for NULL
+ *  arguments or a desc without type and dims. */
+IP_API ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_error *err);
+
+/*! ip_input_read_planes() : reads the next `count` z-planes into `dst`, which must hold
+ *  count * dims[0] * dims[1] samples; samples arrive in the host's byte order.
+ *  A gzip stream that ends early or is longer than the dims is reported as IP_ERR_INPUT (the
+ *  end is checked by the call that reads the last plane); float32 samples that are NaN or
+ *  infinite are reported as IP_ERR_INPUT naming the sample as (x,y,z). After any error the
+ *  reader only repeats it. count 0 reads nothing.
+ *  @return IP_OK, IP_ERR_IO or IP_ERR_INPUT; IP_ERR_NOMEM when zlib runs out of memory;
+ *  IP_ERR_ARGUMENT for reading past the last plane
+ *  or a NULL reader or dst. */
+IP_API ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t count,
+                                      ip_error *err);
+
+/*! ip_input_close() : releases the reader (NULL is allowed). */
+IP_API void ip_input_close(ip_input_reader *reader);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
