@@ -13,10 +13,10 @@ A thin layer (ctypes) over the shared library libisoprop; docs/python.md describ
 from ._library import lib as _lib
 from ._library import path as library_path
 from .bricking import brick
-from .errors import Error
+from .errors import ArgumentError, Error
 from .mesh import Mesh, Step
 from .volume import File, Level, open
 
 __version__ = _lib.ip_version().decode()
-__all__ = ["brick", "open", "File", "Level", "Mesh", "Step", "Error", "library_path",
-           "__version__"]
+__all__ = ["brick", "open", "File", "Level", "Mesh", "Step", "Error", "ArgumentError",
+           "library_path", "__version__"]

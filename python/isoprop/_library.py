@@ -31,6 +31,7 @@ _PROTOTYPES = {
     "ip_thread_count": (c_uint, [c_uint]),
     "ip_peak_rss_bytes": (c_uint64, []),
     "ip_now_seconds": (c_double, []),
+    "ip_spacing_check": (c_int, [c_double * 3, c_char_p, ERR]),
     "ip_input_describe": (c_int, [c_char_p, POINTER(S.InputOverrides), POINTER(S.InputDesc), ERR]),
     "ip_bricker_options_default": (None, [POINTER(S.BrickerOptions)]),
     "ip_bricker_run": (c_int, [POINTER(S.InputDesc), c_char_p, POINTER(S.BrickerOptions),

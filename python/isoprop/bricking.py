@@ -1,6 +1,7 @@
 """isoprop.brick(): a brick file from a raw volume (any input the library reads) or from a
 numpy array."""
 import ctypes
+import errno
 import os
 import tempfile
 
@@ -8,7 +9,8 @@ import numpy as np
 
 from . import _structs as S
 from ._library import lib
-from .errors import check, new_error
+from . import _check as C
+from .errors import ArgumentError, check, new_error
 
 # numpy sample types and the library's ip_type (include/isoprop/volume.h)
 TYPES = {np.dtype(np.uint8): 0, np.dtype(np.uint16): 1, np.dtype(np.int16): 2,
@@ -18,38 +20,37 @@ DTYPES = {code: dtype for dtype, code in TYPES.items()}
 
 def type_code(dtype):
     """The ip_type of a numpy dtype or a type name the library knows ("uint16", "short", ...)."""
-    if isinstance(dtype, str):
+    if isinstance(dtype, str) and "\0" not in dtype:
         code = ctypes.c_int()
         if lib.ip_type_parse(dtype.encode(), ctypes.byref(code)) == 0:
             return code.value
     try:
         return TYPES[np.dtype(dtype).newbyteorder("=")]
-    except (TypeError, KeyError):
+    except (TypeError, ValueError, KeyError):
         raise TypeError("dtype %r: the sample type must be uint8, uint16, int16 or float32"
                         % (dtype,)) from None
 
 
 def _overrides(dims, dtype, spacing, endian):
+    """The ip_input_overrides of checked arguments (dims and spacing lists, dtype a code)."""
     o = S.InputOverrides()
     if dims is not None:
-        o.has_dims, o.dims[:] = 1, [int(d) for d in dims]
+        o.has_dims, o.dims[:] = 1, dims
     if dtype is not None:
-        o.has_type, o.type = 1, type_code(dtype)
+        o.has_type, o.type = 1, dtype
     if spacing is not None:
-        o.has_spacing, o.spacing[:] = 1, [float(s) for s in spacing]
+        o.has_spacing, o.spacing[:] = 1, spacing
     if endian is not None:
-        if endian not in ("little", "big"):
-            raise ValueError("endian %r: must be 'little' or 'big'" % (endian,))
         o.has_endian, o.big_endian = 1, int(endian == "big")
     return o
 
 
-def _options(brick_size, subblock_size, hc, threads, mem_mb, force):
+def _options(brick_size, subblock_size, lz4_level, threads, mem_mb, force):
+    """The ip_bricker_options of checked arguments."""
     o = S.BrickerOptions()
     lib.ip_bricker_options_default(ctypes.byref(o))
-    o.brick_edge, o.subblock_edge = brick_size, subblock_size
-    o.lz4_level = 0 if hc is None else (9 if hc is True else int(hc))
-    o.threads, o.memory_limit, o.force = threads, int(mem_mb) << 20, int(bool(force))
+    o.brick_edge, o.subblock_edge, o.lz4_level = brick_size, subblock_size, lz4_level
+    o.threads, o.memory_limit, o.force = threads, mem_mb << 20, int(force)
     return o
 
 
@@ -77,23 +78,67 @@ def _run(path, out, overrides, options, progress):
     return {name: getattr(report, name) for name, _ in S.BrickerReport._fields_}
 
 
-def _array_input(array, out):
-    """Writes `array` (z, y, x) as little-endian raw samples to a new hidden file beside `out`
-    (the same file system, so no other disk fills up); returns its path and dims (x, y, z)."""
-    a = np.asarray(array)
+def _check_spacing(spacing):
+    """The spacing within the library's bounds (ip_spacing_check()), or ArgumentError."""
+    spacing = C.spacing(spacing)
+    if spacing is not None:
+        err = new_error()
+        st = lib.ip_spacing_check((ctypes.c_double * 3)(*spacing), None, ctypes.byref(err))
+        if st != 0:
+            raise ArgumentError(err.message.decode("utf-8", "replace"), st)
+    return spacing
+
+
+def _check_array(source):
+    """The array `source` as a numpy array of a sample type the library reads."""
+    try:
+        a = np.asarray(source)
+    except Exception as e:  # e.g. ragged nested lists
+        raise TypeError("source: must be a path or a numpy array (z, y, x), not %s (%s)"
+                        % (C.describe(source), e)) from None
+    if a.ndim == 0 or a.dtype == object:
+        raise TypeError("source: must be a path or a numpy array (z, y, x), not %s"
+                        % C.describe(source))
+    if a.dtype.newbyteorder("=") not in TYPES:
+        raise TypeError("source: an array of dtype %s: the sample type must be uint8, uint16, "
+                        "int16 or float32" % a.dtype)
     if a.ndim != 3:
-        raise ValueError("array of shape %s: a volume is a 3-D array, shape (z, y, x)" % (a.shape,))
-    if min(a.shape) < 2:
-        raise ValueError("array of shape %s: each dimension must be at least 2" % (a.shape,))
-    type_code(a.dtype)  # refuses other types
+        raise ArgumentError("source: an array of shape %s: a volume is a 3-D array, shape "
+                            "(z, y, x)" % (a.shape,))
+    if min(a.shape) < 2 or max(a.shape) > C.MAX_DIM:
+        raise ArgumentError("source: an array of shape %s: each dimension must be within "
+                            "2 .. %d" % (a.shape, C.MAX_DIM))
+    return a
+
+
+def _scratch_error(e, out, folder):
+    """The OSError `e` met writing an array's scratch file beside `out`, as the same kind of
+    OSError naming `out` (the user's path), not the scratch file."""
+    if e.errno == errno.ENOENT and not os.path.isdir(folder):
+        text = "the output's folder %s does not exist" % folder
+    else:
+        text = ("cannot write the array's samples to a scratch file beside the output (in %s): %s"
+                % (folder, e.strerror or e))
+    return OSError(e.errno, text, os.fsdecode(out))
+
+
+def _array_input(a, out):
+    """Writes the array `a` (z, y, x) as little-endian raw samples to a new hidden file beside
+    `out` (the same file system, so no other disk fills up); returns its path and dims (x, y,
+    z). An OSError (no such folder, no permission, disk full) names `out`."""
     a = np.ascontiguousarray(a, dtype=a.dtype.newbyteorder("<"))
     folder = os.path.dirname(os.path.abspath(os.fsdecode(out)))
-    fd, tmp = tempfile.mkstemp(prefix=".isoprop-", suffix=".raw", dir=folder)
     try:
-        with os.fdopen(fd, "wb") as f:
-            a.tofile(f)
-    except BaseException:
+        fd, tmp = tempfile.mkstemp(prefix=".isoprop-", suffix=".raw", dir=folder)
+    except OSError as e:
+        raise _scratch_error(e, out, folder) from None
+    try:
+        with os.fdopen(fd, "wb") as f:  # not tofile(): its OSError lacks the errno
+            f.write(memoryview(a.reshape(-1).view(np.uint8)))
+    except BaseException as e:
         os.unlink(tmp)
+        if isinstance(e, OSError):
+            raise _scratch_error(e, out, folder) from None
         raise
     return tmp, a.shape[::-1], a.dtype
 
@@ -108,14 +153,37 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, bric
     uint16, int16 or float32. dims (x, y, z), dtype and endian ('little', 'big') override a
     file's; an array has its own. spacing: world units between samples along x, y, z.
     brick_size, subblock_size, hc (True or an LZ4HC level), threads, mem_mb and force are
-    isobrick's options. Raises isoprop.Error (the output is then not written)."""
-    options = _options(brick_size, subblock_size, hc, threads, mem_mb, force)
-    if not isinstance(source, (str, bytes, os.PathLike)):
-        if dims is not None or dtype is not None or endian is not None:
-            raise ValueError("an array gives its own dims and dtype: pass only spacing")
-        tmp, shape, dt = _array_input(source, out)
+    isobrick's options. Every argument is checked first: TypeError or isoprop.ArgumentError
+    (a ValueError) naming it. Raises isoprop.Error (the output is then not written), or an
+    OSError naming `out` when an array's scratch copy cannot be written beside it."""
+    is_path = isinstance(source, (str, bytes, os.PathLike))
+    if is_path:
+        C.path("source", source)
+    C.path("out", out)
+    dims = C.dims(dims)
+    code = None if dtype is None else type_code(dtype)
+    spacing = _check_spacing(spacing)
+    if endian is not None:
+        C.choice("endian", endian, ("little", "big"))
+    brick_size = C.power_of_two("brick_size", brick_size, 2, C.MAX_BRICK_EDGE)
+    subblock_size = C.power_of_two("subblock_size", subblock_size, 1, C.MAX_BRICK_EDGE)
+    if subblock_size > brick_size:
+        raise ArgumentError("subblock_size: %d is larger than brick_size %d"
+                            % (subblock_size, brick_size))
+    options = _options(brick_size, subblock_size, C.hc(hc),
+                       C.whole("threads", threads, 0, C.MAX_BRICK_THREADS),
+                       C.whole("mem_mb", mem_mb, 0, C.MAX_MEM_MB), C.flag("force", force))
+    C.callable_or_none("progress", progress)
+    if not is_path:
+        given = [n for n, v in (("dims", dims), ("dtype", dtype), ("endian", endian))
+                 if v is not None]
+        if given:
+            raise ArgumentError("%s: not with an array, which gives its own dims, dtype and "
+                                "byte order (pass only spacing)" % given[0])
+        tmp, shape, dt = _array_input(_check_array(source), out)
         try:
-            return _run(tmp, out, _overrides(shape, dt, spacing, "little"), options, progress)
+            return _run(tmp, out, _overrides(list(shape), TYPES[dt.newbyteorder("=")], spacing,
+                                             "little"), options, progress)
         except Exception as e:
             if hasattr(e, "message"):  # name the array, not the scratch file, in the message
                 e.args = (e.message.replace(tmp, "array"),)
@@ -123,4 +191,4 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, bric
             raise
         finally:
             os.unlink(tmp)
-    return _run(source, out, _overrides(dims, dtype, spacing, endian), options, progress)
+    return _run(source, out, _overrides(dims, code, spacing, endian), options, progress)

@@ -1,4 +1,5 @@
-"""The exception the module raises for every failure the library reports."""
+"""The exceptions the module raises: Error for every failure the library reports, and
+ArgumentError (an Error and a ValueError) for an argument out of range."""
 from . import _structs as S
 from ._library import lib
 
@@ -13,6 +14,19 @@ class Error(RuntimeError):
         self.status = status
         self.status_name = lib.ip_status_message(status).decode()
         self.message = message
+
+
+IP_ERR_ARGUMENT = -3  # include/isoprop/status.h
+
+
+class ArgumentError(Error, ValueError):
+    """An argument out of range, refused before any work: a ValueError, and an isoprop.Error
+    (status IP_ERR_ARGUMENT unless the library's check said otherwise) since the library
+    refused such values itself before the module checked them. str(e) starts with the
+    argument's name and says what is allowed."""
+
+    def __init__(self, message, status=IP_ERR_ARGUMENT):
+        super().__init__(status, message)
 
 
 def new_error():

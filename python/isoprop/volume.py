@@ -1,6 +1,7 @@
 """isoprop.open(): a brick file, and extraction from it, full or progressive."""
 import ctypes
 import os
+import threading
 import warnings
 from collections import namedtuple
 
@@ -8,8 +9,9 @@ import numpy as np
 
 from . import _structs as S
 from ._library import lib
+from . import _check as C
 from .bricking import DTYPES
-from .errors import check, new_error
+from .errors import ArgumentError, check, new_error
 from .mesh import Mesh, Step, copy_triangles
 from .stats import counts_dict, run_stats
 
@@ -21,47 +23,75 @@ DEFAULT_SIZE = (1600, 1200)  # isorender's
 VIEW_FOV = 30.0  # degrees: the field of view of the named views (isorender --view)
 
 
-def _engine_options(threads, cutoff, foldback, lod, pixel_error, occlusion, prefetch,
-                    cull=False):
-    o = S.EngineOptions()
-    lib.ip_engine_options_default(ctypes.byref(o))
-    if cutoff is not None:
-        o.cutoff_degrees = cutoff
-    if foldback is not None:
-        o.foldback_degrees = foldback
-    o.threads, o.lod, o.pixel_error = threads, int(bool(lod)), pixel_error
-    o.occlusion = int(bool(occlusion))
-    # prefetch: True (on) or False (off), or "always" (isorender --prefetch always)
-    if isinstance(prefetch, str) and prefetch != "always":
-        raise ValueError('prefetch: True, False or "always", not %r' % prefetch)
-    o.prefetch = (S.PREFETCH_ALWAYS if prefetch == "always"
-                  else S.PREFETCH_ON if prefetch else S.PREFETCH_OFF)
-    o.cull = int(bool(cull))
-    return o
+BUSY = "isoprop.File: another call is running on this File (one thread at a time)"
+
+
+class _Args:
+    """The checked keywords of an extraction (or of File.camera()): each as the library takes
+    it. Raises TypeError or isoprop.ArgumentError naming the first bad one, before any work."""
+
+    def __init__(self, view="-y", camera=None, size=DEFAULT_SIZE, threads=0, cutoff=None,
+                 foldback=None, lod=True, pixel_error=1.0, occlusion=True, prefetch=True,
+                 cull=False, cache_mb=None):
+        self.camera = C.camera(camera)
+        self.view = C.view(view, camera)
+        self.size = C.size(size)
+        self.threads = C.whole("threads", threads, 0, C.MAX_VIEW_THREADS)
+        self.cutoff = C.degrees("cutoff", cutoff, 0, True)
+        self.foldback = C.degrees("foldback", foldback, 0, False)
+        self.lod = C.flag("lod", lod)
+        self.pixel_error = C.positive("pixel_error", pixel_error)
+        self.occlusion = C.flag("occlusion", occlusion)
+        self.prefetch = C.prefetch(prefetch)
+        self.cull = C.flag("cull", cull)
+        self.cache_mb = C.cache_mb(cache_mb)
+
+    def engine_options(self):
+        o = S.EngineOptions()
+        lib.ip_engine_options_default(ctypes.byref(o))
+        if self.cutoff is not None:
+            o.cutoff_degrees = self.cutoff
+        if self.foldback is not None:
+            o.foldback_degrees = self.foldback
+        o.threads, o.lod, o.pixel_error = self.threads, int(self.lod), self.pixel_error
+        o.occlusion = int(self.occlusion)
+        # prefetch: True (on) or False (off), or "always" (isorender --prefetch always)
+        o.prefetch = (S.PREFETCH_ALWAYS if self.prefetch == "always"
+                      else S.PREFETCH_ON if self.prefetch else S.PREFETCH_OFF)
+        o.cull = int(self.cull)
+        return o
 
 
 def _camera_from(camera, size):
     """An ip_camera from "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov" (isorender --camera) or a dict with
-    eye, target, up (world units) and fov (degrees, default 30)."""
+    eye, target, up (world units) and fov (degrees, default 30), both as _check.camera() gives
+    them; ArgumentError when the library refuses it."""
     c, err = S.Camera(), new_error()
     c.width, c.height = size
     if isinstance(camera, str):
-        check(lib.ip_camera_parse(camera.encode(), ctypes.byref(c), ctypes.byref(err)), err)
+        if lib.ip_camera_parse(camera.encode(), ctypes.byref(c), ctypes.byref(err)) != 0:
+            raise ArgumentError('camera: %r is not "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov" (world '
+                                "units, degrees)" % camera)
     else:
-        c.eye[:], c.target[:], c.up[:] = (
-            [float(v) for v in camera[k]] for k in ("eye", "target", "up"))
-        c.fov_y = float(camera.get("fov", VIEW_FOV))
-    check(lib.ip_camera_check(ctypes.byref(c), ctypes.byref(err)), err)
+        c.eye[:], c.target[:], c.up[:] = camera["eye"], camera["target"], camera["up"]
+        c.fov_y = camera.get("fov", VIEW_FOV)
+    if lib.ip_camera_check(ctypes.byref(c), ctypes.byref(err)) != 0:
+        raise ArgumentError(err.message.decode("utf-8", "replace"))  # "camera: ..."
     return c
 
 
 class _Run:
-    """One extraction's engine and figures; its engine (if any) is freed by destroy()."""
+    """One extraction's engine and figures; its engine (if any) is freed by destroy().
+    rays and time_limit (None: no limit) and rays_per_step (None: 1, 2, 4, ...) say how a
+    progressive run steps (_advance())."""
 
-    def __init__(self, f, iso, full, camera, options):
+    def __init__(self, f, iso, full, camera, options, rays=None, time_limit=None,
+                 rays_per_step=None):
         self.path, self.summary_bytes = f.path, f._summary_bytes
         self.iso, self.full, self.camera, self.options = iso, full, camera, options
         self.engine, self.wall_seconds, self.warnings = None, 0.0, []
+        self.limit = rays if rays is not None else C.MAX_COUNT
+        self.time_limit, self.rays_per_step, self.target = time_limit, rays_per_step, 1
         lo, hi = f.value_range
         v = float(np.float32(iso))  # the isovalue as the engine takes it
         if not (lo < v <= hi):
@@ -80,15 +110,44 @@ class _Run:
             self.engine = None
 
 
+class _Call:
+    """`with _Call(f):` around every use of a File's store, cache or engines. One call at a
+    time: a second one, from another thread or from inside the first (on_step), raises
+    RuntimeError at once rather than wait. The lock is what makes releasing the GIL in the
+    library's calls safe: no other call can free the cache or an engine under one."""
+
+    def __init__(self, f):
+        self.f = f
+
+    def __enter__(self):
+        if not self.f._lock.acquire(blocking=False):
+            raise RuntimeError(BUSY)
+        try:
+            self.f._reap()
+        except BaseException:
+            self.f._lock.release()
+            raise
+
+    def __exit__(self, *exc):
+        try:
+            self.f._reap()
+        finally:
+            self.f._lock.release()
+
+
 class File:
     """An open brick file (isoprop.open()). Attributes: path, dims (x, y, z samples), shape
     (z, y, x, as a numpy array of the volume), dtype (numpy), spacing (x, y, z world units),
     value_range (min, max), levels (a tuple of Level, level 0 first), brick_size,
-    subblock_size, file_bytes. One thread at a time may use it; close() (or a with block)
-    frees it, and so does garbage collection."""
+    subblock_size, file_bytes. One call at a time: a call (extract(), a step of
+    extract_steps(), close()) made while another is running on the same File, from another
+    thread or from an on_step callback, raises RuntimeError; it never waits, and never
+    crashes. close() (or a with block) frees it, and so does garbage collection."""
 
     def __init__(self, path):
+        self._lock, self._orphans = threading.Lock(), []
         self._store, self._cache, self._cache_budget, self._runs = None, None, 0, set()
+        C.path("path", path)
         err, store = new_error(), ctypes.c_void_p()
         check(lib.ip_store_open(os.fsencode(path), ctypes.byref(store), ctypes.byref(err)), err)
         self._store = store
@@ -111,7 +170,13 @@ class File:
 
     # -- life time ------------------------------------------------------------------------
     def close(self):
-        """Frees the engines of unfinished extract_steps() runs, the cache and the store."""
+        """Frees the engines of unfinished extract_steps() runs, the cache and the store.
+        Raises RuntimeError, closing nothing, while another call on this File is running (the
+        File stays usable; close it once that call has returned)."""
+        with _Call(self):
+            self._close()
+
+    def _close(self):
         for run in list(self._runs):
             run.destroy()
         self._runs.clear()
@@ -129,12 +194,34 @@ class File:
         self.close()
 
     def __del__(self):
-        if getattr(self, "_store", None) is not None and lib is not None:
-            self.close()
+        # no call can be running: a running call holds a reference to the File
+        if getattr(self, "_store", None) is not None and lib is not None and \
+                self._lock.acquire(blocking=False):
+            try:
+                self._close()
+            finally:
+                self._lock.release()
 
     def __repr__(self):
         return "<isoprop.File %s %s %s>" % (self.path, "x".join(map(str, self.dims)),
                                             self.dtype.name)
+
+    def _reap(self):
+        """Frees the engines of extract_steps() runs that ended while another call held the
+        File (_drop()); under the lock."""
+        while self._orphans:
+            self._end(self._orphans.pop())
+
+    def _drop(self, run):
+        """Frees `run` (an extract_steps() run that has ended) now, or, when another call is
+        running (a generator closed from another thread, or collected during a call), when
+        that call ends."""
+        self._orphans.append(run)
+        if self._lock.acquire(blocking=False):
+            try:
+                self._reap()
+            finally:
+                self._lock.release()
 
     def _open_store(self):
         if not self._store:
@@ -145,7 +232,7 @@ class File:
         """The brick cache, kept from one extraction to the next (warm); `cache_mb` other than
         the current budget makes a new one (None: keep it, or the default budget)."""
         store = self._open_store()
-        budget = lib.ip_cache_default_budget() if cache_mb is None else int(cache_mb) << 20
+        budget = lib.ip_cache_default_budget() if cache_mb is None else cache_mb << 20
         if self._cache and (cache_mb is None or budget == self._cache_budget):
             return self._cache
         if self._runs:
@@ -160,20 +247,20 @@ class File:
         return cache
 
     def camera(self, view="-y", camera=None, size=DEFAULT_SIZE):
-        """The camera an extraction uses, as a dict (eye, target, up, fov, width, height)."""
-        c = self._camera(view, camera, size)
+        """The camera an extraction uses, as a dict (eye, target, up, fov, width, height).
+        Touches nothing of the File but its box: callable at any time, from any thread."""
+        c = self._camera(_Args(view=view, camera=camera, size=size))
         return {"eye": tuple(c.eye), "target": tuple(c.target), "up": tuple(c.up),
                 "fov": c.fov_y, "width": c.width, "height": c.height}
 
-    def _camera(self, view, camera, size):
+    def _camera(self, a):
         self._open_store()
-        w, h = (int(v) for v in size)
-        if camera is not None:
-            return _camera_from(camera, (w, h))
+        if a.camera is not None:
+            return _camera_from(a.camera, a.size)
         c, err = S.Camera(), new_error()
         lo, hi = ((ctypes.c_double * 3)(*b) for b in self.world_box)
-        check(lib.ip_camera_fit_axis(lo, hi, view.encode(), VIEW_FOV, w, h, ctypes.byref(c),
-                                     ctypes.byref(err)), err)
+        check(lib.ip_camera_fit_axis(lo, hi, a.view.encode(), VIEW_FOV, a.size[0], a.size[1],
+                                     ctypes.byref(c), ctypes.byref(err)), err)
         return c
 
     # -- extraction -----------------------------------------------------------------------
@@ -194,56 +281,88 @@ class File:
         every core), cutoff and foldback (degrees), lod, pixel_error, occlusion, prefetch (True,
         False or "always") and cull are isorender's options (cull off by default here: the mesh
         is the product, not an image of it); cache_mb the brick cache's budget (the cache stays warm
-        between calls). on_step(step), if given, sees each step (as extract_steps() yields).
-        Raises isoprop.Error for a file that cannot be read."""
-        kw = dict(view=view, camera=camera, size=size, threads=threads, cutoff=cutoff,
+        between calls). on_step(step), if given, sees each step (as extract_steps() yields);
+        it runs inside the call, so calling this File from it raises RuntimeError.
+        Every argument is checked first (TypeError, or isoprop.ArgumentError, a ValueError,
+        naming it). Raises isoprop.Error for a file that cannot be read, RuntimeError when
+        another call on this File is running."""
+        iso = C.isovalue(iso)
+        a = _Args(view=view, camera=camera, size=size, threads=threads, cutoff=cutoff,
                   foldback=foldback, lod=lod, pixel_error=pixel_error, occlusion=occlusion,
                   prefetch=prefetch, cull=cull, cache_mb=cache_mb)
-        if full not in (False, True, "lod"):
-            raise ValueError('full: False, True or "lod", not %r' % (full,))
+        rays = C.count_or_none("rays", rays, 0)
+        time_limit = C.seconds_or_none("time_limit", time_limit)
+        C.callable_or_none("on_step", on_step)
+        full = C.full(full)
         if full:
-            if rays is not None or time_limit is not None or on_step is not None:
-                raise ValueError("full=True extracts everything: no rays, time_limit or on_step")
-            if full == "lod" and not lod:
-                raise ValueError('full="lod" is the full extraction at adaptive resolution: '
-                                 "not with lod=False (full=True is that)")
-            return self._extract_full(iso, full, **kw)
-        run = self._begin(iso, **kw)
-        try:
-            for first, count, counts in self._steps(run, rays, time_limit, None):
-                if on_step is not None:
-                    on_step(self._step(run, first, count, counts))
-            mesh = lib.ip_engine_mesh(run.engine).contents
-            vertices, normals = copy_triangles(mesh, 0, mesh.triangle_count)
-            return Mesh(vertices, normals, self._stats(run))
-        finally:
-            self._end(run)
+            given = [n for n, v in (("rays", rays), ("time_limit", time_limit),
+                                    ("on_step", on_step)) if v is not None]
+            if given:
+                raise ArgumentError("%s: not with full=%r, which extracts everything (no rays, "
+                                    "time_limit or on_step)" % (given[0], full))
+            if full == "lod" and not a.lod:
+                raise ArgumentError('full: "lod" is the full extraction at adaptive resolution: '
+                                    "not with lod=False (full=True is that)")
+            with _Call(self):
+                return self._extract_full(iso, full, a)
+        with _Call(self):
+            run = self._begin(iso, a, rays, time_limit, None)
+            try:
+                while True:
+                    step = self._advance(run)
+                    if step is None:
+                        break
+                    if on_step is not None:
+                        on_step(self._step(run, *step))
+                mesh = lib.ip_engine_mesh(run.engine).contents
+                vertices, normals = copy_triangles(mesh, 0, mesh.triangle_count)
+                return Mesh(vertices, normals, self._stats(run))
+            finally:
+                self._end(run)
 
-    def extract_steps(self, iso, *, rays_per_step=None, rays=None, time_limit=None, **kw):
+    def extract_steps(self, iso, *, rays_per_step=None, rays=None, time_limit=None, view="-y",
+                      camera=None, size=DEFAULT_SIZE, threads=0, cutoff=None, foldback=None,
+                      lod=True, pixel_error=1.0, occlusion=True, prefetch=True, cull=False,
+                      cache_mb=None):
         """Progressive extraction as a generator: yields a Step (the step's new triangles, its
         counts, the run's statistics so far) after each step of the engine, until every pixel
         has had its ray, `rays` rays or `time_limit` seconds. Steps cast `rays_per_step` rays
         each (None: 1, 2, 4, ... as isorender does, so that the first images come at once).
-        Other keywords as extract(). Closing the generator (or leaving its loop) frees the
-        engine; the triangles of all steps, in order, are those of one extract() of the same
-        rays on one thread."""
-        if rays_per_step is not None and rays_per_step < 1:
-            raise ValueError("rays_per_step %r: must be at least 1" % (rays_per_step,))
-        run = self._begin(iso, **kw)
-        try:
-            for first, count, counts in self._steps(run, rays, time_limit, rays_per_step):
-                yield self._step(run, first, count, counts)
-        finally:
-            self._end(run)
+        Other keywords as extract(), checked here, before the first step. Closing the
+        generator (or leaving its loop) frees the engine; the triangles of all steps, in
+        order, are those of one extract() of the same rays on one thread. Each step is one
+        call on the File (RuntimeError while another is running); between steps the File is
+        free for other calls."""
+        iso = C.isovalue(iso)
+        a = _Args(view=view, camera=camera, size=size, threads=threads, cutoff=cutoff,
+                  foldback=foldback, lod=lod, pixel_error=pixel_error, occlusion=occlusion,
+                  prefetch=prefetch, cull=cull, cache_mb=cache_mb)
+        rays_per_step = C.count_or_none("rays_per_step", rays_per_step, 1)
+        rays = C.count_or_none("rays", rays, 0)
+        time_limit = C.seconds_or_none("time_limit", time_limit)
+        return self._steps(iso, a, rays, time_limit, rays_per_step)
 
-    def _begin(self, iso, view="-y", camera=None, size=DEFAULT_SIZE, threads=0, cutoff=None,
-               foldback=None, lod=True, pixel_error=1.0, occlusion=True, prefetch=True,
-               cull=False, cache_mb=None):
-        cam = self._camera(view, camera, size)
-        options = _engine_options(threads, cutoff, foldback, lod, pixel_error, occlusion,
-                                  prefetch, cull)
-        cache = self._cache_for(cache_mb)
-        run = _Run(self, iso, False, cam, options)
+    def _steps(self, iso, a, rays, time_limit, rays_per_step):
+        run = None
+        try:
+            while True:
+                with _Call(self):
+                    if run is None:
+                        run = self._begin(iso, a, rays, time_limit, rays_per_step)
+                    step = self._advance(run)
+                    if step is None:
+                        return
+                    step = self._step(run, *step)
+                yield step
+        finally:
+            if run is not None:
+                self._drop(run)
+
+    def _begin(self, iso, a, rays, time_limit, rays_per_step):
+        cam = self._camera(a)
+        options = a.engine_options()
+        cache = self._cache_for(a.cache_mb)
+        run = _Run(self, iso, False, cam, options, rays, time_limit, rays_per_step)
         err, engine = new_error(), ctypes.c_void_p()
         check(lib.ip_engine_create(cache, ctypes.byref(options), ctypes.byref(engine),
                                    ctypes.byref(err)), err)
@@ -251,7 +370,7 @@ class File:
         self._runs.add(run)
         try:  # the view's set-up counts in its time, as in isorender
             start = lib.ip_now_seconds()
-            st = lib.ip_engine_begin(engine, ctypes.byref(cam), float(iso), ctypes.byref(err))
+            st = lib.ip_engine_begin(engine, ctypes.byref(cam), iso, ctypes.byref(err))
             run.wall_seconds = lib.ip_now_seconds() - start
             check(st, err)
         except BaseException:
@@ -263,33 +382,33 @@ class File:
         run.destroy()
         self._runs.discard(run)
 
-    def _steps(self, run, rays, time_limit, rays_per_step):
-        """Steps the engine as isorender does; yields (first new triangle, how many, counts of
-        the step) after each."""
-        limit = rays if rays is not None else 2 ** 64 - 1
-        target, err, counts, total = 1, new_error(), S.EngineCounts(), S.EngineCounts()
-        while run.engine and not lib.ip_engine_done(run.engine):
-            lib.ip_engine_totals(run.engine, ctypes.byref(total))
-            if total.rays >= limit:
-                break
-            left = time_limit - run.wall_seconds if time_limit is not None else 0.0
-            if time_limit is not None and left <= 0:
-                break
-            if rays_per_step is None:
-                batch = min(target, limit) - total.rays
-            else:
-                batch = min(rays_per_step, limit - total.rays)
-            first = lib.ip_engine_mesh(run.engine).contents.triangle_count
-            start = lib.ip_now_seconds()
-            st = lib.ip_engine_step(run.engine, batch, left, ctypes.byref(counts),
-                                    ctypes.byref(err))
-            run.wall_seconds += lib.ip_now_seconds() - start
-            check(st, err)
-            now = lib.ip_engine_mesh(run.engine).contents.triangle_count
-            yield first, now - first, counts
-            target *= 2
+    def _advance(self, run):
+        """One step of the engine as isorender takes it: returns (first new triangle, how many,
+        counts of the step), or None once every pixel has had its ray, the rays are cast or
+        the time is up. Under the lock."""
         if not run.engine:
             raise ValueError("%s: the file was closed during the extraction" % self.path)
+        if lib.ip_engine_done(run.engine):
+            return None
+        err, counts, total = new_error(), S.EngineCounts(), S.EngineCounts()
+        lib.ip_engine_totals(run.engine, ctypes.byref(total))
+        if total.rays >= run.limit:
+            return None
+        left = run.time_limit - run.wall_seconds if run.time_limit is not None else 0.0
+        if run.time_limit is not None and left <= 0:
+            return None
+        if run.rays_per_step is None:
+            batch = min(run.target, run.limit) - total.rays
+        else:
+            batch = min(run.rays_per_step, run.limit - total.rays)
+        first = lib.ip_engine_mesh(run.engine).contents.triangle_count
+        start = lib.ip_now_seconds()
+        st = lib.ip_engine_step(run.engine, batch, left, ctypes.byref(counts), ctypes.byref(err))
+        run.wall_seconds += lib.ip_now_seconds() - start
+        check(st, err)
+        now = lib.ip_engine_mesh(run.engine).contents.triangle_count
+        run.target *= 2
+        return first, now - first, counts
 
     def _step(self, run, first, count, counts):
         vertices, normals = copy_triangles(lib.ip_engine_mesh(run.engine).contents, first, count)
@@ -301,22 +420,21 @@ class File:
             lib.ip_engine_totals(run.engine, ctypes.byref(counts))
         return run_stats(run, counts, self._cache)
 
-    def _extract_full(self, iso, full, view, camera, size, threads, cache_mb, **engine_kw):
-        cam = self._camera(view, camera, size)
-        options = _engine_options(threads, **engine_kw)
-        cache = self._cache_for(cache_mb)
+    def _extract_full(self, iso, full, a):
+        cam = self._camera(a)
+        options = a.engine_options()
+        cache = self._cache_for(a.cache_mb)
         run = _Run(self, iso, full, cam, options)
         mesh, counts, err = S.Mesh(), S.EngineCounts(), new_error()
         lib.ip_mesh_init(ctypes.byref(mesh))
         try:
             start = lib.ip_now_seconds()
             if full == "lod":
-                st = lib.ip_extract_full_lod(cache, float(iso), ctypes.byref(cam),
-                                             options.pixel_error, threads, None, 0,
-                                             ctypes.byref(mesh), ctypes.byref(counts),
-                                             ctypes.byref(err))
+                st = lib.ip_extract_full_lod(cache, iso, ctypes.byref(cam), options.pixel_error,
+                                             a.threads, None, 0, ctypes.byref(mesh),
+                                             ctypes.byref(counts), ctypes.byref(err))
             else:
-                st = lib.ip_extract_full(cache, float(iso), 0, threads, ctypes.byref(mesh),
+                st = lib.ip_extract_full(cache, iso, 0, a.threads, ctypes.byref(mesh),
                                          ctypes.byref(counts), ctypes.byref(err))
             run.wall_seconds = lib.ip_now_seconds() - start
             check(st, err)
@@ -329,5 +447,5 @@ class File:
 def open(path):  # noqa: A001 (isoprop.open, as the module's API names it)
     """Opens the brick file at `path` (verifying its header and summaries) and returns a
     File. Raises isoprop.Error naming the file when it is missing, not a brick file or
-    corrupt."""
+    corrupt; TypeError or isoprop.ArgumentError for a `path` that is no path."""
     return File(path)
