@@ -398,22 +398,28 @@ int main(int argc, char **argv)
     o.brick.progress = report_progress;
     o.brick.progress_user = &progress;
     ip_bricker_report report;
+    tool_outputs written = {0}; /* the brick file, once written: the rule of every program */
     if (ip_bricker_run(&desc, out, &o.brick, &report, &err) != IP_OK) {
         tool_progress_end(&progress.bar);
-        rc = tool_fail("isobrick", &err);
-        tool_signals_reraise(); /* cancelled by a signal: end as killed by it */
-        return rc;
+        /* cancelled by a signal: tool_outputs_end() says so, and ends as killed by it */
+        rc = err.code == IP_ERR_CANCELLED && tool_signal_caught() ? 1 : tool_fail("isobrick", &err);
+        return tool_outputs_end(&written, "isobrick", out, rc);
     }
     tool_progress_end(&progress.bar);
+    if (tool_outputs_add(&written, out) != 0) {
+        fprintf(stderr, "isobrick: %s: out of memory\n", out);
+        return tool_outputs_end(&written, "isobrick", out, 1);
+    }
+    tool_outputs_complete(&written);
     if (o.verbose) {
         char mode[64];
         fprintf(stderr, "isobrick: phases: read %.2f s (%s), encode %.2f s, write %.2f s\n",
                 report.seconds_read, read_mode(&report, mode, sizeof mode), report.seconds_encode,
                 report.seconds_write);
         if (print_levels(out) != 0)
-            return 1;
+            return tool_outputs_end(&written, "isobrick", out, 1);
     }
     if (!o.quiet)
         print_summary(&report, &desc, out);
-    return 0;
+    return tool_outputs_end(&written, "isobrick", out, 0);
 }

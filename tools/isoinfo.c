@@ -356,6 +356,8 @@ int main(int argc, char **argv)
     file_facts facts;
     gather_facts(store, &facts);
     int rc = check ? verify(store, cache, json) : 0;
+    int said = rc != 0 && tool_signal_caught(); /* verify() said it was cancelled */
+    tool_outputs written = {0};
     ip_cache_stats stats;
     ip_cache_get_stats(cache, &stats);
     uint64_t summary_bytes = ip_store_summary_memory(store);
@@ -364,9 +366,13 @@ int main(int argc, char **argv)
         tool_print_cache_table(stdout, &stats, summary_bytes);
     if (rc == 0 && tool_signal_caught())
         rc = 1; /* the last brick was checked, but the run was interrupted: no output */
-    if (stats_path && !tool_signal_caught() &&
-        tool_write_stats_file("isoinfo", stats_path, force, &stats, summary_bytes, NULL, NULL) != 0)
+    if (rc == 0 && stats_path &&
+        (tool_write_stats_file("isoinfo", stats_path, force, &stats, summary_bytes, NULL, NULL) !=
+             0 ||
+         tool_outputs_add(&written, stats_path) != 0))
         rc = 1;
+    if (rc == 0)
+        tool_outputs_complete(&written);
     if (rc != 0 || !report)
         ; /* nothing more on stdout */
     else if (o.histogram)
@@ -379,6 +385,5 @@ int main(int argc, char **argv)
     }
     ip_cache_destroy(cache);
     ip_store_close(store);
-    tool_signals_reraise();
-    return rc;
+    return tool_outputs_end(&written, "isoinfo", said ? NULL : path, rc);
 }

@@ -128,19 +128,24 @@ done
 : >afile
 expect_error 1 "not a folder" render --turntable 2 -o afile
 
-# the MP4: without ffmpeg, the frames stay, a clear message, and exit 1 (the MP4 is missing)
+# the MP4: without ffmpeg, refused before any work, in one line, exit 1, nothing written
 mkdir -p nobin
-run_capture env PATH="$work/nobin" "$bin/isorender" c.ibv --iso 60 --size 120x90 --software \
-    --quiet --turntable 2 -o nf --mp4 t.mp4
-check "without ffmpeg, --mp4 exits 1" test "$rc" = 1
-check "and says so" sh -c 'printf "%s" "$0" | grep -q "ffmpeg not found: frames are in nf; install ffmpeg to get an MP4"' "$err"
-check "and the frames are written" test -e nf/frame_000.png -a -e nf/frame_001.png -a ! -e t.mp4
-# an ffmpeg that fails leaves no MP4
+expect_error 1 "t.mp4: --mp4 needs ffmpeg, which is not on the PATH" env PATH="$work/nobin" \
+    "$bin/isorender" c.ibv --iso 60 --size 120x90 --software --quiet --turntable 2 -o nf --mp4 t.mp4
+check "and nothing is written" test ! -e nf -a ! -e t.mp4
+# an ffmpeg that fails: the run fails as a whole, leaving no MP4, no frame and not the folder
+# it made (its outputs are a set: all or none)
 printf '#!/bin/sh\nexit 3\n' >nobin/ffmpeg
 chmod +x nobin/ffmpeg
 run_capture env PATH="$work/nobin" "$bin/isorender" c.ibv --iso 60 --size 120x90 --software \
     --quiet --turntable 2 -o nf --mp4 t.mp4 --force
 check "a failing ffmpeg: exit 1, no MP4" sh -c '[ "$0" = 1 ] && [ ! -e t.mp4 ] && [ ! -e t.mp4.partial ]' "$rc"
+check "... and no frames, nor the folder the run made" test ! -e nf
+mkdir kept && : >kept/other.txt
+run_capture env PATH="$work/nobin" "$bin/isorender" c.ibv --iso 60 --size 120x90 --software \
+    --quiet --turntable 2 -o kept --mp4 t.mp4 --force
+check "a folder that was there stays, with what it held, without the frames" \
+    sh -c '[ "$0" = 1 ] && [ -e kept/other.txt ] && [ ! -e kept/frame_000.png ]' "$rc"
 if command -v ffmpeg >/dev/null; then
     run_capture render --turntable 4 -o mf --mp4 t.mp4
     check "ffmpeg encodes the MP4" test "$rc" = 0

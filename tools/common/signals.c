@@ -50,6 +50,11 @@ void tool_signals_cancel_engine(ip_engine *engine)
         sched_yield();
 }
 
+void tool_signals_forget(void)
+{
+    signal_caught = 0;
+}
+
 void tool_signals_reraise(void)
 {
     int sig = signal_caught;

@@ -18,6 +18,7 @@
 #include "tool_values.h"
 #include "tool_files.h"
 #include "tool_signals.h"
+#include "tool_outputs.h"
 #include "tool_progress.h"
 #include "tool_command_line.h"
 #include "tool_options.h"

@@ -14,6 +14,9 @@ int tool_signal_caught(void);
 /* The engine a signal cancels from now on (NULL: none). Before an engine is destroyed, call
  * with NULL: it returns once no handler can still be using the old one. */
 void tool_signals_cancel_engine(ip_engine *engine);
+/* Forgets the signal caught: the run ends as if none had come (a signal after every output
+ * was written, tool_outputs_end()). */
+void tool_signals_forget(void);
 /* When a signal was caught: flushes stdout and stderr, restores the default action and
  * raises the signal again (the process ends there). Returns when none was caught. */
 void tool_signals_reraise(void);

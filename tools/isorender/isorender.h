@@ -82,7 +82,7 @@ typedef struct run {
     int owners_known;           /* visible_triangles and the checkpoints' `visible` are set */
     const char *renderer_name;
     char warning[600]; /* the --iso warning, "" when none */
-    int writing;       /* 1 once the outputs are being written */
+    tool_outputs outputs; /* the files this run wrote: all of them, or none when it fails */
     strip_frames strip;
     uint64_t mesh_vertices, mesh_dropped; /* of the mesh file: vertices, degenerate triangles */
     /* several --iso: this run is the first surface's; others[] the later ones', each a run of

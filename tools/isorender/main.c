@@ -30,8 +30,19 @@ static void drop_bricks(run *r)
 #endif
 }
 
-/* Renders, then writes every output (each all-or-nothing). A signal caught before the
- * writing starts means no output at all. */
+/* Records the output just written at `path` into the run's set; a signal caught since the
+ * last output stops the run there (the set is then removed). Returns 0 or 1. */
+static int wrote(run *r, const char *path)
+{
+    if (tool_outputs_add(&r->outputs, path) != 0) {
+        fprintf(stderr, "isorender: %s: out of memory\n", path);
+        return 1;
+    }
+    return tool_signal_caught() ? 1 : 0;
+}
+
+/* Renders, then writes every output, as a set (tool_outputs.h): a failure or a signal before
+ * the last one is written leaves none of them. */
 static int finish(run *r, ip_error *err)
 {
     ip_cache_stats st;
@@ -58,22 +69,29 @@ static int finish(run *r, ip_error *err)
         free(strip);
         return rc != 0 ? tool_fail("isorender", err) : 1;
     }
-    r->writing = 1;
     if (ip_png_write(r->o.out, rgba, r->camera.width, r->camera.height, r->o.common.force, err) !=
         IP_OK)
         rc = -1;
     free(rgba);
+    if (rc == 0 && wrote(r, r->o.out) != 0)
+        rc = 1;
     if (rc == 0 && strip &&
         ip_png_write(r->o.strip, strip, strip_width, strip_height, r->o.common.force, err) != IP_OK)
         rc = -1;
+    if (rc == 0 && strip && wrote(r, r->o.strip) != 0)
+        rc = 1;
     free(strip);
     if (rc != 0)
-        return tool_fail("isorender", err);
-    for (size_t i = 0; i <= r->other_count; i++)
-        if (r->o.mesh && write_mesh(surface_run(r, i), err) != 0)
+        return rc < 0 ? tool_fail("isorender", err) : 1;
+    for (size_t i = 0; i <= r->other_count; i++) {
+        run *s = surface_run(r, i);
+        if (r->o.mesh && (write_mesh(s, err) != 0 || wrote(r, s->o.mesh) != 0))
             return 1;
+    }
     if (r->o.progress && !r->o.full &&
-        tool_write_text_file("isorender", r->o.progress, r->o.common.force, progress_csv, r) != 0)
+        (tool_write_text_file("isorender", r->o.progress, r->o.common.force, progress_csv, r) !=
+             0 ||
+         wrote(r, r->o.progress) != 0))
         return 1;
     uint64_t summary = ip_store_summary_memory(r->store);
     /* with --stats - or --progress -, stdout holds that output alone: the summary goes to
@@ -87,9 +105,11 @@ static int finish(run *r, ip_error *err)
         tool_print_cache_table(report, &st, summary);
     }
     if (r->o.common.stats &&
-        tool_write_stats_file("isorender", r->o.common.stats, r->o.common.force, &st, summary,
-                              json_counts, r) != 0)
+        (tool_write_stats_file("isorender", r->o.common.stats, r->o.common.force, &st, summary,
+                               json_counts, r) != 0 ||
+         wrote(r, r->o.common.stats) != 0))
         return 1;
+    tool_outputs_complete(&r->outputs);
     return 0;
 }
 
@@ -149,14 +169,11 @@ int main(int argc, char **argv)
             rc = tool_fail("isorender", &err); /* a cancel by a signal is reported below */
     }
     tool_signals_cancel_engine(NULL);
-    if (tool_signal_caught() && !r.writing)
-        fprintf(stderr, "isorender: %s: cancelled; no output written\n", r.o.file);
     free_surfaces(&r);
     ip_engine_destroy(r.engine);
     ip_mesh_free(&r.full_mesh);
     free(r.checkpoints);
     ip_cache_destroy(r.cache);
     ip_store_close(r.store);
-    tool_signals_reraise();
-    return rc;
+    return tool_outputs_end(&r.outputs, "isorender", r.o.file, rc);
 }

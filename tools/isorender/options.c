@@ -63,7 +63,7 @@ static const char usage[] =
     "                      turned 360/N degrees more in azimuth each time, each frame a\n"
     "                      complete image extracted for its own view (--full: one extraction)\n"
     "  --mp4 OUT.mp4       with --turntable: also encode the frames with ffmpeg (H.264, 25 fps);\n"
-    "                      without ffmpeg the frames stay and isorender exits 1\n"
+    "                      without ffmpeg on the PATH it is refused before any work\n"
     "  --axes              draw an axis triad in the bottom-left corner: the directions of the\n"
     "                      file's physical axes as the camera sees them (x red, y green, z\n"
     "                      blue), labelled R/L, A/P, S where the file names an anatomical space\n"

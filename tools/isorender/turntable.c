@@ -96,7 +96,7 @@ static int turntable_extract(run *r, ip_error *err)
 
 /* Encodes the frames into r->o.mp4 with ffmpeg (H.264, yuv420p, TURNTABLE_FPS frames a
  * second), through a temporary file renamed at the end. Returns 0 or 1 after a message. */
-static int turntable_encode(const run *r)
+static int turntable_encode(run *r)
 {
     char pattern[4096], partial[4096], rate[16];
     snprintf(pattern, sizeof pattern, "%s/frame_%%0%dd.png", r->o.out,
@@ -111,15 +111,10 @@ static int turntable_encode(const run *r)
     extern char **environ;
     pid_t pid;
     int error = posix_spawnp(&pid, "ffmpeg", NULL, NULL, args, environ), status = 0;
-    if (error == ENOENT) {
-        fprintf(stderr,
-                "isorender: ffmpeg not found: frames are in %s; install ffmpeg to get an MP4\n",
-                r->o.out);
-        return 1;
-    }
     if (error != 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status) ||
         WEXITSTATUS(status) != 0) {
-        fprintf(stderr, "isorender: %s: ffmpeg failed; frames are in %s\n", r->o.mp4, r->o.out);
+        fprintf(stderr, "isorender: %s: ffmpeg failed%s\n", r->o.mp4,
+                error == ENOENT ? ": not found (install ffmpeg)" : "");
         remove(partial);
         return 1;
     }
@@ -132,6 +127,28 @@ static int turntable_encode(const run *r)
         fprintf(stderr, "isorender: %s: %s\n", r->o.mp4, strerror(errno));
         remove(partial);
         return 1;
+    }
+    if (tool_outputs_add(&r->outputs, r->o.mp4) != 0) {
+        fprintf(stderr, "isorender: %s: out of memory\n", r->o.mp4);
+        return 1;
+    }
+    return 0;
+}
+
+/* Whether `program` is an executable file in a folder of $PATH. */
+static int on_path(const char *program)
+{
+    const char *path = getenv("PATH");
+    while (path && *path) {
+        const char *end = strchr(path, ':');
+        size_t length = end ? (size_t)(end - path) : strlen(path);
+        char file[4096];
+        if (length > 0 && length < sizeof file - strlen(program) - 2) {
+            snprintf(file, sizeof file, "%.*s/%s", (int)length, path, program);
+            if (access(file, X_OK) == 0)
+                return 1;
+        }
+        path = end ? end + 1 : NULL;
     }
     return 0;
 }
@@ -154,10 +171,14 @@ static int turntable_frame(run *r, uint64_t f, ip_renderer **gl, uint8_t *rgba, 
                  r->o.out);
         return -1;
     }
-    r->writing = 1;
     if (ip_png_write(path, rgba, r->camera.width, r->camera.height, r->o.common.force, err) !=
         IP_OK)
         return -1;
+    if (tool_outputs_add(&r->outputs, path) != 0) {
+        err->code = IP_ERR_NOMEM;
+        snprintf(err->message, sizeof err->message, "%.900s: out of memory", path);
+        return -1;
+    }
     if (!r->o.common.quiet)
         printf("  frame %llu of %llu: %s, %llu triangles\n", (unsigned long long)f + 1,
                (unsigned long long)r->o.turntable, path, (unsigned long long)all_triangles(r));
@@ -166,7 +187,19 @@ static int turntable_frame(run *r, uint64_t f, ip_renderer **gl, uint8_t *rgba, 
 
 int turntable_run(run *r, ip_error *err)
 {
-    if (mkdir(r->o.out, 0777) != 0 && errno != EEXIST) {
+    if (r->o.mp4 && !on_path("ffmpeg")) { /* before any work: the frames alone are not asked */
+        fprintf(stderr, "isorender: %s: --mp4 needs ffmpeg, which is not on the PATH (Debian "
+                        "package ffmpeg)\n",
+                r->o.mp4);
+        return 1;
+    }
+    if (mkdir(r->o.out, 0777) == 0) {
+        if (tool_outputs_made_folder(&r->outputs, r->o.out) != 0) {
+            rmdir(r->o.out);
+            fprintf(stderr, "isorender: %s: out of memory\n", r->o.out);
+            return 1;
+        }
+    } else if (errno != EEXIST) {
         fprintf(stderr, "isorender: %s: %s\n", r->o.out, strerror(errno));
         return 1;
     }
@@ -195,5 +228,8 @@ int turntable_run(run *r, ip_error *err)
         return 1;
     if (!r->o.common.quiet)
         printf("%s: %llu frames in %s\n", r->o.file, (unsigned long long)r->o.turntable, r->o.out);
-    return r->o.mp4 ? turntable_encode(r) : 0;
+    if (r->o.mp4 && turntable_encode(r) != 0)
+        return 1;
+    tool_outputs_complete(&r->outputs);
+    return 0;
 }

@@ -1,0 +1,115 @@
+# A full or failing disk under every program's outputs (tests/helpers/fault_io.c, preloaded):
+# a run whose disk fills up, or whose fsync, link or rename fails, at any point (before its
+# first output, inside one, between two, at the last one's commit) fails with one line naming
+# the output and the error, exit 1, and leaves none of its outputs and no temporary file: a
+# run's outputs are a set, all of them or none.
+. "$(dirname "$0")/lib.sh"
+
+shim=$bin/tests/libfault_io.so
+# faulty VAR=VALUE... COMMAND...: COMMAND with the shim and the fault settings given
+faulty() {
+    set -- env LD_PRELOAD="$shim" "$@"
+    run_capture "$@"
+}
+# leaves_only FILE...: the folder holds exactly these files (hidden ones included)
+# (.out and .err are the test's own: run_capture's)
+leaves_only() {
+    [ "$(ls -A | grep -v -x -e .out -e .err | sort | tr '\n' ' ')" = \
+        "$(printf '%s\n' "$@" | sort | tr '\n' ' ')" ]
+}
+# failed_cleanly WHAT TEXT FILE...: exit 1, one line on stderr holding TEXT, and the folder
+# holds only FILE...
+failed_cleanly() {
+    what=$1 text=$2
+    shift 2
+    lines=$(printf '%s\n' "$err" | grep -c .)
+    check "$what: exit 1 (got $rc)" test "$rc" = 1
+    check "$what: one line naming the file and the error ($err)" \
+        sh -c '[ "$0" = 1 ] && printf "%s" "$1" | grep -qF -- "$2"' "$lines" "$err" "$text"
+    check "$what: none of the outputs, no temporary file ($(ls -A | tr '\n' ' '))" leaves_only "$@"
+}
+
+"$bin/isogen" sphere --dims 40x40x40 --type uint8 -o "$work/" --quiet
+raw=sphere_40x40x40_uint8.raw
+"$bin/isobrick" "$raw" -o s.ibv --brick-size 8 --quiet
+
+# The shim interposes write, pwrite, fsync, rename and linkat; where the programs' own
+# interceptors come first (the sanitizer runtimes), it cannot, and the test says so.
+mkdir probe
+faulty IP_FAULT_BYTES=0 "$bin/isogen" sphere --dims 8x8x8 --type uint8 -o probe/ --quiet
+if [ "$rc" = 0 ]; then
+    echo "SKIP: the fault shim cannot interpose the programs' writes here (a sanitizer runtime's" \
+         "interceptors come first)"
+    exit 77
+fi
+rm -rf probe
+
+# --- isogen: one output ---
+faulty IP_FAULT_BYTES=30000 "$bin/isogen" sphere --dims 40x40x30 --type uint8 -o "$work/" --quiet
+failed_cleanly "isogen, disk full inside the volume" "sphere_40x40x30_uint8.raw: write failed: No space left on device" "$raw" s.ibv
+faulty IP_FAULT_CALL=fsync IP_FAULT_ERRNO=EIO "$bin/isogen" sphere --dims 40x40x30 --type uint8 -o "$work/" --quiet
+failed_cleanly "isogen, fsync fails" "fsync failed: Input/output error" "$raw" s.ibv
+
+# --- isobrick: one output, written in parts by several threads ---
+size=$(stat -c %s s.ibv)
+for budget in 0 $((size / 2)) $((size - 1)); do
+    faulty IP_FAULT_BYTES=$budget "$bin/isobrick" "$raw" -o b.ibv --brick-size 8 --quiet
+    failed_cleanly "isobrick, disk full after $budget of $size bytes" "b.ibv" "$raw" s.ibv
+    check "... and it says the disk is full" sh -c 'printf "%s" "$0" | grep -q "No space left on device"' "$err"
+done
+for call in fsync linkat; do
+    faulty IP_FAULT_CALL=$call IP_FAULT_ERRNO=EIO "$bin/isobrick" "$raw" -o b.ibv --brick-size 8 --quiet
+    failed_cleanly "isobrick, $call fails" "b.ibv" "$raw" s.ibv
+done
+
+# --- isoinfo --stats ---
+faulty IP_FAULT_BYTES=10 "$bin/isoinfo" s.ibv --stats v.json
+failed_cleanly "isoinfo --stats, disk full" "v.json: write failed: No space left on device" "$raw" s.ibv
+
+# --- isorender: five outputs, written in this order ---
+outputs="i.png st.png m.ply p.csv r.json"
+render="$bin/isorender s.ibv --iso 128.5 --size 160x120 --software --quiet -o i.png --strip st.png
+        --mesh m.ply --progress p.csv --stats r.json"
+$render
+check "a run with room writes all five" test -s i.png -a -s st.png -a -s m.ply -a -s p.csv -a -s r.json
+# the byte each output starts at, in the order written
+start=0
+starts=""
+for f in $outputs; do
+    starts="$starts $start"
+    start=$((start + $(stat -c %s "$f")))
+done
+rm -f $outputs
+k=0
+for f in $outputs; do
+    k=$((k + 1))
+    first=$(echo $starts | cut -d' ' -f$k)
+    budget=$((first + 5))
+    faulty IP_FAULT_BYTES=$budget $render
+    failed_cleanly "isorender, disk full inside output $k ($f)" "$f: write failed: No space left on device" "$raw" s.ibv
+    faulty IP_FAULT_CALL=linkat IP_FAULT_NTH=$k IP_FAULT_ERRNO=EIO $render
+    failed_cleanly "isorender, output $k ($f) cannot be linked into place" "$f: cannot create: Input/output error" "$raw" s.ibv
+    faulty IP_FAULT_CALL=fsync IP_FAULT_NTH=$k IP_FAULT_ERRNO=EIO $render
+    failed_cleanly "isorender, output $k ($f) cannot be made durable" "$f: fsync failed: Input/output error" "$raw" s.ibv
+done
+# with --force and the outputs there before: the failed run takes away the new files it had
+# put in place (whose old versions it had replaced) and leaves the others as they were
+# (docs/reliability.md)
+$render
+mkdir old && cp $outputs old/
+faulty IP_FAULT_CALL=rename IP_FAULT_NTH=3 IP_FAULT_ERRNO=EIO $render --force
+check "isorender --force, the third rename fails: exit 1 ($err)" test "$rc" = 1
+check "... the two outputs it had replaced are gone" test ! -e i.png -a ! -e st.png
+check "... the three it had not reached are the old ones" \
+    sh -c 'cmp -s m.ply old/m.ply && cmp -s p.csv old/p.csv && cmp -s r.json old/r.json'
+check "... and no temporary file is left" leaves_only "$raw" s.ibv old m.ply p.csv r.json
+rm -rf old m.ply p.csv r.json
+
+# --- isorender --turntable: frames in a folder it makes ---
+frame=$( "$bin/isorender" s.ibv --iso 128.5 --size 160x120 --software --quiet -o one.png && stat -c %s one.png)
+rm -f one.png
+faulty IP_FAULT_BYTES=$((frame + frame / 2)) "$bin/isorender" s.ibv --iso 128.5 --size 160x120 \
+    --software --quiet --turntable 3 -o tt
+failed_cleanly "isorender --turntable, disk full at the second frame" "tt/frame_" "$raw" s.ibv
+check "... which said the disk is full" sh -c 'printf "%s" "$0" | grep -q "No space left on device"' "$err"
+finish
