@@ -19,8 +19,8 @@ void *__wrap_calloc(size_t count, size_t size);
 void *__wrap_realloc(void *p, size_t size);
 int __wrap_posix_memalign(void **out, size_t alignment, size_t size);
 
-static long fail_at;  /* the allocation to fail (1-based); 0: none */
-static long counted;  /* allocations counted since arming */
+static long fail_at;   /* the allocation to fail (1-based); 0: none */
+static long counted;   /* allocations counted since arming */
 static int failed_one; /* the armed allocation was reached and failed */
 
 /* 1 when this allocation is the one to fail. Single-threaded runs: plain counters. */
@@ -58,8 +58,8 @@ int __wrap_posix_memalign(void **out, size_t alignment, size_t size)
 static void check_error(ip_status st, const ip_error *err, const char *call)
 {
     CHECK_MSG(st < 0, "%s: status %d", call, (int)st);
-    CHECK_MSG(err->message[0] != '\0' && strchr(err->message, '\n') == NULL,
-              "%s: message \"%s\"", call, err->message);
+    CHECK_MSG(err->message[0] != '\0' && strchr(err->message, '\n') == NULL, "%s: message \"%s\"",
+              call, err->message);
 }
 
 /* One whole run on `raw` into `ibv`; returns 1 when every call succeeded. */

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #include "isoprop/bricker.h"
@@ -15,7 +16,8 @@ static const char usage[] =
     "Bricks INPUT (NAME_XxYxZ_TYPE.raw, any raw file with --dims/--type, .nrrd, .nhdr, .mhd,\n"
     "or a folder holding a DICOM series) into an LZ4-compressed brick file with min/max\n"
     "summaries and a level-of-detail pyramid.\n"
-    "  -o OUT.ibv          output (default: bricks/NAME.ibv)\n"
+    "  -o OUT.ibv          output (default: bricks/STEM.ibv, the input's name without its\n"
+    "                      extension: ch2.nii.gz gives bricks/ch2.ibv)\n"
     "  --dims XxYxZ        samples along x, y, z (raw input)\n"
     "  --type T            uint8, uint16, int16 or float32 (raw input)\n"
     "  --endian E          little (default) or big\n"
@@ -210,8 +212,12 @@ static int default_output(const char *input, char *out, size_t size)
     snprintf(name, sizeof name, "%.*s", (int)end, input);
     const char *base = strrchr(name, '/');
     base = base ? base + 1 : name;
+    /* the stem: without the extension, both parts of a compressed one (ch2.nii.gz: ch2) */
     const char *dot = strrchr(base, '.');
-    int len = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
+    size_t base_len = strlen(base);
+    if (base_len > 7 && strcasecmp(base + base_len - 7, ".nii.gz") == 0)
+        dot = base + base_len - 7;
+    int len = dot && dot != base ? (int)(dot - base) : (int)base_len;
     if (mkdir("bricks", 0777) != 0 && errno != EEXIST)
         return -1;
     return snprintf(out, size, "bricks/%.*s.ibv", len, base) < (int)size ? 0 : -1;

@@ -1,7 +1,9 @@
 /* The brick file layout: derived geometry, header and summary encoding, validation. */
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <xxhash.h>
 
 #include "internal.h"
@@ -357,11 +359,55 @@ static ip_status parse_orientation(const unsigned char *h, uint32_t version, con
     return IP_OK;
 }
 
+static int ends_with(const char *name, const char *suffix)
+{
+    size_t n = strlen(name), m = strlen(suffix);
+    return n >= m && strcasecmp(name + n - m, suffix) == 0;
+}
+
+/* What a file that is not a brick file holds, when it is one of the volumes the bricker reads
+ * (by its first `size` bytes and its name), or NULL: for a message that says to brick it. */
+static const char *volume_kind(const unsigned char *h, size_t size, const char *name)
+{
+    if (size >= 132 && memcmp(h + 128, "DICM", 4) == 0)
+        return "a DICOM file";
+    if (size >= 4 && (memcmp(h, "II*", 4) == 0 || memcmp(h, "MM\0*", 4) == 0 ||
+                      memcmp(h, "II+", 4) == 0 || memcmp(h, "MM\0+", 4) == 0))
+        return "a TIFF file";
+    if (size >= 4 && memcmp(h, "NRRD", 4) == 0)
+        return "an NRRD volume";
+    if (size >= 4 && (ip__load_u32le(h) == 348 || ip__load_u32le(h) == 540 ||
+                      ip__load_u32le(h) == 0x5c010000u || ip__load_u32le(h) == 0x1c020000u))
+        return "a NIfTI volume";
+    if (ends_with(name, ".nii.gz") || ends_with(name, ".nii"))
+        return "a NIfTI volume";
+    if (ends_with(name, ".nrrd") || ends_with(name, ".nhdr"))
+        return "an NRRD volume";
+    if (ends_with(name, ".mhd") || ends_with(name, ".mha"))
+        return "a MetaImage volume";
+    if (ends_with(name, ".tif") || ends_with(name, ".tiff"))
+        return "a TIFF file";
+    if (ends_with(name, ".raw"))
+        return "a raw volume";
+    return NULL;
+}
+
+/* Fails for a file that is not a brick file: saying to brick it first when it is a volume. */
+static ip_status not_a_brick_file(const unsigned char *h, size_t size, const char *name,
+                                  const char *why, ip_error *err)
+{
+    const char *kind = volume_kind(h, size, name);
+    if (kind)
+        return ip__fail(err, IP_ERR_FORMAT,
+                        "%s: %s, not a brick file: brick it first (isobrick %s)", name, kind, name);
+    return ip__fail(err, IP_ERR_FORMAT, "%s: %s", name, why);
+}
+
 static ip_status parse_header(const unsigned char *h, const char *name, unsigned flags,
                               ip_layout *layout, ip_error *err)
 {
     if (memcmp(h + IP_HDR_MAGIC, IP_MAGIC, IP_HDR_MAGIC_SIZE) != 0)
-        return ip__fail(err, IP_ERR_FORMAT, "%s: not a brick file (bad magic)", name);
+        return not_a_brick_file(h, IP_HEADER_SIZE, name, "not a brick file (bad magic)", err);
     uint32_t version = ip__load_u32le(h + IP_HDR_VERSION);
     if (version < 1 || version > IP_FORMAT_VERSION)
         return ip__fail(err, IP_ERR_UNSUPPORTED,
@@ -509,9 +555,12 @@ ip_status ip__format_parse_header(const unsigned char header[IP_HEADER_SIZE], ui
                                   const char *name, unsigned flags, ip_layout *layout,
                                   ip_error *err)
 {
-    if (file_size < IP_HEADER_SIZE)
-        return ip__fail(err, IP_ERR_FORMAT, "%s: %llu bytes is too short for a brick file", name,
-                        (unsigned long long)file_size);
+    if (file_size < IP_HEADER_SIZE) {
+        char why[96];
+        snprintf(why, sizeof why, "%llu bytes is too short for a brick file",
+                 (unsigned long long)file_size);
+        return not_a_brick_file(header, (size_t)file_size, name, why, err);
+    }
     ip_status st = parse_header(header, name, flags, layout, err);
     return st == IP_OK ? check_sections(layout, file_size, name, err) : st;
 }

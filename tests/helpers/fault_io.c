@@ -80,7 +80,7 @@ ssize_t pwrite(int fd, const void *buf, size_t count, off_t offset)
     size_t n = allowed(fd, count);
     if (n == 0 && count > 0)
         return -1;
-    return REAL(pwrite, ssize_t (*)(int, const void *, size_t, off_t))(fd, buf, n, offset);
+    return REAL(pwrite, ssize_t(*)(int, const void *, size_t, off_t))(fd, buf, n, offset);
 }
 
 ssize_t pwrite64(int fd, const void *buf, size_t count, off_t offset)
@@ -93,7 +93,7 @@ ssize_t write(int fd, const void *buf, size_t count)
     size_t n = allowed(fd, count);
     if (n == 0 && count > 0)
         return -1;
-    return REAL(write, ssize_t (*)(int, const void *, size_t))(fd, buf, n);
+    return REAL(write, ssize_t(*)(int, const void *, size_t))(fd, buf, n);
 }
 
 int fsync(int fd)
@@ -129,8 +129,8 @@ int linkat(int olddirfd, const char *oldpath, int newdirfd, const char *newpath,
         errno = fault_errno();
         return -1;
     }
-    return REAL(linkat, int (*)(int, const char *, int, const char *, int))(olddirfd, oldpath,
-                                                                          newdirfd, newpath, flags);
+    return REAL(linkat, int (*)(int, const char *, int, const char *, int))(
+        olddirfd, oldpath, newdirfd, newpath, flags);
 }
 
 int close(int fd)

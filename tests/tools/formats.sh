@@ -52,4 +52,25 @@ expect_error 1 "formats/notreally.tif: not a readable TIFF" "$bin/isobrick" form
 expect_error 1 "differ from the TIFF's" "$bin/isobrick" formats/stack.tif --dims 45x38x26 \
     -o bad.ibv
 check "no output after bad TIFFs" test ! -e bad.ibv
+
+# --- a volume where a brick file is wanted: say to brick it, with the command ---
+for input in formats/volume.nii.gz formats/stack.tif "$raw"; do
+    expect_error 1 "$input: " "$bin/isorender" "$input" --iso 0.5 -o v.png
+    check "isorender $input: names the command" \
+        sh -c 'printf "%s" "$0" | grep -qF "not a brick file: brick it first (isobrick $1)"' "$err" "$input"
+    expect_error 1 "brick it first (isobrick $input)" "$bin/isoinfo" "$input"
+done
+check "and writes nothing" test ! -e v.png
+# the default output is named for the input's stem: both parts of .nii.gz go
+run_capture "$bin/isobrick" formats/volume.nii.gz --brick-size 8 --quiet
+check "isobrick volume.nii.gz writes bricks/volume.ibv ($err)" test "$rc" = 0 -a -e bricks/volume.ibv
+check "... not bricks/volume.nii.ibv" test ! -e bricks/volume.nii.ibv
+# images are PNG, and named so
+expect_error 2 "-o v.jpg: images are written as PNG: name it .png" "$bin/isorender" raw.ibv \
+    --iso 0.5 -o v.jpg
+expect_error 2 "--strip s.gif: images are written as PNG" "$bin/isorender" raw.ibv --iso 0.5 \
+    -o v.png --strip s.gif
+check "no image under another name" test ! -e v.jpg -a ! -e v.png
+run_capture "$bin/isorender" raw.ibv --iso 0.5 -o V.PNG --quiet
+check "a .PNG name is a PNG name ($err)" test "$rc" = 0 -a -e V.PNG
 finish

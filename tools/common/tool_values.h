@@ -11,6 +11,14 @@
 int tool_fail(const char *program, const ip_error *err);
 int tool_usage_error(const char *program, const char *fmt, ...);
 
+/* Whether `path` names a PNG image by its extension (.png, any case): the only image format the
+ * programs write, so that no other name is given PNG bytes. */
+int tool_is_png_name(const char *path);
+
+/* The usage error (exit 2) for an image option whose file is not named .png; 0 when it is (or
+ * when path is NULL). */
+int tool_check_png_name(const char *program, const char *option, const char *path);
+
 /* Parses a non-negative integer option value; returns 0 on success, -1 on bad text. */
 int tool_parse_u64(const char *text, uint64_t *out);
 /* Parses the value of `option` as an integer from `least` to `most`, into *out. Returns 0, or

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "isoprop/version.h"
 #include "tool_common.h"
@@ -16,6 +17,20 @@ int tool_fail(const char *program, const ip_error *err)
     fprintf(stderr, "%s: %s\n", program,
             err->message[0] ? err->message : ip_status_message(err->code));
     return 1;
+}
+
+int tool_is_png_name(const char *path)
+{
+    size_t n = strlen(path);
+    return n > 4 && strcasecmp(path + n - 4, ".png") == 0;
+}
+
+int tool_check_png_name(const char *program, const char *option, const char *path)
+{
+    if (!path || tool_is_png_name(path))
+        return 0;
+    return tool_usage_error(program, "%s %s: images are written as PNG: name it .png", option,
+                            path);
 }
 
 int tool_usage_error(const char *program, const char *fmt, ...)

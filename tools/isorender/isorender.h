@@ -81,7 +81,7 @@ typedef struct run {
     uint64_t visible_triangles; /* triangles of the mesh that own a pixel of its image */
     int owners_known;           /* visible_triangles and the checkpoints' `visible` are set */
     const char *renderer_name;
-    char warning[600]; /* the --iso warning, "" when none */
+    char warning[600];    /* the --iso warning, "" when none */
     tool_outputs outputs; /* the files this run wrote: all of them, or none when it fails */
     strip_frames strip;
     uint64_t mesh_vertices, mesh_dropped; /* of the mesh file: vertices, degenerate triangles */

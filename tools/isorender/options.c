@@ -243,6 +243,10 @@ int parse_args(int argc, char **argv, options *o)
     if (o->axes && ip_overlay_axes_check(o->common.width, o->common.height, &why) != IP_OK)
         return tool_usage_error("isorender", "--%s", why.message); /* "--axes: the triad..." */
     rc = check_smooth_options(o);
+    if (!rc && !o->turntable)
+        rc = tool_check_png_name("isorender", "-o", o->out);
+    if (!rc)
+        rc = tool_check_png_name("isorender", "--strip", o->strip);
     if (rc)
         return rc;
     rc = check_turntable_options(o);

@@ -188,8 +188,9 @@ static int turntable_frame(run *r, uint64_t f, ip_renderer **gl, uint8_t *rgba, 
 int turntable_run(run *r, ip_error *err)
 {
     if (r->o.mp4 && !on_path("ffmpeg")) { /* before any work: the frames alone are not asked */
-        fprintf(stderr, "isorender: %s: --mp4 needs ffmpeg, which is not on the PATH (Debian "
-                        "package ffmpeg)\n",
+        fprintf(stderr,
+                "isorender: %s: --mp4 needs ffmpeg, which is not on the PATH (Debian "
+                "package ffmpeg)\n",
                 r->o.mp4);
         return 1;
     }

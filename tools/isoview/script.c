@@ -131,6 +131,11 @@ static int parse_command(viewer *v, char *line, command *c, ip_error *err)
     } else if (!strcmp(word, "screenshot")) {
         if (args != 1)
             goto arguments;
+        if (!tool_is_png_name(arg1)) {
+            set_error(err, IP_ERR_ARGUMENT,
+                      "screenshot %s: images are written as PNG: name it .png", arg1);
+            return -1;
+        }
         if (ip_output_check(arg1, v->o.common.force, err) != IP_OK)
             return -1;
         c->kind = COMMAND_SCREENSHOT;

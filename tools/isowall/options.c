@@ -114,6 +114,9 @@ int wall_parse_args(int argc, char **argv, wall_options *o)
         return tool_usage_error("isowall", "-o and --tiles-dir: one or the other");
     if (!o->out && !o->tiles_dir)
         o->out = "isowall.png";
+    if (o->out && !tool_is_png_name(o->out))
+        return tool_usage_error("isowall", "-o %s: images are written as PNG: name it .png",
+                                o->out);
     if (!o->unit_w) {
         o->unit_w = (o->tile_w + 7) / 8;
         o->unit_h = (o->tile_h + 7) / 8;
