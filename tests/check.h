@@ -14,15 +14,19 @@
 static int test_checks_passed;
 static int test_checks_failed;
 
-#define CHECK(cond)                                                                  \
-    do {                                                                             \
-        if (cond) {                                                                  \
-            test_checks_passed++;                                                    \
-        } else {                                                                     \
-            test_checks_failed++;                                                    \
-            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
-        }                                                                            \
-    } while (0)
+static inline int test_check(int ok, const char *file, int line, const char *condition)
+{
+    if (ok) {
+        test_checks_passed++;
+        return 1;
+    }
+    test_checks_failed++;
+    fprintf(stderr, "%s:%d: CHECK failed: %s\n", file, line, condition);
+    return 0;
+}
+
+/* CHECK(cond): an expression, 1 when cond held, else 0 (as CHECK_EQ and its kin below) */
+#define CHECK(cond) test_check((cond) ? 1 : 0, __FILE__, __LINE__, #cond)
 
 #define CHECK_MSG(cond, ...)                                                         \
     do {                                                                             \
@@ -227,8 +231,9 @@ static inline int test_check_near(const char *file, int line, const char *ea, co
     }
     test_checks_failed++;
     fprintf(stderr, "%s:%d: CHECK_NEAR failed: |%s - %s| <= %s\n", file, line, ea, eb, et);
-    fprintf(stderr, "    %s = %.17g\n    %s = %.17g\n    difference %.17g, tolerance %.17g\n", ea,
-            a, eb, b, fabs(a - b), tol);
+    test_value_print(ea, test_value_double(a));
+    test_value_print(eb, test_value_double(b));
+    fprintf(stderr, "    difference %.17g, tolerance %g\n", fabs(a - b), tol);
     return 0;
 }
 #define CHECK_NEAR(a, b, tol) test_check_near(__FILE__, __LINE__, #a, #b, #tol, a, b, tol)
@@ -252,6 +257,18 @@ static inline int test_check_mem_eq(const char *file, int line, const char *ea, 
 }
 #define CHECK_MEM_EQ(a, b, n) test_check_mem_eq(__FILE__, __LINE__, #a, #b, #n, a, b, n)
 
+/* Prints "    expr = "text"" (or NULL), or nothing where expr is that string literal. */
+static inline void test_string_print(const char *expr, const char *text)
+{
+    size_t n = text ? strlen(text) : 0;
+    if (!text && strcmp(expr, "NULL") == 0)
+        return;
+    if (text && expr[0] == '"' && strncmp(expr + 1, text, n) == 0 &&
+        strcmp(expr + 1 + n, "\"") == 0)
+        return;
+    fprintf(stderr, text ? "    %s = \"%s\"\n" : "    %s = %s\n", expr, text ? text : "NULL");
+}
+
 static inline int test_check_str_eq(const char *file, int line, const char *ea, const char *eb,
                                     const char *a, const char *b)
 {
@@ -261,8 +278,8 @@ static inline int test_check_str_eq(const char *file, int line, const char *ea, 
     }
     test_checks_failed++;
     fprintf(stderr, "%s:%d: CHECK_STR_EQ failed: %s equals %s\n", file, line, ea, eb);
-    fprintf(stderr, a ? "    %s = \"%s\"\n" : "    %s = %s\n", ea, a ? a : "NULL");
-    fprintf(stderr, b ? "    %s = \"%s\"\n" : "    %s = %s\n", eb, b ? b : "NULL");
+    test_string_print(ea, a);
+    test_string_print(eb, b);
     return 0;
 }
 #define CHECK_STR_EQ(a, b) test_check_str_eq(__FILE__, __LINE__, #a, #b, a, b)
