@@ -19,7 +19,7 @@ static inline void describe_fails(const char *path, const ip_input_overrides *ov
     CHECK_MSG(status == code, "%s: got %d (%s), expected %d", path, status, err.message, code);
     CHECK_CONTAINS(err.message, name);
     CHECK_CONTAINS(err.message, needle);
-    CHECK(strchr(err.message, '\n') == NULL);
+    CHECK_EQ(strchr(err.message, '\n'), NULL);
 }
 
 #endif

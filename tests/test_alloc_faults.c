@@ -134,7 +134,7 @@ done:
     return ok;
 }
 
-int main(void)
+static void check_every_allocation(void)
 {
     const char *dir = test_tmp_dir("test_alloc_faults");
     char raw[4200], ibv[4200], ply[4200];
@@ -167,6 +167,11 @@ int main(void)
     printf("test_alloc_faults: %ld runs, each allocation of the run failed once; %ld runs failed "
            "cleanly, the others absorbed the failure\n",
            runs, failures_seen);
-    CHECK(runs > 10);
-    return test_summary("test_alloc_faults");
+    CHECK_GT(runs, 10);
+}
+
+int main(int argc, char **argv)
+{
+    static const test_case cases[] = {TEST_CASE(check_every_allocation)};
+    return RUN_CASES(argc, argv, cases, "test_alloc_faults");
 }

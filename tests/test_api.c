@@ -114,9 +114,10 @@ static int all_zero(const uint64_t *words, size_t count)
 #define RESERVED_COUNT(s) (sizeof(s).reserved / sizeof(s).reserved[0])
 
 /* What the library fills keeps the reserved words zero, whatever the caller's memory held. */
-static void check_reserved_zero(const char *dir)
+static void check_reserved_zero(void)
 {
-    char raw[4096], ibv[4096];
+    const char *dir = test_tmp_dir("test_api");
+    char raw[4200], ibv[4200];
     ip_error err;
     ip_gen_params params = {0, IP_FIELD_SPHERE, {20, 18, 16}, IP_UINT8, 0.0, 1};
     snprintf(raw, sizeof raw, "%s/sphere_20x18x16_uint8.raw", dir);
@@ -178,11 +179,10 @@ static void check_reserved_zero(const char *dir)
     ip_store_close(store);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    check_sized_in();
-    check_later_caller();
-    check_entry_points();
-    check_reserved_zero(test_tmp_dir("test_api"));
-    return test_summary("test_api");
+    static const test_case cases[] = {TEST_CASE(check_sized_in), TEST_CASE(check_later_caller),
+                                      TEST_CASE(check_entry_points),
+                                      TEST_CASE(check_reserved_zero)};
+    return RUN_CASES(argc, argv, cases, "test_api");
 }

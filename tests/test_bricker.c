@@ -81,6 +81,8 @@ static void write_value(void *dst, size_t i, ip_type type, float v)
     }
 }
 
+static const char *scratch_dir; /* this program's scratch folder (setup) */
+
 static volume make_volume(const char *dir, const uint32_t dims[3], ip_type type, int fill,
                           char *path, size_t path_size)
 {
@@ -133,14 +135,16 @@ static void check_file(const char *ibv, const volume *v)
     float *sub = malloc(sizeof(float) * 2 * ip_layout_subblocks_per_brick(l));
     float *want = malloc(most * sizeof(float));
     REQUIRE(dst && work && sub && want);
-    CHECK(l->type == v->type && l->dims[0] == v->dims[0] && l->dims[2] == v->dims[2]);
-    CHECK(l->levels[l->level_count - 1].brick_count == 1);
+    CHECK_EQ(l->type, v->type);
+    CHECK_EQ(l->dims[0], v->dims[0]);
+    CHECK_EQ(l->dims[2], v->dims[2]);
+    CHECK_EQ(l->levels[l->level_count - 1].brick_count, 1);
     int sample_errors = 0, range_errors = 0;
     for (uint64_t g = 0; g < l->brick_count; g++) {
         uint32_t level, brick[3], origin[3], extent[3];
         ip_brick_coords(l, g, &level, brick);
         ip_brick_extent(l, level, brick, origin, extent);
-        CHECK(ip_store_read_brick(s, g, dst, work, &err) == IP_OK);
+        CHECK_EQ(ip_store_read_brick(s, g, dst, work, &err), IP_OK);
         uint32_t per = l->brick_edge / l->subblock_edge;
         for (uint32_t z = 0; z < extent[2]; z++)
             for (uint32_t y = 0; y < extent[1]; y++)
@@ -186,11 +190,12 @@ static void check_file(const char *ibv, const volume *v)
     }
     CHECK_MSG(sample_errors == 0, "%s: %d samples differ", ibv, sample_errors);
     CHECK_MSG(range_errors == 0, "%s: %d summaries differ", ibv, range_errors);
-    CHECK(ip_store_verify_octree(s, &err) == IP_OK);
+    CHECK_EQ(ip_store_verify_octree(s, &err), IP_OK);
     float level_lo = INFINITY, level_hi = -INFINITY;
     for (size_t i = 0; i < (size_t)v->dims[0] * v->dims[1] * v->dims[2]; i++)
         level_lo = fminf(level_lo, v->values[i]), level_hi = fmaxf(level_hi, v->values[i]);
-    CHECK(l->value_min == level_lo && l->value_max == level_hi);
+    CHECK_EQ(l->value_min, level_lo);
+    CHECK_EQ(l->value_max, level_hi);
     free(dst);
     free(work);
     free(sub);
@@ -267,9 +272,9 @@ static void round_trip_on(const char *dir, uint32_t x, uint32_t y, uint32_t z, i
     CHECK_MSG(brick_file(raw, ibv, b, s, threads, &r) == 0, "%s", raw);
     check_file(ibv, &v);
     if (fill == FILL_CONSTANT)
-        CHECK(r.bricks_constant == r.bricks);
+        CHECK_EQ(r.bricks_constant, r.bricks);
     if (fill == FILL_NOISE)
-        CHECK(r.bricks_constant == 0);
+        CHECK_EQ(r.bricks_constant, 0);
     free(v.values);
 }
 
@@ -305,8 +310,9 @@ static int same_files(const char *a, const char *b)
     return same;
 }
 
-static void test_deterministic(const char *dir)
+static void test_deterministic(void)
 {
+    const char *dir = scratch_dir;
     char raw[4096], a[4200], b[4200];
     uint32_t dims[3] = {70, 41, 37};
     volume v = make_volume(dir, dims, IP_UINT16, 0, raw, sizeof raw);
@@ -334,9 +340,10 @@ static int count_entries(const char *dir)
     return n;
 }
 
-static void test_cancel_and_limits(const char *dir)
+static void test_cancel_and_limits(void)
 {
-    char sub[4200], raw[4096], out[4400];
+    const char *dir = scratch_dir;
+    char sub[4200], raw[4460], out[4400];
     snprintf(sub, sizeof sub, "%s/cancel", dir);
     mkdir(sub, 0777);
     uint32_t dims[3] = {50, 40, 90};
@@ -349,23 +356,23 @@ static void test_cancel_and_limits(const char *dir)
     ip_bricker_options_default(&o);
     o.brick_edge = 8;
     o.progress = cancel_half;
-    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_ERR_CANCELLED);
-    CHECK(access(out, F_OK) != 0);
-    CHECK(count_entries(sub) == 1); /* only the input: no temporary or spill file left */
+    CHECK_EQ(ip_bricker_run(&desc, out, &o, NULL, &err), IP_ERR_CANCELLED);
+    CHECK_NE(access(out, F_OK), 0);
+    CHECK_EQ(count_entries(sub), 1); /* only the input: no temporary or spill file left */
 
     o.progress = NULL;
     o.memory_limit = 1024;
-    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_ERR_LIMIT);
+    CHECK_EQ(ip_bricker_run(&desc, out, &o, NULL, &err), IP_ERR_LIMIT);
     CHECK_CONTAINS(err.message, "MiB");
-    CHECK(access(out, F_OK) != 0);
+    CHECK_NE(access(out, F_OK), 0);
 
     o.memory_limit = 0;
-    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_OK);
-    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_ERR_EXISTS);
+    CHECK_EQ(ip_bricker_run(&desc, out, &o, NULL, &err), IP_OK);
+    CHECK_EQ(ip_bricker_run(&desc, out, &o, NULL, &err), IP_ERR_EXISTS);
     CHECK_CONTAINS(err.message, "out.ibv");
     o.force = 1;
-    CHECK(ip_bricker_run(&desc, out, &o, NULL, &err) == IP_OK);
-    CHECK(count_entries(sub) == 2);
+    CHECK_EQ(ip_bricker_run(&desc, out, &o, NULL, &err), IP_OK);
+    CHECK_EQ(count_entries(sub), 2);
     free(v.values);
 }
 
@@ -392,10 +399,10 @@ static void test_memory_plan(void)
     ip_error err;
     REQUIRE(ip_bricker_memory_needed(&desc, &o, &plan, &err) == IP_OK);
     CHECK_MSG(plan <= (uint64_t)1024 << 20, "plan %llu bytes", (unsigned long long)plan);
-    CHECK(plan >= (uint64_t)33 * 3072 * 3072 * 2);
+    CHECK_GE(plan, (uint64_t)33 * 3072 * 3072 * 2);
     o.memory_limit = 0;
     REQUIRE(ip_bricker_memory_needed(&desc, &o, &roomy, &err) == IP_OK);
-    CHECK(roomy - plan == (uint64_t)32 * 3072 * 3072 * 2);
+    CHECK_EQ(roomy - plan, (uint64_t)32 * 3072 * 3072 * 2);
     desc.dims[0] = desc.dims[1] = 2048;
     desc.dims[2] = 936;
     o.memory_limit = (uint64_t)1024 << 20;
@@ -451,8 +458,9 @@ static int direct_reads_work(const char *path)
  * of 8-cell bricks) are bricked: as they are, the next chunk read while one is encoded; under a
  * memory limit that leaves no room for the second chunk; and behind 100 bytes of a MetaImage
  * HeaderSize, an offset no direct read meets, so that every read goes through the page cache. */
-static void test_direct_reads(const char *dir)
+static void test_direct_reads(void)
 {
+    const char *dir = scratch_dir;
     char sub[4200], raw[4096], skewed[4400], mhd[4400], a[4400], b[4400], c[4400];
     snprintf(sub, sizeof sub, "%s/direct", dir);
     mkdir(sub, 0777);
@@ -498,23 +506,29 @@ static void test_direct_reads(const char *dir)
     REQUIRE(brick_limited(raw, a, 0, &ra) == 0);
     REQUIRE(brick_limited(raw, b, least, &rb) == 0);
     REQUIRE(brick_limited(mhd, c, 0, &rc) == 0);
-    CHECK(ra.read_overlap && !rb.read_overlap && rc.read_overlap);
-    CHECK(ra.memory_planned == most && rb.memory_planned == least);
+    CHECK(ra.read_overlap);
+    CHECK(!rb.read_overlap);
+    CHECK(rc.read_overlap);
+    CHECK_EQ(ra.memory_planned, most);
+    CHECK_EQ(rb.memory_planned, least);
     int direct = direct_reads_work(raw);
     printf("test_bricker: O_DIRECT reads %s here: %llu and %llu of %llu bytes read directly\n",
            direct ? "work" : "do not work", (unsigned long long)ra.bytes_direct,
            (unsigned long long)rb.bytes_direct, (unsigned long long)ra.input_bytes);
-    if (direct)
-        CHECK(ra.bytes_direct == ra.input_bytes && rb.bytes_direct == rb.input_bytes);
-    CHECK(rc.bytes_direct == 0);
+    if (direct) {
+        CHECK_EQ(ra.bytes_direct, ra.input_bytes);
+        CHECK_EQ(rb.bytes_direct, rb.input_bytes);
+    }
+    CHECK_EQ(rc.bytes_direct, 0);
     check_file(a, &v);
     CHECK_MSG(same_files(a, b), "%s and %s differ", a, b);
     CHECK_MSG(same_files(a, c), "%s and %s differ", a, c);
     free(v.values);
 }
 
-static void test_shared_data(const char *dir)
+static void test_shared_data(void)
 {
+    const char *dir = scratch_dir;
     const char *data = getenv("IP_SKIP_SHARED_DATA") ? NULL : getenv("IP_SHARED_DATA");
     DIR *d = data ? opendir(data) : NULL;
     if (!d) {
@@ -554,9 +568,9 @@ static void test_shared_data(const char *dir)
     closedir(d);
 }
 
-int main(void)
+static void test_round_trips(void)
 {
-    const char *dir = test_tmp_dir("test_bricker");
+    const char *dir = scratch_dir;
     for (int t = 0; t < IP_TYPE_COUNT; t++) {
         round_trip(dir, 2, 2, 2, (ip_type)t, 0, 32, 8);      /* tiny */
         round_trip(dir, 103, 94, 161, (ip_type)t, 0, 32, 8); /* odd dims */
@@ -570,12 +584,27 @@ int main(void)
         round_trip_on(dir, 131, 77, 70, (ip_type)t, FILL_NOISE, 16, 4, 1);
         round_trip_on(dir, 45, 52, 39, (ip_type)t, FILL_NOISE, 8, 2, 2);
     }
+}
+
+static void test_round_trips_hc(void)
+{
     for (int t = 0; t < IP_TYPE_COUNT; t++)
-        round_trip_hc(dir, (ip_type)t);
-    test_deterministic(dir);
-    test_cancel_and_limits(dir);
-    test_memory_plan();
-    test_direct_reads(dir);
-    test_shared_data(dir);
-    return test_summary("test_bricker");
+        round_trip_hc(scratch_dir, (ip_type)t);
+}
+
+static const test_case cases[] = {
+    TEST_CASE(test_round_trips),   TEST_CASE(test_round_trips_hc),
+    TEST_CASE(test_deterministic), TEST_CASE(test_cancel_and_limits),
+    TEST_CASE(test_memory_plan),   TEST_CASE(test_direct_reads),
+    TEST_CASE(test_shared_data),
+};
+
+static void make_scratch_dir(void)
+{
+    scratch_dir = test_tmp_dir("test_bricker");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_bricker", make_scratch_dir, NULL);
 }

@@ -18,6 +18,11 @@
 #define GROUPS_PER_EDGE (8 / IP_CELL_GROUP)
 #define BRICK_BYTES (736 + GROUPS_PER_EDGE * GROUPS_PER_EDGE * GROUPS_PER_EDGE * 2)
 
+/* What the cases share: the scratch folder, a brick file in it and the store open on it. */
+static const char *scratch_dir;
+static char scratch_ibv[4200];
+static ip_store *the_store;
+
 /* 33^3 uint8 samples, B = 8: 4x4x4 full level-0 bricks, then the pyramid. Sample value
  * depends on the brick so contents can be checked. */
 static void make_file(const char *dir, char *ibv, size_t size)
@@ -85,12 +90,14 @@ static void pin_unpin(ip_cache *c, uint64_t g)
     ip_brick b;
     ip_error err;
     REQUIRE(ip_cache_pin_brick(c, g, &b, &err) == IP_OK);
-    CHECK(b.index == g && brick_ok(&b));
+    CHECK_EQ(b.index, g);
+    CHECK(brick_ok(&b));
     ip_cache_unpin_brick(c, &b);
 }
 
-static void test_scripted_lru(const ip_store *s)
+static void test_scripted_lru(void)
 {
+    const ip_store *s = the_store;
     ip_cache *c;
     ip_cache_stats st;
     REQUIRE(ip_cache_create(s, 4 * BRICK_BYTES, &c, NULL) == IP_OK);
@@ -102,34 +109,46 @@ static void test_scripted_lru(const ip_store *s)
     CHECK_MSG(st.hits == 3 && st.misses == 7 && st.evictions == 3,
               "hits %llu misses %llu evictions %llu", (unsigned long long)st.hits,
               (unsigned long long)st.misses, (unsigned long long)st.evictions);
-    CHECK(st.resident_bytes == 4 * BRICK_BYTES && st.resident_peak_bytes == 4 * BRICK_BYTES);
-    CHECK(st.bricks_touched == 5 && st.bytes_decompressed == 7 * SAMPLE_BYTES);
-    CHECK(st.pinned_bytes == 0 && st.over_budget_pins == 0);
+    CHECK_EQ(st.resident_bytes, 4 * BRICK_BYTES);
+    CHECK_EQ(st.resident_peak_bytes, 4 * BRICK_BYTES);
+    CHECK_EQ(st.bricks_touched, 5);
+    CHECK_EQ(st.bytes_decompressed, 7 * SAMPLE_BYTES);
+    CHECK_EQ(st.pinned_bytes, 0);
+    CHECK_EQ(st.over_budget_pins, 0);
     /* brick 4 was evicted last: asking again is a miss; brick 2 (just used) is a hit */
     pin_unpin(c, 2);
     pin_unpin(c, 4);
     ip_cache_get_stats(c, &st);
-    CHECK(st.hits == 4 && st.misses == 8 && st.evictions == 4);
+    CHECK_EQ(st.hits, 4);
+    CHECK_EQ(st.misses, 8);
+    CHECK_EQ(st.evictions, 4);
     /* trimming: keep one brick's worth (the most recent, 4), then all but the pinned one */
-    CHECK(ip_cache_trim(c, BRICK_BYTES) == 3 * BRICK_BYTES);
+    CHECK_EQ(ip_cache_trim(c, BRICK_BYTES), 3 * BRICK_BYTES);
     ip_cache_get_stats(c, &st);
-    CHECK(st.resident_bytes == BRICK_BYTES && st.resident_bricks == 1 && st.evictions == 4);
+    CHECK_EQ(st.resident_bytes, BRICK_BYTES);
+    CHECK_EQ(st.resident_bricks, 1);
+    CHECK_EQ(st.evictions, 4);
     pin_unpin(c, 4);
     ip_cache_get_stats(c, &st);
-    CHECK(st.hits == 5 && st.misses == 8);
+    CHECK_EQ(st.hits, 5);
+    CHECK_EQ(st.misses, 8);
     ip_brick held;
     REQUIRE(ip_cache_pin_brick(c, 0, &held, NULL) == IP_OK);
-    CHECK(ip_cache_trim(c, 0) == BRICK_BYTES); /* brick 4 goes, pinned brick 0 stays */
+    CHECK_EQ(ip_cache_trim(c, 0), BRICK_BYTES); /* brick 4 goes, pinned brick 0 stays */
     ip_cache_get_stats(c, &st);
-    CHECK(st.resident_bytes == BRICK_BYTES && st.pinned_bytes == BRICK_BYTES);
+    CHECK_EQ(st.resident_bytes, BRICK_BYTES);
+    CHECK_EQ(st.pinned_bytes, BRICK_BYTES);
     CHECK(brick_ok(&held));
     ip_cache_unpin_brick(c, &held);
-    CHECK(ip_cache_trim(c, 0) == BRICK_BYTES);
+    CHECK_EQ(ip_cache_trim(c, 0), BRICK_BYTES);
     ip_cache_get_stats(c, &st);
-    CHECK(st.resident_bytes == 0 && st.resident_bricks == 0 && st.evictions == 4);
+    CHECK_EQ(st.resident_bytes, 0);
+    CHECK_EQ(st.resident_bricks, 0);
+    CHECK_EQ(st.evictions, 4);
     pin_unpin(c, 0); /* loads again */
     ip_cache_get_stats(c, &st);
-    CHECK(st.misses == 10 && st.resident_bytes == BRICK_BYTES);
+    CHECK_EQ(st.misses, 10);
+    CHECK_EQ(st.resident_bytes, BRICK_BYTES);
     ip_cache_destroy(c);
 
     /* a long pseudo-random sequence against the model, for several budgets */
@@ -149,13 +168,14 @@ static void test_scripted_lru(const ip_store *s)
                   (unsigned long long)st.hits, (unsigned long long)st.misses,
                   (unsigned long long)st.evictions, (unsigned long long)m.hits,
                   (unsigned long long)m.misses, (unsigned long long)m.evictions);
-        CHECK(st.resident_peak_bytes <= (uint64_t)capacity * BRICK_BYTES);
+        CHECK_LE(st.resident_peak_bytes, (uint64_t)capacity * BRICK_BYTES);
         ip_cache_destroy(c);
     }
 }
 
-static void test_pinning(const ip_store *s)
+static void test_pinning(void)
 {
+    const ip_store *s = the_store;
     ip_cache *c;
     ip_cache_stats st;
     ip_brick held[5];
@@ -164,9 +184,10 @@ static void test_pinning(const ip_store *s)
     for (uint64_t g = 0; g < 5; g++)
         REQUIRE(ip_cache_pin_brick(c, g, &held[g], &err) == IP_OK);
     ip_cache_get_stats(c, &st);
-    CHECK(st.over_budget_pins == 1); /* the fifth found every resident brick pinned */
-    CHECK(st.resident_bytes == 5 * BRICK_BYTES && st.pinned_bytes == 5 * BRICK_BYTES);
-    CHECK(st.evictions == 0);
+    CHECK_EQ(st.over_budget_pins, 1); /* the fifth found every resident brick pinned */
+    CHECK_EQ(st.resident_bytes, 5 * BRICK_BYTES);
+    CHECK_EQ(st.pinned_bytes, 5 * BRICK_BYTES);
+    CHECK_EQ(st.evictions, 0);
     /* pinned bricks survive other traffic */
     pin_unpin(c, 6);
     pin_unpin(c, 7);
@@ -177,12 +198,12 @@ static void test_pinning(const ip_store *s)
     /* a second pin of a pinned brick is a hit on the same samples */
     ip_brick again;
     REQUIRE(ip_cache_pin_brick(c, 2, &again, &err) == IP_OK);
-    CHECK(again.samples == held[2].samples);
+    CHECK_EQ(again.samples, held[2].samples);
     ip_cache_unpin_brick(c, &again);
     for (int i = 0; i < 5; i++)
         ip_cache_unpin_brick(c, &held[i]);
     ip_cache_get_stats(c, &st);
-    CHECK(st.pinned_bytes == 0);
+    CHECK_EQ(st.pinned_bytes, 0);
     /* unpinned, the next miss brings the cache back within its budget */
     pin_unpin(c, 20);
     ip_cache_get_stats(c, &st);
@@ -191,8 +212,9 @@ static void test_pinning(const ip_store *s)
     ip_cache_destroy(c);
 }
 
-static void test_corrupt_brick(const char *dir, const char *ibv)
+static void test_corrupt_brick(void)
 {
+    const char *dir = scratch_dir, *ibv = scratch_ibv;
     char bad[4200];
     snprintf(bad, sizeof bad, "%s/corrupt.ibv", dir);
     char cmd[9000];
@@ -216,7 +238,7 @@ static void test_corrupt_brick(const char *dir, const char *ibv)
     ip_cache *c;
     REQUIRE(ip_cache_create(s, 1 << 20, &c, NULL) == IP_OK);
     ip_brick b;
-    CHECK(ip_cache_pin_brick(c, 21, &b, &err) == IP_ERR_CHECKSUM);
+    CHECK_EQ(ip_cache_pin_brick(c, 21, &b, &err), IP_ERR_CHECKSUM);
     CHECK_CONTAINS(err.message, "corrupt.ibv");
     CHECK_CONTAINS(err.message, "brick 21");
     int others = 1;
@@ -231,8 +253,9 @@ static void test_corrupt_brick(const char *dir, const char *ibv)
     CHECK(others);
     ip_cache_stats st;
     ip_cache_get_stats(c, &st);
-    CHECK(st.errors == 1 && st.misses == ip_store_layout(s)->brick_count - 1);
-    CHECK(ip_cache_pin_brick(c, 21, &b, &err) == IP_ERR_CHECKSUM); /* still reported */
+    CHECK_EQ(st.errors, 1);
+    CHECK_EQ(st.misses, ip_store_layout(s)->brick_count - 1);
+    CHECK_EQ(ip_cache_pin_brick(c, 21, &b, &err), IP_ERR_CHECKSUM); /* still reported */
     ip_cache_destroy(c);
     ip_store_close(s);
 }
@@ -296,8 +319,9 @@ static void run_hammer(const ip_store *s, uint64_t budget, int threads, int roun
     ip_cache_destroy(cache);
 }
 
-static void test_threads(const ip_store *s)
+static void test_threads(void)
 {
+    const ip_store *s = the_store;
     const ip_layout *l = ip_store_layout(s);
     ip_cache_stats st;
     int bad;
@@ -306,27 +330,31 @@ static void test_threads(const ip_store *s)
      * threads miss on it together */
     run_hammer(s, 64ull << 20, 8, 3000, &st, &bad, &pins);
     CHECK(!bad);
-    CHECK(st.hits + st.misses == pins);
+    CHECK_EQ(st.hits + st.misses, pins);
     CHECK_MSG(st.misses == st.bricks_touched, "misses %llu touched %llu",
               (unsigned long long)st.misses, (unsigned long long)st.bricks_touched);
-    CHECK(st.bricks_touched == l->brick_count && st.evictions == 0 && st.errors == 0);
-    CHECK(st.pinned_bytes == 0);
+    CHECK_EQ(st.bricks_touched, l->brick_count);
+    CHECK_EQ(st.evictions, 0);
+    CHECK_EQ(st.errors, 0);
+    CHECK_EQ(st.pinned_bytes, 0);
     /* a budget for a sixth of the bricks: constant eviction under contention */
     run_hammer(s, 12 * BRICK_BYTES, 8, 3000, &st, &bad, &pins);
     CHECK(!bad);
-    CHECK(st.hits + st.misses == pins);
-    CHECK(st.misses == st.resident_bricks + st.evictions);
-    CHECK(st.pinned_bytes == 0 && st.errors == 0);
+    CHECK_EQ(st.hits + st.misses, pins);
+    CHECK_EQ(st.misses, st.resident_bricks + st.evictions);
+    CHECK_EQ(st.pinned_bytes, 0);
+    CHECK_EQ(st.errors, 0);
     CHECK_MSG(st.resident_bytes <= 12 * BRICK_BYTES || st.over_budget_pins > 0, "resident %llu",
               (unsigned long long)st.resident_bytes);
-    CHECK(st.resident_peak_bytes <= (12 + 16) * BRICK_BYTES); /* budget + what 8 threads pin */
+    CHECK_LE(st.resident_peak_bytes, (12 + 16) * BRICK_BYTES); /* budget + what 8 threads pin */
 }
 
 /* The cell-group ranges (ip_brick.group_ranges) of every brick of every level, against the
  * least and greatest corner of the group's cells sample by sample; dims whose bricks end with
  * cell counts that IP_CELL_GROUP does not divide (a last group narrower), int16 samples. */
-static void test_group_ranges(const char *dir)
+static void test_group_ranges(void)
 {
+    const char *dir = scratch_dir;
     char raw[4200], ibv[4200];
     snprintf(raw, sizeof raw, "%s/groups_27x22x19_int16.raw", dir);
     snprintf(ibv, sizeof ibv, "%s/groups.ibv", dir);
@@ -378,14 +406,16 @@ static void test_group_ranges(const char *dir)
     }
     CHECK_MSG(bad == 0, "%llu of %llu cell groups with a wrong range", (unsigned long long)bad,
               (unsigned long long)groups);
-    CHECK(odd > 0 && groups > 0);
+    CHECK_GT(odd, 0);
+    CHECK_GT(groups, 0);
     ip_cache_destroy(c);
     ip_store_close(s);
 }
 
 /* ip__cache_pin_resident(): a pin of what is resident, never a read */
-static void test_pin_resident(const ip_store *s)
+static void test_pin_resident(void)
 {
+    const ip_store *s = the_store;
     ip_cache *c;
     ip_cache_stats st;
     ip_brick b;
@@ -393,33 +423,47 @@ static void test_pin_resident(const ip_store *s)
     CHECK(!ip__cache_pin_resident(c, 3, &b)); /* not resident: nothing read, nothing touched */
     CHECK(!ip__cache_pin_resident(c, 1u << 30, &b)); /* no such brick */
     ip_cache_get_stats(c, &st);
-    CHECK(st.misses == 0 && st.hits == 0 && st.resident_bytes == 0 && st.bricks_touched == 0);
+    CHECK_EQ(st.misses, 0);
+    CHECK_EQ(st.hits, 0);
+    CHECK_EQ(st.resident_bytes, 0);
+    CHECK_EQ(st.bricks_touched, 0);
     pin_unpin(c, 3);
-    CHECK(ip__cache_pin_resident(c, 3, &b)); /* resident now: a hit on the same brick */
-    CHECK(b.index == 3 && brick_ok(&b));
+    if (!CHECK(ip__cache_pin_resident(c, 3, &b))) { /* resident now: a hit on the same brick */
+        ip_cache_destroy(c);
+        return;
+    }
+    CHECK_EQ(b.index, 3);
+    CHECK(brick_ok(&b));
     ip_cache_get_stats(c, &st);
-    CHECK(st.misses == 1 && st.hits == 1 && st.pinned_bytes == BRICK_BYTES);
+    CHECK_EQ(st.misses, 1);
+    CHECK_EQ(st.hits, 1);
+    CHECK_EQ(st.pinned_bytes, BRICK_BYTES);
     ip_cache_unpin_brick(c, &b);
     ip_cache_get_stats(c, &st);
-    CHECK(st.pinned_bytes == 0);
+    CHECK_EQ(st.pinned_bytes, 0);
     ip_cache_destroy(c);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_scripted_lru), TEST_CASE(test_pinning),       TEST_CASE(test_pin_resident),
+    TEST_CASE(test_threads),      TEST_CASE(test_corrupt_brick), TEST_CASE(test_group_ranges),
+};
+
+static void open_store(void)
 {
-    const char *dir = test_tmp_dir("test_cache");
-    char ibv[4200];
-    make_file(dir, ibv, sizeof ibv);
-    ip_store *s;
+    scratch_dir = test_tmp_dir("test_cache");
+    make_file(scratch_dir, scratch_ibv, sizeof scratch_ibv);
     ip_error err;
-    REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
-    REQUIRE(ip_store_layout(s)->levels[0].brick_count == 64);
-    test_scripted_lru(s);
-    test_pinning(s);
-    test_pin_resident(s);
-    test_threads(s);
-    ip_store_close(s);
-    test_corrupt_brick(dir, ibv);
-    test_group_ranges(dir);
-    return test_summary("test_cache");
+    REQUIRE(ip_store_open(scratch_ibv, &the_store, &err) == IP_OK);
+    REQUIRE(ip_store_layout(the_store)->levels[0].brick_count == 64);
+}
+
+static void close_store(void)
+{
+    ip_store_close(the_store);
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_cache", open_store, close_store);
 }

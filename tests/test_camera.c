@@ -52,10 +52,10 @@ static void check_up_orthonormal(const ip_camera *c, const char *what)
 static void test_distance_and_pixel_size(void)
 {
     ip_camera c = {{0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 90.0, 100, 50};
-    CHECK(NEAR(ip_camera_distance(&c), 10.0, 1e-12));
+    CHECK_NEAR(ip_camera_distance(&c), 10.0, 1e-12);
     /* a 90 degree field of view spans 2 * distance at the target: 20 world units / 50 px */
-    CHECK(NEAR(ip_camera_pixel_size(&c, 50), 0.4, 1e-12));
-    CHECK(NEAR(ip_camera_pixel_size(&c, 100), 0.2, 1e-12));
+    CHECK_NEAR(ip_camera_pixel_size(&c, 50), 0.4, 1e-12);
+    CHECK_NEAR(ip_camera_pixel_size(&c, 100), 0.2, 1e-12);
 }
 
 static void test_orbit(void)
@@ -122,18 +122,19 @@ static void test_pan(void)
     }
     CHECK(same_point(eye_move, target_move, 1e-12));
     /* by the asked world units along right and up */
-    CHECK(NEAR(dot(eye_move, b.right), 1.5, 1e-12));
-    CHECK(NEAR(dot(eye_move, b.up), -0.75, 1e-12));
-    CHECK(NEAR(dot(eye_move, b.forward), 0.0, 1e-12));
+    CHECK_NEAR(dot(eye_move, b.right), 1.5, 1e-12);
+    CHECK_NEAR(dot(eye_move, b.up), -0.75, 1e-12);
+    CHECK_NEAR(dot(eye_move, b.forward), 0.0, 1e-12);
     /* the view direction, the distance and up stay */
     direction(&start, d0);
     direction(&c, d1);
     CHECK(same_point(d0, d1, 1e-12));
-    CHECK(NEAR(ip_camera_distance(&c), ip_camera_distance(&start), 1e-12));
+    CHECK_NEAR(ip_camera_distance(&c), ip_camera_distance(&start), 1e-12);
     CHECK(same_point(c.up, start.up, 0.0));
     /* and back */
     ip_camera_pan(&c, -1.5, 0.75);
-    CHECK(same_point(c.eye, start.eye, 1e-12) && same_point(c.target, start.target, 1e-12));
+    CHECK(same_point(c.eye, start.eye, 1e-12));
+    CHECK(same_point(c.target, start.target, 1e-12));
 }
 
 static void test_dolly(void)
@@ -147,30 +148,34 @@ static void test_dolly(void)
     CHECK_MSG(NEAR(ip_camera_distance(&c), distance / 2.0, 1e-12), "%.17g", ip_camera_distance(&c));
     direction(&c, d1);
     CHECK(same_point(d0, d1, 1e-12));
-    CHECK(same_point(c.target, start.target, 0.0) && same_point(c.up, start.up, 0.0));
+    CHECK(same_point(c.target, start.target, 0.0));
+    CHECK(same_point(c.up, start.up, 0.0));
 
     ip_camera_dolly(&c, 0.25, 0.0, INFINITY); /* away: twice the start */
-    CHECK(NEAR(ip_camera_distance(&c), 2.0 * distance, 1e-12));
+    CHECK_NEAR(ip_camera_distance(&c), 2.0 * distance, 1e-12);
     direction(&c, d1);
     CHECK(same_point(d0, d1, 1e-12));
 
     /* the limits */
     c = start;
     ip_camera_dolly(&c, 1e9, 0.5, 100.0);
-    CHECK(NEAR(ip_camera_distance(&c), 0.5, 1e-12));
+    CHECK_NEAR(ip_camera_distance(&c), 0.5, 1e-12);
     ip_camera_dolly(&c, 1e-9, 0.5, 100.0);
-    CHECK(NEAR(ip_camera_distance(&c), 100.0, 1e-9));
+    CHECK_NEAR(ip_camera_distance(&c), 100.0, 1e-9);
     direction(&c, d1);
     CHECK(same_point(d0, d1, 1e-12));
     ip_error err;
-    CHECK(ip_camera_check(&c, &err) == IP_OK);
+    CHECK_EQ(ip_camera_check(&c, &err), IP_OK);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_distance_and_pixel_size),
+    TEST_CASE(test_orbit),
+    TEST_CASE(test_pan),
+    TEST_CASE(test_dolly),
+};
+
+int main(int argc, char **argv)
 {
-    test_distance_and_pixel_size();
-    test_orbit();
-    test_pan();
-    test_dolly();
-    return test_summary("test_camera");
+    return RUN_CASES(argc, argv, cases, "test_camera");
 }

@@ -99,23 +99,27 @@ static ip_brick_entry round_trip(const void *samples, const uint32_t e[3], ip_ty
 {
     size_t count = (size_t)e[0] * e[1] * e[2], raw = count * ip_type_size(type);
     size_t bound = ip__codec_bound(count, type), work_size = ip__codec_work_size(count, type);
-    CHECK(bound >= raw);
+    CHECK_GE(bound, raw);
     unsigned char *out = guarded(bound), *work = guarded(work_size), *dst = guarded(raw);
     ip_brick_entry entry;
     memset(&entry, 0xEE, sizeof entry);
     CHECK_MSG(ip__codec_encode(samples, e, type, level, out, work, &entry) == IP_OK, "%s", what);
     CHECK_MSG(guard_intact(out, bound) && guard_intact(work, work_size), "%s: encode", what);
-    CHECK(entry.offset == 0);
+    CHECK_EQ(entry.offset, 0);
     CHECK_MSG(entry.encoding <= IP_BRICK_LZ4, "%s: encoding %u", what, entry.encoding);
     if (entry.encoding == IP_BRICK_CONSTANT) {
-        CHECK(entry.stored_size == 0 && entry.filters == 0 && entry.checksum == 0);
+        CHECK_EQ(entry.stored_size, 0);
+        CHECK_EQ(entry.filters, 0);
+        CHECK_EQ(entry.checksum, 0);
     } else if (entry.encoding == IP_BRICK_RAW) {
-        CHECK(entry.stored_size == raw && entry.filters == 0);
+        CHECK_EQ(entry.stored_size, raw);
+        CHECK_EQ(entry.filters, 0);
         CHECK_MSG(memcmp(out, samples, raw) == 0, "%s: raw payload", what); /* little-endian */
     } else {
         CHECK_MSG(entry.stored_size > 0 && entry.stored_size < raw, "%s: LZ4 of %u bytes for %zu",
                   what, entry.stored_size, raw);
-        CHECK((entry.filters & ~7u) == 0 && (entry.filters & 5u) != 5u);
+        CHECK_EQ(entry.filters & ~7u, 0);
+        CHECK_NE(entry.filters & 5u, 5u);
         /* shuffle is kept for wide samples, meaningless for bytes */
         CHECK_MSG((entry.filters & IP_FILTER_SHUFFLE) == (ip_type_size(type) > 1 ? 2u : 0u),
                   "%s: filters %u", what, entry.filters);
@@ -170,7 +174,9 @@ static void test_round_trips(void)
                         CHECK_MSG(entry.encoding == IP_BRICK_LZ4, "%s: compressible", what);
                     free(samples);
                 }
-    CHECK(seen[IP_BRICK_CONSTANT] > 0 && seen[IP_BRICK_RAW] > 0 && seen[IP_BRICK_LZ4] > 0);
+    CHECK_GT(seen[IP_BRICK_CONSTANT], 0);
+    CHECK_GT(seen[IP_BRICK_RAW], 0);
+    CHECK_GT(seen[IP_BRICK_LZ4], 0);
     printf("codec: %d constant, %d raw, %d LZ4 (%d with MED)\n", seen[0], seen[1], seen[2],
            seen[3]);
 }
@@ -184,7 +190,7 @@ static void test_constant_fill(void)
     for (int t = 0; t < IP_TYPE_COUNT; t++) {
         size_t raw = 60 * ip_type_size((ip_type)t);
         unsigned char *dst = guarded(raw);
-        CHECK(ip__codec_decode(&entry, NULL, e, (ip_type)t, values[t], dst, NULL) == IP_OK);
+        CHECK_EQ(ip__codec_decode(&entry, NULL, e, (ip_type)t, values[t], dst, NULL), IP_OK);
         int same = 1;
         for (size_t i = 0; i < 60; i++) {
             double v = t == IP_UINT8    ? ((uint8_t *)dst)[i]
@@ -294,7 +300,8 @@ static void test_decoder_against_spec(void)
                     CHECK_MSG(st == IP_OK && memcmp(dst, samples, raw) == 0,
                               "type %d, %ux%ux%u, %s, filters %u: status %d", t, e[0], e[1], e[2],
                               pattern_names[p], combos[c], (int)st);
-                    CHECK(guard_intact(dst, raw) && guard_intact(work, work_size));
+                    CHECK(guard_intact(dst, raw));
+                    CHECK(guard_intact(work, work_size));
                     free(samples);
                     free(payload);
                     free(dst);
@@ -364,7 +371,8 @@ static void test_malformed(void)
             st = ip__codec_decode(&bad, garbage, e, type, 0, dst, scratch);
             /* random bytes may happen to form a valid block of exactly the size: then OK */
             CHECK_MSG(st == IP_ERR_CORRUPT || st == IP_OK, "type %d: garbage: %d", t, (int)st);
-            CHECK(guard_intact(dst, raw) && guard_intact(scratch, work_size));
+            CHECK(guard_intact(dst, raw));
+            CHECK(guard_intact(scratch, work_size));
             free(dst);
             free(scratch);
         }
@@ -401,12 +409,13 @@ static void test_arguments(void)
     const uint32_t e[3] = {2, 2, 2}, empty[3] = {0, 2, 2};
     uint8_t samples[8] = {1, 2, 3, 4, 5, 6, 7, 8}, out[64], work[256];
     ip_brick_entry entry;
-    CHECK(ip__codec_encode(samples, empty, IP_UINT8, IP_LZ4_FAST, out, work, &entry) ==
-          IP_ERR_ARGUMENT);
-    CHECK(ip__codec_encode(samples, e, (ip_type)IP_TYPE_COUNT, IP_LZ4_FAST, out, work, &entry) ==
-          IP_ERR_ARGUMENT);
-    CHECK(ip__codec_bound(8, IP_UINT8) >= 8 && ip__codec_bound(100, IP_FLOAT32) >= 400);
-    CHECK(ip__codec_work_size(100, IP_UINT16) >= 3 * 200 + ip__codec_bound(100, IP_UINT16));
+    CHECK_EQ(ip__codec_encode(samples, empty, IP_UINT8, IP_LZ4_FAST, out, work, &entry),
+             IP_ERR_ARGUMENT);
+    CHECK_EQ(ip__codec_encode(samples, e, (ip_type)IP_TYPE_COUNT, IP_LZ4_FAST, out, work, &entry),
+             IP_ERR_ARGUMENT);
+    CHECK_GE(ip__codec_bound(8, IP_UINT8), 8);
+    CHECK_GE(ip__codec_bound(100, IP_FLOAT32), 400);
+    CHECK_GE(ip__codec_work_size(100, IP_UINT16), 3 * 200 + ip__codec_bound(100, IP_UINT16));
 }
 
 /* The fast level's filter choice: its payload is exactly the specification's encoding with
@@ -455,13 +464,16 @@ static void test_fast_filter_choice(void)
         }
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_arguments),
+    TEST_CASE(test_round_trips),
+    TEST_CASE(test_fast_filter_choice),
+    TEST_CASE(test_constant_fill),
+    TEST_CASE(test_decoder_against_spec),
+    TEST_CASE(test_malformed),
+};
+
+int main(int argc, char **argv)
 {
-    test_arguments();
-    test_round_trips();
-    test_fast_filter_choice();
-    test_constant_fill();
-    test_decoder_against_spec();
-    test_malformed();
-    return test_summary("test_codec");
+    return RUN_CASES(argc, argv, cases, "test_codec");
 }

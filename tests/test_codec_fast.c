@@ -320,9 +320,12 @@ static void test_real_volumes(void)
         printf("codec fast paths: %d blocks of real volumes\n", blocks);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_random_streams),
+    TEST_CASE(test_real_volumes),
+};
+
+int main(int argc, char **argv)
 {
-    test_random_streams();
-    test_real_volumes();
-    return test_summary("test_codec_fast");
+    return RUN_CASES(argc, argv, cases, "test_codec_fast");
 }

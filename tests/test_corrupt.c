@@ -351,7 +351,7 @@ static void check_payload_flips(const subject *s, const char *dir)
         copies++;
     }
     report(s->name, "one bit flipped in a payload", copies, runs, &verify);
-    CHECK(verify.errors == copies);
+    CHECK_EQ(verify.errors, copies);
     unlink(path);
     free(copy);
     free(bricks);
@@ -387,7 +387,8 @@ static void check_zero_pages(const subject *s, const char *dir)
         copies++;
     }
     report(s->name, "a 4 KiB page of the data section zeroed", copies, runs, &verify);
-    CHECK(copies > 0 && verify.errors == copies);
+    CHECK_GT(copies, 0);
+    CHECK_EQ(verify.errors, copies);
     unlink(path);
     free(copy);
 }
@@ -496,34 +497,87 @@ static void check_changing(const subject *s, const char *dir)
     REQUIRE(sigaction(SIGBUS, &old, NULL) == 0);
 }
 
-int main(void)
+/* The volumes, each opened as a subject (made and read once) by the first case that uses it and
+ * closed when a case uses the other one, or after the last case. */
+static const struct {
+    const char *name;
+    ip_field field;
+    uint32_t dims[3];
+    ip_type type;
+    uint32_t edge, subblock;
+    float iso;
+    const char *axis;
+} volumes[] = {
+    /* many small LZ4 bricks over four pyramid levels; the surface fills the volume */
+    {"gyroid-u16", IP_FIELD_GYROID, {34, 37, 29}, IP_UINT16, 8, 2, 2047.5f, "-y"},
+    /* float32 samples, raw and LZ4 bricks, constant bricks around the sphere */
+    {"sphere-f32", IP_FIELD_SPHERE, {30, 27, 33}, IP_FLOAT32, 4, 2, 0.1f, "+x"},
+};
+static const char *scratch_dir;
+static subject the_subject;
+static int subject_volume = -1; /* the volume the_subject holds, or -1 */
+
+static void close_the_subject(void)
 {
-    const char *dir = test_tmp_dir("test_corrupt");
-    struct {
-        const char *name;
-        ip_field field;
-        uint32_t dims[3];
-        ip_type type;
-        uint32_t edge, subblock;
-        float iso;
-        const char *axis;
-    } volumes[] = {
-        /* many small LZ4 bricks over four pyramid levels; the surface fills the volume */
-        {"gyroid-u16", IP_FIELD_GYROID, {34, 37, 29}, IP_UINT16, 8, 2, 2047.5f, "-y"},
-        /* float32 samples, raw and LZ4 bricks, constant bricks around the sphere */
-        {"sphere-f32", IP_FIELD_SPHERE, {30, 27, 33}, IP_FLOAT32, 4, 2, 0.1f, "+x"},
-    };
-    for (size_t v = 0; v < sizeof volumes / sizeof volumes[0]; v++) {
+    if (subject_volume >= 0)
+        close_subject(&the_subject);
+    subject_volume = -1;
+}
+
+static const subject *subject_of(int v)
+{
+    if (subject_volume != v) {
+        close_the_subject();
         char ibv[4200];
-        make_volume(dir, volumes[v].field, volumes[v].dims, volumes[v].type, volumes[v].edge,
-                    volumes[v].subblock, ibv, sizeof ibv);
-        subject s;
-        memset(&s, 0, sizeof s);
-        open_subject(&s, volumes[v].name, ibv, volumes[v].iso, volumes[v].axis);
-        check_payload_flips(&s, dir);
-        check_zero_pages(&s, dir);
-        check_changing(&s, dir);
-        close_subject(&s);
+        make_volume(scratch_dir, volumes[v].field, volumes[v].dims, volumes[v].type,
+                    volumes[v].edge, volumes[v].subblock, ibv, sizeof ibv);
+        memset(&the_subject, 0, sizeof the_subject);
+        open_subject(&the_subject, volumes[v].name, ibv, volumes[v].iso, volumes[v].axis);
+        subject_volume = v;
     }
-    return test_summary("test_corrupt");
+    return &the_subject;
+}
+
+static void gyroid_payload_flips(void)
+{
+    check_payload_flips(subject_of(0), scratch_dir);
+}
+static void gyroid_zero_pages(void)
+{
+    check_zero_pages(subject_of(0), scratch_dir);
+}
+static void gyroid_changing(void)
+{
+    check_changing(subject_of(0), scratch_dir);
+}
+static void sphere_payload_flips(void)
+{
+    check_payload_flips(subject_of(1), scratch_dir);
+}
+static void sphere_zero_pages(void)
+{
+    check_zero_pages(subject_of(1), scratch_dir);
+}
+static void sphere_changing(void)
+{
+    check_changing(subject_of(1), scratch_dir);
+}
+
+static const test_case cases[] = {
+    {"check_payload_flips:gyroid-u16", gyroid_payload_flips},
+    {"check_zero_pages:gyroid-u16", gyroid_zero_pages},
+    {"check_changing:gyroid-u16", gyroid_changing},
+    {"check_payload_flips:sphere-f32", sphere_payload_flips},
+    {"check_zero_pages:sphere-f32", sphere_zero_pages},
+    {"check_changing:sphere-f32", sphere_changing},
+};
+
+static void make_scratch_dir(void)
+{
+    scratch_dir = test_tmp_dir("test_corrupt");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_corrupt", make_scratch_dir, close_the_subject);
 }

@@ -149,8 +149,11 @@ static void check_view(scene *s, const char *what, const char *axis, float iso, 
     ip_mesh_init_with_cells(&full);
     ip_engine_counts fc;
     REQUIRE(ip_extract_full(s->cache, iso, 0, 0, &full, &fc, &err) == IP_OK);
-    CHECK(t.rays == (uint64_t)w * h && t.retired < t.rays && t.nodes > 0);
-    CHECK(part->triangle_count == t.triangles && full.triangle_count == fc.triangles);
+    CHECK_EQ(t.rays, (uint64_t)w * h);
+    CHECK_LT(t.retired, t.rays);
+    CHECK_GT(t.nodes, 0);
+    CHECK_EQ(part->triangle_count, t.triangles);
+    CHECK_EQ(full.triangle_count, fc.triangles);
     CHECK_MSG(part->triangle_count > 0 && part->triangle_count <= full.triangle_count,
               "%s %s: %llu progressive, %llu full triangles", what, axis,
               (unsigned long long)part->triangle_count, (unsigned long long)full.triangle_count);
@@ -189,16 +192,18 @@ static void check_view(scene *s, const char *what, const char *axis, float iso, 
     ip_engine_destroy(e);
 }
 
-/* Adaptive resolution on a long volume seen end-on, whose far half projects to less than a
- * pixel per cell: the far part comes from coarse levels, so fewer level-0 bricks are decoded,
- * and the image stays close to the full-resolution one. */
-static void check_lod(const char *dir)
+/* The long volume check_lod() and the checks after it look at, a gyroid of 24 x 24 x 512
+ * samples in bricks of 8: generated and bricked into dir/long.ibv by the first that runs. */
+static void long_volume(const char *dir, char *ibv, size_t size)
 {
-    char raw[4200], ibv[4200];
+    static int made;
+    snprintf(ibv, size, "%s/long.ibv", dir);
+    if (made)
+        return;
+    char raw[4200];
     ip_gen_params p = {sizeof(ip_gen_params), IP_FIELD_GYROID, {24, 24, 512}, IP_UINT8, 0.0, 1};
     ip_error err;
     snprintf(raw, sizeof raw, "%s/long_24x24x512_uint8.raw", dir);
-    snprintf(ibv, sizeof ibv, "%s/long.ibv", dir);
     REQUIRE(ip_generate_write(&p, raw, 1, &err) == IP_OK);
     ip_input_desc d;
     ip_bricker_options bo;
@@ -208,6 +213,17 @@ static void check_lod(const char *dir)
     bo.subblock_edge = 4;
     bo.force = 1;
     REQUIRE(ip_bricker_run(&d, ibv, &bo, NULL, &err) == IP_OK);
+    made = 1;
+}
+
+/* Adaptive resolution on a long volume seen end-on, whose far half projects to less than a
+ * pixel per cell: the far part comes from coarse levels, so fewer level-0 bricks are decoded,
+ * and the image stays close to the full-resolution one. */
+static void check_lod(const char *dir)
+{
+    char ibv[4200];
+    ip_error err;
+    long_volume(dir, ibv, sizeof ibv);
     scene s;
     open_scene(ibv, &s);
     ip_camera cam;
@@ -253,7 +269,8 @@ static void check_lod(const char *dir)
            "coverage differs on %zu of %zu pixels, mean colour difference %.2f %%\n",
            (unsigned long long)fine_misses[0], (unsigned long long)fine_misses[1],
            (unsigned long long)coarse_misses[1], coverage_diff, covered, 100 * colour_diff);
-    CHECK(coarse_misses[0] == 0 && coarse_misses[1] > 0);
+    CHECK_EQ(coarse_misses[0], 0);
+    CHECK_GT(coarse_misses[1], 0);
     CHECK_MSG(fine_misses[1] * 10 < fine_misses[0] * 7, "lod decoded %llu of %llu fine bricks",
               (unsigned long long)fine_misses[1], (unsigned long long)fine_misses[0]);
     CHECK_MSG(coverage_diff * 100 <= covered * LOD_COVERAGE_TOLERANCE_PCT,
@@ -275,7 +292,7 @@ static void check_lod(const char *dir)
 static void check_lod_exact(const char *dir)
 {
     char ibv[4200];
-    snprintf(ibv, sizeof ibv, "%s/long.ibv", dir); /* made by check_lod() */
+    long_volume(dir, ibv, sizeof ibv);
     scene s;
     open_scene(ibv, &s);
     static const struct {
@@ -327,7 +344,8 @@ static void check_lod_exact(const char *dir)
                           "lod view %zu, %d threads, occlusion %d: %llu triangles not in the "
                           "full extraction at its levels, %zu pixels differ",
                           v, threads, occlusion, (unsigned long long)missing, differ);
-                CHECK(part->triangle_count > 0 && part->triangle_count <= full.triangle_count);
+                CHECK_GT(part->triangle_count, 0);
+                CHECK_LE(part->triangle_count, full.triangle_count);
                 ip_engine_destroy(e);
             }
         printf("test_engine: lod exact, view %zu: %u levels, %llu triangles in the full "
@@ -351,7 +369,7 @@ static void check_lod_exact(const char *dir)
 static void check_reuse_exact(const char *dir)
 {
     char ibv[4200];
-    snprintf(ibv, sizeof ibv, "%s/long.ibv", dir); /* made by check_lod() */
+    long_volume(dir, ibv, sizeof ibv);
     scene s;
     open_scene(ibv, &s);
     const uint32_t w = 96, h = 72, n = w * h;
@@ -399,7 +417,7 @@ static void check_reuse_exact(const char *dir)
                           "extraction at its levels, %zu pixels differ (%llu kept)",
                           threads, cull, step, (unsigned long long)missing, differ,
                           (unsigned long long)t.kept);
-                CHECK(t.triangles == part->triangle_count);
+                CHECK_EQ(t.triangles, part->triangle_count);
                 ip_mesh_free(&full);
             }
             printf("test_engine: reuse, %d threads, cull %d: %llu of 7 views kept triangles\n",
@@ -411,7 +429,7 @@ static void check_reuse_exact(const char *dir)
             /* another isovalue keeps nothing */
             ip_engine_counts t;
             run_all_rays(e, &cam, 100.5f, &t);
-            CHECK(t.kept == 0);
+            CHECK_EQ(t.kept, 0);
             ip_engine_destroy(e);
         }
     free(ia);
@@ -427,7 +445,7 @@ static void check_reuse_exact(const char *dir)
 static void check_read_ahead(const char *dir)
 {
     char ibv[4200];
-    snprintf(ibv, sizeof ibv, "%s/long.ibv", dir); /* made by check_lod() */
+    long_volume(dir, ibv, sizeof ibv);
     ip_error err;
     ip_store *store;
     ip_cache *cache;
@@ -446,7 +464,7 @@ static void check_read_ahead(const char *dir)
     REQUIRE(ip_camera_fit_axis(lo, hi, "-x", 30.0, 96, 72, &a, &err) == IP_OK);
     REQUIRE(ip_camera_fit_axis(lo, hi, "+x", 30.0, 96, 72, &b, &err) == IP_OK);
     REQUIRE(ip_engine_begin(e, &a, 127.5f, &err) == IP_OK);
-    CHECK(ip_engine_read_ahead(e, &b, &err) == IP_ERR_ARGUMENT); /* not done yet */
+    CHECK_EQ(ip_engine_read_ahead(e, &b, &err), IP_ERR_ARGUMENT); /* not done yet */
     while (!ip_engine_done(e))
         REQUIRE(ip_engine_step(e, 0, 0, NULL, &err) == IP_OK);
     uint64_t triangles = ip_engine_mesh(e)->triangle_count;
@@ -463,13 +481,13 @@ static void check_read_ahead(const char *dir)
               "read ahead: %llu bricks loaded ahead (%llu of %llu touched before)",
               (unsigned long long)(after.prefetched - before.prefetched),
               (unsigned long long)before.bricks_touched, (unsigned long long)before.bricks_total);
-    CHECK(ip_engine_mesh(e)->triangle_count == triangles);
+    CHECK_EQ(ip_engine_mesh(e)->triangle_count, triangles);
     ip_camera bad = b;
     bad.fov_y = 0;
-    CHECK(ip_engine_read_ahead(e, &bad, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_engine_read_ahead(e, &bad, &err), IP_ERR_ARGUMENT);
     ip_engine_counts t;
     run_all_rays(e, &b, 127.5f, &t); /* begin stops the reader; the view as ever */
-    CHECK(t.rays == 96 * 72);
+    CHECK_EQ(t.rays, 96 * 72);
     ip_engine_destroy(e);
     ip_cache_destroy(cache);
     ip_store_close(store);
@@ -557,14 +575,16 @@ static void check_empty_space(scene *s, float iso)
     run_all_rays(e, &cam, iso, &t);
     ip_cache_stats st;
     ip_cache_get_stats(cache, &st);
-    CHECK(t.rays == 256 && t.seeds == 0);
+    CHECK_EQ(t.rays, 256);
+    CHECK_EQ(t.seeds, 0);
     CHECK_MSG(st.misses == 0 && st.bricks_touched == 0, "empty space decoded %llu bricks",
               (unsigned long long)st.misses);
     /* and the same engine on a view of the sphere does decode bricks */
     REQUIRE(ip_camera_fit_axis(s->lo, s->hi, "+z", 30.0, 32, 32, &cam, &err) == IP_OK);
     run_all_rays(e, &cam, iso, &t);
     ip_cache_get_stats(cache, &st);
-    CHECK(t.seeds > 0 && st.misses > 0);
+    CHECK_GT(t.seeds, 0);
+    CHECK_GT(st.misses, 0);
     ip_engine_destroy(e);
     ip_cache_destroy(cache);
 }
@@ -586,9 +606,9 @@ static void check_cancel_restart(scene *s, float iso_a, float iso_b)
     REQUIRE(ip_engine_create(s->cache, &o, &fresh, &err) == IP_OK);
     REQUIRE(ip_engine_begin(e, &cam, iso_a, &err) == IP_OK);
     REQUIRE(ip_engine_step(e, 300, 0, NULL, &err) == IP_OK);
-    CHECK(ip_engine_mesh(e)->triangle_count > 0);
+    CHECK_GT(ip_engine_mesh(e)->triangle_count, 0);
     ip_engine_cancel(e);
-    CHECK(ip_engine_step(e, 0, 0, NULL, &err) == IP_ERR_CANCELLED);
+    CHECK_EQ(ip_engine_step(e, 0, 0, NULL, &err), IP_ERR_CANCELLED);
     CHECK(!ip_engine_done(e));
     ip_engine_counts ta, tb;
     run_all_rays(e, &cam, iso_b, &ta);
@@ -665,9 +685,9 @@ static void check_depth_queue(void)
         REQUIRE(ip__depth_queue_push(&q, &c, depth) == IP_OK);
     }
     ip_queued_cell far[4];
-    CHECK(ip__depth_queue_take_far(&q, far, 4) == 4);
+    CHECK_EQ(ip__depth_queue_take_far(&q, far, 4), 4);
     for (int k = 0; k < 4; k++)
-        CHECK(far[k].max_versine >= 100.0 + 0.75 * IP_DEPTH_BUCKETS * 0.5 - 0.5);
+        CHECK_GE(far[k].max_versine, 100.0 + 0.75 * IP_DEPTH_BUCKETS * 0.5 - 0.5);
     unsigned taken = 4, out_of_order = 0;
     double last_bucket = -1;
     ip_queued_cell c;
@@ -687,7 +707,8 @@ static void check_depth_queue(void)
         REQUIRE(ip__depth_queue_push(&q, &one, 150.0 + i % 7) == IP_OK);
         wrong += !ip__depth_queue_pop(&q, &c) || c.cell[0] != i;
     }
-    CHECK(wrong == 0 && q.capacity == capacity);
+    CHECK_EQ(wrong, 0);
+    CHECK_EQ(q.capacity, capacity);
     ip_queued_cell left = {{7, 7, 7}, 0};
     REQUIRE(ip__depth_queue_push(&q, &left, 120.0) == IP_OK);
     ip__depth_queue_start(&q, 10.0, 1.0); /* leaves nothing of the cell above */
@@ -695,8 +716,11 @@ static void check_depth_queue(void)
     ip_queued_cell a = {{1, 0, 0}, 0}, b = {{2, 0, 0}, 0};
     REQUIRE(ip__depth_queue_push(&q, &a, 30.0) == IP_OK);
     REQUIRE(ip__depth_queue_push(&q, &b, 12.0) == IP_OK);
-    CHECK(ip__depth_queue_pop(&q, &c) && c.cell[0] == 2);
-    CHECK(ip__depth_queue_pop(&q, &c) && c.cell[0] == 1 && !ip__depth_queue_pop(&q, &c));
+    CHECK(ip__depth_queue_pop(&q, &c));
+    CHECK_EQ(c.cell[0], 2);
+    CHECK(ip__depth_queue_pop(&q, &c));
+    CHECK_EQ(c.cell[0], 1);
+    CHECK(!ip__depth_queue_pop(&q, &c));
     ip__depth_queue_free(&q);
 }
 
@@ -779,7 +803,9 @@ static void check_cull_mask(void)
     printf("test_engine: cull mask: %u triangles, %u within the margin of a pixel centre, %u "
            "culled wrongly, %u kept beyond it\n",
            tested, shown, wrong, extra);
-    CHECK(tested > 15000 && shown > tested / 10 && shown < tested - tested / 10);
+    CHECK_GT(tested, 15000);
+    CHECK_GT(shown, tested / 10);
+    CHECK_LT(shown, tested - tested / 10);
     CHECK_MSG(wrong == 0, "cull mask: %u of %u triangles culled wrongly", wrong, tested);
     CHECK_MSG(extra < tested / 100, "cull mask: %u of %u triangles kept beyond the margin", extra,
               tested);
@@ -838,7 +864,9 @@ static void check_coverage_indexed(void)
     printf("test_engine: indexed coverage: %u cells (%u shown), %u masks differ; %u of %u entries "
            "written, %u differ\n",
            cells, shown, differ, written, entries, unequal);
-    CHECK(cells > 3000 && shown > cells / 4 && written > entries / 4);
+    CHECK_GT(cells, 3000);
+    CHECK_GT(shown, cells / 4);
+    CHECK_GT(written, entries / 4);
     CHECK_MSG(differ == 0 && unequal == 0, "indexed coverage: %u masks, %u entries differ", differ,
               unequal);
     ip__coverage_free(&by_corner);
@@ -890,9 +918,13 @@ static void check_culling(scene *s, float iso)
                (unsigned long long)t[1].culled, (unsigned long long)t[0].triangles, differ);
         CHECK_MSG(differ == 0, "culling: %zu pixels differ after %llu rays", differ,
                   (unsigned long long)t[1].rays);
-        CHECK(t[0].rays == t[1].rays && t[0].cells == t[1].cells && t[0].culled == 0);
-        CHECK(t[1].culled > 0 && t[1].triangles + t[1].culled == t[0].triangles);
-        CHECK(kept->triangle_count == t[1].triangles && triangles_not_in(kept, whole) == 0);
+        CHECK_EQ(t[0].rays, t[1].rays);
+        CHECK_EQ(t[0].cells, t[1].cells);
+        CHECK_EQ(t[0].culled, 0);
+        CHECK_GT(t[1].culled, 0);
+        CHECK_EQ(t[1].triangles + t[1].culled, t[0].triangles);
+        CHECK_EQ(kept->triangle_count, t[1].triangles);
+        CHECK_EQ(triangles_not_in(kept, whole), 0);
     }
     for (int k = 0; k < 2; k++) {
         free(index[k]);
@@ -1002,7 +1034,7 @@ static void check_reach_box(void)
     double back_lo[3] = {-1, -1, -45}, back_hi[3] = {1, 1, -42};
     memset(reached, 0, sizeof reached);
     ip__reach_box(&basis, &cam, back_lo, back_hi, 3, tx, ty, reached);
-    CHECK(memchr(reached, 0, sizeof reached) == NULL);
+    CHECK_EQ(memchr(reached, 0, sizeof reached), NULL);
 }
 
 /* The tiles every brick holding `iso` may show in, brick by brick over each level's whole grid:
@@ -1195,7 +1227,8 @@ static void check_occlusion(const char *dir)
                       "occlusion %d, %d threads: %zu coverage, %zu colour differences from the "
                       "full extraction",
                       occlusion, threads, coverage_diff, colour_diff);
-            CHECK(owners > 0 && owners <= m->triangle_count);
+            CHECK_GT(owners, 0);
+            CHECK_LE(owners, m->triangle_count);
             CHECK(occlusion ? t.deferred > 0 : t.deferred == 0);
             ip_engine_destroy(e);
         }
@@ -1204,7 +1237,7 @@ static void check_occlusion(const char *dir)
         CHECK_MSG(10 * triangles[k][1] < 9 * triangles[k][0],
                   "%d threads: occlusion extracts %llu triangles, %llu without", k + 1,
                   (unsigned long long)triangles[k][1], (unsigned long long)triangles[k][0]);
-        CHECK(visible[k][1] == visible[k][0]);
+        CHECK_EQ(visible[k][1], visible[k][0]);
     }
     reference_close(&r);
     close_scene(&s);
@@ -1268,13 +1301,13 @@ static void check_retirement(const char *dir)
             CHECK_MSG(coverage_diff == 0 && colour_diff == 0,
                       "wall, occlusion %d, %d threads: %zu coverage, %zu colour differences",
                       occlusion, threads, coverage_diff, colour_diff);
-            CHECK(t.rays == n);
+            CHECK_EQ(t.rays, n);
             if (occlusion) /* more than the rays outside the wall: the wall's own retired */
                 CHECK_MSG(t.retired > n - covered + covered / 2,
                           "%d threads: %llu rays retired, %zu pixels covered of %zu", threads,
                           (unsigned long long)t.retired, covered, n);
             else
-                CHECK(t.retired == 0);
+                CHECK_EQ(t.retired, 0);
             nodes[occlusion] = t.nodes;
             ip_engine_destroy(e);
         }
@@ -1321,7 +1354,7 @@ static void check_ray_budgets(scene *s, float iso, uint32_t width, uint32_t heig
               (unsigned long long)pixels);
     ip_engine_counts t;
     ip_engine_totals(e, &t);
-    CHECK(t.rays == pixels);
+    CHECK_EQ(t.rays, pixels);
     ip_engine_destroy(e);
 }
 
@@ -1347,12 +1380,12 @@ static void check_regions(scene *s, float iso)
     o.threads = 2;
     for (int k = 0; k < 2; k++) {
         REQUIRE(ip_engine_create(s->cache, &o, &e[k], &err) == IP_OK);
-        CHECK(ip_engine_set_region(e[k], 0, 0, 1, 1, 0, 1, &err) == IP_ERR_ARGUMENT);
+        CHECK_EQ(ip_engine_set_region(e[k], 0, 0, 1, 1, 0, 1, &err), IP_ERR_ARGUMENT);
         REQUIRE(ip_engine_begin(e[k], &cam, iso, &err) == IP_OK);
     }
-    CHECK(ip_engine_set_region(e[0], W - 7, 0, 8, 1, 0, 1, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_engine_set_region(e[0], 0, 0, 0, 5, 0, 0, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_engine_set_region(e[0], 0, 0, 4, 4, 10, 7, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_engine_set_region(e[0], W - 7, 0, 8, 1, 0, 1, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_engine_set_region(e[0], 0, 0, 0, 5, 0, 0, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_engine_set_region(e[0], 0, 0, 4, 4, 10, 7, &err), IP_ERR_ARGUMENT);
     uint64_t rays = 0, exact = 0, regions = 0;
     for (int pass = 0; pass < 2; pass++)
         for (uint32_t y = 0; y < H; y += RH)
@@ -1393,8 +1426,9 @@ static void check_regions(scene *s, float iso)
             memcmp(part + 4 * (size_t)y * 40, want + 4 * ((y + 17) * (size_t)W + 31), 4 * 40) != 0;
     CHECK_MSG(part_diff == 0, "ip_raster_mesh_part: %zu rows differ from the whole image",
               part_diff);
-    CHECK(ip_raster_mesh_part(&full, &cam, NULL, s->lo, s->hi, W - 7, 0, 8, 1, depth, part, &err) ==
-          IP_ERR_ARGUMENT);
+    CHECK_EQ(
+        ip_raster_mesh_part(&full, &cam, NULL, s->lo, s->hi, W - 7, 0, 8, 1, depth, part, &err),
+        IP_ERR_ARGUMENT);
     memcpy(got, want, n * 4);
     for (int k = 0; k < 2; k++) {
         REQUIRE(ip_raster_mesh_part(ip_engine_mesh(e[k]), &cam, NULL, s->lo, s->hi, 0, 0, W, H,
@@ -1460,49 +1494,142 @@ static void check_shared_data(void)
     }
 }
 
-int main(void)
+/* The scenes the first cases share, each made and opened by the first case that looks at it and
+ * closed when a case looks at another one, or after the last case. */
+enum {
+    SPHERE,
+    GYROID,
+    MARSCHNER_LOBB
+};
+static const char *scratch_dir;
+static scene the_scene;
+static int scene_kind = -1; /* the scene the_scene holds, or -1 */
+
+static void close_the_scene(void)
 {
-    const char *dir = test_tmp_dir("test_engine");
-    char ibv[4200];
-    scene s;
-    make_volume(dir, IP_FIELD_SPHERE, 40, IP_UINT8, 8, ibv, sizeof ibv);
-    open_scene(ibv, &s);
-    check_view(&s, "sphere", "-y", 127.5f, 120, 100);
-    check_view(&s, "sphere", "+z", 90.5f, 100, 120);
-    check_empty_space(&s, 200.5f);
-    check_reach_tiles(&s);
-    close_scene(&s);
+    if (scene_kind >= 0)
+        close_scene(&the_scene);
+    scene_kind = -1;
+}
 
-    make_volume(dir, IP_FIELD_GYROID, 36, IP_FLOAT32, 8, ibv, sizeof ibv);
-    open_scene(ibv, &s);
-    check_view(&s, "gyroid", "-x", 0.5f, 128, 96);
-    check_view(&s, "gyroid", "+y", 0.6f, 96, 128);
-    check_cancel_restart(&s, 0.5f, 0.45f);
-    check_ray_budgets(&s, 0.5f, 97, 61);
-    check_ray_budgets(&s, 0.5f, 320, 240);
-    check_regions(&s, 0.5f);
-    check_threads(&s, 0.5f);
-    check_culling(&s, 0.5f);
-    close_scene(&s);
+static scene *scene_of(int kind)
+{
+    if (scene_kind != kind) {
+        close_the_scene();
+        char ibv[4200];
+        if (kind == SPHERE)
+            make_volume(scratch_dir, IP_FIELD_SPHERE, 40, IP_UINT8, 8, ibv, sizeof ibv);
+        else if (kind == GYROID)
+            make_volume(scratch_dir, IP_FIELD_GYROID, 36, IP_FLOAT32, 8, ibv, sizeof ibv);
+        else
+            make_volume(scratch_dir, IP_FIELD_MARSCHNER_LOBB, 41, IP_UINT16, 16, ibv, sizeof ibv);
+        open_scene(ibv, &the_scene);
+        scene_kind = kind;
+    }
+    return &the_scene;
+}
 
-    make_volume(dir, IP_FIELD_MARSCHNER_LOBB, 41, IP_UINT16, 16, ibv, sizeof ibv);
-    open_scene(ibv, &s);
-    check_view(&s, "marschner-lobb", "+x", 2047.5f, 140, 110);
-    check_view(&s, "marschner-lobb", "-z", 2047.5f, 110, 140);
-    close_scene(&s);
+static void sphere_views(void)
+{
+    check_view(scene_of(SPHERE), "sphere", "-y", 127.5f, 120, 100);
+    check_view(scene_of(SPHERE), "sphere", "+z", 90.5f, 100, 120);
+}
+static void sphere_empty_space(void)
+{
+    check_empty_space(scene_of(SPHERE), 200.5f);
+}
+static void sphere_reach_tiles(void)
+{
+    check_reach_tiles(scene_of(SPHERE));
+}
+static void gyroid_views(void)
+{
+    check_view(scene_of(GYROID), "gyroid", "-x", 0.5f, 128, 96);
+    check_view(scene_of(GYROID), "gyroid", "+y", 0.6f, 96, 128);
+}
+static void gyroid_cancel_restart(void)
+{
+    check_cancel_restart(scene_of(GYROID), 0.5f, 0.45f);
+}
+static void gyroid_ray_budgets(void)
+{
+    check_ray_budgets(scene_of(GYROID), 0.5f, 97, 61);
+    check_ray_budgets(scene_of(GYROID), 0.5f, 320, 240);
+}
+static void gyroid_regions(void)
+{
+    check_regions(scene_of(GYROID), 0.5f);
+}
+static void gyroid_threads(void)
+{
+    check_threads(scene_of(GYROID), 0.5f);
+}
+static void gyroid_culling(void)
+{
+    check_culling(scene_of(GYROID), 0.5f);
+}
+static void marschner_lobb_views(void)
+{
+    check_view(scene_of(MARSCHNER_LOBB), "marschner-lobb", "+x", 2047.5f, 140, 110);
+    check_view(scene_of(MARSCHNER_LOBB), "marschner-lobb", "-z", 2047.5f, 110, 140);
+}
+static void lod(void)
+{
+    check_lod(scratch_dir);
+}
+static void lod_exact(void)
+{
+    check_lod_exact(scratch_dir);
+}
+static void reuse_exact(void)
+{
+    check_reuse_exact(scratch_dir);
+}
+static void read_ahead(void)
+{
+    check_read_ahead(scratch_dir);
+}
+static void occlusion(void)
+{
+    check_occlusion(scratch_dir);
+}
+static void retirement(void)
+{
+    check_retirement(scratch_dir);
+}
 
-    check_lod(dir);
-    check_lod_exact(dir);
-    check_reuse_exact(dir);
-    check_read_ahead(dir);
-    check_coverage_box_test();
-    check_cull_mask();
-    check_coverage_indexed();
-    check_depth_queue();
-    check_reach_box();
-    check_coverage_reach();
-    check_occlusion(dir);
-    check_retirement(dir);
-    check_shared_data();
-    return test_summary("test_engine");
+static const test_case cases[] = {
+    {"check_view:sphere", sphere_views},
+    {"check_empty_space", sphere_empty_space},
+    {"check_reach_tiles", sphere_reach_tiles},
+    {"check_view:gyroid", gyroid_views},
+    {"check_cancel_restart", gyroid_cancel_restart},
+    {"check_ray_budgets", gyroid_ray_budgets},
+    {"check_regions", gyroid_regions},
+    {"check_threads", gyroid_threads},
+    {"check_culling", gyroid_culling},
+    {"check_view:marschner-lobb", marschner_lobb_views},
+    {"check_lod", lod},
+    {"check_lod_exact", lod_exact},
+    {"check_reuse_exact", reuse_exact},
+    {"check_read_ahead", read_ahead},
+    TEST_CASE(check_coverage_box_test),
+    TEST_CASE(check_cull_mask),
+    TEST_CASE(check_coverage_indexed),
+    TEST_CASE(check_depth_queue),
+    TEST_CASE(check_reach_box),
+    TEST_CASE(check_coverage_reach),
+    {"check_occlusion", occlusion},
+    {"check_retirement", retirement},
+    TEST_CASE(check_shared_data),
+};
+
+static void make_scratch_dir(void)
+{
+    scratch_dir = test_tmp_dir("test_engine");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_engine", make_scratch_dir, close_the_scene);
 }

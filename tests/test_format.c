@@ -65,13 +65,14 @@ static void check_layout_against_spec(const uint32_t dims[3], uint32_t B, uint32
             break;
     }
     CHECK_MSG(l.level_count == k + 1, "%s: %u levels, wanted %u", what, l.level_count, k + 1);
-    CHECK(l.brick_count == bricks_total && l.node_count == nodes_total);
-    CHECK(l.data_offset == IP_HEADER_SIZE);
+    CHECK_EQ(l.brick_count, bricks_total);
+    CHECK_EQ(l.node_count, nodes_total);
+    CHECK_EQ(l.data_offset, IP_HEADER_SIZE);
     uint64_t P = B / s;
     CHECK_MSG(l.summary_size ==
                   l.level_count * 64ull + bricks_total * (24 + 8 + 8 * P * P * P) + nodes_total * 8,
               "%s: summary size", what);
-    CHECK(ip_layout_subblocks_per_brick(&l) == P * P * P);
+    CHECK_EQ(ip_layout_subblocks_per_brick(&l), P * P * P);
 
     /* every brick: coordinates and global index agree, extents tile the level's cells */
     for (uint32_t lv = 0; lv < l.level_count; lv++) {
@@ -79,7 +80,9 @@ static void check_layout_against_spec(const uint32_t dims[3], uint32_t B, uint32
         for (uint32_t bx = 0; bx < l.levels[lv].bricks[0]; bx++) {
             uint32_t b[3] = {bx, l.levels[lv].bricks[1] - 1, 0}, o[3], ext[3];
             ip_brick_extent(&l, lv, b, o, ext);
-            CHECK(o[0] == bx * B && ext[0] >= 2 && ext[0] <= B + 1);
+            CHECK_EQ(o[0], bx * B);
+            CHECK_GE(ext[0], 2);
+            CHECK_LE(ext[0], B + 1);
             cells_x += ext[0] - 1;
         }
         CHECK_MSG(cells_x == l.levels[lv].dims[0] - 1, "%s: level %u bricks cover x", what, lv);
@@ -98,16 +101,19 @@ static void check_layout_against_spec(const uint32_t dims[3], uint32_t B, uint32
             uint32_t grid[3];
             ip__octree_grid(&l, lv, j, grid);
             for (int a = 0; a < 3; a++)
-                CHECK(grid[a] == ceil_div_u64(L->bricks[a], 1ull << j));
+                CHECK_EQ(grid[a], ceil_div_u64(L->bricks[a], 1ull << j));
             for (uint32_t z = 0; z < grid[2]; z++)
                 for (uint32_t y = 0; y < grid[1]; y++)
                     for (uint32_t x = 0; x < grid[0]; x++) {
                         uint32_t node[3] = {x, y, z};
-                        CHECK(ip__octree_node_index(&l, lv, j, node) == expect);
+                        CHECK_EQ(ip__octree_node_index(&l, lv, j, node), expect);
                         expect++;
                     }
-            if (j == L->octree_depth)
-                CHECK(grid[0] == 1 && grid[1] == 1 && grid[2] == 1);
+            if (j == L->octree_depth) {
+                CHECK_EQ(grid[0], 1);
+                CHECK_EQ(grid[1], 1);
+                CHECK_EQ(grid[2], 1);
+            }
         }
         CHECK_MSG(expect == L->first_node + L->node_count, "%s: level %u node numbering", what, lv);
         /* Morton order: a permutation, by increasing interleaved code */
@@ -153,10 +159,14 @@ static void test_layouts(void)
     const uint32_t two[3] = {2, 2, 2};
     const double one[3] = {1, 1, 1};
     REQUIRE(ip__layout_init(&l, two, IP_UINT8, one, 32, 8, &err) == IP_OK);
-    CHECK(l.level_count == 1 && l.brick_count == 1 && l.node_count == 0);
+    CHECK_EQ(l.level_count, 1);
+    CHECK_EQ(l.brick_count, 1);
+    CHECK_EQ(l.node_count, 0);
     uint32_t b[3] = {0, 0, 0}, o[3], e[3];
     ip_brick_extent(&l, 0, b, o, e);
-    CHECK(e[0] == 2 && e[1] == 2 && e[2] == 2);
+    CHECK_EQ(e[0], 2);
+    CHECK_EQ(e[1], 2);
+    CHECK_EQ(e[2], 2);
 }
 
 static void layout_refused(const uint32_t dims[3], ip_type type, const double spacing[3],
@@ -283,61 +293,71 @@ static void test_header_round_trip(void)
     const ip_layout *l = &m.layout;
     const unsigned char *h = m.bytes;
     /* the named offsets hold the fields of docs/format.md */
-    CHECK(memcmp(h + IP_HDR_MAGIC, "\x89IBV\r\n\x1a\n", 8) == 0);
-    CHECK(ip__load_u32le(h + IP_HDR_VERSION) == 2);
-    CHECK(ip__load_u32le(h + IP_HDR_HEADER_SIZE) == 256);
-    CHECK(ip__load_u32le(h + IP_HDR_DIMS) == 13 && ip__load_u32le(h + IP_HDR_DIMS + 4) == 9 &&
-          ip__load_u32le(h + IP_HDR_DIMS + 8) == 6);
-    CHECK(ip__load_u32le(h + IP_HDR_TYPE) == IP_UINT16);
+    CHECK_MEM_EQ(h + IP_HDR_MAGIC, "\x89IBV\r\n\x1a\n", 8);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_VERSION), 2);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_HEADER_SIZE), 256);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_DIMS), 13);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_DIMS + 4), 9);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_DIMS + 8), 6);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_TYPE), IP_UINT16);
     double sp;
     uint64_t bits = ip__load_u64le(h + IP_HDR_SPACING + 8);
     memcpy(&sp, &bits, 8);
-    CHECK(sp == 0.25);
-    CHECK(ip__load_u32le(h + IP_HDR_BRICK_EDGE) == 4 &&
-          ip__load_u32le(h + IP_HDR_SUBBLOCK_EDGE) == 2);
-    CHECK(ip__load_u32le(h + IP_HDR_LEVEL_COUNT) == l->level_count);
-    CHECK(ip__load_u32le(h + IP_HDR_FLAGS) == 0);
-    CHECK(ip__load_f32le(h + IP_HDR_VALUE_MIN) == 5 && ip__load_f32le(h + IP_HDR_VALUE_MAX) == 9);
-    CHECK(ip__load_u64le(h + IP_HDR_BRICK_COUNT) == l->brick_count);
-    CHECK(ip__load_u64le(h + IP_HDR_NODE_COUNT) == l->node_count);
-    CHECK(ip__load_u64le(h + IP_HDR_DATA_OFFSET) == 256);
-    CHECK(ip__load_u64le(h + IP_HDR_DATA_SIZE) == l->data_size);
-    CHECK(ip__load_u64le(h + IP_HDR_SUMMARY_OFFSET) == l->summary_offset);
-    CHECK(ip__load_u64le(h + IP_HDR_SUMMARY_SIZE) == l->summary_size);
-    CHECK(ip__load_u64le(h + IP_HDR_FILE_SIZE) == m.size);
-    CHECK(ip__load_f64le(h + IP_HDR_ORIGIN) == 10 && ip__load_f64le(h + IP_HDR_ORIGIN + 8) == -20 &&
-          ip__load_f64le(h + IP_HDR_ORIGIN + 16) == 5.5);
-    CHECK(ip__load_f64le(h + IP_HDR_DIRECTIONS + 8) == 0.5);      /* x direction, y component */
-    CHECK(ip__load_f64le(h + IP_HDR_DIRECTIONS + 3 * 8) == -0.5); /* y direction, x component */
-    CHECK(ip__load_f64le(h + IP_HDR_DIRECTIONS + 8 * 8) == -1);   /* z direction, z component */
-    CHECK(ip__load_u32le(h + IP_HDR_SPACE) == IP_SPACE_LPS);
+    CHECK_EQ(sp, 0.25);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_BRICK_EDGE), 4);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_SUBBLOCK_EDGE), 2);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_LEVEL_COUNT), l->level_count);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_FLAGS), 0);
+    CHECK_EQ(ip__load_f32le(h + IP_HDR_VALUE_MIN), 5);
+    CHECK_EQ(ip__load_f32le(h + IP_HDR_VALUE_MAX), 9);
+    CHECK_EQ(ip__load_u64le(h + IP_HDR_BRICK_COUNT), l->brick_count);
+    CHECK_EQ(ip__load_u64le(h + IP_HDR_NODE_COUNT), l->node_count);
+    CHECK_EQ(ip__load_u64le(h + IP_HDR_DATA_OFFSET), 256);
+    CHECK_EQ(ip__load_u64le(h + IP_HDR_DATA_SIZE), l->data_size);
+    CHECK_EQ(ip__load_u64le(h + IP_HDR_SUMMARY_OFFSET), l->summary_offset);
+    CHECK_EQ(ip__load_u64le(h + IP_HDR_SUMMARY_SIZE), l->summary_size);
+    CHECK_EQ(ip__load_u64le(h + IP_HDR_FILE_SIZE), m.size);
+    CHECK_EQ(ip__load_f64le(h + IP_HDR_ORIGIN), 10);
+    CHECK_EQ(ip__load_f64le(h + IP_HDR_ORIGIN + 8), -20);
+    CHECK_EQ(ip__load_f64le(h + IP_HDR_ORIGIN + 16), 5.5);
+    CHECK_EQ(ip__load_f64le(h + IP_HDR_DIRECTIONS + 8), 0.5);      /* x direction, y component */
+    CHECK_EQ(ip__load_f64le(h + IP_HDR_DIRECTIONS + 3 * 8), -0.5); /* y direction, x component */
+    CHECK_EQ(ip__load_f64le(h + IP_HDR_DIRECTIONS + 8 * 8), -1);   /* z direction, z component */
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_SPACE), IP_SPACE_LPS);
     for (int i = IP_HDR_RESERVED; i < IP_HDR_CHECKSUM; i++)
-        CHECK(h[i] == 0);
-    CHECK(ip__load_u64le(h + IP_HDR_CHECKSUM) == ip__format_checksum(h, 248));
+        CHECK_EQ(h[i], 0);
+    CHECK_EQ(ip__load_u64le(h + IP_HDR_CHECKSUM), ip__format_checksum(h, 248));
 
     ip_layout parsed;
     ip_error err;
     REQUIRE(parse(&m, &parsed, &err) == IP_OK);
-    CHECK(memcmp(parsed.dims, l->dims, sizeof l->dims) == 0);
-    CHECK(memcmp(parsed.spacing, l->spacing, sizeof l->spacing) == 0);
-    CHECK(memcmp(&parsed.orientation, &l->orientation, sizeof l->orientation) == 0);
-    CHECK(parsed.type == l->type && parsed.brick_edge == 4 && parsed.subblock_edge == 2);
-    CHECK(parsed.level_count == l->level_count && parsed.brick_count == l->brick_count &&
-          parsed.node_count == l->node_count);
-    CHECK(parsed.value_min == 5 && parsed.value_max == 9);
-    CHECK(parsed.data_offset == 256 && parsed.data_size == l->data_size);
-    CHECK(parsed.summary_offset == l->summary_offset && parsed.summary_size == l->summary_size &&
-          parsed.file_size == m.size);
-    CHECK(parsed.summary_checksum == ip__load_u64le(h + IP_HDR_SUMMARY_CHECKSUM));
+    CHECK_MEM_EQ(parsed.dims, l->dims, sizeof l->dims);
+    CHECK_MEM_EQ(parsed.spacing, l->spacing, sizeof l->spacing);
+    CHECK_MEM_EQ(&parsed.orientation, &l->orientation, sizeof l->orientation);
+    CHECK_EQ(parsed.type, l->type);
+    CHECK_EQ(parsed.brick_edge, 4);
+    CHECK_EQ(parsed.subblock_edge, 2);
+    CHECK_EQ(parsed.level_count, l->level_count);
+    CHECK_EQ(parsed.brick_count, l->brick_count);
+    CHECK_EQ(parsed.node_count, l->node_count);
+    CHECK_EQ(parsed.value_min, 5);
+    CHECK_EQ(parsed.value_max, 9);
+    CHECK_EQ(parsed.data_offset, 256);
+    CHECK_EQ(parsed.data_size, l->data_size);
+    CHECK_EQ(parsed.summary_offset, l->summary_offset);
+    CHECK_EQ(parsed.summary_size, l->summary_size);
+    CHECK_EQ(parsed.file_size, m.size);
+    CHECK_EQ(parsed.summary_checksum, ip__load_u64le(h + IP_HDR_SUMMARY_CHECKSUM));
     for (uint32_t k = 0; k < l->level_count; k++) {
-        CHECK(memcmp(parsed.levels[k].dims, l->levels[k].dims, sizeof l->levels[k].dims) == 0);
-        CHECK(parsed.levels[k].first_brick == l->levels[k].first_brick);
-        CHECK(parsed.levels[k].value_min == 5 && parsed.levels[k].value_max == 9);
+        CHECK_MEM_EQ(parsed.levels[k].dims, l->levels[k].dims, sizeof l->levels[k].dims);
+        CHECK_EQ(parsed.levels[k].first_brick, l->levels[k].first_brick);
+        CHECK_EQ(parsed.levels[k].value_min, 5);
+        CHECK_EQ(parsed.levels[k].value_max, 9);
     }
     /* re-encoding the parsed layout gives the same header bytes */
     unsigned char again[IP_HEADER_SIZE];
     ip__format_header_encode(&parsed, again);
-    CHECK(memcmp(again, h, IP_HEADER_SIZE) == 0);
+    CHECK_MEM_EQ(again, h, IP_HEADER_SIZE);
     free(m.bytes);
 }
 
@@ -348,14 +368,19 @@ static void test_entry_round_trip(void)
     unsigned char d[IP_DIRECTORY_ENTRY_SIZE];
     memset(d, 0xFF, sizeof d);
     ip__format_entry_encode(&e, d);
-    CHECK(ip__load_u64le(d + IP_DIR_OFFSET) == e.offset);
-    CHECK(ip__load_u32le(d + IP_DIR_STORED_SIZE) == e.stored_size);
-    CHECK(d[IP_DIR_ENCODING] == IP_BRICK_LZ4 && d[IP_DIR_FILTERS] == 6);
-    CHECK(d[IP_DIR_RESERVED] == 0 && d[IP_DIR_RESERVED + 1] == 0);
-    CHECK(ip__load_u64le(d + IP_DIR_CHECKSUM) == e.checksum);
+    CHECK_EQ(ip__load_u64le(d + IP_DIR_OFFSET), e.offset);
+    CHECK_EQ(ip__load_u32le(d + IP_DIR_STORED_SIZE), e.stored_size);
+    CHECK_EQ(d[IP_DIR_ENCODING], IP_BRICK_LZ4);
+    CHECK_EQ(d[IP_DIR_FILTERS], 6);
+    CHECK_EQ(d[IP_DIR_RESERVED], 0);
+    CHECK_EQ(d[IP_DIR_RESERVED + 1], 0);
+    CHECK_EQ(ip__load_u64le(d + IP_DIR_CHECKSUM), e.checksum);
     ip__format_entry_decode(d, &back);
-    CHECK(back.offset == e.offset && back.stored_size == e.stored_size &&
-          back.encoding == e.encoding && back.filters == e.filters && back.checksum == e.checksum);
+    CHECK_EQ(back.offset, e.offset);
+    CHECK_EQ(back.stored_size, e.stored_size);
+    CHECK_EQ(back.encoding, e.encoding);
+    CHECK_EQ(back.filters, e.filters);
+    CHECK_EQ(back.checksum, e.checksum);
 }
 
 /* Parsing the image after `change` (then resealed unless `keep_checksums`) fails with `code`
@@ -574,8 +599,8 @@ static void test_header_refusals(void)
 
     /* with IP_PARSE_SKIP_CHECKSUMS a wrong header checksum passes */
     m.bytes[IP_HDR_CHECKSUM] ^= 1;
-    CHECK(ip__format_parse(m.bytes, m.size, NAME, IP_PARSE_SKIP_CHECKSUMS, &l, &err) == IP_OK);
-    CHECK(ip__format_parse(m.bytes, m.size, NAME, 0, &l, &err) == IP_ERR_CHECKSUM);
+    CHECK_EQ(ip__format_parse(m.bytes, m.size, NAME, IP_PARSE_SKIP_CHECKSUMS, &l, &err), IP_OK);
+    CHECK_EQ(ip__format_parse(m.bytes, m.size, NAME, 0, &l, &err), IP_ERR_CHECKSUM);
     free(m.bytes);
 }
 
@@ -666,15 +691,17 @@ static void test_version_1(void)
     ip_layout l, identity;
     ip_error err;
     REQUIRE(parse(&m, &l, &err) == IP_OK);
-    CHECK(l.format_version == IP_FORMAT_VERSION); /* the file's own version is kept */
+    CHECK_EQ(l.format_version, IP_FORMAT_VERSION); /* the file's own version is kept */
     make_version_1(&m, 0);
     reseal(&m);
     REQUIRE(parse(&m, &l, &err) == IP_OK);
-    CHECK(l.format_version == 1);
+    CHECK_EQ(l.format_version, 1);
     ip_orientation_identity(&identity.orientation);
-    CHECK(memcmp(&l.orientation, &identity.orientation, sizeof l.orientation) == 0);
-    CHECK(ip_orientation_is_identity(&l.orientation) && l.orientation.space == IP_SPACE_UNKNOWN);
-    CHECK(l.dims[0] == 13 && l.spacing[1] == 0.25);
+    CHECK_MEM_EQ(&l.orientation, &identity.orientation, sizeof l.orientation);
+    CHECK(ip_orientation_is_identity(&l.orientation));
+    CHECK_EQ(l.orientation.space, IP_SPACE_UNKNOWN);
+    CHECK_EQ(l.dims[0], 13);
+    CHECK_EQ(l.spacing[1], 0.25);
     free(m.bytes);
 }
 
@@ -726,7 +753,7 @@ static void test_summary_refusals(void)
     ip_error err;
     set_entry_encoding(&m, 0 << 8 | IP_BRICK_LZ4);
     reseal(&m);
-    CHECK(parse(&m, &l, &err) == IP_OK); /* a raw-sized LZ4 block is a possible size */
+    CHECK_EQ(parse(&m, &l, &err), IP_OK); /* a raw-sized LZ4 block is a possible size */
     refused(&m, set_entry_size, 0ull << 32 | 0, 1, IP_ERR_FORMAT, "an LZ4 payload of impossible");
     refused(&m, set_entry_size, 0ull << 32 | (raw + raw / 255 + 17), 1, IP_ERR_FORMAT,
             "an LZ4 payload of impossible");
@@ -773,15 +800,14 @@ static void test_truncations(void)
     free(m.bytes);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_layouts),           TEST_CASE(test_layout_arguments),
+    TEST_CASE(test_header_round_trip), TEST_CASE(test_entry_round_trip),
+    TEST_CASE(test_header_refusals),   TEST_CASE(test_version_1),
+    TEST_CASE(test_summary_refusals),  TEST_CASE(test_truncations),
+};
+
+int main(int argc, char **argv)
 {
-    test_layouts();
-    test_layout_arguments();
-    test_header_round_trip();
-    test_entry_round_trip();
-    test_header_refusals();
-    test_version_1();
-    test_summary_refusals();
-    test_truncations();
-    return test_summary("test_format");
+    return RUN_CASES(argc, argv, cases, "test_format");
 }

@@ -136,15 +136,17 @@ static void test_names(void)
     ip_field f;
     char buf[64];
     uint32_t dims[3] = {512, 512, 234};
-    for (int i = 0; i < 4; i++)
-        CHECK(ip_field_parse(ip_field_name((ip_field)i), &f) == IP_OK && f == (ip_field)i);
-    CHECK(strcmp(ip_field_name(IP_FIELD_MARSCHNER_LOBB), "marschner-lobb") == 0);
-    CHECK(ip_field_parse("Shepp-Logan", &f) == IP_ERR_ARGUMENT);
-    CHECK(ip_field_parse("cube", &f) == IP_ERR_ARGUMENT);
-    CHECK(ip_raw_file_name(buf, sizeof buf, "ct_head", dims, IP_UINT16) == IP_OK);
-    CHECK(strcmp(buf, "ct_head_512x512x234_uint16.raw") == 0);
-    CHECK(ip_raw_file_name(buf, 20, "ct_head", dims, IP_UINT16) == IP_ERR_ARGUMENT);
-    CHECK(ip_raw_file_name(buf, sizeof buf, "x", dims, (ip_type)9) == IP_ERR_ARGUMENT);
+    for (int i = 0; i < 4; i++) {
+        CHECK_EQ(ip_field_parse(ip_field_name((ip_field)i), &f), IP_OK);
+        CHECK_EQ(f, (ip_field)i);
+    }
+    CHECK_STR_EQ(ip_field_name(IP_FIELD_MARSCHNER_LOBB), "marschner-lobb");
+    CHECK_EQ(ip_field_parse("Shepp-Logan", &f), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_field_parse("cube", &f), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_raw_file_name(buf, sizeof buf, "ct_head", dims, IP_UINT16), IP_OK);
+    CHECK_STR_EQ(buf, "ct_head_512x512x234_uint16.raw");
+    CHECK_EQ(ip_raw_file_name(buf, 20, "ct_head", dims, IP_UINT16), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_raw_file_name(buf, sizeof buf, "x", dims, (ip_type)9), IP_ERR_ARGUMENT);
 }
 
 static void test_bad_params(void)
@@ -152,17 +154,17 @@ static void test_bad_params(void)
     ip_error err;
     uint16_t plane[16];
     ip_gen_params p = params_of(IP_FIELD_SPHERE, 4, 4, 4, IP_UINT16);
-    CHECK(ip_generate_plane(&p, 4, plane, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_generate_plane(&p, 4, plane, &err), IP_ERR_ARGUMENT);
     p.dims[1] = 1;
-    CHECK(ip_generate_plane(&p, 0, plane, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_generate_plane(&p, 0, plane, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "at least 2");
     p = params_of((ip_field)7, 4, 4, 4, IP_UINT16);
-    CHECK(ip_generate_plane(&p, 0, plane, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_generate_plane(&p, 0, plane, &err), IP_ERR_ARGUMENT);
     p = params_of(IP_FIELD_SPHERE, 4, 4, 4, IP_UINT16);
     p.noise = -1.0;
-    CHECK(ip_generate_plane(&p, 0, plane, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_generate_plane(&p, 0, plane, &err), IP_ERR_ARGUMENT);
     p.noise = NAN;
-    CHECK(ip_generate_plane(&p, 0, plane, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_generate_plane(&p, 0, plane, &err), IP_ERR_ARGUMENT);
 }
 
 /* Same parameters give the same bytes, and a plane generated alone equals its place in the
@@ -176,11 +178,13 @@ static void test_determinism(void)
     unsigned char *a = generate_file(&p, "det_a.raw", &n1);
     unsigned char *b = generate_file(&p, "det_b.raw", &n2);
     REQUIRE(a && b);
-    CHECK(n1 == 37u * 29 * 23 * 2 && n1 == n2 && memcmp(a, b, n1) == 0);
+    CHECK_EQ(n1, 37u * 29 * 23 * 2);
+    if (CHECK_EQ(n1, n2))
+        CHECK_MEM_EQ(a, b, n1);
     uint16_t plane[37 * 29];
     ip_error err;
     for (uint32_t z = 0; z < 23; z += 11) {
-        CHECK(ip_generate_plane(&p, z, plane, &err) == IP_OK);
+        CHECK_EQ(ip_generate_plane(&p, z, plane, &err), IP_OK);
         int same = 1;
         for (size_t i = 0; i < 37 * 29; i++)
             same &= plane[i] == file_sample(a, IP_UINT16, z * 37 * 29 + i);
@@ -204,7 +208,7 @@ static void test_type_ranges(void)
         double hi;
         unsigned char *data = generate_file(&p, "range.raw", &size);
         REQUIRE(data);
-        CHECK(size == 41u * 41 * 41 * ip_type_size(cases[c].type));
+        CHECK_EQ(size, 41u * 41 * 41 * ip_type_size(cases[c].type));
         double lo = min_of(data, cases[c].type, 41u * 41 * 41, &hi);
         CHECK_MSG(lo == cases[c].lo && hi == cases[c].hi, "%s: %g..%g", ip_type_name(cases[c].type),
                   lo, hi);
@@ -246,11 +250,13 @@ static void test_sphere(void)
     REQUIRE(data);
     size_t centre = 16 + 33 * (16 + 33 * 16);
     min_of(data, IP_UINT8, 33u * 33 * 33, &hi);
-    CHECK(data[centre] == 255 && hi == 255);
-    CHECK(data[0] == 0 && data[size - 1] == 0);
+    CHECK_EQ(data[centre], 255);
+    CHECK_EQ(hi, 255);
+    CHECK_EQ(data[0], 0);
+    CHECK_EQ(data[size - 1], 0);
     /* Linear fall-off: half way to the face centre, the value is one half. */
-    CHECK(fabs(plane_sample(&p, 24, 16, 16) - 0.5) < 1e-9);
-    CHECK(data[32 + 33 * (16 + 33 * 16)] == 0);
+    CHECK_NEAR(plane_sample(&p, 24, 16, 16), 0.5, 1e-9);
+    CHECK_EQ(data[32 + 33 * (16 + 33 * 16)], 0);
     free(data);
 }
 
@@ -258,14 +264,14 @@ static void test_shepp_logan_structure(void)
 {
     ip_gen_params p = params_of(IP_FIELD_SHEPP_LOGAN, 65, 65, 65, IP_FLOAT32);
     /* Outside the head, the corners and the middle of a face: 0. */
-    CHECK(plane_sample(&p, 0, 0, 0) == 0.0);
-    CHECK(plane_sample(&p, 0, 32, 32) == 0.0);
+    CHECK_EQ(plane_sample(&p, 0, 0, 0), 0.0);
+    CHECK_EQ(plane_sample(&p, 0, 32, 32), 0.0);
     /* The centre is brain: skull 1.0 minus 0.8. */
-    CHECK(fabs(plane_sample(&p, 32, 32, 32) - 0.2) < 1e-6);
+    CHECK_NEAR(plane_sample(&p, 32, 32, 32), 0.2, 1e-6);
     /* y = 0.906: inside the skull (b = 0.92), outside the brain (b = 0.874). */
-    CHECK(plane_sample(&p, 32, 61, 32) == 1.0);
+    CHECK_EQ(plane_sample(&p, 32, 61, 32), 1.0);
     /* The left ventricle (centre x = -0.22, z = -0.25) is darker than the brain around it. */
-    CHECK(plane_sample(&p, 25, 32, 24) < 0.05);
+    CHECK_LT(plane_sample(&p, 25, 32, 24), 0.05);
 }
 
 static void test_noise(void)
@@ -280,9 +286,10 @@ static void test_noise(void)
     p.seed = 8;
     unsigned char *other = generate_file(&p, "noisy_other.raw", &n3);
     REQUIRE(clean && noisy && again && other);
-    CHECK(n1 == n0 && memcmp(noisy, again, n1) == 0);
-    CHECK(memcmp(noisy, clean, n1) != 0);
-    CHECK(memcmp(noisy, other, n1) != 0);
+    if (CHECK_EQ(n1, n0))
+        CHECK_MEM_EQ(noisy, again, n1);
+    CHECK_NE(memcmp(noisy, clean, n1), 0);
+    CHECK_NE(memcmp(noisy, other, n1), 0);
     /* Where clamping cannot act, the added noise has mean 0 and standard deviation 0.05. */
     double sum = 0, sum2 = 0;
     size_t count = 0, changed = 0, samples = 40u * 40 * 40;
@@ -298,7 +305,7 @@ static void test_noise(void)
     double mean = sum / (double)count, sd = sqrt(sum2 / (double)count - mean * mean);
     CHECK_MSG(count > 1000 && fabs(mean) < 0.005 && fabs(sd - 0.05) < 0.005,
               "count %zu mean %g sd %g", count, mean, sd);
-    CHECK(changed > samples / 2);
+    CHECK_GT(changed, samples / 2);
     free(clean);
     free(noisy);
     free(again);
@@ -312,18 +319,20 @@ static void test_existing_and_missing_folder(void)
     const char *path = tmp_path("keep.raw");
     size_t size = 0;
     write_file(path, "keep", 4);
-    CHECK(ip_generate_write(&p, path, 0, &err) == IP_ERR_EXISTS);
+    CHECK_EQ(ip_generate_write(&p, path, 0, &err), IP_ERR_EXISTS);
     CHECK_CONTAINS(err.message, path);
     unsigned char *data = read_file(path, &size);
-    CHECK(data && size == 4 && memcmp(data, "keep", 4) == 0);
+    if (CHECK_NE(data, NULL) && CHECK_EQ(size, 4))
+        CHECK_MEM_EQ(data, "keep", 4);
     free(data);
-    CHECK(ip_generate_write(&p, path, 1, &err) == IP_OK);
+    CHECK_EQ(ip_generate_write(&p, path, 1, &err), IP_OK);
     data = read_file(path, &size);
-    CHECK(data && size == 512);
+    CHECK_NE(data, NULL);
+    CHECK_EQ(size, 512);
     free(data);
 
     const char *missing = tmp_path("no_such_folder/out.raw");
-    CHECK(ip_generate_write(&p, missing, 0, &err) == IP_ERR_IO);
+    CHECK_EQ(ip_generate_write(&p, missing, 0, &err), IP_ERR_IO);
     CHECK_CONTAINS(err.message, missing);
     CHECK(!file_exists(tmp_path("no_such_folder")));
 }
@@ -387,7 +396,7 @@ static void test_upsample_linear(void)
     write_input("ramp", dims, IP_FLOAT32, ramp, &in);
     unsigned char *out = upsample(&in, 2, "ramp_x2.raw", &size);
     REQUIRE(out);
-    CHECK(size == 10u * 8 * 6 * 4);
+    CHECK_EQ(size, 10u * 8 * 6 * 4);
     double worst = 0;
     for (uint32_t z = 0, i = 0; z < 6; z++)
         for (uint32_t y = 0; y < 8; y++)
@@ -398,11 +407,11 @@ static void test_upsample_linear(void)
             }
     CHECK_MSG(worst < 1e-5, "worst error %g", worst);
     /* The eight corners are the input's corners, exactly. */
-    CHECK(file_sample(out, IP_FLOAT32, 0) == 0.0);
-    CHECK(file_sample(out, IP_FLOAT32, 9) == 4.0);
-    CHECK(file_sample(out, IP_FLOAT32, 9 + 10 * 7) == 10.0);
-    CHECK(file_sample(out, IP_FLOAT32, 10u * 8 * 6 - 1) == 16.0);
-    CHECK(file_sample(out, IP_FLOAT32, 10u * 8 * 5) == 6.0);
+    CHECK_EQ(file_sample(out, IP_FLOAT32, 0), 0.0);
+    CHECK_EQ(file_sample(out, IP_FLOAT32, 9), 4.0);
+    CHECK_EQ(file_sample(out, IP_FLOAT32, 9 + 10 * 7), 10.0);
+    CHECK_EQ(file_sample(out, IP_FLOAT32, 10u * 8 * 6 - 1), 16.0);
+    CHECK_EQ(file_sample(out, IP_FLOAT32, 10u * 8 * 5), 6.0);
     free(out);
 }
 
@@ -417,7 +426,8 @@ static void test_upsample_identity(void)
         unsigned char *out = upsample(&in, 1, "ident_x1.raw", &size);
         unsigned char *orig = read_file(in.path, &in_size);
         REQUIRE(out && orig);
-        CHECK(size == in_size && memcmp(out, orig, size) == 0);
+        if (CHECK_EQ(size, in_size))
+            CHECK_MEM_EQ(out, orig, size);
         free(out);
         free(orig);
     }
@@ -434,16 +444,16 @@ static void test_upsample_rounding(void)
     write_input("step", dims, IP_UINT16, step3, &in);
     unsigned char *out = upsample(&in, 3, "step_x3.raw", &size);
     REQUIRE(out);
-    CHECK(size == 6u * 6 * 6 * 2);
+    CHECK_EQ(size, 6u * 6 * 6 * 2);
     for (size_t row = 0; row < 36; row++)
         for (size_t x = 0; x < 6; x++)
-            CHECK(file_sample(out, IP_UINT16, row * 6 + x) == unsigned_expect[x]);
+            CHECK_EQ(file_sample(out, IP_UINT16, row * 6 + x), unsigned_expect[x]);
     free(out);
     write_input("step_signed", dims, IP_INT16, step3_negative, &in);
     out = upsample(&in, 3, "step_signed_x3.raw", &size);
     REQUIRE(out);
     for (size_t x = 0; x < 6; x++)
-        CHECK(file_sample(out, IP_INT16, 6 * 35 + x) == signed_expect[x]);
+        CHECK_EQ(file_sample(out, IP_INT16, 6 * 35 + x), signed_expect[x]);
     free(out);
 }
 
@@ -456,42 +466,72 @@ static void test_upsample_errors(void)
     write_input("small", dims, IP_UINT8, ramp, &in);
     const char *path = tmp_path("small_keep.raw");
     write_file(path, "keep", 4);
-    CHECK(ip_upsample_write(&in, 2, path, 0, &err) == IP_ERR_EXISTS);
+    CHECK_EQ(ip_upsample_write(&in, 2, path, 0, &err), IP_ERR_EXISTS);
     unsigned char *data = read_file(path, &size);
-    CHECK(data && size == 4 && memcmp(data, "keep", 4) == 0);
+    if (CHECK_NE(data, NULL) && CHECK_EQ(size, 4))
+        CHECK_MEM_EQ(data, "keep", 4);
     free(data);
-    CHECK(ip_upsample_write(&in, 0, tmp_path("zero.raw"), 0, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_upsample_write(&in, 0, tmp_path("zero.raw"), 0, &err), IP_ERR_ARGUMENT);
     CHECK(!file_exists(tmp_path("zero.raw")));
     const char *missing = tmp_path("missing_folder/up.raw");
-    CHECK(ip_upsample_write(&in, 2, missing, 0, &err) == IP_ERR_IO);
+    CHECK_EQ(ip_upsample_write(&in, 2, missing, 0, &err), IP_ERR_IO);
     CHECK_CONTAINS(err.message, missing);
     /* An input shorter than its description fails while reading; no output remains. */
     ip_input_desc truncated = in;
     write_file(tmp_path("short.bin"), "\1\2\3", 3);
     snprintf(truncated.data_path, sizeof truncated.data_path, "%s", tmp_path("short.bin"));
-    CHECK(ip_upsample_write(&truncated, 2, tmp_path("from_short.raw"), 0, &err) != IP_OK);
-    CHECK(err.message[0] != '\0');
+    CHECK_NE(ip_upsample_write(&truncated, 2, tmp_path("from_short.raw"), 0, &err), IP_OK);
+    CHECK_NE(err.message[0], '\0');
     CHECK(!file_exists(tmp_path("from_short.raw")));
 }
 
-int main(void)
+/* Runs an upsampling case and checks that the folder holds only the inputs and outputs it names,
+ * `files` of them more than before: no temporary file remains. */
+static void without_temporaries(void (*test)(void), int files)
+{
+    int before = count_entries(tmp);
+    test();
+    CHECK_MSG(count_entries(tmp) == before + files, "%d entries, expected %d", count_entries(tmp),
+              before + files);
+}
+static void upsample_linear(void)
+{
+    without_temporaries(test_upsample_linear, 2); /* ramp, ramp_x2 */
+}
+static void upsample_identity(void)
+{
+    without_temporaries(test_upsample_identity, 3); /* ident, ident16, ident_x1 */
+}
+static void upsample_rounding(void)
+{
+    without_temporaries(test_upsample_rounding, 4); /* step, step_signed and their x3 */
+}
+static void upsample_errors(void)
+{
+    without_temporaries(test_upsample_errors, 3); /* small, small_keep, short */
+}
+
+static const test_case cases[] = {
+    TEST_CASE(test_names),
+    TEST_CASE(test_bad_params),
+    TEST_CASE(test_determinism),
+    TEST_CASE(test_type_ranges),
+    TEST_CASE(test_sphere),
+    TEST_CASE(test_shepp_logan_structure),
+    TEST_CASE(test_noise),
+    TEST_CASE(test_existing_and_missing_folder),
+    {"test_upsample_linear", upsample_linear},
+    {"test_upsample_identity", upsample_identity},
+    {"test_upsample_rounding", upsample_rounding},
+    {"test_upsample_errors", upsample_errors},
+};
+
+static void make_scratch_dir(void)
 {
     tmp = test_tmp_dir("test_generate");
-    test_names();
-    test_bad_params();
-    test_determinism();
-    test_type_ranges();
-    test_sphere();
-    test_shepp_logan_structure();
-    test_noise();
-    test_existing_and_missing_folder();
-    int before = count_entries(tmp);
-    test_upsample_linear();
-    test_upsample_identity();
-    test_upsample_rounding();
-    test_upsample_errors();
-    /* Only the inputs and outputs named above remain: no temporary files. */
-    CHECK_MSG(count_entries(tmp) == before + 12, "%d entries, expected %d", count_entries(tmp),
-              before + 12);
-    return test_summary("test_generate");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_generate", make_scratch_dir, NULL);
 }

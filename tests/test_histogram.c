@@ -43,8 +43,8 @@ static void check_level(const ip_store *s, const double *raw, const ip_gen_param
     REQUIRE(ip_histogram_compute(s, k, bins, &h, &err) == IP_OK);
     const ip_layout *l = ip_store_layout(s);
     const uint32_t *d = l->levels[k].dims;
-    CHECK(h->level == k);
-    CHECK(h->samples == (uint64_t)d[0] * d[1] * d[2]);
+    CHECK_EQ(h->level, k);
+    CHECK_EQ(h->samples, (uint64_t)d[0] * d[1] * d[2]);
     uint64_t *want = calloc(h->bin_count, sizeof *want);
     REQUIRE(want);
     for (uint32_t z = 0; z < d[2]; z++)
@@ -64,14 +64,16 @@ static void check_level(const ip_store *s, const double *raw, const ip_gen_param
     }
     CHECK_MSG(same, "level %u of %s %s: counts differ from the raw samples", k,
               ip_field_name(p->field), ip_type_name(p->type));
-    CHECK(sum + h->unbinned == h->samples);
-    CHECK(h->unbinned == 0);
-    CHECK(h->bricks_read + h->bricks_constant == l->levels[k].brick_count);
+    CHECK_EQ(sum + h->unbinned, h->samples);
+    CHECK_EQ(h->unbinned, 0);
+    CHECK_EQ(h->bricks_read + h->bricks_constant, l->levels[k].brick_count);
     /* edges increase and cover the range */
-    CHECK(h->bins[0].lo == l->value_min);
-    CHECK(h->bins[h->bin_count - 1].hi >= l->value_max);
-    for (uint32_t b = 0; b + 1 < h->bin_count; b++)
-        CHECK(h->bins[b].hi == h->bins[b + 1].lo && h->bins[b].lo < h->bins[b].hi);
+    CHECK_EQ(h->bins[0].lo, l->value_min);
+    CHECK_GE(h->bins[h->bin_count - 1].hi, l->value_max);
+    for (uint32_t b = 0; b + 1 < h->bin_count; b++) {
+        CHECK_EQ(h->bins[b].hi, h->bins[b + 1].lo);
+        CHECK_LT(h->bins[b].lo, h->bins[b].hi);
+    }
     /* active sub-blocks: a brute-force count over every sub-block of the level */
     uint32_t per = ip_layout_subblocks_per_brick(l);
     const ip_level_layout *lv = &l->levels[k];
@@ -90,7 +92,7 @@ static void check_level(const ip_store *s, const double *raw, const ip_gen_param
         active_same &= n == h->bins[b].active_subblocks;
     }
     CHECK_MSG(active_same, "level %u: active sub-blocks differ from a direct count", k);
-    CHECK(nonempty == h->subblocks);
+    CHECK_EQ(nonempty, h->subblocks);
     free(want);
     ip_histogram_free(h);
 }
@@ -113,7 +115,8 @@ static uint64_t check_volume(const char *dir, const char *stem, const ip_gen_par
         lo = raw[i] < lo ? raw[i] : lo;
         hi = raw[i] > hi ? raw[i] : hi;
     }
-    CHECK(lo == l->value_min && hi == l->value_max);
+    CHECK_EQ(lo, l->value_min);
+    CHECK_EQ(hi, l->value_max);
     uint64_t constant = 0;
     uint32_t bin_counts[] = {1, 7, 64, 1000};
     for (uint32_t k = 0; k < l->level_count; k++)
@@ -122,18 +125,20 @@ static uint64_t check_volume(const char *dir, const char *stem, const ip_gen_par
     ip_histogram *h;
     REQUIRE(ip_histogram_compute(s, 0, 64, &h, &err) == IP_OK);
     constant = h->bricks_constant;
-    CHECK(h->bin_count <= 64);
+    CHECK_LE(h->bin_count, 64);
     if (p->type != IP_FLOAT32) {
         /* whole-value bins: each holds the same number of values */
         double w = h->bins[0].hi - h->bins[0].lo;
-        CHECK(w == floor(w) && w == ceil((hi - lo + 1) / 64));
+        CHECK_EQ(w, floor(w));
+        CHECK_EQ(w, ceil((hi - lo + 1) / 64));
         ip_histogram *fine;
         REQUIRE(ip_histogram_compute(s, 0, IP_HISTOGRAM_MAX_BINS, &fine, &err) == IP_OK);
-        CHECK(fine->bin_count == (uint32_t)(hi - lo + 1));
-        CHECK(fine->bins[0].hi - fine->bins[0].lo == 1);
+        CHECK_EQ(fine->bin_count, (uint32_t)(hi - lo + 1));
+        CHECK_EQ(fine->bins[0].hi - fine->bins[0].lo, 1);
         ip_histogram_free(fine);
     } else {
-        CHECK(h->bin_count == 64 && h->bins[63].hi == l->value_max);
+        if (CHECK_EQ(h->bin_count, 64))
+            CHECK_EQ(h->bins[63].hi, l->value_max);
     }
     ip_histogram_free(h);
     ip_store_close(s);
@@ -154,40 +159,68 @@ static void check_errors_and_default(const char *dir)
     const ip_layout *l = ip_store_layout(s);
     REQUIRE(l->level_count >= 3);
     ip_histogram *h = NULL;
-    CHECK(ip_histogram_compute(s, l->level_count, 64, &h, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_histogram_compute(s, l->level_count, 64, &h, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "levels.ibv");
     CHECK_CONTAINS(err.message, "past the pyramid");
-    CHECK(ip_histogram_compute(s, 0, 0, &h, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_histogram_compute(s, 0, 0, &h, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "bins");
-    CHECK(ip_histogram_compute(s, 0, IP_HISTOGRAM_MAX_BINS + 1, &h, &err) == IP_ERR_ARGUMENT);
-    CHECK(h == NULL);
+    CHECK_EQ(ip_histogram_compute(s, 0, IP_HISTOGRAM_MAX_BINS + 1, &h, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(h, NULL);
     /* the default level: the finest within the bound */
-    CHECK(ip_histogram_default_level(l, UINT64_MAX) == 0);
-    CHECK(ip_histogram_default_level(l, 0) == l->level_count - 1);
+    CHECK_EQ(ip_histogram_default_level(l, UINT64_MAX), 0);
+    CHECK_EQ(ip_histogram_default_level(l, 0), l->level_count - 1);
     const uint32_t *d1 = l->levels[1].dims;
     uint64_t n1 = (uint64_t)d1[0] * d1[1] * d1[2];
-    CHECK(ip_histogram_default_level(l, n1) == 1);
-    CHECK(ip_histogram_default_level(l, n1 - 1) == 2);
-    CHECK(ip_histogram_default_level(l, IP_HISTOGRAM_DEFAULT_SAMPLES) == 0);
+    CHECK_EQ(ip_histogram_default_level(l, n1), 1);
+    CHECK_EQ(ip_histogram_default_level(l, n1 - 1), 2);
+    CHECK_EQ(ip_histogram_default_level(l, IP_HISTOGRAM_DEFAULT_SAMPLES), 0);
     ip_histogram_free(NULL);
     ip_store_close(s);
 }
 
-int main(void)
+static const char *scratch_dir;
+
+static void gyroid_volume(void)
 {
-    const char *dir = test_tmp_dir("test_histogram");
     ip_gen_params gyroid = {
         sizeof(ip_gen_params), IP_FIELD_GYROID, {21, 18, 19}, IP_UINT16, 0.02, 7};
-    check_volume(dir, "gyroid", &gyroid);
+    check_volume(scratch_dir, "gyroid", &gyroid);
+}
+static void sphere_volume(void)
+{
     ip_gen_params sphere = {sizeof(ip_gen_params), IP_FIELD_SPHERE, {26, 23, 17}, IP_UINT8, 0.0, 1};
-    uint64_t constant = check_volume(dir, "sphere", &sphere);
+    uint64_t constant = check_volume(scratch_dir, "sphere", &sphere);
     CHECK_MSG(constant > 0, "the sphere has no constant brick: that path is not tested");
+}
+static void phantom_volume(void)
+{
     ip_gen_params phantom = {
         sizeof(ip_gen_params), IP_FIELD_SHEPP_LOGAN, {19, 22, 20}, IP_INT16, 0.01, 3};
-    check_volume(dir, "phantom", &phantom);
+    check_volume(scratch_dir, "phantom", &phantom);
+}
+static void lobb_volume(void)
+{
     ip_gen_params lobb = {
         sizeof(ip_gen_params), IP_FIELD_MARSCHNER_LOBB, {17, 20, 18}, IP_FLOAT32, 0.0, 1};
-    check_volume(dir, "lobb", &lobb);
-    check_errors_and_default(dir);
-    return test_summary("test_histogram");
+    check_volume(scratch_dir, "lobb", &lobb);
+}
+static void errors_and_default(void)
+{
+    check_errors_and_default(scratch_dir);
+}
+
+static const test_case cases[] = {
+    {"check_volume:gyroid", gyroid_volume},           {"check_volume:sphere", sphere_volume},
+    {"check_volume:phantom", phantom_volume},         {"check_volume:lobb", lobb_volume},
+    {"check_errors_and_default", errors_and_default},
+};
+
+static void make_scratch_dir(void)
+{
+    scratch_dir = test_tmp_dir("test_histogram");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_histogram", make_scratch_dir, NULL);
 }

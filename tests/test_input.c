@@ -168,7 +168,7 @@ static int read_and_compare(const ip_input_desc *desc, uint32_t step)
         }
     }
     CHECK_MSG(wrong == 0, "%s: %d wrong samples", desc->path, wrong);
-    CHECK(ip_input_read_planes(reader, buf, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_input_read_planes(reader, buf, 1, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "planes");
     free(buf);
     ip_input_close(reader);
@@ -200,7 +200,7 @@ static void read_fails(const ip_input_desc *desc, ip_status code, const char *ne
     CHECK_MSG(status == code, "%s: got %d (%s), expected %d", desc->path, status, err.message,
               code);
     CHECK_CONTAINS(err.message, needle);
-    CHECK(ip_input_read_planes(reader, buf, 1, &err) != IP_OK);
+    CHECK_NE(ip_input_read_planes(reader, buf, 1, &err), IP_OK);
     free(buf);
     ip_input_close(reader);
 }
@@ -227,12 +227,18 @@ static void test_raw_by_name(void)
         write_volume(path, "wb", files[i].type, files[i].dims, 0);
         if (!describe_ok(path, NULL, &d))
             continue;
-        CHECK(d.dims[0] == files[i].dims[0] && d.dims[1] == files[i].dims[1] &&
-              d.dims[2] == files[i].dims[2]);
-        CHECK(d.type == files[i].type);
-        CHECK(strcmp(d.path, path) == 0 && strcmp(d.data_path, path) == 0);
-        CHECK(d.data_offset == 0 && d.big_endian == 0 && d.encoding == IP_ENCODING_RAW);
-        CHECK(d.spacing[0] == 1.0 && d.spacing[1] == 1.0 && d.spacing[2] == 1.0);
+        CHECK_EQ(d.dims[0], files[i].dims[0]);
+        CHECK_EQ(d.dims[1], files[i].dims[1]);
+        CHECK_EQ(d.dims[2], files[i].dims[2]);
+        CHECK_EQ(d.type, files[i].type);
+        CHECK_STR_EQ(d.path, path);
+        CHECK_STR_EQ(d.data_path, path);
+        CHECK_EQ(d.data_offset, 0);
+        CHECK_EQ(d.big_endian, 0);
+        CHECK_EQ(d.encoding, IP_ENCODING_RAW);
+        CHECK_EQ(d.spacing[0], 1.0);
+        CHECK_EQ(d.spacing[1], 1.0);
+        CHECK_EQ(d.spacing[2], 1.0);
         read_and_compare(&d, 1);
         read_and_compare(&d, 2);
     }
@@ -255,8 +261,12 @@ static void test_raw_by_overrides(void)
     ov.spacing[1] = 0.5;
     ov.spacing[2] = 2.5;
     if (describe_ok(path, &ov, &d)) {
-        CHECK(d.dims[0] == 7 && d.dims[1] == 6 && d.dims[2] == 5 && d.type == IP_INT16);
-        CHECK(d.spacing[0] == 0.5 && d.spacing[2] == 2.5);
+        CHECK_EQ(d.dims[0], 7);
+        CHECK_EQ(d.dims[1], 6);
+        CHECK_EQ(d.dims[2], 5);
+        CHECK_EQ(d.type, IP_INT16);
+        CHECK_EQ(d.spacing[0], 0.5);
+        CHECK_EQ(d.spacing[2], 2.5);
         read_and_compare(&d, 5);
     }
     /* Neither the name nor the overrides say enough. */
@@ -291,13 +301,20 @@ static void test_overrides_win(void)
     ov.has_endian = 1;
     ov.big_endian = 1;
     if (describe_ok(path, &ov, &d)) {
-        CHECK(d.dims[0] == 4 && d.dims[2] == 2 && d.type == IP_UINT16 && d.big_endian == 1);
+        CHECK_EQ(d.dims[0], 4);
+        CHECK_EQ(d.dims[2], 2);
+        CHECK_EQ(d.type, IP_UINT16);
+        CHECK_EQ(d.big_endian, 1);
         read_and_compare(&d, 2);
     }
     /* Only the type overridden: dims still come from the name (2x2x6 x 2 bytes = 48). */
     ov.has_dims = 0;
-    if (describe_ok(path, &ov, &d))
-        CHECK(d.dims[0] == 2 && d.dims[1] == 2 && d.dims[2] == 6 && d.type == IP_UINT16);
+    if (describe_ok(path, &ov, &d)) {
+        CHECK_EQ(d.dims[0], 2);
+        CHECK_EQ(d.dims[1], 2);
+        CHECK_EQ(d.dims[2], 6);
+        CHECK_EQ(d.type, IP_UINT16);
+    }
     /* An unknown type in the name does not matter once the type is given. */
     in_scratch(path, "odd_4x3x2_uint64.raw");
     write_volume(path, "wb", IP_UINT16, dims, 0);
@@ -317,7 +334,7 @@ static void test_big_endian_raw(void)
     in_scratch(path, "be_9x4x3_uint16.raw");
     write_volume(path, "wb", IP_UINT16, dims, 1);
     if (describe_ok(path, &ov, &d)) {
-        CHECK(d.big_endian == 1);
+        CHECK_EQ(d.big_endian, 1);
         read_and_compare(&d, 1);
     }
     in_scratch(path, "be_9x4x3_float32.raw");
@@ -337,8 +354,9 @@ static void test_big_endian_raw(void)
         ip_error err;
         uint16_t plane[4];
         REQUIRE(ip_input_open(&d, &r, &err) == IP_OK);
-        CHECK(ip_input_read_planes(r, plane, 1, &err) == IP_OK);
-        CHECK(plane[0] == 258 && plane[3] == 258);
+        CHECK_EQ(ip_input_read_planes(r, plane, 1, &err), IP_OK);
+        CHECK_EQ(plane[0], 258);
+        CHECK_EQ(plane[3], 258);
         ip_input_close(r);
     }
 }
@@ -366,10 +384,15 @@ static void test_nrrd_attached(void)
     write_text(path, header);
     write_volume(path, "ab", IP_INT16, dims, 0);
     if (describe_ok(path, NULL, &d)) {
-        CHECK(d.data_offset == strlen(header));
-        CHECK(d.type == IP_INT16 && d.dims[0] == 5 && d.dims[1] == 4 && d.dims[2] == 3);
-        CHECK(d.spacing[0] == 0.5 && d.spacing[1] == 0.75 && d.spacing[2] == 1.0);
-        CHECK(strcmp(d.data_path, path) == 0);
+        CHECK_EQ(d.data_offset, strlen(header));
+        CHECK_EQ(d.type, IP_INT16);
+        CHECK_EQ(d.dims[0], 5);
+        CHECK_EQ(d.dims[1], 4);
+        CHECK_EQ(d.dims[2], 3);
+        CHECK_EQ(d.spacing[0], 0.5);
+        CHECK_EQ(d.spacing[1], 0.75);
+        CHECK_EQ(d.spacing[2], 1.0);
+        CHECK_STR_EQ(d.data_path, path);
         read_and_compare(&d, 1);
     }
     /* CRLF line endings and every type spelling of the format. */
@@ -404,7 +427,8 @@ static void test_nrrd_attached(void)
         write_volume(path, "ab", types[i].type, dims, 1);
         if (describe_ok(path, NULL, &d)) {
             CHECK_MSG(d.type == types[i].type, "%s", types[i].spelling);
-            CHECK(d.data_offset == strlen(text) && d.big_endian == 1);
+            CHECK_EQ(d.data_offset, strlen(text));
+            CHECK_EQ(d.big_endian, 1);
             read_and_compare(&d, 3);
         }
     }
@@ -424,8 +448,8 @@ static void test_nrrd_detached(void)
                        "encoding: raw\ndata file: detached_data.bin\nline skip: 2\n"
                        "byte skip: 3\n");
     if (describe_ok(header, NULL, &d)) {
-        CHECK(strcmp(d.data_path, data) == 0);
-        CHECK(d.data_offset == strlen("P5\n# preamble line\nXYZ"));
+        CHECK_STR_EQ(d.data_path, data);
+        CHECK_EQ(d.data_offset, strlen("P5\n# preamble line\nXYZ"));
         read_and_compare(&d, 4);
     }
     /* "datafile:" spelling, an absolute path, and a header given by a relative path. */
@@ -438,7 +462,8 @@ static void test_nrrd_detached(void)
              data);
     write_text(header, text);
     if (describe_ok(header, NULL, &d)) {
-        CHECK(strcmp(d.data_path, data) == 0 && d.data_offset == 0);
+        CHECK_STR_EQ(d.data_path, data);
+        CHECK_EQ(d.data_offset, 0);
         read_and_compare(&d, 1);
     }
     char cwd[4096];
@@ -447,7 +472,7 @@ static void test_nrrd_detached(void)
     write_text("relative.nhdr", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 6 5 4\n"
                                 "encoding: raw\ndata file: ./detached_plain.raw\n");
     if (describe_ok("relative.nhdr", NULL, &d)) {
-        CHECK(strcmp(d.data_path, "./detached_plain.raw") == 0);
+        CHECK_STR_EQ(d.data_path, "./detached_plain.raw");
         read_and_compare(&d, 2);
     }
     REQUIRE(chdir(cwd) == 0);
@@ -464,7 +489,8 @@ static void test_nrrd_gzip(void)
     write_text(path, header);
     append_gzip_volume(path, IP_UINT16, dims, 1);
     if (describe_ok(path, NULL, &d)) {
-        CHECK(d.encoding == IP_ENCODING_GZIP && d.data_offset == strlen(header));
+        CHECK_EQ(d.encoding, IP_ENCODING_GZIP);
+        CHECK_EQ(d.data_offset, strlen(header));
         read_and_compare(&d, 1);
         read_and_compare(&d, 4);
         read_and_compare(&d, 11);
@@ -477,7 +503,8 @@ static void test_nrrd_gzip(void)
     write_text(path, "NRRD0004\ntype: float\ndimension: 3\nsizes: 17 13 11\nendian: little\n"
                      "encoding: gz\ndata file: gzip_data.raw.gz\n");
     if (describe_ok(path, NULL, &d)) {
-        CHECK(d.encoding == IP_ENCODING_GZIP && strcmp(d.data_path, data) == 0);
+        CHECK_EQ(d.encoding, IP_ENCODING_GZIP);
+        CHECK_STR_EQ(d.data_path, data);
         read_and_compare(&d, 3);
     }
     /* Two gzip members one after the other are one valid gzip file. */
@@ -503,7 +530,9 @@ static void test_nrrd_space_directions(void)
                      "space origin: (1,2,3)\nencoding: raw\n\n");
     write_volume(path, "ab", IP_UINT8, dims, 0);
     if (describe_ok(path, NULL, &d)) {
-        CHECK(d.spacing[0] == 0.5 && d.spacing[1] == 2.0 && d.spacing[2] == 3.0);
+        CHECK_EQ(d.spacing[0], 0.5);
+        CHECK_EQ(d.spacing[1], 2.0);
+        CHECK_EQ(d.spacing[2], 3.0);
         read_and_compare(&d, 3);
     }
     /* Oblique axes: the spacing is the length of each direction vector. */
@@ -511,21 +540,28 @@ static void test_nrrd_space_directions(void)
                      "space directions: (3,4,0) (0, 0, -2.5) (0.6,0,0.8)\nencoding: raw\n\n");
     write_volume(path, "ab", IP_UINT8, dims, 0);
     if (describe_ok(path, NULL, &d)) {
-        CHECK(fabs(d.spacing[0] - 5.0) < 1e-12 && fabs(d.spacing[1] - 2.5) < 1e-12 &&
-              fabs(d.spacing[2] - 1.0) < 1e-12);
+        CHECK_NEAR(d.spacing[0], 5.0, 1e-12);
+        CHECK_NEAR(d.spacing[1], 2.5, 1e-12);
+        CHECK_NEAR(d.spacing[2], 1.0, 1e-12);
     }
     /* "none" marks an axis without a direction: it keeps the default spacing. */
     write_text(path, "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 3 3 3\n"
                      "space directions: (0,0,4) none (2,0,0)\nencoding: raw\n\n");
     write_volume(path, "ab", IP_UINT8, dims, 0);
-    if (describe_ok(path, NULL, &d))
-        CHECK(d.spacing[0] == 4.0 && d.spacing[1] == 1.0 && d.spacing[2] == 2.0);
+    if (describe_ok(path, NULL, &d)) {
+        CHECK_EQ(d.spacing[0], 4.0);
+        CHECK_EQ(d.spacing[1], 1.0);
+        CHECK_EQ(d.spacing[2], 2.0);
+    }
     /* An explicit spacing override wins over the directions. */
     ip_input_overrides ov = {0};
     ov.has_spacing = 1;
     ov.spacing[0] = ov.spacing[1] = ov.spacing[2] = 0.25;
-    if (describe_ok(path, &ov, &d))
-        CHECK(d.spacing[0] == 0.25 && d.spacing[1] == 0.25 && d.spacing[2] == 0.25);
+    if (describe_ok(path, &ov, &d)) {
+        CHECK_EQ(d.spacing[0], 0.25);
+        CHECK_EQ(d.spacing[1], 0.25);
+        CHECK_EQ(d.spacing[2], 0.25);
+    }
 }
 
 static void test_nrrd_byte_skip(void)
@@ -542,7 +578,7 @@ static void test_nrrd_byte_skip(void)
     write_text(header, "NRRD0004\ntype: int16\ndimension: 3\nsizes: 8 3 2\nendian: big\n"
                        "encoding: raw\nbyte skip: -1\ndata file: skip_end.dat\n");
     if (describe_ok(header, NULL, &d)) {
-        CHECK(d.data_offset == strlen(prefix));
+        CHECK_EQ(d.data_offset, strlen(prefix));
         read_and_compare(&d, 1);
     }
     /* ... attached too: the blank line's position does not matter then. */
@@ -551,7 +587,7 @@ static void test_nrrd_byte_skip(void)
                        "encoding: raw\nbyte skip: -1\n\nsome padding");
     write_volume(header, "ab", IP_INT16, dims, 1);
     if (describe_ok(header, NULL, &d)) {
-        CHECK(d.data_offset == file_size(header) - 8 * 3 * 2 * 2);
+        CHECK_EQ(d.data_offset, file_size(header) - 8 * 3 * 2 * 2);
         read_and_compare(&d, 2);
     }
     /* A positive byte skip after an attached header. */
@@ -559,7 +595,7 @@ static void test_nrrd_byte_skip(void)
                        "encoding: raw\nbyte skip: 5\n\n12345");
     write_volume(header, "ab", IP_INT16, dims, 1);
     if (describe_ok(header, NULL, &d)) {
-        CHECK(d.data_offset == file_size(header) - 8 * 3 * 2 * 2);
+        CHECK_EQ(d.data_offset, file_size(header) - 8 * 3 * 2 * 2);
         read_and_compare(&d, 2);
     }
 }
@@ -602,8 +638,12 @@ static void test_mhd(void)
                        "BinaryDataByteOrderMSB = True\nElementType = MET_USHORT\n"
                        "ElementDataFile = meta_data.raw\n");
     if (describe_ok(header, NULL, &d)) {
-        CHECK(strcmp(d.data_path, data) == 0 && d.big_endian == 1 && d.type == IP_UINT16);
-        CHECK(d.spacing[0] == 0.5 && d.spacing[1] == 1.5 && d.spacing[2] == 2.0);
+        CHECK_STR_EQ(d.data_path, data);
+        CHECK_EQ(d.big_endian, 1);
+        CHECK_EQ(d.type, IP_UINT16);
+        CHECK_EQ(d.spacing[0], 0.5);
+        CHECK_EQ(d.spacing[1], 1.5);
+        CHECK_EQ(d.spacing[2], 2.0);
         read_and_compare(&d, 1);
     }
     /* ElementSize stands in for a missing ElementSpacing; ElementByteOrderMSB spelling. */
@@ -612,7 +652,9 @@ static void test_mhd(void)
                        "ElementByteOrderMSB = False\nElementType = MET_SHORT\n"
                        "ElementDataFile = meta_data.raw\n");
     if (describe_ok(header, NULL, &d)) {
-        CHECK(d.spacing[0] == 3.0 && d.spacing[1] == 2.0 && d.spacing[2] == 1.0);
+        CHECK_EQ(d.spacing[0], 3.0);
+        CHECK_EQ(d.spacing[1], 2.0);
+        CHECK_EQ(d.spacing[2], 1.0);
         read_and_compare(&d, 3);
     }
     /* LOCAL: the data follow the header line that says so. */
@@ -622,7 +664,8 @@ static void test_mhd(void)
     write_text(header, local);
     write_volume(header, "ab", IP_FLOAT32, dims, 0);
     if (describe_ok(header, NULL, &d)) {
-        CHECK(d.data_offset == strlen(local) && strcmp(d.data_path, header) == 0);
+        CHECK_EQ(d.data_offset, strlen(local));
+        CHECK_STR_EQ(d.data_path, header);
         read_and_compare(&d, 2);
     }
     /* HeaderSize skips bytes of the data file; -1 puts the data at its end. */
@@ -637,7 +680,7 @@ static void test_mhd(void)
                  at_end ? -1 : 16);
         write_text(header, text);
         if (describe_ok(header, NULL, &d)) {
-            CHECK(d.data_offset == 16);
+            CHECK_EQ(d.data_offset, 16);
             read_and_compare(&d, 3);
         }
     }
@@ -674,10 +717,13 @@ static void test_nrrd_spaces(void)
                       strcmp(ip_space_name(d.orientation.space), cases[i].name) == 0,
                   "space: %s", cases[i].field);
         /* the file's own space, not converted: the origin and directions as written */
-        CHECK(d.orientation.origin[0] == 1 && d.orientation.origin[1] == 2 &&
-              d.orientation.origin[2] == 3);
-        CHECK(d.orientation.directions[0][2] == -1 && d.orientation.directions[1][1] == 1 &&
-              d.orientation.directions[2][0] == 1 && d.spacing[0] == 2);
+        CHECK_EQ(d.orientation.origin[0], 1);
+        CHECK_EQ(d.orientation.origin[1], 2);
+        CHECK_EQ(d.orientation.origin[2], 3);
+        CHECK_EQ(d.orientation.directions[0][2], -1);
+        CHECK_EQ(d.orientation.directions[1][1], 1);
+        CHECK_EQ(d.orientation.directions[2][0], 1);
+        CHECK_EQ(d.spacing[0], 2);
     }
 }
 
@@ -717,11 +763,14 @@ static void test_mhd_orientation(void)
                 worst = fmax(worst, fabs(d.orientation.directions[a][c] -
                                          (cases[i].framed ? axes[a][c] : a == c)));
         CHECK_MSG(worst < 1e-12, "%s: directions off by %g", cases[i].matrix_key, worst);
-        CHECK(d.orientation.origin[0] == 10 && d.orientation.origin[1] == -20 &&
-              d.orientation.origin[2] == 30.5);
-        CHECK(d.spacing[0] == 0.5 && d.spacing[1] == 0.75 && d.spacing[2] == 2);
-        CHECK(d.orientation.space == IP_SPACE_UNKNOWN);
-        CHECK(read_and_compare(&d, 3) == 0);
+        CHECK_EQ(d.orientation.origin[0], 10);
+        CHECK_EQ(d.orientation.origin[1], -20);
+        CHECK_EQ(d.orientation.origin[2], 30.5);
+        CHECK_EQ(d.spacing[0], 0.5);
+        CHECK_EQ(d.spacing[1], 0.75);
+        CHECK_EQ(d.spacing[2], 2);
+        CHECK_EQ(d.orientation.space, IP_SPACE_UNKNOWN);
+        CHECK_EQ(read_and_compare(&d, 3), 0);
     }
     /* neither key: the identity */
     write_text(header, "NDims = 3\nDimSize = 7 5 3\nElementType = MET_UCHAR\n"
@@ -746,7 +795,7 @@ static void test_mhd_compressed(void)
                        "CompressedData = True\nCompressedDataSize = 999\n"
                        "ElementDataFile = meta_zlib.zraw\n");
     if (describe_ok(header, NULL, &d)) {
-        CHECK(d.encoding == IP_ENCODING_GZIP);
+        CHECK_EQ(d.encoding, IP_ENCODING_GZIP);
         read_and_compare(&d, 2);
     }
     /* LOCAL, compressed with a gzip wrapper. */
@@ -1093,13 +1142,13 @@ static void test_non_finite_floats(void)
         ip_error err;
         float plane[20];
         REQUIRE(ip_input_open(&d, &r, &err) == IP_OK);
-        CHECK(ip_input_read_planes(r, plane, 1, &err) == IP_OK);
-        CHECK(plane[19] == (float)expected_value(IP_FLOAT32, 4, 3, 0));
-        CHECK(ip_input_read_planes(r, plane, 1, &err) == IP_ERR_INPUT);
+        CHECK_EQ(ip_input_read_planes(r, plane, 1, &err), IP_OK);
+        CHECK_EQ(plane[19], (float)expected_value(IP_FLOAT32, 4, 3, 0));
+        CHECK_EQ(ip_input_read_planes(r, plane, 1, &err), IP_ERR_INPUT);
         CHECK_CONTAINS(err.message, "nan_5x4x3_float32.raw");
         CHECK_CONTAINS(err.message, "(2,1,1)");
         CHECK_CONTAINS(err.message, "NaN");
-        CHECK(ip_input_read_planes(r, plane, 1, &err) == IP_ERR_INPUT);
+        CHECK_EQ(ip_input_read_planes(r, plane, 1, &err), IP_ERR_INPUT);
         ip_input_close(r);
     }
     /* Infinity, big-endian, inside a gzip NRRD, in the last plane. */
@@ -1148,11 +1197,11 @@ static void test_limits(void)
 
     ip_input_desc d;
     ip_error err;
-    CHECK(ip_input_describe(NULL, NULL, &d, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_input_describe(path, NULL, NULL, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_input_describe("", NULL, &d, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_input_open(NULL, NULL, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_input_read_planes(NULL, NULL, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_input_describe(NULL, NULL, &d, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_input_describe(path, NULL, NULL, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_input_describe("", NULL, &d, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_input_open(NULL, NULL, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_input_read_planes(NULL, NULL, 1, &err), IP_ERR_ARGUMENT);
     ip_input_close(NULL);
 }
 
@@ -1194,7 +1243,8 @@ static void test_large_offsets(void)
                 seen_b = buf[count * plane - 1] == mark_b;
         }
         CHECK_MSG(ok, "%s", err.message);
-        CHECK(seen_a && seen_b);
+        CHECK(seen_a);
+        CHECK(seen_b);
         ip_input_close(r);
         free(buf);
     }
@@ -1235,7 +1285,7 @@ static void check_shared_volume(const char *path)
     CHECK_MSG(status == IP_OK, "%s", err.message);
     CHECK_MSG(bytes_read == size, "%s: read %llu of %llu bytes", path,
               (unsigned long long)bytes_read, (unsigned long long)size);
-    CHECK(ip_input_read_planes(r, buf, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_input_read_planes(r, buf, 1, &err), IP_ERR_ARGUMENT);
     ip_input_close(r);
     close(fd);
     free(buf);
@@ -1266,32 +1316,27 @@ static void test_shared_data(void)
     printf("test_input: checked %d shared volumes in %s\n", count, folder);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_raw_by_name),       TEST_CASE(test_raw_by_overrides),
+    TEST_CASE(test_overrides_win),     TEST_CASE(test_big_endian_raw),
+    TEST_CASE(test_nrrd_attached),     TEST_CASE(test_nrrd_detached),
+    TEST_CASE(test_nrrd_gzip),         TEST_CASE(test_nrrd_space_directions),
+    TEST_CASE(test_nrrd_byte_skip),    TEST_CASE(test_nrrd_overrides),
+    TEST_CASE(test_nrrd_spaces),       TEST_CASE(test_mhd),
+    TEST_CASE(test_mhd_compressed),    TEST_CASE(test_mhd_orientation),
+    TEST_CASE(test_wrong_size),        TEST_CASE(test_unknown_type),
+    TEST_CASE(test_dimension_under_2), TEST_CASE(test_bad_headers),
+    TEST_CASE(test_missing_files),     TEST_CASE(test_bad_gzip),
+    TEST_CASE(test_non_finite_floats), TEST_CASE(test_limits),
+    TEST_CASE(test_large_offsets),     TEST_CASE(test_shared_data),
+};
+
+static void make_scratch_dir(void)
 {
     snprintf(scratch, sizeof scratch, "%s", test_tmp_dir("test_input"));
-    test_raw_by_name();
-    test_raw_by_overrides();
-    test_overrides_win();
-    test_big_endian_raw();
-    test_nrrd_attached();
-    test_nrrd_detached();
-    test_nrrd_gzip();
-    test_nrrd_space_directions();
-    test_nrrd_byte_skip();
-    test_nrrd_overrides();
-    test_nrrd_spaces();
-    test_mhd();
-    test_mhd_compressed();
-    test_mhd_orientation();
-    test_wrong_size();
-    test_unknown_type();
-    test_dimension_under_2();
-    test_bad_headers();
-    test_missing_files();
-    test_bad_gzip();
-    test_non_finite_floats();
-    test_limits();
-    test_large_offsets();
-    test_shared_data();
-    return test_summary("test_input");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_input", make_scratch_dir, NULL);
 }

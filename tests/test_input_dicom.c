@@ -78,8 +78,8 @@ static void check_samples(const ip_input_desc *desc, const void *volume)
         CHECK_MSG(ip_input_read_planes(r, got, 3, &err) == IP_OK, "%s", err.message);
         CHECK_MSG(ip_input_read_planes(r, got + 3 * plane, desc->dims[2] - 3, &err) == IP_OK, "%s",
                   err.message);
-        CHECK(memcmp(got, volume, bytes) == 0);
-        CHECK(ip_input_read_planes(r, got, 1, &err) == IP_ERR_ARGUMENT);
+        CHECK_MEM_EQ(got, volume, bytes);
+        CHECK_EQ(ip_input_read_planes(r, got, 1, &err), IP_ERR_ARGUMENT);
     }
     ip_input_close(r);
     free(got);
@@ -100,13 +100,17 @@ static void test_series(ip_type type, const char *name)
     write_text_file(dir, ".hidden", "not a slice");
     write_index(dir);
     CHECK_MSG(ip_input_describe(dir, NULL, &desc, &err) == IP_OK, "%s", err.message);
-    CHECK(desc.encoding == IP_ENCODING_DICOM);
-    CHECK(desc.dims[0] == 13 && desc.dims[1] == 11 && desc.dims[2] == 9);
-    CHECK(desc.type == type);
+    CHECK_EQ(desc.encoding, IP_ENCODING_DICOM);
+    CHECK_EQ(desc.dims[0], 13);
+    CHECK_EQ(desc.dims[1], 11);
+    CHECK_EQ(desc.dims[2], 9);
+    CHECK_EQ(desc.type, type);
     CHECK_MSG(fabs(desc.spacing[0] - 0.8) < 1e-9 && fabs(desc.spacing[1] - 0.7) < 1e-9 &&
                   fabs(desc.spacing[2] - 2.5) < 1e-9,
               "spacing %g %g %g", desc.spacing[0], desc.spacing[1], desc.spacing[2]);
-    CHECK(desc.has_rescale && desc.rescale_slope == 1.0 && desc.rescale_intercept == -1024.0);
+    CHECK(desc.has_rescale);
+    CHECK_EQ(desc.rescale_slope, 1.0);
+    CHECK_EQ(desc.rescale_intercept, -1024.0);
     check_samples(&desc, volume);
     free(volume);
 }
@@ -129,13 +133,15 @@ static void test_overrides(void)
     o.has_spacing = 1;
     o.spacing[0] = 1, o.spacing[1] = 2, o.spacing[2] = 3;
     CHECK_MSG(ip_input_describe(dir, &o, &desc, &err) == IP_OK, "%s", err.message);
-    CHECK(desc.spacing[0] == 1 && desc.spacing[1] == 2 && desc.spacing[2] == 3);
+    CHECK_EQ(desc.spacing[0], 1);
+    CHECK_EQ(desc.spacing[1], 2);
+    CHECK_EQ(desc.spacing[2], 3);
     CHECK(!desc.has_rescale);
     check_samples(&desc, volume);
     o.has_dims = 1;
     o.dims[0] = 5, o.dims[1] = 6, o.dims[2] = 4;
     CHECK_MSG(ip_input_describe(dir, &o, &desc, &err) == IP_OK, "%s", err.message);
-    CHECK(ip_input_open(&desc, &r, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip_input_open(&desc, &r, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "not the 5x6x4");
     ip_input_close(r);
     free(volume);
@@ -153,7 +159,7 @@ static void expect_refused(const char *dir, ip_status code, const char *names, c
         return;
     CHECK_CONTAINS(err.message, names);
     CHECK_CONTAINS(err.message, text);
-    CHECK(strchr(err.message, '\n') == NULL);
+    CHECK_EQ(strchr(err.message, '\n'), NULL);
 }
 
 /* A folder with the series of `s` less the plane `skip` (none when >= dims[2]), then the
@@ -275,7 +281,7 @@ static void test_malformed(void)
             }
             /* what describes (a cut among the elements after the image, none here) reads */
             ip_input_reader *r = NULL;
-            CHECK(ip_input_open(&desc, &r, &err) == IP_OK);
+            CHECK_EQ(ip_input_open(&desc, &r, &err), IP_OK);
             ip_input_close(r);
         }
         CHECK_MSG(refused == cuts, "%s: %zu of %zu cuts refused with a line naming the file",
@@ -291,7 +297,7 @@ static void test_malformed(void)
         REQUIRE(truncate(path, (off_t)(size - 3)) == 0);
         uint16_t *planes = malloc(4 * 8 * 7 * sizeof *planes);
         REQUIRE(planes != NULL);
-        CHECK(ip_input_read_planes(r, planes, 4, &err) == IP_ERR_INPUT);
+        CHECK_EQ(ip_input_read_planes(r, planes, 4, &err), IP_ERR_INPUT);
         CHECK_CONTAINS(err.message, "IM0002.dcm");
         ip_input_close(r);
         free(planes);
@@ -368,22 +374,42 @@ static void test_changed_file(void)
     test_dicom_write_slice(&wider, volume, 1, path);
     uint16_t *planes = malloc(2 * 8 * 7 * sizeof *planes);
     REQUIRE(planes != NULL);
-    CHECK(ip_input_read_planes(r, planes, 2, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip_input_read_planes(r, planes, 2, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "changed/IM0002.dcm");
     ip_input_close(r);
     free(planes);
     free(volume);
 }
 
-int main(void)
+static void test_series_int16(void)
+{
+    test_series(IP_INT16, "int16");
+}
+static void test_series_uint16(void)
+{
+    test_series(IP_UINT16, "uint16");
+}
+static void test_series_uint8(void)
+{
+    test_series(IP_UINT8, "uint8");
+}
+
+static const test_case cases[] = {
+    {"test_series:int16", test_series_int16},
+    {"test_series:uint16", test_series_uint16},
+    {"test_series:uint8", test_series_uint8},
+    TEST_CASE(test_overrides),
+    TEST_CASE(test_refused),
+    TEST_CASE(test_changed_file),
+    TEST_CASE(test_malformed),
+};
+
+static void make_scratch_dir(void)
 {
     snprintf(scratch, sizeof scratch, "%s", test_tmp_dir("test_input_dicom"));
-    test_series(IP_INT16, "int16");
-    test_series(IP_UINT16, "uint16");
-    test_series(IP_UINT8, "uint8");
-    test_overrides();
-    test_refused();
-    test_changed_file();
-    test_malformed();
-    return test_summary("test_input_dicom");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_input_dicom", make_scratch_dir, NULL);
 }

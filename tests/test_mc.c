@@ -317,7 +317,7 @@ static void test_table_matches_generator(void)
         if (g.triangle_count > max_triangles)
             max_triangles = g.triangle_count;
     }
-    CHECK(max_triangles == IP_MC_MAX_TRIANGLES);
+    CHECK_EQ(max_triangles, IP_MC_MAX_TRIANGLES);
 }
 
 /* Within one cell, a triangle side joining two edges of one face is an outline segment and is
@@ -373,7 +373,7 @@ static void test_case_counts(void)
         CHECK_MSG(cell_edges_manifold(c), "case 0x%02x: a diagonal on a face", c);
         /* The complement has the same crossed edges; with no ambiguous face it is the same
          * outline reversed. With one, it is the case's outline under the opposite rule. */
-        CHECK(ip__mc_edge_table[255 - c] == ip__mc_edge_table[c]);
+        CHECK_EQ(ip__mc_edge_table[255 - c], ip__mc_edge_table[c]);
         CHECK_MSG(ip__mc_triangle_count[255 - c] == other_rule.triangle_count,
                   "case 0x%02x: complement %d, opposite rule %d", c, ip__mc_triangle_count[255 - c],
                   other_rule.triangle_count);
@@ -396,7 +396,8 @@ static void test_case_counts(void)
     }
     printf("complement: %d cases without an ambiguous face match; %d cases with one differ\n",
            complement_equal, complement_differs);
-    CHECK(complement_equal == 136 && complement_differs == 88); /* as stated in mc.h */
+    CHECK_EQ(complement_equal, 136);
+    CHECK_EQ(complement_differs, 88); /* as stated in mc.h */
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -408,6 +409,9 @@ typedef struct grid {
     float v[GRID][GRID][GRID]; /* [z][y][x] */
     float g[GRID][GRID][GRID][3];
 } grid;
+
+/* The grid the extraction cases fill (setup), too large for the stack. */
+static grid *the_grid;
 
 typedef struct mesh_report {
     long triangles;
@@ -633,8 +637,9 @@ static double sphere_value(double x, double y, double z, const double c[3], doub
     return radius - sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-static void test_sphere(grid *gr)
+static void test_sphere(void)
 {
+    grid *gr = the_grid;
     const double centre[3] = {15.37, 16.11, 15.73};
     for (int z = 0; z < GRID; z++)
         for (int y = 0; y < GRID; y++)
@@ -647,7 +652,7 @@ static void test_sphere(grid *gr)
         check_closed(use_gradients ? "sphere (gradients)" : "sphere", &r, 2000);
         printf("%-22s %ld facing inward, %ld slivers\n", "", r.inward, r.slivers);
         CHECK_MSG(r.inward == 0, "sphere: %ld triangles or normals face inward", r.inward);
-        CHECK(r.slivers < r.triangles / 100);
+        CHECK_LT(r.slivers, r.triangles / 100);
     }
     /* Topology does not depend on the cell's shape. */
     const float stretched[3] = {0.5f, 1.75f, 1.25f};
@@ -661,8 +666,9 @@ static void test_sphere(grid *gr)
     check_closed("sphere (inexact spacing)", &r, 2000);
 }
 
-static void test_touching_spheres(grid *gr)
+static void test_touching_spheres(void)
 {
+    grid *gr = the_grid;
     /* Centres along a face diagonal, touching at the centre of a cell face: the face's two
      * diagonal corners fall one in each sphere and the other two just outside both. */
     const double d = 3.5, radius = d * sqrt(2.0);
@@ -676,15 +682,16 @@ static void test_touching_spheres(grid *gr)
     const float unit[3] = {1, 1, 1};
     mesh_report r = mesh_grid(gr, 0.0f, 0, unit, NULL);
     check_closed("touching spheres", &r, 500);
-    CHECK(r.ambiguous_faces > 0);
+    CHECK_GT(r.ambiguous_faces, 0);
     r = mesh_grid(gr, -0.1f, 0, unit, NULL);
     check_closed("merged spheres", &r, 500);
     r = mesh_grid(gr, 0.1f, 0, unit, NULL);
     check_closed("nearly touching", &r, 500);
 }
 
-static void test_gyroid(grid *gr)
+static void test_gyroid(void)
 {
+    grid *gr = the_grid;
     const double k = 2.0 * 3.14159265358979 / 9.7;
     for (int z = 0; z < GRID; z++)
         for (int y = 0; y < GRID; y++)
@@ -698,8 +705,9 @@ static void test_gyroid(grid *gr)
     check_closed("gyroid", &r, 5000);
 }
 
-static void test_random(grid *gr)
+static void test_random(void)
 {
+    grid *gr = the_grid;
     for (uint64_t seed = 1; seed <= 3; seed++) {
         uint64_t state = seed;
         for (int z = 0; z < GRID; z++)
@@ -719,8 +727,9 @@ static void test_random(grid *gr)
 
 /* Many samples exactly equal to iso: vertices land on corners, triangles collapse, yet the
  * welded mesh must still be closed and free of NaN. */
-static void test_values_equal_to_iso(grid *gr)
+static void test_values_equal_to_iso(void)
 {
+    grid *gr = the_grid;
     const double centre[3] = {15.5, 15.2, 16.0};
     for (int z = 0; z < GRID; z++)
         for (int y = 0; y < GRID; y++)
@@ -732,7 +741,7 @@ static void test_values_equal_to_iso(grid *gr)
         for (int y = 0; y < GRID; y++)
             for (int x = 0; x < GRID; x++)
                 at_iso += gr->v[z][y][x] == 2.0f;
-    CHECK(at_iso > 1000);
+    CHECK_GT(at_iso, 1000);
     mesh_report r = mesh_grid(gr, 2.0f, 0, unit, NULL);
     check_closed("quantised sphere", &r, 1000);
 
@@ -837,7 +846,8 @@ static void test_ray_plane(void)
         }
     }
     printf("plane rays: %d hits, %d misses\n", hits, misses);
-    CHECK(hits > 1000 && misses > 1000);
+    CHECK_GT(hits, 1000);
+    CHECK_GT(misses, 1000);
     CHECK_MSG(wrong == 0, "%d rays disagree with the plane", wrong);
 }
 
@@ -862,18 +872,19 @@ static void test_ray_first_active_cell_missed(void)
     const float far_a[3] = {2, 2, 2}, far_b[3] = {4, 2, 2};
     const float ray_origin[3] = {-1.0f, 1.6f, 1.6f}, ray_dir[3] = {1.0f, 0.0f, 0.0f};
     float t = -1.0f;
-    CHECK(ip__mc_case(cell[0], 0.5f) == 0x01 && ip__mc_edge_table[0x01] != 0); /* A is active */
-    CHECK(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, far_a, ray_origin, ray_dir, &t) == 0);
-    CHECK(t == -1.0f);
-    CHECK(ip__mc_ray_hits_cell(cell[1], 0.5f, origin_b, far_b, ray_origin, ray_dir, &t) == 1);
-    CHECK(fabsf(t - 4.0f) < 1e-6f); /* the plane x = 3 */
-    CHECK(ip__mc_ray_hits_cell(cell[1], 0.5f, origin_b, far_b, ray_origin, ray_dir, NULL) == 1);
+    CHECK_EQ(ip__mc_case(cell[0], 0.5f), 0x01);
+    CHECK_NE(ip__mc_edge_table[0x01], 0); /* A is active */
+    CHECK_EQ(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, far_a, ray_origin, ray_dir, &t), 0);
+    CHECK_EQ(t, -1.0f);
+    CHECK_EQ(ip__mc_ray_hits_cell(cell[1], 0.5f, origin_b, far_b, ray_origin, ray_dir, &t), 1);
+    CHECK_NEAR(t, 4.0f, 1e-6f); /* the plane x = 3 */
+    CHECK_EQ(ip__mc_ray_hits_cell(cell[1], 0.5f, origin_b, far_b, ray_origin, ray_dir, NULL), 1);
     /* Aimed at the cap instead, the same cell is hit; from behind the ray misses (t < 0). */
     const float at_cap[3] = {-1.0f, 0.2f, 0.2f};
-    CHECK(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, far_a, at_cap, ray_dir, &t) == 1);
-    CHECK(fabsf(t - 1.6f) < 1e-5f); /* the cap lies on x + y + z = 1 */
+    CHECK_EQ(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, far_a, at_cap, ray_dir, &t), 1);
+    CHECK_NEAR(t, 1.6f, 1e-5f); /* the cap lies on x + y + z = 1 */
     const float behind[3] = {5.0f, 0.2f, 0.2f};
-    CHECK(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, far_a, behind, ray_dir, &t) == 0);
+    CHECK_EQ(ip__mc_ray_hits_cell(cell[0], 0.5f, origin_a, far_a, behind, ray_dir, &t), 0);
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -940,6 +951,30 @@ static int bench(int n)
     return 0;
 }
 
+static const test_case cases[] = {
+    TEST_CASE(test_table_matches_generator),
+    TEST_CASE(test_case_counts),
+    TEST_CASE(test_sphere),
+    TEST_CASE(test_touching_spheres),
+    TEST_CASE(test_gyroid),
+    TEST_CASE(test_random),
+    TEST_CASE(test_values_equal_to_iso),
+    TEST_CASE(test_non_finite_values),
+    TEST_CASE(test_ray_plane),
+    TEST_CASE(test_ray_first_active_cell_missed),
+};
+
+static void make_grid(void)
+{
+    the_grid = calloc(1, sizeof *the_grid);
+    REQUIRE(the_grid);
+}
+
+static void free_grid(void)
+{
+    free(the_grid);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "--emit-table") == 0) {
@@ -948,18 +983,5 @@ int main(int argc, char **argv)
     }
     if (argc > 2 && strcmp(argv[1], "--bench") == 0)
         return bench(atoi(argv[2]));
-    test_table_matches_generator();
-    test_case_counts();
-    grid *gr = calloc(1, sizeof *gr);
-    REQUIRE(gr);
-    test_sphere(gr);
-    test_touching_spheres(gr);
-    test_gyroid(gr);
-    test_random(gr);
-    test_values_equal_to_iso(gr);
-    free(gr);
-    test_non_finite_values();
-    test_ray_plane();
-    test_ray_first_active_cell_missed();
-    return test_summary("test_mc");
+    return RUN_CASES_WITH(argc, argv, cases, "test_mc", make_grid, free_grid);
 }

@@ -11,11 +11,15 @@
 
 static void test_normal_packing(void)
 {
-    CHECK(ip_normal_pack(1.0f) == 32767 && ip_normal_pack(-1.0f) == -32767);
-    CHECK(ip_normal_pack(0.0f) == 0 && ip_normal_pack(-0.0f) == 0);
-    CHECK(ip_normal_pack(2.0f) == 32767 && ip_normal_pack(-5.0f) == -32767); /* clamped */
-    CHECK(ip_normal_pack(NAN) == 0);
-    CHECK(ip_normal_pack(INFINITY) == 32767 && ip_normal_pack(-INFINITY) == -32767);
+    CHECK_EQ(ip_normal_pack(1.0f), 32767);
+    CHECK_EQ(ip_normal_pack(-1.0f), -32767);
+    CHECK_EQ(ip_normal_pack(0.0f), 0);
+    CHECK_EQ(ip_normal_pack(-0.0f), 0);
+    CHECK_EQ(ip_normal_pack(2.0f), 32767);
+    CHECK_EQ(ip_normal_pack(-5.0f), -32767); /* clamped */
+    CHECK_EQ(ip_normal_pack(NAN), 0);
+    CHECK_EQ(ip_normal_pack(INFINITY), 32767);
+    CHECK_EQ(ip_normal_pack(-INFINITY), -32767);
     float worst = 0;
     for (int i = -1000; i <= 1000; i++) {
         float v = (float)i / 1000.0f;
@@ -53,11 +57,14 @@ static void test_appends(void)
     ip_mesh plain, with;
     ip_mesh_init(&plain);
     ip_mesh_init_with_cells(&with);
-    CHECK(!plain.with_cells && with.with_cells);
-    CHECK(ip_mesh_append_float_normals(&plain, p, n, NULL, N) == IP_OK);
-    CHECK(ip_mesh_append_float_normals(&with, p, n, cells, N) == IP_OK);
-    CHECK(plain.triangle_count == N && with.triangle_count == N);
-    CHECK(plain.cells == NULL && with.cells != NULL);
+    CHECK(!plain.with_cells);
+    CHECK(with.with_cells);
+    CHECK_EQ(ip_mesh_append_float_normals(&plain, p, n, NULL, N), IP_OK);
+    CHECK_EQ(ip_mesh_append_float_normals(&with, p, n, cells, N), IP_OK);
+    CHECK_EQ(plain.triangle_count, N);
+    CHECK_EQ(with.triangle_count, N);
+    CHECK_EQ(plain.cells, NULL);
+    CHECK_NE(with.cells, NULL);
     int same = 1;
     for (uint64_t t = 0; t < N; t++) {
         same &= with.cells[t] == 1000 + t;
@@ -67,28 +74,38 @@ static void test_appends(void)
                     with.normals[9 * t + i] == plain.normals[9 * t + i];
     }
     CHECK(same);
-    CHECK(plain.capacity >= N && plain.capacity <= 2 * N + 1024);
+    CHECK_GE(plain.capacity, N);
+    CHECK_LE(plain.capacity, 2 * N + 1024);
 
     /* a range of one mesh onto another, with and without cell ids */
     ip_mesh part;
     ip_mesh_init_with_cells(&part);
-    CHECK(ip_mesh_append_mesh(&part, &with, 100, 50) == IP_OK);
-    CHECK(part.triangle_count == 50 && part.cells[0] == 1100 && part.cells[49] == 1149);
-    CHECK(part.positions[0] == p[900] && part.normals[9 * 49 + 4] == with.normals[9 * 149 + 4]);
-    CHECK(ip_mesh_append_mesh(&part, &plain, 0, 10) == IP_ERR_ARGUMENT);   /* no ids to copy */
-    CHECK(ip_mesh_append_mesh(&part, &with, N - 5, 6) == IP_ERR_ARGUMENT); /* past the end */
-    CHECK(ip_mesh_append_mesh(&part, &with, N + 1, 0) == IP_ERR_ARGUMENT);
-    CHECK(ip_mesh_append_mesh(&part, &with, N, 0) == IP_OK);
-    CHECK(part.triangle_count == 50);
-    CHECK(ip_mesh_append_mesh(&plain, &with, 0, 3) == IP_OK); /* ids dropped */
-    CHECK(plain.triangle_count == N + 3 && plain.cells == NULL);
+    CHECK_EQ(ip_mesh_append_mesh(&part, &with, 100, 50), IP_OK);
+    if (CHECK_EQ(part.triangle_count, 50)) {
+        CHECK_EQ(part.cells[0], 1100);
+        CHECK_EQ(part.cells[49], 1149);
+    }
+    CHECK_EQ(part.positions[0], p[900]);
+    CHECK_EQ(part.normals[9 * 49 + 4], with.normals[9 * 149 + 4]);
+    CHECK_EQ(ip_mesh_append_mesh(&part, &plain, 0, 10), IP_ERR_ARGUMENT);   /* no ids to copy */
+    CHECK_EQ(ip_mesh_append_mesh(&part, &with, N - 5, 6), IP_ERR_ARGUMENT); /* past the end */
+    CHECK_EQ(ip_mesh_append_mesh(&part, &with, N + 1, 0), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_mesh_append_mesh(&part, &with, N, 0), IP_OK);
+    CHECK_EQ(part.triangle_count, 50);
+    CHECK_EQ(ip_mesh_append_mesh(&plain, &with, 0, 3), IP_OK); /* ids dropped */
+    CHECK_EQ(plain.triangle_count, N + 3);
+    CHECK_EQ(plain.cells, NULL);
 
     /* clear keeps the memory; free keeps the choice of cell ids */
     ip_mesh_clear(&with);
-    CHECK(with.triangle_count == 0 && with.capacity >= N);
+    CHECK_EQ(with.triangle_count, 0);
+    CHECK_GE(with.capacity, N);
     ip_mesh_free(&with);
-    CHECK(with.positions == NULL && with.capacity == 0 && with.with_cells);
-    CHECK(ip_mesh_append_float_normals(&with, p, n, cells, 1) == IP_OK && with.cells[0] == 1000);
+    CHECK_EQ(with.positions, NULL);
+    CHECK_EQ(with.capacity, 0);
+    CHECK(with.with_cells);
+    if (CHECK_EQ(ip_mesh_append_float_normals(&with, p, n, cells, 1), IP_OK))
+        CHECK_EQ(with.cells[0], 1000);
     ip_mesh_free(&with);
     ip_mesh_free(&plain);
     ip_mesh_free(&part);
@@ -118,8 +135,8 @@ static void test_ply(void)
     two_triangles(&m, p);
     ip_error err;
     REQUIRE(ip_mesh_write_ply(&m, path, 0, &err) == IP_OK);
-    CHECK(ip_mesh_write_ply(&m, path, 0, &err) == IP_ERR_EXISTS);
-    CHECK(ip_mesh_write_ply(&m, path, 1, &err) == IP_OK);
+    CHECK_EQ(ip_mesh_write_ply(&m, path, 0, &err), IP_ERR_EXISTS);
+    CHECK_EQ(ip_mesh_write_ply(&m, path, 1, &err), IP_OK);
 
     FILE *f = fopen(path, "rb");
     REQUIRE(f);
@@ -128,16 +145,21 @@ static void test_ply(void)
     fclose(f);
     const char *end = strstr((const char *)buf, "end_header\n");
     REQUIRE(end);
-    CHECK(strstr((const char *)buf, "element vertex 6\n") != NULL);
-    CHECK(strstr((const char *)buf, "element face 2\n") != NULL);
+    CHECK_NE(strstr((const char *)buf, "element vertex 6\n"), NULL);
+    CHECK_NE(strstr((const char *)buf, "element face 2\n"), NULL);
     size_t body = (size_t)(end - (const char *)buf) + strlen("end_header\n");
-    CHECK(size == body + 6 * 24 + 2 * 13); /* 6 vertices of 6 floats, 2 faces of 1 + 3 ints */
+    CHECK_EQ(size, body + 6 * 24 + 2 * 13); /* 6 vertices of 6 floats, 2 faces of 1 + 3 ints */
     const unsigned char *v = buf + body;
     /* vertex 4 (triangle 1, vertex 1): position p[12..14], normal (0, -1, 0) */
-    CHECK(ip__load_f32le(v + 4 * 24) == p[12] && ip__load_f32le(v + 4 * 24 + 8) == p[14]);
-    CHECK(ip__load_f32le(v + 4 * 24 + 12) == 0.0f && ip__load_f32le(v + 4 * 24 + 16) == -1.0f);
+    CHECK_EQ(ip__load_f32le(v + 4 * 24), p[12]);
+    CHECK_EQ(ip__load_f32le(v + 4 * 24 + 8), p[14]);
+    CHECK_EQ(ip__load_f32le(v + 4 * 24 + 12), 0.0f);
+    CHECK_EQ(ip__load_f32le(v + 4 * 24 + 16), -1.0f);
     const unsigned char *face = v + 6 * 24 + 13;
-    CHECK(face[0] == 3 && face[1] == 3 && face[5] == 4 && face[9] == 5);
+    CHECK_EQ(face[0], 3);
+    CHECK_EQ(face[1], 3);
+    CHECK_EQ(face[5], 4);
+    CHECK_EQ(face[9], 5);
     ip_mesh_free(&m);
 }
 
@@ -179,33 +201,39 @@ static void test_stl_obj(void)
     ip_mesh m;
     two_triangles(&m, p);
     ip_error err;
-    CHECK(strcmp(ip_mesh_format_of(stl), "STL") == 0 && strcmp(ip_mesh_format_of(obj), "OBJ") == 0);
-    CHECK(ip_mesh_format_of(bad) == NULL && ip_mesh_format_of(".stl") == NULL);
+    CHECK_STR_EQ(ip_mesh_format_of(stl), "STL");
+    CHECK_STR_EQ(ip_mesh_format_of(obj), "OBJ");
+    CHECK_EQ(ip_mesh_format_of(bad), NULL);
+    CHECK_EQ(ip_mesh_format_of(".stl"), NULL);
     REQUIRE(ip_mesh_write(&m, stl, 0, &err) == IP_OK);
     REQUIRE(ip_mesh_write(&m, obj, 0, &err) == IP_OK);
-    CHECK(ip_mesh_write(&m, bad, 0, &err) == IP_ERR_ARGUMENT && strstr(err.message, "two.off"));
+    if (CHECK_EQ(ip_mesh_write(&m, bad, 0, &err), IP_ERR_ARGUMENT))
+        CHECK_CONTAINS(err.message, "two.off");
     CHECK(no_file(bad));
 
     static unsigned char buf[4096];
     size_t size = read_file(stl, buf, sizeof buf);
-    CHECK(size == 84 + 2 * 50);
-    CHECK(memcmp(buf, "solid", 5) != 0);
-    CHECK(buf[80] == 2 && buf[81] == 0 && buf[82] == 0 && buf[83] == 0);
+    CHECK_EQ(size, 84 + 2 * 50);
+    CHECK_NE(memcmp(buf, "solid", 5), 0);
+    CHECK_EQ(buf[80], 2);
+    CHECK_EQ(buf[81], 0);
+    CHECK_EQ(buf[82], 0);
+    CHECK_EQ(buf[83], 0);
     for (int t = 0; t < 2; t++) {
         const unsigned char *r = buf + 84 + 50 * t;
         float a[3], b[3], c[3], nx = ip__load_f32le(r), ny = ip__load_f32le(r + 4),
                                 nz = ip__load_f32le(r + 8);
         for (int k = 0; k < 9; k++)
-            CHECK(ip__load_f32le(r + 12 + 4 * k) == p[9 * t + k]);
+            CHECK_EQ(ip__load_f32le(r + 12 + 4 * k), p[9 * t + k]);
         for (int k = 0; k < 3; k++) {
             a[k] = p[9 * t + k];
             b[k] = p[9 * t + 3 + k] - a[k];
             c[k] = p[9 * t + 6 + k] - a[k];
         }
         /* the face normal is unit length and at right angles to both edges */
-        CHECK(fabsf(nx * nx + ny * ny + nz * nz - 1.0f) < 1e-5f);
-        CHECK(fabsf(nx * b[0] + ny * b[1] + nz * b[2]) < 1e-4f);
-        CHECK(fabsf(nx * c[0] + ny * c[1] + nz * c[2]) < 1e-4f);
+        CHECK_LT(fabsf(nx * nx + ny * ny + nz * nz - 1.0f), 1e-5f);
+        CHECK_LT(fabsf(nx * b[0] + ny * b[1] + nz * b[2]), 1e-4f);
+        CHECK_LT(fabsf(nx * c[0] + ny * c[1] + nz * c[2]), 1e-4f);
     }
 
     size = read_file(obj, buf, sizeof buf - 1);
@@ -214,18 +242,25 @@ static void test_stl_obj(void)
     for (char *line = strtok((char *)buf, "\n"); line; line = strtok(NULL, "\n")) {
         float x, y, z;
         if (sscanf(line, "v %f %f %f", &x, &y, &z) == 3) {
-            CHECK(x == p[3 * v] && y == p[3 * v + 1] && z == p[3 * v + 2]);
+            CHECK_EQ(x, p[3 * v]);
+            CHECK_EQ(y, p[3 * v + 1]);
+            CHECK_EQ(z, p[3 * v + 2]);
             v++;
         } else if (strncmp(line, "vn ", 3) == 0) {
             vn++;
         } else if (line[0] == 'f') {
             unsigned a, b, c, a2, b2, c2;
-            CHECK(sscanf(line, "f %u//%u %u//%u %u//%u", &a, &a2, &b, &b2, &c, &c2) == 6);
-            CHECK(a == 3u * (unsigned)faces + 1 && b == a + 1 && c == a + 2 && a2 == a);
+            CHECK_EQ(sscanf(line, "f %u//%u %u//%u %u//%u", &a, &a2, &b, &b2, &c, &c2), 6);
+            CHECK_EQ(a, 3u * (unsigned)faces + 1);
+            CHECK_EQ(b, a + 1);
+            CHECK_EQ(c, a + 2);
+            CHECK_EQ(a2, a);
             faces++;
         }
     }
-    CHECK(v == 6 && vn == 6 && faces == 2);
+    CHECK_EQ(v, 6);
+    CHECK_EQ(vn, 6);
+    CHECK_EQ(faces, 2);
     ip_mesh_free(&m);
 }
 
@@ -250,25 +285,29 @@ static void read_glb(unsigned char *buf, size_t size, glb_file *g)
 {
     memset(g, 0, sizeof *g);
     REQUIRE(size >= 20);
-    CHECK(memcmp(buf, "glTF", 4) == 0 && ip__load_u32le(buf + 4) == 2);
+    CHECK_MEM_EQ(buf, "glTF", 4);
+    CHECK_EQ(ip__load_u32le(buf + 4), 2);
     CHECK_MSG(ip__load_u32le(buf + 8) == size, "header length %u, file %zu",
               (unsigned)ip__load_u32le(buf + 8), size);
     uint32_t json_length = ip__load_u32le(buf + 12);
-    CHECK(json_length % 4 == 0 && memcmp(buf + 16, "JSON", 4) == 0);
+    CHECK_EQ(json_length % 4, 0);
+    CHECK_MEM_EQ(buf + 16, "JSON", 4);
     REQUIRE(20 + (size_t)json_length <= size);
     size_t end = 20 + json_length;
     if (end < size) {
         REQUIRE(end + 8 <= size);
         g->bin_length = ip__load_u32le(buf + end);
-        CHECK(memcmp(buf + end + 4, "BIN\0", 4) == 0 && g->bin_length % 4 == 0);
-        CHECK(end + 8 + g->bin_length == size);
+        CHECK_MEM_EQ(buf + end + 4, "BIN\0", 4);
+        CHECK_EQ(g->bin_length % 4, 0);
+        CHECK_EQ(end + 8 + g->bin_length, size);
         g->bin = buf + end + 8;
     }
     char *json = (char *)buf + 16; /* over the chunk header, now read: room for a terminator */
     memmove(json, buf + 20, json_length);
     json[json_length] = 0;
     g->json = json;
-    CHECK(strstr(json, "\"version\":\"2.0\"") && strstr(json, "\"generator\":\"isoprop "));
+    CHECK_CONTAINS(json, "\"version\":\"2.0\"");
+    CHECK_CONTAINS(json, "\"generator\":\"isoprop ");
     const char *accessors = strstr(json, "\"accessors\":");
     for (int i = 0; i < 3; i++)
         g->count[i] = -1;
@@ -279,9 +318,9 @@ static void read_glb(unsigned char *buf, size_t size, glb_file *g)
         g->count[i] = json_number(a, "\"count\":");
     const char *min = strstr(accessors, "\"min\":["), *max = strstr(accessors, "\"max\":[");
     REQUIRE(min && max);
-    CHECK(sscanf(min, "\"min\":[%f,%f,%f]", &g->min[0], &g->min[1], &g->min[2]) == 3);
-    CHECK(sscanf(max, "\"max\":[%f,%f,%f]", &g->max[0], &g->max[1], &g->max[2]) == 3);
-    CHECK(json_number(json, "\"buffers\":[{\"byteLength\":") == g->bin_length);
+    CHECK_EQ(sscanf(min, "\"min\":[%f,%f,%f]", &g->min[0], &g->min[1], &g->min[2]), 3);
+    CHECK_EQ(sscanf(max, "\"max\":[%f,%f,%f]", &g->max[0], &g->max[1], &g->max[2]), 3);
+    CHECK_EQ(json_number(json, "\"buffers\":[{\"byteLength\":"), g->bin_length);
 }
 
 /* Compares a .glb's vertices (and indices, if any) with those expected: positions exactly,
@@ -289,11 +328,12 @@ static void read_glb(unsigned char *buf, size_t size, glb_file *g)
 static void check_glb_arrays(const glb_file *g, const float *positions, const int16_t *normals,
                              uint64_t vertices, const uint32_t *indices, uint64_t triangles)
 {
-    CHECK(g->count[0] == (long long)vertices && g->count[1] == (long long)vertices);
-    CHECK(g->count[2] == (indices ? (long long)(3 * triangles) : -1));
-    CHECK(g->bin_length == 24 * vertices + (indices ? 12 * triangles : 0));
-    CHECK(json_number(g->json, "\"mode\":") == 4);
-    CHECK((strstr(g->json, "\"indices\":2") != NULL) == (indices != NULL));
+    CHECK_EQ(g->count[0], (long long)vertices);
+    CHECK_EQ(g->count[1], (long long)vertices);
+    CHECK_EQ(g->count[2], indices ? (long long)(3 * triangles) : -1);
+    CHECK_EQ(g->bin_length, 24 * vertices + (indices ? 12 * triangles : 0));
+    CHECK_EQ(json_number(g->json, "\"mode\":"), 4);
+    CHECK_EQ(strstr(g->json, "\"indices\":2") != NULL, indices != NULL);
     int same = 1;
     for (uint64_t i = 0; i < vertices; i++) {
         float length = 0;
@@ -343,9 +383,9 @@ static void test_glb(void)
         REQUIRE(ip_mesh_append_float_normals(&m, p, n, NULL, 1) == IP_OK);
     }
     ip_error err;
-    CHECK(strcmp(ip_mesh_format_of(welded_path), "GLB") == 0);
+    CHECK_STR_EQ(ip_mesh_format_of(welded_path), "GLB");
     REQUIRE(ip_mesh_write(&m, soup_path, 0, &err) == IP_OK);
-    CHECK(ip_mesh_write_glb(&m, soup_path, 0, &err) == IP_ERR_EXISTS);
+    CHECK_EQ(ip_mesh_write_glb(&m, soup_path, 0, &err), IP_ERR_EXISTS);
     static unsigned char buf[1 << 16];
     glb_file g;
     read_glb(buf, read_file(soup_path, buf, sizeof buf), &g);
@@ -353,7 +393,8 @@ static void test_glb(void)
 
     ip_indexed_mesh w;
     REQUIRE(ip_mesh_weld(&m, &w) == IP_OK);
-    CHECK(w.vertex_count == 7 && w.triangle_count == 5);
+    CHECK_EQ(w.vertex_count, 7);
+    CHECK_EQ(w.triangle_count, 5);
     REQUIRE(ip_indexed_mesh_write(&w, welded_path, 0, &err) == IP_OK);
     read_glb(buf, read_file(welded_path, buf, sizeof buf), &g);
     check_glb_arrays(&g, w.positions, w.normals, 7, w.indices, 5);
@@ -363,13 +404,15 @@ static void test_glb(void)
     REQUIRE(ip_mesh_write_glb(&empty, empty_path, 0, &err) == IP_OK);
     size_t size = read_file(empty_path, buf, sizeof buf);
     read_glb(buf, size, &g);
-    CHECK(g.bin == NULL && g.count[0] == -1 && strstr(g.json, "\"meshes\"") == NULL);
+    CHECK_EQ(g.bin, NULL);
+    CHECK_EQ(g.count[0], -1);
+    CHECK_EQ(strstr(g.json, "\"meshes\""), NULL);
 
     /* a position that is not finite has no place in glTF's bounds: refused, nothing written */
     m.positions[4] = INFINITY;
     remove(soup_path);
-    CHECK(ip_mesh_write(&m, soup_path, 0, &err) == IP_ERR_ARGUMENT &&
-          strstr(err.message, "soup.glb"));
+    if (CHECK_EQ(ip_mesh_write(&m, soup_path, 0, &err), IP_ERR_ARGUMENT))
+        CHECK_CONTAINS(err.message, "soup.glb");
     CHECK(no_file(soup_path));
     ip_indexed_mesh_free(&w);
     ip_mesh_free(&m);
@@ -403,16 +446,20 @@ static void test_indexed_files(void)
     buf[size] = 0;
     const char *end = strstr((const char *)buf, "end_header\n");
     REQUIRE(end);
-    CHECK(strstr((const char *)buf, "element vertex 4\n") &&
-          strstr((const char *)buf, "element face 2\n"));
+    CHECK(strstr((const char *)buf, "element vertex 4\n"));
+    CHECK(strstr((const char *)buf, "element face 2\n"));
     size_t body = (size_t)(end - (const char *)buf) + strlen("end_header\n");
-    CHECK(size == body + 4 * 24 + 2 * 13);
+    CHECK_EQ(size, body + 4 * 24 + 2 * 13);
     const unsigned char *face = buf + body + 4 * 24;
-    CHECK(face[0] == 3 && ip__load_u32le(face + 1) == 0 && ip__load_u32le(face + 5) == 1 &&
-          ip__load_u32le(face + 9) == 2);
-    CHECK(face[13] == 3 && ip__load_u32le(face + 14) == 0 && ip__load_u32le(face + 18) == 2 &&
-          ip__load_u32le(face + 22) == 3);
-    CHECK(ip__load_f32le(buf + body + 3 * 24 + 4) == 1.0f); /* vertex 3 is (0, 1, 0) */
+    CHECK_EQ(face[0], 3);
+    CHECK_EQ(ip__load_u32le(face + 1), 0);
+    CHECK_EQ(ip__load_u32le(face + 5), 1);
+    CHECK_EQ(ip__load_u32le(face + 9), 2);
+    CHECK_EQ(face[13], 3);
+    CHECK_EQ(ip__load_u32le(face + 14), 0);
+    CHECK_EQ(ip__load_u32le(face + 18), 2);
+    CHECK_EQ(ip__load_u32le(face + 22), 3);
+    CHECK_EQ(ip__load_f32le(buf + body + 3 * 24 + 4), 1.0f); /* vertex 3 is (0, 1, 0) */
 
     size = read_file(obj, buf, sizeof buf - 1);
     buf[size] = 0;
@@ -422,17 +469,23 @@ static void test_indexed_files(void)
         vn += strncmp(line, "vn ", 3) == 0;
         if (line[0] == 'f') {
             unsigned a, b, c, a2, b2, c2;
-            CHECK(sscanf(line, "f %u//%u %u//%u %u//%u", &a, &a2, &b, &b2, &c, &c2) == 6);
-            CHECK(a == 1 && b == (faces ? 3u : 2u) && c == (faces ? 4u : 3u) && a2 == a && c2 == c);
+            CHECK_EQ(sscanf(line, "f %u//%u %u//%u %u//%u", &a, &a2, &b, &b2, &c, &c2), 6);
+            CHECK_EQ(a, 1);
+            CHECK_EQ(b, faces ? 3u : 2u);
+            CHECK_EQ(c, faces ? 4u : 3u);
+            CHECK_EQ(a2, a);
+            CHECK_EQ(c2, c);
             faces++;
         }
     }
-    CHECK(v == 4 && vn == 4 && faces == 2);
+    CHECK_EQ(v, 4);
+    CHECK_EQ(vn, 4);
+    CHECK_EQ(faces, 2);
 
     size = read_file(stl, buf, sizeof buf);
-    CHECK(size == 84 + 2 * 50);
+    CHECK_EQ(size, 84 + 2 * 50);
     for (int k = 0; k < 9; k++)
-        CHECK(ip__load_f32le(buf + 84 + 50 + 12 + 4 * k) == p[9 + k]);
+        CHECK_EQ(ip__load_f32le(buf + 84 + 50 + 12 + 4 * k), p[9 + k]);
     ip_indexed_mesh_free(&w);
     ip_mesh_free(&m);
 }
@@ -474,15 +527,17 @@ static void test_populated_growth(void)
               (unsigned long long)total, (unsigned long long)m.capacity);
     ip_mesh_clear(&m);
     REQUIRE(ip_mesh_append(&m, p, n, cells, 1) == IP_OK);
-    CHECK(m.triangle_count == 1 && m.cells[0] == cells[0]);
+    CHECK_EQ(m.triangle_count, 1);
+    CHECK_EQ(m.cells[0], cells[0]);
     for (uint64_t i = 1; i < total; i++) /* filled again to the same size: nothing asked again */
         REQUIRE(ip_mesh_append(&m, p, n, cells, 1) == IP_OK);
-    CHECK(m.populated == populated);
+    CHECK_EQ(m.populated, populated);
     /* grown: the mark holds the moved triangles, then goes ahead of them again */
     for (uint64_t before = m.capacity; m.capacity == before;)
         REQUIRE(ip_mesh_append(&m, p, n, cells, 1) == IP_OK);
-    CHECK(m.populated > m.triangle_count && m.populated <= m.triangle_count + 16384 &&
-          m.populated <= m.capacity);
+    CHECK_GT(m.populated, m.triangle_count);
+    CHECK_LE(m.populated, m.triangle_count + 16384);
+    CHECK_LE(m.populated, m.capacity);
 
     unsigned char *buffer = malloc(3 << 20);
     REQUIRE(buffer);
@@ -499,14 +554,14 @@ static void test_populated_growth(void)
     ip_mesh_free(&m);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_normal_packing), TEST_CASE(test_populated_growth),
+    TEST_CASE(test_appends),        TEST_CASE(test_ply),
+    TEST_CASE(test_stl_obj),        TEST_CASE(test_glb),
+    TEST_CASE(test_indexed_files),
+};
+
+int main(int argc, char **argv)
 {
-    test_normal_packing();
-    test_populated_growth();
-    test_appends();
-    test_ply();
-    test_stl_obj();
-    test_glb();
-    test_indexed_files();
-    return test_summary("test_mesh");
+    return RUN_CASES(argc, argv, cases, "test_mesh");
 }

@@ -129,9 +129,9 @@ static void test_sphere(void)
     CHECK_MSG(r0 - rl > 10 * fabs(r0 - rt) && r0 - rl > 0.005 * r0,
               "Laplacian smoothing shrinks the radius to %.4f, Taubin to %.4f, from %.4f", rl, rt,
               r0);
-    CHECK(taubin.vertex_count == original.vertex_count &&
-          taubin.triangle_count == original.triangle_count &&
-          memcmp(taubin.indices, original.indices, 3 * original.triangle_count * 4) == 0);
+    CHECK_EQ(taubin.vertex_count, original.vertex_count);
+    if (CHECK_EQ(taubin.triangle_count, original.triangle_count))
+        CHECK_MEM_EQ(taubin.indices, original.indices, 3 * original.triangle_count * 4);
     CHECK_MSG(normals_outward(&taubin), "the smoothed normals are not outward unit vectors");
     ip_indexed_mesh_free(&original);
     ip_indexed_mesh_free(&taubin);
@@ -191,8 +191,9 @@ static void test_plane(void)
     CHECK_MSG(rim_kept, "a boundary vertex moved");
     CHECK_MSG(moved > (n - 2) * (n - 2) / 2, "only %d inner vertices moved", moved);
     CHECK_MSG(up, "the plane's normals are not +z");
-    CHECK(m.vertex_count == before.vertex_count && m.triangle_count == before.triangle_count &&
-          memcmp(m.indices, before.indices, 3 * m.triangle_count * 4) == 0);
+    CHECK_EQ(m.vertex_count, before.vertex_count);
+    if (CHECK_EQ(m.triangle_count, before.triangle_count))
+        CHECK_MEM_EQ(m.indices, before.indices, 3 * m.triangle_count * 4);
 
     /* bad factors: refused, the mesh unchanged; 0 iterations change nothing */
     ip_indexed_mesh_free(&before);
@@ -201,22 +202,25 @@ static void test_plane(void)
                              {0.5, 0.1}, {0.5, -2},    {0.5, NAN}};
     for (size_t b = 0; b < sizeof bad / sizeof bad[0]; b++) {
         err.message[0] = 0;
-        CHECK(ip_indexed_mesh_smooth_taubin(&m, 3, bad[b][0], bad[b][1], &err) == IP_ERR_ARGUMENT);
+        CHECK_EQ(ip_indexed_mesh_smooth_taubin(&m, 3, bad[b][0], bad[b][1], &err), IP_ERR_ARGUMENT);
         CHECK_CONTAINS(err.message, "Taubin");
     }
-    CHECK(ip_indexed_mesh_smooth_taubin(&m, 0, IP_TAUBIN_LAMBDA, IP_TAUBIN_MU, NULL) == IP_OK);
-    CHECK(memcmp(m.positions, before.positions, 3 * m.vertex_count * sizeof(float)) == 0);
+    CHECK_EQ(ip_indexed_mesh_smooth_taubin(&m, 0, IP_TAUBIN_LAMBDA, IP_TAUBIN_MU, NULL), IP_OK);
+    CHECK_MEM_EQ(m.positions, before.positions, 3 * m.vertex_count * sizeof(float));
     ip_indexed_mesh_free(&m);
     ip_indexed_mesh_free(&before);
 
     ip_indexed_mesh empty;
     ip_indexed_mesh_init(&empty);
-    CHECK(ip_indexed_mesh_smooth_taubin(&empty, 5, IP_TAUBIN_LAMBDA, IP_TAUBIN_MU, NULL) == IP_OK);
+    CHECK_EQ(ip_indexed_mesh_smooth_taubin(&empty, 5, IP_TAUBIN_LAMBDA, IP_TAUBIN_MU, NULL), IP_OK);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_plane),
+    TEST_CASE(test_sphere),
+};
+
+int main(int argc, char **argv)
 {
-    test_plane();
-    test_sphere();
-    return test_summary("test_mesh_smooth");
+    return RUN_CASES(argc, argv, cases, "test_mesh_smooth");
 }

@@ -39,19 +39,27 @@ static void test_small(void)
     ip_indexed_mesh w;
     REQUIRE(ip_mesh_weld(&m, &w) == IP_OK);
     CHECK_MSG(w.vertex_count == 4, "%llu vertices", (unsigned long long)w.vertex_count);
-    CHECK(w.triangle_count == 3 && w.dropped_triangles == 1);
+    CHECK_EQ(w.triangle_count, 3);
+    CHECK_EQ(w.dropped_triangles, 1);
     static const uint32_t expected[9] = {0, 1, 2, 1, 3, 2, 0, 1, 2};
-    CHECK(memcmp(w.indices, expected, sizeof expected) == 0);
-    CHECK(w.positions[9] == 1 && w.positions[10] == 1 && w.positions[11] == 0);
+    CHECK_MEM_EQ(w.indices, expected, sizeof expected);
+    CHECK_EQ(w.positions[9], 1);
+    CHECK_EQ(w.positions[10], 1);
+    CHECK_EQ(w.positions[11], 0);
     /* vertex 0 only ever had "up"; vertices 1 and 2 are shared by "up" and "side" */
-    CHECK(w.normals[0] == 0 && w.normals[1] == 0 && w.normals[2] == 32767);
+    CHECK_EQ(w.normals[0], 0);
+    CHECK_EQ(w.normals[1], 0);
+    CHECK_EQ(w.normals[2], 32767);
     float n1[3] = {ip_normal_unpack(w.normals[3]), ip_normal_unpack(w.normals[4]),
                    ip_normal_unpack(w.normals[5])};
     /* twice up and once side, normalised */
-    CHECK(fabsf(n1[0] - 1 / sqrtf(5)) < 1e-4f && n1[1] == 0 && fabsf(n1[2] - 2 / sqrtf(5)) < 1e-4f);
-    CHECK(m.triangle_count == 4); /* the soup is unchanged */
+    CHECK_NEAR(n1[0], 1 / sqrtf(5), 1e-4f);
+    CHECK_EQ(n1[1], 0);
+    CHECK_NEAR(n1[2], 2 / sqrtf(5), 1e-4f);
+    CHECK_EQ(m.triangle_count, 4); /* the soup is unchanged */
     ip_indexed_mesh_free(&w);
-    CHECK(w.positions == NULL && w.vertex_count == 0);
+    CHECK_EQ(w.positions, NULL);
+    CHECK_EQ(w.vertex_count, 0);
 
     /* opposite normals cancel: the first corner's stays */
     ip_mesh_clear(&m);
@@ -59,12 +67,15 @@ static void test_small(void)
     add_triangle(&m, a, up);
     add_triangle(&m, a, down);
     REQUIRE(ip_mesh_weld(&m, &w) == IP_OK);
-    CHECK(w.vertex_count == 3 && w.normals[2] == 32767);
+    CHECK_EQ(w.vertex_count, 3);
+    CHECK_EQ(w.normals[2], 32767);
     ip_indexed_mesh_free(&w);
 
     ip_mesh_clear(&m);
     REQUIRE(ip_mesh_weld(&m, &w) == IP_OK);
-    CHECK(w.vertex_count == 0 && w.triangle_count == 0 && w.dropped_triangles == 0);
+    CHECK_EQ(w.vertex_count, 0);
+    CHECK_EQ(w.triangle_count, 0);
+    CHECK_EQ(w.dropped_triangles, 0);
     ip_indexed_mesh_free(&w);
     ip_mesh_free(&m);
 }
@@ -238,7 +249,7 @@ static topology weld_extraction(ip_cache *cache, float iso, const char *what)
               (unsigned long long)r.boundary_inside);
     if (r.boundary == 0) {
         CHECK_MSG(euler == 2, "%s: V - E + F = %lld, not a sphere's 2", what, euler);
-        CHECK(2 * r.edges == 3 * w.triangle_count); /* every edge in exactly two triangles */
+        CHECK_EQ(2 * r.edges, 3 * w.triangle_count); /* every edge in exactly two triangles */
     }
     ip_indexed_mesh_free(&w);
     ip_mesh_free(&soup);
@@ -276,10 +287,13 @@ static void test_closed_and_open(void)
     CHECK_MSG(open.boundary > 0, "the gyroid shows no open edge");
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_small),
+    TEST_CASE(test_growth),
+    TEST_CASE(test_closed_and_open),
+};
+
+int main(int argc, char **argv)
 {
-    test_small();
-    test_growth();
-    test_closed_and_open();
-    return test_summary("test_mesh_weld");
+    return RUN_CASES(argc, argv, cases, "test_mesh_weld");
 }

@@ -71,13 +71,18 @@ static void test_round_trips(void)
                     CHECK_MSG(st == IP_OK, "%s: %s", name, err.message);
                     if (st != IP_OK)
                         continue;
-                    CHECK(d.type == type && d.big_endian == be);
-                    CHECK(d.dims[0] == 13 && d.dims[1] == 7 && d.dims[2] == 5);
-                    CHECK(d.spacing[0] == 0.5 && d.spacing[1] == 0.75 && d.spacing[2] == 2.0);
-                    CHECK(d.encoding == (gz ? IP_ENCODING_GZIP : IP_ENCODING_RAW));
+                    CHECK_EQ(d.type, type);
+                    CHECK_EQ(d.big_endian, be);
+                    CHECK_EQ(d.dims[0], 13);
+                    CHECK_EQ(d.dims[1], 7);
+                    CHECK_EQ(d.dims[2], 5);
+                    CHECK_EQ(d.spacing[0], 0.5);
+                    CHECK_EQ(d.spacing[1], 0.75);
+                    CHECK_EQ(d.spacing[2], 2.0);
+                    CHECK_EQ(d.encoding, gz ? IP_ENCODING_GZIP : IP_ENCODING_RAW);
                     uint64_t offset = version == 1 ? 352 : 544;
-                    CHECK(d.data_offset == (gz ? 0 : offset));
-                    CHECK(d.stream_skip == (gz ? offset : 0));
+                    CHECK_EQ(d.data_offset, gz ? 0 : offset);
+                    CHECK_EQ(d.stream_skip, gz ? offset : 0);
                     CHECK(!d.has_rescale);
                     void *got = read_volume(&d, &err);
                     CHECK_MSG(got != NULL, "%s: %s", name, got ? "" : err.message);
@@ -88,7 +93,7 @@ static void test_round_trips(void)
                     free(samples);
                     cases++;
                 }
-    CHECK(cases == 32);
+    CHECK_EQ(cases, 32);
 }
 
 /* The scaling is reported (slope 0 or 1 with intercept 0: none); a 4D file with one volume is
@@ -107,10 +112,14 @@ static void test_header_fields(void)
     s.vox_offset = 400;
     REQUIRE(write_nifti(in_scratch(path, "scaled.nii"), IP_INT16, dims, samples, &s) == 0);
     REQUIRE(ip_input_describe(path, NULL, &d, &err) == IP_OK);
-    CHECK(d.has_rescale && d.rescale_slope == 2.5 && d.rescale_intercept == -1024);
-    CHECK(d.data_offset == 400 && d.dims[2] == 2);
+    CHECK(d.has_rescale);
+    CHECK_EQ(d.rescale_slope, 2.5);
+    CHECK_EQ(d.rescale_intercept, -1024);
+    CHECK_EQ(d.data_offset, 400);
+    CHECK_EQ(d.dims[2], 2);
     void *got = read_volume(&d, &err);
-    CHECK(got != NULL && memcmp(got, samples, 4 * 3 * 2 * 2) == 0);
+    if (CHECK_NE(got, NULL))
+        CHECK_MEM_EQ(got, samples, 4 * 3 * 2 * 2);
     free(got);
     s.slope = 0;
     REQUIRE(write_nifti(path, IP_INT16, dims, samples, &s) == 0);
@@ -130,7 +139,10 @@ static void test_header_fields(void)
     o.spacing[0] = o.spacing[1] = o.spacing[2] = 0.1;
     ip_status st = ip_input_describe(path, &o, &d, &err);
     CHECK_MSG(st == IP_OK, "%s", err.message);
-    CHECK(d.type == IP_UINT16 && d.dims[0] == 2 && d.dims[2] == 4 && d.spacing[1] == 0.1);
+    CHECK_EQ(d.type, IP_UINT16);
+    CHECK_EQ(d.dims[0], 2);
+    CHECK_EQ(d.dims[2], 4);
+    CHECK_EQ(d.spacing[1], 0.1);
     free(samples);
 }
 
@@ -303,7 +315,7 @@ static void test_bad_files(void)
     REQUIRE(f != NULL && fwrite(whole, 1, size - 30, f) == size - 30 && fclose(f) == 0);
     REQUIRE(ip_input_describe(path, NULL, &d, &err) == IP_OK);
     void *got = read_volume(&d, &err);
-    CHECK(got == NULL);
+    CHECK_EQ(got, NULL);
     CHECK_CONTAINS(err.message, "short.nii.gz");
     free(got);
     s.gzip = 0;
@@ -339,12 +351,19 @@ static void test_bad_files(void)
     free(samples);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_round_trips),
+    TEST_CASE(test_header_fields),
+    TEST_CASE(test_orientation),
+    TEST_CASE(test_bad_files),
+};
+
+static void make_scratch_dir(void)
 {
     snprintf(scratch, sizeof scratch, "%s", test_tmp_dir("test_nifti"));
-    test_round_trips();
-    test_header_fields();
-    test_orientation();
-    test_bad_files();
-    return test_summary("test_nifti");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_nifti", make_scratch_dir, NULL);
 }

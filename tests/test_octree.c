@@ -63,59 +63,111 @@ static void brute_range(const ip_layout *l, uint32_t k, uint32_t depth, const ui
             }
 }
 
-int main(void)
+/* What the cases share: a layout, random ranges for its bricks and the octree built on them
+ * (built_nodes()). */
+static ip_layout the_layout;
+static float *the_bricks, *the_nodes;
+
+static void make_bricks(void)
 {
-    ip_layout l;
+    ip_layout *l = &the_layout;
     const uint32_t dims[3] = {300, 170, 90}; /* odd brick counts: partial nodes on each axis */
     const double spacing[3] = {1, 1, 1};
-    REQUIRE(ip__layout_init(&l, dims, IP_UINT8, spacing, 16, 4, NULL) == IP_OK);
-    REQUIRE(l.node_count > 0 && l.levels[0].octree_depth >= 2);
-    float *bricks = malloc(2 * l.brick_count * sizeof(float));
-    float *nodes = calloc(2 * l.node_count, sizeof(float));
-    REQUIRE(bricks && nodes);
+    REQUIRE(ip__layout_init(l, dims, IP_UINT8, spacing, 16, 4, NULL) == IP_OK);
+    REQUIRE(l->node_count > 0 && l->levels[0].octree_depth >= 2);
+    the_bricks = malloc(2 * l->brick_count * sizeof(float));
+    the_nodes = calloc(2 * l->node_count, sizeof(float));
+    REQUIRE(the_bricks && the_nodes);
     uint64_t state = 3;
-    for (uint64_t g = 0; g < l.brick_count; g++) {
+    for (uint64_t g = 0; g < l->brick_count; g++) {
         state = state * 6364136223846793005ull + 1442695040888963407ull;
         float a = (float)(state >> 40) / 1000.0f, b = (float)((state >> 20) & 0xfffff) / 1000.0f;
-        bricks[2 * g] = a < b ? a : b;
-        bricks[2 * g + 1] = a < b ? b : a;
+        the_bricks[2 * g] = a < b ? a : b;
+        the_bricks[2 * g + 1] = a < b ? b : a;
     }
-    CHECK(ip__octree_walk(&l, bricks, nodes, store_node, nodes) == 0);
+}
 
-    /* every node of every level and depth holds the range of the bricks below it */
+static void free_bricks(void)
+{
+    free(the_bricks);
+    free(the_nodes);
+}
+
+/* The octree of the bricks' ranges, built by the walk once, by the first case that needs it. */
+static float *built_nodes(void)
+{
+    static int built;
+    if (!built)
+        CHECK_EQ(ip__octree_walk(&the_layout, the_bricks, the_nodes, store_node, the_nodes), 0);
+    built = 1;
+    return the_nodes;
+}
+
+/* every node of every level and depth holds the range of the bricks below it */
+static void walk_stores_ranges(void)
+{
+    const ip_layout *l = &the_layout;
+    const float *nodes = built_nodes();
     int all_right = 1;
     uint64_t node_total = 0;
-    for (uint32_t k = 0; k < l.level_count; k++)
-        for (uint32_t depth = 1; depth <= l.levels[k].octree_depth; depth++) {
+    for (uint32_t k = 0; k < l->level_count; k++)
+        for (uint32_t depth = 1; depth <= l->levels[k].octree_depth; depth++) {
             uint32_t grid[3];
-            ip__octree_grid(&l, k, depth, grid);
+            ip__octree_grid(l, k, depth, grid);
             for (uint32_t z = 0; z < grid[2]; z++)
                 for (uint32_t y = 0; y < grid[1]; y++)
                     for (uint32_t x = 0; x < grid[0]; x++) {
                         uint32_t node[3] = {x, y, z};
                         float want[2];
-                        brute_range(&l, k, depth, node, bricks, want);
-                        const float *got = &nodes[2 * ip__octree_node_index(&l, k, depth, node)];
+                        brute_range(l, k, depth, node, the_bricks, want);
+                        const float *got = &nodes[2 * ip__octree_node_index(l, k, depth, node)];
                         all_right &= got[0] == want[0] && got[1] == want[1];
                         node_total++;
                     }
         }
     CHECK(all_right);
-    CHECK(node_total == l.node_count);
+    CHECK_EQ(node_total, l->node_count);
+}
 
-    /* checking against the built octree visits every node and finds nothing */
+/* checking against the built octree visits every node and finds nothing */
+static void walk_checks_every_node(void)
+{
+    const ip_layout *l = &the_layout;
+    float *nodes = built_nodes();
     visit_log v = {nodes, 0, 1, 0, 0, {0}};
-    CHECK(ip__octree_walk(&l, bricks, nodes, check_node, &v) == 0);
-    CHECK(v.visits == l.node_count && v.order_ok);
+    CHECK_EQ(ip__octree_walk(l, the_bricks, nodes, check_node, &v), 0);
+    CHECK_EQ(v.visits, l->node_count);
+    CHECK(v.order_ok);
+}
 
-    /* a wrong node at depth 2 of level 0: the walk stops there with the visitor's value */
+/* a wrong node at depth 2 of level 0: the walk stops there with the visitor's value (the node
+ * is right again after) */
+static void walk_stops_at_wrong_node(void)
+{
+    const ip_layout *l = &the_layout;
+    float *nodes = built_nodes();
     uint32_t target[3] = {1, 0, 1};
-    nodes[2 * ip__octree_node_index(&l, 0, 2, target) + 1] += 1.0f;
+    float *wrong = &nodes[2 * ip__octree_node_index(l, 0, 2, target) + 1];
+    float right = *wrong;
+    *wrong += 1.0f;
     visit_log w = {nodes, 0, 1, 0, 0, {0}};
-    CHECK(ip__octree_walk(&l, bricks, nodes, check_node, &w) == 7);
-    CHECK(w.bad[0] == 0 && w.bad[1] == 2 && w.bad[2] == 1 && w.bad[3] == 0 && w.bad[4] == 1);
-    CHECK(w.visits < l.node_count);
-    free(bricks);
-    free(nodes);
-    return test_summary("test_octree");
+    CHECK_EQ(ip__octree_walk(l, the_bricks, nodes, check_node, &w), 7);
+    CHECK_EQ(w.bad[0], 0);
+    CHECK_EQ(w.bad[1], 2);
+    CHECK_EQ(w.bad[2], 1);
+    CHECK_EQ(w.bad[3], 0);
+    CHECK_EQ(w.bad[4], 1);
+    CHECK_LT(w.visits, l->node_count);
+    *wrong = right;
+}
+
+static const test_case cases[] = {
+    TEST_CASE(walk_stores_ranges),
+    TEST_CASE(walk_checks_every_node),
+    TEST_CASE(walk_stops_at_wrong_node),
+};
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_octree", make_bricks, free_bricks);
 }

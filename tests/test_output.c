@@ -72,7 +72,7 @@ static void test_version(void)
 {
     char want[64];
     snprintf(want, sizeof want, "%d.%d.%d", IP_VERSION_MAJOR, IP_VERSION_MINOR, IP_VERSION_PATCH);
-    CHECK(ip_version() != NULL);
+    CHECK_NE(ip_version(), NULL);
     CHECK_MSG(strcmp(ip_version(), want) == 0, "ip_version() %s, header %s", ip_version(), want);
 }
 
@@ -81,25 +81,25 @@ static void test_output_check(void)
     char a[4096], d[4096], f[4096];
     ip_error err;
     at(a, "absent.txt");
-    CHECK(ip_output_check(a, 0, &err) == IP_OK);
-    CHECK(ip_output_check(a, 1, &err) == IP_OK);
+    CHECK_EQ(ip_output_check(a, 0, &err), IP_OK);
+    CHECK_EQ(ip_output_check(a, 1, &err), IP_OK);
     write_text(a, "kept");
-    CHECK(ip_output_check(a, 0, &err) == IP_ERR_EXISTS);
+    CHECK_EQ(ip_output_check(a, 0, &err), IP_ERR_EXISTS);
     CHECK_CONTAINS(err.message, "absent.txt");
     CHECK_CONTAINS(err.message, "--force");
-    CHECK(ip_output_check(a, 1, &err) == IP_OK);
+    CHECK_EQ(ip_output_check(a, 1, &err), IP_OK);
     at(d, "folder");
     REQUIRE(mkdir(d, 0777) == 0);
-    CHECK(ip_output_check(d, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_output_check(d, 1, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "a directory");
     at(f, "fifo");
     REQUIRE(mkfifo(f, 0666) == 0);
-    CHECK(ip_output_check(f, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_output_check(f, 1, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "a FIFO");
-    CHECK(ip_output_check("/dev/null", 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_output_check("/dev/null", 1, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "/dev/null");
     CHECK_CONTAINS(err.message, "character device");
-    CHECK(ip_output_check("", 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_output_check("", 1, &err), IP_ERR_ARGUMENT);
 }
 
 static void test_same_file(void)
@@ -132,8 +132,8 @@ static void test_same_file(void)
     CHECK(!ip_path_same_file("new.png", "same.raw"));
     REQUIRE(chdir(cwd) == 0);
     ip_error err;
-    CHECK(ip_output_not_input(other, a, &err) == IP_OK);
-    CHECK(ip_output_not_input(link_path, a, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_output_not_input(other, a, &err), IP_OK);
+    CHECK_EQ(ip_output_not_input(link_path, a, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "same-link.raw");
     CHECK_CONTAINS(err.message, "same.raw");
 }
@@ -143,38 +143,43 @@ static void test_output_write(void)
     char p[4096], f[4096], d[4096];
     ip_error err;
     at(p, "whole.json");
-    CHECK(ip_output_write(p, "{}\n", 3, 0, &err) == IP_OK);
-    CHECK(strcmp(read_text(p), "{}\n") == 0);
-    CHECK(ip_output_write(p, "{\"x\": 1}\n", 9, 0, &err) == IP_ERR_EXISTS);
-    CHECK(strcmp(read_text(p), "{}\n") == 0);
-    CHECK(ip_output_write(p, "{\"x\": 1}\n", 9, 1, &err) == IP_OK);
-    CHECK(strcmp(read_text(p), "{\"x\": 1}\n") == 0);
+    CHECK_EQ(ip_output_write(p, "{}\n", 3, 0, &err), IP_OK);
+    CHECK_STR_EQ(read_text(p), "{}\n");
+    CHECK_EQ(ip_output_write(p, "{\"x\": 1}\n", 9, 0, &err), IP_ERR_EXISTS);
+    CHECK_STR_EQ(read_text(p), "{}\n");
+    CHECK_EQ(ip_output_write(p, "{\"x\": 1}\n", 9, 1, &err), IP_OK);
+    CHECK_STR_EQ(read_text(p), "{\"x\": 1}\n");
     /* a FIFO, a device, a directory, a link to a device: refused even with force, untouched */
     at(f, "out-fifo");
     REQUIRE(mkfifo(f, 0666) == 0);
-    CHECK(ip_output_write(f, "x", 1, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_output_write(f, "x", 1, 1, &err), IP_ERR_ARGUMENT);
     struct stat st;
-    CHECK(lstat(f, &st) == 0 && S_ISFIFO(st.st_mode));
+    if (CHECK_EQ(lstat(f, &st), 0))
+        CHECK(S_ISFIFO(st.st_mode));
     at(d, "out-dir");
     REQUIRE(mkdir(d, 0777) == 0);
-    CHECK(ip_output_write(d, "x", 1, 1, &err) == IP_ERR_ARGUMENT);
-    CHECK(stat(d, &st) == 0 && S_ISDIR(st.st_mode));
+    CHECK_EQ(ip_output_write(d, "x", 1, 1, &err), IP_ERR_ARGUMENT);
+    if (CHECK_EQ(stat(d, &st), 0))
+        CHECK(S_ISDIR(st.st_mode));
     char l[4096];
     at(l, "null-link");
     REQUIRE(symlink("/dev/null", l) == 0);
-    CHECK(ip_output_write(l, "x", 1, 1, &err) == IP_ERR_ARGUMENT);
-    CHECK(lstat(l, &st) == 0 && S_ISLNK(st.st_mode));
-    CHECK(stat("/dev/null", &st) == 0 && S_ISCHR(st.st_mode));
+    CHECK_EQ(ip_output_write(l, "x", 1, 1, &err), IP_ERR_ARGUMENT);
+    if (CHECK_EQ(lstat(l, &st), 0))
+        CHECK(S_ISLNK(st.st_mode));
+    if (CHECK_EQ(stat("/dev/null", &st), 0))
+        CHECK(S_ISCHR(st.st_mode));
     /* the library's other writers follow the same rule */
     uint8_t rgba[4 * 4] = {0};
-    CHECK(ip_png_write(f, rgba, 2, 2, 1, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_png_write("/dev/null", rgba, 2, 2, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_png_write(f, rgba, 2, 2, 1, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_png_write("/dev/null", rgba, 2, 2, 1, &err), IP_ERR_ARGUMENT);
     ip_mesh mesh;
     ip_mesh_init(&mesh);
-    CHECK(ip_mesh_write_ply(&mesh, f, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_mesh_write_ply(&mesh, f, 1, &err), IP_ERR_ARGUMENT);
     ip_gen_params params = {sizeof(ip_gen_params), IP_FIELD_SPHERE, {4, 4, 4}, IP_UINT8, 0.0, 1};
-    CHECK(ip_generate_write(&params, f, 1, &err) == IP_ERR_ARGUMENT);
-    CHECK(lstat(f, &st) == 0 && S_ISFIFO(st.st_mode));
+    CHECK_EQ(ip_generate_write(&params, f, 1, &err), IP_ERR_ARGUMENT);
+    if (CHECK_EQ(lstat(f, &st), 0))
+        CHECK(S_ISFIFO(st.st_mode));
     CHECK(!temporaries_left());
 }
 
@@ -194,14 +199,15 @@ static void test_output_is_input(void)
     ip_bricker_options_default(&options);
     options.force = 1;
     options.threads = 1;
-    CHECK(ip_bricker_run(&desc, raw, &options, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_bricker_run(&desc, raw, &options, NULL, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "sphere_8x6x5_uint8.raw");
     format_path(spelled, "%s/./sphere_8x6x5_uint8.raw", scratch);
-    CHECK(ip_bricker_run(&desc, spelled, &options, NULL, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_upsample_write(&desc, 2, raw, 1, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_upsample_write(&desc, 1, spelled, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_bricker_run(&desc, spelled, &options, NULL, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_upsample_write(&desc, 2, raw, 1, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_upsample_write(&desc, 1, spelled, 1, &err), IP_ERR_ARGUMENT);
     REQUIRE(stat(raw, &after) == 0);
-    CHECK(after.st_ino == before.st_ino && after.st_size == before.st_size);
+    CHECK_EQ(after.st_ino, before.st_ino);
+    CHECK_EQ(after.st_size, before.st_size);
     /* a detached header: its data file is an input too */
     at(header, "detached.nhdr");
     at(data, "sphere_8x6x5_uint8.raw");
@@ -212,16 +218,17 @@ static void test_output_is_input(void)
              data);
     write_text(header, text);
     REQUIRE(ip_input_describe(header, NULL, &desc, &err) == IP_OK);
-    CHECK(ip_bricker_run(&desc, data, &options, NULL, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_bricker_run(&desc, header, &options, NULL, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_upsample_write(&desc, 2, data, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_bricker_run(&desc, data, &options, NULL, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_bricker_run(&desc, header, &options, NULL, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_upsample_write(&desc, 2, data, 1, &err), IP_ERR_ARGUMENT);
     REQUIRE(stat(raw, &after) == 0);
-    CHECK(after.st_ino == before.st_ino && after.st_size == before.st_size);
+    CHECK_EQ(after.st_ino, before.st_ino);
+    CHECK_EQ(after.st_size, before.st_size);
     /* and a brick file that is not an input is written */
     at(ibv, "good.ibv");
-    CHECK(ip_bricker_run(&desc, ibv, &options, NULL, &err) == IP_OK);
+    CHECK_EQ(ip_bricker_run(&desc, ibv, &options, NULL, &err), IP_OK);
     /* an existing device or FIFO is never replaced by a brick file */
-    CHECK(ip_bricker_run(&desc, "/dev/null", &options, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_bricker_run(&desc, "/dev/null", &options, NULL, &err), IP_ERR_ARGUMENT);
     CHECK(!temporaries_left());
 }
 
@@ -247,19 +254,19 @@ static void test_fifo_inputs(void)
     alarm(10);
     at(named, "fifo_4x4x4_uint8.raw");
     REQUIRE(mkfifo(named, 0666) == 0);
-    CHECK(ip_input_describe(named, NULL, &desc, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip_input_describe(named, NULL, &desc, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "not a regular file");
     at(f, "fifo.nrrd");
     REQUIRE(mkfifo(f, 0666) == 0);
-    CHECK(ip_input_describe(f, NULL, &desc, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip_input_describe(f, NULL, &desc, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "fifo.nrrd: not a regular file");
     at(mhd, "fifo.mhd");
     REQUIRE(mkfifo(mhd, 0666) == 0);
-    CHECK(ip_input_describe(mhd, NULL, &desc, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip_input_describe(mhd, NULL, &desc, &err), IP_ERR_INPUT);
     at(header, "to-fifo.nhdr");
     write_text(header, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n"
                        "data file: fifo_4x4x4_uint8.raw\n");
-    CHECK(ip_input_describe(header, NULL, &desc, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip_input_describe(header, NULL, &desc, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "not a regular file");
     /* a data file that turns into a FIFO after it was described */
     char raw[4096];
@@ -270,20 +277,23 @@ static void test_fifo_inputs(void)
     REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
     REQUIRE(unlink(raw) == 0 && mkfifo(raw, 0666) == 0);
     ip_input_reader *reader = NULL;
-    CHECK(ip_input_open(&desc, &reader, &err) == IP_ERR_INPUT);
-    CHECK(reader == NULL);
+    CHECK_EQ(ip_input_open(&desc, &reader, &err), IP_ERR_INPUT);
+    CHECK_EQ(reader, NULL);
     alarm(0);
     CHECK_MSG(!alarm_rang, "an input FIFO hung for 10 s");
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_version),      TEST_CASE(test_output_check),    TEST_CASE(test_same_file),
+    TEST_CASE(test_output_write), TEST_CASE(test_output_is_input), TEST_CASE(test_fifo_inputs),
+};
+
+static void make_scratch_dir(void)
 {
     snprintf(scratch, sizeof scratch, "%s", test_tmp_dir("test_output"));
-    test_version();
-    test_output_check();
-    test_same_file();
-    test_output_write();
-    test_output_is_input();
-    test_fifo_inputs();
-    return test_summary("test_output");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_output", make_scratch_dir, NULL);
 }

@@ -141,37 +141,37 @@ static void check_spin(void)
     spun s = {.lock = NULL};
     atomic_init(&s.word, 7);
     /* no time: one look */
-    CHECK(ip__spin_while(&s.word, 7, 0, NULL) == 0);
-    CHECK(ip__spin_while(&s.word, 6, 0, NULL) == 1);
-    CHECK(ip__spin_while(&s.word, 6, 1e-3, NULL) == 1);
+    CHECK_EQ(ip__spin_while(&s.word, 7, 0, NULL), 0);
+    CHECK_EQ(ip__spin_while(&s.word, 6, 0, NULL), 1);
+    CHECK_EQ(ip__spin_while(&s.word, 6, 1e-3, NULL), 1);
     /* unchanged: it returns once its time is out, not before */
     double t0 = ip_now_seconds();
-    CHECK(ip__spin_while(&s.word, 7, 1e-3, NULL) == 0);
-    CHECK(ip_now_seconds() - t0 >= 1e-3);
+    CHECK_EQ(ip__spin_while(&s.word, 7, 1e-3, NULL), 0);
+    CHECK_GE(ip_now_seconds() - t0, 1e-3);
     /* another thread's change ends the spin (long before its 30 s) */
     pthread_t other;
     REQUIRE(pthread_create(&other, NULL, change_later, &s) == 0);
-    CHECK(ip__spin_while(&s.word, 7, 30.0, NULL) == 1);
-    CHECK(atomic_load(&s.word) == 8);
+    CHECK_EQ(ip__spin_while(&s.word, 7, 30.0, NULL), 1);
+    CHECK_EQ(atomic_load(&s.word), 8);
     pthread_join(other, NULL);
     /* with a mutex held: let go while spinning (the writer needs it), held again after */
     pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
     s.lock = &lock;
     pthread_mutex_lock(&lock);
     REQUIRE(pthread_create(&other, NULL, change_later, &s) == 0);
-    CHECK(ip__spin_while(&s.word, 8, 30.0, &lock) == 1);
-    CHECK(atomic_load(&s.word) == 9);
-    CHECK(pthread_mutex_trylock(&lock) == EBUSY); /* this thread holds it */
+    CHECK_EQ(ip__spin_while(&s.word, 8, 30.0, &lock), 1);
+    CHECK_EQ(atomic_load(&s.word), 9);
+    CHECK_EQ(pthread_mutex_trylock(&lock), EBUSY); /* this thread holds it */
     pthread_mutex_unlock(&lock);
     pthread_join(other, NULL);
     /* pools spin up to as many threads as cores, and not beyond */
     ip__pool *pool = NULL;
     REQUIRE(ip__pool_create(ip_thread_count(0), &pool, NULL) == IP_OK);
-    CHECK(ip__pool_spin_seconds(pool) == IP_SPIN_SECONDS);
+    CHECK_EQ(ip__pool_spin_seconds(pool), IP_SPIN_SECONDS);
     ip__pool_destroy(pool);
     if (ip_thread_count(0) < IP_MAX_THREADS) {
         REQUIRE(ip__pool_create(ip_thread_count(0) + 1, &pool, NULL) == IP_OK);
-        CHECK(ip__pool_spin_seconds(pool) == 0);
+        CHECK_EQ(ip__pool_spin_seconds(pool), 0);
         ip__pool_destroy(pool);
     }
 }
@@ -182,63 +182,94 @@ static void caller_job(void *user, unsigned index)
     who[index] = pthread_self();
 }
 
-int main(void)
-{
-    static tally t;
-    ip__pool *pool = NULL;
+static tally the_tally; /* (large: not on the stack) */
 
-    /* Several runs of all sizes on one pool: none, fewer jobs than threads, as many, many more. */
+/* Several runs of all sizes on one pool: none, fewer jobs than threads, as many, many more. */
+static void runs_of_all_sizes(void)
+{
+    ip__pool *pool = NULL;
     REQUIRE(ip__pool_create(4, &pool, NULL) == IP_OK);
-    CHECK(ip__pool_threads(pool) == 4);
+    CHECK_EQ(ip__pool_threads(pool), 4);
     const unsigned sizes[] = {0, 1, 2, 3, 4, 5, 17, 64, 1000, MAX_JOBS};
     for (int repeat = 0; repeat < 20; repeat++)
         for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++)
-            check_run(pool, &t, sizes[k]);
+            check_run(pool, &the_tally, sizes[k]);
     ip__pool_destroy(pool);
+}
 
-    /* Many runs in a row, as an engine's steps: each waits for its jobs before the next. */
+/* Many runs in a row, as an engine's steps: each waits for its jobs before the next. */
+static void runs_in_a_row(void)
+{
+    ip__pool *pool = NULL;
     REQUIRE(ip__pool_create(3, &pool, NULL) == IP_OK);
     for (int repeat = 0; repeat < 2000; repeat++)
-        check_run(pool, &t, 1 + (unsigned)repeat % 7);
+        check_run(pool, &the_tally, 1 + (unsigned)repeat % 7);
     ip__pool_destroy(pool);
+}
 
-    /* A pool of 1 starts no thread: every job runs on the caller, in order. */
+/* A pool of 1 starts no thread: every job runs on the caller, in order. */
+static void pool_of_one(void)
+{
+    ip__pool *pool = NULL;
     REQUIRE(ip__pool_create(1, &pool, NULL) == IP_OK);
-    CHECK(ip__pool_threads(pool) == 1);
-    check_run(pool, &t, 0);
-    check_run(pool, &t, 1);
-    check_run(pool, &t, 100);
+    CHECK_EQ(ip__pool_threads(pool), 1);
+    check_run(pool, &the_tally, 0);
+    check_run(pool, &the_tally, 1);
+    check_run(pool, &the_tally, 100);
     pthread_t who[8];
     ip__pool_run(pool, 8, caller_job, who);
     unsigned on_caller = 0;
     for (unsigned i = 0; i < 8; i++)
         on_caller += pthread_equal(who[i], pthread_self()) != 0;
-    CHECK(on_caller == 8);
+    CHECK_EQ(on_caller, 8);
     ip__pool_destroy(pool);
+}
 
-    /* Helpers run jobs at the same time as the caller, each job on its own thread. */
+/* Helpers run jobs at the same time as the caller, each job on its own thread. */
+static void concurrent(void)
+{
     check_concurrent(2);
     check_concurrent(4);
     check_concurrent(8);
+}
 
-    /* The count is clamped to 1 .. IP_MAX_THREADS. */
+/* The count is clamped to 1 .. IP_MAX_THREADS. */
+static void clamped_counts(void)
+{
+    ip__pool *pool = NULL;
     REQUIRE(ip__pool_create(0, &pool, NULL) == IP_OK);
-    CHECK(ip__pool_threads(pool) == 1);
-    check_run(pool, &t, 10);
+    CHECK_EQ(ip__pool_threads(pool), 1);
+    check_run(pool, &the_tally, 10);
     ip__pool_destroy(pool);
     REQUIRE(ip__pool_create(IP_MAX_THREADS + 10, &pool, NULL) == IP_OK);
-    CHECK(ip__pool_threads(pool) <= IP_MAX_THREADS);
-    check_run(pool, &t, 300);
+    CHECK_LE(ip__pool_threads(pool), IP_MAX_THREADS);
+    check_run(pool, &the_tally, 300);
     ip__pool_destroy(pool);
+}
 
-    /* Destroyed without a run, at once after its helpers started; NULL is a no-op. */
+/* Destroyed without a run, at once after its helpers started; NULL is a no-op. */
+static void destroyed_unused(void)
+{
+    ip__pool *pool = NULL;
     for (int repeat = 0; repeat < 50; repeat++) {
         REQUIRE(ip__pool_create(1 + (unsigned)repeat % 6, &pool, NULL) == IP_OK);
         ip__pool_destroy(pool);
     }
     ip__pool_destroy(NULL);
     CHECK(1);
+}
 
-    check_spin();
-    return test_summary("test_pool");
+static const test_case cases[] = {
+    {"runs_of_all_sizes", runs_of_all_sizes},
+    {"runs_in_a_row", runs_in_a_row},
+    {"pool_of_one", pool_of_one},
+    {"check_concurrent", concurrent},
+    {"clamped_counts", clamped_counts},
+    {"destroyed_unused", destroyed_unused},
+    TEST_CASE(check_spin),
+};
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES(argc, argv, cases, "test_pool");
 }

@@ -32,6 +32,10 @@ typedef struct run_result {
     ip_cache_stats stats;
 } run_result;
 
+/* What the cases share: the scratch folder and the scene in it (setup). */
+static const char *scratch_dir;
+static scene the_scene;
+
 /* A gyroid in bricks of 8 cells: many bricks, and a surface across the whole picture. */
 static void make_scene(const char *dir, scene *s)
 {
@@ -104,8 +108,9 @@ static int same_mesh(const ip_mesh *a, const ip_mesh *b)
 
 /* Same triangles (one thread) or same image (two), and the counts' relationship, reading
  * ahead every brick planned or only those not in memory. */
-static void check_engine(const scene *s)
+static void check_engine(void)
 {
+    const scene *s = &the_scene;
     for (unsigned threads = 1; threads <= 2; threads++)
         for (int mode = IP_PREFETCH_ON; mode <= IP_PREFETCH_ALWAYS; mode++) {
             run_result off, on;
@@ -117,20 +122,23 @@ static void check_engine(const scene *s)
                 CHECK_MSG(same_mesh(&off.mesh, &on.mesh), "%llu against %llu triangles",
                           (unsigned long long)off.mesh.triangle_count,
                           (unsigned long long)on.mesh.triangle_count);
-            CHECK(memcmp(off.rgba, on.rgba, (size_t)WIDTH * HEIGHT * 4) == 0);
-            CHECK(off.mesh.triangle_count > 1000);
-            CHECK(off.stats.prefetched == 0 && off.stats.prefetch_hits == 0);
+            CHECK_MEM_EQ(off.rgba, on.rgba, (size_t)WIDTH * HEIGHT * 4);
+            CHECK_GT(off.mesh.triangle_count, 1000);
+            CHECK_EQ(off.stats.prefetched, 0);
+            CHECK_EQ(off.stats.prefetch_hits, 0);
             /* nothing is evicted: each touched brick was loaded once, by a miss or ahead */
-            CHECK(on.stats.evictions == 0 && off.stats.evictions == 0);
-            CHECK(off.stats.misses == off.stats.bricks_touched);
+            CHECK_EQ(on.stats.evictions, 0);
+            CHECK_EQ(off.stats.evictions, 0);
+            CHECK_EQ(off.stats.misses, off.stats.bricks_touched);
             CHECK_MSG(on.stats.misses + on.stats.prefetch_hits == on.stats.bricks_touched,
                       "%llu misses + %llu prefetch hits, %llu bricks touched",
                       (unsigned long long)on.stats.misses,
                       (unsigned long long)on.stats.prefetch_hits,
                       (unsigned long long)on.stats.bricks_touched);
-            CHECK(on.stats.prefetch_hits <= on.stats.prefetched);
+            CHECK_LE(on.stats.prefetch_hits, on.stats.prefetched);
             CHECK(on.stats.bricks_touched == off.stats.bricks_touched || threads == 2);
-            CHECK(on.stats.errors == 0 && on.stats.wait_seconds >= 0);
+            CHECK_EQ(on.stats.errors, 0);
+            CHECK_GE(on.stats.wait_seconds, 0);
             printf(
                 "test_prefetch: %u thread(s), %s: %llu bricks touched; off: %llu misses; on: %llu "
                 "misses, %llu loaded ahead, %llu of them pinned\n",
@@ -156,8 +164,9 @@ static void read_whole(const char *path)
 
 /* With the workers on every core and every payload in the page cache, IP_PREFETCH_ON leaves
  * every brick to the workers (nothing is loaded ahead) and draws the same image. */
-static void check_leaves_in_memory(const scene *s)
+static void check_leaves_in_memory(void)
 {
+    const scene *s = &the_scene;
     read_whole(s->path);
     ip_store *store;
     ip_error err;
@@ -174,18 +183,20 @@ static void check_leaves_in_memory(const scene *s)
     run_result off, on;
     render(s, s->path, IP_PREFETCH_OFF, cores, 256ull << 20, &off);
     render(s, s->path, IP_PREFETCH_ON, cores, 256ull << 20, &on);
-    CHECK(off.status == IP_OK && on.status == IP_OK);
+    CHECK_EQ(off.status, IP_OK);
+    CHECK_EQ(on.status, IP_OK);
     CHECK_MSG(on.stats.prefetched == 0, "%llu bricks loaded ahead",
               (unsigned long long)on.stats.prefetched);
-    CHECK(on.stats.misses == on.stats.bricks_touched);
-    CHECK(memcmp(off.rgba, on.rgba, (size_t)WIDTH * HEIGHT * 4) == 0);
+    CHECK_EQ(on.stats.misses, on.stats.bricks_touched);
+    CHECK_MEM_EQ(off.rgba, on.rgba, (size_t)WIDTH * HEIGHT * 4);
     free_result(&off);
     free_result(&on);
 }
 
 /* A budget far below the bricks the view needs: loads ahead never raise the peak past it. */
-static void check_budget(const scene *s)
+static void check_budget(void)
 {
+    const scene *s = &the_scene;
     ip_cache_stats st;
     ip_store *store;
     ip_cache *cache;
@@ -203,10 +214,12 @@ static void check_budget(const scene *s)
     run_result off, on;
     render(s, s->path, IP_PREFETCH_OFF, 2, budget, &off);
     render(s, s->path, IP_PREFETCH_ALWAYS, 2, budget, &on);
-    CHECK(off.status == IP_OK && on.status == IP_OK);
-    CHECK(memcmp(off.rgba, on.rgba, (size_t)WIDTH * HEIGHT * 4) == 0);
-    CHECK(on.stats.evictions > 0);
-    CHECK(on.stats.over_budget_pins == 0 && off.stats.over_budget_pins == 0);
+    CHECK_EQ(off.status, IP_OK);
+    CHECK_EQ(on.status, IP_OK);
+    CHECK_MEM_EQ(off.rgba, on.rgba, (size_t)WIDTH * HEIGHT * 4);
+    CHECK_GT(on.stats.evictions, 0);
+    CHECK_EQ(on.stats.over_budget_pins, 0);
+    CHECK_EQ(off.stats.over_budget_pins, 0);
     CHECK_MSG(on.stats.resident_peak_bytes <= budget, "peak %llu, budget %llu",
               (unsigned long long)on.stats.resident_peak_bytes, (unsigned long long)budget);
     free_result(&off);
@@ -214,8 +227,9 @@ static void check_budget(const scene *s)
 }
 
 /* The cache's side, on one thread: deterministic outcomes and counts. */
-static void check_cache(const scene *s)
+static void check_cache(void)
 {
+    const scene *s = &the_scene;
     ip_store *store;
     ip_cache *cache;
     ip_error err;
@@ -231,40 +245,48 @@ static void check_cache(const scene *s)
     /* room for 3 bricks */
     REQUIRE(ip_cache_create(store, 3 * bytes, &cache, &err) == IP_OK);
     uint64_t before = ip__cache_tick_now(cache);
-    CHECK(ip__cache_prefetch_brick(cache, 0, before) == IP__PREFETCH_LOADED);
-    CHECK(ip__cache_prefetch_brick(cache, 0, before) == IP__PREFETCH_PRESENT);
-    CHECK(ip__cache_prefetch_unused(cache) == 1);
+    CHECK_EQ(ip__cache_prefetch_brick(cache, 0, before), IP__PREFETCH_LOADED);
+    CHECK_EQ(ip__cache_prefetch_brick(cache, 0, before), IP__PREFETCH_PRESENT);
+    CHECK_EQ(ip__cache_prefetch_unused(cache), 1);
     REQUIRE(ip_cache_pin_brick(cache, 0, &b[0], &err) == IP_OK);
     ip_cache_get_stats(cache, &st);
-    CHECK(st.prefetched == 1 && st.prefetch_hits == 1 && st.misses == 0 && st.hits == 1);
-    CHECK(ip__cache_prefetch_unused(cache) == 0);
+    CHECK_EQ(st.prefetched, 1);
+    CHECK_EQ(st.prefetch_hits, 1);
+    CHECK_EQ(st.misses, 0);
+    CHECK_EQ(st.hits, 1);
+    CHECK_EQ(ip__cache_prefetch_unused(cache), 0);
     REQUIRE(ip_cache_pin_brick(cache, 1, &b[1], &err) == IP_OK);
     REQUIRE(ip_cache_pin_brick(cache, 2, &b[2], &err) == IP_OK);
     /* full of pinned bricks: a load ahead must not go over the budget */
-    CHECK(ip__cache_prefetch_brick(cache, 3, UINT64_MAX) == IP__PREFETCH_FULL);
+    CHECK_EQ(ip__cache_prefetch_brick(cache, 3, UINT64_MAX), IP__PREFETCH_FULL);
     for (int i = 0; i < 3; i++)
         ip_cache_unpin_brick(cache, &b[i]);
     /* unpinned, but pinned since `before`: still too valuable to push out */
-    CHECK(ip__cache_prefetch_brick(cache, 3, before) == IP__PREFETCH_FULL);
+    CHECK_EQ(ip__cache_prefetch_brick(cache, 3, before), IP__PREFETCH_FULL);
     ip_cache_get_stats(cache, &st);
-    CHECK(st.resident_bricks == 3 && st.evictions == 0);
+    CHECK_EQ(st.resident_bricks, 3);
+    CHECK_EQ(st.evictions, 0);
     /* older than the tick given: the least recently used goes */
     uint64_t now = ip__cache_tick_now(cache);
-    CHECK(ip__cache_prefetch_brick(cache, 3, now) == IP__PREFETCH_LOADED);
-    CHECK(ip__cache_prefetch_brick(cache, 4, now) == IP__PREFETCH_LOADED);
+    CHECK_EQ(ip__cache_prefetch_brick(cache, 3, now), IP__PREFETCH_LOADED);
+    CHECK_EQ(ip__cache_prefetch_brick(cache, 4, now), IP__PREFETCH_LOADED);
     /* the two loaded ahead are not pushed out by a third: brick 2 goes, then nothing */
-    CHECK(ip__cache_prefetch_brick(cache, 5, now) == IP__PREFETCH_LOADED);
-    CHECK(ip__cache_prefetch_brick(cache, 6, now) == IP__PREFETCH_FULL);
+    CHECK_EQ(ip__cache_prefetch_brick(cache, 5, now), IP__PREFETCH_LOADED);
+    CHECK_EQ(ip__cache_prefetch_brick(cache, 6, now), IP__PREFETCH_FULL);
     ip_cache_get_stats(cache, &st);
-    CHECK(st.resident_peak_bytes <= 3 * bytes && st.prefetched == 4 && st.prefetch_hits == 1);
-    CHECK(ip__cache_prefetch_unused(cache) == 3);
+    CHECK_LE(st.resident_peak_bytes, 3 * bytes);
+    CHECK_EQ(st.prefetched, 4);
+    CHECK_EQ(st.prefetch_hits, 1);
+    CHECK_EQ(ip__cache_prefetch_unused(cache), 3);
     /* a brick loaded ahead and evicted unpinned is no prefetch hit */
-    CHECK(ip_cache_trim(cache, 0) == 3 * bytes);
-    CHECK(ip__cache_prefetch_unused(cache) == 0);
+    CHECK_EQ(ip_cache_trim(cache, 0), 3 * bytes);
+    CHECK_EQ(ip__cache_prefetch_unused(cache), 0);
     REQUIRE(ip_cache_pin_brick(cache, 3, &b[0], &err) == IP_OK);
     ip_cache_unpin_brick(cache, &b[0]);
     ip_cache_get_stats(cache, &st);
-    CHECK(st.prefetch_hits == 1 && st.misses == 3 && st.errors == 0);
+    CHECK_EQ(st.prefetch_hits, 1);
+    CHECK_EQ(st.misses, 3);
+    CHECK_EQ(st.errors, 0);
     ip_cache_destroy(cache);
     ip_store_close(store);
 }
@@ -299,8 +321,10 @@ static void corrupt_copy(const char *from, const char *to)
 }
 
 /* A failing read ahead surfaces as the worker's own error, the same line as without it. */
-static void check_corrupt(const scene *s, const char *dir)
+static void check_corrupt(void)
 {
+    const scene *s = &the_scene;
+    const char *dir = scratch_dir;
     char bad[4300];
     snprintf(bad, sizeof bad, "%s/bad.ibv", dir);
     corrupt_copy(s->path, bad);
@@ -308,22 +332,24 @@ static void check_corrupt(const scene *s, const char *dir)
         run_result off, on;
         render(s, bad, IP_PREFETCH_OFF, threads, 256ull << 20, &off);
         render(s, bad, IP_PREFETCH_ALWAYS, threads, 256ull << 20, &on);
-        CHECK(off.status == IP_ERR_CHECKSUM && on.status == IP_ERR_CHECKSUM);
+        CHECK_EQ(off.status, IP_ERR_CHECKSUM);
+        CHECK_EQ(on.status, IP_ERR_CHECKSUM);
         CHECK_CONTAINS(on.message, "checksum mismatch");
         CHECK_CONTAINS(on.message, bad);
-        CHECK(strchr(on.message, '\n') == NULL);
+        CHECK_EQ(strchr(on.message, '\n'), NULL);
         if (threads == 1) /* the same first brick fails */
             CHECK_MSG(strcmp(off.message, on.message) == 0, "'%s' against '%s'", off.message,
                       on.message);
-        CHECK(on.stats.prefetched == 0); /* nothing bad was ever cached */
+        CHECK_EQ(on.stats.prefetched, 0); /* nothing bad was ever cached */
         free_result(&off);
         free_result(&on);
     }
 }
 
 /* Cancelled halfway, then the same view again: the triangles of an uninterrupted run. */
-static void check_cancel(const scene *s)
+static void check_cancel(void)
 {
+    const scene *s = &the_scene;
     ip_store *store;
     ip_cache *cache;
     ip_engine *engine;
@@ -338,7 +364,7 @@ static void check_cancel(const scene *s)
     REQUIRE(ip_engine_begin(engine, &s->camera, ISO, &err) == IP_OK);
     REQUIRE(ip_engine_step(engine, 64, 0, NULL, &err) == IP_OK);
     ip_engine_cancel(engine);
-    CHECK(ip_engine_step(engine, 0, 0, NULL, &err) == IP_ERR_CANCELLED);
+    CHECK_EQ(ip_engine_step(engine, 0, 0, NULL, &err), IP_ERR_CANCELLED);
     REQUIRE(ip_engine_begin(engine, &s->camera, ISO, &err) == IP_OK);
     while (!ip_engine_done(engine))
         REQUIRE(ip_engine_step(engine, 0, 0, NULL, &err) == IP_OK);
@@ -351,16 +377,18 @@ static void check_cancel(const scene *s)
     ip_store_close(store);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(check_cache),  TEST_CASE(check_engine),  TEST_CASE(check_leaves_in_memory),
+    TEST_CASE(check_budget), TEST_CASE(check_corrupt), TEST_CASE(check_cancel),
+};
+
+static void make_the_scene(void)
 {
-    const char *dir = test_tmp_dir("test_prefetch");
-    scene s;
-    make_scene(dir, &s);
-    check_cache(&s);
-    check_engine(&s);
-    check_leaves_in_memory(&s);
-    check_budget(&s);
-    check_corrupt(&s, dir);
-    check_cancel(&s);
-    return test_summary("test_prefetch");
+    scratch_dir = test_tmp_dir("test_prefetch");
+    make_scene(scratch_dir, &the_scene);
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_prefetch", make_the_scene, NULL);
 }

@@ -85,7 +85,7 @@ static void test_single_triangle(void)
                 count += covered[y * W + x];
             }
         CHECK_MSG(wrong == 0, "winding %d: %d pixels differ from the fill rule", o, wrong);
-        CHECK(count == 36);
+        CHECK_EQ(count, 36);
     }
 }
 
@@ -114,7 +114,7 @@ static void test_shared_edges_square(void)
     const double split[2][6] = {{2.5, 2.5, 10.5, 2.5, 2.5, 10.5},
                                 {10.5, 10.5, 2.5, 10.5, 10.5, 2.5}};
     uint8_t all[W * H];
-    CHECK(union_coverage(&c, split, 2, all) == 0);
+    CHECK_EQ(union_coverage(&c, split, 2, all), 0);
     int wrong = 0;
     for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++)
@@ -139,9 +139,9 @@ static void check_polygon(const ip_camera *c, const double *xy, int n, double cx
     size_t pixels = (size_t)c->width * c->height;
     uint8_t *a = malloc(pixels), *b = malloc(pixels);
     REQUIRE(a && b);
-    CHECK(union_coverage(c, (const double(*)[6])centre_fan, n, a) == 0);
-    CHECK(union_coverage(c, (const double(*)[6])corner_fan, n - 2, b) == 0);
-    CHECK(memcmp(a, b, pixels) == 0);
+    CHECK_EQ(union_coverage(c, (const double(*)[6])centre_fan, n, a), 0);
+    CHECK_EQ(union_coverage(c, (const double(*)[6])corner_fan, n - 2, b), 0);
+    CHECK_MEM_EQ(a, b, pixels);
     free(a);
     free(b);
 }
@@ -179,9 +179,9 @@ static void test_depth(void)
         add_screen_triangle(&m, &c, order ? big : small, order ? 10.0 : 8.0);
         REQUIRE(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, NULL) == IP_OK);
         uint32_t near_index = order ? 0 : 1;
-        CHECK(index[15 * W + 15] == near_index);    /* inside both: the nearer one */
-        CHECK(index[5 * W + 40] == 1 - near_index); /* the big one alone */
-        CHECK(index[40 * W + 40] == UINT32_MAX);
+        CHECK_EQ(index[15 * W + 15], near_index);    /* inside both: the nearer one */
+        CHECK_EQ(index[5 * W + 40], 1 - near_index); /* the big one alone */
+        CHECK_EQ(index[40 * W + 40], UINT32_MAX);
         ip_mesh_free(&m);
     }
     /* equal depth: the lower index wins */
@@ -195,7 +195,8 @@ static void test_depth(void)
         second += index[i] == 1;
         first += index[i] == 0;
     }
-    CHECK(first > 100 && second == 0);
+    CHECK_GT(first, 100);
+    CHECK_EQ(second, 0);
     ip_mesh_free(&m);
 }
 
@@ -235,12 +236,14 @@ static void test_part(void)
     /* the depth alone, without an image */
     REQUIRE(ip_raster_mesh_part(&m, &c, NULL, box_lo, box_hi, 0, 0, W, H, depth, NULL, NULL) ==
             IP_OK);
-    CHECK(fabs(depth[15 * W + 15] - 1 / 8.0) < 1e-6 && depth[40 * W + 40] == 0);
+    CHECK_NEAR(depth[15 * W + 15], 1 / 8.0, 1e-6);
+    CHECK_EQ(depth[40 * W + 40], 0);
     ip_error err;
     const uint32_t bad[4][4] = {{0, 0, 0, H}, {0, 0, W, 0}, {1, 0, W, H}, {0, H, 1, 1}};
     for (int p = 0; p < 4; p++) {
-        CHECK(ip_raster_mesh_part(&m, &c, NULL, box_lo, box_hi, bad[p][0], bad[p][1], bad[p][2],
-                                  bad[p][3], depth, part, &err) == IP_ERR_ARGUMENT);
+        CHECK_EQ(ip_raster_mesh_part(&m, &c, NULL, box_lo, box_hi, bad[p][0], bad[p][1], bad[p][2],
+                                     bad[p][3], depth, part, &err),
+                 IP_ERR_ARGUMENT);
         CHECK_CONTAINS(err.message, "part");
     }
     ip_mesh_free(&m);
@@ -320,7 +323,7 @@ static void test_cube(void)
                 facing += face[t][i] * (c.eye[i] - p[i]);
             back_faces += facing <= 0;
         }
-    CHECK(covered > 1000);
+    CHECK_GT(covered, 1000);
     CHECK_MSG(back_faces == 0, "%d pixels show a back face", back_faces);
     CHECK_MSG(ray_mismatch <= covered / 200, "%d of %d pixels disagree with ray casting",
               ray_mismatch, covered);
@@ -344,15 +347,15 @@ static void test_cube(void)
                 out_of_range += px[i] < floor(dark) || px[i] > ceil(fmin(bright, 255));
             }
         }
-    CHECK(out_of_range == 0);
-    CHECK(bad_background == 0);
+    CHECK_EQ(out_of_range, 0);
+    CHECK_EQ(bad_background, 0);
     /* two-sided lighting: inward normals give the same image */
     uint8_t *flipped = malloc(pixels * 4);
     REQUIRE(flipped);
     for (uint64_t i = 0; i < 9 * m.triangle_count; i++)
         m.normals[i] = -m.normals[i];
     REQUIRE(ip_raster_mesh(&m, &c, lo, hi, NULL, flipped, NULL) == IP_OK);
-    CHECK(memcmp(rgba, flipped, pixels * 4) == 0);
+    CHECK_MEM_EQ(rgba, flipped, pixels * 4);
     free(flipped);
     free(index);
     free(rgba);
@@ -373,7 +376,7 @@ static void test_head_on_shading(void)
     const uint8_t *centre = rgba + 4 * (24 * W + 32);
     for (int i = 0; i < 3; i++) {
         double bright = fmin(1.0, s.surface[i] * (s.ambient + s.diffuse) + s.specular);
-        CHECK(abs(centre[i] - (int)lround(255 * bright)) <= 1);
+        CHECK_LE(abs(centre[i] - (int)lround(255 * bright)), 1);
     }
     ip_mesh_free(&m);
 }
@@ -423,26 +426,26 @@ static void test_surfaces(void)
     raster_alone(&near_small, &c, red, a_img);
     raster_alone(&far_big, &c, blue, b_img);
     REQUIRE(ip_raster_surfaces(two, 2, &c, NULL, box_lo, box_hi, out, NULL) == IP_OK);
-    CHECK(blend_error(out + inside, a_img + inside, b_img + inside, 0.4) <= 1);
-    CHECK(memcmp(out + big_only, b_img + big_only, 4) == 0);
-    CHECK(memcmp(out + empty, bg + empty, 4) == 0);
-    CHECK(out[inside + 3] == 255);
+    CHECK_LE(blend_error(out + inside, a_img + inside, b_img + inside, 0.4), 1);
+    CHECK_MEM_EQ(out + big_only, b_img + big_only, 4);
+    CHECK_MEM_EQ(out + empty, bg + empty, 4);
+    CHECK_EQ(out[inside + 3], 255);
     /* the order of the surfaces does not matter with one translucent surface */
     ip_surface swapped[2] = {two[1], two[0]};
     uint8_t other[W * H * 4];
     REQUIRE(ip_raster_surfaces(swapped, 2, &c, NULL, box_lo, box_hi, other, NULL) == IP_OK);
-    CHECK(memcmp(out, other, sizeof out) == 0);
+    CHECK_MEM_EQ(out, other, sizeof out);
     /* behind the opaque surface, a translucent one does not show */
     ip_surface hidden[2] = {{&far_small, {0.9f, 0.2f, 0.1f}, 0.4f},
                             {&near_big, {0.1f, 0.3f, 0.9f}, 1.0f}};
     raster_alone(&near_big, &c, blue, b_img);
     REQUIRE(ip_raster_surfaces(hidden, 2, &c, NULL, box_lo, box_hi, out, NULL) == IP_OK);
-    CHECK(memcmp(out, b_img, sizeof out) == 0);
+    CHECK_MEM_EQ(out, b_img, sizeof out);
     /* over the background alone */
     ip_surface alone = {&near_small, {0.9f, 0.2f, 0.1f}, 0.4f};
     REQUIRE(ip_raster_surfaces(&alone, 1, &c, NULL, box_lo, box_hi, out, NULL) == IP_OK);
-    CHECK(blend_error(out + inside, a_img + inside, bg + inside, 0.4) <= 1);
-    CHECK(memcmp(out + empty, bg + empty, 4) == 0);
+    CHECK_LE(blend_error(out + inside, a_img + inside, bg + inside, 0.4), 1);
+    CHECK_MEM_EQ(out + empty, bg + empty, 4);
     /* only the nearest layer of a translucent surface shows, whatever its triangles' order:
      * a second layer behind it changes nothing */
     ip_mesh layers[2];
@@ -456,9 +459,9 @@ static void test_surfaces(void)
     uint8_t first[W * H * 4];
     REQUIRE(ip_raster_surfaces(&l0, 1, &c, NULL, box_lo, box_hi, first, NULL) == IP_OK);
     REQUIRE(ip_raster_surfaces(&l1, 1, &c, NULL, box_lo, box_hi, other, NULL) == IP_OK);
-    CHECK(memcmp(first, other, sizeof out) == 0);
+    CHECK_MEM_EQ(first, other, sizeof out);
     REQUIRE(ip_raster_surfaces(&alone, 1, &c, NULL, box_lo, box_hi, out, NULL) == IP_OK);
-    CHECK(memcmp(first, out, sizeof out) == 0);
+    CHECK_MEM_EQ(first, out, sizeof out);
     /* opaque surfaces only: the concatenated mesh, each pixel in its surface's colour */
     ip_mesh both;
     ip_mesh_init(&both);
@@ -477,27 +480,29 @@ static void test_surfaces(void)
         if (index[i] != UINT32_MAX)
             shown[index[i]]++;
     }
-    CHECK(wrong == 0 && shown[0] > 100 && shown[1] > 100);
+    CHECK_EQ(wrong, 0);
+    CHECK_GT(shown[0], 100);
+    CHECK_GT(shown[1], 100);
     /* bad surfaces */
     ip_error err;
     ip_surface bad = alone;
-    CHECK(ip_raster_surfaces(&bad, 0, &c, NULL, box_lo, box_hi, out, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_raster_surfaces(&bad, IP_MAX_SURFACES + 1, &c, NULL, box_lo, box_hi, out, &err) ==
-          IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_raster_surfaces(&bad, 0, &c, NULL, box_lo, box_hi, out, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_raster_surfaces(&bad, IP_MAX_SURFACES + 1, &c, NULL, box_lo, box_hi, out, &err),
+             IP_ERR_ARGUMENT);
     const float opacities[3] = {0.0f, 1.5f, NAN};
     for (int i = 0; i < 3; i++) {
         bad.opacity = opacities[i];
-        CHECK(ip_raster_surfaces(&bad, 1, &c, NULL, box_lo, box_hi, out, &err) == IP_ERR_ARGUMENT);
+        CHECK_EQ(ip_raster_surfaces(&bad, 1, &c, NULL, box_lo, box_hi, out, &err), IP_ERR_ARGUMENT);
         CHECK_CONTAINS(err.message, "opacity");
     }
     bad = alone;
     bad.colour[1] = -0.1f;
-    CHECK(ip_surfaces_check(&bad, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_surfaces_check(&bad, 1, &err), IP_ERR_ARGUMENT);
     bad = alone;
     bad.mesh = NULL;
-    CHECK(ip_surfaces_check(&bad, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_surfaces_check(&bad, 1, &err), IP_ERR_ARGUMENT);
     /* no image: an argument error, not a write through NULL */
-    CHECK(ip_raster_surfaces(&alone, 1, &c, NULL, box_lo, box_hi, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_raster_surfaces(&alone, 1, &c, NULL, box_lo, box_hi, NULL, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "no image");
     ip_mesh *meshes[] = {&near_small, &far_big,   &near_big, &far_small,
                          &layers[0],  &layers[1], &both};
@@ -543,7 +548,7 @@ static void test_clipping(void)
             covered += i != UINT32_MAX;
             mismatch += hit != (i != UINT32_MAX) || (i != UINT32_MAX && i > 1);
         }
-    CHECK(covered > 120 * 90 / 3);
+    CHECK_GT(covered, 120 * 90 / 3);
     CHECK_MSG(mismatch <= covered / 200, "%d of %d pixels disagree with ray casting", mismatch,
               covered);
     /* a triangle wholly behind the eye covers nothing */
@@ -554,7 +559,7 @@ static void test_clipping(void)
     int any = 0;
     for (int i = 0; i < 120 * 90; i++)
         any += index[i] != UINT32_MAX;
-    CHECK(any == 0);
+    CHECK_EQ(any, 0);
     ip_mesh_free(&m);
 }
 
@@ -566,30 +571,30 @@ static void test_bad_arguments(void)
     uint32_t index[W * H];
     ip_error err;
     c.fov_y = 0;
-    CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err), IP_ERR_ARGUMENT);
     c = front_camera(70000, 2);
-    CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, NULL, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_raster_mesh(&m, &c, box_lo, box_hi, NULL, NULL, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "larger");
     const double bad_hi[3] = {20, NAN, 5}, inverted_hi[3] = {-30, 20, 5};
     c = front_camera(W, H);
-    CHECK(ip_raster_mesh(&m, &c, box_lo, bad_hi, index, NULL, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_raster_mesh(&m, &c, box_lo, inverted_hi, index, NULL, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_raster_mesh(&m, &c, box_lo, bad_hi, index, NULL, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_raster_mesh(&m, &c, box_lo, inverted_hi, index, NULL, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "box");
     /* a triangle with a non-finite vertex is skipped, the others drawn */
     const double xy[6] = {2.5, 2.5, 30.5, 2.5, 2.5, 30.5};
     add_screen_triangle(&m, &c, xy, 10.0);
     add_screen_triangle(&m, &c, xy, 9.0);
     m.positions[4] = NAN;
-    CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err) == IP_OK);
-    CHECK(index[5 * W + 5] == 1);
+    CHECK_EQ(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err), IP_OK);
+    CHECK_EQ(index[5 * W + 5], 1);
     ip_mesh_clear(&m);
     /* an empty mesh: only background */
     c = front_camera(W, H);
-    CHECK(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err) == IP_OK);
+    CHECK_EQ(ip_raster_mesh(&m, &c, box_lo, box_hi, index, NULL, &err), IP_OK);
     int any = 0;
     for (int i = 0; i < W * H; i++)
         any += index[i] != UINT32_MAX;
-    CHECK(any == 0);
+    CHECK_EQ(any, 0);
     ip_mesh_free(&m);
 }
 
@@ -629,15 +634,16 @@ static void test_png(void)
         for (int i = 0; i < PW * PH * 4; i++)
             rgba[i] = (uint8_t)(i % 4 == 3 && opaque ? 255 : rand() & 255);
         ip_error err;
-        CHECK(ip_png_write(path, rgba, PW, PH, opaque, &err) == IP_OK);
+        CHECK_EQ(ip_png_write(path, rgba, PW, PH, opaque, &err), IP_OK);
         uint32_t w = 0, h = 0;
         int had_alpha = -1;
         uint8_t *back = read_png(path, &w, &h, &had_alpha);
-        CHECK(back != NULL);
+        CHECK_NE(back, NULL);
         if (back) {
-            CHECK(w == PW && h == PH);
-            CHECK(had_alpha == !opaque);
-            CHECK(memcmp(back, rgba, sizeof rgba) == 0);
+            CHECK_EQ(w, PW);
+            CHECK_EQ(h, PH);
+            CHECK_EQ(had_alpha, !opaque);
+            CHECK_MEM_EQ(back, rgba, sizeof rgba);
         }
         free(back);
     }
@@ -646,14 +652,15 @@ static void test_png(void)
     REQUIRE(stat(path, &before) == 0);
     ip_error err;
     memset(rgba, 0, sizeof rgba);
-    CHECK(ip_png_write(path, rgba, PW, PH, 0, &err) == IP_ERR_EXISTS);
+    CHECK_EQ(ip_png_write(path, rgba, PW, PH, 0, &err), IP_ERR_EXISTS);
     CHECK_CONTAINS(err.message, "exists");
     REQUIRE(stat(path, &after) == 0);
-    CHECK(before.st_size == after.st_size && before.st_ino == after.st_ino);
-    CHECK(ip_png_write(path, rgba, 0, PH, 1, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(before.st_size, after.st_size);
+    CHECK_EQ(before.st_ino, after.st_ino);
+    CHECK_EQ(ip_png_write(path, rgba, 0, PH, 1, &err), IP_ERR_ARGUMENT);
     snprintf(path, sizeof path, "%s/missing/image.png", dir);
-    CHECK(ip_png_write(path, rgba, PW, PH, 0, &err) == IP_ERR_IO);
-    CHECK(stat(path, &after) != 0);
+    CHECK_EQ(ip_png_write(path, rgba, PW, PH, 0, &err), IP_ERR_IO);
+    CHECK_NE(stat(path, &after), 0);
 }
 
 /* A mesh of `count` random triangles in front of the camera (some crossing the near plane and
@@ -700,27 +707,28 @@ static void test_canvas(void)
             ip_canvas *canvas;
             ip_error err;
             REQUIRE(ip_canvas_create(thread_counts[t], &canvas, &err) == IP_OK);
-            CHECK(ip_canvas_shade(canvas, NULL) == NULL);
-            CHECK(ip_canvas_add(canvas, &m, 0, &err) == IP_ERR_ARGUMENT);
+            CHECK_EQ(ip_canvas_shade(canvas, NULL), NULL);
+            CHECK_EQ(ip_canvas_add(canvas, &m, 0, &err), IP_ERR_ARGUMENT);
             REQUIRE(ip_canvas_begin(canvas, &c, &shading, box_lo, box_hi, &err) == IP_OK);
             const uint64_t cuts[] = {0, 1, 6, 69, 70, 400, 700};
             uint32_t rows[2];
             const uint8_t *got = ip_canvas_shade(canvas, rows);
-            CHECK(rows[0] == 0 && rows[1] == c.height);
+            CHECK_EQ(rows[0], 0);
+            CHECK_EQ(rows[1], c.height);
             for (size_t k = 1; k < sizeof cuts / sizeof cuts[0]; k++) {
                 memcpy(before, got, 4 * pixels);
                 ip_mesh part = m;
                 part.triangle_count = cuts[k]; /* the mesh's first triangles */
-                CHECK(ip_canvas_add(canvas, &part, cuts[k - 1] + 1, &err) == IP_ERR_ARGUMENT);
+                CHECK_EQ(ip_canvas_add(canvas, &part, cuts[k - 1] + 1, &err), IP_ERR_ARGUMENT);
                 REQUIRE(ip_canvas_add(canvas, &part, cuts[k - 1], &err) == IP_OK);
-                CHECK(ip_canvas_triangle_count(canvas) == cuts[k]);
+                CHECK_EQ(ip_canvas_triangle_count(canvas), cuts[k]);
                 got = ip_canvas_shade(canvas, rows);
                 REQUIRE(ip_raster_mesh_shaded(&part, &c, &shading, box_lo, box_hi, want_index, want,
                                               &err) == IP_OK);
                 CHECK_MSG(!memcmp(got, want, 4 * pixels), "%u threads, %llu triangles",
                           thread_counts[t], (unsigned long long)cuts[k]);
-                CHECK(!memcmp(ip_canvas_triangle_index(canvas), want_index,
-                              pixels * sizeof *want_index));
+                CHECK_MEM_EQ(ip_canvas_triangle_index(canvas), want_index,
+                             pixels * sizeof *want_index);
                 size_t outside = 0;
                 for (size_t p = 0; p < pixels; p++)
                     if (memcmp(got + 4 * p, before + 4 * p, 4) &&
@@ -730,18 +738,19 @@ static void test_canvas(void)
                           rows[0], rows[1]);
             }
             ip_canvas_shade(canvas, rows); /* nothing changed since */
-            CHECK(rows[0] == 0 && rows[1] == 0);
-            CHECK(ip_canvas_memory(canvas) >= pixels * 29);
+            CHECK_EQ(rows[0], 0);
+            CHECK_EQ(rows[1], 0);
+            CHECK_GE(ip_canvas_memory(canvas), pixels * 29);
             /* a new image of another size, default shading: buffers reused or grown */
             ip_camera small = front_camera(20, 10);
             REQUIRE(ip_canvas_begin(canvas, &small, NULL, box_lo, box_hi, &err) == IP_OK);
             REQUIRE(ip_canvas_add(canvas, &m, 0, &err) == IP_OK);
             uint8_t small_want[20 * 10 * 4];
             REQUIRE(ip_raster_mesh(&m, &small, box_lo, box_hi, NULL, small_want, &err) == IP_OK);
-            CHECK(!memcmp(ip_canvas_shade(canvas, NULL), small_want, sizeof small_want));
+            CHECK_MEM_EQ(ip_canvas_shade(canvas, NULL), small_want, sizeof small_want);
             ip_camera bad = small;
             bad.fov_y = 0;
-            CHECK(ip_canvas_begin(canvas, &bad, NULL, box_lo, box_hi, &err) == IP_ERR_ARGUMENT);
+            CHECK_EQ(ip_canvas_begin(canvas, &bad, NULL, box_lo, box_hi, &err), IP_ERR_ARGUMENT);
             ip_canvas_destroy(canvas);
         }
         free(want);
@@ -752,19 +761,22 @@ static void test_canvas(void)
     ip_canvas_destroy(NULL);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_single_triangle),
+    TEST_CASE(test_shared_edges_square),
+    TEST_CASE(test_shared_edges_polygons),
+    TEST_CASE(test_depth),
+    TEST_CASE(test_part),
+    TEST_CASE(test_cube),
+    TEST_CASE(test_head_on_shading),
+    TEST_CASE(test_surfaces),
+    TEST_CASE(test_clipping),
+    TEST_CASE(test_bad_arguments),
+    TEST_CASE(test_png),
+    TEST_CASE(test_canvas),
+};
+
+int main(int argc, char **argv)
 {
-    test_single_triangle();
-    test_shared_edges_square();
-    test_shared_edges_polygons();
-    test_depth();
-    test_part();
-    test_cube();
-    test_head_on_shading();
-    test_surfaces();
-    test_clipping();
-    test_bad_arguments();
-    test_png();
-    test_canvas();
-    return test_summary("test_raster");
+    return RUN_CASES(argc, argv, cases, "test_raster");
 }

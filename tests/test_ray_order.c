@@ -33,10 +33,13 @@ static uint64_t walk_once(uint32_t w, uint32_t h, uint64_t *hash)
     CHECK_MSG(outside == 0 && repeats == 0, "%ux%u: %llu outside, %llu repeats", w, h,
               (unsigned long long)outside, (unsigned long long)repeats);
     CHECK_MSG(n == (uint64_t)w * h, "%ux%u: %llu pixels", w, h, (unsigned long long)n);
-    CHECK(ip__ray_order_count(&order) == (uint64_t)w * h && ip__ray_order_emitted(&order) == n);
-    CHECK(level_went_back == 0);
+    CHECK_EQ(ip__ray_order_count(&order), (uint64_t)w * h);
+    CHECK_EQ(ip__ray_order_emitted(&order), n);
+    CHECK_EQ(level_went_back, 0);
     x = y = 12345;
-    CHECK(ip__ray_order_next(&order, &x, &y) == 0 && x == 12345 && y == 12345);
+    CHECK_EQ(ip__ray_order_next(&order, &x, &y), 0);
+    CHECK_EQ(x, 12345);
+    CHECK_EQ(y, 12345);
     free(seen);
     return n;
 }
@@ -175,7 +178,7 @@ static void test_matches_reference(void)
                 fprintf(stderr, "%ux%u, local from 2, in ranges of 7: differs\n", w, h),
                     mismatches++;
         }
-    CHECK(mismatches == 0);
+    CHECK_EQ(mismatches, 0);
     static const uint32_t sizes[][2] = {
         {640, 480}, {255, 257}, {1000, 3}, {129, 1025}, {1600, 1200}};
     for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
@@ -200,20 +203,23 @@ static void test_first_rays(void)
     REQUIRE(ip__ray_order_init(&order, 16, 16) == IP_OK);
     for (size_t i = 0; i < sizeof expected / sizeof expected[0]; i++) {
         uint32_t x = 0, y = 0;
-        CHECK(ip__ray_order_next(&order, &x, &y) == 1);
+        CHECK_EQ(ip__ray_order_next(&order, &x, &y), 1);
         CHECK_MSG(x == expected[i][0] && y == expected[i][1], "ray %zu is (%u, %u)", i, x, y);
-        CHECK(ip__ray_order_level(&order) == (i == 0 ? 0u : i < 5 ? 1u : 2u));
+        CHECK_EQ(ip__ray_order_level(&order), i == 0 ? 0u : i < 5 ? 1u : 2u);
     }
     /* Reset replays the same order. */
     ip__ray_order_reset(&order);
-    CHECK(ip__ray_order_emitted(&order) == 0);
+    CHECK_EQ(ip__ray_order_emitted(&order), 0);
     uint32_t x = 0, y = 0;
-    CHECK(ip__ray_order_next(&order, &x, &y) == 1 && x == 8 && y == 8);
+    CHECK_EQ(ip__ray_order_next(&order, &x, &y), 1);
+    CHECK_EQ(x, 8);
+    CHECK_EQ(y, 8);
     /* A single row: the centre, then the quarter points. */
     REQUIRE(ip__ray_order_init(&order, 8, 1) == IP_OK);
     static const uint32_t row[8] = {4, 2, 6, 1, 5, 3, 7, 0};
     for (int i = 0; i < 8; i++) {
-        CHECK(ip__ray_order_next(&order, &x, &y) == 1 && y == 0);
+        CHECK_EQ(ip__ray_order_next(&order, &x, &y), 1);
+        CHECK_EQ(y, 0);
         CHECK_MSG(x == row[i], "8x1 ray %d is %u", i, x);
     }
 }
@@ -221,14 +227,16 @@ static void test_first_rays(void)
 static void test_bad_arguments(void)
 {
     ip_ray_order order;
-    CHECK(ip__ray_order_init(NULL, 4, 4) == IP_ERR_ARGUMENT);
-    CHECK(ip__ray_order_init(&order, 0, 4) == IP_ERR_ARGUMENT);
-    CHECK(ip__ray_order_init(&order, 4, 0) == IP_ERR_ARGUMENT);
-    CHECK(ip__ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE + 1, 4) == IP_ERR_ARGUMENT);
-    CHECK(ip__ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE, 1) == IP_OK);
+    CHECK_EQ(ip__ray_order_init(NULL, 4, 4), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip__ray_order_init(&order, 0, 4), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip__ray_order_init(&order, 4, 0), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip__ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE + 1, 4), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip__ray_order_init(&order, IP_RAY_ORDER_MAX_SIDE, 1), IP_OK);
     uint32_t x, y;
-    CHECK(ip__ray_order_next(&order, &x, &y) == 1 && x == IP_RAY_ORDER_MAX_SIDE / 2 && y == 0);
-    CHECK(ip__ray_order_count(&order) == IP_RAY_ORDER_MAX_SIDE);
+    CHECK_EQ(ip__ray_order_next(&order, &x, &y), 1);
+    CHECK_EQ(x, IP_RAY_ORDER_MAX_SIDE / 2);
+    CHECK_EQ(y, 0);
+    CHECK_EQ(ip__ray_order_count(&order), IP_RAY_ORDER_MAX_SIDE);
 }
 
 /* Exact squared Euclidean distance transform along one line: the lower envelope of the
@@ -423,8 +431,8 @@ static void test_distance_transform(void)
             state = state * 6364136223846793005ull + 1442695040888963407ull;
             cast[(state >> 33) % ((uint64_t)w * h)] = 1;
         }
-        CHECK(fabs(max_distance(cast, w, h) - max_distance_brute(cast, w, h, 0)) < 1e-9);
-        CHECK(max_chessboard_distance(cast, w, h) == (uint32_t)max_distance_brute(cast, w, h, 1));
+        CHECK_NEAR(max_distance(cast, w, h), max_distance_brute(cast, w, h, 0), 1e-9);
+        CHECK_EQ(max_chessboard_distance(cast, w, h), (uint32_t)max_distance_brute(cast, w, h, 1));
         free(cast);
     }
 }
@@ -528,11 +536,11 @@ static void test_ranges(uint32_t w, uint32_t h, uint32_t local_from, uint64_t ra
     ip__ray_order_set_local_from(&whole, local_from);
     ip__ray_order_set_local_from(&part, local_from);
     uint64_t cells = ip__ray_order_cells(&whole), n = 0, differ = 0;
-    CHECK(cells >= (uint64_t)w * h);
+    CHECK_GE(cells, (uint64_t)w * h);
     for (uint64_t start = 0; start < cells; start += range) {
         uint64_t end = cells - start < range ? cells : start + range;
         ip__ray_order_seek(&part, start);
-        CHECK(ip__ray_order_position(&part) == start);
+        CHECK_EQ(ip__ray_order_position(&part), start);
         uint32_t x, y, ex, ey;
         while (ip__ray_order_next_before(&part, end, &x, &y)) {
             n++;
@@ -626,39 +634,67 @@ static void test_level_positions(uint32_t w, uint32_t h)
               "%ux%u: %u level positions wrong", w, h, wrong);
 }
 
-int main(int argc, char **argv)
+static void test_spreads(void)
 {
-    if (argc > 3 && strcmp(argv[1], "--bench") == 0)
-        return bench((uint32_t)atoi(argv[2]), (uint32_t)atoi(argv[3]));
-    test_every_pixel_once();
-    test_matches_reference();
-    test_first_rays();
-    test_bad_arguments();
-    test_distance_transform();
     test_spread(64, 64);
     test_spread(256, 256);
     test_spread(256, 128);
     test_spread(17, 13);
     test_spread(640, 480);
     test_spread(1, 100);
+}
+
+static void test_local_levels_all(void)
+{
     test_local_levels(1600, 1200, 8);
     test_local_levels(640, 480, 0);
     test_local_levels(255, 257, 5);
     test_local_levels(1000, 1, 3);
     test_local_levels(17, 13, 40); /* past the last level: Bayer order throughout */
+}
+
+static void test_ranges_all(void)
+{
     test_ranges(1600, 1200, 8, 64);
     test_ranges(1600, 1200, UINT32_MAX, 1000);
     test_ranges(17, 13, 2, 1);
     test_ranges(1000, 1, 3, 7);
     test_ranges(1, 1, 0, 1);
     test_ranges(255, 257, 5, 3);
+}
+
+static void test_blocks_all(void)
+{
     test_blocks(1600, 1200, 8, 3, 1000);
     test_blocks(255, 257, 5, 2, 333);
     test_blocks(97, 61, 4, 1, 16);
     test_blocks(640, 480, 0, 4, 1u << 20);
     test_blocks(1000, 3, 2, 1, 64); /* the shorter axis stops splitting: few blocks */
+}
+
+static void test_level_positions_all(void)
+{
     test_level_positions(1600, 1200);
     test_level_positions(1000, 3);
     test_level_positions(1, 1);
-    return test_summary("test_ray_order");
+}
+
+static const test_case cases[] = {
+    TEST_CASE(test_every_pixel_once),
+    TEST_CASE(test_matches_reference),
+    TEST_CASE(test_first_rays),
+    TEST_CASE(test_bad_arguments),
+    TEST_CASE(test_distance_transform),
+    {"test_spread", test_spreads},
+    {"test_local_levels", test_local_levels_all},
+    {"test_ranges", test_ranges_all},
+    {"test_blocks", test_blocks_all},
+    {"test_level_positions", test_level_positions_all},
+};
+
+int main(int argc, char **argv)
+{
+    if (argc > 3 && strcmp(argv[1], "--bench") == 0)
+        return bench((uint32_t)atoi(argv[2]), (uint32_t)atoi(argv[3]));
+    return RUN_CASES(argc, argv, cases, "test_ray_order");
 }

@@ -146,7 +146,7 @@ static void compare_with_raster(const ip_mesh *m, const ip_camera *c, const uint
             size_t i = (size_t)y * c->width + x;
             int ref_covered = index[i] != UINT32_MAX;
             int gl_covered = !is_background(gl + 4 * i, y, c->height);
-            CHECK(is_background(ref + 4 * i, y, c->height) == !ref_covered);
+            CHECK_EQ(is_background(ref + 4 * i, y, c->height), !ref_covered);
             covered += ref_covered;
             coverage_mismatch += ref_covered != gl_covered;
             int diff = 0;
@@ -165,10 +165,10 @@ static void compare_with_raster(const ip_mesh *m, const ip_camera *c, const uint
     printf("%ux%u: %zu covered, %zu coverage mismatches, %zu shading outliers (> %d levels) "
            "of %zu, worst %d\n",
            c->width, c->height, covered, coverage_mismatch, outliers, SHADE_LEVELS, both, worst);
-    CHECK(covered > pixels / 10);
-    CHECK(coverage_mismatch <= COVERAGE_MISMATCH_FRACTION * covered);
-    CHECK(outliers <= SHADE_OUTLIER_FRACTION * both);
-    CHECK(bad_background == 0);
+    CHECK_GT(covered, pixels / 10);
+    CHECK_LE(coverage_mismatch, COVERAGE_MISMATCH_FRACTION * covered);
+    CHECK_LE(outliers, SHADE_OUTLIER_FRACTION * both);
+    CHECK_EQ(bad_background, 0);
     free(index);
     free(ref);
 }
@@ -188,7 +188,7 @@ static void test_against_raster(ip_renderer *r, const ip_mesh *m)
     uint8_t *gl = malloc(320 * 240 * 4);
     REQUIRE(gl);
     REQUIRE(ip_renderer_upload(r, m, 0, NULL) == IP_OK);
-    CHECK(ip_renderer_triangle_count(r) == m->triangle_count);
+    CHECK_EQ(ip_renderer_triangle_count(r), m->triangle_count);
     draw_and_read(r, &c, gl);
     compare_with_raster(m, &c, gl);
     /* the eye inside the sphere: triangles cross the near plane and reach behind the eye */
@@ -214,7 +214,7 @@ static void test_incremental_upload(ip_renderer *r, const ip_mesh *m)
     REQUIRE(ip_renderer_upload(r, m, 0, NULL) == IP_OK);
     draw_and_read(r, &c, once);
     draw_and_read(r, &c, again);
-    CHECK(memcmp(once, again, bytes) == 0);
+    CHECK_MEM_EQ(once, again, bytes);
 
     ip_renderer *fresh = NULL;
     REQUIRE(ip_renderer_create_headless(320, 240, &fresh, NULL) == IP_OK);
@@ -224,11 +224,11 @@ static void test_incremental_upload(ip_renderer *r, const ip_mesh *m)
     for (int k = 0; k < 3; k++) {
         uint64_t count = cuts[k + 1] - cuts[k];
         REQUIRE(ip_mesh_append_mesh(&partial, m, cuts[k], count) == IP_OK);
-        CHECK(ip_renderer_upload(fresh, &partial, cuts[k], NULL) == IP_OK);
-        CHECK(ip_renderer_triangle_count(fresh) == cuts[k + 1]);
+        CHECK_EQ(ip_renderer_upload(fresh, &partial, cuts[k], NULL), IP_OK);
+        CHECK_EQ(ip_renderer_triangle_count(fresh), cuts[k + 1]);
     }
     draw_and_read(fresh, &c, parts);
-    CHECK(memcmp(once, parts, bytes) == 0);
+    CHECK_MEM_EQ(once, parts, bytes);
 
     /* drawing only what each upload added over the image drawn before gives the same image */
     ip_renderer *added = NULL;
@@ -242,21 +242,22 @@ static void test_incremental_upload(ip_renderer *r, const ip_mesh *m)
                   "%s", why.message);
     }
     REQUIRE(ip_renderer_read_rgba(added, again, NULL) == IP_OK);
-    CHECK(memcmp(once, again, bytes) == 0);
+    CHECK_MEM_EQ(once, again, bytes);
     ip_error why;
-    CHECK(ip_renderer_draw_added(added, &c, scene_lo, scene_hi, m->triangle_count + 1, &why) ==
-          IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_draw_added(added, &c, scene_lo, scene_hi, m->triangle_count + 1, &why),
+             IP_ERR_ARGUMENT);
     ip_renderer_destroy(added);
 
     /* nothing to append, then a first triangle past the end */
     ip_error err;
-    CHECK(ip_renderer_upload(fresh, &partial, partial.triangle_count, &err) == IP_OK);
-    CHECK(ip_renderer_upload(fresh, &partial, partial.triangle_count + 1, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_renderer_triangle_count(fresh) == m->triangle_count);
+    CHECK_EQ(ip_renderer_upload(fresh, &partial, partial.triangle_count, &err), IP_OK);
+    CHECK_EQ(ip_renderer_upload(fresh, &partial, partial.triangle_count + 1, &err),
+             IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_triangle_count(fresh), m->triangle_count);
 
     /* cleared: the background alone, as the rasterizer draws it for an empty mesh */
     ip_renderer_clear_mesh(fresh);
-    CHECK(ip_renderer_triangle_count(fresh) == 0);
+    CHECK_EQ(ip_renderer_triangle_count(fresh), 0);
     draw_and_read(fresh, &c, parts);
     ip_mesh empty;
     ip_mesh_init(&empty);
@@ -264,7 +265,7 @@ static void test_incremental_upload(ip_renderer *r, const ip_mesh *m)
     int worst = 0;
     for (size_t i = 0; i < bytes; i++)
         worst = abs(parts[i] - again[i]) > worst ? abs(parts[i] - again[i]) : worst;
-    CHECK(worst <= 1);
+    CHECK_LE(worst, 1);
     ip_renderer_destroy(fresh);
     ip_mesh_free(&partial);
     free(once);
@@ -291,20 +292,20 @@ static void test_streamed_draw(ip_renderer *r)
     REQUIRE(ip_renderer_upload(r, &big, 0, NULL) == IP_OK);
     draw_and_read(r, &c, whole);
     ip_renderer_clear_mesh(r);
-    CHECK(ip_renderer_draw_mesh(r, &big, &c, scene_lo, scene_hi, &err) == IP_OK);
-    CHECK(ip_renderer_read_rgba(r, streamed, &err) == IP_OK);
+    CHECK_EQ(ip_renderer_draw_mesh(r, &big, &c, scene_lo, scene_hi, &err), IP_OK);
+    CHECK_EQ(ip_renderer_read_rgba(r, streamed, &err), IP_OK);
     CHECK_MSG(memcmp(whole, streamed, bytes) == 0, "a streamed draw differs from one draw");
-    CHECK(ip_renderer_triangle_count(r) == 0);
+    CHECK_EQ(ip_renderer_triangle_count(r), 0);
     /* an empty mesh: the background alone */
     ip_mesh none;
     ip_mesh_init(&none);
-    CHECK(ip_renderer_draw_mesh(r, &none, &c, scene_lo, scene_hi, &err) == IP_OK);
-    CHECK(ip_renderer_read_rgba(r, streamed, &err) == IP_OK);
+    CHECK_EQ(ip_renderer_draw_mesh(r, &none, &c, scene_lo, scene_hi, &err), IP_OK);
+    CHECK_EQ(ip_renderer_read_rgba(r, streamed, &err), IP_OK);
     draw_and_read(r, &c, empty);
-    CHECK(memcmp(empty, streamed, bytes) == 0);
+    CHECK_MEM_EQ(empty, streamed, bytes);
     /* a camera of another size is refused */
     ip_camera small = scene_camera(100, 80);
-    CHECK(ip_renderer_draw_mesh(r, &big, &small, scene_lo, scene_hi, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_draw_mesh(r, &big, &small, scene_lo, scene_hi, &err), IP_ERR_ARGUMENT);
     free(whole);
     free(streamed);
     free(empty);
@@ -322,7 +323,7 @@ static size_t surfaces_outliers(ip_renderer *r, const ip_surface *f, size_t coun
     ip_error err;
     ip_status st = ip_renderer_draw_surfaces(r, f, count, c, scene_lo, scene_hi, &err);
     CHECK_MSG(st == IP_OK, "%s", err.message);
-    CHECK(ip_renderer_read_rgba(r, gl, &err) == IP_OK);
+    CHECK_EQ(ip_renderer_read_rgba(r, gl, &err), IP_OK);
     REQUIRE(ip_raster_surfaces(f, count, c, NULL, scene_lo, scene_hi, ref, NULL) == IP_OK);
     int worst = 0;
     for (size_t i = 0; i < pixels; i++) {
@@ -355,30 +356,30 @@ static void test_surfaces(ip_renderer *r)
     uint8_t *gl = malloc(pixels * 4), *plain = malloc(pixels * 4);
     REQUIRE(gl && plain);
     ip_surface f[2] = {{&sphere, {0.93f, 0.6f, 0.5f}, 0.4f}, {&box, {0.3f, 0.5f, 0.9f}, 1.0f}};
-    CHECK(surfaces_outliers(r, f, 2, &c, gl) <= SHADE_OUTLIER_FRACTION * pixels);
+    CHECK_LE(surfaces_outliers(r, f, 2, &c, gl), SHADE_OUTLIER_FRACTION * pixels);
     f[1].opacity = 0.7f; /* two translucent surfaces: the depth is redrawn for the second */
-    CHECK(surfaces_outliers(r, f, 2, &c, gl) <= SHADE_OUTLIER_FRACTION * pixels);
+    CHECK_LE(surfaces_outliers(r, f, 2, &c, gl), SHADE_OUTLIER_FRACTION * pixels);
     f[0].opacity = 1.0f;
-    CHECK(surfaces_outliers(r, f, 2, &c, gl) <= SHADE_OUTLIER_FRACTION * pixels);
+    CHECK_LE(surfaces_outliers(r, f, 2, &c, gl), SHADE_OUTLIER_FRACTION * pixels);
     /* one opaque surface: draw_mesh's image in its colour */
     ip_error err;
     ip_shading s;
     ip_shading_default(&s);
     memcpy(s.surface, f[0].colour, sizeof s.surface);
     REQUIRE(ip_renderer_set_shading(r, &s, NULL) == IP_OK);
-    CHECK(ip_renderer_draw_mesh(r, &sphere, &c, scene_lo, scene_hi, &err) == IP_OK);
-    CHECK(ip_renderer_read_rgba(r, plain, &err) == IP_OK);
+    CHECK_EQ(ip_renderer_draw_mesh(r, &sphere, &c, scene_lo, scene_hi, &err), IP_OK);
+    CHECK_EQ(ip_renderer_read_rgba(r, plain, &err), IP_OK);
     REQUIRE(ip_renderer_set_shading(r, NULL, NULL) == IP_OK);
-    CHECK(ip_renderer_draw_surfaces(r, f, 1, &c, scene_lo, scene_hi, &err) == IP_OK);
-    CHECK(ip_renderer_read_rgba(r, gl, &err) == IP_OK);
-    CHECK(memcmp(gl, plain, pixels * 4) == 0);
+    CHECK_EQ(ip_renderer_draw_surfaces(r, f, 1, &c, scene_lo, scene_hi, &err), IP_OK);
+    CHECK_EQ(ip_renderer_read_rgba(r, gl, &err), IP_OK);
+    CHECK_MEM_EQ(gl, plain, pixels * 4);
     /* the translucent sphere changes the picture */
     f[0].opacity = 0.4f;
-    CHECK(ip_renderer_draw_surfaces(r, f, 1, &c, scene_lo, scene_hi, &err) == IP_OK);
-    CHECK(ip_renderer_read_rgba(r, gl, &err) == IP_OK);
-    CHECK(memcmp(gl, plain, pixels * 4) != 0);
+    CHECK_EQ(ip_renderer_draw_surfaces(r, f, 1, &c, scene_lo, scene_hi, &err), IP_OK);
+    CHECK_EQ(ip_renderer_read_rgba(r, gl, &err), IP_OK);
+    CHECK_NE(memcmp(gl, plain, pixels * 4), 0);
     f[0].opacity = 0.0f;
-    CHECK(ip_renderer_draw_surfaces(r, f, 1, &c, scene_lo, scene_hi, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_draw_surfaces(r, f, 1, &c, scene_lo, scene_hi, &err), IP_ERR_ARGUMENT);
     free(gl);
     free(plain);
     ip_mesh_free(&sphere);
@@ -389,9 +390,9 @@ static void test_resize_and_errors(ip_renderer *r, const ip_mesh *m)
 {
     ip_error err;
     ip_camera c = scene_camera(320, 240);
-    CHECK(ip_renderer_resize(r, 0, 10, &err) == IP_ERR_ARGUMENT);
-    CHECK(ip_renderer_resize(r, 201, 150, &err) == IP_OK);
-    CHECK(ip_renderer_draw(r, &c, scene_lo, scene_hi, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_resize(r, 0, 10, &err), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_resize(r, 201, 150, &err), IP_OK);
+    CHECK_EQ(ip_renderer_draw(r, &c, scene_lo, scene_hi, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "camera is 320x240");
     c = scene_camera(201, 150);
     uint8_t *gl = malloc(201 * 150 * 4);
@@ -399,9 +400,9 @@ static void test_resize_and_errors(ip_renderer *r, const ip_mesh *m)
     draw_and_read(r, &c, gl);
     compare_with_raster(m, &c, gl);
     const double inverted_hi[3] = {-2, 1.5, 1.5};
-    CHECK(ip_renderer_draw(r, &c, scene_lo, inverted_hi, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_draw(r, &c, scene_lo, inverted_hi, &err), IP_ERR_ARGUMENT);
     c.fov_y = 200;
-    CHECK(ip_renderer_draw(r, &c, scene_lo, scene_hi, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_draw(r, &c, scene_lo, scene_hi, &err), IP_ERR_ARGUMENT);
     free(gl);
 }
 
@@ -411,13 +412,13 @@ static void test_samples(ip_renderer *r, const uint8_t *image)
 {
     ip_error err;
     ip_camera c = scene_camera(320, 240);
-    CHECK(ip_renderer_set_samples(r, 0, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_set_samples(r, 0, &err), IP_ERR_ARGUMENT);
     CHECK_CONTAINS(err.message, "samples a pixel");
-    CHECK(ip_renderer_set_samples(r, 100000, &err) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_renderer_set_samples(r, 100000, &err), IP_ERR_ARGUMENT);
     uint8_t *aa = malloc(320 * 240 * 4);
     REQUIRE(aa);
     draw_and_read(r, &c, aa);
-    CHECK(memcmp(aa, image, 320 * 240 * 4) == 0);
+    CHECK_MEM_EQ(aa, image, 320 * 240 * 4);
     REQUIRE(ip_renderer_set_samples(r, 4, &err) == IP_OK);
     draw_and_read(r, &c, aa);
     size_t changed = 0, far = 0;
@@ -426,11 +427,11 @@ static void test_samples(ip_renderer *r, const uint8_t *image)
         changed += d > 0;
         far += d > 4;
     }
-    CHECK(changed > 0);
-    CHECK(far < 320 * 240 * 4 / 20); /* the silhouettes and the edges between surfaces */
+    CHECK_GT(changed, 0);
+    CHECK_LT(far, 320 * 240 * 4 / 20); /* the silhouettes and the edges between surfaces */
     REQUIRE(ip_renderer_set_samples(r, 1, &err) == IP_OK);
     draw_and_read(r, &c, aa);
-    CHECK(memcmp(aa, image, 320 * 240 * 4) == 0);
+    CHECK_MEM_EQ(aa, image, 320 * 240 * 4);
     free(aa);
 }
 
@@ -458,10 +459,10 @@ static void test_threads(ip_renderer *r, const uint8_t *image)
     pthread_t thread;
     REQUIRE(pthread_create(&thread, NULL, draw_on_thread, &job) == 0);
     REQUIRE(pthread_join(thread, NULL) == 0);
-    CHECK(memcmp(job.rgba, image, 320 * 240 * 4) == 0);
+    CHECK_MEM_EQ(job.rgba, image, 320 * 240 * 4);
     memset(job.rgba, 0, 320 * 240 * 4);
     draw_and_read(r, &c, job.rgba);
-    CHECK(memcmp(job.rgba, image, 320 * 240 * 4) == 0);
+    CHECK_MEM_EQ(job.rgba, image, 320 * 240 * 4);
     free(job.rgba);
 }
 
@@ -481,7 +482,7 @@ static void test_on_current_context(const ip_mesh *m, const uint8_t *headless_im
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, buffers[0]);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, buffers[1]);
-    CHECK(glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE);
+    CHECK_EQ(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
     /* state a caller might leave behind */
     glEnable(GL_CULL_FACE);
     glEnable(GL_BLEND);
@@ -495,9 +496,9 @@ static void test_on_current_context(const ip_mesh *m, const uint8_t *headless_im
         uint8_t *rgba = malloc(320 * 240 * 4);
         REQUIRE(rgba);
         ip_camera c = scene_camera(320, 240);
-        CHECK(ip_renderer_upload(r, m, 0, NULL) == IP_OK);
+        CHECK_EQ(ip_renderer_upload(r, m, 0, NULL), IP_OK);
         draw_and_read(r, &c, rgba);
-        CHECK(memcmp(rgba, headless_image, 320 * 240 * 4) == 0);
+        CHECK_MEM_EQ(rgba, headless_image, 320 * 240 * 4);
         ip_renderer_destroy(r);
         free(rgba);
     }
@@ -506,40 +507,129 @@ static void test_on_current_context(const ip_mesh *m, const uint8_t *headless_im
     ip_gl_context_destroy(context);
 }
 
-int main(void)
+/* What the cases share: a headless renderer of 320 x 240 (made again by a case after
+ * on_current_context() destroyed it), the scene's mesh, and the scene's image as drawn with the
+ * mesh uploaded again (reference_image()). */
+static ip_renderer *the_renderer;
+static int mesh_uploaded; /* the renderer holds the mesh alone (renderer_with_mesh()) */
+static ip_mesh the_mesh;
+static uint8_t *the_image;
+
+static void open_renderer(void)
 {
-    ip_renderer *r = NULL;
     ip_error err;
-    ip_status st = ip_renderer_create_headless(320, 240, &r, &err);
+    ip_status st = ip_renderer_create_headless(320, 240, &the_renderer, &err);
     if (st == IP_ERR_UNSUPPORTED) {
         printf("test_render: skipped: %s\n", err.message);
-        return 77;
+        exit(77);
     }
     REQUIRE(st == IP_OK);
-    ip_mesh m;
-    build_scene(&m);
-    printf("scene: %llu triangles\n", (unsigned long long)m.triangle_count);
-    test_against_raster(r, &m);
-    test_incremental_upload(r, &m);
-    test_streamed_draw(r);
-    test_surfaces(r);
-    ip_renderer_clear_mesh(r);
-    REQUIRE(ip_renderer_upload(r, &m, 0, NULL) == IP_OK);
+    build_scene(&the_mesh);
+    printf("scene: %llu triangles\n", (unsigned long long)the_mesh.triangle_count);
+}
 
-    uint8_t *image = malloc(320 * 240 * 4);
-    REQUIRE(image);
-    ip_camera c = scene_camera(320, 240);
-    draw_and_read(r, &c, image);
-    test_threads(r, image);
-    test_samples(r, image);
-    test_resize_and_errors(r, &m);
+static void close_renderer(void)
+{
+    ip_renderer_destroy(the_renderer);
+    free(the_image);
+    ip_mesh_free(&the_mesh);
+}
+
+static ip_renderer *renderer(void)
+{
+    if (!the_renderer) {
+        REQUIRE(ip_renderer_create_headless(320, 240, &the_renderer, NULL) == IP_OK);
+        mesh_uploaded = 0;
+    }
+    return the_renderer;
+}
+
+/* The renderer with the scene's mesh uploaded again, alone (the cases before change what it
+ * holds). */
+static ip_renderer *renderer_with_mesh(void)
+{
+    ip_renderer *r = renderer();
+    if (!mesh_uploaded) {
+        ip_renderer_clear_mesh(r);
+        REQUIRE(ip_renderer_upload(r, &the_mesh, 0, NULL) == IP_OK);
+        mesh_uploaded = 1;
+    }
+    return r;
+}
+
+/* The scene drawn by the renderer with the mesh, made by the first case that compares with it. */
+static const uint8_t *reference_image(void)
+{
+    if (!the_image) {
+        ip_renderer *r = renderer_with_mesh();
+        the_image = malloc(320 * 240 * 4);
+        REQUIRE(the_image);
+        ip_camera c = scene_camera(320, 240);
+        draw_and_read(r, &c, the_image);
+    }
+    return the_image;
+}
+
+static void against_raster(void)
+{
+    test_against_raster(renderer(), &the_mesh);
+    mesh_uploaded = 0;
+}
+static void incremental_upload(void)
+{
+    test_incremental_upload(renderer(), &the_mesh);
+    mesh_uploaded = 0;
+}
+static void streamed_draw(void)
+{
+    test_streamed_draw(renderer());
+    mesh_uploaded = 0;
+}
+static void surfaces(void)
+{
+    test_surfaces(renderer());
+    mesh_uploaded = 0;
+}
+static void threads(void)
+{
+    const uint8_t *image = reference_image();
+    test_threads(renderer_with_mesh(), image);
+}
+static void samples(void)
+{
+    const uint8_t *image = reference_image();
+    test_samples(renderer_with_mesh(), image);
+}
+static void resize_and_errors(void)
+{
+    test_resize_and_errors(renderer_with_mesh(), &the_mesh);
+}
+static void on_current_context(void)
+{
+    const uint8_t *image = reference_image();
+    ip_renderer *r = renderer();
     ip_renderer_destroy(r);
-    test_on_current_context(&m, image);
-    /* no context is current any more */
-    CHECK(ip_renderer_create_current(320, 240, 0, &r, &err) == IP_ERR_UNSUPPORTED);
-    CHECK(r == NULL);
+    the_renderer = NULL;
+    test_on_current_context(&the_mesh, image);
+    /* no context is current any more: refused, r cleared */
+    ip_error err;
+    CHECK_EQ(ip_renderer_create_current(320, 240, 0, &r, &err), IP_ERR_UNSUPPORTED);
+    CHECK_EQ(r, NULL);
     CHECK_CONTAINS(err.message, "no OpenGL context");
-    free(image);
-    ip_mesh_free(&m);
-    return test_summary("test_render");
+}
+
+static const test_case cases[] = {
+    {"test_against_raster", against_raster},
+    {"test_incremental_upload", incremental_upload},
+    {"test_streamed_draw", streamed_draw},
+    {"test_surfaces", surfaces},
+    {"test_threads", threads},
+    {"test_samples", samples},
+    {"test_resize_and_errors", resize_and_errors},
+    {"test_on_current_context", on_current_context},
+};
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_render", open_renderer, close_renderer);
 }

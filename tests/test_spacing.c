@@ -13,6 +13,8 @@
 #include "isoprop/input.h"
 #include "isoprop/volume.h"
 
+static const char *scratch_dir;
+
 static void check_accepted(double x, double y, double z)
 {
     const double s[3] = {x, y, z};
@@ -32,7 +34,7 @@ static void check_refused(double x, double y, double z, const char *needle)
               z);
     CHECK_CONTAINS(err.message, "v.raw: spacing");
     CHECK_CONTAINS(err.message, needle);
-    CHECK(strchr(err.message, '\n') == NULL);
+    CHECK_EQ(strchr(err.message, '\n'), NULL);
 }
 
 static void test_bounds(void)
@@ -55,13 +57,14 @@ static void test_bounds(void)
     check_refused(1, 1, INFINITY, "along z");
     const double s[3] = {1e-12, 1, 1};
     ip_error err;
-    CHECK(ip_spacing_check(s, NULL, &err) == IP_ERR_UNSUPPORTED);
-    CHECK(strncmp(err.message, "spacing 1e-12", 13) == 0);
+    CHECK_EQ(ip_spacing_check(s, NULL, &err), IP_ERR_UNSUPPORTED);
+    CHECK_EQ(strncmp(err.message, "spacing 1e-12", 13), 0);
 }
 
 /* The library refuses such a spacing where volumes come in and where brick files are made. */
-static void test_refused_by_the_library(const char *dir)
+static void test_refused_by_the_library(void)
 {
+    const char *dir = scratch_dir;
     char raw[4096], ibv[4096];
     ip_error err;
     ip_gen_params params = {sizeof(ip_gen_params), IP_FIELD_SPHERE, {6, 5, 4}, IP_UINT8, 0.0, 1};
@@ -73,26 +76,26 @@ static void test_refused_by_the_library(const char *dir)
     o.has_spacing = 1;
     o.spacing[0] = o.spacing[1] = o.spacing[2] = 1e-12;
     ip_input_desc desc;
-    CHECK(ip_input_describe(raw, &o, &desc, &err) == IP_ERR_UNSUPPORTED);
+    CHECK_EQ(ip_input_describe(raw, &o, &desc, &err), IP_ERR_UNSUPPORTED);
     CHECK_CONTAINS(err.message, "sphere_6x5x4_uint8.raw: spacing 1e-12 along x");
     o.spacing[0] = o.spacing[1] = 1;
     o.spacing[2] = 5000;
-    CHECK(ip_input_describe(raw, &o, &desc, &err) == IP_ERR_UNSUPPORTED);
+    CHECK_EQ(ip_input_describe(raw, &o, &desc, &err), IP_ERR_UNSUPPORTED);
     o.spacing[2] = 1000;
-    CHECK(ip_input_describe(raw, &o, &desc, &err) == IP_OK);
+    CHECK_EQ(ip_input_describe(raw, &o, &desc, &err), IP_OK);
     /* a description made by hand goes through the same check */
     REQUIRE(ip_input_describe(raw, NULL, &desc, &err) == IP_OK);
     desc.spacing[1] = 1e-12;
     ip_bricker_options options;
     ip_bricker_options_default(&options);
     options.threads = 1;
-    CHECK(ip_bricker_run(&desc, ibv, &options, NULL, &err) == IP_ERR_UNSUPPORTED);
+    CHECK_EQ(ip_bricker_run(&desc, ibv, &options, NULL, &err), IP_ERR_UNSUPPORTED);
     CHECK_CONTAINS(err.message, "along y");
     struct stat st;
-    CHECK(stat(ibv, &st) != 0);
+    CHECK_NE(stat(ibv, &st), 0);
     desc.spacing[1] = IP_SPACING_MIN;
     desc.spacing[0] = desc.spacing[2] = IP_SPACING_MIN;
-    CHECK(ip_bricker_run(&desc, ibv, &options, NULL, &err) == IP_OK);
+    CHECK_EQ(ip_bricker_run(&desc, ibv, &options, NULL, &err), IP_OK);
 }
 
 /* The depth range encloses the box at every accepted scale: the near plane stays in front of
@@ -132,11 +135,18 @@ static void test_depth_range_scales(void)
     check_depth_range_scales(box);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_bounds),
+    TEST_CASE(test_refused_by_the_library),
+    TEST_CASE(test_depth_range_scales),
+};
+
+static void make_scratch_dir(void)
 {
-    const char *dir = test_tmp_dir("test_spacing");
-    test_bounds();
-    test_refused_by_the_library(dir);
-    test_depth_range_scales();
-    return test_summary("test_spacing");
+    scratch_dir = test_tmp_dir("test_spacing");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_spacing", make_scratch_dir, NULL);
 }

@@ -15,6 +15,10 @@
 #include "isoprop/generate.h"
 #include "isoprop/store.h"
 
+/* What the cases share: the scratch folder and a brick file in it (make_file()). */
+static const char *scratch_dir;
+static char scratch_ibv[4200];
+
 /* Volume `p` written as STEM's raw file in dir and bricked with 4-cell bricks, 2-cell
  * sub-blocks, into dir/STEM.ibv (its path in ibv). */
 static void make_volume(const char *dir, const ip_gen_params *p, const char *stem, char *ibv,
@@ -99,8 +103,9 @@ static uint64_t first_payload(const ip_store *s, ip_brick_entry *e)
 /* docs/format.md: the padding before the summary section and a directory entry's reserved
  * bytes are zero; a file with anything else there is not one this reader wrote or knows. The
  * checksums are recomputed, so only the rule itself can reject these. */
-static void test_zero_fields(const char *dir, const char *ibv)
+static void test_zero_fields(void)
 {
+    const char *dir = scratch_dir, *ibv = scratch_ibv;
     size_t size;
     unsigned char *good = read_whole(ibv, &size);
     ip_layout l;
@@ -149,25 +154,27 @@ static void test_zero_fields(const char *dir, const char *ibv)
 
 /* A FIFO (or any non-regular file) is refused at once: opening it for reading would wait for a
  * writer forever. The test would hang, not fail, without the fix: ctest's timeout catches it. */
-static void test_not_regular(const char *dir)
+static void test_not_regular(void)
 {
+    const char *dir = scratch_dir;
     char fifo[4200];
     snprintf(fifo, sizeof fifo, "%s/fifo.ibv", dir);
     REQUIRE(mkfifo(fifo, 0600) == 0);
     ip_store *s = NULL;
     ip_error err;
-    CHECK(ip_store_open(fifo, &s, &err) == IP_ERR_IO);
+    CHECK_EQ(ip_store_open(fifo, &s, &err), IP_ERR_IO);
     CHECK_CONTAINS(err.message, fifo);
     CHECK_CONTAINS(err.message, "not a regular file");
-    CHECK(ip_store_open(dir, &s, &err) == IP_ERR_IO);
+    CHECK_EQ(ip_store_open(dir, &s, &err), IP_ERR_IO);
     CHECK_CONTAINS(err.message, "not a regular file");
     unlink(fifo);
 }
 
 /* The file shrinks after opening: reading a brick past the new end is an I/O error naming the
  * file, the brick and both sizes; bricks still inside the file read as before. */
-static void test_truncated_while_open(const char *dir, const char *ibv)
+static void test_truncated_while_open(void)
 {
+    const char *dir = scratch_dir, *ibv = scratch_ibv;
     char path[4200], cmd[9000];
     snprintf(path, sizeof path, "%s/shrinks.ibv", dir);
     snprintf(cmd, sizeof cmd, "cp '%s' '%s'", ibv, path);
@@ -192,8 +199,8 @@ static void test_truncated_while_open(const char *dir, const char *ibv)
         }
     }
     REQUIRE(last != g0 && truncate(path, (off_t)cut) == 0);
-    CHECK(ip_store_read_brick(s, g0, dst, work, &err) == IP_OK);
-    CHECK(ip_store_read_brick(s, last, dst, work, &err) == IP_ERR_IO);
+    CHECK_EQ(ip_store_read_brick(s, g0, dst, work, &err), IP_OK);
+    CHECK_EQ(ip_store_read_brick(s, last, dst, work, &err), IP_ERR_IO);
     CHECK_CONTAINS(err.message, path);
     char brick[64], sizes[96];
     snprintf(brick, sizeof brick, "brick %llu ", (unsigned long long)last);
@@ -203,7 +210,7 @@ static void test_truncated_while_open(const char *dir, const char *ibv)
     CHECK_CONTAINS(err.message, "truncated or rewritten");
     /* to nothing at all: every payload is then past the end */
     REQUIRE(truncate(path, 0) == 0);
-    CHECK(ip_store_read_brick(s, g0, dst, work, &err) == IP_ERR_IO);
+    CHECK_EQ(ip_store_read_brick(s, g0, dst, work, &err), IP_ERR_IO);
     CHECK_CONTAINS(err.message, "ends at byte 0");
     ip_store_close(s);
     free(dst);
@@ -212,8 +219,9 @@ static void test_truncated_while_open(const char *dir, const char *ibv)
 
 /* Bytes rewritten in place after opening: the payload read is the payload checked, so the
  * brick fails its checksum; the summaries were read at open and stay as verified. */
-static void test_rewritten_while_open(const char *dir, const char *ibv)
+static void test_rewritten_while_open(void)
 {
+    const char *dir = scratch_dir, *ibv = scratch_ibv;
     char path[4200], cmd[9000];
     snprintf(path, sizeof path, "%s/rewritten.ibv", dir);
     snprintf(cmd, sizeof cmd, "cp '%s' '%s'", ibv, path);
@@ -233,22 +241,23 @@ static void test_rewritten_while_open(const char *dir, const char *ibv)
                                            5,    6,    7,    8,    9, 10, 11, 12};
     poke(path, e.offset, junk, e.stored_size < sizeof junk ? e.stored_size : sizeof junk);
     poke(path, l->summary_offset + 16, junk, sizeof junk); /* the summary too */
-    CHECK(ip_store_read_brick(s, g, dst, work, &err) == IP_ERR_CHECKSUM);
+    CHECK_EQ(ip_store_read_brick(s, g, dst, work, &err), IP_ERR_CHECKSUM);
     CHECK_CONTAINS(err.message, path);
     float after[2];
     ip_store_brick_range(s, g, after);
-    CHECK(memcmp(before, after, sizeof before) == 0);
+    CHECK_MEM_EQ(before, after, sizeof before);
     ip_store_close(s);
     /* reopened, the file fails as a whole: its summary no longer matches its checksum */
-    CHECK(ip_store_open(path, &s, &err) == IP_ERR_CHECKSUM);
+    CHECK_EQ(ip_store_open(path, &s, &err), IP_ERR_CHECKSUM);
     CHECK_CONTAINS(err.message, "summary section checksum");
     free(dst);
     free(work);
 }
 
 /* Reading every brick of a good file: each decodes, and its scratch is what the store says. */
-static void test_reads(const char *ibv)
+static void test_reads(void)
 {
+    const char *ibv = scratch_ibv;
     ip_store *s;
     ip_error err;
     REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
@@ -264,7 +273,7 @@ static void test_reads(const char *ibv)
     for (uint64_t g = 0; g < l->brick_count; g++)
         bad += ip_store_verify_brick(s, g, dst, work, &err) != IP_OK;
     CHECK_MSG(bad == 0, "%d bricks failed: %s", bad, err.message);
-    CHECK(ip_store_verify_octree(s, &err) == IP_OK);
+    CHECK_EQ(ip_store_verify_octree(s, &err), IP_OK);
     ip_store_close(s);
     free(dst);
     free(work);
@@ -273,14 +282,15 @@ static void test_reads(const char *ibv)
 /* The accessors without a test through the others: the path, the octree's node ranges (the
  * top node of each level covers all its bricks), ip_store_check_summary() on good and altered
  * samples, and the prefetch hint (which must leave reads unchanged). */
-static void test_accessors(const char *ibv)
+static void test_accessors(void)
 {
+    const char *ibv = scratch_ibv;
     ip_store *s;
     ip_error err;
     REQUIRE(ip_store_open(ibv, &s, &err) == IP_OK);
-    CHECK(strcmp(ip_store_path(s), ibv) == 0);
+    CHECK_STR_EQ(ip_store_path(s), ibv);
     const ip_layout *l = ip_store_layout(s);
-    CHECK(l->level_count > 1);
+    CHECK_GT(l->level_count, 1);
     for (uint32_t k = 0; k < l->level_count; k++) {
         const ip_level_layout *lv = &l->levels[k];
         float lo = INFINITY, hi = -INFINITY, r[2];
@@ -293,12 +303,14 @@ static void test_accessors(const char *ibv)
         const float *top = ip_store_node_range(s, k, lv->octree_depth, root);
         CHECK_MSG(top[0] == lo && top[1] == hi, "level %u: top node [%g, %g], bricks [%g, %g]", k,
                   top[0], top[1], lo, hi);
-        CHECK(lv->value_min == lo && lv->value_max == hi);
+        CHECK_EQ(lv->value_min, lo);
+        CHECK_EQ(lv->value_max, hi);
         /* depth 0 is the brick grid itself */
         const uint32_t last[3] = {lv->bricks[0] - 1, lv->bricks[1] - 1, lv->bricks[2] - 1};
         ip_store_brick_range(s, ip_brick_global_index(l, k, last), r);
         const float *node = ip_store_node_range(s, k, 0, last);
-        CHECK(node[0] == r[0] && node[1] == r[1]);
+        CHECK_EQ(node[0], r[0]);
+        CHECK_EQ(node[1], r[1]);
     }
     ip_brick_entry e;
     uint64_t g = first_payload(s, &e);
@@ -308,14 +320,14 @@ static void test_accessors(const char *ibv)
     REQUIRE(dst && work && l->type == IP_UINT16);
     ip_store_prefetch_brick(s, g);
     REQUIRE(ip_store_read_brick(s, g, dst, work, &err) == IP_OK);
-    CHECK(ip_store_check_summary(s, g, dst, &err) == IP_OK);
+    CHECK_EQ(ip_store_check_summary(s, g, dst, &err), IP_OK);
     float range[2];
     ip_store_brick_range(s, g, range);
     /* one sample past the brick's maximum, then one sample moved inside the range but into a
      * sub-block whose range it leaves */
     uint16_t kept = dst[count - 1];
     dst[count - 1] = (uint16_t)(range[1] < 65535 ? range[1] + 1 : 0);
-    CHECK(ip_store_check_summary(s, g, dst, &err) == IP_ERR_CORRUPT);
+    CHECK_EQ(ip_store_check_summary(s, g, dst, &err), IP_ERR_CORRUPT);
     CHECK_CONTAINS(err.message, ibv);
     CHECK_CONTAINS(err.message, "samples disagree with the summary");
     dst[count - 1] = kept;
@@ -323,10 +335,10 @@ static void test_accessors(const char *ibv)
     const float *sub = ip_store_subblock_ranges(s, g);
     REQUIRE(sub[0] > range[0] || sub[1] < range[1]);
     dst[0] = (uint16_t)(sub[0] > range[0] ? range[0] : range[1]);
-    CHECK(ip_store_check_summary(s, g, dst, &err) == IP_ERR_CORRUPT);
+    CHECK_EQ(ip_store_check_summary(s, g, dst, &err), IP_ERR_CORRUPT);
     CHECK_CONTAINS(err.message, "samples disagree with the summary");
     REQUIRE(ip_store_read_brick(s, g, dst, work, &err) == IP_OK);
-    CHECK(ip_store_check_summary(s, g, dst, &err) == IP_OK);
+    CHECK_EQ(ip_store_check_summary(s, g, dst, &err), IP_OK);
     ip_store_close(s);
     free(dst);
     free(work);
@@ -341,8 +353,9 @@ static void make_phantom(const char *dir, const char *name, char *ibv, size_t si
 
 /* The sub-block ranges as the store holds them (those of uniform bricks shared by value) are
  * the file's, bit for bit, for every brick; the store holds less than the summary section. */
-static void test_compact_summaries(const char *dir)
+static void test_compact_summaries(void)
 {
+    const char *dir = scratch_dir;
     char ibv[4400];
     ip_error err;
     make_phantom(dir, "phantom", ibv, sizeof ibv);
@@ -368,9 +381,11 @@ static void test_compact_summaries(const char *dir)
             mismatches += a != b;
         }
     }
-    CHECK(constant > 0 && constant < l->brick_count); /* both kinds are exercised */
-    CHECK(mismatches == 0);
-    CHECK(ip_store_summary_memory(s) > 0 && ip_store_summary_memory(s) < l->summary_size);
+    CHECK_GT(constant, 0);
+    CHECK_LT(constant, l->brick_count); /* both kinds are exercised */
+    CHECK_EQ(mismatches, 0);
+    CHECK_GT(ip_store_summary_memory(s), 0);
+    CHECK_LT(ip_store_summary_memory(s), l->summary_size);
     ip_store_close(s);
     free(file);
 }
@@ -379,8 +394,9 @@ static void test_compact_summaries(const char *dir)
  * a payload brick once the kernel has dropped the file's pages (unless the file system keeps
  * files in memory), 1 for a constant brick whatever the page cache holds; -1 only where the
  * kernel cannot tell, and then throughout. */
-static void test_in_memory(const char *dir)
+static void test_in_memory(void)
 {
+    const char *dir = scratch_dir;
     char ibv[4400];
     ip_error err;
     make_phantom(dir, "in_memory", ibv, sizeof ibv);
@@ -425,22 +441,28 @@ static void test_in_memory(const char *dir)
     }
     close(fd);
     CHECK_MSG(memory_fs ? in == 1 : in == 0, "brick %llu: %d", (unsigned long long)g, in);
-    CHECK(ip_store_brick_in_memory(s, constant) == 1);
+    CHECK_EQ(ip_store_brick_in_memory(s, constant), 1);
     ip_store_close(s);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_reads),
+    TEST_CASE(test_accessors),
+    TEST_CASE(test_zero_fields),
+    TEST_CASE(test_not_regular),
+    TEST_CASE(test_truncated_while_open),
+    TEST_CASE(test_rewritten_while_open),
+    TEST_CASE(test_compact_summaries),
+    TEST_CASE(test_in_memory),
+};
+
+static void make_scratch_file(void)
 {
-    const char *dir = test_tmp_dir("test_store");
-    char ibv[4200];
-    make_file(dir, ibv, sizeof ibv);
-    test_reads(ibv);
-    test_accessors(ibv);
-    test_zero_fields(dir, ibv);
-    test_not_regular(dir);
-    test_truncated_while_open(dir, ibv);
-    test_rewritten_while_open(dir, ibv);
-    test_compact_summaries(dir);
-    test_in_memory(dir);
-    return test_summary("test_store");
+    scratch_dir = test_tmp_dir("test_store");
+    make_file(scratch_dir, scratch_ibv, sizeof scratch_ibv);
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_store", make_scratch_file, NULL);
 }

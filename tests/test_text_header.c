@@ -83,17 +83,23 @@ static void test_dispatch(void)
     toy_header h;
     ip_error err;
     fresh(&h, &nocase_keys);
-    CHECK(dispatch(&h, &nocase_keys, "sizes", "7 5 3", NULL, &err) == IP_OK);
-    CHECK(h.sizes_count == 3 && h.sizes[0] == 7 && h.sizes[2] == 3);
-    CHECK(dispatch(&h, &nocase_keys, "SPACING", "0.5 1 2.25", NULL, &err) == IP_OK);
-    CHECK(h.spacing_count == 3 && h.spacing[0] == 0.5 && h.spacing[2] == 2.25);
-    CHECK(dispatch(&h, &nocase_keys, "Unknown", "whatever", NULL, &err) == IP_OK); /* ignored */
-    CHECK(dispatch(&h, &nocase_keys, "Custom", "fine", NULL, &err) == IP_OK);
-    CHECK(h.custom_calls == 1 && strcmp(h.custom_key, "Custom") == 0);
+    CHECK_EQ(dispatch(&h, &nocase_keys, "sizes", "7 5 3", NULL, &err), IP_OK);
+    CHECK_EQ(h.sizes_count, 3);
+    CHECK_EQ(h.sizes[0], 7);
+    CHECK_EQ(h.sizes[2], 3);
+    CHECK_EQ(dispatch(&h, &nocase_keys, "SPACING", "0.5 1 2.25", NULL, &err), IP_OK);
+    CHECK_EQ(h.spacing_count, 3);
+    CHECK_EQ(h.spacing[0], 0.5);
+    CHECK_EQ(h.spacing[2], 2.25);
+    CHECK_EQ(dispatch(&h, &nocase_keys, "Unknown", "whatever", NULL, &err), IP_OK); /* ignored */
+    CHECK_EQ(dispatch(&h, &nocase_keys, "Custom", "fine", NULL, &err), IP_OK);
+    CHECK_EQ(h.custom_calls, 1);
+    CHECK_STR_EQ(h.custom_key, "Custom");
     dispatch_fails(&nocase_keys, "custom", "bad", "toy.hdr: line 12: bad Custom 'bad': not good");
     /* counts past 3 are reported, only 3 stored */
-    CHECK(dispatch(&h, &nocase_keys, "Sizes", "1 2 3 4", NULL, &err) == IP_OK);
-    CHECK(h.sizes_count == 4 && h.sizes[2] == 3);
+    CHECK_EQ(dispatch(&h, &nocase_keys, "Sizes", "1 2 3 4", NULL, &err), IP_OK);
+    CHECK_EQ(h.sizes_count, 4);
+    CHECK_EQ(h.sizes[2], 3);
     dispatch_fails(&nocase_keys, "Sizes", "1 x 3",
                    "toy.hdr: line 12: bad Sizes '1 x 3': not whole numbers");
     dispatch_fails(&nocase_keys, "Spacing", "1 nope", "bad Spacing '1 nope': not numbers");
@@ -103,18 +109,19 @@ static void test_dispatch(void)
     dispatch_fails(&field_keys, "Other name", "",
                    "toy.hdr: line 12: field 'Other name' has no value");
     /* case matters where the table says so */
-    CHECK(dispatch(&h, &field_keys, "custom", "bad", NULL, &err) == IP_OK && h.custom_calls == 0);
+    CHECK_EQ(dispatch(&h, &field_keys, "custom", "bad", NULL, &err), IP_OK);
+    CHECK_EQ(h.custom_calls, 0);
 
     /* a key that an override replaces is not read at all, even when its value is bad */
     ip_input_overrides o;
     memset(&o, 0, sizeof o);
     o.has_dims = 1;
     o.has_endian = 1;
-    CHECK(dispatch(&h, &field_keys, "Sizes", "not numbers", &o, &err) == IP_OK);
-    CHECK(h.sizes_count == -1);
-    CHECK(dispatch(&h, &field_keys, "Other name", "bad", &o, &err) == IP_OK);
-    CHECK(h.custom_calls == 0);
-    CHECK(dispatch(&h, &field_keys, "Custom", "bad", &o, &err) == IP_ERR_INPUT);
+    CHECK_EQ(dispatch(&h, &field_keys, "Sizes", "not numbers", &o, &err), IP_OK);
+    CHECK_EQ(h.sizes_count, -1);
+    CHECK_EQ(dispatch(&h, &field_keys, "Other name", "bad", &o, &err), IP_OK);
+    CHECK_EQ(h.custom_calls, 0);
+    CHECK_EQ(dispatch(&h, &field_keys, "Custom", "bad", &o, &err), IP_ERR_INPUT);
 }
 
 static void test_shared_parsers(void)
@@ -122,20 +129,22 @@ static void test_shared_parsers(void)
     toy_header h;
     ip_error err;
     fresh(&h, &nocase_keys);
-    CHECK(dispatch(&h, &nocase_keys, "Type", "MET_USHORT", NULL, &err) == IP_OK);
-    CHECK(h.has_type == 1 && h.type == IP_UINT16);
+    CHECK_EQ(dispatch(&h, &nocase_keys, "Type", "MET_USHORT", NULL, &err), IP_OK);
+    CHECK_EQ(h.has_type, 1);
+    CHECK_EQ(h.type, IP_UINT16);
     fresh(&h, &nocase_keys);
-    CHECK(dispatch(&h, &nocase_keys, "Type", "ushort", NULL, &err) == IP_ERR_INPUT); /* NRRD's */
-    CHECK(h.has_type == 0);
+    CHECK_EQ(dispatch(&h, &nocase_keys, "Type", "ushort", NULL, &err), IP_ERR_INPUT); /* NRRD's */
+    CHECK_EQ(h.has_type, 0);
     CHECK_CONTAINS(err.message, "toy.hdr: unsupported Toy Type 'ushort' (supported: MET_UCHAR, "
                                 "MET_USHORT, MET_SHORT, MET_FLOAT)");
     fresh(&h, &field_keys);
-    CHECK(dispatch(&h, &field_keys, "Type", "unsigned short int", NULL, &err) == IP_OK);
-    CHECK(h.type == IP_UINT16);
+    CHECK_EQ(dispatch(&h, &field_keys, "Type", "unsigned short int", NULL, &err), IP_OK);
+    CHECK_EQ(h.type, IP_UINT16);
     dispatch_fails(&field_keys, "Type", "float32",
                    "unsupported TOY Type 'float32' (supported: uint8, uint16, int16, float)");
 
-    CHECK(dispatch(&h, &field_keys, "Dims", "3", NULL, &err) == IP_OK && h.dims == 3);
+    CHECK_EQ(dispatch(&h, &field_keys, "Dims", "3", NULL, &err), IP_OK);
+    CHECK_EQ(h.dims, 3);
     dispatch_fails(&field_keys, "Dims", "0", "bad Dims '0': not a positive whole number");
     dispatch_fails(&field_keys, "Dims", "2", "toy.hdr: TOY Dims 2 is not supported (need 3)");
     dispatch_fails(&nocase_keys, "Dims", "4", "toy.hdr: Dims 4 is not supported (need 3)");
@@ -148,17 +157,17 @@ static void test_checks(void)
     ip_input_overrides o;
     memset(&o, 0, sizeof o);
     fresh(&h, &nocase_keys);
-    CHECK(ip__text_check_dims(&h, 0, "Dims", -1, "Sizes", NULL, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip__text_check_dims(&h, 0, "Dims", -1, "Sizes", NULL, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "toy.hdr: missing key 'Dims'");
-    CHECK(ip__text_check_dims(&h, 3, "Dims", -1, "Sizes", NULL, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip__text_check_dims(&h, 3, "Dims", -1, "Sizes", NULL, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "toy.hdr: missing key 'Sizes'");
-    CHECK(ip__text_check_dims(&h, 3, "Dims", 2, "Sizes", NULL, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip__text_check_dims(&h, 3, "Dims", 2, "Sizes", NULL, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "toy.hdr: Sizes has 2 values, Dims is 3");
-    CHECK(ip__text_check_dims(&h, 3, "Dims", 3, "Sizes", NULL, &err) == IP_OK);
+    CHECK_EQ(ip__text_check_dims(&h, 3, "Dims", 3, "Sizes", NULL, &err), IP_OK);
     o.has_dims = 1;
-    CHECK(ip__text_check_dims(&h, 0, "Dims", -1, "Sizes", &o, &err) == IP_OK);
+    CHECK_EQ(ip__text_check_dims(&h, 0, "Dims", -1, "Sizes", &o, &err), IP_OK);
     fresh(&h, &field_keys);
-    CHECK(ip__text_missing(&h, "encoding", &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip__text_missing(&h, "encoding", &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "toy.hdr: missing field 'encoding'");
 
     ip_input_desc desc;
@@ -167,10 +176,15 @@ static void test_checks(void)
     memset(&found, 0, sizeof found);
     const uint64_t sizes[3] = {4, 5, 6};
     ip__text_found_layout(0, IP_INT16, 2, sizes, &desc, &found);
-    CHECK(!found.has_type && !found.has_dims && desc.type == IP_UINT8);
+    CHECK(!found.has_type);
+    CHECK(!found.has_dims);
+    CHECK_EQ(desc.type, IP_UINT8);
     ip__text_found_layout(1, IP_INT16, 3, sizes, &desc, &found);
-    CHECK(found.has_type && desc.type == IP_INT16);
-    CHECK(found.has_dims && found.dims[0] == 4 && found.dims[2] == 6);
+    CHECK(found.has_type);
+    CHECK_EQ(desc.type, IP_INT16);
+    CHECK(found.has_dims);
+    CHECK_EQ(found.dims[0], 4);
+    CHECK_EQ(found.dims[2], 6);
 }
 
 /* A whole header through ip__text_read_header: "key value" lines up to "end". */
@@ -232,42 +246,48 @@ static void test_read_header(void)
     ip_error err;
     memset(&desc, 0, sizeof desc);
     memset(&found, 0, sizeof found);
-    CHECK(ip__text_read_header(&toy_format, path, NULL, &desc, &found, &err) == IP_OK);
-    CHECK(found.has_dims && found.dims[0] == 8 && found.dims[1] == 9 && found.dims[2] == 10);
-    CHECK(found.has_type && desc.type == IP_INT16);
-    CHECK(desc.data_offset == strlen(text) - strlen("DATA")); /* the bytes the header took */
+    CHECK_EQ(ip__text_read_header(&toy_format, path, NULL, &desc, &found, &err), IP_OK);
+    CHECK(found.has_dims);
+    CHECK_EQ(found.dims[0], 8);
+    CHECK_EQ(found.dims[1], 9);
+    CHECK_EQ(found.dims[2], 10);
+    CHECK(found.has_type);
+    CHECK_EQ(desc.type, IP_INT16);
+    CHECK_EQ(desc.data_offset, strlen(text) - strlen("DATA")); /* the bytes the header took */
 
     f = fopen(path, "wb");
     REQUIRE(f && fputs("dims 3\nsizes 8 9\nend\n", f) >= 0 && fclose(f) == 0);
-    CHECK(ip__text_read_header(&toy_format, path, NULL, &desc, &found, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip__text_read_header(&toy_format, path, NULL, &desc, &found, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "toy.hdr: Sizes has 2 values, Dims is 3");
     f = fopen(path, "wb");
     REQUIRE(f && fputs("dims 3\nsizes 8 9 1\ntype double\nend\n", f) >= 0 && fclose(f) == 0);
-    CHECK(ip__text_read_header(&toy_format, path, NULL, &desc, &found, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip__text_read_header(&toy_format, path, NULL, &desc, &found, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "unsupported Toy Type 'double'");
 
     snprintf(path, sizeof path, "%s/absent.hdr", dir);
-    CHECK(ip__text_read_header(&toy_format, path, NULL, &desc, &found, &err) == IP_ERR_IO);
+    CHECK_EQ(ip__text_read_header(&toy_format, path, NULL, &desc, &found, &err), IP_ERR_IO);
     CHECK_CONTAINS(err.message, "absent.hdr: cannot open");
 }
 
 static void test_type_names(void)
 {
     ip_type t = IP_UINT8;
-    CHECK(strcmp(ip_type_name(IP_UINT8), "uint8") == 0);
-    CHECK(strcmp(ip_type_name(IP_FLOAT32), "float32") == 0);
-    CHECK(strcmp(ip_type_name((ip_type)9), "unknown") == 0);
+    CHECK_STR_EQ(ip_type_name(IP_UINT8), "uint8");
+    CHECK_STR_EQ(ip_type_name(IP_FLOAT32), "float32");
+    CHECK_STR_EQ(ip_type_name((ip_type)9), "unknown");
     /* each spelling set accepts its own names only; ip_type_parse accepts them all */
-    CHECK(ip__type_from_name("float", IP_TYPE_SPELLING_NRRD, &t) == IP_OK && t == IP_FLOAT32);
-    CHECK(ip__type_from_name("float32", IP_TYPE_SPELLING_NRRD, &t) == IP_ERR_ARGUMENT);
-    CHECK(ip__type_from_name("met_short", IP_TYPE_SPELLING_METAIMAGE, &t) == IP_OK &&
-          t == IP_INT16);
-    CHECK(ip__type_from_name("short", IP_TYPE_SPELLING_METAIMAGE, &t) == IP_ERR_ARGUMENT);
-    CHECK(ip__type_from_name("u16", IP_TYPE_SPELLING_OTHER, &t) == IP_OK && t == IP_UINT16);
-    CHECK(ip__type_from_name(NULL, IP_TYPE_SPELLING_ALL, &t) == IP_ERR_ARGUMENT);
+    CHECK_EQ(ip__type_from_name("float", IP_TYPE_SPELLING_NRRD, &t), IP_OK);
+    CHECK_EQ(t, IP_FLOAT32);
+    CHECK_EQ(ip__type_from_name("float32", IP_TYPE_SPELLING_NRRD, &t), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip__type_from_name("met_short", IP_TYPE_SPELLING_METAIMAGE, &t), IP_OK);
+    CHECK_EQ(t, IP_INT16);
+    CHECK_EQ(ip__type_from_name("short", IP_TYPE_SPELLING_METAIMAGE, &t), IP_ERR_ARGUMENT);
+    CHECK_EQ(ip__type_from_name("u16", IP_TYPE_SPELLING_OTHER, &t), IP_OK);
+    CHECK_EQ(t, IP_UINT16);
+    CHECK_EQ(ip__type_from_name(NULL, IP_TYPE_SPELLING_ALL, &t), IP_ERR_ARGUMENT);
     t = IP_UINT8;
-    CHECK(ip__type_from_name("uint64", IP_TYPE_SPELLING_ALL, &t) == IP_ERR_ARGUMENT);
-    CHECK(t == IP_UINT8);
+    CHECK_EQ(ip__type_from_name("uint64", IP_TYPE_SPELLING_ALL, &t), IP_ERR_ARGUMENT);
+    CHECK_EQ(t, IP_UINT8);
     const char *every[] = {"uint8",     "uchar", "unsigned char",    "uint8_t",
                            "MET_UCHAR", "u8",    "signed short int", "i16",
                            "MET_FLOAT", "f32",   "float32"};
@@ -277,21 +297,21 @@ static void test_type_names(void)
     CHECK(all);
     char names[64];
     ip__type_names(IP_TYPE_SPELLING_NRRD, names, sizeof names);
-    CHECK(strcmp(names, "uint8, uint16, int16, float") == 0);
+    CHECK_STR_EQ(names, "uint8, uint16, int16, float");
     ip__type_names(IP_TYPE_SPELLING_METAIMAGE, names, sizeof names);
-    CHECK(strcmp(names, "MET_UCHAR, MET_USHORT, MET_SHORT, MET_FLOAT") == 0);
+    CHECK_STR_EQ(names, "MET_UCHAR, MET_USHORT, MET_SHORT, MET_FLOAT");
     ip__type_names(IP_TYPE_SPELLING_CANONICAL, names, sizeof names);
-    CHECK(strcmp(names, "uint8, uint16, int16, float32") == 0);
+    CHECK_STR_EQ(names, "uint8, uint16, int16, float32");
     ip__type_names(IP_TYPE_SPELLING_NRRD, names, 10); /* cut short, terminated */
-    CHECK(strlen(names) < 10);
+    CHECK_LT(strlen(names), 10);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_dispatch),    TEST_CASE(test_shared_parsers), TEST_CASE(test_checks),
+    TEST_CASE(test_read_header), TEST_CASE(test_type_names),
+};
+
+int main(int argc, char **argv)
 {
-    test_dispatch();
-    test_shared_parsers();
-    test_checks();
-    test_read_header();
-    test_type_names();
-    return test_summary("test_text_header");
+    return RUN_CASES(argc, argv, cases, "test_text_header");
 }

@@ -46,7 +46,7 @@ static void check_reads_as(const char *path, ip_type type, const uint32_t dims[3
     CHECK_MSG(st == IP_OK, "%s: %s", path, err.message);
     if (st != IP_OK)
         return;
-    CHECK(d.encoding == IP_ENCODING_TIFF);
+    CHECK_EQ(d.encoding, IP_ENCODING_TIFF);
     CHECK_MSG(d.type == type, "%s: type %s", path, ip_type_name(d.type));
     CHECK_MSG(d.dims[0] == dims[0] && d.dims[1] == dims[1] && d.dims[2] == dims[2],
               "%s: dims %ux%ux%u", path, d.dims[0], d.dims[1], d.dims[2]);
@@ -122,27 +122,32 @@ static void test_imagej_spacing(void)
     ip_input_desc d;
     ip_error err;
     REQUIRE(ip_input_describe(path, NULL, &d, &err) == IP_OK);
-    CHECK(d.spacing[0] == 0.25 && d.spacing[1] == 0.25 && d.spacing[2] == 2.5);
+    CHECK_EQ(d.spacing[0], 0.25);
+    CHECK_EQ(d.spacing[1], 0.25);
+    CHECK_EQ(d.spacing[2], 2.5);
     ip_input_overrides o = {0};
     o.has_spacing = 1;
     o.spacing[0] = o.spacing[1] = o.spacing[2] = 3;
     REQUIRE(ip_input_describe(path, &o, &d, &err) == IP_OK);
-    CHECK(d.spacing[0] == 3 && d.spacing[2] == 3);
+    CHECK_EQ(d.spacing[0], 3);
+    CHECK_EQ(d.spacing[2], 3);
     /* dims and type may be repeated, not changed */
     ip_input_overrides same = {0};
     same.has_dims = same.has_type = 1;
     memcpy(same.dims, dims, sizeof same.dims);
     same.type = IP_UINT16;
-    CHECK(ip_input_describe(path, &same, &d, &err) == IP_OK);
+    CHECK_EQ(ip_input_describe(path, &same, &d, &err), IP_OK);
     same.type = IP_UINT8;
-    CHECK(ip_input_describe(path, &same, &d, &err) == IP_ERR_INPUT);
+    CHECK_EQ(ip_input_describe(path, &same, &d, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "cannot be overridden");
     /* a plain TIFF has no spacing: 1,1,1 */
     style.imagej_spacing = 0;
     REQUIRE(write_tiff(in_scratch(path, "plain.tif"), IP_UINT16, dims[0], dims[1], dims[2], samples,
                        &style) == 0);
     REQUIRE(ip_input_describe(path, NULL, &d, &err) == IP_OK);
-    CHECK(d.spacing[0] == 1 && d.spacing[1] == 1 && d.spacing[2] == 1);
+    CHECK_EQ(d.spacing[0], 1);
+    CHECK_EQ(d.spacing[1], 1);
+    CHECK_EQ(d.spacing[2], 1);
     free(samples);
 }
 
@@ -260,19 +265,23 @@ static void test_bad_files(void)
     REQUIRE(ip_input_describe(path, NULL, &d, &err) == IP_OK);
     REQUIRE(truncate(path, 8 + 2 * 8 * 6 + 20) == 0);
     void *got = read_volume(&d, &err);
-    CHECK(got == NULL);
+    CHECK_EQ(got, NULL);
     CHECK_CONTAINS(err.message, "cut.tif");
     free(got);
     free(samples);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_types_and_layouts), TEST_CASE(test_folder_order), TEST_CASE(test_imagej_spacing),
+    TEST_CASE(test_bad_folders),       TEST_CASE(test_bad_files),
+};
+
+static void make_scratch_dir(void)
 {
     snprintf(scratch, sizeof scratch, "%s", test_tmp_dir("test_tiff"));
-    test_types_and_layouts();
-    test_folder_order();
-    test_imagej_spacing();
-    test_bad_folders();
-    test_bad_files();
-    return test_summary("test_tiff");
+}
+
+int main(int argc, char **argv)
+{
+    return RUN_CASES_WITH(argc, argv, cases, "test_tiff", make_scratch_dir, NULL);
 }

@@ -127,13 +127,15 @@ static void check_signal_after_complete(void)
     CHECK(exists("c2"));
 }
 
-int main(void)
+static void make_scratch_dir(void)
 {
     snprintf(dir, sizeof dir, "%s", test_tmp_dir("test_tool_outputs"));
-    check_failed_run();
-    check_complete_run();
-    check_made_folder();
-    check_signal_before_complete();
-    check_signal_after_complete();
-    return test_summary("test_tool_outputs");
+}
+
+int main(int argc, char **argv)
+{
+    static const test_case cases[] = {
+        TEST_CASE(check_failed_run), TEST_CASE(check_complete_run), TEST_CASE(check_made_folder),
+        TEST_CASE(check_signal_before_complete), TEST_CASE(check_signal_after_complete)};
+    return RUN_CASES_WITH(argc, argv, cases, "test_tool_outputs", make_scratch_dir, NULL);
 }

@@ -23,22 +23,37 @@ static void test_values(void)
     const double x[3] = {1, 0, 0}, y[3] = {0, 1, 0};
     double z[3], d[3];
     ip__vec3_cross(x, y, z);
-    CHECK(z[0] == 0 && z[1] == 0 && z[2] == 1);
-    CHECK(ip__vec3_dot(x, y) == 0 && ip__vec3_dot(z, z) == 1);
+    CHECK_EQ(z[0], 0);
+    CHECK_EQ(z[1], 0);
+    CHECK_EQ(z[2], 1);
+    CHECK_EQ(ip__vec3_dot(x, y), 0);
+    CHECK_EQ(ip__vec3_dot(z, z), 1);
     const double a[3] = {4, 6, 3}, b[3] = {1, 2, 3};
     ip__vec3_sub(a, b, d);
-    CHECK(d[0] == 3 && d[1] == 4 && d[2] == 0);
-    CHECK(ip__vec3_length(d) == 5);
-    CHECK(ip__vec3_normalize(d) == 5 && d[0] == 0.6 && d[1] == 0.8 && d[2] == 0);
+    CHECK_EQ(d[0], 3);
+    CHECK_EQ(d[1], 4);
+    CHECK_EQ(d[2], 0);
+    CHECK_EQ(ip__vec3_length(d), 5);
+    CHECK_EQ(ip__vec3_normalize(d), 5);
+    CHECK_EQ(d[0], 0.6);
+    CHECK_EQ(d[1], 0.8);
+    CHECK_EQ(d[2], 0);
     double zero[3] = {0, 0, 0};
-    CHECK(ip__vec3_normalize(zero) == 0 && zero[0] == 0 && zero[1] == 0 && zero[2] == 0);
+    CHECK_EQ(ip__vec3_normalize(zero), 0);
+    CHECK_EQ(zero[0], 0);
+    CHECK_EQ(zero[1], 0);
+    CHECK_EQ(zero[2], 0);
     /* out may alias an input */
     double u[3] = {1, 0, 0};
     ip__vec3_cross(u, y, u);
-    CHECK(u[0] == 0 && u[1] == 0 && u[2] == 1);
+    CHECK_EQ(u[0], 0);
+    CHECK_EQ(u[1], 0);
+    CHECK_EQ(u[2], 1);
     double s[3] = {5, 5, 5};
     ip__vec3_sub(s, b, s);
-    CHECK(s[0] == 4 && s[1] == 3 && s[2] == 2);
+    CHECK_EQ(s[0], 4);
+    CHECK_EQ(s[1], 3);
+    CHECK_EQ(s[2], 2);
 }
 
 static void test_same_bits(void)
@@ -67,9 +82,12 @@ static void test_same_bits(void)
     CHECK(ok);
 }
 
-int main(void)
+static const test_case cases[] = {
+    TEST_CASE(test_values),
+    TEST_CASE(test_same_bits),
+};
+
+int main(int argc, char **argv)
 {
-    test_values();
-    test_same_bits();
-    return test_summary("test_vec3");
+    return RUN_CASES(argc, argv, cases, "test_vec3");
 }

@@ -4,6 +4,7 @@
 
 #include "array.h"
 #include "depth_queue.h"
+#include "internal.h"
 
 #define NONE UINT32_MAX
 
@@ -26,6 +27,7 @@ void ip__depth_queue_free(ip_depth_queue *q)
 
 void ip__depth_queue_start(ip_depth_queue *q, double around, double width)
 {
+    IP_ASSERT(width > 0);
     for (uint32_t b = q->first; b <= q->last && b < IP_DEPTH_BUCKETS; b++)
         q->head[b] = NONE; /* what a propagation that stopped early left */
     q->first = IP_DEPTH_BUCKETS;
@@ -41,6 +43,7 @@ void ip__depth_queue_start(ip_depth_queue *q, double around, double width)
 static uint32_t bucket_of(const ip_depth_queue *q, double depth)
 {
     double b = (depth - q->base) * q->scale;
+    IP_ASSERT(b == b); /* not a NaN: a bucket, near or far */
     return b <= 0 ? 0 : b >= IP_DEPTH_BUCKETS - 1 ? IP_DEPTH_BUCKETS - 1 : (uint32_t)b;
 }
 
@@ -64,6 +67,7 @@ ip_status ip__depth_queue_push(ip_depth_queue *q, const ip_queued_cell *cell, do
     if (s == NONE)
         return IP_ERR_NOMEM;
     uint32_t b = bucket_of(q, depth);
+    IP_ASSERT(s < q->used && b < IP_DEPTH_BUCKETS);
     q->slots[s] = (ip_depth_slot){*cell, q->head[b]};
     q->head[b] = s;
     q->first = b < q->first ? b : q->first;
@@ -76,6 +80,7 @@ ip_status ip__depth_queue_push(ip_depth_queue *q, const ip_queued_cell *cell, do
 static void take(ip_depth_queue *q, uint32_t b, ip_queued_cell *cell)
 {
     uint32_t s = q->head[b];
+    IP_ASSERT(q->count > 0 && q->first <= b && b <= q->last && s < q->used);
     *cell = q->slots[s].cell;
     q->head[b] = q->slots[s].next;
     q->slots[s].next = q->free;
@@ -87,9 +92,11 @@ int ip__depth_queue_pop(ip_depth_queue *q, ip_queued_cell *cell)
 {
     if (q->count == 0)
         return 0;
-    while (q->head[q->first] == NONE)
+    while (q->head[q->first] == NONE) {
+        IP_ASSERT(q->first < q->last); /* a cell is queued: some bucket up to last holds it */
         q->first++;
-    take(q, q->first, cell);
+    }
+    take(q, q->first, cell); /* the nearest: no bucket before first holds a cell */
     return 1;
 }
 
@@ -97,8 +104,10 @@ unsigned ip__depth_queue_take_far(ip_depth_queue *q, ip_queued_cell *out, unsign
 {
     unsigned n = 0;
     while (n < max && q->count > 0) {
-        while (q->head[q->last] == NONE)
+        while (q->head[q->last] == NONE) {
+            IP_ASSERT(q->last > q->first); /* a cell is queued: some bucket from first holds it */
             q->last--;
+        }
         take(q, q->last, &out[n++]);
     }
     return n;

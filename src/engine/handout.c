@@ -34,6 +34,9 @@ static int claim_range(ip_engine *e, ip_engine_worker *w)
                 first = i;
         int found = e->leftover_count > 0;
         if (found) {
+            /* an unwalked rest of a range within the order (ip__engine_leave_range()) */
+            IP_ASSERT(e->leftovers[first].start < e->leftovers[first].end &&
+                      e->leftovers[first].end <= e->order_cells);
             ip__ray_order_seek(&w->order, e->leftovers[first].start);
             w->range_end = e->leftovers[first].end;
             e->leftovers[first] = e->leftovers[--e->leftover_count];
@@ -58,6 +61,7 @@ static int claim_range(ip_engine *e, ip_engine_worker *w)
     } while (!atomic_compare_exchange_weak(&e->next_position, &start, start + length));
     ip__ray_order_seek(&w->order, start);
     w->range_end = e->order_cells - start < length ? e->order_cells : start + length;
+    IP_ASSERT(start < w->range_end && w->range_end <= e->order_cells);
     return w->holding = 1;
 }
 
@@ -65,7 +69,9 @@ void ip__engine_leave_range(ip_engine *e, ip_engine_worker *w)
 {
     uint64_t position = ip__ray_order_position(&w->order);
     if (w->holding && position < w->range_end) {
+        IP_ASSERT(w->range_end <= e->order_cells);
         pthread_mutex_lock(&e->leftover_lock);
+        IP_ASSERT(e->leftover_count < e->threads); /* one range a worker at a time */
         e->leftovers[e->leftover_count++] = (ip_order_range){position, w->range_end};
         atomic_store(&e->leftovers_waiting, e->leftover_count);
         pthread_mutex_unlock(&e->leftover_lock);
@@ -106,6 +112,7 @@ uint64_t ip__engine_take_rays(ip_engine *e, ip_engine_worker *w, ip_order_ray *r
         } else
             w->holding = 0;
     }
+    IP_ASSERT(n <= RAY_ROOM);
     if (e->step_limited && n < want) /* the order ran out: give the rest of the share back */
         atomic_fetch_add(&e->step_rays_left, want - n);
     atomic_fetch_add(&e->rays_taken, n + retired);

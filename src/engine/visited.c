@@ -28,8 +28,11 @@ ip_status ip__visited_init(ip_visited *v, const ip_layout *layout)
 void ip__visited_clear(ip_visited *v)
 {
     uint64_t n = atomic_load(&v->holder_count);
+    IP_ASSERT(n == 0 || n <= v->layout->brick_count);
     for (uint64_t i = 0; i < n; i++) {
         uint64_t g = v->holders[i];
+        /* each holder once, with its bitmap: freed here, so a second listing would find none */
+        IP_ASSERT(g < v->layout->brick_count && atomic_load(&v->bitmaps[g]) != NULL);
         free(atomic_load(&v->bitmaps[g]));
         atomic_store(&v->bitmaps[g], NULL);
     }
@@ -60,6 +63,7 @@ static uint64_t brick_of(const ip_visited *v, uint32_t level, const uint32_t cel
 /* Brick g's bitmap, allocated and published first if it has none; NULL when out of memory. */
 static atomic_uint_fast64_t *brick_bitmap(ip_visited *v, uint64_t g)
 {
+    IP_ASSERT(g < v->layout->brick_count);
     atomic_uint_fast64_t *m = atomic_load_explicit(&v->bitmaps[g], memory_order_acquire);
     if (!m) {
         atomic_uint_fast64_t *fresh = calloc(v->words_per_brick, sizeof *fresh);
@@ -68,7 +72,9 @@ static atomic_uint_fast64_t *brick_bitmap(ip_visited *v, uint64_t g)
         atomic_uint_fast64_t *expected = NULL;
         if (atomic_compare_exchange_strong(&v->bitmaps[g], &expected, fresh)) {
             m = fresh;
-            v->holders[atomic_fetch_add(&v->holder_count, 1)] = g; /* each brick once */
+            uint64_t holder = atomic_fetch_add(&v->holder_count, 1);
+            IP_ASSERT(holder < v->layout->brick_count); /* each brick once: room for all */
+            v->holders[holder] = g;
         } else {
             free(fresh); /* another thread published first */
             m = expected;
@@ -85,6 +91,8 @@ int ip__visited_mark(ip_visited *v, uint32_t level, const uint32_t cell[3])
 
 int ip__visited_mark_part(ip_visited *v, uint64_t brick, uint64_t part)
 {
+    uint64_t edge = v->layout->brick_edge, groups = (edge + IP_CELL_GROUP - 1) / IP_CELL_GROUP;
+    IP_ASSERT(part < v->subblocks_per_brick + groups * groups * groups); /* its bit's room */
     atomic_uint_fast64_t *m = brick_bitmap(v, brick);
     if (!m)
         return -1;

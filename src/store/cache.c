@@ -133,10 +133,48 @@ ip_status ip_cache_create(const ip_store *store, uint64_t budget_bytes, ip_cache
     return IP_OK;
 }
 
+#ifdef NDEBUG
+#define check_resident(c, at_rest) ((void)0)
+#else
+/* The resident set's invariants (IP_ASSERT), at the places that look at every resident entry
+ * anyway; evict_lock held, or no other thread (`at_rest`: no load in flight, nothing pinned,
+ * every entry resident or free). Each resident entry is where its resident_slot says, pinnable
+ * (pins >= 0) and in its brick's slot; the heap holds the resident entries, each once, in heap
+ * order, with none parked; the resident bytes are theirs, plus those of the loads in flight. */
+static void check_resident(const ip_cache *c, int at_rest)
+{
+    uint64_t bytes = 0;
+    for (uint64_t i = 0; i < c->resident_count; i++) {
+        const entry *e = c->resident[i];
+        uint64_t g = atomic_load(&e->brick);
+        IP_ASSERT(e->resident_slot == i);
+        IP_ASSERT(atomic_load(&e->pins) >= 0);
+        IP_ASSERT(!at_rest || atomic_load(&e->pins) == 0); /* ip_cache_destroy(): none pinned */
+        IP_ASSERT(g < c->layout->brick_count && atomic_load(&c->slots[g].entry) == e);
+        bytes += e->bytes;
+    }
+    IP_ASSERT(at_rest ? bytes == c->resident_bytes : bytes <= c->resident_bytes);
+    IP_ASSERT(c->resident_peak >= c->resident_bytes);
+    IP_ASSERT(c->heap.count == c->resident_count && c->heap.parked_count == 0);
+    for (uint64_t i = 0; i < c->heap.count; i++) { /* each resident entry, so each once */
+        const entry *e = c->heap.items[i].value;
+        IP_ASSERT(e->resident_slot < c->resident_count && c->resident[e->resident_slot] == e);
+        IP_ASSERT(i == 0 || c->heap.items[(i - 1) / 2].key <= c->heap.items[i].key);
+    }
+    if (at_rest) { /* the other entries are free */
+        uint64_t free_count = 0;
+        for (const entry *e = c->free_entries; e; e = e->next_free, free_count++)
+            IP_ASSERT(atomic_load(&e->pins) == -1);
+        IP_ASSERT(c->resident_count + free_count == c->all_count);
+    }
+}
+#endif
+
 void ip_cache_destroy(ip_cache *c)
 {
     if (!c)
         return;
+    check_resident(c, 1);
     for (uint64_t i = 0; i < c->all_count; i++) {
         free(c->all_entries[i]->samples);
         free(c->all_entries[i]);
@@ -257,6 +295,10 @@ static entry *evict_one(ip_cache *c, uint64_t below)
         return NULL;
     if (atomic_exchange(&victim->prefetched, 0)) /* loaded ahead for nothing */
         atomic_fetch_sub(&c->prefetch_unused, 1);
+    IP_ASSERT(victim->resident_slot < c->resident_count &&
+              c->resident[victim->resident_slot] == victim);
+    IP_ASSERT(atomic_load(&c->slots[atomic_load(&victim->brick)].entry) == victim);
+    IP_ASSERT(c->resident_bytes >= victim->bytes);
     atomic_store(&c->slots[atomic_load(&victim->brick)].entry, NULL);
     c->resident[victim->resident_slot] = c->resident[--c->resident_count];
     c->resident[victim->resident_slot]->resident_slot = victim->resident_slot;
@@ -269,6 +311,9 @@ static entry *evict_one(ip_cache *c, uint64_t below)
  * would let memory outgrow the budget when brick sizes vary. evict_lock held. */
 static void free_entry(ip_cache *c, entry *e)
 {
+    IP_ASSERT(atomic_load(&e->pins) == -1); /* evicted, or never published */
+    IP_ASSERT(atomic_load(&e->brick) == UINT64_MAX ||
+              atomic_load(&c->slots[atomic_load(&e->brick)].entry) != e);
     free(e->samples);
     e->samples = NULL;
     e->capacity = 0;
@@ -318,6 +363,7 @@ static entry *reserve_entry(ip_cache *c, size_t bytes, int ahead, uint64_t below
             free_entry(c, spare);
         spare = victim;
     }
+    IP_ASSERT(!ahead || c->resident_bytes + bytes <= c->budget); /* never over budget */
     entry *e = spare;
     if (!e && c->free_entries) {
         e = c->free_entries;
@@ -325,6 +371,7 @@ static entry *reserve_entry(ip_cache *c, size_t bytes, int ahead, uint64_t below
     }
     if (!e && !(e = new_entry(c)))
         return NULL;
+    IP_ASSERT(atomic_load(&e->pins) == -1); /* not pinnable until load_brick() publishes it */
     if (e->capacity != bytes) {
         free(e->samples);
         e->samples = malloc(bytes);
@@ -348,6 +395,7 @@ static ip_status add_resident(ip_cache *c, entry *e)
     /* the parking room of evict_one() may hold every resident entry at once */
     if (ip__lru_heap_reserve(&c->heap, c->heap.count + 1) != IP_OK)
         return IP_ERR_NOMEM;
+    IP_ASSERT(c->resident_count < UINT32_MAX); /* fits in resident_slot */
     e->resident_slot = (uint32_t)c->resident_count;
     c->resident[c->resident_count++] = e;
     heap_push(c, e);
@@ -551,6 +599,8 @@ static ip_status load_brick(ip_cache *c, uint64_t g, int ahead, uint64_t below, 
         atomic_fetch_add(&c->prefetch_unused, 1);
     }
     atomic_store(&e->pins, ahead ? 0 : 1);
+    /* brick g was not resident (one load per brick, see claim_load()): its slot is empty */
+    IP_ASSERT(atomic_load(&c->slots[g].entry) == NULL);
     atomic_store_explicit(&c->slots[g].entry, e, memory_order_release);
     pthread_mutex_unlock(&c->evict_lock);
     atomic_fetch_add(&c->bytes_decompressed,
@@ -664,7 +714,9 @@ void ip_cache_unpin_brick(ip_cache *c, const ip_brick *b)
 {
     entry *e = atomic_load_explicit(&c->slots[b->index].entry, memory_order_acquire);
     /* a pinned brick stays in its slot, so the slot still holds its entry */
-    atomic_fetch_sub(&e->pins, 1);
+    IP_ASSERT(e != NULL && atomic_load(&e->brick) == b->index);
+    int pins = atomic_fetch_sub(&e->pins, 1);
+    IP_ASSERT(pins >= 1); /* pinned by this caller: never below zero once released */
 }
 
 uint64_t ip_cache_trim(ip_cache *c, uint64_t keep_bytes)
@@ -678,6 +730,7 @@ uint64_t ip_cache_trim(ip_cache *c, uint64_t keep_bytes)
         freed += victim->bytes;
         free_entry(c, victim);
     }
+    check_resident(c, 0);
     pthread_mutex_unlock(&c->evict_lock);
     return freed;
 }
@@ -694,6 +747,7 @@ void ip_cache_get_stats(const ip_cache *cc, ip_cache_stats *s)
     for (uint64_t i = 0; i < c->resident_count; i++) /* pinned bytes, counted when asked */
         if (atomic_load(&c->resident[i]->pins) > 0)
             s->pinned_bytes += c->resident[i]->bytes;
+    check_resident(c, 0);
     pthread_mutex_unlock(&c->evict_lock);
     for (int i = 0; i < HIT_STRIPES; i++)
         s->hits += atomic_load(&c->hits[i].value);

@@ -2,6 +2,7 @@
 #include <stdlib.h>
 
 #include "array.h"
+#include "internal.h"
 #include "lru_heap.h"
 
 void ip__lru_heap_free(ip_lru_heap *h)
@@ -53,12 +54,14 @@ static void sift_down(ip_lru_item *items, uint64_t n, uint64_t i)
 
 void ip__lru_heap_push(ip_lru_heap *h, uint64_t key, void *value)
 {
+    IP_ASSERT(h->count < h->capacity); /* the room ip__lru_heap_reserve() made */
     h->items[h->count] = (ip_lru_item){key, value};
     sift_up(h->items, h->count++);
 }
 
 ip_lru_item ip__lru_heap_pop(ip_lru_heap *h)
 {
+    IP_ASSERT(h->count > 0);
     ip_lru_item top = h->items[0];
     h->items[0] = h->items[--h->count];
     if (h->count > 0)
@@ -68,6 +71,7 @@ ip_lru_item ip__lru_heap_pop(ip_lru_heap *h)
 
 void ip__lru_heap_park(ip_lru_heap *h, ip_lru_item item)
 {
+    IP_ASSERT(h->parked_count < h->capacity);
     h->parked[h->parked_count++] = item;
 }
 
