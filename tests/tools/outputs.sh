@@ -16,14 +16,19 @@ intact() { cmp -s F.ibv F.orig && cmp -s "$raw" raw.orig; }
 none_of() { for f in "$@"; do [ ! -e "$f" ] || return 1; done; }
 
 # --- isorender: an output that is the input, however spelled ---
-for opt in -o --mesh --stats --progress; do
+for opt in --mesh --stats --progress; do
     expect_error 1 "F.ibv" $render $opt F.ibv --force
     check "isorender $opt F.ibv --force leaves the brick file intact" intact
 done
+# (an image must be named .png: -o F.ibv is a usage error before any file is looked at)
+expect_error 2 "-o F.ibv: images are written as PNG" $render -o F.ibv --force
+ln F.ibv same.png
+expect_error 1 "same file as the input" $render -o same.png --force
+check "isorender -o (the input under a .png name) --force leaves the brick file intact" intact
 expect_error 1 "same file as the input" $render --stats ./F.ibv --force -o a.png
 expect_error 1 "same file as the input" $render --stats "$work/../$(basename "$work")/F.ibv" --force -o a.png
-ln F.ibv hard.ibv
-expect_error 1 "same file as the input" $render -o hard.ibv --force
+ln F.ibv hard.png
+expect_error 1 "same file as the input" $render -o hard.png --force
 ln -s F.ibv soft.ibv
 expect_error 1 "same file as the input" $render --mesh soft.ibv --force
 check "the brick file is intact after every attempt" intact
@@ -37,10 +42,14 @@ expect_error 1 "same file as the output" $render --stats "$work/X.json" -o X.png
 check "nothing written" none_of X.png X.json
 
 # --- isorender: only regular files are replaced ---
-for opt in -o --mesh --stats --progress; do
+for opt in --mesh --stats --progress; do
     expect_error 1 "not a regular file" $render $opt /dev/null --force
     expect_error 1 "a FIFO" timeout 10 $render $opt fifo --force
 done
+ln -s /dev/null null.png
+mkfifo fifo.png
+expect_error 1 "not a regular file" $render -o null.png --force
+expect_error 1 "a FIFO" timeout 10 $render -o fifo.png --force
 check "/dev/null is still a character device" test -c /dev/null
 check "the FIFO is still a FIFO" test -p fifo
 mkdir folder.png
