@@ -3,8 +3,11 @@
 # image of the same camera and total size (>= 99.99 % identical pixels); the statistics have
 # one record per process whose units add up to the work units and rays to the pixels, fewer of
 # them stolen than taken (with --static: each tile's units on its owner, none stolen); bad
-# --wall, --tile and --unit values are usage errors (exit 2). Registered only where the build
-# found MPI; skipped when mpirun is missing.
+# --wall, --tile, --unit and --timeout values are usage errors (exit 2). The watchdog: a process
+# stopped (SIGSTOP) in the middle of a wall with --timeout 3 ends the job within 30 s, non-zero,
+# with one line naming it (process 2, named by process 0; process 0, named by process 1), and
+# nothing is left running; a process that computes for longer than --timeout 1 without a message
+# does not end it. Registered only where the build found MPI; skipped when mpirun is missing.
 . "$(dirname "$0")/lib.sh"
 
 if ! command -v mpirun >/dev/null 2>&1; then
@@ -65,8 +68,8 @@ check "every process stole fewer units than it took ($over did not)" test "$over
 busy=$(grep '"rank": ' dyn.json | grep -c '"units": [1-9]')
 check "every process took units ($busy of 4)" test "$busy" = 4
 
-# --- static: one tile's regions per process, the same image ---
-run_capture wall --azimuth 20 --elevation 15 --static -o static.png --stats static.json
+# --- static: one tile's regions per process, the same image (and no watchdog: --timeout 0) ---
+run_capture wall --azimuth 20 --elevation 15 --static -o static.png --stats static.json --timeout 0
 check "static run exits 0 (got $rc: $err)" test "$rc" = 0
 line=$("$compare" static.png ref.png --max-pct 0.01)
 check "static wall equals isorender's image: $line" test $? = 0
@@ -100,6 +103,68 @@ check "a bad brick file: exit 1, one line naming it (got $rc, $lines lines)" \
     test "$rc" = 1 -a "$lines" = 1
 check "a bad brick file: no image" test ! -e bad.png
 
+# --- the watchdog ---
+# stop_rank K: a wall of 3x2 tiles of 640x480 with --timeout 3, whose process K is stopped
+# (SIGSTOP) as soon as it has written its process id (ISOWALL_PID_DIR: once its watchdog runs,
+# before its first collective call, so the wall cannot end without it); sets rc, err, took
+# (seconds from the stop to the end of mpirun) and left (processes of the wall still there
+# afterwards, then continued and killed)
+stop_rank() {
+    pids=$work/pids_$1
+    mkdir -p "$pids"
+    ISOWALL_PID_DIR=$pids timeout 60 mpirun --oversubscribe --allow-run-as-root -np 4 \
+        "$bin/isowall" g.ibv --iso 0.5 --wall 3x2 --tile 640x480 --timeout 3 --quiet \
+        -o "stop_$1.png" >"$work/.out" 2>"$work/.err" &
+    job=$!
+    i=0
+    while [ ! -s "$pids/rank_$1.pid" ] && [ "$i" -lt 1200 ] && kill -0 "$job" 2>/dev/null; do
+        sleep 0.05
+        i=$((i + 1))
+    done
+    stopped=$(cat "$pids/rank_$1.pid" 2>/dev/null)
+    [ -n "$stopped" ] && kill -STOP "$stopped"
+    t0=$(date +%s.%N)
+    wait "$job"
+    rc=$?
+    took=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+    err=$(cat "$work/.err")
+    left=0
+    for f in "$pids"/rank_*.pid; do
+        p=$(cat "$f" 2>/dev/null) || continue
+        if kill -0 "$p" 2>/dev/null && grep -q isowall "/proc/$p/cmdline" 2>/dev/null; then
+            left=$((left + 1))
+            kill -CONT "$p" 2>/dev/null
+            kill -KILL "$p" 2>/dev/null
+        fi
+    done
+}
+for k in 2 0; do
+    namer=$((k == 0 ? 1 : 0))
+    stop_rank $k
+    echo "process $k stopped: the wall ended $took s later, exit $rc"
+    check "process $k stopped: found its process id" test -n "$stopped"
+    check "process $k stopped: a non-zero exit, not the safety net's (got $rc)" \
+        test "$rc" != 0 -a "$rc" != 124
+    check "process $k stopped: the wall ended within 30 s of the stop ($took s)" \
+        awk -v t="$took" 'BEGIN { exit !(t < 30) }'
+    named=$(printf '%s\n' "$err" | grep -c "^isowall: rank $k sent nothing for [0-9.]* s (rank $namer was ")
+    lines=$(printf '%s\n' "$err" | grep -c '^isowall: ')
+    check "process $k stopped: one line naming it, from process $namer ($named of $lines: $err)" \
+        test "$named" = 1 -a "$lines" = 1
+    check "process $k stopped: nothing left running ($left)" test "$left" = 0
+done
+# process 0 alone casts the one unit of the second pass, then draws the one tile and writes the
+# 2048x2048 image, while the others wait for it (--static, a 1x1 wall, one unit a pass): it
+# sends nothing on the wall's communicator for longer than the timeout (here 2-3 s; the line
+# below says how long on this run), and the wall ends as usual
+run_capture timeout 300 mpirun --oversubscribe --allow-run-as-root -np 4 "$bin/isowall" g.ibv \
+    --iso 0.5 --wall 1x1 --tile 2048x2048 --unit 2048x2048 --static --timeout 1 --quiet \
+    -o slow.png --stats slow.json
+check "a process busy for longer than --timeout 1: exit 0 (got $rc: $err)" test "$rc" = 0
+quiet=$(awk -v c="$(top slow.json coarse_s)" -v e="$(top slow.json extraction_s)" \
+    -v t="$(top slow.json time_s)" 'BEGIN { printf "%.1f s, then %.1f s", e - c, t - e }')
+echo "process 0 sent nothing for $quiet (the second pass; the tile and the image), --timeout 1"
+
 # --- bad values: usage errors before MPI starts ---
 expect_error 2 "--wall '0x2'" "$bin/isowall" g.ibv --iso 0.5 --wall 0x2 --tile 160x120
 expect_error 2 "--wall '3'" "$bin/isowall" g.ibv --iso 0.5 --wall 3 --tile 160x120
@@ -110,6 +175,10 @@ expect_error 2 "--unit 200x10 is larger" "$bin/isowall" g.ibv --iso 0.5 --wall 3
 expect_error 2 "--wall CxR and --tile WxH are required" "$bin/isowall" g.ibv --iso 0.5 --wall 3x2
 expect_error 2 "--size is isorender's" "$bin/isowall" g.ibv --iso 0.5 --wall 3x2 --tile 8x8 \
     --size 16x16
+expect_error 2 "--timeout '-1' is not seconds" "$bin/isowall" g.ibv --iso 0.5 --wall 3x2 \
+    --tile 160x120 --timeout -1
+expect_error 2 "--timeout 'soon' is not seconds" "$bin/isowall" g.ibv --iso 0.5 --wall 3x2 \
+    --tile 160x120 --timeout soon
 expect_error 2 "larger than 65536" "$bin/isowall" g.ibv --iso 0.5 --wall 200x1 --tile 400x8
 
 # random views (tools/dev/soak_exact.sh with SOAK_WALL=on): 12 cases on the generated volumes, 3 of

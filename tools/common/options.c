@@ -83,23 +83,37 @@ int tool_parse_clip(const char *text, ip_clip_plane *plane)
 
 /* ---- option parsers ---- */
 
+/* The least a number may be: any finite one, more than 0, or 0 and more. */
+enum {
+    ANY_NUMBER,
+    POSITIVE,
+    NON_NEGATIVE
+};
+
 static int parse_double_option(const char *p, const tool_option *opt, const char *value, void *base,
-                               int positive)
+                               int least)
 {
     double *out = (double *)(void *)((char *)base + opt->offset);
-    if (tool_parse_double(value, out) != 0 || (positive && *out <= 0))
+    if (tool_parse_double(value, out) != 0 || (least == POSITIVE && *out <= 0) ||
+        (least == NON_NEGATIVE && *out < 0))
         return tool_usage_error(p, "%s '%s' %s", opt->name, value, opt->problem);
     return 0;
 }
 
 int tool_option_number(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
-    return parse_double_option(p, opt, v[0], base, 0);
+    return parse_double_option(p, opt, v[0], base, ANY_NUMBER);
 }
 
 int tool_option_positive(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
-    return parse_double_option(p, opt, v[0], base, 1);
+    return parse_double_option(p, opt, v[0], base, POSITIVE);
+}
+
+int tool_option_non_negative(const char *p, const tool_option *opt, const char *const *v,
+                             void *base)
+{
+    return parse_double_option(p, opt, v[0], base, NON_NEGATIVE);
 }
 
 int tool_option_background(const char *p, const tool_option *opt, const char *const *v, void *base)

@@ -11,9 +11,9 @@
 #include "isoprop/status.h"
 #include "tool_command_line.h"
 
-/* Parsers for tables: a finite number, and a number > 0, into the double at base + offset;
- * a bad value is "NAME 'VALUE' PROBLEM" (option->problem). */
-tool_option_parse tool_option_number, tool_option_positive;
+/* Parsers for tables: a finite number, a number > 0, and a number >= 0, into the double at
+ * base + offset; a bad value is "NAME 'VALUE' PROBLEM" (option->problem). */
+tool_option_parse tool_option_number, tool_option_positive, tool_option_non_negative;
 
 /* An on|off switch into the int at base + offset (1 or 0); a bad value is "NAME must be on or
  * off". */

@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "composite.h"
+#include "watch.h"
 
 double wall_cpu_seconds(void)
 {
@@ -103,6 +104,7 @@ static int draw_tile(wall_composite *c, uint32_t t, const ip_mesh *mesh, uint8_t
     uint32_t col = t % w->cols, row = t / w->cols;
     size_t pixels = (size_t)w->tile_w * w->tile_h;
     double start = wall_cpu_seconds();
+    wall_watch_stage("drawing tile %u for the composite", t);
     ip_status st = ip_raster_mesh_part(mesh, &w->camera, c->shading, w->lo, w->hi, col * w->tile_w,
                                        row * w->tile_h, w->tile_w, w->tile_h, (double *)buf,
                                        buf + pixels * sizeof(double), err);
@@ -153,6 +155,7 @@ int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *d
     c->busy_seconds += wall_cpu_seconds() - start;
     /* every rank learns who draws what (one byte per tile and rank) */
     double wait = MPI_Wtime();
+    wall_watch_stage("learning which process draws which tile at the composite");
     MPI_Allgather(mine, (int)w->tile_count, MPI_BYTE, all, (int)w->tile_count, MPI_BYTE,
                   MPI_COMM_WORLD);
     c->idle_seconds += MPI_Wtime() - wait;
@@ -168,6 +171,7 @@ int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *d
             size_t n = pack_covered(own, w->tile_w, w->tile_h, packed);
             c->busy_seconds += wall_cpu_seconds() - start;
             wait = MPI_Wtime();
+            wall_watch_stage("sending tile %u to rank %d at the composite", t, owner);
             MPI_Send(packed, (int)n, MPI_BYTE, owner, (int)t, MPI_COMM_WORLD);
             c->idle_seconds += MPI_Wtime() - wait;
             c->bytes_sent += n;
@@ -182,6 +186,7 @@ int wall_composite_run(wall_composite *c, const ip_mesh *mesh, wall_tile_done *d
                     break;
             } else {
                 wait = MPI_Wtime();
+                wall_watch_stage("waiting for tile %u from rank %d at the composite", t, r);
                 MPI_Recv(packed, (int)(HEADER + bytes), MPI_BYTE, r, (int)t, MPI_COMM_WORLD,
                          MPI_STATUS_IGNORE);
                 c->idle_seconds += MPI_Wtime() - wait;

@@ -9,7 +9,7 @@
  * of the fullest share once its own is spent (main.c); or with --static by display tile (tile t
  * to rank t % N, one copy per projector). Each rank then draws its own triangles into the tiles
  * they touch, and the tile's owner keeps the nearest surface of each pixel (direct-send
- * compositing).
+ * compositing). A watchdog (watch.h) ends the wall, naming it, when a process stops answering.
  * MPI stays in this program; the library knows nothing of it.
  */
 #ifndef ISOWALL_H
@@ -32,7 +32,11 @@ typedef struct wall_options {
     int is_static;            /* --static: one display tile's units per rank */
     tool_orbit_options orbit; /* --azimuth, --elevation, --zoom */
     ip_shading shading;       /* --color, --background */
+    double timeout;           /* --timeout SECONDS: the watchdog (watch.h); 0: none */
 } wall_options;
+
+/* --timeout's default: seconds of silence from a process that end the wall. */
+#define WALL_DEFAULT_TIMEOUT 60.0
 
 /* A screen region: a rectangle inside one display tile. */
 typedef struct wall_region {

@@ -13,6 +13,7 @@
 #include "isoprop/cache.h"
 #include "isoprop/engine.h"
 #include "isoprop/store.h"
+#include "watch.h"
 
 /* What one rank did, gathered on rank 0 for --stats (doubles, so one MPI type carries it). */
 enum {
@@ -51,6 +52,12 @@ typedef struct wall_run {
     double start, coarse_seconds, extraction_seconds, total_seconds;
     const char *program;
 } wall_run;
+
+/* "the first pass" or "the second pass", for the watchdog's line. */
+static const char *pass_name(int pass)
+{
+    return pass ? "the second pass" : "the first pass";
+}
 
 /* The rank that takes unit u of a pass under --static: the owner of the unit's tile. */
 static int tile_owner(uint32_t tile, int ranks)
@@ -189,8 +196,13 @@ static int64_t next_static(const wall_run *r, int64_t *cursor)
 static int64_t next_dynamic(wall_run *r, int pass, int *stealing)
 {
     double wait = MPI_Wtime();
+    wall_watch_stage("taking a unit of %s from the window of shares on rank 0", pass_name(pass));
     uint64_t mine = word_op(r, pass * r->ranks + r->rank, 1, MPI_SUM);
     int64_t at = (uint32_t)mine < (uint32_t)(mine >> 32) ? (int64_t)(uint32_t)mine : -1;
+    if (at < 0)
+        wall_watch_stage("stealing a unit of %s under an exclusive lock of the window of "
+                         "shares on rank 0",
+                         pass_name(pass));
     if (at < 0 && (at = steal(r, pass)) >= 0)
         *stealing = 1;
     r->idle += MPI_Wtime() - wait;
@@ -221,6 +233,7 @@ static int run_pass(wall_run *r, int pass, ip_error *err)
         uint64_t pixels = (uint64_t)g->width * g->height, coarse = wall_coarse_rays(g);
         uint64_t first = pass ? coarse : 0, count = pass ? pixels - coarse : coarse;
         double start = wall_cpu_seconds();
+        wall_watch_stage("casting the rays of region %lld in %s", (long long)u, pass_name(pass));
         if (count > 0) {
             if (ip_engine_set_region(r->engine, g->x, g->y, g->width, g->height, first, count,
                                      err) != IP_OK)
@@ -341,6 +354,7 @@ static int order_second_pass(wall_run *r)
 {
     uint32_t n = r->layout.region_count;
     double wait = MPI_Wtime();
+    wall_watch_stage("exchanging the costs of the first pass's units");
     MPI_Allreduce(MPI_IN_PLACE, r->cost, (int)n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
     MPI_Allreduce(MPI_IN_PLACE, r->taker, (int)n, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     r->idle += MPI_Wtime() - wait;
@@ -388,6 +402,7 @@ static int write_tile(uint32_t t, const uint8_t *rgba, void *user, ip_error *err
     char path[4096];
     snprintf(path, sizeof path, "%s/tile_%u_%u.png", r->o.tiles_dir, t % r->layout.cols,
              t / r->layout.cols);
+    wall_watch_stage("writing %s", path);
     return ip_png_write(path, rgba, r->layout.tile_w, r->layout.tile_h, r->o.common.force, err) ==
                    IP_OK
                ? 0
@@ -412,6 +427,7 @@ static void composite(wall_run *r, int to_tiles)
 static int write_image(wall_run *r, const char *path)
 {
     int ok = 1;
+    wall_watch_stage(r->rank == 0 ? "writing %s" : "waiting for rank 0 to write %s", path);
     if (r->rank == 0) {
         ip_error err;
         ip_error_clear(&err);
@@ -431,14 +447,17 @@ static int extract(wall_run *r)
     ip_error err;
     ip_error_clear(&err);
     double wait = MPI_Wtime();
+    wall_watch_stage("at the barrier before the first pass");
     MPI_Barrier(MPI_COMM_WORLD);
     r->start = MPI_Wtime();
     r->idle += r->start - wait;
     for (int pass = 0; pass < 2; pass++) {
         int failed = run_pass(r, pass, &err) != 0;
+        wall_watch_stage("waiting for every process to end %s", pass_name(pass));
         if (report_first_failure(r, failed, &err))
             return -1;
         wait = MPI_Wtime();
+        wall_watch_stage("at the barrier after %s", pass_name(pass));
         MPI_Barrier(MPI_COMM_WORLD); /* the pass is done on every rank */
         r->idle += MPI_Wtime() - wait;
         if (pass == 0) {
@@ -449,6 +468,7 @@ static int extract(wall_run *r)
                         fprintf(stderr, "%s: out of memory for the second pass\n", r->program);
                     return -1;
                 }
+                wall_watch_stage("at the barrier after the second pass's shares were set");
                 MPI_Barrier(MPI_COMM_WORLD); /* the shares are set */
             }
             if (r->o.coarse) {
@@ -563,6 +583,7 @@ static int report(wall_run *r)
         fprintf(stderr, "%s: out of memory\n", r->program);
         MPI_Abort(MPI_COMM_WORLD, 1);
     }
+    wall_watch_stage("gathering the statistics on rank 0");
     MPI_Gather(mine, REC_COUNT, MPI_DOUBLE, all, REC_COUNT, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     int ok = 1;
     if (r->rank == 0) {
@@ -580,6 +601,7 @@ static int report(wall_run *r)
             ok = 0;
         free(all);
     }
+    wall_watch_stage("waiting for rank 0 to write the statistics");
     MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
     return ok ? 0 : 1;
 }
@@ -594,6 +616,7 @@ static int open_run(wall_run *r)
     ip_error_clear(&err);
     int ok = 1;
     if (r->rank == 0) {
+        wall_watch_stage("checking the outputs");
         const char *inputs[] = {r->o.file};
         const char *outputs[] = {r->o.out, r->o.coarse, r->o.common.stats};
         ok = tool_check_paths(r->program, inputs, 1, outputs, 3, r->o.common.force) == 0;
@@ -602,8 +625,10 @@ static int open_run(wall_run *r)
             ok = 0;
         }
     }
+    wall_watch_stage("waiting for every process at the start (rank 0 checks the outputs)");
     if (!all_ok(ok))
         return 1;
+    wall_watch_stage("opening the brick file");
     int failed = ip_store_open(r->o.file, &r->store, &err) != IP_OK;
     if (!failed)
         failed = ip_cache_create(r->store, r->o.common.cache_bytes, &r->cache, &err) != IP_OK ||
@@ -615,14 +640,33 @@ static int open_run(wall_run *r)
             ip_engine_create(r->cache, &eo, &r->engine, &err) != IP_OK ||
             ip_engine_begin(r->engine, &r->layout.camera, (float)r->o.common.iso, &err) != IP_OK;
     }
+    wall_watch_stage("waiting for every process to open the brick file");
     if (report_first_failure(r, failed, &err))
         return 1;
     if (r->rank == 0)
         tool_warn_iso_range(r->program, r->store, r->o.common.iso, NULL, 0);
     size_t bytes = r->rank == 0 ? 2 * (size_t)r->ranks * sizeof(uint64_t) : 0;
-    MPI_Win_allocate((MPI_Aint)bytes, sizeof(uint64_t), MPI_INFO_NULL, MPI_COMM_WORLD, &r->counters,
-                     &r->counter_window);
-    r->window_made = 1;
+    wall_watch_stage("making the window of shares with every process");
+    /* an MPI whose one-sided component cannot work beside the watchdog's thread (OpenMPI 4's
+     * osc pt2pt under MPI_THREAD_MULTIPLE) fails here: said once, not as MPI's fatal error */
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+    int made = MPI_Win_allocate((MPI_Aint)bytes, sizeof(uint64_t), MPI_INFO_NULL, MPI_COMM_WORLD,
+                                &r->counters, &r->counter_window);
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_ARE_FATAL);
+    r->window_made = made == MPI_SUCCESS;
+    if (!all_ok(r->window_made)) {
+        char why[MPI_MAX_ERROR_STRING] = "on another process";
+        int length = 0;
+        if (!r->window_made)
+            MPI_Error_string(made, why, &length);
+        if (r->rank == 0)
+            fprintf(stderr, "%s: MPI cannot make the window of shares (%s)%s\n", r->program, why,
+                    r->o.timeout > 0 ? " beside the watchdog's thread (MPI_THREAD_MULTIPLE, "
+                                       "which OpenMPI 4's osc pt2pt refuses): try --timeout 0, "
+                                       "no watchdog"
+                                     : "");
+        return 1;
+    }
     size_t pixels = (size_t)r->layout.camera.width * r->layout.camera.height;
     uint32_t n = r->layout.region_count;
     r->cost = calloc(n, sizeof *r->cost);
@@ -638,12 +682,14 @@ static int open_run(wall_run *r)
     }
     if (!ok_regions)
         fprintf(stderr, "%s: out of memory for the regions\n", r->program);
+    wall_watch_stage("waiting for every process to lay out the regions");
     if (!all_ok(ok_regions))
         return 1;
     int need_image = !r->o.tiles_dir || r->o.coarse;
     if (r->rank == 0 && need_image && !(r->image = malloc(4 * pixels)))
         fprintf(stderr, "%s: out of memory for the %ux%u image\n", r->program,
                 r->layout.camera.width, r->layout.camera.height);
+    wall_watch_stage("waiting for rank 0 to make room for the image");
     if (!all_ok(r->rank != 0 || !need_image || r->image != NULL))
         return 1;
     r->composite = (wall_composite){&r->layout, &r->o.shading, r->rank, r->ranks, NULL, 0, 0, 0, 0};
@@ -653,6 +699,7 @@ static int open_run(wall_run *r)
 /* Frees what open_run() made, as far as it got. */
 static void close_run(wall_run *r)
 {
+    wall_watch_stage("freeing the window of shares with every process");
     if (r->window_made)
         MPI_Win_free(&r->counter_window);
     ip_engine_destroy(r->engine);
@@ -693,6 +740,26 @@ static int parse_quietly_off_rank_zero(int argc, char **argv, wall_options *o)
     return rc;
 }
 
+/* With ISOWALL_PID_DIR=DIR in the environment, each process writes its process id into
+ * DIR/rank_K.pid (K: its rank) once its watchdog runs, so that a script can find, signal or
+ * trace one rank (the test of the watchdog stops one). Written under another name, then
+ * renamed: a reader never sees a part of it. */
+static void write_pid_file(int rank)
+{
+    const char *dir = getenv("ISOWALL_PID_DIR");
+    if (!dir || !*dir)
+        return;
+    char path[4096], part[4200];
+    snprintf(path, sizeof path, "%s/rank_%d.pid", dir, rank);
+    snprintf(part, sizeof part, "%s.part", path);
+    FILE *f = fopen(part, "w");
+    int ok = f && fprintf(f, "%ld\n", (long)getpid()) > 0;
+    ok = f && fclose(f) == 0 && ok && rename(part, path) == 0;
+    if (!ok)
+        fprintf(stderr, "isowall: warning: ISOWALL_PID_DIR: cannot write %s: %s\n", path,
+                strerror(errno));
+}
+
 int main(int argc, char **argv)
 {
     wall_run r;
@@ -701,14 +768,31 @@ int main(int argc, char **argv)
     int rc = parse_quietly_off_rank_zero(argc, argv, &r.o);
     if (rc)
         return rc;
-    int provided;
-    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+    /* the watchdog's thread calls MPI beside the main thread; without it, only the main
+     * thread does (the engine's threads never do) */
+    int watch = r.o.timeout > 0, provided;
+    MPI_Init_thread(&argc, &argv, watch ? MPI_THREAD_MULTIPLE : MPI_THREAD_FUNNELED, &provided);
     MPI_Comm_rank(MPI_COMM_WORLD, &r.rank);
     MPI_Comm_size(MPI_COMM_WORLD, &r.ranks);
+    if (watch) { /* the lowest level any process got, so that all decide alike */
+        MPI_Allreduce(MPI_IN_PLACE, &provided, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+        if (provided < MPI_THREAD_MULTIPLE) {
+            if (r.rank == 0)
+                fprintf(stderr,
+                        "%s: warning: this MPI gives no MPI_THREAD_MULTIPLE: no watchdog "
+                        "(--timeout), a process that stops answering hangs the wall\n",
+                        r.program);
+            watch = 0;
+        }
+    }
+    if (watch)
+        wall_watch_start(r.program, r.o.timeout);
+    write_pid_file(r.rank);
     rc = open_run(&r);
     if (rc == 0)
         rc = extract(&r) == 0 ? report(&r) : 1;
     close_run(&r);
+    wall_watch_stop();
     MPI_Finalize();
     return rc;
 }

@@ -40,6 +40,9 @@ static const char usage[] =
     "                      the composite; units; rays; triangles; bytes_sent; stolen: units\n"
     "                      taken from other processes' shares) and balance, the\n"
     "                      largest busy_s over the mean\n"
+    "  --timeout SECONDS   the watchdog: when a process has sent nothing for this long (not\n"
+    "                      even the heartbeat its helper thread sends while it computes), end\n"
+    "                      the wall with an error naming it (default 60; 0: no watchdog)\n"
     "  -f, --force         replace existing outputs (regular files only; never an input)\n"
     "  -q, --quiet         print nothing but errors and warnings\n"
     "  --version           print the version and exit\n"
@@ -80,6 +83,8 @@ static const tool_option wall_table[] = {
     {"--static", NULL, 0, offsetof(wall_options, is_static), NULL, NULL, NULL},
     {"--tiles-dir", NULL, 1, offsetof(wall_options, tiles_dir), NULL, NULL, NULL},
     {"--coarse", NULL, 1, offsetof(wall_options, coarse), NULL, NULL, NULL},
+    {"--timeout", NULL, 1, offsetof(wall_options, timeout), tool_option_non_negative,
+     "is not seconds (0: no watchdog)", NULL},
     TOOL_ORBIT_OPTION_ROWS(wall_options, orbit),
     {"--color", NULL, 1, 0, parse_color, NULL, NULL},
     {"--background", NULL, 1, offsetof(wall_options, shading), tool_option_background, NULL, NULL},
@@ -91,6 +96,7 @@ int wall_parse_args(int argc, char **argv, wall_options *o)
     tool_view_options_default(&o->common, 0, 0);
     tool_orbit_options_default(&o->orbit);
     ip_shading_default(&o->shading);
+    o->timeout = WALL_DEFAULT_TIMEOUT;
     int rc = tool_parse_view_command_line("isowall", usage, &o->common, wall_table,
                                           sizeof wall_table / sizeof wall_table[0], o, &o->file,
                                           argc, argv);
