@@ -112,4 +112,24 @@ faulty IP_FAULT_BYTES=$((frame + frame / 2)) "$bin/isorender" s.ibv --iso 128.5 
     --software --quiet --turntable 3 -o tt
 failed_cleanly "isorender --turntable, disk full at the second frame" "tt/frame_" "$raw" s.ibv
 check "... which said the disk is full" sh -c 'printf "%s" "$0" | grep -q "No space left on device"' "$err"
+
+# --- isowall: the image on rank 0, then the statistics; tiles on their owners ---
+if command -v mpirun >/dev/null 2>&1 && [ -x "$bin/isowall" ]; then
+    wall() {
+        run_capture timeout 300 mpirun --oversubscribe --allow-run-as-root -np 2 \
+            -x LD_PRELOAD="$shim" -x IP_FAULT_CALL="$1" -x IP_FAULT_NTH="$2" -x IP_FAULT_ERRNO=EIO \
+            "$bin/isowall" s.ibv --iso 128.5 --wall 2x1 --tile 80x60 --quiet --timeout 0 "${@:3}"
+    }
+    wall linkat 2 -o w.png --stats w.json
+    check "isowall, the statistics cannot be linked: exit non-zero ($rc)" test "$rc" != 0
+    check "... it says so, naming the file" sh -c 'printf "%s" "$0" | grep -q "w.json: cannot create: Input/output error"' "$err"
+    check "... and the image it had written is gone" leaves_only "$raw" s.ibv
+    mkdir tiles
+    wall linkat 2 --tiles-dir tiles --stats w.json
+    check "isowall --tiles-dir, the statistics cannot be linked: exit non-zero ($rc)" test "$rc" != 0
+    check "... no tile is left" test -z "$(ls -A tiles)"
+    rmdir tiles
+else
+    echo "full_disk: isowall part skipped: no mpirun or no isowall"
+fi
 finish

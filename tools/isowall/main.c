@@ -32,6 +32,8 @@ enum {
 
 typedef struct wall_run {
     wall_options o;
+    tool_outputs outputs; /* the files this process wrote: kept only when every process's run
+                             succeeded (tool_outputs.h) */
     int rank, ranks;
     ip_store *store;
     ip_cache *cache;
@@ -403,10 +405,15 @@ static int write_tile(uint32_t t, const uint8_t *rgba, void *user, ip_error *err
     snprintf(path, sizeof path, "%s/tile_%u_%u.png", r->o.tiles_dir, t % r->layout.cols,
              t / r->layout.cols);
     wall_watch_stage("writing %s", path);
-    return ip_png_write(path, rgba, r->layout.tile_w, r->layout.tile_h, r->o.common.force, err) ==
-                   IP_OK
-               ? 0
-               : -1;
+    if (ip_png_write(path, rgba, r->layout.tile_w, r->layout.tile_h, r->o.common.force, err) !=
+        IP_OK)
+        return -1;
+    if (tool_outputs_add(&r->outputs, path) != 0) {
+        err->code = IP_ERR_NOMEM;
+        snprintf(err->message, sizeof err->message, "%.900s: out of memory", path);
+        return -1;
+    }
+    return 0;
 }
 
 /* Composites the ranks' meshes as they are now into rank 0's image (tiles_dir NULL) or the
@@ -434,6 +441,9 @@ static int write_image(wall_run *r, const char *path)
         if (ip_png_write(path, r->image, r->layout.camera.width, r->layout.camera.height,
                          r->o.common.force, &err) != IP_OK) {
             tool_fail(r->program, &err);
+            ok = 0;
+        } else if (tool_outputs_add(&r->outputs, path) != 0) {
+            fprintf(stderr, "%s: %s: out of memory\n", r->program, path);
             ok = 0;
         }
     }
@@ -596,8 +606,9 @@ static int report(wall_run *r)
                    r->o.is_static ? "static" : "dynamic", sum_of(&v, REC_RAYS),
                    sum_of(&v, REC_TRIANGLES), sum_of(&v, REC_BUSY), max_of(&v, REC_BUSY),
                    balance_of(&v), r->total_seconds);
-        if (r->o.common.stats && tool_write_text_file(r->program, r->o.common.stats,
-                                                      r->o.common.force, fill_stats, &v) != 0)
+        if (r->o.common.stats && (tool_write_text_file(r->program, r->o.common.stats,
+                                                       r->o.common.force, fill_stats, &v) != 0 ||
+                                  tool_outputs_add(&r->outputs, r->o.common.stats) != 0))
             ok = 0;
         free(all);
     }
@@ -791,6 +802,10 @@ int main(int argc, char **argv)
     rc = open_run(&r);
     if (rc == 0)
         rc = extract(&r) == 0 ? report(&r) : 1;
+    /* the outputs of all the processes are one set: a failure anywhere removes them all */
+    if (!all_ok(rc == 0)) /* every process calls it */
+        tool_outputs_discard(&r.outputs);
+    tool_outputs_end(&r.outputs, r.program, r.o.file, rc);
     close_run(&r);
     wall_watch_stop();
     MPI_Finalize();
