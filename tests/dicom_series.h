@@ -35,6 +35,7 @@ typedef struct test_dicom_series {
     const char *syntax;      /* Transfer Syntax UID (NULL: one by slice, see below) */
     const char *photometric; /* NULL: MONOCHROME2 */
     int no_position;         /* 1: leave out Image Position (Patient) */
+    int sequences;           /* 1: add a Referenced Image Sequence and an Icon Image Sequence */
 } test_dicom_series;
 
 /* A series of `dims`, spacing 0.7 (y) x 0.8 (x) x 2.5 mm, rescale 1 x stored - 1024. */
@@ -205,6 +206,47 @@ static inline void test_deflate_tail(test_bytes *b, size_t from)
     free(packed);
 }
 
+/* The header of a sequence or an item of undefined length (an item or a sequence delimiter
+ * when group is FFFE and element not E000), in b's encoding. */
+static inline void test_dicom_open(test_bytes *b, uint16_t group, uint16_t element, int sequence)
+{
+    test_bytes_uint(b, group, 2);
+    test_bytes_uint(b, element, 2);
+    if (sequence && !b->implicit)
+        test_bytes_put(b, "SQ\0\0", 4);
+    test_bytes_uint(b, group == 0xFFFE && element != 0xE000 ? 0 : 0xFFFFFFFFu, 4);
+}
+
+/* A Referenced Image Sequence (0008,1140): one item of two UIDs; sequence and item of
+ * undefined length. */
+static inline void test_dicom_references(test_bytes *b)
+{
+    test_dicom_open(b, 0x0008, 0x1140, 1);
+    test_dicom_open(b, 0xFFFE, 0xE000, 0);
+    test_dicom_text(b, 0x0008, 0x1150, "UI", TEST_DICOM_CT_STORAGE);
+    test_dicom_text(b, 0x0008, 0x1155, "UI", "1.2.826.0.1.3680043.2.1125.5");
+    test_dicom_open(b, 0xFFFE, 0xE00D, 0);
+    test_dicom_open(b, 0xFFFE, 0xE0DD, 0);
+}
+
+/* An Icon Image Sequence (0088,0200): one item holding a 2 x 2 8-bit image of its own. */
+static inline void test_dicom_icon(test_bytes *b)
+{
+    test_dicom_open(b, 0x0088, 0x0200, 1);
+    test_dicom_open(b, 0xFFFE, 0xE000, 0);
+    test_dicom_us(b, 0x0028, 0x0002, 1);
+    test_dicom_text(b, 0x0028, 0x0004, "CS", "MONOCHROME2");
+    test_dicom_us(b, 0x0028, 0x0010, 2);
+    test_dicom_us(b, 0x0028, 0x0011, 2);
+    test_dicom_us(b, 0x0028, 0x0100, 8);
+    test_dicom_us(b, 0x0028, 0x0101, 8);
+    test_dicom_us(b, 0x0028, 0x0102, 7);
+    test_dicom_us(b, 0x0028, 0x0103, 0);
+    test_dicom_element(b, 0x7FE0, 0x0010, "OB", "\x10\x80\xF0\x40", 4);
+    test_dicom_open(b, 0xFFFE, 0xE00D, 0);
+    test_dicom_open(b, 0xFFFE, 0xE0DD, 0);
+}
+
 /* The transfer syntax of slice z when the series names none: they take turns. */
 static inline const char *test_dicom_syntax_of(const test_dicom_series *s, uint32_t z)
 {
@@ -234,6 +276,8 @@ static inline void test_dicom_slice_bytes(const test_dicom_series *s, const void
     test_dicom_text(&b, 0x0008, 0x0016, "UI", TEST_DICOM_CT_STORAGE);
     test_dicom_text(&b, 0x0008, 0x0018, "UI", instance);
     test_dicom_text(&b, 0x0008, 0x0060, "CS", "CT");
+    if (s->sequences)
+        test_dicom_references(&b);
     test_dicom_text(&b, 0x0020, 0x000D, "UI", "1.2.826.0.1.3680043.2.1125.7");
     test_dicom_text(&b, 0x0020, 0x000E, "UI", s->series_uid);
     snprintf(text, sizeof text, "%u", z + 1);
@@ -258,6 +302,8 @@ static inline void test_dicom_slice_bytes(const test_dicom_series *s, const void
         snprintf(text, sizeof text, "%g", s->slope);
         test_dicom_text(&b, 0x0028, 0x1053, "DS", text);
     }
+    if (s->sequences)
+        test_dicom_icon(&b);
     if (strcmp(syntax, TEST_DICOM_RLE) == 0) {
         test_dicom_rle_pixels(&b, plane, count, sample);
     } else {

@@ -430,6 +430,28 @@ static void test_deflated(void)
     free(volume);
 }
 
+/* Slices holding sequences (a Referenced Image Sequence, an Icon Image Sequence with an image
+ * of its own), in each transfer syntax: read exactly. */
+static void test_sequences(void)
+{
+    const char *syntaxes[] = {TEST_DICOM_EXPLICIT_LE, TEST_DICOM_IMPLICIT_LE,
+                              TEST_DICOM_EXPLICIT_BE, TEST_DICOM_RLE, TEST_DICOM_DEFLATE};
+    char dir[4096];
+    for (size_t k = 0; k < sizeof syntaxes / sizeof syntaxes[0]; k++) {
+        test_dicom_series s = test_dicom_default(6, 5, 4, IP_UINT16);
+        void *volume = make_volume(&s);
+        ip_input_desc desc;
+        ip_error err;
+        s.syntax = syntaxes[k];
+        s.sequences = 1;
+        test_dicom_write_series(&s, volume, fresh_folder(dir, "sequences"));
+        CHECK_MSG(ip_input_describe(dir, NULL, &desc, &err) == IP_OK, "%s: %s", syntaxes[k],
+                  err.message);
+        check_samples(&desc, volume);
+        free(volume);
+    }
+}
+
 /* Pixel Data longer than the image its header describes (Rows x Columns x samples x bytes x
  * frames): refused, since the header and the data then describe different images; only the
  * one byte that pads an odd length to an even one is taken (an 8-bit slice of 5 x 3 pixels,
@@ -573,6 +595,19 @@ static void test_fuzz_findings(void)
     expect_refused(dir, IP_ERR_INPUT, "zero_slope/IM0001.dcm",
                    "a Rescale Slope that is not a number other than 0");
 
+    /* an Icon Image Sequence stored as OB (GDCM would guess at its items), a private
+     * transfer syntax (GE's implicit VR big endian, which GDCM reads with its own rules) */
+    test_dicom_series icon = s;
+    icon.sequences = 1;
+    write_case(fresh_folder(dir, "icon_ob"), &icon, volume, 99, NULL, 0);
+    patch_file(dir, "IM0002.dcm", "\x88\x00\x00\x02SQ", "\x88\x00\x00\x02OB", 6);
+    expect_refused(dir, IP_ERR_INPUT, "icon_ob/IM0002.dcm", "a value representation OB, not SQ");
+    test_dicom_series private_syntax = s;
+    private_syntax.syntax = "1.2.840.113619.5.2";
+    write_case(fresh_folder(dir, "private_syntax"), &private_syntax, volume, 99, NULL, 0);
+    expect_refused(dir, IP_ERR_INPUT, "private_syntax/IM0001.dcm",
+                   "transfer syntax 1.2.840.113619.5.2: a private or non-standard encoding");
+
     s.syntax = TEST_DICOM_RLE;
     write_case(fresh_folder(dir, "rle_segments"), &s, volume, 99, NULL, 0);
     /* the RLE header: 2 segments (one a byte of the 16-bit samples), the first at byte 64 */
@@ -611,6 +646,7 @@ int main(void)
     test_changed_file();
     test_malformed();
     test_deflated();
+    test_sequences();
     test_long_pixel_data();
     test_odd_member();
     test_fuzz_findings();

@@ -89,98 +89,22 @@ static void *make_volume(const test_dicom_series *s)
     return v;
 }
 
-/* The header of a sequence or an item of undefined length, or a delimiter, in b's encoding. */
-static void put_open(test_bytes *b, uint16_t group, uint16_t element, int sequence)
-{
-    test_bytes_uint(b, group, 2);
-    test_bytes_uint(b, element, 2);
-    if (sequence && !b->implicit) {
-        test_bytes_put(b, "SQ\0\0", 4);
-    }
-    test_bytes_uint(b, group == 0xFFFE && element != 0xE000 ? 0 : 0xFFFFFFFFu, 4);
-}
-
-/* Sequences for the seeds that hold some (in the encoding of `slice`): a Referenced Image
- * Sequence (0008,1140), one item of two UIDs, into *refs; an Icon Image Sequence (0088,0200),
- * one item of a 2 x 2 8-bit image, into *icon. Both of undefined length, as are their items. */
-static void make_sequences(const test_bytes *slice, test_bytes *refs, test_bytes *icon)
-{
-    refs->implicit = icon->implicit = slice->implicit;
-    refs->big_endian = icon->big_endian = slice->big_endian;
-    put_open(refs, 0x0008, 0x1140, 1);
-    put_open(refs, 0xFFFE, 0xE000, 0);
-    test_dicom_text(refs, 0x0008, 0x1150, "UI", TEST_DICOM_CT_STORAGE);
-    test_dicom_text(refs, 0x0008, 0x1155, "UI", "1.2.826.0.1.3680043.2.1125.5");
-    put_open(refs, 0xFFFE, 0xE00D, 0);
-    put_open(refs, 0xFFFE, 0xE0DD, 0);
-    put_open(icon, 0x0088, 0x0200, 1);
-    put_open(icon, 0xFFFE, 0xE000, 0);
-    test_dicom_us(icon, 0x0028, 0x0002, 1);
-    test_dicom_text(icon, 0x0028, 0x0004, "CS", "MONOCHROME2");
-    test_dicom_us(icon, 0x0028, 0x0010, 2);
-    test_dicom_us(icon, 0x0028, 0x0011, 2);
-    test_dicom_us(icon, 0x0028, 0x0100, 8);
-    test_dicom_us(icon, 0x0028, 0x0101, 8);
-    test_dicom_us(icon, 0x0028, 0x0102, 7);
-    test_dicom_us(icon, 0x0028, 0x0103, 0);
-    test_dicom_element(icon, 0x7FE0, 0x0010, "OB", "\x10\x80\xF0\x40", 4);
-    put_open(icon, 0xFFFE, 0xE00D, 0);
-    put_open(icon, 0xFFFE, 0xE0DD, 0);
-}
-
-/* Inserts `what` into *b before the first element of tag (group, element) in b's encoding. */
-static void insert_before(test_bytes *b, uint16_t group, uint16_t element, const test_bytes *what)
-{
-    test_bytes tag = {0};
-    tag.big_endian = b->big_endian;
-    test_bytes_uint(&tag, group, 2);
-    test_bytes_uint(&tag, element, 2);
-    size_t at = 132;
-    while (at + 4 <= b->size && memcmp(b->data + at, tag.data, 4) != 0)
-        at++;
-    REQUIRE(at + 4 <= b->size);
-    test_bytes rest = {0};
-    test_bytes_put(&rest, b->data + at, b->size - at);
-    b->size = at;
-    test_bytes_put(b, what->data, what->size);
-    test_bytes_put(b, rest.data, rest.size);
-    free(rest.data);
-    free(tag.data);
-}
-
-/* Slice z of `s`, with the sequences of make_sequences() when `sequences`. */
-static void slice_bytes(const test_dicom_series *s, const void *volume, uint32_t z, int sequences,
-                        test_bytes *out)
-{
-    test_dicom_slice_bytes(s, volume, z, out);
-    if (!sequences)
-        return;
-    test_bytes refs = {0}, icon = {0};
-    make_sequences(out, &refs, &icon);
-    insert_before(out, 0x0020, 0x000D, &refs);
-    insert_before(out, 0x7FE0, 0x0010, &icon);
-    free(refs.data);
-    free(icon.data);
-}
-
 /* One seed: the series `s` (positions 10, 12, 14, ... mm, so that every slice's position text
- * has the length of the first's) with the harness's `flags`, with sequences or not, as
- * DIR/name. */
-static int write_seed(const char *dir, const char *name, test_dicom_series s, unsigned flags,
-                      int sequences)
+ * has the length of the first's) with the harness's `flags`, as DIR/name. */
+static int write_seed(const char *dir, const char *name, test_dicom_series s, unsigned flags)
 {
     char path[4200];
     test_bytes out = {0}, template = {0};
     void *volume = make_volume(&s);
     unsigned char head[2] = {(unsigned char)(s.dims[2] - 2), (unsigned char)flags};
     REQUIRE(s.dims[2] >= 2 && s.dims[2] <= 4);
-    slice_bytes(&s, volume, 0, sequences, &template);
+    test_dicom_slice_bytes(&s, volume, 0, &template);
     test_bytes_put(&out, head, 2);
     put16(&out, template.size);
     test_bytes_put(&out, template.data, template.size);
     for (uint32_t z = 1; z < s.dims[2]; z++) {
         test_bytes slice = {0};
-        slice_bytes(&s, volume, z, sequences, &slice);
+        test_dicom_slice_bytes(&s, volume, z, &slice);
         put_edits(&out, z, &template, &slice);
         free(slice.data);
     }
@@ -232,8 +156,9 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < sizeof seeds / sizeof seeds[0]; i++) {
         test_dicom_series s = test_dicom_default(4, 3, seeds[i].slices, seeds[i].type);
         s.syntax = seeds[i].syntax;
+        s.sequences = seeds[i].sequences;
         s.origin_z = 10, s.step_z = 2;
-        status |= write_seed(argv[1], seeds[i].name, s, seeds[i].flags, seeds[i].sequences);
+        status |= write_seed(argv[1], seeds[i].name, s, seeds[i].flags);
     }
     return status;
 }
