@@ -1,7 +1,8 @@
 /* DICOM series written by the tests, byte by byte: single-frame Part 10 files (128-byte
  * preamble, "DICM", the group 0002 meta header in explicit VR little endian with its group
  * length, then the data set), one file a z-plane of a volume, in explicit or implicit VR little
- * endian or explicit VR big endian, uncompressed or RLE Lossless. */
+ * endian or explicit VR big endian, uncompressed or RLE Lossless, or deflated explicit VR
+ * little endian. */
 #ifndef ISOPROP_TEST_DICOM_SERIES_H
 #define ISOPROP_TEST_DICOM_SERIES_H
 
@@ -9,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <zlib.h>
 
 #include "check.h"
 #include "isoprop/volume.h"
@@ -17,6 +19,7 @@
 #define TEST_DICOM_IMPLICIT_LE "1.2.840.10008.1.2"
 #define TEST_DICOM_EXPLICIT_BE "1.2.840.10008.1.2.2"
 #define TEST_DICOM_RLE "1.2.840.10008.1.2.5"
+#define TEST_DICOM_DEFLATE "1.2.840.10008.1.2.1.99"
 #define TEST_DICOM_CT_STORAGE "1.2.840.10008.5.1.4.1.1.2"
 
 /* What the files of a series say. */
@@ -32,6 +35,7 @@ typedef struct test_dicom_series {
     const char *syntax;      /* Transfer Syntax UID (NULL: one by slice, see below) */
     const char *photometric; /* NULL: MONOCHROME2 */
     int no_position;         /* 1: leave out Image Position (Patient) */
+    int sequences;           /* 1: add a Referenced Image Sequence and an Icon Image Sequence */
 } test_dicom_series;
 
 /* A series of `dims`, spacing 0.7 (y) x 0.8 (x) x 2.5 mm, rescale 1 x stored - 1024. */
@@ -173,6 +177,76 @@ static inline void test_dicom_rle_pixels(test_bytes *b, const unsigned char *pla
     free(frag.data);
 }
 
+/* The zlib level of deflated data sets: stored blocks (0) make bytes that do not depend on
+ * the zlib version (tests/helpers/make_dicom_corpus.c, whose output is compared with files). */
+#ifndef TEST_DICOM_DEFLATE_LEVEL
+#define TEST_DICOM_DEFLATE_LEVEL Z_BEST_COMPRESSION
+#endif
+
+/* Replaces b->data[from ..] by its raw deflate stream (RFC 1951, no zlib header: PS3.5 A.5). */
+static inline void test_deflate_tail(test_bytes *b, size_t from)
+{
+    z_stream z;
+    memset(&z, 0, sizeof z);
+    REQUIRE(deflateInit2(&z, TEST_DICOM_DEFLATE_LEVEL, Z_DEFLATED, -MAX_WBITS, 8,
+                         Z_DEFAULT_STRATEGY) == Z_OK);
+    uLong bound = deflateBound(&z, (uLong)(b->size - from));
+    unsigned char *packed = malloc(bound);
+    REQUIRE(packed != NULL);
+    z.next_in = b->data + from;
+    z.avail_in = (uInt)(b->size - from);
+    z.next_out = packed;
+    z.avail_out = (uInt)bound;
+    REQUIRE(deflate(&z, Z_FINISH) == Z_STREAM_END);
+    b->size = from;
+    test_bytes_put(b, packed, bound - z.avail_out);
+    if (b->size & 1)
+        test_bytes_put(b, "\0", 1); /* the file's length even */
+    deflateEnd(&z);
+    free(packed);
+}
+
+/* The header of a sequence or an item of undefined length (an item or a sequence delimiter
+ * when group is FFFE and element not E000), in b's encoding. */
+static inline void test_dicom_open(test_bytes *b, uint16_t group, uint16_t element, int sequence)
+{
+    test_bytes_uint(b, group, 2);
+    test_bytes_uint(b, element, 2);
+    if (sequence && !b->implicit)
+        test_bytes_put(b, "SQ\0\0", 4);
+    test_bytes_uint(b, group == 0xFFFE && element != 0xE000 ? 0 : 0xFFFFFFFFu, 4);
+}
+
+/* A Referenced Image Sequence (0008,1140): one item of two UIDs; sequence and item of
+ * undefined length. */
+static inline void test_dicom_references(test_bytes *b)
+{
+    test_dicom_open(b, 0x0008, 0x1140, 1);
+    test_dicom_open(b, 0xFFFE, 0xE000, 0);
+    test_dicom_text(b, 0x0008, 0x1150, "UI", TEST_DICOM_CT_STORAGE);
+    test_dicom_text(b, 0x0008, 0x1155, "UI", "1.2.826.0.1.3680043.2.1125.5");
+    test_dicom_open(b, 0xFFFE, 0xE00D, 0);
+    test_dicom_open(b, 0xFFFE, 0xE0DD, 0);
+}
+
+/* An Icon Image Sequence (0088,0200): one item holding a 2 x 2 8-bit image of its own. */
+static inline void test_dicom_icon(test_bytes *b)
+{
+    test_dicom_open(b, 0x0088, 0x0200, 1);
+    test_dicom_open(b, 0xFFFE, 0xE000, 0);
+    test_dicom_us(b, 0x0028, 0x0002, 1);
+    test_dicom_text(b, 0x0028, 0x0004, "CS", "MONOCHROME2");
+    test_dicom_us(b, 0x0028, 0x0010, 2);
+    test_dicom_us(b, 0x0028, 0x0011, 2);
+    test_dicom_us(b, 0x0028, 0x0100, 8);
+    test_dicom_us(b, 0x0028, 0x0101, 8);
+    test_dicom_us(b, 0x0028, 0x0102, 7);
+    test_dicom_us(b, 0x0028, 0x0103, 0);
+    test_dicom_element(b, 0x7FE0, 0x0010, "OB", "\x10\x80\xF0\x40", 4);
+    test_dicom_open(b, 0xFFFE, 0xE00D, 0);
+    test_dicom_open(b, 0xFFFE, 0xE0DD, 0);
+}
+
 /* The transfer syntax of slice z when the series names none: they take turns. */
 static inline const char *test_dicom_syntax_of(const test_dicom_series *s, uint32_t z)
 {
@@ -181,10 +255,10 @@ static inline const char *test_dicom_syntax_of(const test_dicom_series *s, uint3
     return s->syntax ? s->syntax : turns[z % 4];
 }
 
-/* Writes plane z of `volume` (dims[0] x dims[1] x dims[2] samples of s->type, x fastest, host
- * order) as the DICOM file `path`. */
-static inline void test_dicom_write_slice(const test_dicom_series *s, const void *volume,
-                                          uint32_t z, const char *path)
+/* The bytes of plane z of `volume` (dims[0] x dims[1] x dims[2] samples of s->type, x fastest,
+ * host order) as a DICOM file, into *out (empty; the caller frees out->data). */
+static inline void test_dicom_slice_bytes(const test_dicom_series *s, const void *volume,
+                                          uint32_t z, test_bytes *out)
 {
     const char *syntax = test_dicom_syntax_of(s, z);
     size_t sample = ip_type_size(s->type), count = (size_t)s->dims[0] * s->dims[1];
@@ -196,11 +270,14 @@ static inline void test_dicom_write_slice(const test_dicom_series *s, const void
     test_bytes_put(&b, (unsigned char[128]){0}, 128);
     test_bytes_put(&b, "DICM", 4);
     test_dicom_meta(&b, instance, syntax);
+    size_t data_set = b.size;
     b.implicit = strcmp(syntax, TEST_DICOM_IMPLICIT_LE) == 0;
     b.big_endian = strcmp(syntax, TEST_DICOM_EXPLICIT_BE) == 0;
     test_dicom_text(&b, 0x0008, 0x0016, "UI", TEST_DICOM_CT_STORAGE);
     test_dicom_text(&b, 0x0008, 0x0018, "UI", instance);
     test_dicom_text(&b, 0x0008, 0x0060, "CS", "CT");
+    if (s->sequences)
+        test_dicom_references(&b);
     test_dicom_text(&b, 0x0020, 0x000D, "UI", "1.2.826.0.1.3680043.2.1125.7");
     test_dicom_text(&b, 0x0020, 0x000E, "UI", s->series_uid);
     snprintf(text, sizeof text, "%u", z + 1);
@@ -225,6 +302,8 @@ static inline void test_dicom_write_slice(const test_dicom_series *s, const void
         snprintf(text, sizeof text, "%g", s->slope);
         test_dicom_text(&b, 0x0028, 0x1053, "DS", text);
     }
+    if (s->sequences)
+        test_dicom_icon(&b);
     if (strcmp(syntax, TEST_DICOM_RLE) == 0) {
         test_dicom_rle_pixels(&b, plane, count, sample);
     } else {
@@ -236,6 +315,17 @@ static inline void test_dicom_write_slice(const test_dicom_series *s, const void
         test_dicom_element(&b, 0x7FE0, 0x0010, sample == 1 ? "OB" : "OW", swapped, count * sample);
         free(swapped);
     }
+    if (strcmp(syntax, TEST_DICOM_DEFLATE) == 0)
+        test_deflate_tail(&b, data_set);
+    *out = b;
+}
+
+/* Writes plane z of `volume` as the DICOM file `path` (test_dicom_slice_bytes()). */
+static inline void test_dicom_write_slice(const test_dicom_series *s, const void *volume,
+                                          uint32_t z, const char *path)
+{
+    test_bytes b = {0};
+    test_dicom_slice_bytes(s, volume, z, &b);
     FILE *f = fopen(path, "wb");
     REQUIRE(f != NULL);
     REQUIRE(fwrite(b.data, 1, b.size, f) == b.size);

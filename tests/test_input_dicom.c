@@ -252,7 +252,7 @@ static void test_refused(void)
 static void test_malformed(void)
 {
     const char *syntaxes[] = {TEST_DICOM_EXPLICIT_LE, TEST_DICOM_IMPLICIT_LE,
-                              TEST_DICOM_EXPLICIT_BE, TEST_DICOM_RLE};
+                              TEST_DICOM_EXPLICIT_BE, TEST_DICOM_RLE, TEST_DICOM_DEFLATE};
     char dir[4096], path[4200];
     for (size_t k = 0; k < sizeof syntaxes / sizeof syntaxes[0]; k++) {
         test_dicom_series s = test_dicom_default(8, 7, 4, IP_UINT16);
@@ -381,6 +381,266 @@ static void test_changed_file(void)
     free(volume);
 }
 
+/* Replaces the one occurrence of `from` (n bytes) in dir/name by `to` (n bytes). */
+static void patch_file(const char *dir, const char *name, const void *from, const void *to,
+                       size_t n)
+{
+    char path[4200];
+    static unsigned char bytes[1 << 16];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "r+b");
+    REQUIRE(f != NULL);
+    size_t size = fread(bytes, 1, sizeof bytes, f), found = 0, at = 0;
+    REQUIRE(size < sizeof bytes);
+    for (size_t i = 0; i + n <= size; i++)
+        if (memcmp(bytes + i, from, n) == 0)
+            found++, at = i;
+    REQUIRE(found == 1);
+    memcpy(bytes + at, to, n);
+    REQUIRE(fseek(f, 0, SEEK_SET) == 0 && fwrite(bytes, 1, size, f) == size && fclose(f) == 0);
+}
+
+/* Writes a DICOM file without Pixel Data (a presentation state, or an index under another
+ * name than DICOMDIR) as dir/name: meta header, SOP class, a few elements. */
+static void write_non_image(const char *dir, const char *name, const char *sop_class)
+{
+    char path[4200];
+    test_bytes b = {0};
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    test_bytes_put(&b, (unsigned char[128]){0}, 128);
+    test_bytes_put(&b, "DICM", 4);
+    test_dicom_meta(&b, "1.2.826.0.1.3680043.2.1125.77", TEST_DICOM_EXPLICIT_LE);
+    test_dicom_text(&b, 0x0008, 0x0016, "UI", sop_class);
+    test_dicom_text(&b, 0x0008, 0x0018, "UI", "1.2.826.0.1.3680043.2.1125.77");
+    test_dicom_text(&b, 0x0008, 0x0060, "CS", "PR");
+    test_dicom_text(&b, 0x0020, 0x000E, "UI", "1.2.826.0.1.3680043.2.1125.1.1");
+    FILE *f = fopen(path, "wb");
+    REQUIRE(f != NULL && fwrite(b.data, 1, b.size, f) == b.size && fclose(f) == 0);
+    free(b.data);
+}
+
+/* A deflated series (explicit VR little endian, its data set deflated): inflated for the check
+ * of its structure, then read by the library, sample for sample. */
+static void test_deflated(void)
+{
+    char dir[4096];
+    test_dicom_series s = test_dicom_default(7, 5, 4, IP_INT16);
+    void *volume = make_volume(&s);
+    ip_input_desc desc;
+    ip_error err;
+    s.syntax = TEST_DICOM_DEFLATE;
+    test_dicom_write_series(&s, volume, fresh_folder(dir, "deflated"));
+    CHECK_MSG(ip_input_describe(dir, NULL, &desc, &err) == IP_OK, "%s", err.message);
+    CHECK(desc.dims[0] == 7 && desc.dims[1] == 5 && desc.dims[2] == 4 && desc.type == IP_INT16);
+    check_samples(&desc, volume);
+    free(volume);
+}
+
+/* Slices holding sequences (a Referenced Image Sequence, an Icon Image Sequence with an image
+ * of its own), in each transfer syntax: read exactly. */
+static void test_sequences(void)
+{
+    const char *syntaxes[] = {TEST_DICOM_EXPLICIT_LE, TEST_DICOM_IMPLICIT_LE,
+                              TEST_DICOM_EXPLICIT_BE, TEST_DICOM_RLE, TEST_DICOM_DEFLATE};
+    char dir[4096];
+    for (size_t k = 0; k < sizeof syntaxes / sizeof syntaxes[0]; k++) {
+        test_dicom_series s = test_dicom_default(6, 5, 4, IP_UINT16);
+        void *volume = make_volume(&s);
+        ip_input_desc desc;
+        ip_error err;
+        s.syntax = syntaxes[k];
+        s.sequences = 1;
+        test_dicom_write_series(&s, volume, fresh_folder(dir, "sequences"));
+        CHECK_MSG(ip_input_describe(dir, NULL, &desc, &err) == IP_OK, "%s: %s", syntaxes[k],
+                  err.message);
+        check_samples(&desc, volume);
+        free(volume);
+    }
+}
+
+/* Pixel Data longer than the image its header describes (Rows x Columns x samples x bytes x
+ * frames): refused, since the header and the data then describe different images; only the
+ * one byte that pads an odd length to an even one is taken (an 8-bit slice of 5 x 3 pixels,
+ * 15 bytes in a Pixel Data of 16). */
+static void test_long_pixel_data(void)
+{
+    char dir[4096];
+    test_dicom_series s = test_dicom_default(8, 7, 4, IP_UINT16);
+    void *volume = make_volume(&s);
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+    /* Rows lowered from 7 to 6: 112 bytes of Pixel Data for an image of 96 */
+    write_case(fresh_folder(dir, "long_rows"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0002.dcm", "\x28\x00\x10\x00US\x02\x00\x07\x00",
+               "\x28\x00\x10\x00US\x02\x00\x06\x00", 10);
+    expect_refused(dir, IP_ERR_INPUT, "long_rows/IM0002.dcm",
+                   "its Pixel Data holds 112 bytes, more than the 96 of the 8x6 image");
+    /* Bits Allocated 8 over 16-bit samples: twice the image */
+    write_case(fresh_folder(dir, "long_bits"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0003.dcm", "\x28\x00\x00\x01US\x02\x00\x10\x00",
+               "\x28\x00\x00\x01US\x02\x00\x08\x00", 10);
+    expect_refused(dir, IP_ERR_INPUT, "long_bits/IM0003.dcm",
+                   "its Pixel Data holds 112 bytes, more than the 56 of the 8x7 image of 8 bits");
+    free(volume);
+    /* an odd number of 8-bit samples, padded by one byte: read exactly */
+    test_dicom_series odd = test_dicom_default(5, 3, 4, IP_UINT8);
+    ip_input_desc desc;
+    ip_error err;
+    volume = make_volume(&odd);
+    odd.syntax = TEST_DICOM_EXPLICIT_LE;
+    test_dicom_write_series(&odd, volume, fresh_folder(dir, "padded"));
+    CHECK_MSG(ip_input_describe(dir, NULL, &desc, &err) == IP_OK, "%s", err.message);
+    check_samples(&desc, volume);
+    free(volume);
+}
+
+/* A series with one odd member: a slice of other Columns or Bits Allocated (each a consistent
+ * file of its own), a DICOM object without Pixel Data (a presentation state; an index under
+ * another name than DICOMDIR), files that are not DICOM (text first in name order; an empty
+ * file and one shorter than a preamble among the slices): each refused in one line naming the
+ * file. */
+static void test_odd_member(void)
+{
+    char dir[4096];
+    test_dicom_series s = test_dicom_default(8, 7, 6, IP_UINT16), odd;
+    void *volume = make_volume(&s);
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+
+    odd = s, odd.dims[0] = 7, odd.origin_z += 6 * s.step_z;
+    write_case(fresh_folder(dir, "columns"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_INPUT, "columns/odd.dcm",
+                   "mixed series: a different size (rows, columns) than IM0001.dcm (7x7 uint16");
+
+    odd = s, odd.type = IP_UINT8, odd.origin_z += 6 * s.step_z;
+    write_case(fresh_folder(dir, "bits"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_INPUT, "bits/odd.dcm", "mixed series: a different sample type");
+
+    write_case(fresh_folder(dir, "presentation"), &s, volume, 99, NULL, 0);
+    write_non_image(dir, "PS0001.dcm", "1.2.840.10008.5.1.4.1.1.11.1");
+    expect_refused(dir, IP_ERR_INPUT, "presentation/PS0001.dcm", "holds no Pixel Data");
+
+    write_case(fresh_folder(dir, "index"), &s, volume, 99, NULL, 0);
+    write_non_image(dir, "INDEX", "1.2.840.10008.1.3.10");
+    expect_refused(dir, IP_ERR_INPUT, "index/INDEX", "holds no Pixel Data");
+
+    write_case(fresh_folder(dir, "text_first"), &s, volume, 99, NULL, 0);
+    write_text_file(dir, "0readme.txt", "series of Tuesday\n");
+    expect_refused(dir, IP_ERR_INPUT, "text_first/0readme.txt", "neither DICOM nor TIFF");
+
+    write_case(fresh_folder(dir, "empty_file"), &s, volume, 99, NULL, 0);
+    write_text_file(dir, "zz_empty.dcm", "");
+    expect_refused(dir, IP_ERR_INPUT, "empty_file/zz_empty.dcm", "not a DICOM file");
+
+    write_case(fresh_folder(dir, "short_file"), &s, volume, 99, NULL, 0);
+    write_text_file(dir, "zz_short.dcm", "DICM, but too early");
+    expect_refused(dir, IP_ERR_INPUT, "short_file/zz_short.dcm", "not a DICOM file");
+    free(volume);
+}
+
+/* What the fuzz harness (tests/fuzz/fuzz_dicom.c) found, each refused in one line naming the
+ * file now: an unknown value representation in the meta header (GDCM reads it as UN, with a
+ * 32-bit length, and stopped the process on an assertion); RLE Lossless Pixel Data whose header
+ * gives no segment (GDCM's decoder divided by zero); a transfer syntax UID holding a line feed
+ * (it went into the message as it was, making it two lines); an element GDCM reads through its
+ * Attribute class (Frame Increment Pointer) of another value representation than its
+ * dictionary's (an assertion in GDCM's decoding); a Rescale Intercept without a Rescale Slope
+ * (GDCM read a slope of 0 for an MR image and asserted), and a slope of 0; 8-bit samples of 7
+ * bits stored (an assertion in GDCM's decoders). And the structure rules that keep
+ * GDCM on its plain reading path: elements in ascending order, Rows of its dictionary's value
+ * representation. */
+static void test_fuzz_findings(void)
+{
+    char dir[4096];
+    test_dicom_series s = test_dicom_default(8, 7, 4, IP_UINT16);
+    void *volume = make_volume(&s);
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+
+    write_case(fresh_folder(dir, "meta_vr"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0002.dcm", "\x02\x00\x10\x00UI", "\x02\x00\x10\x00UK", 6);
+    expect_refused(dir, IP_ERR_INPUT, "meta_vr/IM0002.dcm",
+                   "an unknown value representation at byte");
+
+    write_case(fresh_folder(dir, "line_feed"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0003.dcm", "1.2.840.10008.1.2.1\0", "1.2.840\n10008.1.2.1\0", 20);
+    expect_refused(dir, IP_ERR_UNSUPPORTED, "line_feed/IM0003.dcm",
+                   "unknown transfer syntax 1.2.840?10008.1.2.1");
+
+    write_case(fresh_folder(dir, "order"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0001.dcm", "\x20\x00\x13\x00IS", "\x20\x00\x33\x00IS", 6);
+    expect_refused(dir, IP_ERR_INPUT, "order/IM0001.dcm", "out of ascending tag order");
+
+    /* Frame Increment Pointer (0028,0009), AT in GDCM's dictionary, as CS: GDCM asserted on it
+     * when decoding (here the Photometric Interpretation's element retagged) */
+    write_case(fresh_folder(dir, "frame_pointer"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0003.dcm",
+               "\x28\x00\x04\x00"
+               "CS",
+               "\x28\x00\x09\x00"
+               "CS",
+               6);
+    expect_refused(dir, IP_ERR_INPUT, "frame_pointer/IM0003.dcm",
+                   "a value representation CS, not AT, at byte");
+
+    write_case(fresh_folder(dir, "rows_vr"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0004.dcm", "\x28\x00\x10\x00US", "\x28\x00\x10\x00SS", 6);
+    expect_refused(dir, IP_ERR_INPUT, "rows_vr/IM0004.dcm", "a value representation SS, not US");
+
+    /* Rescale Slope (0028,1053) retagged (0028,1055): an intercept without a slope, which
+     * GDCM read as one over a slope of 0 for an MR image, and asserted on; a slope of 0 */
+    write_case(fresh_folder(dir, "no_slope"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0004.dcm",
+               "\x28\x00\x53\x10"
+               "DS",
+               "\x28\x00\x55\x10"
+               "DS",
+               6);
+    expect_refused(dir, IP_ERR_INPUT, "no_slope/IM0004.dcm",
+                   "a Rescale Intercept without a Rescale Slope");
+    test_dicom_series flat = s;
+    flat.slope = 0;
+    write_case(fresh_folder(dir, "zero_slope"), &flat, volume, 99, NULL, 0);
+    expect_refused(dir, IP_ERR_INPUT, "zero_slope/IM0001.dcm",
+                   "a Rescale Slope that is not a number other than 0");
+
+    /* an Icon Image Sequence stored as OB (GDCM would guess at its items), a private
+     * transfer syntax (GE's implicit VR big endian, which GDCM reads with its own rules) */
+    test_dicom_series icon = s;
+    icon.sequences = 1;
+    write_case(fresh_folder(dir, "icon_ob"), &icon, volume, 99, NULL, 0);
+    patch_file(dir, "IM0002.dcm", "\x88\x00\x00\x02SQ", "\x88\x00\x00\x02OB", 6);
+    expect_refused(dir, IP_ERR_INPUT, "icon_ob/IM0002.dcm", "a value representation OB, not SQ");
+    test_dicom_series private_syntax = s;
+    private_syntax.syntax = "1.2.840.113619.5.2";
+    write_case(fresh_folder(dir, "private_syntax"), &private_syntax, volume, 99, NULL, 0);
+    expect_refused(dir, IP_ERR_INPUT, "private_syntax/IM0001.dcm",
+                   "transfer syntax 1.2.840.113619.5.2: a private or non-standard encoding");
+
+    s.syntax = TEST_DICOM_RLE;
+    write_case(fresh_folder(dir, "rle_segments"), &s, volume, 99, NULL, 0);
+    /* the RLE header: 2 segments (one a byte of the 16-bit samples), the first at byte 64 */
+    patch_file(dir, "IM0002.dcm", "\x02\0\0\0\x40\0\0\0", "\0\0\0\0\x40\0\0\0", 8);
+    expect_refused(dir, IP_ERR_INPUT, "rle_segments/IM0002.dcm",
+                   "RLE Lossless Pixel Data without a header that fits its image");
+    free(volume);
+
+    /* 8-bit samples of 7 bits stored (High Bit 6): described, then GDCM's decoder asserted
+     * that 8-bit samples store 8 bits */
+    test_dicom_series bytes = test_dicom_default(8, 7, 4, IP_UINT8);
+    volume = make_volume(&bytes);
+    bytes.syntax = TEST_DICOM_EXPLICIT_LE;
+    write_case(fresh_folder(dir, "seven_bits"), &bytes, volume, 99, NULL, 0);
+    for (unsigned z = 1; z <= 4; z++) {
+        char name[32];
+        snprintf(name, sizeof name, "IM%04u.dcm", z);
+        patch_file(dir, name, "\x28\x00\x01\x01US\x02\x00\x08\x00",
+                   "\x28\x00\x01\x01US\x02\x00\x07\x00", 10);
+        patch_file(dir, name, "\x28\x00\x02\x01US\x02\x00\x07\x00",
+                   "\x28\x00\x02\x01US\x02\x00\x06\x00", 10);
+    }
+    expect_refused(dir, IP_ERR_INPUT, "seven_bits/IM0001.dcm",
+                   "8-bit samples of 7 bits stored: only 8 bits stored in 8 are decoded");
+    free(volume);
+}
+
 static void test_series_int16(void)
 {
     test_series(IP_INT16, "int16");
@@ -402,6 +662,11 @@ static const test_case cases[] = {
     TEST_CASE(test_refused),
     TEST_CASE(test_changed_file),
     TEST_CASE(test_malformed),
+    TEST_CASE(test_deflated),
+    TEST_CASE(test_sequences),
+    TEST_CASE(test_long_pixel_data),
+    TEST_CASE(test_odd_member),
+    TEST_CASE(test_fuzz_findings),
 };
 
 static void make_scratch_dir(void)

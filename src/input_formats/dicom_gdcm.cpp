@@ -3,6 +3,7 @@
 // only plain C values cross dicom_gdcm.h.
 #include "dicom_gdcm.h"
 
+#include <gdcmException.h>
 #include <gdcmImage.h>
 #include <gdcmImageReader.h>
 #include <gdcmJPEG2000Codec.h>
@@ -35,10 +36,15 @@ void keep_quiet()
     (void)quiet;
 }
 
+// The reason into why[size], on one line (what GDCM's exceptions say holds line breaks).
 void say(char *why, size_t size, const char *text)
 {
-    if (size > 0)
-        std::snprintf(why, size, "%s", text);
+    if (size == 0)
+        return;
+    std::snprintf(why, size, "%s", text);
+    for (char *c = why; *c; c++)
+        if (static_cast<unsigned char>(*c) < 0x20 || *c == 0x7F)
+            *c = ' ';
 }
 
 // `text` without the trailing spaces and NULs that pad DICOM values to an even length.
@@ -178,6 +184,8 @@ template <typename Work> int guarded(Work work, char *why, size_t why_size)
         if (!reason)
             return 0;
         say(why, why_size, reason);
+    } catch (const gdcm::Exception &e) {
+        say(why, why_size, e.GetDescription()); // what() adds GDCM's source file and line
     } catch (const std::exception &e) {
         say(why, why_size, e.what());
     } catch (...) {

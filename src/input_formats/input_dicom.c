@@ -131,6 +131,17 @@ static ip_status check_magic(const char *path, ip_error *err)
 
 /* ---- one file's header ---- */
 
+/* `value` as a message shows it: control characters (a value may hold any byte) as '?', so
+ * that every message stays one line. Returns out. */
+static const char *shown(const char *value, char out[IP_DICOM_VALUE_MAX])
+{
+    size_t i = 0;
+    for (; value[i] && i + 1 < IP_DICOM_VALUE_MAX; i++)
+        out[i] = (unsigned char)value[i] < 0x20 || value[i] == 0x7F ? '?' : value[i];
+    out[i] = '\0';
+    return out;
+}
+
 /* The numbers of a '\'-separated value; *count as ip__text_parse_double_list. */
 static int parse_numbers(const char *value, double *out, int max, int *count)
 {
@@ -168,6 +179,7 @@ static ip_status field_numbers(const char *path, const ip_dicom_header *h, ip_di
 {
     int got = 0;
     const char *value = h->value[f];
+    char text[IP_DICOM_VALUE_MAX];
     if (value[0] == '\0' && !isnan(fallback)) {
         for (int i = 0; i < count; i++)
             out[i] = fallback;
@@ -177,7 +189,7 @@ static ip_status field_numbers(const char *path, const ip_dicom_header *h, ip_di
         return ip__fail(err, IP_ERR_INPUT, "%s: lacks %s", path, field_names[f]);
     if (parse_numbers(value, out, count, &got) != 0 || got != count)
         return ip__fail(err, IP_ERR_INPUT, "%s: bad %s '%.80s' (%d number%s expected)", path,
-                        field_names[f], value, count, count == 1 ? "" : "s");
+                        field_names[f], shown(value, text), count, count == 1 ? "" : "s");
     return IP_OK;
 }
 
@@ -186,18 +198,22 @@ static ip_status field_count(const char *path, const ip_dicom_header *h, ip_dico
                              double fallback, uint32_t *out, ip_error *err)
 {
     double value;
+    char text[IP_DICOM_VALUE_MAX];
+    *out = 0;
     ip_status st = field_numbers(path, h, f, &value, 1, fallback, err);
     if (st != IP_OK)
         return st;
     if (value != floor(value) || value < 0 || value > 65535)
-        return ip__fail(err, IP_ERR_INPUT, "%s: bad %s '%.80s'", path, field_names[f], h->value[f]);
+        return ip__fail(err, IP_ERR_INPUT, "%s: bad %s '%.80s'", path, field_names[f],
+                        shown(h->value[f], text));
     *out = (uint32_t)value;
     return IP_OK;
 }
 
 static ip_status check_syntax(const char *path, const ip_dicom_header *h, ip_error *err)
 {
-    const char *uid = h->value[IP_DICOM_TRANSFER_SYNTAX];
+    char text[IP_DICOM_VALUE_MAX];
+    const char *uid = shown(h->value[IP_DICOM_TRANSFER_SYNTAX], text);
     if (uid[0] == '\0')
         return ip__fail(err, IP_ERR_INPUT, "%s: lacks %s", path,
                         field_names[IP_DICOM_TRANSFER_SYNTAX]);
@@ -216,6 +232,7 @@ static ip_status check_syntax(const char *path, const ip_dicom_header *h, ip_err
 static ip_status check_pixels(const char *path, const ip_dicom_header *h, ip_error *err)
 {
     uint32_t samples, frames;
+    char text[IP_DICOM_VALUE_MAX];
     const char *photometric = h->value[IP_DICOM_PHOTOMETRIC];
     ip_status st;
     if ((st = field_count(path, h, IP_DICOM_SAMPLES_PER_PIXEL, 1, &samples, err)) != IP_OK ||
@@ -233,7 +250,7 @@ static ip_status check_pixels(const char *path, const ip_dicom_header *h, ip_err
     if (photometric[0] != '\0' && strcmp(photometric, "MONOCHROME2") != 0)
         return ip__fail(err, IP_ERR_UNSUPPORTED,
                         "%s: photometric interpretation %.40s is not supported, only MONOCHROME2",
-                        path, photometric);
+                        path, shown(photometric, text));
     if (frames > 1)
         return ip__fail(err, IP_ERR_UNSUPPORTED,
                         "%s: %u frames in one file: only single-frame files are supported", path,
@@ -334,7 +351,7 @@ done:
 /* Every file of one series: otherwise the count of series and their UIDs. */
 static ip_status check_one_series(const dicom_series *s, ip_error *err)
 {
-    char list[600] = "";
+    char list[600] = "", text[IP_DICOM_VALUE_MAX];
     size_t used = 0;
     uint64_t series = 0;
     for (uint64_t i = 0; i < s->count; i++) {
@@ -344,9 +361,9 @@ static ip_status check_one_series(const dicom_series *s, ip_error *err)
         if (j < i)
             continue; /* a series seen before */
         if (++series <= 4 && used < sizeof list)
-            used +=
-                (size_t)snprintf(list + used, sizeof list - used, "%s%s", series > 1 ? ", " : "",
-                                 s->slices[i].series[0] ? s->slices[i].series : "(none)");
+            used += (size_t)snprintf(
+                list + used, sizeof list - used, "%s%s", series > 1 ? ", " : "",
+                s->slices[i].series[0] ? shown(s->slices[i].series, text) : "(none)");
     }
     if (series > 1)
         return ip__fail(err, IP_ERR_INPUT,
