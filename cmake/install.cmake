@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Installation (cmake --install BUILD [--prefix P]): the libraries, their public headers, the
 # CMake package (find_package(isoprop [COMPONENTS render])) and the pkg-config files isoprop.pc
 # and isoprop-render.pc. The package and the .pc files find the prefix from where they lie, so

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A tiny test harness: CHECK and its kin record a failure and go on; main() runs the program's
  * cases with RUN_CASES (every case, or those named on its command line), which returns
  * test_summary(). */

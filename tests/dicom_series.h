@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* DICOM series written by the tests, byte by byte: single-frame Part 10 files (128-byte
  * preamble, "DICM", the group 0002 meta header in explicit VR little endian with its group
  * length, then the data set), one file a z-plane of a volume, in explicit or implicit VR little

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Checks on ip_input shared by the tests of the input readers (after check.h). */
 #ifndef ISOPROP_TEST_INPUT_CHECK_H
 #define ISOPROP_TEST_INPUT_CHECK_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* For tests, fuzzers and tests/helpers/corrupt.c: recomputes every checksum of a brick file
  * image in memory from the header's own fields (docs/format.md): each payload's in its
  * directory entry, the summary section's, the header's. Trusts nothing: every offset is

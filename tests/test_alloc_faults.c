@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Allocation failures through the public calls: a small whole run (describe, brick, open,
  * cache, engine steps to the exact image, full extraction, weld, write) is repeated with the
  * library's Nth allocation failing, for every N until a run makes fewer allocations than N.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The stable path of the API (include/isoprop/status.h, "Structs that may grow"): option structs
  * read only as far as the caller's size says, a zero size standing for the 0.2.0 struct, a
  * later caller's struct taken when what this library does not know is zero and refused

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The growable-array helper (src/common/array.c). */
 #include <stdint.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Bricking round trips: every sample of every brick of every level, and every summary,
  * recomputed from the raw input; plus determinism, cancellation and memory limits. */
 #include <dirent.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The brick cache: exact LRU counts against a reference model, pinning over budget,
  * a corrupted brick, many threads pinning at once (decode-once, counts that agree), and the
  * cell-group ranges of every brick against brute force. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Camera motions: orbit, pan, dolly and the sizes they use (isoprop/camera.h). */
 #include <math.h>
 #include <stdio.h>

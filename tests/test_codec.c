@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The brick codec (src/brickfile/codec.c) on its own: encode/decode round trips of every
  * sample type at both compression paths (LZ4 and LZ4HC) over odd extents, constant bricks, the
  * raw fallback, the decoder against a reference encoder written from docs/format.md for every

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The codec's fast decoding paths (the fused unshuffle + zigzag + running sum, in SSE2 or in
  * its portable form) against a reference decoder written plainly from docs/format.md
  * "Filters": one sample at a time, no buffers shared between steps. This file is built twice:

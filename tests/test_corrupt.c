@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Corrupted and changing brick files never give a wrong image, a crash or a hang.
  *
  * For small brick files made here, every payload brick in turn gets a bit flipped in a copy

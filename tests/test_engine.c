@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The engine against the paper's guarantee: once every pixel has had its ray, the image of the
  * progressive mesh equals the image of the full extraction (same coverage, >= 99.99 % equal
  * pixels), and every progressive triangle is a triangle of the full result (same cell, same

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The brick file format (src/brickfile/format.c) on its own, in memory: the layout derived from
  * odd dimensions and brick edges against the formulas of docs/format.md, brick coordinates and
  * extents, the octree numbering, the Morton order, header and directory entry round trips

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Generators and upsampling: determinism, value conventions, structure, and atomic output. */
 #include <dirent.h>
 #include <math.h>

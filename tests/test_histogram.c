@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The histogram against a direct count of the raw samples: at every level (the pyramid takes
  * every 2^k-th sample), for integer and float types, with constant bricks; the active
  * sub-blocks against a brute-force count over the summaries; the default level; bad

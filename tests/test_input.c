@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The input module: raw files by name and by overrides, NRRD, MetaImage, gzip, byte order,
  * large offsets, and every kind of bad input. Test files are generated in the scratch folder. */
 #include <dirent.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* DICOM series input: folders of DICOM files the test writes (dicom_series.h) from a synthetic
  * volume, in shuffled file order and mixed transfer syntaxes, described and read back sample
  * for sample; and each way a series folder can be wrong, refused in one line naming it. */

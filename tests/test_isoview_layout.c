@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview's text layout (tools/isoview/layout.c): the help's second column starts at one x
  * for every row, past the widest key; rows stack by the font's line height; a text without
  * tabs is one cell a row at x = 0; a table too large for the cells given says so. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The cache's LRU heap (src/store/lru_heap.c): smallest key first, parking, room. */
 #include <stdint.h>
 

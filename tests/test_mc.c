@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Marching cubes: regenerates the case tables from the face rule, then checks that meshes from
  * many fields are closed and consistently oriented, and that the seeding ray test is exact.
  * "test_mc --emit-table" prints src/engine/mc_table.c; "test_mc --bench N" times a sphere of N^3. */

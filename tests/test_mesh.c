@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Meshes: packed normals, cell ids on request, appends, and the writers (PLY, STL, OBJ, binary
  * glTF) of soups and of welded meshes. */
 #include <math.h>

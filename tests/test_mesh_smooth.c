@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Taubin smoothing: on a sphere extracted fully from a binary volume (terraced), the radius varies
  * less afterwards and the sphere barely shrinks, while Laplacian smoothing (mu = 0) of as many
  * iterations shrinks it clearly; a plane stays flat and keeps its rim; counts and indices stay;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Vertex welding: shared vertices by exact position, averaged normals, degenerate triangles
  * left out; and the surface of a full extraction comes out closed (a sphere well inside the
  * volume) or open exactly where it meets the volume's faces. */

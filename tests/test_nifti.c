@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* NIfTI input: NIfTI-1 and -2, both byte orders, .nii and .nii.gz, every supported type, the
  * spacing from pixdim, the scaling reported, overrides, and the usual breakages (truncated,
  * 4D, bad magic, unsupported datatype, .hdr/.img pairs), each one line naming the file. The

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The min/max octree walk shared by the bricker and the store (src/brickfile/summary.c): every
  * node gets the range of the bricks below it, and a checking visitor stops at the first node
  * that disagrees. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The output rules (isoprop/output.h) and where the library applies them: an existing file is
  * kept without force, only regular files are ever replaced (a FIFO, a device, a directory or a
  * link to a device is refused even with force), an output is never an input however it is

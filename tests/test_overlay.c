@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Tests of the figure overlays (src/render/overlay.c): the scale bar's length against the
  * camera's projection, the axis triad's directions as the camera turns, and that each draws
  * only inside the corner box it reports. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The thread pool: every job runs exactly once per run, runs can follow each other on one
  * pool, the helpers really run jobs at the same time as the caller (with signals blocked), a
  * pool of 1 runs on the caller, and a pool may be destroyed without ever running. The spin

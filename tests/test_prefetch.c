@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Reading bricks ahead (src/store/cache_prefetch.h, src/engine/prefetch.c): counts, never times.
  * The cache: a brick loaded ahead is a hit at its first pin and counted once in prefetch_hits;
  * a load ahead never goes over the budget, never evicts a pinned brick or one pinned since the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Tests of the software rasterizer (coverage, fill rule, depth, clipping, shading) and PNGs. */
 #include <math.h>
 #include <png.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Progressive ray order: every pixel exactly once, centre first, evenly spread prefixes.
  * "test_ray_order --bench W H" times a full walk of a W x H image. */
 #include <math.h>

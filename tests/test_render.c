@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Tests of the OpenGL renderer against the software rasterizer; skipped without headless EGL. */
 #include <epoxy/gl.h>
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Ray seeding: passing over the cells of inactive cell groups (the cache's group ranges)
  * changes nothing a ray finds, ray by ray, and reads the corners of fewer cells. Counts, no
  * clock. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Spacing bounds: ip_spacing_check() accepts exactly [IP_SPACING_MIN, IP_SPACING_MAX] with a
  * largest-to-smallest ratio of at most IP_SPACING_RATIO_MAX; ip_input_describe() and
  * ip_bricker_run() refuse the rest; and the camera's depth range scales with the volume, so

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The store against a hostile or changing file: what it checks on opening (the padding before
  * the summary, reserved directory bytes, non-regular files), and what a reader gets when the
  * file changes after opening (truncated, rewritten in place): a clear error naming the file

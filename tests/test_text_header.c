@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The text-header helpers shared by the NRRD and MetaImage readers (src/input/text_header.c):
  * the key table dispatch, the shared key parsers and checks, the reading driver, and the one
  * table of sample type names (src/common/volume.c). */

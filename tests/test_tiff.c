@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* TIFF input: multi-page files and folders of numbered files, every supported sample type,
  * strips and tiles, compressed pages, ImageJ's spacing, and the usual breakages (mixed
  * sizes, a missing slice, an unsupported type or compression), each one line naming the file.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The rule every program follows for its outputs (tools/common/tool_outputs.h): a run's
  * outputs are a set, all of them or none. A failed run removes what it wrote; a signal before
  * the set is complete removes it and ends the run as killed by the signal; a signal after it is

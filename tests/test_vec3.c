@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The vec3 helpers (src/common/vec3.h): values, aliasing, and the same bits as the written-out
  * expressions they replaced. */
 #include <math.h>

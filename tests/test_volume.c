@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Sample types, dimension parsing and status messages. */
 #include "check.h"
 #include "isoprop/volume.h"

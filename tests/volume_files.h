@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Writing small test volumes as TIFF (libtiff's writing API: a multi-page file or one file a
  * plane) and as NIfTI-1/2 (the header by hand, .nii or .nii.gz through zlib), from samples in
  * the host's byte order; and reading a volume back whole through ip_input. For the tests of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Test volumes on disk: a generated field written as a raw file, a raw file bricked. */
 #ifndef ISOPROP_TEST_VOLUMES_H
 #define ISOPROP_TEST_VOLUMES_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isobrick: brick a raw, NRRD or MetaImage volume into a brick file (.ibv), once. */
 #include <errno.h>
 #include <stddef.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isogen: writes a synthetic test volume, or an upsampled copy of a volume, as a raw file. */
 #include <inttypes.h>
 #include <stddef.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoinfo: describe a brick file (.ibv), as text or JSON, and verify it. */
 #include <math.h>
 #include <stddef.h>

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # isoprop set-up: installs the Debian packages the project needs (only those missing),
 # configures and builds, then runs one job.
 #

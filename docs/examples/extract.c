@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* extract: an example of a program built on libisoprop (docs/api.md).
  *
  *   extract FILE.ibv ISO [--full] [--size WxH] [--threads N] [--mesh OUT.ply]

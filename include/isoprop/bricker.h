@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: bricking a raw volume into a brick file, streaming, with bounded memory.
  *
  * The input is read once, plane by plane. Each pyramid level keeps one slab of B+1 planes;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: the pinhole camera shared by ray casting and rendering.
  *
  * World coordinates honour voxel spacing: sample (i, j, k) of level 0 sits at

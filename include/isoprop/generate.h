@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: synthetic and upsampled volumes for tests, demos and benchmarks.
  *
  * Every generator is a pure function of (parameters, sample position), so a volume of any size

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: the histogram of a brick file's sample values, to choose an isovalue.
  *
  * ip_histogram_compute() counts the samples of one level of the pyramid in bins spread evenly

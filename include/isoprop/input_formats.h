@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: the input component, libisoprop_input: the readers of TIFF (libtiff) and DICOM
  * (GDCM), apart from the core so that libisoprop links only lz4, xxhash, zlib, libm and threads
  * and a program that opens brick files loads no image-format library.

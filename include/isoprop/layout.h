@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: the shape of a brick file: its levels, bricks and directory entries.
  *
  * docs/format.md specifies every byte. In short: a 256-byte header, then the brick payloads

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: triangle meshes produced by extraction.
  *
  * A mesh is a triangle soup in world units: each triangle has 3 positions (floats) and 3 unit

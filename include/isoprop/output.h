@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: the rules every output file follows, and whole files written all-or-nothing.
  *
  * Every file the library writes (brick files, raw volumes, PNG images, PLY meshes, and the

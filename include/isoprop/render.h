@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: rendering of extracted meshes, on the GPU (OpenGL 3.3 core) and in software.
  *
  * Both renderers draw the same picture of an ip_mesh seen by an ip_camera (see camera.h for

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: a brick file opened for reading.
  *
  * ip_store_open() reads the header and the summary section once, into memory the store owns,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: process-level facts the library and the programs share: a monotonic clock, the
  * peak resident set and the thread-count rule. Thread-safe.
  */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: the library's version, the one source of truth (CMakeLists.txt reads it from here
  * for project(VERSION); the programs print it for --version). Semantic versioning: the major
  * number changes with incompatible API or brick-format changes, the minor with additions, the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """isoprop: isosurfaces of volumes far larger than memory, from Python.
 
     import isoprop

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Checks of the arguments of the module's functions, made before any work.
 
 Each check returns the value as the module passes it on, or raises TypeError (a value of the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Finding and loading libisoprop.so, and the prototypes of the functions the module calls.
 
 Where the library is, first found wins:

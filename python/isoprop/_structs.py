@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """ctypes mirrors of the public C structs that the module passes to libisoprop.
 
 Each class copies a struct of include/isoprop/*.h field by field, in order. The test

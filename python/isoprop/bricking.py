@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """isoprop.brick(): a brick file from a raw volume (any input the library reads) or from a
 numpy array."""
 import ctypes

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The exceptions the module raises: Error for every failure the library reports, and
 ArgumentError (an Error and a ValueError) for an argument out of range."""
 from . import _structs as S

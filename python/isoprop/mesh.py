@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Triangles copied out of a libisoprop mesh into numpy arrays."""
 import ctypes
 

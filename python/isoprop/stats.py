@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The statistics of an extraction, as a dict with the keys of isorender's --stats JSON
 (tools/isorender/stats.c, tools/common/report.c). Left out, since they need the run's image:
 the renderer's work (final_pixel_pct, visible_triangles, overdraw); "renderer" is "none" and the

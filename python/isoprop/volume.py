@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """isoprop.open(): a brick file, and extraction from it, full or progressive."""
 import ctypes
 import os

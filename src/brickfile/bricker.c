@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Streaming bricking: input planes -> pyramid slabs -> compressed bricks -> brick file. */
 #include <errno.h>
 #include <fcntl.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Brick payload codec: constant detection, predictors, byte shuffle, LZ4 blocks. */
 #include <lz4.h>
 #include <lz4hc.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: encoding and decoding of one brick's payload.
  *
  * A brick is stored as a constant (no payload), raw little-endian samples, or one LZ4 block of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The brick file layout: derived geometry, header and summary encoding, validation. */
 #include <math.h>
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop internal: the brick file's header and summary section, encoded and parsed.
  *
  * This module computes the layout from the volume's shape (the public part of it is

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop internal: every byte offset of the brick file's fixed-size records, named once.
  *
  * docs/format.md is the specification; these names are its tables ("Header", "Level table

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Min/max summaries of bricks and sub-blocks. */
 #include <math.h>
 

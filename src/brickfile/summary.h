@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Min/max summaries of a brick and its sub-blocks, over cell corners. Internal. */
 #ifndef ISOPROP_SUMMARY_H
 #define ISOPROP_SUMMARY_H

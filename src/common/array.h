@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Growable arrays: the one place that works out a larger capacity and reallocates. Internal. */
 #ifndef ISOPROP_ARRAY_H
 #define ISOPROP_ARRAY_H

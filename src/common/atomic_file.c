@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Atomic output files; see atomic_file.h for the guarantees. */
 #include <errno.h>
 #include <fcntl.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Atomic output files: all-or-nothing creation of a file at a path.
  *
  * The bytes go to an unnamed file (O_TMPFILE) in the destination's folder, or, where the file

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The pinhole camera: basis, pixel rays, projection, OpenGL matrices, framing presets, motions. */
 #include <math.h>
 #include <stdio.h>

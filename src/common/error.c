@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Status messages and the error-report helpers. */
 #include <errno.h>
 #include <stdarg.h>

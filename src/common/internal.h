@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Internal helpers shared by the library's source files; not part of the public API. */
 #ifndef ISOPROP_INTERNAL_H
 #define ISOPROP_INTERNAL_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Triangle soups: growth and append (the file formats: mesh_write.c). */
 #include <stdio.h>
 #include <stdlib.h>

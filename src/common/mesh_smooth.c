@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Taubin smoothing of a welded mesh: each iteration moves every vertex toward the average of
  * its neighbours (factor lambda > 0), then away from it (factor mu < -lambda). The first step
  * alone, repeated, is Laplacian smoothing, which shrinks a closed surface toward a point; the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A mesh moved from world coordinates into its volume's physical space. */
 #include "isoprop/mesh.h"
 

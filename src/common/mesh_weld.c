@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Vertex welding: a triangle soup to an indexed mesh, joining corners at exactly one position.
  * Marching cubes computes a vertex shared by neighbouring cells with the same bits in each
  * (src/engine/mc.h), so no tolerance is needed, and none is used: a tolerance could join

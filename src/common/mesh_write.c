@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Meshes to files: binary PLY, binary STL, Wavefront OBJ and binary glTF, chosen by extension,
  * from a triangle soup or an indexed mesh alike (a soup is written as the indexed mesh whose
  * triangle t has vertices 3t, 3t + 1, 3t + 2). Every file is written all-or-nothing

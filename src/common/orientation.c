@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Origin and axis directions of a volume in its file's physical space. */
 #include <math.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The library's thread pool: helpers started once, woken for each run by a generation
  * counter, taking job indices under one mutex. Jobs are coarse (a worker's share of a step,
  * a layer or a group of planes), so one lock per job costs nothing. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A small persistent thread pool: started once, it runs numbered jobs on its threads and on
  * the caller's, and waits for them all. Internal to the library. */
 #ifndef ISOPROP_POOL_H

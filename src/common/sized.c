@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Sized structs: the caller's option struct read only as far as it goes. */
 #include <string.h>
 

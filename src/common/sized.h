@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Sized structs (include/isoprop/status.h): the public option structs that start with their
  * size, read from the caller's memory only as far as the caller's struct goes. */
 #ifndef ISOPROP_SIZED_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Process-level facts: a monotonic clock, the peak resident set, the number of cores. */
 #include <stdint.h>
 #include <stdio.h>

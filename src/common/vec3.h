@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Small operations on 3-vectors of doubles, inline. Internal. Each computes exactly what its
  * expression in the comment computes, in that order, so a caller that replaces the written-out
  * expression with it gets the same bits. `out` may alias an input. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Sample types, dimension parsing and small platform helpers. */
 #include <math.h>
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Beams against the min/max octree: root -> bricks -> sub-blocks -> cell groups -> cells. */
 #include <math.h>
 

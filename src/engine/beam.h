@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Beams: whether the rays through a screen tile could still extract anything, tested once for
  * the whole tile against the min/max octree (bulk retirement of rays; see retire.c). Internal. */
 #ifndef ISOPROP_BEAM_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A pixel's ray: the walk through each distance band's octree, its seed and propagation. */
 #include <math.h>
 

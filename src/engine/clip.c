@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Clipping planes: a box is dropped when it lies wholly beyond one plane. */
 #include <math.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Clipping planes: which boxes of the volume the planes keep (isoprop/engine.h, ip_clip_plane).
  * Internal. */
 #ifndef ISOPROP_CLIP_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The coverage depth buffer: what extracted surface already hides, for occlusion-aware
  * propagation.
  *

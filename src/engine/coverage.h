@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The coverage depth buffer of occlusion-aware propagation. Internal.
  *
  * Two entries per pixel of the image. The first, `depth`: an upper bound on the view depth of

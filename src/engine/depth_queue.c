@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A propagation's queue of cells, nearest first, in buckets of view depth. */
 #include <stdlib.h>
 #include <string.h>

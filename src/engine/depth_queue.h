@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A propagation's queue of cells, nearest to the eye first: buckets of view depth. Internal.
  *
  * Propagation that takes the nearest queued cell first extracts the surface in front before

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The progressive engine: its life, views and regions, and steps run by the workers on the pool
  * (the ray hand-out, a ray's walk, bulk retirement and shared propagation have files of their
  * own: engine_state.h). */

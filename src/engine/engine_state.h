@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The progressive engine's state, shared by the files that make it up (internal): the engine
  * and its workers (engine.c: lifecycle, views, steps), the ray order handed out to the workers
  * (handout.c), a pixel's ray (cast.c), rays retired in bulk by screen tiles (retire.c) and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Full extraction: every active cell of a level, brick by brick, skipping by summaries; and at
  * a view's adaptive resolution, each level's cells of its distance band (lod.h). */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The ray order handed out to the engine's workers: ranges of positions claimed without a
  * lock, batches of rays, the step's budget. */
 #include <stdatomic.h>

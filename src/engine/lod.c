@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Adaptive resolution: the distance bands of a view's pyramid levels (lod.h). */
 #include <math.h>
 

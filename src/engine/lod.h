@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Adaptive resolution: the distance bands of a view's pyramid levels. Internal.
  *
  * A view uses levels 0 .. levels - 1. A cell of level k belongs to the view's surface when

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Marching cubes: the case of a cell, its triangles, and the ray test that seeding relies on. */
 #include <float.h>
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: marching cubes: the case tables and the triangulation of one cell.
  *
  * Corners. Corner i of a cell sits at offset (i & 1, (i >> 1) & 1, (i >> 2) & 1) along (x, y, z)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The engine's background reader (prefetch.h): plans from the summaries and the ray order,
  * asks the kernel for the payloads ahead, loads bricks into the cache ahead of the workers. */
 #include <pthread.h>

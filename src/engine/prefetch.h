@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The engine's background reader: one thread per engine that reads and decodes into the cache
  * the bricks the next rays of the progressive order will seed in, and their neighbours across
  * brick faces, where propagation goes next, so that the workers find them resident instead of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Breadth-first propagation of the isosurface from a seed, within the cut-off angle, stopped
  * where the surface folds back and outside the view frustum. */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Surface propagation from a seed cell, and the triangle output shared with full extraction.
  * Internal. */
 #ifndef ISOPROP_PROPAGATE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Progressive ray order: a breadth-first quadtree over the screen, Bayer order within a level. */
 #include "ray_order.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: the progressive order in which rays are cast over the screen.
  *
  * Every pixel of a width x height image is visited exactly once, coarse to fine, so that any

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Screen tiles that the bricks holding the isovalue may show in. */
 #include <math.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Screen tiles that the bricks holding the isovalue may show in: the rays of the others can meet
  * no active cell, so the engine settles them from the start (engine.c). Internal. */
 #ifndef ISOPROP_REACH_H

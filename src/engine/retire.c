@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Rays retired in bulk: screen tiles of 8 x 8 pixels tested as beams against the octree, and
  * the Z-order blocks of rays they retire at once (docs/occlusion.md). */
 #include <math.h>

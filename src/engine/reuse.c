@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Reuse across views (engine.h, "Reuse"): what a new view keeps of the mesh of the view before.
  *
  * The mesh holds whole cells, each as one run of triangles with its cell id (extracted cells

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Samples, cells and their triangulation for one level, read through the brick cache. */
 #include <math.h>
 #include <stdlib.h>

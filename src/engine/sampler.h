@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Reading samples and cells of one level through the brick cache. Internal.
  *
  * A sampler keeps a few bricks pinned (the ones it read last), so that the samples of a cell

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Ray seeding through the min/max octree: root -> bricks -> sub-blocks -> cells, front to back
  * (the bricks of a short stretch of ray by a DDA over them instead of down the octree). */
 #include <math.h>

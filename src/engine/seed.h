@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Ray seeding: the first cell along a ray whose marching-cubes triangles the ray hits. Internal. */
 #ifndef ISOPROP_SEED_H
 #define ISOPROP_SEED_H

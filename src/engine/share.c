@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Idle workers help the others' propagations: parts of long queues handed out during a step. */
 #include <string.h>
 #include "engine_state.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A sparse, concurrent bit set over the cells of every level. */
 #include <stdlib.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The set of cells already extracted, one bit per cell, stored per brick and allocated only
  * for the bricks propagation reaches, so its memory follows the surface, not the volume.
  * Thread-safe: bits are set with atomic operations and a brick's bitmap is published with a

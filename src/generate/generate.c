@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Synthetic volumes: the Shepp-Logan phantom and test fields, deterministic noise, raw output. */
 #include <inttypes.h>
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Trilinear upsampling of an input volume into a larger raw file, streamed plane by plane. */
 #include <inttypes.h>
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Finding the readers of TIFF and DICOM, which live in the input component libisoprop_input
  * (src/input_formats/, include/isoprop/input_formats.h): linked in where the build put them
  * in the same library (IP_INPUT_FORMATS_LINKED: the static library, the component itself),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Describing an input volume: format dispatch, the NAME_XxYxZ_TYPE.raw convention, overrides,
  * the checks made before any sample is read. */
 #include <ctype.h>

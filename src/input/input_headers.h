@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Internal to the input module: the header formats input.c reads (NRRD, MetaImage), each a
  * table of what text_header.c needs to read it. Not part of the public API. */
 #ifndef ISOPROP_INPUT_HEADERS_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* MetaImage headers (.mhd with a separate data file, .mha or ElementDataFile = LOCAL with the
  * data right after the header): "Key = Value" lines ending with ElementDataFile. */
 #include <math.h>

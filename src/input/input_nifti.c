@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* NIfTI-1 and NIfTI-2 input: one file holding the header and the samples (magic "n+1" or
  * "n+2"; .nii, or .nii.gz compressed as a whole), in either byte order. The header gives the
  * dims (3D, or 4D and up with every further dimension 1), the sample type, the spacing

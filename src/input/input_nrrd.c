@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* NRRD headers: attached (.nrrd, data after the blank line) and detached (.nhdr, data in the
  * file that `data file:` names), raw or gzip encoded. Follows the NRRD0001-0005 format
  * description; only what a 3-D scalar volume needs is interpreted, other fields are ignored. */

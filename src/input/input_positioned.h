@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Positioned reads of uncompressed input, for callers that read planes from several threads
  * (the bricker) and ask the kernel to read ahead. Internal. */
 #ifndef ISOPROP_INPUT_POSITIONED_H

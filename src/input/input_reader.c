@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Streaming z-planes out of an input volume: positioned reads for raw data, zlib's inflate for
  * gzip (and zlib) streams, then conversion to the host's byte order and a float32 check. */
 #include <errno.h>

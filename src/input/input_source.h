@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Internal to the input module: the formats with binary headers (TIFF, NIfTI, DICOM), each
  * described by one function, and the plane sources of the encodings that are not one byte
  * stream (TIFF pages or files, DICOM files), which the reader drives one plane at a time.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Text headers (NRRD, MetaImage): the line reader, the value parsers and the table of keys
  * that both readers dispatch their lines through. */
 #include <ctype.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Internal to the input module: reading a text header (NRRD, MetaImage) line by line, parsing
  * its values, and one table-driven dispatch of "key, value" to the parser of the key. Not part
  * of the public API. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The structure of a DICOM Part 10 file, checked before GDCM parses it (dicom_check.h). Only
  * the element framing is read: tags, value representations and lengths, and the few values
  * that size the image (Rows, Columns, Samples per Pixel, Bits Allocated, Number of Frames).

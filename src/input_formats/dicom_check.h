@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A DICOM Part 10 file's structure checked before the DICOM library parses it: every element's
  * length within the file, sequences and items closed, and the Pixel Data as long as the image
  * its header describes. The library (GDCM) stops the process on some truncated files and reads

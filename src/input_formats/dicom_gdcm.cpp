@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 // DICOM files through GDCM: the header fields DICOM input needs, and one file's pixels decoded
 // into a caller's buffer. The only C++ of the library: every call is inside try/catch, and
 // only plain C values cross dicom_gdcm.h.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Internal to the input module: the few calls into the DICOM library (GDCM, dicom_gdcm.cpp)
  * behind a C interface, so that the rest of DICOM input (listing, grouping, sorting, checks,
  * messages: input_dicom.c) is C. Nothing thrown or allocated in C++ crosses it. Not part of

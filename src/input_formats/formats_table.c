@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The input component's entry: its readers as the core's loader takes them. */
 #include <stddef.h>
 

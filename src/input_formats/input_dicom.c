@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* DICOM input: a folder holding one series of single-frame DICOM files, one file a z-plane.
  * The files' headers and pixels are read through dicom_gdcm.h; everything else is here:
  * which files count, one series, slices alike, their order along the slice normal, an even

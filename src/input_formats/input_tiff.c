@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* TIFF input through libtiff: a multi-page TIFF file (every page a z-plane) or a folder of
  * numbered single-page TIFF files (every file a z-plane, in the order of the number in its
  * name). Pages hold one sample per pixel: 8-bit unsigned, 16-bit unsigned or signed, 32-bit

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Internal to the input component (libisoprop_input): its readers, which the core reaches
  * through the table of formats_table.c (ip__input_formats, src/input/input_source.h). */
 #ifndef ISOPROP_INPUT_READERS_H

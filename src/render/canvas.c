@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The canvas: the software rasterizer's image of a growing mesh, kept from frame to frame so
  * that each frame draws only the triangles added since the last and shades only the pixels
  * they changed. */

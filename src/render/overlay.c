@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Figure overlays drawn into a finished RGBA image: the axis triad and the scale bar
  * (isoprop/render.h). They are drawn after rendering, on the CPU, so that the OpenGL and the
  * software renderers, with or without anti-aliasing, get the same overlay. */

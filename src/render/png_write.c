@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* PNG output of rendered images through libpng, written atomically. */
 #include <png.h>
 #include <setjmp.h>

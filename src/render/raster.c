@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The software reference rasterizer: exact coverage, depth and shading of a mesh, no GPU. */
 #include <math.h>
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The software rasterizer's core, shared by the one-off images (raster.c) and the canvas that
  * draws a growing mesh frame after frame (canvas.c). Internal. */
 #ifndef ISOPROP_RASTER_CORE_H

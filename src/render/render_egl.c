@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Headless OpenGL 3.3 core contexts: EGL on Mesa's surfaceless platform (llvmpipe, no GPU). */
 #include <EGL/egl.h>
 #include <EGL/eglext.h>

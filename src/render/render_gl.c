@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The OpenGL 3.3 core renderer: mesh buffers on the GPU, shaders, drawing and read-back. */
 #include <epoxy/gl.h>
 #include <stdint.h>

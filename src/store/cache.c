@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The brick cache: lock-free hits, one decode per miss, exact LRU under a byte budget. */
 #include <math.h>
 #include <pthread.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Loading bricks into the cache ahead of their first pin, for a background reader (the
  * engine's, src/engine/prefetch.c). Internal to the library.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The histogram of one level's samples, and the sub-blocks each bin edge would cross. */
 #include <math.h>
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The cache's LRU min-heap. */
 #include <stdlib.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The cache's LRU order: a binary min-heap of (key, value) items, with room to set items aside
  * while popping. Internal to the store stage. Not thread-safe: the cache calls it under its
  * eviction lock. */

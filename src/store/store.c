@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A brick file opened for reading: its summaries held in memory, bricks read on demand. */
 #include <errno.h>
 #include <fcntl.h>

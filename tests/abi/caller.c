@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A caller compiled against the headers of isoprop 0.2.0 (tests/abi/0.2.0/, the stable tier: no
  * IP_EXPERIMENTAL) and run against the library being built: the stable API must keep working
  * for programs compiled before, every struct laid out as they know it. It generates a sphere,

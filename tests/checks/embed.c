@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* An embedder's program: the whole chain through the public API alone (isoprop/isoprop.h,
  * linked with libisoprop.so, no internal header on its include path). Generates a sphere,
  * bricks it, opens it with a small cache, extracts the isosurface progressively until every

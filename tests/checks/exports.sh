@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # A shared library exports exactly its public API: every function declared with IP_API in its
 # public headers, and nothing else (no internal ip__ symbol, nothing without the ip_ prefix, no
 # function of another library's headers).

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The layering of the library, checked on its object files: a stage (a folder of src/) may call
 # only functions defined in itself or in the stages it uses, directly or through another
 # (CMakeLists.txt, src/README.md). Arguments, one per stage, earlier stages first:

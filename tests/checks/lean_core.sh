@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The lean core: libisoprop.so links only lz4, xxhash, zlib, libm and the C library (threads
 # and dlopen are in it; libdl and libpthread where an older C library keeps them apart), at most
 # 12 libraries in all as ldd lists them; the image-format libraries (libtiff, GDCM, the C++

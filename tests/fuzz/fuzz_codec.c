@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libFuzzer harness: the brick payload decoder on arbitrary payloads and directory entries.
  * Decoding must stay inside its buffers whatever the bytes; when the payload was produced by
  * the encoder from the fuzzed samples, decoding must give the samples back exactly. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libFuzzer harness: DICOM series input, whole small series through the public input API, the
  * way isobrick reads them: ip_input_describe() on a folder of 2 to 4 files, then every plane
  * read (ip_input_open, ip_input_read_planes one plane at a time, ip_input_close).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libFuzzer harness: the store, the cache and the engine on mutated brick files, not only the
  * parsers. Whatever the bytes, opening, progressive extraction, full extraction, rasterizing
  * the result and isoinfo-style verification must never crash, hang, leak or trip ASan/UBSan;

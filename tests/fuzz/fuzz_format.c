@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libFuzzer harness: the brick file header and summary parser on arbitrary bytes.
  * Each input is parsed twice: with checksums (the real path) and without them, so that the
  * structure checks behind the checksums are explored too. Opening must never read out of

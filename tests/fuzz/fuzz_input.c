@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libFuzzer harness: the NRRD and MetaImage header parsers, the TIFF (libtiff) and NIfTI-1/2
  * readers and the plane reader, through the public input API on files, since that is how they
  * meet untrusted bytes.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* corrupt: exact, fast mutations of brick files, for tools/dev/fault_inject.sh.
  *
  *   corrupt info FILE

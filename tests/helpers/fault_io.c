@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* A full or failing disk for the end-to-end tests, loaded with LD_PRELOAD: writes to regular
  * files fail once a byte budget is spent, or one call of a kind fails, with the errno asked.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* make_dicom: writes a small int16 volume twice, as a raw file and as a DICOM series made from
  * it (dicom_series.h: shuffled file order, transfer syntaxes by turns), for the end-to-end
  * tests of DICOM input.

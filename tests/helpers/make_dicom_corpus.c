@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* make_dicom_corpus: writes the seed inputs of the DICOM fuzz harness (tests/fuzz/fuzz_dicom.c):
  * small valid series (dicom_series.h) in each transfer syntax the tests write, encoded in the
  * harness's input layout: slice 0 is the template, and each other slice the edits that turn the

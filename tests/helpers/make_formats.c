@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* make_formats: a raw volume written again as TIFF and NIfTI, for the end-to-end test that
  * they brick to the same samples as the raw file.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* ply_triangles: the triangles of a binary PLY that isorender wrote (vertices of float
  * x,y,z,nx,ny,nz; faces of 3 int indices), for the end-to-end tests of welding and smoothing.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* png_compare: compares two PNG images pixel by pixel, for the end-to-end tests.
  *
  *   png_compare A.png B.png [--level L] [--max-pct P] [--crop X,Y,W,H] [--bbox]

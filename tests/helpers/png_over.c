@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* png_over: the expected image of a translucent surface over another, for the end-to-end
  * tests, made from images of each surface alone.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* png_pixel: prints the colour of one pixel of a PNG image, for the end-to-end tests.
  *
  *   png_pixel IMAGE.png X,Y

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* png_read: reading a PNG image as 8-bit RGBA for the image helpers (png_read.h). */
 #include "png_read.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* png_read: reading a PNG image as 8-bit RGBA, shared by the image helpers of the end-to-end
  * tests (png_compare, png_over, png_pixel). */
 #ifndef ISOPROP_TESTS_PNG_READ_H

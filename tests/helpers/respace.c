@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* respace: a copy of a brick file with another spacing in its header (checksum recomputed),
  * for the end-to-end tests of files whose spacing the programs must refuse to render (isobrick
  * no longer writes them).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Prints the size and every field's offset of the public structs that the Python module
  * mirrors with ctypes (python/isoprop/_structs.py), one "STRUCT SIZE" line per struct and one
  * "STRUCT.FIELD OFFSET" line per field, and the value of every constant it mirrors, one

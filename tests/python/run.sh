@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # Runs one Python test: run.sh PYTHON3 TEST.py, PYTHON3 being a python3 with numpy that CMake
 # found (python/CMakeLists.txt), or empty when there is none (the test is skipped).
 # In the AddressSanitizer build the library needs the sanitizer's runtime loaded before it,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Shared by the Python tests: the build's programs, a scratch folder, PLY reading.
 
 Environment (set by ctest, python/CMakeLists.txt): PYTHONPATH holds build/python, IP_BIN the

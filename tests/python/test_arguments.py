@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Every argument of every public function is checked before any work: a bad one raises
 TypeError (wrong type) or isoprop.ArgumentError (out of range: a ValueError and an
 isoprop.Error) whose message starts with the argument's name; nothing is written, no cache is

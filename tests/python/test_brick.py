@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """isoprop.brick(): from a numpy array (z, y, x) the same brick file as from the raw file of the
 same samples; every sample type; overrides for a plain raw file; errors leave no output and no
 scratch file; progress and cancelling."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """isoprop.brick()'s output path when it cannot be written: a missing folder, a file size cap
 (RLIMIT_FSIZE, no root needed) and, when run as root, a full disk (a small tmpfs). Each error
 names the output path the caller gave, never the array's hidden scratch file, and leaves

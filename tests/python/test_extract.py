@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """File.extract() and extract_steps() against isorender: full extraction triangle for triangle
 as isorender --full --mesh writes them, a progressive run on one thread likewise, the
 statistics' keys against isorender --stats, steps against one run, errors."""

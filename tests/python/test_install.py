@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Where the module finds libisoprop: installed with cmake --install into a prefix, it loads
 the prefix's library (relative to itself); ISOPROP_LIBRARY overrides, and a wrong one fails
 at import with a message that names the variable."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The ctypes mirrors of python/isoprop/_structs.py against the C compiler: the size of every
 mirrored struct, the offset of every field and the value of every mirrored constant, as
 tests/helpers/struct_layouts.c prints them."""

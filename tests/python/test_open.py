@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """isoprop.open(): the file's attributes against isoinfo --json; errors for missing and corrupt
 files; closing."""
 import gc

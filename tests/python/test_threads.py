@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """One File used from several threads: a call that finds another running on the same File
 raises RuntimeError (BUSY) at once, close() included, and nothing crashes. Deterministic
 cases hold a call open (inside the library's full extraction, or in an on_step callback) and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isorender --aa N: OpenGL multisampling. Silhouettes get intermediate colours, so the image
 # comes closer to a 4 times larger one shrunk by a box filter; the rest of the image stays.
 # Bad values are refused before any work.

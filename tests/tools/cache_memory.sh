@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Bounded memory: every brick of a 1 GiB volume read through a 32 MiB cache keeps the
 # process's peak RSS under budget + summaries + 64 MiB, whatever the file's size.
 . "$(dirname "$0")/lib.sh"

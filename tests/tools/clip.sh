@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Clipping planes (--clip): the engine neither seeds nor propagates beyond them, so that the
 # progressive image of every ray equals the clipped full extraction's; the triangles lie on
 # the kept side (within a cell's diagonal: cells are kept or dropped whole); a plane that keeps

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # DICOM series end to end: isobrick bricks a series written by the tests (shuffled file order,
 # transfer syntaxes by turns: explicit and implicit VR little endian, explicit VR big endian,
 # RLE) to the same samples as the raw volume it was made from, reports the rescale, and refuses

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # No silently empty or wrong image: a spacing outside the bounds that render correctly is
 # refused by isobrick (flags and headers alike) and by isorender and isoview (brick files
 # written before the bounds existed); spacings at the bounds render the same picture as

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # A FIFO (or another file that is not regular) named as an input never hangs a program: each
 # is refused at once with one line naming it. Every run is under `timeout 10`, so that a hang
 # fails the test (exit 124) instead of blocking it.

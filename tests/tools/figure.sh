@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isorender's figure options: --azimuth, --elevation and --zoom turn and magnify the view,
 # --color and --background colour the image, --turntable writes the frames of a full turn
 # (and an MP4 through ffmpeg when it is installed). Bad values are refused before any work.

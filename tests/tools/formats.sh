@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # TIFF and NIfTI input end to end: a raw volume written again as a multi-page TIFF, a folder of
 # TIFF files, a NIfTI-1 .nii.gz and a big-endian NIfTI-2 .nii (tests/helpers/make_formats.c)
 # bricks to the same file as the raw volume itself: the same samples, and the same spacing,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # A full or failing disk under every program's outputs (tests/helpers/fault_io.c, preloaded):
 # a run whose disk fills up, or whose fsync, link or rename fails, at any point (before its
 # first output, inside one, between two, at the last one's commit) fails with one line naming

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isoinfo --histogram end to end (text and JSON: keys, counts that sum to the level's samples,
 # whole-value bins, option errors), and --verify's progress bar, forced on a pipe.
 . "$(dirname "$0")/lib.sh"

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # The installed library as an embedder meets it: `cmake --install` of this build into scratch
 # prefixes; docs/examples/extract.c built with pkg-config against the core component alone
 # (no render.h, no libisoprop_render) and with CMake's find_package(isoprop) (shared, static,

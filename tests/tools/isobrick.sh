@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isobrick and isoinfo end to end: bad input, atomic output, verification, JSON keys.
 . "$(dirname "$0")/lib.sh"
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # End-to-end test of isogen: output names, -o forms, --force, bad command lines, sizes, upsampling.
 set -u
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isorender end to end: image, mesh, stats and progress files; bad input.
 . "$(dirname "$0")/lib.sh"
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isoview end to end, in a virtual X server (xvfb-run; Mesa's llvmpipe through GLX): once
 # refinement completes, the window shows what isorender renders for the same view; a scripted
 # walk (orbit, zoom, isovalue changes, full extraction) refines, keeps the cache within its

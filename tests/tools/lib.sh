@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Helpers for the end-to-end tests of the programs. Source it; call finish at the end.
 # IP_BIN: folder with the programs; IP_TEST_TMP: scratch space; IP_SHARED_DATA: real volumes.
 # The scratch folder $work is removed when the test passes or skips (exit 0 or 77) and kept,

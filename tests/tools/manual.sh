@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # The man pages (made from each program's --help by help2man, when the build found it) and
 # the bash completion script: each program completes its own options, and files.
 src=$(cd "$(dirname "$0")/../.." && pwd) # before lib.sh's cd

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isorender's mesh files: shared vertices by default (--weld) or not (--no-weld), the same
 # triangles either way; a fully extracted sphere comes out closed, a progressive run's mesh
 # open (and a note says so); binary glTF.

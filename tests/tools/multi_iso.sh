@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isorender with several --iso: each surface extracted by its own run, drawn together with its
 # own colour and opacity. On nested spheres (isogen sphere: the isosurface c is the sphere of
 # radius 1 - c), the images are checked against the single-surface images: opaque, the outer

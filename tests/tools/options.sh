@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Small things every program shares: --version (the one version of include/isoprop/version.h),
 # messages that say what is wrong with --size and --dims, and isorender's time line saying
 # that its parts are CPU seconds summed over the threads.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Outputs of every program: --force never clobbers an input or a device, no two outputs of a
 # run coincide, only regular files are replaced, every output (isorender's --stats JSON and
 # --progress CSV included) respects --force and appears only when complete. Each refusal is

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isorender --axes and --scale-bar: the overlays change only their corners, the scale bar is
 # as long as the projection makes its length at the target's depth, and the triad follows the
 # camera. --verbose says where each was drawn and what it shows.

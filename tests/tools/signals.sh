@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Ctrl-C and SIGTERM: isorender, isobrick, isoinfo --verify (and isoview, when a virtual X
 # server is at hand) stop cleanly, write no output, say so in one line and then end as
 # killed by the signal: shell status 130 for SIGINT, 143 for SIGTERM. Each run is long

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isorender --smooth N: Taubin smoothing of the mesh file. The Shepp-Logan phantom is piecewise
 # constant, so its surfaces terrace (here the head's outline, at 20.5): smoothing keeps the
 # counts and the closed topology, makes neighbouring triangles' normals closer and barely

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # The exact-image guarantee over random views (tools/dev/soak_exact.sh): 24 cases on the generated
 # volumes, a fixed seed, each progressive image against the full extraction's, byte for byte
 # (--full's, or --full-lod's for the cases with adaptive resolution: about half), some with

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Physical space end to end: a NRRD header with a space, a space origin and turned space
 # directions bricks to a file whose isoinfo shows them (the spacing being the vectors'
 # lengths), and a header that names nothing bricks to the identity. The same turn written as

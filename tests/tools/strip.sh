@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isorender --strip: the progress strip holds the real image of the run at each of its points,
 # side by side over a band of labels; bad --strip options are refused before any work.
 . "$(dirname "$0")/lib.sh"

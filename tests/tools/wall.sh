@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isowall, the display wall's parallel renderer, on 4 MPI processes (oversubscribed): the
 # wall's image, dynamic and --static, and the tiles of --tiles-dir equal isorender's software
 # image of the same camera and total size (>= 99.99 % identical pixels); the statistics have

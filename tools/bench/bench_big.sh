@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # Out of core for real: the Visible Woman head upsampled 4x (2048x2048x936 uint16, 7.3 GiB)
 # and 6x (3072x3072x1404 uint16, 24.7 GiB, more than this machine's RAM), each bricked once
 # with a capped working memory and viewed cold with a 512 MiB brick cache. Prints Markdown
@@ -28,7 +29,7 @@
 # reads that went to the device, which includes the program's own libraries). Not a test.
 set -eu
 if [ $# -lt 1 ]; then
-    sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '3,28p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
 root=$(cd "$(dirname "$0")/../.." && pwd)

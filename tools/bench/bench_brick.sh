@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # Bricking benchmark: for each volume in the data folder, the brick file against whole-file
 # lz4 -1 and zstd -1. Prints one Markdown table. Not a test: numbers depend on the machine.
 #

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* bench_cache: speed of the brick cache on one brick file, printed as Markdown tables.
  *
  * Three parts, each over the bricks of level 0:

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # Brick-cache benchmark: decode throughput (ours against LZ4 and XXH64 alone), hit latency,
 # and random and sequential runs under several budgets; then `lz4 -b1` on the raw input, for
 # LZ4's own figure on the whole file. Prints Markdown. Not a test: numbers depend on the machine.

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Two builds of isorender side by side on one brick file: time to 85 % and 99.5 % final pixels
 # and to all rays, from a fresh process and warm (--warm), in interleaved runs (old fresh, old
 # warm, new fresh, new warm, ...); prints the medians with [min-max] and the triangles
@@ -10,7 +11,7 @@
 # Uses the software rasterizer (--software); what is timed is the engine's own clock.
 set -eu
 if [ $# -lt 5 ]; then
-    sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '3,10p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
 old=$1 new=$2 file=$3 iso=$4 view=$5 runs=${6:-5} size=${7:-1600x1200}

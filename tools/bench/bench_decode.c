@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* bench_decode: how fast one thread reads bricks, and where the time goes.
  *
  * Reads every level-0 brick with a payload (or of every level, --all-levels; constant bricks

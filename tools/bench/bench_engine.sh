@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # The engine's performance against its peers, in one run on one machine (results in
 # docs/benchmarks.md). Prints one Markdown table per part:
 #

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* bench_floor: the floor under any exact view. The cells whose triangles own a pixel of the
  * final image (the full extraction rasterised for the view) are what every exact method must
  * at least triangulate; this times marching cubes with normals over exactly those cells, as

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The floor under the 99.5 % targets, beside the engine and Flying Edges in one run: per round,
 # VTK's Flying Edges (first Update() in its process and again), isorender to 99.5 % final
 # pixels from a fresh process and warm (--warm), and bench_floor (marching cubes over only the
@@ -15,7 +16,7 @@
 # the engine's and the floor's; VTK uses every core. Needs python3-vtk9, as bench_engine.sh.
 set -eu
 if [ $# -lt 3 ]; then
-    sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '3,15p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
 build=$1 file=$2 raw=$3 runs=${4:-5} threads=${5:-2}

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # Occlusion-aware propagation against the paper's propagation (isorender --occlusion on|off)
 # on the Visible Woman head at 1600x1200 (results in docs/notes/performance-notebook.md, part 6).
 # Prints a Markdown table per case: medians over REPEAT interleaved runs of the time to 85 %

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # Reproduces the paper's Tables 1 and 2 (Liu, Finkelstein, Li) on the Visible Woman head:
 # skin 600.5 from the front (--view -y) and bone 1224.5 from the side (--view -x), 1600x1200,
 # cut-off 1.81 degrees; progressive extraction cold (a fresh process, page cache dropped when

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* bench_pool: what it costs to hand a step to worker threads, as the engine does once per
  * ip_engine_step() (every viewer frame): starting and joining threads for each step (how the
  * library worked before the pool) against waking the threads of a pool started once.

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Cold views with reading ahead on and off, interleaved (docs/notes/performance-notebook.md,
 # parts 13 and 21). Needs root for drop_caches; writes its files to /tmp/pf/r. MODES (default
 # "on off") lists the --prefetch values compared, taken in turn, the order rotating from run to

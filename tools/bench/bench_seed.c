@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Ray seeding alone: casts the ray of every pixel through level 0 of a brick file (one
  * thread, the bricks already decoded), with the cell-group ranges used and not, and prints
  * the time and the cells read and tested per ray of each, and what decoding the bricks cost

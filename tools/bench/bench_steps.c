@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* bench_steps: the progressive engine driven as the viewer drives it, in many small steps of a
  * fixed number of rays, or as isorender's --progress drives it, in steps ending at 1, 2, 4, ...
  * rays, through the public API only (so the same source measures any build of the library).

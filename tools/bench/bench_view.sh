@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # The viewer on volumes far larger than its cache: isoview driven by a script under a virtual X
 # server, on the Visible Woman head upsampled 4x and 6x (the brick files tools/bench/bench_big.sh
 # makes in DIR: x4.ibv, x6.ibv), cold (page cache dropped first) and warm. Prints a Markdown table
@@ -21,7 +22,7 @@
 # Each isoview writes --stats, read with python3. Not a test.
 set -eu
 if [ $# -lt 1 ]; then
-    sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '3,22p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
 root=$(cd "$(dirname "$0")/../.." && pwd)

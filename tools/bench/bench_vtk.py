@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """The VTK side of tools/bench/bench_engine.sh: isosurface extraction of a raw volume with VTK's
 vtkFlyingEdges3D and vtkMarchingCubes (only the filter's Update() is timed), VTK's own rendering
 of the result offscreen, and the peak memory of Flying Edges on a large volume.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # The display wall's bad case (docs/scale-out.md): isowall on the Visible Woman head (skin
 # 600.5) on a 6x4 wall whose camera puts the whole head inside one display tile, with the
 # regions of each tile on the process that owns it (--static, one copy per projector, the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The command line, parsed from the programs' tables of options with getopt_long. */
 #include <getopt.h>
 #include <stdio.h>

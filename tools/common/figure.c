@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Figure options: the orbit (--azimuth, --elevation, --zoom), the camera, colours. */
 #include <ctype.h>
 #include <math.h>

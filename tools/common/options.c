@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The shared options: parsers for option tables; isorender's and isoview's view options. */
 #include <ctype.h>
 #include <stddef.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The outputs of one run, as a set: all of them or none. */
 #include <signal.h>
 #include <stdio.h>

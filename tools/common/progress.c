@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The progress bar on stderr. */
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* What the programs print and write: JSON, byte counts, cache statistics, --stats files. */
 #include <math.h>
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Ctrl-C and SIGTERM: recorded, the engine cancelled, and raised again at the end. */
 #include <errno.h>
 #include <pthread.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The programs' command lines, parsed from tables of options. */
 #ifndef ISOPROP_TOOL_COMMAND_LINE_H
 #define ISOPROP_TOOL_COMMAND_LINE_H

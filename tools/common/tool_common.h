@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Helpers shared by the programs (not part of the library): option values, errors, JSON. */
 #ifndef ISOPROP_TOOL_COMMON_H
 #define ISOPROP_TOOL_COMMON_H

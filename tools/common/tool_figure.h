@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Figure options: the orbit (--azimuth, --elevation, --zoom), the camera, colours. */
 #ifndef ISOPROP_TOOL_FIGURE_H
 #define ISOPROP_TOOL_FIGURE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The programs' files: checked before any work; text outputs written all-or-nothing. */
 #ifndef ISOPROP_TOOL_FILES_H
 #define ISOPROP_TOOL_FILES_H

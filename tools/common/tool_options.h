@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The shared options: parsers for option tables; isorender's and isoview's view options. */
 #ifndef ISOPROP_TOOL_OPTIONS_H
 #define ISOPROP_TOOL_OPTIONS_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The outputs of one run, as a set: all of them or none. */
 #ifndef ISOPROP_TOOL_OUTPUTS_H
 #define ISOPROP_TOOL_OUTPUTS_H

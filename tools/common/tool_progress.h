@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The programs' progress bar on stderr. */
 #ifndef ISOPROP_TOOL_PROGRESS_H
 #define ISOPROP_TOOL_PROGRESS_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* What the programs print and write: JSON, byte counts, cache statistics, --stats files. */
 #ifndef ISOPROP_TOOL_REPORT_H
 #define ISOPROP_TOOL_REPORT_H

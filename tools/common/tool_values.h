@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The programs' option values (numbers, dimensions, pairs, counts) and their errors. */
 #ifndef ISOPROP_TOOL_VALUES_H
 #define ISOPROP_TOOL_VALUES_H

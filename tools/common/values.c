@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The programs' option values: numbers, dimensions, pairs, counts; and their errors. */
 #include <ctype.h>
 #include <errno.h>

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Bash completion for the isoprop programs (isobrick, isogen, isoinfo, isorender, isoview, isowall).
 # The option names come from the program's own --help, so that they follow its options;
 # after an option that takes a file, and for the positional argument, files are offered.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # Checks that the C sources follow .clang-format: runs `clang-format --dry-run --Werror` over
 # every *.c and *.h of src/, tools/, tests/, include/ and docs/ and the *.cpp of src/ (tracked
 # or new, not ignored) and exits 1 when any would change, listing each difference as

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # Checks that two builds give byte-identical outputs: the brick files isobrick writes, and the
 # PNG images and PLY meshes isorender writes, progressive (one thread: a deterministic triangle
 # order) and full, with and without adaptive resolution, over several brick edges and views, on

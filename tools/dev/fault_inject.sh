@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Fault injection: corrupted and changing brick files against isoinfo --verify and isorender.
 # A corrupted brick file must never give a wrong image, a crash or a hang: each run must end
 # in a clear error (non-zero exit, exactly one stderr line naming the file, no image written)

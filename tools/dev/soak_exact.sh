@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # Soaks the engine's guarantee: once every ray has been cast, the progressive image equals the
 # full extraction's: --full with adaptive resolution off, --full-lod (each level's cells in its
 # distance band) with it on. Runs CASES random cases over generated volumes and the sample

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender's drawing: the renderer, the image of the surfaces and the figure overlays. */
 #include <math.h>
 #include <stdio.h>

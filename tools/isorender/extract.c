@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender's extraction, progressive (with checkpoints) or full, of every surface. */
 #include <stdint.h>
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender's parts (not part of the library): the run's state and each file's functions. */
 #ifndef ISORENDER_H
 #define ISORENDER_H

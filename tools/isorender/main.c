@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender: extract an isosurface progressively (or fully) and render it to PNG, headless. */
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender --mesh: the mesh file, welded, smoothed and in the volume's physical space. */
 #include <stdio.h>
 #include <string.h>

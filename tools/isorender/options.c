@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender's command line: the usage, the option table and the checks across options. */
 #include <stddef.h>
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender's figures: final pixels, overdraw, --progress's CSV, --stats' JSON, the summary. */
 #include <math.h>
 #include <stdint.h>

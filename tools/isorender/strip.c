@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender --strip: the image as extracted by a few points of the run, side by side. */
 #include <math.h>
 #include <stdio.h>

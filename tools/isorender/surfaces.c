@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender's surfaces (several --iso): a run each; their colours, opacities and mesh files. */
 #include <stdio.h>
 #include <stdlib.h>

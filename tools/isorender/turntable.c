@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender --turntable: frames with the eye turned around the target, and their MP4. */
 #include <errno.h>
 #include <spawn.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview's controls: the mouse and keyboard (GLFW callbacks), and the changes of view and
  * isovalue they and the script make (each restarts the progressive order). */
 #include <math.h>

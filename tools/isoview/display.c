@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview's image between frames: a framebuffer object that keeps the picture from one frame to
  * the next (a window's back buffer is undefined after a swap), so that a frame draws only what
  * is new, and is copied to the window before the overlay. The software renderer sends the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview's parts (not part of the library): the viewer's state and what each file gives the
  * others. main.c runs the frames (extraction slices, drawing, screenshots, statistics),
  * options.c reads the command line, script.c the --script commands, controls.c the mouse and

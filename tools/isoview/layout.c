@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview's text layout: the help table and the columns of the overlay's text. */
 #include <string.h>
 

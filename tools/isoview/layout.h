@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview's text layout, apart from the window so that a unit test can check it: the overlay's
  * text as a table of rows ('\n' between rows) of cells ('\t' between a row's cells), each
  * column starting at one x for every row, in stb_easy_font units (a line is 12 high). */

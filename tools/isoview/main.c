@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview: the interactive viewer. The isosurface refines progressively in a window while it
  * stays responsive: each frame casts rays for a time slice (ip_engine_step() on the render
  * thread, whose workers use every core), uploads the triangles added since the last frame and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview's command line: the shared view options (tool_common) and isoview's own. */
 #include <stddef.h>
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview's overlay: the heads-up text and the help, stb_easy_font's quads drawn as indexed
  * triangles in pixel coordinates over the rendered frame. */
 #include <stdint.h>

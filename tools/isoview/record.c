@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview's record of each pass for --stats: when the change came, when its first frame was
  * shown, when 85 % and 99.5 % of the final pixels were on the screen and when refinement was
  * complete. A pixel is final from the first frame that had drawn the triangle the finished

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoview --script FILE: commands that drive the viewer for tests and demos, one a line;
  * blank lines and lines starting with '#' are ignored. Commands run in order, each at the
  * start of a frame, until a wait:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Compositing the wall: per display tile, the processes whose triangles reach it draw them
  * (depth and colour) and send the rectangle of the pixels they cover to the tile's owner,
  * which keeps the nearest surface of each pixel (direct send; ties go to the lower rank, so the

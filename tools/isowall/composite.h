@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isowall's compositing of the display tiles (MPI). */
 #ifndef ISOWALL_COMPOSITE_H
 #define ISOWALL_COMPOSITE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isowall: sort-first parallel extraction and rendering for a display wall, on MPI.
  *
  * The wall's image (C x R display tiles of W x H pixels, one camera) is cut into screen

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The wall's screen regions and the tiles a mesh reaches. */
 #include <math.h>
 #include <stdlib.h>

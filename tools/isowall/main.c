@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isowall: the run on every MPI process: extraction of the work units, the composite, the
  * outputs and the statistics (see isowall.h). */
 #include <errno.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isowall's command line. */
 #include <stddef.h>
 #include <stdio.h>

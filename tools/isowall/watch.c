@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isowall's watchdog: heartbeats on a helper thread, and one line naming a silent process
  * (see watch.h). */
 #include <errno.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isowall's watchdog: a wall whose process stops answering (stopped, its node gone, its link
  * cut) ends with an error naming it instead of hanging.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: the brick cache: decoded bricks in memory, up to a byte budget, least recently
  * used evicted first.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: progressive view-dependent isosurface extraction (Liu, Finkelstein, Li).
  *
  * ip_engine_begin() fixes a view and an isovalue; each ip_engine_step() casts the next rays of

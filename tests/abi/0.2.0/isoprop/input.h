@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: reading input volumes (headerless raw, NRRD, MetaImage, TIFF, NIfTI, DICOM) plane
  * by plane.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: the public API of libisoprop in one include.
  *
  * Brick a volume once (input.h, bricker.h), open the brick file (store.h, layout.h), keep its

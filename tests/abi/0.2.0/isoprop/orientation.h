@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: where a volume lies in its file's physical space.
  *
  * A sample's engine (world) position is its index x spacing along each axis. Its physical

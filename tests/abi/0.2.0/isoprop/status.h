@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: status codes and error messages.
  *
  * Every library function that can fail returns an ip_status: IP_OK (0) or a negative code.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop: sample types and volume geometry shared by every layer.
  *
  * A volume is a grid of dims[0] x dims[1] x dims[2] samples, x fastest, then y, then z.
