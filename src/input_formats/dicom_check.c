@@ -42,6 +42,8 @@ typedef struct walk {
     uint32_t pixel_length; /* ... else its length */
     size_t pixel_at;       /* where its element starts */
     int has_samples;       /* Samples per Pixel is there */
+    /* the data set's even groups 6000-60FE and 5000-50FE: OVERLAY_* bits */
+    uint8_t overlays[128], curves[128];
     int in_icon;           /* walking the Icon Image Sequence (0088,0200) of the data set */
     int rle;               /* the transfer syntax is RLE Lossless */
     uint64_t fragments;    /* the data set's Pixel Data fragments, its offset table not counted */
@@ -51,6 +53,12 @@ typedef struct walk {
     char *why;
     size_t why_size;
 } walk;
+
+/* What an overlay (60xx) or curve (50xx) group holds, as GDCM counts them. */
+#define GROUP_DATA 1 /* (xxxx,3000), not empty */
+#define OVERLAY_ROWS 2
+#define OVERLAY_COLUMNS 4
+#define OVERLAY_BIT_POSITION 8
 
 /* How the elements being walked are encoded. */
 typedef struct coding {
@@ -281,6 +289,49 @@ static int nonzero_decimal(const walk *w, size_t at, uint32_t length)
     return value != 0 && value - value == 0; /* finite */
 }
 
+/* Notes an element of an overlay or curve group (even groups 6000-60FE, 5000-50FE) that
+ * makes GDCM read the group. */
+static void note_group(walk *w, uint32_t tag, uint32_t length)
+{
+    unsigned group = tag >> 16, element = tag & 0xFFFF;
+    if (length == 0 || (group & 1) || ((group & 0xFF00) != 0x6000 && (group & 0xFF00) != 0x5000))
+        return;
+    uint8_t *flags = (group & 0xFF00) == 0x6000 ? &w->overlays[(group & 0xFF) / 2]
+                                                : &w->curves[(group & 0xFF) / 2];
+    *flags |= element == 0x3000   ? GROUP_DATA
+              : element == 0x0010 ? OVERLAY_ROWS
+              : element == 0x0011 ? OVERLAY_COLUMNS
+              : element == 0x0102 ? OVERLAY_BIT_POSITION
+                                  : 0;
+}
+
+/* GDCM reads the overlays (a 60xx group with Overlay Data, or with Overlay Rows, Columns and
+ * Bit Position) and the curves (a 50xx group with Curve Data) of a file when it reads its
+ * image, and stops the process on many: its overlay reader asserts on any element it does not
+ * know (Overlay Activation Layer among them), on a format other than RECT, on more than 16
+ * overlays. Neither is needed for the samples: such a file is refused. */
+static int check_groups(walk *w)
+{
+    for (unsigned i = 0; i < 128; i++) {
+        const uint8_t o = w->overlays[i],
+                      plane = OVERLAY_ROWS | OVERLAY_COLUMNS | OVERLAY_BIT_POSITION;
+        const char *what = NULL;
+        unsigned group = 0;
+        if ((o & GROUP_DATA) || (o & plane) == plane)
+            what = "an overlay", group = 0x6000 + 2 * i;
+        else if (w->curves[i] & GROUP_DATA)
+            what = "a curve", group = 0x5000 + 2 * i;
+        if (what) {
+            snprintf(w->why, w->why_size,
+                     "holds %s (group %04X): overlays and curves are not read (GDCM stops the "
+                     "process on some)",
+                     what, group);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 /* Lengths that GDCM replaces by others, taking the file for one of a known broken writer's
  * (GDCM_SUPPORT_BROKEN_IMPLEMENTATION): refused rather than read two ways. */
 static int rewritten_length(uint32_t tag, const uint8_t *vr, uint32_t length, coding c)
@@ -470,6 +521,7 @@ static int walk_elements(walk *w, size_t *at, size_t end, int depth, place where
                 return -1;
         } else if (depth == 0 && where == DATA_SET) {
             note_value(w, tag, value, length, c.big);
+            note_group(w, tag, length);
         } else if (in_icon) {
             note_icon(w, &image, tag, value, length, c.big);
         }
@@ -770,7 +822,7 @@ static int walk_data_set(walk *w, size_t at, const char *syntax)
                  "holds no Pixel Data (7FE0,0010): not an image, or cut short");
         return -1;
     }
-    return check_pixels(w);
+    return check_pixels(w) != 0 || check_groups(w) != 0 ? -1 : 0;
 }
 
 int ip__dicom_check_file(const char *path, char *why, size_t why_size)
