@@ -37,6 +37,7 @@ typedef struct test_dicom_series {
     const char *photometric; /* NULL: MONOCHROME2 */
     int no_position;         /* 1: leave out Image Position (Patient) */
     int sequences;           /* 1: add a Referenced Image Sequence and an Icon Image Sequence */
+    int overlay;             /* 1: add an overlay plane (group 6000) of the image's size */
 } test_dicom_series;
 
 /* A series of `dims`, spacing 0.7 (y) x 0.8 (x) x 2.5 mm, rescale 1 x stored - 1024. */
@@ -248,6 +249,27 @@ static inline void test_dicom_icon(test_bytes *b)
     test_dicom_open(b, 0xFFFE, 0xE0DD, 0);
 }
 
+/* An overlay plane (group 6000) of columns x rows, every other bit set. */
+static inline void test_dicom_overlay(test_bytes *b, uint32_t columns, uint32_t rows)
+{
+    test_bytes origin = {0};
+    unsigned char bits[512];
+    size_t size = ((size_t)columns * rows + 7) / 8;
+    REQUIRE(size <= sizeof bits);
+    memset(bits, 0x55, size);
+    origin.big_endian = b->big_endian;
+    test_bytes_uint(&origin, 1, 2);
+    test_bytes_uint(&origin, 1, 2);
+    test_dicom_us(b, 0x6000, 0x0010, rows);
+    test_dicom_us(b, 0x6000, 0x0011, columns);
+    test_dicom_text(b, 0x6000, 0x0040, "CS", "G");
+    test_dicom_element(b, 0x6000, 0x0050, "SS", origin.data, 4);
+    test_dicom_us(b, 0x6000, 0x0100, 1);
+    test_dicom_us(b, 0x6000, 0x0102, 0);
+    test_dicom_element(b, 0x6000, 0x3000, "OB", bits, size);
+    free(origin.data);
+}
+
 /* The transfer syntax of slice z when the series names none: they take turns. */
 static inline const char *test_dicom_syntax_of(const test_dicom_series *s, uint32_t z)
 {
@@ -305,6 +327,8 @@ static inline void test_dicom_slice_bytes(const test_dicom_series *s, const void
     }
     if (s->sequences)
         test_dicom_icon(&b);
+    if (s->overlay)
+        test_dicom_overlay(&b, s->dims[0], s->dims[1]);
     if (strcmp(syntax, TEST_DICOM_RLE) == 0) {
         test_dicom_rle_pixels(&b, plane, count, sample);
     } else {

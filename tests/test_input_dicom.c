@@ -545,7 +545,10 @@ static void test_odd_member(void)
  * Attribute class (Frame Increment Pointer) of another value representation than its
  * dictionary's (an assertion in GDCM's decoding); a Rescale Intercept without a Rescale Slope
  * (GDCM read a slope of 0 for an MR image and asserted), and a slope of 0; 8-bit samples of 7
- * bits stored (an assertion in GDCM's decoders). And the structure rules that keep
+ * bits stored (an assertion in GDCM's decoders); an icon image of 2 samples a pixel (an
+ * assertion when GDCM reads the file's image); an overlay plane (GDCM's overlay reader asserts
+ * on standard elements it does not know: found by reading its source after the icon). And the
+ * structure rules that keep
  * GDCM on its plain reading path: elements in ascending order, Rows of its dictionary's value
  * representation. */
 static void test_fuzz_findings(void)
@@ -609,6 +612,22 @@ static void test_fuzz_findings(void)
     write_case(fresh_folder(dir, "icon_ob"), &icon, volume, 99, NULL, 0);
     patch_file(dir, "IM0002.dcm", "\x88\x00\x00\x02SQ", "\x88\x00\x00\x02OB", 6);
     expect_refused(dir, IP_ERR_INPUT, "icon_ob/IM0002.dcm", "a value representation OB, not SQ");
+    /* an icon of 2 samples a pixel: GDCM asserted on it while reading the file's image */
+    write_case(fresh_folder(dir, "icon_samples"), &icon, volume, 99, NULL, 0);
+    patch_file(dir, "IM0003.dcm",
+               "\xFE\xFF\x00\xE0\xFF\xFF\xFF\xFF\x28\x00\x02\x00US\x02\x00\x01\x00",
+               "\xFE\xFF\x00\xE0\xFF\xFF\xFF\xFF\x28\x00\x02\x00US\x02\x00\x02\x00", 18);
+    expect_refused(dir, IP_ERR_INPUT, "icon_samples/IM0003.dcm",
+                   "an icon image that GDCM cannot read");
+    /* a well-formed overlay plane: refused all the same, since GDCM's overlay reader, which
+     * runs whenever it reads the image, stops the process on a format other than RECT and on
+     * elements it does not know, Overlay Activation Layer (60xx,1001) among them (the two
+     * crafted_overlay_* inputs of the corpus) */
+    test_dicom_series overlay = s;
+    overlay.overlay = 1;
+    write_case(fresh_folder(dir, "overlay"), &overlay, volume, 99, NULL, 0);
+    expect_refused(dir, IP_ERR_INPUT, "overlay/IM0001.dcm",
+                   "holds an overlay (group 6000): overlays and curves are not read");
     test_dicom_series private_syntax = s;
     private_syntax.syntax = "1.2.840.113619.5.2";
     write_case(fresh_folder(dir, "private_syntax"), &private_syntax, volume, 99, NULL, 0);

@@ -42,6 +42,10 @@ typedef struct walk {
     int encapsulated;      /* ... as fragments (a compressed transfer syntax) */
     uint32_t pixel_length; /* ... else its length */
     size_t pixel_at;       /* where its element starts */
+    int has_samples;       /* Samples per Pixel is there */
+    /* the data set's even groups 6000-60FE and 5000-50FE: OVERLAY_* bits */
+    uint8_t overlays[128], curves[128];
+    int in_icon;           /* walking the Icon Image Sequence (0088,0200) of the data set */
     int rle;               /* the transfer syntax is RLE Lossless */
     uint64_t fragments;    /* the data set's Pixel Data fragments, its offset table not counted */
     int bad_rle;           /* one of them does not start with a usable RLE header */
@@ -50,6 +54,12 @@ typedef struct walk {
     char *why;
     size_t why_size;
 } walk;
+
+/* What an overlay (60xx) or curve (50xx) group holds, as GDCM counts them. */
+#define GROUP_DATA 1 /* (xxxx,3000), not empty */
+#define OVERLAY_ROWS 2
+#define OVERLAY_COLUMNS 4
+#define OVERLAY_BIT_POSITION 8
 
 /* How the elements being walked are encoded. */
 typedef struct coding {
@@ -227,6 +237,7 @@ static void note_value(walk *w, uint32_t tag, size_t at, uint32_t length, int bi
                                                    : NULL;
     if (!field)
         return;
+    w->has_samples |= tag == TAG(0x0028, 0x0002);
     if (tag == TAG(0x0028, 0x0008)) { /* IS: decimal text, read as GDCM does (a negative
                                         * count or none is one frame) */
         uint64_t n = 0;
@@ -279,6 +290,49 @@ static int nonzero_decimal(const walk *w, size_t at, uint32_t length)
     return value != 0 && value - value == 0; /* finite */
 }
 
+/* Notes an element of an overlay or curve group (even groups 6000-60FE, 5000-50FE) that
+ * makes GDCM read the group. */
+static void note_group(walk *w, uint32_t tag, uint32_t length)
+{
+    unsigned group = tag >> 16, element = tag & 0xFFFF;
+    if (length == 0 || (group & 1) || ((group & 0xFF00) != 0x6000 && (group & 0xFF00) != 0x5000))
+        return;
+    uint8_t *flags = (group & 0xFF00) == 0x6000 ? &w->overlays[(group & 0xFF) / 2]
+                                                : &w->curves[(group & 0xFF) / 2];
+    *flags |= element == 0x3000   ? GROUP_DATA
+              : element == 0x0010 ? OVERLAY_ROWS
+              : element == 0x0011 ? OVERLAY_COLUMNS
+              : element == 0x0102 ? OVERLAY_BIT_POSITION
+                                  : 0;
+}
+
+/* GDCM reads the overlays (a 60xx group with Overlay Data, or with Overlay Rows, Columns and
+ * Bit Position) and the curves (a 50xx group with Curve Data) of a file when it reads its
+ * image, and stops the process on many: its overlay reader asserts on any element it does not
+ * know (Overlay Activation Layer among them), on a format other than RECT, on more than 16
+ * overlays. Neither is needed for the samples: such a file is refused. */
+static int check_groups(walk *w)
+{
+    for (unsigned i = 0; i < 128; i++) {
+        const uint8_t o = w->overlays[i],
+                      plane = OVERLAY_ROWS | OVERLAY_COLUMNS | OVERLAY_BIT_POSITION;
+        const char *what = NULL;
+        unsigned group = 0;
+        if ((o & GROUP_DATA) || (o & plane) == plane)
+            what = "an overlay", group = 0x6000 + 2 * i;
+        else if (w->curves[i] & GROUP_DATA)
+            what = "a curve", group = 0x5000 + 2 * i;
+        if (what) {
+            snprintf(w->why, w->why_size,
+                     "holds %s (group %04X): overlays and curves are not read (GDCM stops the "
+                     "process on some)",
+                     what, group);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 /* Lengths that GDCM replaces by others, taking the file for one of a known broken writer's
  * (GDCM_SUPPORT_BROKEN_IMPLEMENTATION): refused rather than read two ways. */
 static int rewritten_length(uint32_t tag, const uint8_t *vr, uint32_t length, coding c)
@@ -291,6 +345,46 @@ static int rewritten_length(uint32_t tag, const uint8_t *vr, uint32_t length, co
 
 static int walk_items(walk *w, size_t *at, size_t end, int defined, int depth, int fragments,
                       coding c);
+
+/* The image of an item of the Icon Image Sequence, as GDCM reads it when it reads the file's
+ * image: -1 absent, -2 not a 16-bit value. */
+typedef struct icon {
+    long samples, rows, columns, bits;
+    int photometric; /* 0 absent, 1 one GDCM reads, -1 another (empty, PALETTE COLOR, ...) */
+} icon;
+
+static void note_icon(const walk *w, icon *i, uint32_t tag, size_t at, uint32_t length, int big)
+{
+    long *field = tag == TAG(0x0028, 0x0002)   ? &i->samples
+                  : tag == TAG(0x0028, 0x0010) ? &i->rows
+                  : tag == TAG(0x0028, 0x0011) ? &i->columns
+                  : tag == TAG(0x0028, 0x0100) ? &i->bits
+                                               : NULL;
+    if (field) {
+        *field = length == 2 ? (long)u16(w, at, big) : -2;
+    } else if (tag == TAG(0x0028, 0x0004)) {
+        static const char *const read[] = {"MONOCHROME1", "MONOCHROME2", "RGB"};
+        size_t n = length;
+        while (n > 0 && (w->data[at + n - 1] == ' ' || w->data[at + n - 1] == 0))
+            n--;
+        i->photometric = -1;
+        for (size_t k = 0; k < sizeof read / sizeof read[0]; k++)
+            if (n == strlen(read[k]) && memcmp(w->data + at, read[k], n) == 0)
+                i->photometric = 1;
+    }
+}
+
+/* GDCM reads the first item of the Icon Image Sequence with the file's image, asserting that
+ * its samples a pixel are 1, 3 or 4 and that its photometric interpretation is one it knows
+ * (and dereferencing an empty one); taken here: 1, 3 or 4 samples, 8 or 16 bits, a size, and
+ * MONOCHROME1, MONOCHROME2 or RGB when there is one. */
+static int check_icon(walk *w, size_t at, const icon *i)
+{
+    if ((i->samples == -1 || i->samples == 1 || i->samples == 3 || i->samples == 4) &&
+        (i->bits == 8 || i->bits == 16) && i->rows > 0 && i->columns > 0 && i->photometric >= 0)
+        return 0;
+    return fail(w, at, TAG(0x0088, 0x0200), "an icon image that GDCM cannot read");
+}
 
 /* One fragment of the data set's Pixel Data, `length` bytes at `at`: counted, and its RLE
  * header looked at (PS3.5 G.5: the number of segments, then 15 offsets, little endian; the
@@ -320,7 +414,10 @@ static void note_fragment(walk *w, size_t at, uint32_t length)
 static int walk_elements(walk *w, size_t *at, size_t end, int depth, place where, coding c)
 {
     int first = 1, intercept = 0, slope = 0;
+    int in_icon = w->in_icon && depth == 1 && (where == ITEM_DEFINED || where == ITEM_UNDEFINED);
+    icon image = {-1, -1, -1, -1, 0};
     uint32_t previous = 0;
+    w->in_icon = 0; /* not for the sequences in it */
     while (*at < end) {
         size_t start = *at;
         if (end - start < 8)
@@ -335,6 +432,8 @@ static int walk_elements(walk *w, size_t *at, size_t end, int depth, place where
                 return fail(w, start, tag, "an item delimiter with a length");
             if (intercept && !slope)
                 return fail(w, start, tag, "a Rescale Intercept without a Rescale Slope");
+            if (in_icon && check_icon(w, start, &image) != 0)
+                return -1;
             *at = start + 8;
             return 1;
         }
@@ -391,7 +490,10 @@ static int walk_elements(walk *w, size_t *at, size_t end, int depth, place where
                 inner.implicit = 1; /* CP-246: its items are in implicit VR */
             else if (!sequence && !c.implicit)
                 return fail(w, start, tag, "an undefined length on a value");
-            if (walk_items(w, at, end, 0, depth + 1, 0, inner) != 0)
+            w->in_icon = depth == 0 && tag == TAG(0x0088, 0x0200);
+            int r = walk_items(w, at, end, 0, depth + 1, 0, inner);
+            w->in_icon = 0;
+            if (r != 0)
                 return -1;
             continue;
         }
@@ -406,6 +508,7 @@ static int walk_elements(walk *w, size_t *at, size_t end, int depth, place where
                 return fail(w, start, tag, "a Rescale Slope that is not a number other than 0");
             slope = 1;
         }
+        w->in_icon = depth == 0 && tag == TAG(0x0088, 0x0200);
         if (sequence) {
             size_t inner = value;
             if (walk_items(w, &inner, value + length, 1, depth + 1, 0, c) != 0)
@@ -419,11 +522,17 @@ static int walk_elements(walk *w, size_t *at, size_t end, int depth, place where
                 return -1;
         } else if (depth == 0 && where == DATA_SET) {
             note_value(w, tag, value, length, c.big);
+            note_group(w, tag, length);
+        } else if (in_icon) {
+            note_icon(w, &image, tag, value, length, c.big);
         }
+        w->in_icon = 0;
         *at = value + length;
     }
     if (intercept && !slope)
         return fail(w, *at, TAG(0x0028, 0x1052), "a Rescale Intercept without a Rescale Slope");
+    if (in_icon && check_icon(w, *at, &image) != 0)
+        return -1;
     return 0;
 }
 
@@ -535,6 +644,12 @@ static int check_pixels(walk *w)
                      w->pixel_length, w->pixel_length < need ? "less" : "more",
                      (unsigned long long)need, (unsigned long long)w->columns,
                      (unsigned long long)w->rows, (unsigned long long)w->bits);
+        return -1;
+    }
+    /* GDCM asserts that the samples a pixel are 1, 3 or 4 */
+    if (w->has_samples && w->samples != 1 && w->samples != 3 && w->samples != 4) {
+        snprintf(w->why, w->why_size, "%llu samples a pixel: not an image GDCM reads",
+                 (unsigned long long)w->samples);
         return -1;
     }
     /* GDCM's decoders assert that 8-bit samples store all 8 bits */
@@ -708,7 +823,7 @@ static int walk_data_set(walk *w, size_t at, const char *syntax)
                  "holds no Pixel Data (7FE0,0010): not an image, or cut short");
         return -1;
     }
-    return check_pixels(w);
+    return check_pixels(w) != 0 || check_groups(w) != 0 ? -1 : 0;
 }
 
 int ip__dicom_check_file(const char *path, char *why, size_t why_size)
