@@ -31,6 +31,15 @@ int tool_outputs_add(tool_outputs *o, const char *path)
     return 0;
 }
 
+int tool_outputs_add_or_error(tool_outputs *o, const char *path, ip_error *err)
+{
+    if (tool_outputs_add(o, path) == 0)
+        return 0;
+    err->code = IP_ERR_NOMEM;
+    snprintf(err->message, sizeof err->message, "%.900s: out of memory", path);
+    return -1;
+}
+
 int tool_outputs_made_folder(tool_outputs *o, const char *path)
 {
     free(o->folder);

@@ -5,6 +5,8 @@
 
 #include <stddef.h>
 
+#include "isoprop/status.h"
+
 /* The outputs a run has written so far. Each output file is all-or-nothing by itself
  * (isoprop/output.h); the set makes the run so: a run that fails, or that a signal stops
  * before its last output is written, removes the ones it wrote, so that it leaves none of its
@@ -22,6 +24,10 @@ typedef struct tool_outputs {
  * not recorded). Returns 0; -1 when there is no memory to record it, after removing the file
  * (the run then fails, and must leave nothing). */
 int tool_outputs_add(tool_outputs *o, const char *path);
+
+/* tool_outputs_add(), with the error (IP_ERR_NOMEM, naming `path`) in *err when it fails, for
+ * a caller that reports an ip_error. Returns 0 or -1. */
+int tool_outputs_add_or_error(tool_outputs *o, const char *path, ip_error *err);
 
 /* Records the folder this run made for its outputs. Returns 0 or -1 (no memory). */
 int tool_outputs_made_folder(tool_outputs *o, const char *path);

@@ -175,11 +175,8 @@ static int turntable_frame(run *r, uint64_t f, ip_renderer **gl, uint8_t *rgba, 
     if (ip_png_write(path, rgba, r->camera.width, r->camera.height, r->o.common.force, err) !=
         IP_OK)
         return -1;
-    if (tool_outputs_add(&r->outputs, path) != 0) {
-        err->code = IP_ERR_NOMEM;
-        snprintf(err->message, sizeof err->message, "%.900s: out of memory", path);
+    if (tool_outputs_add_or_error(&r->outputs, path, err) != 0)
         return -1;
-    }
     if (!r->o.common.quiet)
         printf("  frame %llu of %llu: %s, %llu triangles\n", (unsigned long long)f + 1,
                (unsigned long long)r->o.turntable, path, (unsigned long long)all_triangles(r));

@@ -409,11 +409,8 @@ static int write_tile(uint32_t t, const uint8_t *rgba, void *user, ip_error *err
     if (ip_png_write(path, rgba, r->layout.tile_w, r->layout.tile_h, r->o.common.force, err) !=
         IP_OK)
         return -1;
-    if (tool_outputs_add(&r->outputs, path) != 0) {
-        err->code = IP_ERR_NOMEM;
-        snprintf(err->message, sizeof err->message, "%.900s: out of memory", path);
+    if (tool_outputs_add_or_error(&r->outputs, path, err) != 0)
         return -1;
-    }
     return 0;
 }
 
