@@ -13,9 +13,9 @@ faulty() {
     run_capture "$@"
 }
 # leaves_only FILE...: the folder holds exactly these files (hidden ones included)
-# (.out and .err are the test's own: run_capture's)
+# (.out, .err and .xvfb-status are the test's own: run_capture's and in_xvfb's)
 leaves_only() {
-    [ "$(ls -A | grep -v -x -e .out -e .err | sort | tr '\n' ' ')" = \
+    [ "$(ls -A | grep -v -x -e .out -e .err -e .xvfb-status | sort | tr '\n' ' ')" = \
         "$(printf '%s\n' "$@" | sort | tr '\n' ' ')" ]
 }
 # failed_cleanly WHAT TEXT FILE...: exit 1, one line on stderr holding TEXT, and the folder
@@ -115,6 +115,28 @@ faulty IP_FAULT_BYTES=$((frame + frame / 2)) "$bin/isorender" s.ibv --iso 128.5 
     --software --quiet --turntable 3 -o tt
 failed_cleanly "isorender --turntable, disk full at the second frame" "tt/frame_" "$raw" s.ibv
 check "... which said the disk is full" sh -c 'printf "%s" "$0" | grep -q "No space left on device"' "$err"
+
+# --- isoview: a screenshot and --stats, each refused in one line when the disk fails ---
+if command -v xvfb-run >/dev/null 2>&1; then
+    printf 'wait done\nscreenshot shot.png\nquit\n' >view.txt
+    view() { # view VAR=VALUE...: isoview on the script with the shim and the faults given
+        in_xvfb 170 640x480x24 env LD_PRELOAD="$shim${preload:+ $preload}" "$@" \
+            "$bin/isoview" s.ibv --iso 128.5 --size 160x120 --stats v.json --script view.txt \
+            --quiet
+    }
+    view IP_FAULT_CALL=linkat IP_FAULT_NTH=1 IP_FAULT_ERRNO=EIO
+    check "isoview, the screenshot cannot be linked: exit 1 ($rc: $err)" test "$rc" = 1
+    check "... one line naming it" sh -c 'printf "%s" "$0" | grep -q "shot.png: cannot create: Input/output error"' "$err"
+    check "... no screenshot, no statistics, no temporary file" leaves_only "$raw" s.ibv view.txt
+    view IP_FAULT_CALL=linkat IP_FAULT_NTH=2 IP_FAULT_ERRNO=EIO
+    check "isoview, --stats cannot be linked: exit 1 ($rc: $err)" test "$rc" = 1
+    check "... one line naming it" sh -c 'printf "%s" "$0" | grep -q "v.json: cannot create: Input/output error"' "$err"
+    check "... no statistics (the screenshot, a step of the session, stays)" \
+        leaves_only "$raw" s.ibv view.txt shot.png
+    rm -f shot.png view.txt
+else
+    echo "full_disk: isoview part skipped: xvfb-run is missing (Debian package xvfb)"
+fi
 
 # --- isowall: the image on rank 0, then the statistics; tiles on their owners ---
 if command -v mpirun >/dev/null 2>&1 && [ -x "$bin/isowall" ]; then
