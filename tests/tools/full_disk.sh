@@ -34,13 +34,12 @@ failed_cleanly() {
 raw=sphere_40x40x40_uint8.raw
 "$bin/isobrick" "$raw" -o s.ibv --brick-size 8 --quiet
 
-# The shim interposes write, pwrite, fsync, rename and linkat; where the programs' own
-# interceptors come first (the sanitizer runtimes), it cannot, and the test says so.
+# The shim interposes write, pwrite, fsync, rename and linkat; where something else comes first
+# and it cannot, the test says so and is skipped.
 mkdir probe
 faulty IP_FAULT_BYTES=0 "$bin/isogen" sphere --dims 8x8x8 --type uint8 -o probe/ --quiet
 if [ "$rc" = 0 ]; then
-    echo "SKIP: the fault shim cannot interpose the programs' writes here (a sanitizer runtime's" \
-         "interceptors come first)"
+    echo "SKIP: the fault shim cannot interpose the programs' writes here"
     exit 77
 fi
 rm -rf probe
