@@ -4,11 +4,11 @@
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
-#include <strings.h>
 #include <xxhash.h>
 
 #include "internal.h"
 #include "format.h"
+#include "input_source.h"
 #include "format_offsets.h"
 
 uint64_t ip__format_checksum(const void *data, size_t size)
@@ -360,12 +360,6 @@ static ip_status parse_orientation(const unsigned char *h, uint32_t version, con
     return IP_OK;
 }
 
-static int ends_with(const char *name, const char *suffix)
-{
-    size_t n = strlen(name), m = strlen(suffix);
-    return n >= m && strcasecmp(name + n - m, suffix) == 0;
-}
-
 /* What a file that is not a brick file holds, when it is one of the volumes the bricker reads
  * (by its first `size` bytes and its name), or NULL: for a message that says to brick it. */
 static const char *volume_kind(const unsigned char *h, size_t size, const char *name)
@@ -380,17 +374,7 @@ static const char *volume_kind(const unsigned char *h, size_t size, const char *
     if (size >= 4 && (ip__load_u32le(h) == 348 || ip__load_u32le(h) == 540 ||
                       ip__load_u32le(h) == 0x5c010000u || ip__load_u32le(h) == 0x1c020000u))
         return "a NIfTI volume";
-    if (ends_with(name, ".nii.gz") || ends_with(name, ".nii"))
-        return "a NIfTI volume";
-    if (ends_with(name, ".nrrd") || ends_with(name, ".nhdr"))
-        return "an NRRD volume";
-    if (ends_with(name, ".mhd") || ends_with(name, ".mha"))
-        return "a MetaImage volume";
-    if (ends_with(name, ".tif") || ends_with(name, ".tiff"))
-        return "a TIFF file";
-    if (ends_with(name, ".raw"))
-        return "a raw volume";
-    return NULL;
+    return ip__input_format_named(name); /* else by its name */
 }
 
 /* Fails for a file that is not a brick file: saying to brick it first when it is a volume. */

@@ -59,6 +59,18 @@ static input_kind kind_of(const char *path)
     return INPUT_RAW;
 }
 
+const char *ip__input_format_named(const char *path)
+{
+    switch (kind_of(path)) {
+    case INPUT_NRRD: return "an NRRD volume";
+    case INPUT_MHD: return "a MetaImage volume";
+    case INPUT_TIFF: return "a TIFF file";
+    case INPUT_NIFTI: return "a NIfTI volume";
+    case INPUT_RAW: break;
+    }
+    return has_suffix(path, ".raw") ? "a raw volume" : NULL;
+}
+
 ip_status ip__input_open_regular(const char *path, int *fd, ip_error *err)
 {
     struct stat st;

@@ -62,6 +62,10 @@ ip_status ip__input_formats_load(const char *path, const ip__input_formats **out
 /*! ip__encoding_is_planes() : 1 for the encodings read through a plane source (TIFF, DICOM). */
 int ip__encoding_is_planes(ip_encoding encoding);
 
+/*! ip__input_format_named() : the input format `path` names by its extension, as words for a
+ *  message ("a NIfTI volume", "a raw volume" for .raw), or NULL when it names none. */
+const char *ip__input_format_named(const char *path);
+
 /*! ip__input_open_regular() : opens `path` read-only without waiting (O_NONBLOCK: a FIFO is
  *  refused, never waited on) and checks that it is a regular file; *fd is the caller's to
  *  close. IP_ERR_IO when it cannot be opened, IP_ERR_INPUT when it is not a regular file. */
