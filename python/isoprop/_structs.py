@@ -23,13 +23,23 @@ class Orientation(ctypes.Structure):
     _fields_ = [("origin", c_double * 3), ("directions", (c_double * 3) * 3), ("space", c_int)]
 
 
+RESCALE_UNIT_MAX = 16  # IP_RESCALE_UNIT_MAX, include/isoprop/volume.h
+
+
+class Rescale(ctypes.Structure):
+    """ip_rescale (volume.h)"""
+    _fields_ = [("present", c_int), ("slope", c_double), ("intercept", c_double),
+                ("unit", c_char * RESCALE_UNIT_MAX)]
+
+
 class InputDesc(ctypes.Structure):
     """ip_input_desc (input.h)"""
     _fields_ = [("path", c_char * PATH_MAX), ("data_path", c_char * PATH_MAX),
                 ("data_offset", c_uint64), ("dims", c_uint32 * 3), ("type", c_int),
                 ("big_endian", c_int), ("spacing", c_double * 3), ("encoding", c_int),
                 ("stream_skip", c_uint64), ("has_rescale", c_int), ("rescale_slope", c_double),
-                ("rescale_intercept", c_double), ("orientation", Orientation), ("reserved", c_uint64 * 32)]
+                ("rescale_intercept", c_double), ("orientation", Orientation),
+                ("rescale_unit", c_char * RESCALE_UNIT_MAX), ("reserved", c_uint64 * 30)]
 
 
 class InputOverrides(ctypes.Structure):
@@ -75,7 +85,8 @@ class Layout(ctypes.Structure):
                 ("node_count", c_uint64), ("data_offset", c_uint64), ("data_size", c_uint64),
                 ("summary_offset", c_uint64), ("summary_size", c_uint64),
                 ("summary_checksum", c_uint64), ("file_size", c_uint64),
-                ("levels", LevelLayout * MAX_LEVELS), ("format_version", c_uint32)]
+                ("levels", LevelLayout * MAX_LEVELS), ("format_version", c_uint32),
+                ("rescale", Rescale)]
 
 
 class CacheLevelStats(ctypes.Structure):
@@ -147,6 +158,7 @@ class Mesh(ctypes.Structure):
 MIRRORS = {
     "ip_error": Error,
     "ip_orientation": Orientation,
+    "ip_rescale": Rescale,
     "ip_input_desc": InputDesc,
     "ip_input_overrides": InputOverrides,
     "ip_bricker_options": BrickerOptions,
@@ -170,4 +182,5 @@ CONSTANTS = {
     "IP_PREFETCH_OFF": PREFETCH_OFF,
     "IP_PREFETCH_ON": PREFETCH_ON,
     "IP_PREFETCH_ALWAYS": PREFETCH_ALWAYS,
+    "IP_RESCALE_UNIT_MAX": RESCALE_UNIT_MAX,
 }

@@ -68,6 +68,7 @@ struct field_tag {
 };
 
 const field_tag dataset_fields[] = {
+    {IP_DICOM_MODALITY, 0x0008, 0x0060},
     {IP_DICOM_SERIES_UID, 0x0020, 0x000E},
     {IP_DICOM_POSITION, 0x0020, 0x0032},
     {IP_DICOM_ORIENTATION, 0x0020, 0x0037},
@@ -83,6 +84,7 @@ const field_tag dataset_fields[] = {
     {IP_DICOM_PIXEL_REPRESENTATION, 0x0028, 0x0103},
     {IP_DICOM_RESCALE_INTERCEPT, 0x0028, 0x1052},
     {IP_DICOM_RESCALE_SLOPE, 0x0028, 0x1053},
+    {IP_DICOM_RESCALE_TYPE, 0x0028, 0x1054},
 };
 
 // The transfer syntax as the file's meta header spells it, whether the library knows it or not.

@@ -16,6 +16,7 @@ extern "C" {
  * lacks it); the values of a multi-valued field are separated by '\'. */
 typedef enum ip_dicom_field {
     IP_DICOM_TRANSFER_SYNTAX,      /* (0002,0010) Transfer Syntax UID */
+    IP_DICOM_MODALITY,             /* (0008,0060) CT, MR, ... */
     IP_DICOM_SERIES_UID,           /* (0020,000E) Series Instance UID */
     IP_DICOM_POSITION,             /* (0020,0032) Image Position (Patient): x\y\z in mm */
     IP_DICOM_ORIENTATION,          /* (0020,0037) Image Orientation (Patient): row\column */
@@ -31,6 +32,7 @@ typedef enum ip_dicom_field {
     IP_DICOM_PIXEL_REPRESENTATION, /* (0028,0103) 0 unsigned, 1 two's complement */
     IP_DICOM_RESCALE_INTERCEPT,    /* (0028,1052) */
     IP_DICOM_RESCALE_SLOPE,        /* (0028,1053) */
+    IP_DICOM_RESCALE_TYPE,         /* (0028,1054) the rescaled values' unit: HU, OD, US, ... */
     IP_DICOM_FIELD_COUNT
 } ip_dicom_field;
 

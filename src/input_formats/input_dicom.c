@@ -40,7 +40,8 @@ typedef struct dicom_slice {
     double pixel_spacing[2]; /* between rows (y), between columns (x); mm */
     double position[3], orientation[6];
     double slope, intercept;
-    double along; /* position along the slice normal, mm */
+    char unit[IP_RESCALE_UNIT_MAX]; /* of the rescaled values (rescale_unit()) */
+    double along;                   /* position along the slice normal, mm */
 } dicom_slice;
 
 /* The slices of a folder: sorted by name while read, by position once checked. */
@@ -156,6 +157,7 @@ static int parse_numbers(const char *value, double *out, int max, int *count)
 
 static const char *const field_names[IP_DICOM_FIELD_COUNT] = {
     [IP_DICOM_TRANSFER_SYNTAX] = "Transfer Syntax UID (0002,0010)",
+    [IP_DICOM_MODALITY] = "Modality (0008,0060)",
     [IP_DICOM_SERIES_UID] = "Series Instance UID (0020,000E)",
     [IP_DICOM_POSITION] = "Image Position (Patient) (0020,0032)",
     [IP_DICOM_ORIENTATION] = "Image Orientation (Patient) (0020,0037)",
@@ -171,6 +173,7 @@ static const char *const field_names[IP_DICOM_FIELD_COUNT] = {
     [IP_DICOM_PIXEL_REPRESENTATION] = "Pixel Representation (0028,0103)",
     [IP_DICOM_RESCALE_INTERCEPT] = "Rescale Intercept (0028,1052)",
     [IP_DICOM_RESCALE_SLOPE] = "Rescale Slope (0028,1053)",
+    [IP_DICOM_RESCALE_TYPE] = "Rescale Type (0028,1054)",
 };
 
 /* `count` numbers of field `f` into out (`fallback` for each when the field is absent and
@@ -309,6 +312,23 @@ static ip_status check_orientation(const char *path, const double o[6], ip_error
     return IP_OK;
 }
 
+/* The unit of the rescaled values: the Rescale Type when it names one (1 to
+ * IP_RESCALE_UNIT_MAX - 1 printable characters, other than US, "unspecified"), else "HU" for
+ * a CT (whose rescale gives Hounsfield units), else "" (unknown). */
+static void rescale_unit(const ip_dicom_header *h, char unit[IP_RESCALE_UNIT_MAX])
+{
+    const char *type = h->value[IP_DICOM_RESCALE_TYPE];
+    size_t n = strlen(type);
+    int usable = n > 0 && n < IP_RESCALE_UNIT_MAX && strcmp(type, "US") != 0;
+    for (size_t i = 0; usable && i < n; i++)
+        usable = type[i] >= 0x20 && type[i] <= 0x7e;
+    if (usable)
+        snprintf(unit, IP_RESCALE_UNIT_MAX, "%s", type);
+    else
+        snprintf(unit, IP_RESCALE_UNIT_MAX, "%s",
+                 strcmp(h->value[IP_DICOM_MODALITY], "CT") == 0 ? "HU" : "");
+}
+
 /* The geometry, type and rescale of one file, each checked on its own. */
 static ip_status read_slice(const dicom_series *s, dicom_slice *slice, ip_error *err)
 {
@@ -342,6 +362,7 @@ static ip_status read_slice(const dicom_series *s, dicom_slice *slice, ip_error 
         (st = field_numbers(path, h, IP_DICOM_RESCALE_SLOPE, &slice->slope, 1, 1, err)) != IP_OK)
         goto done;
     st = field_numbers(path, h, IP_DICOM_RESCALE_INTERCEPT, &slice->intercept, 1, 0, err);
+    rescale_unit(h, slice->unit);
 done:
     free(h);
     return st;
@@ -396,7 +417,8 @@ static const char *difference(const dicom_slice *first, const dicom_slice *slice
         return "a different pixel spacing";
     if (!same_numbers(slice->orientation, first->orientation, 6, ORIENTATION_TOLERANCE))
         return "a different orientation";
-    if (slice->slope != first->slope || slice->intercept != first->intercept)
+    if (slice->slope != first->slope || slice->intercept != first->intercept ||
+        strcmp(slice->unit, first->unit) != 0)
         return "a different rescale";
     return NULL;
 }
@@ -564,10 +586,11 @@ static void fill_desc(const dicom_series *s, double spacing_z, const ip_input_ov
         desc->spacing[2] = spacing_z;
     }
     fill_orientation(first, &desc->orientation);
-    /* the identity says nothing worth reporting */
-    desc->has_rescale = first->slope != 1.0 || first->intercept != 0.0;
+    /* the identity without a unit says nothing worth keeping */
+    desc->has_rescale = first->slope != 1.0 || first->intercept != 0.0 || first->unit[0] != '\0';
     desc->rescale_slope = first->slope;
     desc->rescale_intercept = first->intercept;
+    memcpy(desc->rescale_unit, first->unit, sizeof desc->rescale_unit);
 }
 
 ip_status ip__dicom_describe(const char *path, const ip_input_overrides *overrides,

@@ -11,7 +11,7 @@ static const char usage[] =
     "Extracts the isosurface V progressively (rays in the paper's order) and renders it to PNG\n"
     "with OpenGL 3.3 core through EGL (no display needed). --iso given up to 4 times draws as\n"
     "many surfaces together, each extracted by its own progressive run with the same view\n"
-    "and options (see --color and --opacity).\n"
+    "and options (see --color and --opacity); --iso-stored alike.\n" TOOL_ISO_OPTIONS_HELP
     "  --size WxH          image size in pixels (default 1600x1200)\n"
     "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
     "                      (default -y; up is +z, or +y for the z views)\n"

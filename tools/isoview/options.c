@@ -9,7 +9,7 @@
 static const char usage[] =
     "usage: isoview FILE.ibv --iso V [options]\n"
     "Shows the isosurface V in a window (OpenGL 3.3 core through GLFW), refining it\n"
-    "progressively (rays in the paper's order) while you orbit, pan, zoom and change V.\n"
+    "progressively (rays in the paper's order) while you orbit, pan, zoom and change V.\n" TOOL_ISO_OPTIONS_HELP
     "  --size WxH          window size (default 1280x960)\n"
     "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
     "                      (default -y; up is +z, or +y for the z views)\n"
