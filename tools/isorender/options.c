@@ -173,13 +173,15 @@ static int parse_opacity(const char *program, const tool_option *option, const c
 static int check_surface_options(const options *o)
 {
     unsigned n = o->common.iso_count;
+    const char *iso = o->common.iso_given_stored ? "--iso-stored" : "--iso";
     if (n > TOOL_MAX_ISOS)
-        return tool_usage_error("isorender", "--iso given %u times: at most %d surfaces", n,
+        return tool_usage_error("isorender", "%s given %u times: at most %d surfaces", iso, n,
                                 TOOL_MAX_ISOS);
     for (unsigned i = 0; i < n; i++)
         for (unsigned j = 0; j < i; j++)
             if ((float)o->common.isos[i] == (float)o->common.isos[j])
-                return tool_usage_error("isorender", "--iso %g is given twice", o->common.isos[i]);
+                return tool_usage_error("isorender", "%s %g is given twice", iso,
+                                        o->common.isos[i]);
     if (o->colour_count > n || o->opacity_count > n)
         return tool_usage_error("isorender",
                                 "%zu --color and %zu --opacity for %u --iso: at most one of each "
