@@ -323,7 +323,7 @@ static void rescale_unit(const ip_dicom_header *h, char unit[IP_RESCALE_UNIT_MAX
     for (size_t i = 0; usable && i < n; i++)
         usable = type[i] >= 0x20 && type[i] <= 0x7e;
     if (usable)
-        snprintf(unit, IP_RESCALE_UNIT_MAX, "%s", type);
+        memcpy(unit, type, n + 1); /* n < IP_RESCALE_UNIT_MAX */
     else
         snprintf(unit, IP_RESCALE_UNIT_MAX, "%s",
                  strcmp(h->value[IP_DICOM_MODALITY], "CT") == 0 ? "HU" : "");
