@@ -51,6 +51,7 @@ typedef struct walk {
     int bad_rle;           /* one of them does not start with a usable RLE header */
     int bad_first_rle;     /* ... the first one */
     uint32_t rle_segments; /* ... the number of segments the first one's header gives */
+    char sop_class[65];    /* the data set's SOP Class UID (0008,0016), "" until walked past */
     char *why;
     size_t why_size;
 } walk;
@@ -224,10 +225,27 @@ static int check_typed(walk *w, size_t at, uint32_t tag, const uint8_t *vr, uint
     return fail(w, at, tag, what);
 }
 
+/* The UI value data[at .. at + length) into out, as GDCM reads it: up to a NUL, at most 64
+ * characters, without trailing spaces. */
+static void uid_value(const walk *w, size_t at, size_t length, char out[65])
+{
+    size_t n = 0;
+    while (n < length && n < 64 && w->data[at + n] != 0)
+        n++;
+    memcpy(out, w->data + at, n);
+    while (n && out[n - 1] == ' ')
+        n--;
+    out[n] = '\0';
+}
+
 /* The integer value of one of the elements that size the image (US, or IS text for Number of
  * Frames), in the data set itself. */
 static void note_value(walk *w, uint32_t tag, size_t at, uint32_t length, int big)
 {
+    if (tag == TAG(0x0008, 0x0016)) {
+        uid_value(w, at, length, w->sop_class);
+        return;
+    }
     uint64_t *field = tag == TAG(0x0028, 0x0010)   ? &w->rows
                       : tag == TAG(0x0028, 0x0011) ? &w->columns
                       : tag == TAG(0x0028, 0x0002) ? &w->samples
@@ -741,24 +759,17 @@ static uint8_t *inflate_all(const uint8_t *data, size_t size, size_t *out_size, 
     return out;
 }
 
-/* The transfer syntax UID of the meta group data[meta .. end): the first (0002,0010), as
- * GDCM reads it (up to a NUL, without trailing spaces). */
-static void syntax_of(const walk *w, size_t meta, size_t end, char syntax[65])
+/* The value of element (0002,`element`), a UID, of the meta group data[meta .. end): the
+ * first, as GDCM reads it (uid_value()); "" when there is none. */
+static void meta_uid(const walk *w, size_t meta, size_t end, unsigned element, char out[65])
 {
-    syntax[0] = '\0';
+    out[0] = '\0';
     for (size_t p = meta; p + 8 <= end;) {
-        unsigned element = u16(w, p + 2, 0);
         size_t length = u16(w, p + 6, 0), value = p + 8;
         if (vr_form(w->data + p + 4) == 2)
             length = u32(w, p + 8, 0), value = p + 12;
-        if (element == 0x0010) {
-            size_t n = 0;
-            while (n < length && n < 64 && w->data[value + n] != 0)
-                n++;
-            memcpy(syntax, w->data + value, n);
-            while (n && syntax[n - 1] == ' ')
-                n--;
-            syntax[n] = '\0';
+        if (u16(w, p + 2, 0) == element) {
+            uid_value(w, value, length, out);
             return;
         }
         p = value + length;
@@ -767,7 +778,7 @@ static void syntax_of(const walk *w, size_t meta, size_t end, char syntax[65])
 
 /* The meta group from byte 132: its group length first, then group 0002 in explicit VR little
  * endian; *at past it. */
-static int walk_meta(walk *w, size_t *at, char syntax[65])
+static int walk_meta(walk *w, size_t *at, char syntax[65], char media_class[65])
 {
     size_t meta = *at;
     if (w->size - meta < 12 || u16(w, meta, 0) != 0x0002 || u16(w, meta + 2, 0) != 0x0000 ||
@@ -776,7 +787,8 @@ static int walk_meta(walk *w, size_t *at, char syntax[65])
     coding c = {0, 0};
     if (walk_elements(w, at, w->size, 0, META, c) < 0)
         return -1;
-    syntax_of(w, meta, *at, syntax);
+    meta_uid(w, meta, *at, 0x0010, syntax);
+    meta_uid(w, meta, *at, 0x0002, media_class);
     if (!syntax[0]) {
         snprintf(w->why, w->why_size,
                  "not a well-formed DICOM file: no Transfer Syntax UID in its meta header (cut "
@@ -826,9 +838,11 @@ static int walk_data_set(walk *w, size_t at, const char *syntax)
     return check_pixels(w) != 0 || check_groups(w) != 0 ? -1 : 0;
 }
 
-int ip__dicom_check_file(const char *path, char *why, size_t why_size)
+int ip__dicom_check_object(const char *path, char sop_class[65], char *why, size_t why_size)
 {
     size_t size;
+    char media_class[65] = "";
+    sop_class[0] = '\0';
     uint8_t *data = read_all(path, &size, why, why_size);
     if (!data)
         return -1;
@@ -840,8 +854,15 @@ int ip__dicom_check_file(const char *path, char *why, size_t why_size)
     int rc = -1;
     if (size < 132 || memcmp(data + 128, "DICM", 4) != 0)
         snprintf(why, why_size, "not a DICOM file (no \"DICM\" at byte 128)");
-    else if (walk_meta(&w, &at, syntax) == 0)
+    else if (walk_meta(&w, &at, syntax, media_class) == 0)
         rc = walk_data_set(&w, at, syntax);
+    memcpy(sop_class, w.sop_class[0] ? w.sop_class : media_class, 65);
     free(data);
     return rc;
+}
+
+int ip__dicom_check_file(const char *path, char *why, size_t why_size)
+{
+    char sop_class[65];
+    return ip__dicom_check_object(path, sop_class, why, why_size);
 }
