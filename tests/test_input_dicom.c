@@ -546,10 +546,10 @@ static void test_odd_member(void)
  * (GDCM read a slope of 0 for an MR image and asserted), and a slope of 0; 8-bit samples of 7
  * bits stored (an assertion in GDCM's decoders); an icon image of 2 samples a pixel (an
  * assertion when GDCM reads the file's image); an overlay plane (GDCM's overlay reader asserts
- * on standard elements it does not know: found by reading its source after the icon). And the
- * structure rules that keep
- * GDCM on its plain reading path: elements in ascending order, Rows of its dictionary's value
- * representation. */
+ * on standard elements it does not know: found by reading its source after the icon); a
+ * Recognition Code (0008,0010) other than ACR-NEMA's (an assertion when GDCM reads the image).
+ * And the structure rules that keep GDCM on its plain reading path: elements in ascending
+ * order, Rows of its dictionary's value representation. */
 static void test_fuzz_findings(void)
 {
     char dir[4096];
@@ -582,6 +582,13 @@ static void test_fuzz_findings(void)
                6);
     expect_refused(dir, IP_ERR_INPUT, "frame_pointer/IM0003.dcm",
                    "a value representation CS, not AT, at byte");
+
+    /* a Recognition Code (0008,0010) that is not ACR-NEMA's (here the SOP Class UID's element
+     * retagged): GDCM asserted on it when reading the image */
+    write_case(fresh_folder(dir, "recognition"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0002.dcm", "\x08\x00\x16\x00UI", "\x08\x00\x10\x00SH", 6);
+    expect_refused(dir, IP_ERR_INPUT, "recognition/IM0002.dcm",
+                   "a Recognition Code (0008,0010) other than ACR-NEMA's");
 
     write_case(fresh_folder(dir, "rows_vr"), &s, volume, 99, NULL, 0);
     patch_file(dir, "IM0004.dcm", "\x28\x00\x10\x00US", "\x28\x00\x10\x00SS", 6);
