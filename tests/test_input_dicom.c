@@ -241,6 +241,12 @@ static void test_refused(void)
     write_case(fresh_folder(dir, "unplaced"), &s, volume, 99, &odd, 0);
     expect_refused(dir, IP_ERR_INPUT, "unplaced/odd.dcm", "lacks Image Position (Patient)");
 
+    static const double z_nan[] = {-40, -37.5, NAN, -32.5, -30, -27.5};
+    odd = s, odd.z_at = z_nan;
+    write_case(fresh_folder(dir, "nan_position"), &odd, volume, 99, NULL, 0);
+    expect_refused(dir, IP_ERR_INPUT, "nan_position/IM0003.dcm",
+                   "Image Position (Patient) or Image Orientation (Patient) is not finite");
+
     odd = s, odd.dims[2] = 1;
     write_case(fresh_folder(dir, "single"), &odd, volume, 99, NULL, 0);
     expect_refused(dir, IP_ERR_INPUT, "single", "holds one DICOM slice");

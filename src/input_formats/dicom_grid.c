@@ -221,6 +221,23 @@ static ip_status plan_resampled(const dicom_series *s, double least, dicom_grid 
     return IP_OK;
 }
 
+/* Positions and orientations that are numbers (a DS value may read as "nan" or "inf"). */
+static ip_status check_finite(const dicom_series *s, ip_error *err)
+{
+    for (uint64_t i = 0; i < s->count; i++) {
+        const dicom_slice *slice = &s->slices[i];
+        int finite = 1;
+        for (int c = 0; c < 6; c++)
+            finite &= isfinite(slice->orientation[c]) && (c >= 3 || isfinite(slice->position[c]));
+        if (!finite)
+            return ip__fail(err, IP_ERR_INPUT,
+                            "%s/%s: Image Position (Patient) or Image Orientation (Patient) is "
+                            "not finite",
+                            s->folder, slice->name);
+    }
+    return IP_OK;
+}
+
 ip_status ip__dicom_grid_plan(dicom_series *s, ip_regrid tilt, ip_regrid uneven, dicom_grid *g,
                               ip_error *err)
 {
@@ -232,6 +249,8 @@ ip_status ip__dicom_grid_plan(dicom_series *s, ip_regrid tilt, ip_regrid uneven,
         return ip__fail(err, IP_ERR_INPUT,
                         "%s: the folder holds one DICOM slice (%s): a volume needs 2 or more",
                         s->folder, s->slices[0].name);
+    if ((st = check_finite(s, err)) != IP_OK)
+        return st;
     frame(&s->slices[0], &g->orientation);
     for (uint64_t i = 0; i < s->count; i++)
         s->slices[i].along = dot(s->slices[i].position, g->orientation.directions[2]);
