@@ -7,6 +7,7 @@
 #ifndef ISOPROP_TEST_DICOM_SERIES_H
 #define ISOPROP_TEST_DICOM_SERIES_H
 
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,6 +23,10 @@
 #define TEST_DICOM_RLE "1.2.840.10008.1.2.5"
 #define TEST_DICOM_DEFLATE "1.2.840.10008.1.2.1.99"
 #define TEST_DICOM_CT_STORAGE "1.2.840.10008.5.1.4.1.1.2"
+/* SOP classes of objects that are not images */
+#define TEST_DICOM_DIRECTORY "1.2.840.10008.1.3.10"              /* Media Storage Directory */
+#define TEST_DICOM_BASIC_TEXT_SR "1.2.840.10008.5.1.4.1.1.88.11" /* Basic Text SR */
+#define TEST_DICOM_GRAYSCALE_PS "1.2.840.10008.5.1.4.1.1.11.1"   /* Grayscale Softcopy PS */
 
 /* What the files of a series say. */
 typedef struct test_dicom_series {
@@ -40,6 +45,12 @@ typedef struct test_dicom_series {
     int no_position;          /* 1: leave out Image Position (Patient) */
     int sequences;            /* 1: add a Referenced Image Sequence and an Icon Image Sequence */
     int overlay;              /* 1: add an overlay plane (group 6000) of the image's size */
+    /* the geometry of scanners (all zero: slices stacked along z, evenly) */
+    double shift[2];         /* slice z lies z * shift mm further along x and y: a gantry
+                                tilt (the rows run along x, the columns along y) */
+    const double *z_at;      /* NULL, or where each slice lies along z (origin_z, step_z
+                                unused): uneven spacing */
+    const char *description; /* NULL, or a Series Description */
 } test_dicom_series;
 
 /* A series of `dims`, spacing 0.7 (y) x 0.8 (x) x 2.5 mm, rescale 1 x stored - 1024. */
@@ -122,12 +133,14 @@ static inline void test_dicom_us(test_bytes *b, uint16_t group, uint16_t element
     free(v.data);
 }
 
-/* The meta header, always explicit VR little endian, with its group length first. */
-static inline void test_dicom_meta(test_bytes *out, const char *instance, const char *syntax)
+/* The meta header of an object of SOP class `sop_class`, always explicit VR little endian,
+ * with its group length first. */
+static inline void test_dicom_meta_of(test_bytes *out, const char *sop_class, const char *instance,
+                                      const char *syntax)
 {
     test_bytes g = {0};
     test_dicom_element(&g, 0x0002, 0x0001, "OB", "\0\1", 2);
-    test_dicom_text(&g, 0x0002, 0x0002, "UI", TEST_DICOM_CT_STORAGE);
+    test_dicom_text(&g, 0x0002, 0x0002, "UI", sop_class);
     test_dicom_text(&g, 0x0002, 0x0003, "UI", instance);
     test_dicom_text(&g, 0x0002, 0x0010, "UI", syntax);
     test_dicom_text(&g, 0x0002, 0x0012, "UI", "1.2.826.0.1.3680043.2.1125.9");
@@ -137,6 +150,12 @@ static inline void test_dicom_meta(test_bytes *out, const char *instance, const 
     test_bytes_put(out, length, 4);
     test_bytes_put(out, g.data, g.size);
     free(g.data);
+}
+
+/* The meta header of a CT image. */
+static inline void test_dicom_meta(test_bytes *out, const char *instance, const char *syntax)
+{
+    test_dicom_meta_of(out, TEST_DICOM_CT_STORAGE, instance, syntax);
 }
 
 /* One RLE segment (PackBits, literal runs only) of `count` bytes taken every `stride` bytes. */
@@ -272,6 +291,55 @@ static inline void test_dicom_overlay(test_bytes *b, uint32_t columns, uint32_t 
     free(origin.data);
 }
 
+/* Where pixel (x, y) of slice z lies (mm, LPS): the slice's Image Position (Patient), x
+ * columns along its rows (+x) and y rows along its columns (+y). */
+static inline void test_dicom_position(const test_dicom_series *s, uint32_t x, uint32_t y,
+                                       uint32_t z, double p[3])
+{
+    p[0] = -12.5 + z * s->shift[0] + x * s->pixel_spacing[1];
+    p[1] = 30 + z * s->shift[1] + y * s->pixel_spacing[0];
+    p[2] = s->z_at ? s->z_at[z] : s->origin_z + z * s->step_z;
+}
+
+/* An int16 volume of s's dims (the caller frees it) imaging a ball in physical space: each
+ * pixel, at its own position (test_dicom_position()), is 2000 less 40 a millimetre of its
+ * distance from `centre` (mm), so that the iso value 2000 - 40 R bounds the sphere of radius
+ * R about `centre` exactly, however the slices lie. */
+static inline int16_t *test_dicom_ball(const test_dicom_series *s, const double centre[3])
+{
+    int16_t *v = malloc((size_t)s->dims[0] * s->dims[1] * s->dims[2] * sizeof *v);
+    REQUIRE(v != NULL);
+    for (uint32_t z = 0; z < s->dims[2]; z++)
+        for (uint32_t y = 0; y < s->dims[1]; y++)
+            for (uint32_t x = 0; x < s->dims[0]; x++) {
+                double p[3];
+                test_dicom_position(s, x, y, z, p);
+                double d[3] = {p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]};
+                v[((size_t)z * s->dims[1] + y) * s->dims[0] + x] =
+                    (int16_t)lround(2000 - 40 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+            }
+    return v;
+}
+
+/* A series imaging a ball (test_dicom_ball()) as a scanner with its gantry tilted writes it:
+ * 40 x 36 x 13 int16 slices, 2.36 mm apart along their normal, each shifted -0.79 mm along
+ * its columns (y) from the one before: a tilt of 18.5 degrees. */
+static inline test_dicom_series test_dicom_tilted(void)
+{
+    test_dicom_series s = test_dicom_default(40, 36, 13, IP_INT16);
+    s.step_z = 2.36, s.shift[1] = -0.79;
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+    s.series_uid = "1.2.826.0.1.3680043.2.1125.1.3";
+    s.description = "Tilted head";
+    return s;
+}
+
+/* The centre (mm, LPS) of the ball the tilted series images: within every slice's reach. */
+#define TEST_DICOM_BALL_CENTRE \
+    {                          \
+        3.1, 37.5, -25.84      \
+    }
+
 /* The transfer syntax of slice z when the series names none: they take turns. */
 static inline const char *test_dicom_syntax_of(const test_dicom_series *s, uint32_t z)
 {
@@ -302,13 +370,17 @@ static inline void test_dicom_slice_bytes(const test_dicom_series *s, const void
     test_dicom_text(&b, 0x0008, 0x0018, "UI", instance);
     if (!s->modality || s->modality[0])
         test_dicom_text(&b, 0x0008, 0x0060, "CS", s->modality ? s->modality : "CT");
+    if (s->description)
+        test_dicom_text(&b, 0x0008, 0x103E, "LO", s->description);
     if (s->sequences)
         test_dicom_references(&b);
     test_dicom_text(&b, 0x0020, 0x000D, "UI", "1.2.826.0.1.3680043.2.1125.7");
     test_dicom_text(&b, 0x0020, 0x000E, "UI", s->series_uid);
     snprintf(text, sizeof text, "%u", z + 1);
     test_dicom_text(&b, 0x0020, 0x0013, "IS", text);
-    snprintf(text, sizeof text, "-12.5\\30\\%g", s->origin_z + z * s->step_z);
+    double at[3];
+    test_dicom_position(s, 0, 0, z, at);
+    snprintf(text, sizeof text, "%.10g\\%.10g\\%.10g", at[0], at[1], at[2]);
     if (!s->no_position)
         test_dicom_text(&b, 0x0020, 0x0032, "DS", text);
     test_dicom_text(&b, 0x0020, 0x0037, "DS", "1\\0\\0\\0\\1\\0");
@@ -375,6 +447,38 @@ static inline void test_dicom_write_series(const test_dicom_series *s, const voi
         snprintf(path, sizeof path, "%.4000s/IM%04u.dcm", dir, i + 1);
         test_dicom_write_slice(s, volume, (i * 7 + 3) % s->dims[2], path);
     }
+}
+
+/* A DICOM object that is not an image, of SOP class `sop_class` in series `series_uid` (none
+ * for a directory, whose data set holds no SOP Class UID), as the file `path`: a few elements
+ * of its module, no Pixel Data. */
+static inline void test_dicom_write_object(const char *path, const char *sop_class,
+                                           const char *series_uid)
+{
+    test_bytes b = {0};
+    int directory = strcmp(sop_class, TEST_DICOM_DIRECTORY) == 0;
+    int report = strncmp(sop_class, "1.2.840.10008.5.1.4.1.1.88.", 27) == 0;
+    test_bytes_put(&b, (unsigned char[128]){0}, 128);
+    test_bytes_put(&b, "DICM", 4);
+    test_dicom_meta_of(&b, sop_class, "1.2.826.0.1.3680043.2.1125.77", TEST_DICOM_EXPLICIT_LE);
+    if (directory) { /* File-set Identification and an empty Directory Record Sequence */
+        test_dicom_text(&b, 0x0004, 0x1130, "CS", "SCANNER");
+        test_dicom_us(&b, 0x0004, 0x1212, 0);
+        test_dicom_open(&b, 0x0004, 0x1220, 1);
+        test_dicom_open(&b, 0xFFFE, 0xE0DD, 0);
+    } else {
+        test_dicom_text(&b, 0x0008, 0x0016, "UI", sop_class);
+        test_dicom_text(&b, 0x0008, 0x0018, "UI", "1.2.826.0.1.3680043.2.1125.77");
+        test_dicom_text(&b, 0x0008, 0x0060, "CS", report ? "SR" : "PR");
+        test_dicom_text(&b, 0x0020, 0x000E, "UI", series_uid);
+        if (report)
+            test_dicom_text(&b, 0x0040, 0xA040, "CS", "CONTAINER");
+    }
+    FILE *f = fopen(path, "wb");
+    REQUIRE(f != NULL);
+    REQUIRE(fwrite(b.data, 1, b.size, f) == b.size);
+    REQUIRE(fclose(f) == 0);
+    free(b.data);
 }
 
 #endif

@@ -235,8 +235,10 @@ static void test_refused(void)
 
     odd = s, odd.series_uid = "1.2.826.0.1.3680043.2.1125.1.2", odd.origin_z = 100;
     write_case(fresh_folder(dir, "two_series"), &s, volume, 99, &odd, 0);
-    expect_refused(dir, IP_ERR_INPUT, "two_series", "mixes 2 series");
-    expect_refused(dir, IP_ERR_INPUT, "two_series", "1.2.826.0.1.3680043.2.1125.1.2");
+    expect_refused(dir, IP_ERR_INPUT, "two_series", "holds 2 series: pick one by its UID");
+    expect_refused(dir, IP_ERR_INPUT, "two_series",
+                   "1.2.826.0.1.3680043.2.1125.1.1 CT 6 slices; 1.2.826.0.1.3680043.2.1125.1.2 "
+                   "CT 1 slice");
 
     write_case(fresh_folder(dir, "missing"), &s, volume, 3, NULL, 0);
     expect_refused(dir, IP_ERR_INPUT, "missing",
@@ -287,6 +289,12 @@ static void test_refused(void)
     odd = s, odd.origin_z += 6 * s.step_z, odd.no_position = 1;
     write_case(fresh_folder(dir, "unplaced"), &s, volume, 99, &odd, 0);
     expect_refused(dir, IP_ERR_INPUT, "unplaced/odd.dcm", "lacks Image Position (Patient)");
+
+    static const double z_nan[] = {-40, -37.5, NAN, -32.5, -30, -27.5};
+    odd = s, odd.z_at = z_nan;
+    write_case(fresh_folder(dir, "nan_position"), &odd, volume, 99, NULL, 0);
+    expect_refused(dir, IP_ERR_INPUT, "nan_position/IM0003.dcm",
+                   "Image Position (Patient) or Image Orientation (Patient) is not finite");
 
     odd = s, odd.dims[2] = 1;
     write_case(fresh_folder(dir, "single"), &odd, volume, 99, NULL, 0);
@@ -544,8 +552,8 @@ static void test_long_pixel_data(void)
 }
 
 /* A series with one odd member: a slice of other Columns or Bits Allocated (each a consistent
- * file of its own), a DICOM object without Pixel Data (a presentation state; an index under
- * another name than DICOMDIR), files that are not DICOM (text first in name order; an empty
+ * file of its own), a DICOM object without Pixel Data whose SOP class is an image's (objects
+ * that are not images are skipped: test_non_image), files that are not DICOM (text first in name order; an empty
  * file and one shorter than a preamble among the slices): each refused in one line naming the
  * file. */
 static void test_odd_member(void)
@@ -564,13 +572,10 @@ static void test_odd_member(void)
     write_case(fresh_folder(dir, "bits"), &s, volume, 99, &odd, 0);
     expect_refused(dir, IP_ERR_INPUT, "bits/odd.dcm", "mixed series: a different sample type");
 
-    write_case(fresh_folder(dir, "presentation"), &s, volume, 99, NULL, 0);
-    write_non_image(dir, "PS0001.dcm", "1.2.840.10008.5.1.4.1.1.11.1");
-    expect_refused(dir, IP_ERR_INPUT, "presentation/PS0001.dcm", "holds no Pixel Data");
-
-    write_case(fresh_folder(dir, "index"), &s, volume, 99, NULL, 0);
-    write_non_image(dir, "INDEX", "1.2.840.10008.1.3.10");
-    expect_refused(dir, IP_ERR_INPUT, "index/INDEX", "holds no Pixel Data");
+    /* a DICOM object without Pixel Data of an image's SOP class: not skipped, refused */
+    write_case(fresh_folder(dir, "no_pixels"), &s, volume, 99, NULL, 0);
+    write_non_image(dir, "PS0001.dcm", TEST_DICOM_CT_STORAGE);
+    expect_refused(dir, IP_ERR_INPUT, "no_pixels/PS0001.dcm", "holds no Pixel Data");
 
     write_case(fresh_folder(dir, "text_first"), &s, volume, 99, NULL, 0);
     write_text_file(dir, "0readme.txt", "series of Tuesday\n");
@@ -596,10 +601,10 @@ static void test_odd_member(void)
  * (GDCM read a slope of 0 for an MR image and asserted), and a slope of 0; 8-bit samples of 7
  * bits stored (an assertion in GDCM's decoders); an icon image of 2 samples a pixel (an
  * assertion when GDCM reads the file's image); an overlay plane (GDCM's overlay reader asserts
- * on standard elements it does not know: found by reading its source after the icon). And the
- * structure rules that keep
- * GDCM on its plain reading path: elements in ascending order, Rows of its dictionary's value
- * representation. */
+ * on standard elements it does not know: found by reading its source after the icon); a
+ * Recognition Code (0008,0010) other than ACR-NEMA's (an assertion when GDCM reads the image).
+ * And the structure rules that keep GDCM on its plain reading path: elements in ascending
+ * order, Rows of its dictionary's value representation. */
 static void test_fuzz_findings(void)
 {
     char dir[4096];
@@ -632,6 +637,13 @@ static void test_fuzz_findings(void)
                6);
     expect_refused(dir, IP_ERR_INPUT, "frame_pointer/IM0003.dcm",
                    "a value representation CS, not AT, at byte");
+
+    /* a Recognition Code (0008,0010) that is not ACR-NEMA's (here the SOP Class UID's element
+     * retagged): GDCM asserted on it when reading the image */
+    write_case(fresh_folder(dir, "recognition"), &s, volume, 99, NULL, 0);
+    patch_file(dir, "IM0002.dcm", "\x08\x00\x16\x00UI", "\x08\x00\x10\x00SH", 6);
+    expect_refused(dir, IP_ERR_INPUT, "recognition/IM0002.dcm",
+                   "a Recognition Code (0008,0010) other than ACR-NEMA's");
 
     write_case(fresh_folder(dir, "rows_vr"), &s, volume, 99, NULL, 0);
     patch_file(dir, "IM0004.dcm", "\x28\x00\x10\x00US", "\x28\x00\x10\x00SS", 6);
@@ -710,6 +722,339 @@ static void test_fuzz_findings(void)
     free(volume);
 }
 
+/* ---- folders as scanners write them ---- */
+
+/* Describes `dir` with `o` (NULL: none), failing the test with the message when it fails. */
+static int describe(const char *dir, const ip_input_overrides *o, ip_input_desc *desc)
+{
+    ip_error err;
+    ip_status st = ip_input_describe(dir, o, desc, &err);
+    CHECK_MSG(st == IP_OK, "%s: %s", dir, err.message);
+    return st == IP_OK;
+}
+
+/* dir/name as a fresh folder (its parents made), its path into out. */
+static const char *sub_folder(char out[4200], const char *dir, const char *name)
+{
+    char cmd[8600];
+    snprintf(out, 4200, "%s/%s", dir, name);
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", out);
+    REQUIRE(system(cmd) == 0);
+    return out;
+}
+
+/* Objects that are not images, skipped by their SOP class whatever their name: a media storage
+ * directory named DIRFILE (a DICOMDIR as Philips writes it beside the images), a grayscale
+ * presentation state, a basic text structured report, a presentation state whose meta header
+ * says CT (its data set's SOP class counts), and a DICOMDIR; counted in the description; the
+ * samples read exactly. A folder of such objects alone holds no image. */
+static void test_non_image(void)
+{
+    char dir[4096], path[4200];
+    test_dicom_series s = test_dicom_default(8, 7, 6, IP_UINT16);
+    void *volume = make_volume(&s);
+    ip_input_desc desc;
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+    write_case(fresh_folder(dir, "non_image"), &s, volume, 99, NULL, 0);
+    snprintf(path, sizeof path, "%s/DIRFILE", dir);
+    test_dicom_write_object(path, TEST_DICOM_DIRECTORY, NULL);
+    snprintf(path, sizeof path, "%s/PS0001", dir);
+    test_dicom_write_object(path, TEST_DICOM_GRAYSCALE_PS, s.series_uid);
+    snprintf(path, sizeof path, "%s/SR0001", dir);
+    test_dicom_write_object(path, TEST_DICOM_BASIC_TEXT_SR, s.series_uid);
+    write_non_image(dir, "PS0002.dcm", TEST_DICOM_GRAYSCALE_PS);
+    write_index(dir);
+    if (describe(dir, NULL, &desc)) {
+        CHECK_EQ(desc.skipped_objects, 5);
+        CHECK_EQ(desc.source_slices, 6);
+        CHECK_EQ(desc.series_count, 1);
+        CHECK_STR_EQ(desc.series_uid, s.series_uid);
+        CHECK_EQ(desc.resampled, 0);
+        check_samples(&desc, volume);
+    }
+    fresh_folder(dir, "objects_only");
+    snprintf(path, sizeof path, "%s/DIRFILE", dir);
+    test_dicom_write_object(path, TEST_DICOM_DIRECTORY, NULL);
+    snprintf(path, sizeof path, "%s/SR0001", dir);
+    test_dicom_write_object(path, TEST_DICOM_BASIC_TEXT_SR, s.series_uid);
+    expect_refused(dir, IP_ERR_INPUT, "objects_only",
+                   "holds no DICOM images (2 DICOM objects that are not images skipped)");
+    free(volume);
+}
+
+/* A series spread over subfolders (a/, a/b/, c/), the folder itself holding only a DICOMDIR,
+ * and a folder holding only subfolders: read whole, in order of position, exactly. */
+static void test_subfolders(void)
+{
+    char dir[4096], sub[4200], path[4600];
+    const char *const places[] = {"a", "a/b", "c"};
+    test_dicom_series s = test_dicom_default(9, 8, 9, IP_INT16);
+    void *volume = make_volume(&s);
+    ip_input_desc desc;
+    for (int with_index = 1; with_index >= 0; with_index--) {
+        fresh_folder(dir, with_index ? "subfolders" : "only_subfolders");
+        for (uint32_t z = 0; z < s.dims[2]; z++) {
+            sub_folder(sub, dir, places[(z * 5) % 3]);
+            snprintf(path, sizeof path, "%s/IM%04u", sub, z + 1);
+            test_dicom_write_slice(&s, volume, z, path);
+        }
+        if (with_index)
+            write_index(dir);
+        if (describe(dir, NULL, &desc)) {
+            CHECK_EQ(desc.dims[2], 9);
+            CHECK_EQ(desc.skipped_objects, (uint32_t)with_index);
+            check_samples(&desc, volume);
+        }
+    }
+    free(volume);
+}
+
+/* Two series in one folder (each in a subfolder, with a report and a directory beside them):
+ * refused without a pick, naming both; picked by UID and by a prefix of one only; a prefix of
+ * both and a UID of none refused; the list gives each series' UID, description, modality,
+ * slices, size and spacing, in the order of their first file. */
+static void test_several_series(void)
+{
+    char dir[4096], sub[4200], path[4400];
+    test_dicom_series head = test_dicom_default(8, 7, 6, IP_INT16);
+    test_dicom_series lung = test_dicom_default(6, 5, 4, IP_INT16);
+    void *volume = make_volume(&head);
+    head.description = "Head 2.5";
+    lung.series_uid = "1.2.826.0.1.3680043.2.1125.1.22", lung.description = "Lung";
+    lung.step_z = 1.25;
+    fresh_folder(dir, "several");
+    test_dicom_write_series(&head, volume, sub_folder(sub, dir, "S1"));
+    test_dicom_write_series(&lung, volume, sub_folder(sub, dir, "S2"));
+    snprintf(path, sizeof path, "%s/DIRFILE", dir);
+    test_dicom_write_object(path, TEST_DICOM_DIRECTORY, NULL);
+    snprintf(path, sizeof path, "%s/S2/SR0001", dir);
+    test_dicom_write_object(path, TEST_DICOM_BASIC_TEXT_SR, lung.series_uid);
+    expect_refused(dir, IP_ERR_INPUT, "several",
+                   "the folder holds 2 series: pick one by its UID (isobrick --series UID): "
+                   "1.2.826.0.1.3680043.2.1125.1.1 \"Head 2.5\" CT 6 slices; "
+                   "1.2.826.0.1.3680043.2.1125.1.22 \"Lung\" CT 4 slices");
+    ip_input_overrides o = IP_SIZED(ip_input_overrides);
+    ip_input_desc desc;
+    o.series = head.series_uid; /* also a prefix of the other: the exact one wins */
+    if (describe(dir, &o, &desc)) {
+        CHECK_EQ(desc.dims[2], 6);
+        CHECK_EQ(desc.series_count, 2);
+        CHECK_EQ(desc.skipped_objects, 2);
+        check_samples(&desc, volume);
+    }
+    o.series = "1.2.826.0.1.3680043.2.1125.1.2";
+    if (describe(dir, &o, &desc)) {
+        CHECK_STR_EQ(desc.series_uid, lung.series_uid);
+        CHECK_EQ(desc.dims[0], 6);
+        CHECK_EQ(desc.dims[2], 4);
+        CHECK_NEAR(desc.spacing[2], 1.25, 1e-9);
+    }
+    ip_error err;
+    o.series = "1.2.826.0.1.3680043.2.1125.1";
+    CHECK_EQ(ip_input_describe(dir, &o, &desc, &err), IP_ERR_INPUT);
+    CHECK_CONTAINS(err.message, "2 series UIDs start with 1.2.826.0.1.3680043.2.1125.1: give more");
+    o.series = "1.2.3";
+    CHECK_EQ(ip_input_describe(dir, &o, &desc, &err), IP_ERR_INPUT);
+    CHECK_CONTAINS(err.message, "no series UID is or starts with 1.2.3; the folder holds");
+    /* a series asked of another input */
+    snprintf(path, sizeof path, "%s/volume_4x4x4_uint8.raw", scratch);
+    FILE *f = fopen(path, "wb");
+    REQUIRE(f != NULL && fwrite(volume, 1, 64, f) == 64 && fclose(f) == 0);
+    CHECK_EQ(ip_input_describe(path, &o, &desc, &err), IP_ERR_ARGUMENT);
+    CHECK_CONTAINS(err.message, "not a folder of DICOM files");
+
+    ip_dicom_series_info *list = NULL;
+    uint32_t count = 0, skipped = 0;
+    CHECK_MSG(ip_dicom_list_series(dir, &list, &count, &skipped, &err) == IP_OK, "%s", err.message);
+    CHECK_EQ(count, 2);
+    CHECK_EQ(skipped, 2);
+    if (count == 2) {
+        CHECK_STR_EQ(list[0].uid, head.series_uid);
+        CHECK_STR_EQ(list[0].description, "Head 2.5");
+        CHECK_STR_EQ(list[0].modality, "CT");
+        CHECK_EQ(list[0].slices, 6);
+        CHECK_EQ(list[0].dims[0], 8);
+        CHECK_EQ(list[0].dims[1], 7);
+        CHECK_EQ(list[0].dims[2], 6);
+        CHECK_NEAR(list[0].spacing[0], 0.8, 1e-12);
+        CHECK_NEAR(list[0].spacing[1], 0.7, 1e-12);
+        CHECK_NEAR(list[0].spacing[2], 2.5, 1e-12);
+        CHECK_STR_EQ(list[0].problem, "");
+        CHECK_STR_EQ(list[1].uid, lung.series_uid);
+        CHECK_EQ(list[1].slices, 4);
+        CHECK_NEAR(list[1].spacing[2], 1.25, 1e-12);
+    }
+    free(list);
+    free(volume);
+}
+
+/* A series that cannot be read (MONOCHROME1) beside one that can: the other is read; the list
+ * shows the failing one with the reason, its size unknown. */
+static void test_failing_series(void)
+{
+    char dir[4096], sub[4200];
+    test_dicom_series good = test_dicom_default(6, 5, 4, IP_UINT16);
+    test_dicom_series inverted = good;
+    void *volume = make_volume(&good);
+    inverted.series_uid = "1.2.826.0.1.3680043.2.1125.9.9", inverted.photometric = "MONOCHROME1";
+    fresh_folder(dir, "failing");
+    test_dicom_write_series(&good, volume, sub_folder(sub, dir, "A"));
+    test_dicom_write_series(&inverted, volume, sub_folder(sub, dir, "B"));
+    ip_input_overrides o = IP_SIZED(ip_input_overrides);
+    ip_input_desc desc;
+    ip_error err;
+    o.series = good.series_uid;
+    if (describe(dir, &o, &desc))
+        check_samples(&desc, volume);
+    o.series = inverted.series_uid;
+    CHECK_EQ(ip_input_describe(dir, &o, &desc, &err), IP_ERR_UNSUPPORTED);
+    CHECK_CONTAINS(err.message, "failing/B/IM0001.dcm: MONOCHROME1");
+    ip_dicom_series_info *list = NULL;
+    uint32_t count = 0;
+    CHECK(ip_dicom_list_series(dir, &list, &count, NULL, &err) == IP_OK && count == 2);
+    if (count == 2) {
+        CHECK_STR_EQ(list[0].problem, "");
+        CHECK_EQ(list[1].slices, 4);
+        CHECK_EQ(list[1].dims[0], 0);
+        CHECK_CONTAINS(list[1].problem, "failing/B/IM0001.dcm: MONOCHROME1");
+    }
+    free(list);
+    free(volume);
+}
+
+/* The ball the tilted series images (test_dicom_tilted()): centre (mm, LPS) and the radius
+ * of the sphere of the iso value 2000 - 40 x radius. */
+static const double sphere_centre[3] = TEST_DICOM_BALL_CENTRE, sphere_radius = 10;
+
+/* The tilted series into dir. */
+static void tilted_sphere(const char *dir)
+{
+    test_dicom_series s = test_dicom_tilted();
+    int16_t *v = test_dicom_ball(&s, sphere_centre);
+    test_dicom_write_series(&s, v, dir);
+    free(v);
+}
+
+/* The centroid (mm, in desc's physical space) and the radius of the sphere of the same volume
+ * of the samples of desc's volume at or above `iso`. */
+static void measure_sphere(const ip_input_desc *desc, double iso, double centroid[3],
+                           double *radius)
+{
+    size_t plane = (size_t)desc->dims[0] * desc->dims[1];
+    int16_t *v = malloc(plane * desc->dims[2] * sizeof *v);
+    REQUIRE(v != NULL);
+    ip_input_reader *r = NULL;
+    ip_error err;
+    REQUIRE(ip_input_open(desc, &r, &err) == IP_OK);
+    REQUIRE(ip_input_read_planes(r, v, desc->dims[2], &err) == IP_OK);
+    ip_input_close(r);
+    double sum[3] = {0, 0, 0}, count = 0;
+    for (uint32_t z = 0; z < desc->dims[2]; z++)
+        for (uint32_t y = 0; y < desc->dims[1]; y++)
+            for (uint32_t x = 0; x < desc->dims[0]; x++) {
+                if (v[z * plane + (size_t)y * desc->dims[0] + x] < iso)
+                    continue;
+                double w[3] = {x * desc->spacing[0], y * desc->spacing[1], z * desc->spacing[2]},
+                       p[3];
+                ip_orientation_apply(&desc->orientation, w, p);
+                for (int a = 0; a < 3; a++)
+                    sum[a] += p[a];
+                count++;
+            }
+    for (int a = 0; a < 3; a++)
+        centroid[a] = count ? sum[a] / count : 0;
+    double volume = count * desc->spacing[0] * desc->spacing[1] * desc->spacing[2];
+    *radius = cbrt(volume * 3 / (4 * M_PI));
+    free(v);
+}
+
+/* A gantry tilt: resampled by default onto a grid along the slices' rows, columns and normal,
+ * the sphere where it is in physical space (centroid and radius within half a voxel); refused
+ * when asked, naming the tilt and the option; the list says it. */
+static void test_tilt(void)
+{
+    char dir[4096];
+    tilted_sphere(fresh_folder(dir, "tilted"));
+    ip_input_desc desc;
+    if (describe(dir, NULL, &desc)) {
+        CHECK_EQ(desc.resampled, IP_RESAMPLED_TILT);
+        CHECK_NEAR(desc.tilt_degrees, 18.5, 0.05);
+        CHECK_EQ(desc.source_slices, 13);
+        /* the slices' rows, and their columns widened by the 12 x 0.79 mm of the shift */
+        CHECK_EQ(desc.dims[0], 40);
+        CHECK_EQ(desc.dims[1], 36 + 14);
+        CHECK_EQ(desc.dims[2], 13);
+        CHECK_NEAR(desc.spacing[2], 2.36, 1e-9);
+        /* the grid starts 14 rows before the first slice's, at y = 30 - 14 x 0.7 */
+        CHECK_NEAR(desc.orientation.origin[0], -12.5, 1e-9);
+        CHECK_NEAR(desc.orientation.origin[1], 30 - 14 * 0.7, 1e-9);
+        CHECK_NEAR(desc.orientation.origin[2], -40, 1e-9);
+        double centroid[3], radius;
+        measure_sphere(&desc, 2000 - 40 * sphere_radius, centroid, &radius);
+        for (int a = 0; a < 3; a++)
+            CHECK_NEAR(centroid[a], sphere_centre[a], desc.spacing[a] / 2);
+        CHECK_NEAR(radius, sphere_radius, 0.35);
+    }
+    ip_input_overrides o = IP_SIZED(ip_input_overrides);
+    o.tilt = IP_REGRID_REFUSE;
+    ip_error err;
+    CHECK_EQ(ip_input_describe(dir, &o, &desc, &err), IP_ERR_INPUT);
+    CHECK_CONTAINS(err.message, "tilted: gantry tilt: the slices stack 18.5 degrees off their "
+                                "normal, shifted (0, -0.79) mm a slice");
+    CHECK_CONTAINS(err.message, "--correct-tilt");
+    o.tilt = (ip_regrid)7;
+    CHECK_EQ(ip_input_describe(dir, &o, &desc, &err), IP_ERR_ARGUMENT);
+    ip_dicom_series_info *list = NULL;
+    uint32_t count = 0;
+    CHECK(ip_dicom_list_series(dir, &list, &count, NULL, &err) == IP_OK && count == 1);
+    if (count == 1) {
+        CHECK_EQ(list[0].resampled, IP_RESAMPLED_TILT);
+        CHECK_EQ(list[0].dims[1], 50);
+        CHECK_NEAR(list[0].tilt_degrees, 18.5, 0.05);
+    }
+    free(list);
+}
+
+/* Uneven steps (2.5 mm, then a 5 mm gap, then 1.25 mm): refused by default, naming the
+ * option; resampled when asked onto planes 1.25 mm apart, each the linear interpolation of the
+ * two slices around it (exact for samples linear along z, within the rounding). */
+static void test_uneven(void)
+{
+    char dir[4096];
+    static const double z_at[] = {-40, -37.5, -35, -30, -28.75, -27.5, -26.25, -25};
+    test_dicom_series s = test_dicom_default(5, 4, 8, IP_INT16);
+    s.z_at = z_at;
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+    int16_t v[8 * 20];
+    for (int z = 0; z < 8; z++)
+        for (int i = 0; i < 20; i++)
+            v[z * 20 + i] = (int16_t)(i + 8 * (z_at[z] + 40)); /* 8 a mm along z */
+    test_dicom_write_series(&s, v, fresh_folder(dir, "uneven_steps"));
+    expect_refused(
+        dir, IP_ERR_INPUT, "uneven_steps",
+        "a slice is missing between IM0004.dcm (at -40 mm) and IM0003.dcm (at -37.5 mm)");
+    expect_refused(dir, IP_ERR_INPUT, "uneven_steps",
+                   "isobrick --even-spacing resamples them onto an even grid");
+    ip_input_overrides o = IP_SIZED(ip_input_overrides);
+    ip_input_desc desc;
+    o.uneven = IP_REGRID_RESAMPLE;
+    if (!describe(dir, &o, &desc))
+        return;
+    CHECK_EQ(desc.resampled, IP_RESAMPLED_UNEVEN);
+    CHECK_EQ(desc.dims[2], 13); /* 15 mm in steps of 1.25 */
+    CHECK_NEAR(desc.spacing[2], 1.25, 1e-9);
+    CHECK_EQ(desc.source_slices, 8);
+    int16_t got[13 * 20];
+    ip_input_reader *r = NULL;
+    ip_error err;
+    REQUIRE(ip_input_open(&desc, &r, &err) == IP_OK);
+    CHECK_MSG(ip_input_read_planes(r, got, 13, &err) == IP_OK, "%s", err.message);
+    ip_input_close(r);
+    for (int z = 0; z < 13; z++)
+        for (int i = 0; i < 20; i++)
+            CHECK_EQ(got[z * 20 + i], (int16_t)(i + 10 * z));
+}
+
 static void test_series_int16(void)
 {
     test_series(IP_INT16, "int16");
@@ -737,6 +1082,12 @@ static const test_case cases[] = {
     TEST_CASE(test_long_pixel_data),
     TEST_CASE(test_odd_member),
     TEST_CASE(test_fuzz_findings),
+    TEST_CASE(test_non_image),
+    TEST_CASE(test_subfolders),
+    TEST_CASE(test_several_series),
+    TEST_CASE(test_failing_series),
+    TEST_CASE(test_tilt),
+    TEST_CASE(test_uneven),
 };
 
 static void make_scratch_dir(void)

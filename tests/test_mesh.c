@@ -555,11 +555,66 @@ static void test_populated_growth(void)
     ip_mesh_free(&m);
 }
 
+/* Whether the `size` bytes at buf hold the text `text`. */
+static int holds(const unsigned char *buf, size_t size, const char *text)
+{
+    size_t n = strlen(text);
+    for (size_t i = 0; i + n <= size; i++)
+        if (memcmp(buf + i, text, n) == 0)
+            return 1;
+    return 0;
+}
+
+/* The space a mesh file names: in each format, soup and welded; none without a name; a bad
+ * name refused with nothing written; the names ip_mesh_space_of() gives. */
+static void test_space_named(void)
+{
+    static const char *const names[] = {"spaced.ply", "spaced.obj", "spaced.stl", "spaced.glb"};
+    static const char *const tags[] = {"comment space LPS\n", "# space LPS\n",
+                                       "binary STL, space LPS", "\"extras\":{\"space\":\"LPS\"}"};
+    float p[18];
+    ip_mesh m;
+    two_triangles(&m, p);
+    ip_indexed_mesh w;
+    REQUIRE(ip_mesh_weld(&m, &w) == IP_OK);
+    static unsigned char buf[8192];
+    ip_error err;
+    for (size_t i = 0; i < 4; i++) {
+        char path[4200];
+        scratch_path(path, names[i]);
+        REQUIRE(ip_mesh_write_in(&m, path, "LPS", 0, &err) == IP_OK);
+        size_t size = read_file(path, buf, sizeof buf);
+        CHECK_MSG(holds(buf, size, tags[i]), "%s: no space tag", names[i]);
+        REQUIRE(ip_indexed_mesh_write_in(&w, path, "LPS", 1, &err) == IP_OK);
+        size = read_file(path, buf, sizeof buf);
+        CHECK_MSG(holds(buf, size, tags[i]), "%s (welded): no space tag", names[i]);
+        REQUIRE(ip_mesh_write_in(&m, path, NULL, 1, &err) == IP_OK);
+        size = read_file(path, buf, sizeof buf);
+        CHECK_MSG(!holds(buf, size, "space"), "%s: a space named without one", names[i]);
+        scratch_path(path, names[i]);
+        CHECK_EQ(ip_mesh_write_in(&m, path, "R A S", 0, &err), IP_ERR_ARGUMENT);
+        CHECK_EQ(ip_mesh_write_in(&m, path, "", 0, &err), IP_ERR_ARGUMENT);
+        CHECK_EQ(ip_mesh_write_in(&m, path, "a23456789012345678901234567890123", 0, &err),
+                 IP_ERR_ARGUMENT);
+        CHECK_EQ(ip_indexed_mesh_write_in(&w, path, "x\"}", 0, &err), IP_ERR_ARGUMENT);
+        CHECK(no_file(path));
+    }
+    ip_orientation o;
+    ip_orientation_identity(&o);
+    CHECK_STR_EQ(ip_mesh_space_of(&o), "volume");
+    o.space = IP_SPACE_RAS;
+    CHECK_STR_EQ(ip_mesh_space_of(&o), "RAS");
+    o.space = IP_SPACE_LPS;
+    CHECK_STR_EQ(ip_mesh_space_of(&o), "LPS");
+    ip_indexed_mesh_free(&w);
+    ip_mesh_free(&m);
+}
+
 static const test_case cases[] = {
     TEST_CASE(test_normal_packing), TEST_CASE(test_populated_growth),
     TEST_CASE(test_appends),        TEST_CASE(test_ply),
     TEST_CASE(test_stl_obj),        TEST_CASE(test_glb),
-    TEST_CASE(test_indexed_files),
+    TEST_CASE(test_indexed_files),  TEST_CASE(test_space_named),
 };
 
 int main(int argc, char **argv)

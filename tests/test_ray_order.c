@@ -77,8 +77,11 @@ static void reference_order(uint32_t w, uint32_t h, uint32_t local_from, uint32_
         uint32_t nx = level < kx ? level : kx, ny = level < ky ? level : ky;
         uint32_t both = nx < ny ? nx : ny, splits = nx > ny ? nx : ny;
         int local = level >= local_from;
-        for (uint64_t position = 0; position < (1ull << (nx + ny)); position++) {
-            uint64_t p = position;
+        /* every other local level, from the second, is walked from its end */
+        uint64_t cells = 1ull << (nx + ny);
+        int backward = local && ((level - local_from) & 1u);
+        for (uint64_t position = 0; position < cells; position++) {
+            uint64_t p = backward ? cells - 1 - position : position;
             uint32_t cx = 0, cy = 0;
             for (uint32_t s = 0; s < both; s++, p >>= 2) {
                 cx |= digit_x[p & 3] << (local ? s : nx - 1 - s);
@@ -442,6 +445,14 @@ static void test_distance_transform(void)
  * first local one come in the very same sequence, every pixel still comes once, and within a
  * local level consecutive rays are near each other (a mean chessboard step under 1/16 of
  * Bayer order's, which jumps across the screen). */
+/* The chessboard distance between two pixels (level, x, y). */
+static uint32_t chessboard(const uint32_t a[3], const uint32_t b[3])
+{
+    uint32_t dx = a[1] > b[1] ? a[1] - b[1] : b[1] - a[1],
+             dy = a[2] > b[2] ? a[2] - b[2] : b[2] - a[2];
+    return dx > dy ? dx : dy;
+}
+
 static void test_local_levels(uint32_t w, uint32_t h, uint32_t local_from)
 {
     ip_ray_order bayer, local;
@@ -467,7 +478,7 @@ static void test_local_levels(uint32_t w, uint32_t h, uint32_t local_from)
     /* level by level: the same pixels (as sets), in the same order before local_from */
     unsigned char *in_level = calloc(n, 1);
     REQUIRE(in_level);
-    uint64_t start = 0, differ = 0, order_differs = 0;
+    uint64_t start = 0, differ = 0, order_differs = 0, jumps_far = 0, boundaries = 0;
     double steps = 0, bayer_steps = 0;
     uint64_t step_count = 0;
     while (start < n) {
@@ -492,11 +503,22 @@ static void test_local_levels(uint32_t w, uint32_t h, uint32_t local_from)
         }
         for (uint64_t i = start; i < end; i++)
             in_level[(size_t)a[i][2] * w + a[i][1]] = 0;
+        /* a local level after the first starts where the one before ended (walked backward
+         * every other level), within a few of the last level's cells, not across the screen;
+         * skipped cells (empty, or cast before) can move a sparse level's first ray away */
+        if (start > 0 && a[start][0] > local_from && a[start][0] > a[start - 1][0]) {
+            uint32_t cell = (w > h ? w : h) >> a[start - 1][0];
+            boundaries++;
+            jumps_far += chessboard(b[start - 1], b[start]) > 4 * cell + 4;
+        }
         start = end;
     }
     CHECK_MSG(differ == 0, "%ux%u local from %u: %llu rays in another level", w, h, local_from,
               (unsigned long long)differ);
     CHECK_MSG(order_differs == 0, "%ux%u local from %u: coarse levels reordered", w, h, local_from);
+    CHECK_MSG(jumps_far * 4 <= boundaries,
+              "%ux%u local from %u: %llu of %llu local levels start far from the last", w, h,
+              local_from, (unsigned long long)jumps_far, (unsigned long long)boundaries);
     if (step_count > 0) {
         double mean = steps / (double)step_count, bayer_mean = bayer_steps / (double)step_count;
         printf("%ux%u local from level %u: mean step %.2f pixels (Bayer order: %.2f)\n", w, h,

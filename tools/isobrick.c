@@ -27,6 +27,17 @@ static const char usage[] =
     "                      the values stand for stored x S + I, in UNIT (e.g. 1,-1024,HU),\n"
     "                      instead of what the input says; none: no rescale. Kept in the\n"
     "                      brick file: isovalues are then given in UNIT (docs/input.md)\n"
+    "A DICOM folder (docs/dicom.md) is read with its subfolders; objects that are not images\n"
+    "(a DICOMDIR under any name, reports, presentation states) are skipped and counted.\n"
+    "  --list-series       list the folder's series (UID, description, modality, slices,\n"
+    "                      size, spacing) and exit; nothing is written\n"
+    "  --series UID        the series to read (a UID, or a prefix of one only); needed when\n"
+    "                      the folder holds several\n"
+    "  --correct-tilt      resample slices sheared by a gantry tilt onto a regular grid along\n"
+    "                      their normal (the default; the summary says so)\n"
+    "  --no-correct-tilt   refuse a tilted series instead\n"
+    "  --even-spacing      resample unevenly spaced slices (a slice missing included) onto an\n"
+    "                      even grid of the smallest step (default: refused)\n"
     "  --brick-size B      cells per brick edge, a power of two (default 32)\n"
     "  --subblock-size S   cells per sub-block edge, a power of two <= B (default 8)\n"
     "  --hc [LEVEL]        LZ4 high compression (level 1-12, default 9) instead of fast\n"
@@ -82,6 +93,7 @@ typedef struct options {
     ip_rescale rescale; /* not present for --rescale none */
     ip_bricker_options brick;
     int quiet, verbose;
+    int list_series, correct_tilt, no_correct_tilt, even_spacing; /* DICOM folders */
 } options;
 
 /* The values of isobrick's options (tool_option_parse: base is the options). */
@@ -216,11 +228,17 @@ static const tool_option isobrick_options[] = {
     {"--force", "-f", 0, offsetof(options, brick.force), NULL, NULL, NULL},
     {"--quiet", "-q", 0, offsetof(options, quiet), NULL, NULL, NULL},
     {"--verbose", "-v", 0, offsetof(options, verbose), NULL, NULL, NULL},
+    {"--list-series", NULL, 0, offsetof(options, list_series), NULL, NULL, NULL},
+    {"--series", NULL, 1, offsetof(options, overrides.series), NULL, NULL, NULL},
+    {"--correct-tilt", NULL, 0, offsetof(options, correct_tilt), NULL, NULL, NULL},
+    {"--no-correct-tilt", NULL, 0, offsetof(options, no_correct_tilt), NULL, NULL, NULL},
+    {"--even-spacing", NULL, 0, offsetof(options, even_spacing), NULL, NULL, NULL},
 };
 
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
+    o->overrides = IP_SIZED(ip_input_overrides);
     ip_bricker_options_default(&o->brick);
     const tool_option_table table = {isobrick_options,
                                      sizeof isobrick_options / sizeof isobrick_options[0], o};
@@ -232,6 +250,13 @@ static int parse_args(int argc, char **argv, options *o)
         return tool_usage_error("isobrick", "no input file");
     if (o->quiet && o->verbose)
         return tool_usage_error("isobrick", "--quiet and --verbose: one or the other");
+    if (o->correct_tilt && o->no_correct_tilt)
+        return tool_usage_error("isobrick", "--correct-tilt and --no-correct-tilt: one or the "
+                                            "other");
+    o->overrides.tilt = o->no_correct_tilt ? IP_REGRID_REFUSE
+                        : o->correct_tilt  ? IP_REGRID_RESAMPLE
+                                           : IP_REGRID_DEFAULT;
+    o->overrides.uneven = o->even_spacing ? IP_REGRID_RESAMPLE : IP_REGRID_DEFAULT;
     if (o->brick.subblock_edge > o->brick.brick_edge)
         return tool_usage_error("isobrick",
                                 "the sub-block edge %u is larger than the brick edge %u",
@@ -276,6 +301,76 @@ static const char *read_mode(const ip_bricker_report *r, char *text, size_t size
     return text;
 }
 
+/* `text` on stdout with its control characters as '?' (DICOM values may hold any byte). */
+static void print_shown(const char *text)
+{
+    for (const char *c = text; *c; c++)
+        putchar((unsigned char)*c < 0x20 || *c == 0x7F ? '?' : *c);
+}
+
+/* A DICOM series' lines of the summary: which series, the objects skipped, the resampling. */
+static void print_series(const ip_input_desc *d)
+{
+    if (d->encoding != IP_ENCODING_DICOM)
+        return;
+    printf("  series      ");
+    print_shown(d->series_uid);
+    printf(", %u slices", d->source_slices);
+    if (d->series_count > 1)
+        printf(" (one of the %u series in the folder)", d->series_count);
+    printf("\n");
+    if (d->skipped_objects)
+        printf("  skipped     %u DICOM object%s that %s not images (by SOP class)\n",
+               d->skipped_objects, d->skipped_objects == 1 ? "" : "s",
+               d->skipped_objects == 1 ? "is" : "are");
+    if (d->resampled & IP_RESAMPLED_TILT)
+        printf("  resampled   gantry tilt of %.3g degrees: the sheared slices resampled onto a "
+               "regular %ux%ux%u grid along their normal (interpolated samples; "
+               "--no-correct-tilt refuses instead)\n",
+               d->tilt_degrees, d->dims[0], d->dims[1], d->dims[2]);
+    if (d->resampled & IP_RESAMPLED_UNEVEN)
+        printf("  resampled   uneven slice spacing: %u slices resampled onto %u planes %g mm "
+               "apart (interpolated samples)\n",
+               d->source_slices, d->dims[2], d->spacing[2]);
+}
+
+/* --list-series: one line a series of the folder. Returns the exit status. */
+static int list_series(const char *folder)
+{
+    ip_dicom_series_info *list = NULL;
+    uint32_t count = 0, skipped = 0;
+    ip_error err;
+    if (ip_dicom_list_series(folder, &list, &count, &skipped, &err) != IP_OK)
+        return tool_fail("isobrick", &err);
+    print_shown(folder);
+    printf(": %u series", count);
+    if (skipped)
+        printf(", %u DICOM object%s that %s not images skipped", skipped, skipped == 1 ? "" : "s",
+               skipped == 1 ? "is" : "are");
+    printf("\n");
+    for (uint32_t i = 0; i < count; i++) {
+        const ip_dicom_series_info *e = &list[i];
+        print_shown(e->uid[0] ? e->uid : "(no UID)");
+        printf("  \"");
+        print_shown(e->description);
+        printf("\"  ");
+        print_shown(e->modality[0] ? e->modality : "-");
+        printf("  %u slice%s", e->slices, e->slices == 1 ? "" : "s");
+        if (e->dims[0]) /* 0: its files do not tell */
+            printf("  %ux%ux%u %s  spacing %g,%g,%g mm", e->dims[0], e->dims[1], e->dims[2],
+                   ip_type_name(e->type), e->spacing[0], e->spacing[1], e->spacing[2]);
+        if (e->problem[0]) {
+            printf("  not read as it is: ");
+            print_shown(e->problem);
+        } else if (e->resampled & IP_RESAMPLED_TILT) {
+            printf("  gantry tilt %.3g degrees: resampled", e->tilt_degrees);
+        }
+        printf("\n");
+    }
+    free(list);
+    return 0;
+}
+
 static void print_summary(const ip_bricker_report *r, const ip_input_desc *desc, const char *out)
 {
     char in_b[32], file_b[32], rss_b[32], mode[64];
@@ -283,6 +378,7 @@ static void print_summary(const ip_bricker_report *r, const ip_input_desc *desc,
     printf("  input       %s (%llu bytes)\n",
            tool_format_bytes(in_b, sizeof in_b, (double)r->input_bytes),
            (unsigned long long)r->input_bytes);
+    print_series(desc);
     tool_print_rescale(stdout, desc);
     printf("  file        %s (%llu bytes)\n",
            tool_format_bytes(file_b, sizeof file_b, (double)r->file_bytes),
@@ -415,6 +511,8 @@ int main(int argc, char **argv)
         return rc;
     ip_error err;
     ip_error_clear(&err);
+    if (o.list_series)
+        return list_series(o.input);
     ip_input_desc desc;
     if (ip_input_describe(o.input, &o.overrides, &desc, &err) != IP_OK)
         return tool_fail("isobrick", &err);

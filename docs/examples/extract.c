@@ -6,8 +6,9 @@
  * Opens a brick file (made by isobrick), keeps its bricks in a cache, and extracts the
  * isosurface ISO: progressively, for a camera on the -y side of the volume, until every pixel
  * of a WxH image (640x480 by default) has had its ray; or, with --full, every active cell.
- * Prints the number of triangles and writes the mesh (binary PLY, binary STL or OBJ, by the
- * extension). It links libisoprop alone, nothing graphical:
+ * Prints the number of triangles and writes the mesh (binary PLY, binary STL, OBJ or glTF,
+ * by the extension) in the volume's physical space, which the file names. It links
+ * libisoprop alone, nothing graphical:
  *
  *   cc extract.c $(pkg-config --cflags --libs isoprop) -o extract
  *
@@ -100,6 +101,27 @@ static ip_status extract_progressive(ip_cache *cache, const request *q, ip_engin
     return st;
 }
 
+/* Writes the mesh in the volume's physical space (origin, directions and spacing applied, as
+ * isorender --mesh does), naming the space in the file. The engine's mesh is in world units
+ * (sample index x spacing), so a copy is moved. */
+static ip_status write_physical(const ip_store *store, const ip_mesh *mesh, const char *path,
+                                ip_error *err)
+{
+    const ip_orientation *orientation = &ip_store_layout(store)->orientation;
+    ip_mesh physical;
+    ip_mesh_init(&physical);
+    ip_status st = ip_mesh_append_mesh(&physical, mesh, 0, mesh->triangle_count);
+    if (st == IP_OK) {
+        ip_mesh_to_physical(&physical, orientation);
+        st = ip_mesh_write_in(&physical, path, ip_mesh_space_of(orientation), 0, err);
+    } else {
+        err->code = st;
+        snprintf(err->message, sizeof err->message, "%s: out of memory", path);
+    }
+    ip_mesh_free(&physical);
+    return st;
+}
+
 static ip_status run(const request *q, ip_error *err)
 {
     ip_store *store = NULL;
@@ -126,7 +148,7 @@ static ip_status run(const request *q, ip_error *err)
                (unsigned long long)stats.resident_peak_bytes);
     }
     if (st == IP_OK && q->mesh_file)
-        st = ip_mesh_write(mesh, q->mesh_file, 0, err);
+        st = write_physical(store, mesh, q->mesh_file, err);
     ip_mesh_free(&full);
     ip_engine_destroy(engine);
     ip_cache_destroy(cache);

@@ -52,10 +52,34 @@ typedef struct ip_input_desc {
                                    Offset/TransformMatrix/AnatomicalOrientation, NIfTI sform or
                                    qform, DICOM image position/orientation); identity when the
                                    file says nothing or its axes are not orthonormal */
+    /* A DICOM folder (docs/dicom.md); zero for other inputs. */
+    char series_uid[72];      /* the Series Instance UID read (at most 64 characters) */
+    uint32_t series_count;    /* series in the folder (with its subfolders) */
+    uint32_t skipped_objects; /* DICOM objects of the folder that are not images (a SOP class
+                                 of a directory, a report, a presentation state, ...): skipped */
+    uint32_t source_slices;   /* the series' files (slices) */
+    uint32_t resampled;       /* IP_RESAMPLED_* bits: why the slices were resampled onto the
+                                 regular grid dims x spacing (interpolated samples); 0: the
+                                 samples are the stored ones, one slice a plane */
+    double tilt_degrees;      /* the angle between the slices' stacking direction and their
+                                 normal (a gantry tilt); 0 when they stack along the normal */
     char rescale_unit[IP_RESCALE_UNIT_MAX]; /* with has_rescale: the values' unit, "" when the
                                                file names none ("HU" for a DICOM CT) */
-    uint64_t reserved[30]; /* zero: room for later fields at the same size (status.h) */
+    uint64_t reserved[18]; /* zero: room for later fields at the same size (status.h) */
 } ip_input_desc;
+
+/* ip_input_desc.resampled: the slices of a DICOM series were resampled onto a regular grid
+ * because they are sheared (a gantry tilt) or unevenly spaced along their normal. */
+#define IP_RESAMPLED_TILT 1u
+#define IP_RESAMPLED_UNEVEN 2u
+
+/* How a DICOM series whose slices do not lie on a regular grid is read
+ * (ip_input_overrides.tilt and .uneven; docs/dicom.md). */
+typedef enum ip_regrid {
+    IP_REGRID_DEFAULT = 0,  /* a tilt is resampled, uneven spacing refused */
+    IP_REGRID_RESAMPLE = 1, /* resampled onto a regular grid in physical space */
+    IP_REGRID_REFUSE = 2    /* refused (IP_ERR_INPUT) */
+} ip_regrid;
 
 /* Values given on the command line; each applies only where its has_ flag is set, and wins
  * over the file name and over any header. A header field that an override replaces is not
@@ -73,6 +97,12 @@ typedef struct ip_input_overrides {
     int big_endian;
     int has_spacing;
     double spacing[3];
+    /* A DICOM folder (after 0.2.0; zero keeps the defaults): */
+    const char *series; /* the Series Instance UID, or a prefix of one only, of the series to
+                           read from a folder holding several; NULL: the folder must hold one.
+                           Not copied: valid during ip_input_describe() */
+    ip_regrid tilt;     /* slices sheared by a gantry tilt; default: resampled */
+    ip_regrid uneven;   /* slices unevenly spaced (a slice missing included); default: refused */
 } ip_input_overrides;
 
 /*! ip_input_describe() : fills *out for the volume at `path`.
@@ -121,6 +151,41 @@ IP_API ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32
 
 /*! ip_input_close() : releases the reader (NULL is allowed). */
 IP_API void ip_input_close(ip_input_reader *reader);
+
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same. */
+#ifdef IP_EXPERIMENTAL
+
+/* One series of a DICOM folder, as ip_dicom_list_series() finds it. */
+typedef struct ip_dicom_series_info {
+    char uid[72];         /* Series Instance UID (0020,000E), at most 64 characters */
+    char description[72]; /* Series Description (0008,103E), "" when none */
+    char modality[24];    /* Modality (0008,0060), "" when none */
+    uint32_t slices;      /* its files */
+    uint32_t dims[3];     /* the volume it reads as: columns, rows, planes (the slices, or the
+                             planes of the grid it is resampled onto); 0 when it cannot be read */
+    ip_type type;
+    double spacing[3];   /* x, y from Pixel Spacing, z between planes; mm; 0 when unknown */
+    double tilt_degrees; /* as ip_input_desc.tilt_degrees */
+    uint32_t resampled;  /* IP_RESAMPLED_* bits: what reading it with IP_REGRID_RESAMPLE
+                             resamples */
+    char problem[512];   /* "" or the one line that says why it cannot be read as it is (under
+                             the default ip_regrid choices) */
+} ip_dicom_series_info;
+
+/*! ip_dicom_list_series() : the series of the DICOM folder `folder` (its subfolders included),
+ *  in order of their UIDs, into *out (count entries, owned by the caller, released with
+ *  free()); *skipped (may be NULL) receives the number of DICOM objects that are not images.
+ *  A series that cannot be read is listed with its problem; a file that is not DICOM, or
+ *  whose series cannot be told, fails the call.
+ *  @return IP_OK, or IP_ERR_INPUT / IP_ERR_IO naming the folder or file, IP_ERR_UNSUPPORTED
+ *  when the input component cannot be loaded, IP_ERR_NOMEM. */
+IP_API ip_status ip_dicom_list_series(const char *folder, ip_dicom_series_info **out,
+                                      uint32_t *count, uint32_t *skipped, ip_error *err);
+
+#endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus
 }

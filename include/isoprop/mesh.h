@@ -209,6 +209,30 @@ IP_API ip_status ip_indexed_mesh_smooth_taubin(ip_indexed_mesh *mesh, unsigned i
 IP_API ip_status ip_indexed_mesh_write(const ip_indexed_mesh *mesh, const char *path, int force,
                                        ip_error *err);
 
+/* The space of a written mesh's coordinates, named in the file (docs/meshes.md, "Space"). */
+#define IP_MESH_SPACE_GRID "grid" /* world coordinates: sample index x spacing, from 0 */
+#define IP_MESH_SPACE_MAX 31      /* longest space name accepted */
+
+/*! ip_mesh_space_of() : the name of the space a mesh is in once ip_mesh_to_physical() has
+ *  moved it by `orientation`: "RAS", "LAS" or "LPS" where the volume's file names that space,
+ *  "volume" where it names none (its own axes, from its origin, in its spacing's units). A
+ *  static string: not to be freed. */
+IP_API const char *ip_mesh_space_of(const ip_orientation *orientation);
+
+/*! ip_mesh_write_in() : as ip_mesh_write(), naming `space` in the file: a PLY comment
+ *  "space NAME", an OBJ comment "# space NAME", "space NAME" in the STL header, and
+ *  asset.extras.space in glTF. `space`: 1 to IP_MESH_SPACE_MAX letters, digits, '.', '_' or
+ *  '-' (IP_ERR_ARGUMENT otherwise, nothing written); NULL names none, as ip_mesh_write().
+ *  The coordinates are written as they are: moving them is the caller's (ip_mesh_to_physical()).
+ *  @return as ip_mesh_write(). */
+IP_API ip_status ip_mesh_write_in(const ip_mesh *mesh, const char *path, const char *space,
+                                  int force, ip_error *err);
+
+/*! ip_indexed_mesh_write_in() : ip_indexed_mesh_write() naming `space` in the file, as
+ *  ip_mesh_write_in(). @return as ip_mesh_write(). */
+IP_API ip_status ip_indexed_mesh_write_in(const ip_indexed_mesh *mesh, const char *path,
+                                          const char *space, int force, ip_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -69,6 +69,10 @@ _PROTOTYPES = {
                                     ERR]),
     "ip_mesh_init": (None, [POINTER(S.Mesh)]),
     "ip_mesh_free": (None, [POINTER(S.Mesh)]),
+    "ip_mesh_append_mesh": (c_int, [POINTER(S.Mesh), POINTER(S.Mesh), c_uint64, c_uint64]),
+    "ip_mesh_to_physical": (None, [POINTER(S.Mesh), POINTER(S.Orientation)]),
+    "ip_mesh_space_of": (c_char_p, [POINTER(S.Orientation)]),
+    "ip_orientation_is_identity": (c_int, [POINTER(S.Orientation)]),
 }
 
 

@@ -7,7 +7,7 @@ tests/python/test_layouts.py compares every size and field offset here with the 
 tests instead of corrupting memory.
 """
 import ctypes
-from ctypes import c_char, c_double, c_float, c_int, c_int16, c_uint, c_uint32, c_uint64, c_void_p
+from ctypes import c_char, c_char_p, c_double, c_float, c_int, c_int16, c_uint, c_uint32, c_uint64, c_void_p
 
 PATH_MAX = 4096  # IP_PATH_MAX, include/isoprop/volume.h
 MAX_LEVELS = 32  # IP_MAX_LEVELS, include/isoprop/layout.h
@@ -39,14 +39,18 @@ class InputDesc(ctypes.Structure):
                 ("big_endian", c_int), ("spacing", c_double * 3), ("encoding", c_int),
                 ("stream_skip", c_uint64), ("has_rescale", c_int), ("rescale_slope", c_double),
                 ("rescale_intercept", c_double), ("orientation", Orientation),
-                ("rescale_unit", c_char * RESCALE_UNIT_MAX), ("reserved", c_uint64 * 30)]
+                ("series_uid", c_char * 72), ("series_count", c_uint32),
+                ("skipped_objects", c_uint32), ("source_slices", c_uint32), ("resampled", c_uint32),
+                ("tilt_degrees", c_double), ("rescale_unit", c_char * RESCALE_UNIT_MAX),
+                ("reserved", c_uint64 * 18)]
 
 
 class InputOverrides(ctypes.Structure):
     """ip_input_overrides (input.h)"""
     _fields_ = [("size", c_uint32), ("has_dims", c_int), ("dims", c_uint32 * 3), ("has_type", c_int),
                 ("type", c_int), ("has_endian", c_int), ("big_endian", c_int),
-                ("has_spacing", c_int), ("spacing", c_double * 3)]
+                ("has_spacing", c_int), ("spacing", c_double * 3), ("series", c_char_p),
+                ("tilt", c_int), ("uneven", c_int)]
 
 
 # ip_progress_fn (bricker.h): nonzero cancels the run

@@ -13,7 +13,7 @@ from ._library import lib
 from . import _check as C
 from .bricking import DTYPES
 from .errors import ArgumentError, check, new_error
-from .mesh import Mesh, Step, copy_triangles
+from .mesh import Mesh, Step, copy_in_space
 from .stats import counts_dict, run_stats
 
 Level = namedtuple("Level", "level dims bricks value_range")
@@ -28,6 +28,8 @@ intercept, in unit ("HU" for a DICOM CT; "" when the input named none)."""
 DEFAULT_SIZE = (1600, 1200)  # isorender's
 VIEW_FOV = 30.0  # degrees: the field of view of the named views (isorender --view)
 
+
+SPACES = ("physical", "grid")  # extract(space=...): docs/meshes.md, "Space"
 
 BUSY = "isoprop.File: another call is running on this File (one thread at a time)"
 
@@ -92,10 +94,13 @@ class _Run:
     progressive run steps (_advance())."""
 
     def __init__(self, f, iso, full, camera, options, rays=None, time_limit=None,
-                 rays_per_step=None):
+                 rays_per_step=None, space="physical"):
         """iso: (value in the file's units, stored value, whether it was given stored), as
-        File._isovalue() settles it."""
+        File._isovalue() settles it. space: where the triangles go, the file's physical space
+        or the grid (index x spacing)."""
         self.path, self.summary_bytes = f.path, f._summary_bytes
+        self.orientation = f._orientation if space == "physical" else None
+        self.space = f._space if space == "physical" else "grid"
         (self.iso, self.iso_stored, stored), self.rescale = iso, f.rescale
         self.full, self.camera, self.options = full, camera, options
         self.engine, self.wall_seconds, self.warnings = None, 0.0, []
@@ -150,6 +155,8 @@ class _Call:
 class File:
     """An open brick file (isoprop.open()). Attributes: path, dims (x, y, z samples), shape
     (z, y, x, as a numpy array of the volume), dtype (numpy), spacing (x, y, z world units),
+    origin and directions (where sample (0, 0, 0) is and the unit direction of each sample
+    axis in the file's physical space; a mesh's vertices are origin + D (i, j, k) * spacing),
     rescale (a Rescale: what the stored values stand for, as isoinfo shows it; None when the
     file has none), value_range (min, max; in the file's units where it has a rescale),
     value_range_stored (the same as stored values), levels (a tuple of Level, level 0 first),
@@ -183,6 +190,10 @@ class File:
         self.format_version = l.format_version
         self.brick_size, self.subblock_size = l.brick_edge, l.subblock_edge
         self.file_bytes = l.file_size
+        self._orientation = S.Orientation.from_buffer_copy(l.orientation)
+        self.origin = tuple(l.orientation.origin)
+        self.directions = tuple(tuple(d) for d in l.orientation.directions)
+        self._space = lib.ip_mesh_space_of(ctypes.byref(self._orientation)).decode()
         self._summary_bytes = lib.ip_store_summary_memory(store)
         lo, hi = (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
         lib.ip_layout_world_box(ctypes.byref(l), lo, hi)
@@ -303,7 +314,7 @@ class File:
     def extract(self, iso, *, stored=False, view="-y", camera=None, size=DEFAULT_SIZE,
                 rays=None, full=False, time_limit=None, threads=0, cutoff=None, foldback=None,
                 lod=True, pixel_error=1.0, occlusion=True, prefetch=True, cull=False,
-                cache_mb=None, on_step=None):
+                cache_mb=None, on_step=None, space="physical"):
         """Extracts the isosurface `iso` and returns a Mesh (vertices, normals, faces, stats).
         `iso` is in the file's units where it has a rescale (self.rescale: HU for a DICOM CT),
         else a stored value; stored=True takes it as a stored sample value (isorender
@@ -322,6 +333,9 @@ class File:
         is the product, not an image of it); cache_mb the brick cache's budget (the cache stays warm
         between calls). on_step(step), if given, sees each step (as extract_steps() yields);
         it runs inside the call, so calling this File from it raises RuntimeError.
+        space: "physical" (the default) gives the vertices in the file's physical space, as
+        isorender --mesh writes them; "grid" as sample index x spacing from 0 (the Mesh's
+        `space` names which).
         Every argument is checked first (TypeError, or isoprop.ArgumentError, a ValueError,
         naming it). Raises isoprop.Error for a file that cannot be read, RuntimeError when
         another call on this File is running."""
@@ -333,6 +347,7 @@ class File:
         time_limit = C.seconds_or_none("time_limit", time_limit)
         C.callable_or_none("on_step", on_step)
         full = C.full(full)
+        space = C.choice("space", space, SPACES)
         if full:
             given = [n for n, v in (("rays", rays), ("time_limit", time_limit),
                                     ("on_step", on_step)) if v is not None]
@@ -343,9 +358,9 @@ class File:
                 raise ArgumentError('full: "lod" is the full extraction at adaptive resolution: '
                                     "not with lod=False (full=True is that)")
             with _Call(self):
-                return self._extract_full(iso, full, a)
+                return self._extract_full(iso, full, a, space)
         with _Call(self):
-            run = self._begin(iso, a, rays, time_limit, None)
+            run = self._begin(iso, a, rays, time_limit, None, space)
             try:
                 while True:
                     step = self._advance(run)
@@ -354,15 +369,15 @@ class File:
                     if on_step is not None:
                         on_step(self._step(run, *step))
                 mesh = lib.ip_engine_mesh(run.engine).contents
-                vertices, normals = copy_triangles(mesh, 0, mesh.triangle_count)
-                return Mesh(vertices, normals, self._stats(run))
+                vertices, normals = copy_in_space(mesh, 0, mesh.triangle_count, run.orientation)
+                return Mesh(vertices, normals, self._stats(run), run.space)
             finally:
                 self._end(run)
 
     def extract_steps(self, iso, *, stored=False, rays_per_step=None, rays=None,
                       time_limit=None, view="-y", camera=None, size=DEFAULT_SIZE, threads=0,
                       cutoff=None, foldback=None, lod=True, pixel_error=1.0, occlusion=True,
-                      prefetch=True, cull=False, cache_mb=None):
+                      prefetch=True, cull=False, cache_mb=None, space="physical"):
         """Progressive extraction as a generator: yields a Step (the step's new triangles, its
         counts, the run's statistics so far) after each step of the engine, until every pixel
         has had its ray, `rays` rays or `time_limit` seconds. Steps cast `rays_per_step` rays
@@ -379,15 +394,16 @@ class File:
         rays_per_step = C.count_or_none("rays_per_step", rays_per_step, 1)
         rays = C.count_or_none("rays", rays, 0)
         time_limit = C.seconds_or_none("time_limit", time_limit)
-        return self._steps(iso, a, rays, time_limit, rays_per_step)
+        space = C.choice("space", space, SPACES)
+        return self._steps(iso, a, rays, time_limit, rays_per_step, space)
 
-    def _steps(self, iso, a, rays, time_limit, rays_per_step):
+    def _steps(self, iso, a, rays, time_limit, rays_per_step, space):
         run = None
         try:
             while True:
                 with _Call(self):
                     if run is None:
-                        run = self._begin(iso, a, rays, time_limit, rays_per_step)
+                        run = self._begin(iso, a, rays, time_limit, rays_per_step, space)
                     step = self._advance(run)
                     if step is None:
                         return
@@ -397,11 +413,11 @@ class File:
             if run is not None:
                 self._drop(run)
 
-    def _begin(self, iso, a, rays, time_limit, rays_per_step):
+    def _begin(self, iso, a, rays, time_limit, rays_per_step, space):
         cam = self._camera(a)
         options = a.engine_options()
         cache = self._cache_for(a.cache_mb)
-        run = _Run(self, iso, False, cam, options, rays, time_limit, rays_per_step)
+        run = _Run(self, iso, False, cam, options, rays, time_limit, rays_per_step, space)
         err, engine = new_error(), ctypes.c_void_p()
         check(lib.ip_engine_create(cache, ctypes.byref(options), ctypes.byref(engine),
                                    ctypes.byref(err)), err)
@@ -451,8 +467,9 @@ class File:
         return first, now - first, counts
 
     def _step(self, run, first, count, counts):
-        vertices, normals = copy_triangles(lib.ip_engine_mesh(run.engine).contents, first, count)
-        return Step(vertices, normals, self._stats(run), first, counts_dict(counts))
+        vertices, normals = copy_in_space(lib.ip_engine_mesh(run.engine).contents, first, count,
+                                          run.orientation)
+        return Step(vertices, normals, self._stats(run), first, counts_dict(counts), run.space)
 
     def _stats(self, run, counts=None):
         if counts is None:
@@ -460,11 +477,11 @@ class File:
             lib.ip_engine_totals(run.engine, ctypes.byref(counts))
         return run_stats(run, counts, self._cache)
 
-    def _extract_full(self, iso, full, a):
+    def _extract_full(self, iso, full, a, space):
         cam = self._camera(a)
         options = a.engine_options()
         cache = self._cache_for(a.cache_mb)
-        run = _Run(self, iso, full, cam, options)
+        run = _Run(self, iso, full, cam, options, space=space)
         mesh, counts, err = S.Mesh(), S.EngineCounts(), new_error()
         lib.ip_mesh_init(ctypes.byref(mesh))
         try:
@@ -479,10 +496,10 @@ class File:
                                          ctypes.byref(counts), ctypes.byref(err))
             run.wall_seconds = lib.ip_now_seconds() - start
             check(st, err)
-            vertices, normals = copy_triangles(mesh, 0, mesh.triangle_count)
+            vertices, normals = copy_in_space(mesh, 0, mesh.triangle_count, run.orientation)
         finally:
             lib.ip_mesh_free(ctypes.byref(mesh))
-        return Mesh(vertices, normals, self._stats(run, counts))
+        return Mesh(vertices, normals, self._stats(run, counts), run.space)
 
 
 def open(path):  # noqa: A001 (isoprop.open, as the module's API names it)

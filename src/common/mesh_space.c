@@ -18,3 +18,9 @@ void ip_mesh_to_physical(ip_mesh *mesh, const ip_orientation *orientation)
         }
     }
 }
+
+const char *ip_mesh_space_of(const ip_orientation *orientation)
+{
+    const char *name = ip_space_name(orientation->space);
+    return name[0] ? name : "volume";
+}

@@ -92,16 +92,19 @@ typedef struct mesh_view {
     const int16_t *normals;  /* 3 per vertex, packed */
     const uint32_t *indices; /* 3 per triangle; NULL: triangle t is 3t, 3t + 1, 3t + 2 */
     uint64_t vertex_count, triangle_count;
+    const char *space; /* named in the file; NULL: none */
 } mesh_view;
 
 static mesh_view soup_view(const ip_mesh *m)
 {
-    return (mesh_view){m->positions, m->normals, NULL, 3 * m->triangle_count, m->triangle_count};
+    return (mesh_view){m->positions,          m->normals,        NULL,
+                       3 * m->triangle_count, m->triangle_count, NULL};
 }
 
 static mesh_view indexed_view(const ip_indexed_mesh *m)
 {
-    return (mesh_view){m->positions, m->normals, m->indices, m->vertex_count, m->triangle_count};
+    return (mesh_view){m->positions,    m->normals,        m->indices,
+                       m->vertex_count, m->triangle_count, NULL};
 }
 
 /* Vertex k (0..2) of triangle t. */
@@ -119,9 +122,10 @@ static ip_status write_ply(const mesh_view *m, const char *path, int force, ip_e
     writer w;
     if (writer_open(&w, path, force, err) != IP_OK)
         return w.st;
-    put_text(&w,
-             "ply\nformat binary_little_endian 1.0\ncomment isoprop isosurface\n"
-             "element vertex %llu\nproperty float x\nproperty float y\nproperty float z\n",
+    put_text(&w, "ply\nformat binary_little_endian 1.0\ncomment isoprop isosurface\n");
+    if (m->space)
+        put_text(&w, "comment space %s\n", m->space);
+    put_text(&w, "element vertex %llu\nproperty float x\nproperty float y\nproperty float z\n",
              (unsigned long long)m->vertex_count);
     put_text(&w,
              "property float nx\nproperty float ny\nproperty float nz\n"
@@ -181,7 +185,8 @@ static ip_status write_stl(const mesh_view *m, const char *path, int force, ip_e
     unsigned char *p = writer_room(&w, 84);
     if (p) { /* a header that does not start with "solid", which would read as ASCII STL */
         memset(p, 0, 84);
-        memcpy(p, "isoprop isosurface, binary STL", 30);
+        snprintf((char *)p, 80, "isoprop isosurface, binary STL%s%s", m->space ? ", space " : "",
+                 m->space ? m->space : ""); /* at most 30 + 8 + IP_MESH_SPACE_MAX bytes */
         ip__store_u32le(p + 80, (uint32_t)m->triangle_count);
         w.used += 84;
     }
@@ -214,6 +219,8 @@ static ip_status write_obj(const mesh_view *m, const char *path, int force, ip_e
         return w.st;
     put_text(&w, "# isoprop isosurface: %llu triangles, %llu vertices with normals\n",
              (unsigned long long)m->triangle_count, (unsigned long long)m->vertex_count);
+    if (m->space)
+        put_text(&w, "# space %s\n", m->space);
     for (uint64_t i = 0; i < m->vertex_count; i++) {
         const float *p = m->positions + 3 * i;
         const int16_t *n = m->normals + 3 * i;
@@ -264,8 +271,12 @@ static size_t glb_json(const mesh_view *m, const float lo[3], const float hi[3],
                        char *json)
 {
     size_t n = (size_t)snprintf(json, GLB_JSON_BYTES,
-                                "{\"asset\":{\"version\":\"2.0\",\"generator\":\"isoprop %s\"}",
+                                "{\"asset\":{\"version\":\"2.0\",\"generator\":\"isoprop %s\"",
                                 ip_version());
+    if (m->space) /* the name's characters need no escaping in JSON (space_ok()) */
+        n += (size_t)snprintf(json + n, GLB_JSON_BYTES - n, ",\"extras\":{\"space\":\"%s\"}",
+                              m->space);
+    n += (size_t)snprintf(json + n, GLB_JSON_BYTES - n, "}");
     if (m->triangle_count == 0)
         return n + (size_t)snprintf(json + n, GLB_JSON_BYTES - n, "}");
     unsigned long long v = m->vertex_count, bytes = 12 * v;
@@ -423,4 +434,46 @@ ip_status ip_indexed_mesh_write(const ip_indexed_mesh *m, const char *path, int 
 {
     mesh_view v = indexed_view(m);
     return write_by_extension(&v, path, force, err);
+}
+
+/* 1 when `space` is a name ip_mesh_write_in() accepts. */
+static int space_ok(const char *space)
+{
+    size_t n = strlen(space);
+    if (n == 0 || n > IP_MESH_SPACE_MAX)
+        return 0;
+    for (size_t i = 0; i < n; i++) {
+        char c = space[i];
+        if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+              c == '.' || c == '_' || c == '-'))
+            return 0;
+    }
+    return 1;
+}
+
+/* Writes `v` by its name's extension with `space` named in the file (NULL: none). */
+static ip_status write_in(mesh_view *v, const char *path, const char *space, int force,
+                          ip_error *err)
+{
+    if (space && !space_ok(space))
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "%s: the mesh's space name must be 1 to %d letters, digits, '.', '_' or "
+                        "'-'",
+                        path, IP_MESH_SPACE_MAX);
+    v->space = space;
+    return write_by_extension(v, path, force, err);
+}
+
+ip_status ip_mesh_write_in(const ip_mesh *m, const char *path, const char *space, int force,
+                           ip_error *err)
+{
+    mesh_view v = soup_view(m);
+    return write_in(&v, path, space, force, err);
+}
+
+ip_status ip_indexed_mesh_write_in(const ip_indexed_mesh *m, const char *path, const char *space,
+                                   int force, ip_error *err)
+{
+    mesh_view v = indexed_view(m);
+    return write_in(&v, path, space, force, err);
 }

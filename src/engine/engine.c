@@ -163,7 +163,10 @@ double ip_engine_lod_distance(const ip_engine *e, uint32_t level)
 /* The ray order of a width x height image (the view's, or a region's), from its first pixel.
  * The finest levels (cells of at most 2^LOCAL_LEVELS pixels a side, most of the rays) are
  * cast in Z-order: consecutive rays then cross the same bricks and sub-blocks while they are
- * still in the processor's caches. The image is nearly complete by then, so the coarser
+ * still in the processor's caches, and every other one is walked backward, so that a level
+ * starts on the bricks the one before ended on (ray_order.h; on the head upsampled 4x with a
+ * 256 MiB cache, half the brick cache's misses of a view). The image is nearly complete by
+ * then, so the coarser
  * levels, which make it, keep their spread-out order. Those levels' rays also test their
  * tiles (ip__engine_retire()). */
 static void start_order(ip_engine *e, uint32_t width, uint32_t height)

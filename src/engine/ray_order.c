@@ -100,6 +100,13 @@ uint64_t ip__ray_order_emitted(const ip_ray_order *order)
     return order->emitted;
 }
 
+/* 1 when the current level is a local level walked backward: every other local level, from
+ * the second, runs its Z-order from the end, so that it starts where the level before ended. */
+static uint32_t backward(const ip_ray_order *order)
+{
+    return order->level >= order->local_from && ((order->level - order->local_from) & 1u);
+}
+
 static void set_bit(uint32_t *v, uint32_t bit, uint32_t value)
 {
     *v = (*v & ~(1u << bit)) | value << bit;
@@ -115,14 +122,15 @@ static void set_bit(uint32_t *v, uint32_t bit, uint32_t value)
  * goes on. Counting up the position is a carry running from the coarsest split to finer ones. */
 static void next_cell(ip_ray_order *order, uint32_t nx, uint32_t ny)
 {
-    static const uint8_t digit_x[4] = {0, 1, 1, 0}, digit_y[4] = {0, 1, 0, 1};
+    static const uint8_t digit_x[4] = {0, 1, 1, 0};
     uint64_t position = ++order->next_cell;
     uint32_t both = min_u32(nx, ny), s = 0;
     int local = order->level >= order->local_from; /* finest split first: Z-order */
+    uint32_t back = backward(order);
     for (; s < both; s++) {
         uint32_t digit = (uint32_t)(position >> 2 * s) & 3u;
         set_bit(&order->cell_x, local ? s : nx - 1 - s, digit_x[digit]);
-        set_bit(&order->cell_y, local ? s : ny - 1 - s, digit_y[digit]);
+        set_bit(&order->cell_y, local ? s : ny - 1 - s, (digit & 1u) ^ back);
         if (digit != 0)
             return;
     }
@@ -130,7 +138,7 @@ static void next_cell(ip_ray_order *order, uint32_t nx, uint32_t ny)
     uint32_t splits = nx > both ? nx : ny;
     for (; s < splits; s++) {
         uint32_t bit = (uint32_t)(position >> (both + s)) & 1u;
-        set_bit(cell, local ? s : splits - 1 - s, bit);
+        set_bit(cell, local ? s : splits - 1 - s, bit ^ back);
         if (bit)
             return;
     }
@@ -204,21 +212,22 @@ static inline unsigned memo_slot(ip_ray_order *order, unsigned axis, uint32_t sp
  * next_cell() sets on its way there. */
 static void decode_cell(ip_ray_order *order, uint64_t position)
 {
-    static const uint8_t digit_x[4] = {0, 1, 1, 0}, digit_y[4] = {0, 1, 0, 1};
+    static const uint8_t digit_x[4] = {0, 1, 1, 0};
     uint32_t nx = min_u32(order->level, order->x_levels),
              ny = min_u32(order->level, order->y_levels);
     uint32_t both = min_u32(nx, ny), s = 0;
     int local = order->level >= order->local_from;
+    uint32_t back = backward(order);
     order->cell_x = order->cell_y = 0;
     for (; s < both; s++) {
         uint32_t digit = (uint32_t)(position >> 2 * s) & 3u;
         set_bit(&order->cell_x, local ? s : nx - 1 - s, digit_x[digit]);
-        set_bit(&order->cell_y, local ? s : ny - 1 - s, digit_y[digit]);
+        set_bit(&order->cell_y, local ? s : ny - 1 - s, (digit & 1u) ^ back);
     }
     uint32_t *cell = nx > both ? &order->cell_x : &order->cell_y;
     uint32_t splits = nx > both ? nx : ny;
     for (; s < splits; s++)
-        set_bit(cell, local ? s : splits - 1 - s, (uint32_t)(position >> (both + s)) & 1u);
+        set_bit(cell, local ? s : splits - 1 - s, ((uint32_t)(position >> (both + s)) & 1u) ^ back);
 }
 
 void ip__ray_order_seek(ip_ray_order *order, uint64_t position)
@@ -254,7 +263,7 @@ int ip__ray_order_block(ip_ray_order *order, uint32_t k, uint32_t *xs, uint32_t 
         return 0;
     /* the block's low k bits of each cell index run through every value (local levels set
      * bit s of each index from digit s of the position) */
-    uint32_t side = 1u << k, cx0 = order->cell_x, cy0 = order->cell_y;
+    uint32_t side = 1u << k, cx0 = order->cell_x & ~(side - 1), cy0 = order->cell_y & ~(side - 1);
     unsigned sx[1u << IP__RAY_ORDER_BLOCK_MAX], sy[1u << IP__RAY_ORDER_BLOCK_MAX];
     for (uint32_t i = 0; i < side; i++) {
         sx[i] = memo_slot(order, 0, nx, cx0 + i);
@@ -325,8 +334,9 @@ int ip__ray_order_next_before(ip_ray_order *order, uint64_t end, uint32_t *x, ui
         order->level++;
         order->level_base += cells;
         order->next_cell = 0;
-        order->cell_x = order->cell_y = 0;
         forget_cells(order);
+        if (order->level <= last_level)
+            decode_cell(order, 0); /* (0, 0), or the far corner of a backward level */
     }
     return 0;
 }

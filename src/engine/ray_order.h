@@ -26,8 +26,13 @@
  * Local levels (optional, ip__ray_order_set_local_from()): from a chosen level on, the same
  * digits choose the finest split first instead of the coarsest, so that a level is walked in
  * Z-order: consecutive rays land in neighbouring cells, and a ray caster finds the data of the
- * ray before still in its caches. A level holds the same pixels either way; only their order
- * within the level changes, and the coarser levels keep their spread.
+ * ray before still in its caches. Every other local level, from the second, is walked
+ * backward (its positions from the last to the first: each base-4 digit d read as 3 - d, each
+ * single-axis bit b as 1 - b), so that it starts where the level before ended: the data a level
+ * touched last, still in a least-recently-used cache, is what the next one needs first, and a
+ * working set a little larger than the cache is read about once per two levels instead of once
+ * per level. A level holds the same pixels either way; only their order within the level
+ * changes, and the coarser levels keep their spread.
  *
  * Spread (asserted by tests/test_ray_order.c): after the first 4^k rays, levels 0..k-1 are
  * complete, so every pixel is within ceil(S / 2^k) pixels of a cast ray along each axis

@@ -100,13 +100,23 @@ static ip_status describe_by_component(int tiff, const char *path,
 
 /* ---- folders: a DICOM series or numbered TIFF files ---- */
 
-/* The alphabetically first visible regular file of the folder `path` into out; IP_ERR_INPUT
+/* Subfolders deeper than this are not searched for a first file (dicom_folder.c reads as
+ * deep). */
+#define FOLDER_DEPTH 16
+
+static int visible_folder(const struct dirent *entry)
+{
+    return entry->d_name[0] != '.';
+}
+
+/* The alphabetically first visible regular file of the folder `path` into out, else the first
+ * such file of its subfolders (taken in name order, not following links to folders); 0, or -1
  * when there is none. */
-static ip_status first_file_of(const char *path, char out[IP_PATH_MAX], ip_error *err)
+static int first_file_in(const char *path, int depth, char out[IP_PATH_MAX])
 {
     DIR *dir = opendir(path);
     if (!dir)
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open the folder", path);
+        return -1;
     char best[256] = "";
     struct dirent *entry;
     while ((entry = readdir(dir)) != NULL) {
@@ -120,9 +130,35 @@ static ip_status first_file_of(const char *path, char out[IP_PATH_MAX], ip_error
         snprintf(best, sizeof best, "%s", entry->d_name);
     }
     closedir(dir);
-    if (!best[0])
+    if (best[0]) {
+        snprintf(out, IP_PATH_MAX, "%s/%s", path, best);
+        return 0;
+    }
+    struct dirent **names = NULL;
+    int n = depth < FOLDER_DEPTH ? scandir(path, &names, visible_folder, alphasort) : -1,
+        found = -1;
+    for (int i = 0; i < n; i++) {
+        struct stat st;
+        char full[IP_PATH_MAX];
+        if (found != 0 &&
+            snprintf(full, sizeof full, "%s/%s", path, names[i]->d_name) < (int)sizeof full &&
+            lstat(full, &st) == 0 && S_ISDIR(st.st_mode))
+            found = first_file_in(full, depth + 1, out);
+        free(names[i]);
+    }
+    free(names);
+    return found;
+}
+
+/* The folder's first file (first_file_in()); IP_ERR_INPUT when there is none. */
+static ip_status first_file_of(const char *path, char out[IP_PATH_MAX], ip_error *err)
+{
+    DIR *dir = opendir(path);
+    if (!dir)
+        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open the folder", path);
+    closedir(dir);
+    if (first_file_in(path, 0, out) != 0)
         return ip__fail(err, IP_ERR_INPUT, "%s: the folder holds no files", path);
-    snprintf(out, IP_PATH_MAX, "%s/%s", path, best);
     return IP_OK;
 }
 
@@ -435,6 +471,36 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
     return describe_from_name(path, overrides, desc, found, err);
 }
 
+/* A series is picked from a DICOM folder only. */
+static ip_status check_series_asked(const ip_input_overrides *overrides, const ip_input_desc *desc,
+                                    ip_error *err)
+{
+    if (overrides && overrides->series && desc->encoding != IP_ENCODING_DICOM)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "%s: a DICOM series was asked for, but this is not a folder of DICOM "
+                        "files",
+                        desc->path);
+    return IP_OK;
+}
+
+ip_status ip_dicom_list_series(const char *folder, ip_dicom_series_info **out, uint32_t *count,
+                               uint32_t *skipped, ip_error *err)
+{
+    const ip__input_formats *formats;
+    if (!folder || !out || !count)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "ip_dicom_list_series: folder, out and count are "
+                        "required");
+    *out = NULL;
+    *count = 0;
+    if (folder[0] == '\0' || strlen(folder) >= IP_PATH_MAX)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%.64s: path is empty or too long", folder);
+    ip_status st = ip__input_formats_load(folder, &formats, err);
+    if (st != IP_OK)
+        return st;
+    return formats->dicom_list(folder, out, count, skipped, err);
+}
+
 ip_status ip_input_describe(const char *path, const ip_input_overrides *given, ip_input_desc *out,
                             ip_error *err)
 {
@@ -458,6 +524,7 @@ ip_status ip_input_describe(const char *path, const ip_input_overrides *given, i
     memset(&found, 0, sizeof found);
     set_defaults(&desc, path);
     if ((status = read_layout(path, overrides, &desc, &found, err)) != IP_OK ||
+        (status = check_series_asked(overrides, &desc, err)) != IP_OK ||
         (status = apply_overrides(overrides, &desc, &found, err)) != IP_OK ||
         (status = require_layout(&desc, &found, err)) != IP_OK ||
         (status = validate_dims(&desc, &found, err)) != IP_OK ||

@@ -38,19 +38,24 @@ typedef struct ip__plane_source {
     void (*close)(void *state);
 } ip__plane_source;
 
+/* The series of a DICOM folder (ip_dicom_list_series(), include/isoprop/input.h). */
+typedef ip_status (*ip__dicom_list_fn)(const char *folder, ip_dicom_series_info **out,
+                                       uint32_t *count, uint32_t *skipped, ip_error *err);
+
 /* The input component's readers, as the component hands them to the core
  * (ip_input_formats_table(), include/isoprop/input_formats.h). */
 typedef struct ip__input_formats {
     uint32_t abi; /* IP__INPUT_FORMATS_ABI of the component's build */
     ip__describe_fn tiff_describe, dicom_describe;
     const ip__plane_source *tiff_source, *dicom_source;
+    ip__dicom_list_fn dicom_list;
 } ip__input_formats;
 
 /* The table's layout and the version of the structs it passes (ip_input_desc, ...): the core
  * takes only a component of its own version. Raise the last part when ip__input_formats or
  * ip__plane_source change. */
 #define IP__INPUT_FORMATS_ABI \
-    ((uint32_t)(IP_VERSION_MAJOR * 1000000 + IP_VERSION_MINOR * 10000 + IP_VERSION_PATCH * 100 + 1))
+    ((uint32_t)(IP_VERSION_MAJOR * 1000000 + IP_VERSION_MINOR * 10000 + IP_VERSION_PATCH * 100 + 2))
 
 /*! ip__input_formats_load() : the input component's readers, which `path` (a TIFF file or a
  *  DICOM or TIFF folder) needs: the ones linked in (the static library, the component itself),

@@ -51,6 +51,8 @@ typedef struct walk {
     int bad_rle;           /* one of them does not start with a usable RLE header */
     int bad_first_rle;     /* ... the first one */
     uint32_t rle_segments; /* ... the number of segments the first one's header gives */
+    char sop_class[65];    /* the data set's SOP Class UID (0008,0016), "" until walked past */
+    int bad_recognition;   /* its Recognition Code (0008,0010) is one GDCM stops on */
     char *why;
     size_t why_size;
 } walk;
@@ -134,53 +136,53 @@ static const struct typed {
     {TAG(0x0004, 0x1410), "US"},   {TAG(0x0004, 0x1420), "UL"},   {TAG(0x0004, 0x1430), "CS"},
     {TAG(0x0004, 0x1500), "CS"},   {TAG(0x0004, 0x1510), "UI"},   {TAG(0x0004, 0x1511), "UI"},
     {TAG(0x0004, 0x1512), "UI"},   {TAG(0x0008, 0x0005), "CS"},   {TAG(0x0008, 0x0008), "CS"},
-    {TAG(0x0008, 0x0016), "UI"},   {TAG(0x0008, 0x0018), "UI"},   {TAG(0x0008, 0x0020), "DA"},
-    {TAG(0x0008, 0x0030), "TM"},   {TAG(0x0008, 0x0050), "SH"},   {TAG(0x0008, 0x0060), "CS"},
-    {TAG(0x0008, 0x0064), "CS"},   {TAG(0x0008, 0x0070), "LO"},   {TAG(0x0008, 0x0090), "PN"},
-    {TAG(0x0008, 0x0100), "SH"},   {TAG(0x0008, 0x0102), "SH"},   {TAG(0x0008, 0x0103), "SH"},
-    {TAG(0x0008, 0x0104), "LO"},   {TAG(0x0008, 0x1030), "LO"},   {TAG(0x0008, 0x1150), "UI"},
-    {TAG(0x0008, 0x1155), "UI"},   {TAG(0x0008, 0x2111), "ST"},   {TAG(0x0008, 0x9007), "CS"},
-    {TAG(0x0010, 0x0010), "PN"},   {TAG(0x0010, 0x0020), "LO"},   {TAG(0x0010, 0x0030), "DA"},
-    {TAG(0x0010, 0x0040), "CS"},   {TAG(0x0012, 0x0062), "CS"},   {TAG(0x0018, 0x0050), "DS"},
-    {TAG(0x0018, 0x0088), "DS"},   {TAG(0x0018, 0x1063), "DS"},   {TAG(0x0018, 0x1164), "DS"},
-    {TAG(0x0018, 0x1182), "ISUL"}, {TAG(0x0018, 0x1310), "US"},   {TAG(0x0018, 0x1312), "CS"},
-    {TAG(0x0018, 0x6011), "SQ"},   {TAG(0x0018, 0x602C), "FD"},   {TAG(0x0018, 0x602E), "FD"},
-    {TAG(0x0018, 0x9530), "SQ"},   {TAG(0x0020, 0x000D), "UI"},   {TAG(0x0020, 0x000E), "UI"},
-    {TAG(0x0020, 0x0010), "SH"},   {TAG(0x0020, 0x0011), "IS"},   {TAG(0x0020, 0x0013), "IS"},
-    {TAG(0x0020, 0x0020), "CS"},   {TAG(0x0020, 0x0030), "DS"},   {TAG(0x0020, 0x0032), "DS"},
-    {TAG(0x0020, 0x0035), "DS"},   {TAG(0x0020, 0x0037), "DS"},   {TAG(0x0020, 0x0060), "CS"},
-    {TAG(0x0020, 0x9113), "SQ"},   {TAG(0x0020, 0x9116), "SQ"},   {TAG(0x0028, 0x0002), "US"},
-    {TAG(0x0028, 0x0004), "CS"},   {TAG(0x0028, 0x0005), "US"},   {TAG(0x0028, 0x0006), "US"},
-    {TAG(0x0028, 0x0008), "IS"},   {TAG(0x0028, 0x0009), "AT"},   {TAG(0x0028, 0x0010), "US"},
-    {TAG(0x0028, 0x0011), "US"},   {TAG(0x0028, 0x0012), "US"},   {TAG(0x0028, 0x0030), "DS"},
-    {TAG(0x0028, 0x0034), "IS"},   {TAG(0x0028, 0x0100), "US"},   {TAG(0x0028, 0x0101), "US"},
-    {TAG(0x0028, 0x0102), "US"},   {TAG(0x0028, 0x0103), "US"},   {TAG(0x0028, 0x0106), "SSUS"},
-    {TAG(0x0028, 0x0107), "SSUS"}, {TAG(0x0028, 0x0120), "SSUS"}, {TAG(0x0028, 0x1050), "DS"},
-    {TAG(0x0028, 0x1051), "DS"},   {TAG(0x0028, 0x1052), "DS"},   {TAG(0x0028, 0x1053), "DS"},
-    {TAG(0x0028, 0x1054), "LO"},   {TAG(0x0028, 0x1101), "US"},   {TAG(0x0028, 0x1102), "US"},
-    {TAG(0x0028, 0x1103), "US"},   {TAG(0x0028, 0x2110), "CS"},   {TAG(0x0028, 0x2112), "DS"},
-    {TAG(0x0028, 0x2114), "CS"},   {TAG(0x0028, 0x9110), "SQ"},   {TAG(0x0028, 0x9145), "SQ"},
-    {TAG(0x0040, 0x9096), "SQ"},   {TAG(0x0040, 0x9224), "FD"},   {TAG(0x0040, 0x9225), "FD"},
-    {TAG(0x0048, 0x0006), "UL"},   {TAG(0x0048, 0x0007), "UL"},   {TAG(0x0054, 0x0022), "SQ"},
-    {TAG(0x0062, 0x0004), "US"},   {TAG(0x0062, 0x0005), "LO"},   {TAG(0x0062, 0x0006), "ST"},
-    {TAG(0x0062, 0x0008), "CS"},   {TAG(0x0062, 0x0009), "LO"},   {TAG(0x0062, 0x000C), "US"},
-    {TAG(0x0062, 0x000D), "US"},   {TAG(0x0066, 0x0001), "UL"},   {TAG(0x0066, 0x0003), "UL"},
-    {TAG(0x0066, 0x0004), "LT"},   {TAG(0x0066, 0x0009), "CS"},   {TAG(0x0066, 0x000A), "FL"},
-    {TAG(0x0066, 0x000B), "LO"},   {TAG(0x0066, 0x000C), "FL"},   {TAG(0x0066, 0x000D), "CS"},
-    {TAG(0x0066, 0x000E), "CS"},   {TAG(0x0066, 0x0010), "CS"},   {TAG(0x0066, 0x0015), "UL"},
-    {TAG(0x0066, 0x0017), "FL"},   {TAG(0x0066, 0x0018), "FL"},   {TAG(0x0066, 0x0019), "FL"},
-    {TAG(0x0066, 0x001A), "FL"},   {TAG(0x0066, 0x001B), "FL"},   {TAG(0x0066, 0x001C), "FL"},
-    {TAG(0x0066, 0x001E), "UL"},   {TAG(0x0066, 0x001F), "US"},   {TAG(0x0066, 0x0020), "FL"},
-    {TAG(0x0066, 0x002A), "UL"},   {TAG(0x0066, 0x002C), "UL"},   {TAG(0x0066, 0x0031), "LO"},
-    {TAG(0x0066, 0x0036), "LO"},   {TAG(0x0088, 0x0200), "SQ"},   {TAG(0x0400, 0x0510), "UI"},
-    {TAG(0x0400, 0x0520), "OB"},   {TAG(0x3004, 0x000C), "DS"},   {TAG(0x3004, 0x000E), "DS"},
-    {TAG(0x5000, 0x0005), "US"},   {TAG(0x5000, 0x0010), "US"},   {TAG(0x5000, 0x0103), "US"},
-    {TAG(0x5000, 0x0110), "US"},   {TAG(0x5000, 0x0112), "US"},   {TAG(0x5000, 0x0114), "US"},
-    {TAG(0x5200, 0x9229), "SQ"},   {TAG(0x5200, 0x9230), "SQ"},   {TAG(0x5400, 0x1004), "US"},
-    {TAG(0x6000, 0x0010), "US"},   {TAG(0x6000, 0x0011), "US"},   {TAG(0x6000, 0x0015), "IS"},
-    {TAG(0x6000, 0x0022), "LO"},   {TAG(0x6000, 0x0040), "CS"},   {TAG(0x6000, 0x0050), "SS"},
-    {TAG(0x6000, 0x0051), "US"},   {TAG(0x6000, 0x0100), "US"},   {TAG(0x6000, 0x0102), "US"},
-    {TAG(0x6000, 0x0200), "US"},
+    {TAG(0x0008, 0x0010), "SH"},   {TAG(0x0008, 0x0016), "UI"},   {TAG(0x0008, 0x0018), "UI"},
+    {TAG(0x0008, 0x0020), "DA"},   {TAG(0x0008, 0x0030), "TM"},   {TAG(0x0008, 0x0050), "SH"},
+    {TAG(0x0008, 0x0060), "CS"},   {TAG(0x0008, 0x0064), "CS"},   {TAG(0x0008, 0x0070), "LO"},
+    {TAG(0x0008, 0x0090), "PN"},   {TAG(0x0008, 0x0100), "SH"},   {TAG(0x0008, 0x0102), "SH"},
+    {TAG(0x0008, 0x0103), "SH"},   {TAG(0x0008, 0x0104), "LO"},   {TAG(0x0008, 0x1030), "LO"},
+    {TAG(0x0008, 0x1150), "UI"},   {TAG(0x0008, 0x1155), "UI"},   {TAG(0x0008, 0x2111), "ST"},
+    {TAG(0x0008, 0x9007), "CS"},   {TAG(0x0010, 0x0010), "PN"},   {TAG(0x0010, 0x0020), "LO"},
+    {TAG(0x0010, 0x0030), "DA"},   {TAG(0x0010, 0x0040), "CS"},   {TAG(0x0012, 0x0062), "CS"},
+    {TAG(0x0018, 0x0050), "DS"},   {TAG(0x0018, 0x0088), "DS"},   {TAG(0x0018, 0x1063), "DS"},
+    {TAG(0x0018, 0x1164), "DS"},   {TAG(0x0018, 0x1182), "ISUL"}, {TAG(0x0018, 0x1310), "US"},
+    {TAG(0x0018, 0x1312), "CS"},   {TAG(0x0018, 0x6011), "SQ"},   {TAG(0x0018, 0x602C), "FD"},
+    {TAG(0x0018, 0x602E), "FD"},   {TAG(0x0018, 0x9530), "SQ"},   {TAG(0x0020, 0x000D), "UI"},
+    {TAG(0x0020, 0x000E), "UI"},   {TAG(0x0020, 0x0010), "SH"},   {TAG(0x0020, 0x0011), "IS"},
+    {TAG(0x0020, 0x0013), "IS"},   {TAG(0x0020, 0x0020), "CS"},   {TAG(0x0020, 0x0030), "DS"},
+    {TAG(0x0020, 0x0032), "DS"},   {TAG(0x0020, 0x0035), "DS"},   {TAG(0x0020, 0x0037), "DS"},
+    {TAG(0x0020, 0x0060), "CS"},   {TAG(0x0020, 0x9113), "SQ"},   {TAG(0x0020, 0x9116), "SQ"},
+    {TAG(0x0028, 0x0002), "US"},   {TAG(0x0028, 0x0004), "CS"},   {TAG(0x0028, 0x0005), "US"},
+    {TAG(0x0028, 0x0006), "US"},   {TAG(0x0028, 0x0008), "IS"},   {TAG(0x0028, 0x0009), "AT"},
+    {TAG(0x0028, 0x0010), "US"},   {TAG(0x0028, 0x0011), "US"},   {TAG(0x0028, 0x0012), "US"},
+    {TAG(0x0028, 0x0030), "DS"},   {TAG(0x0028, 0x0034), "IS"},   {TAG(0x0028, 0x0100), "US"},
+    {TAG(0x0028, 0x0101), "US"},   {TAG(0x0028, 0x0102), "US"},   {TAG(0x0028, 0x0103), "US"},
+    {TAG(0x0028, 0x0106), "SSUS"}, {TAG(0x0028, 0x0107), "SSUS"}, {TAG(0x0028, 0x0120), "SSUS"},
+    {TAG(0x0028, 0x1050), "DS"},   {TAG(0x0028, 0x1051), "DS"},   {TAG(0x0028, 0x1052), "DS"},
+    {TAG(0x0028, 0x1053), "DS"},   {TAG(0x0028, 0x1054), "LO"},   {TAG(0x0028, 0x1101), "US"},
+    {TAG(0x0028, 0x1102), "US"},   {TAG(0x0028, 0x1103), "US"},   {TAG(0x0028, 0x2110), "CS"},
+    {TAG(0x0028, 0x2112), "DS"},   {TAG(0x0028, 0x2114), "CS"},   {TAG(0x0028, 0x9110), "SQ"},
+    {TAG(0x0028, 0x9145), "SQ"},   {TAG(0x0040, 0x9096), "SQ"},   {TAG(0x0040, 0x9224), "FD"},
+    {TAG(0x0040, 0x9225), "FD"},   {TAG(0x0048, 0x0006), "UL"},   {TAG(0x0048, 0x0007), "UL"},
+    {TAG(0x0054, 0x0022), "SQ"},   {TAG(0x0062, 0x0004), "US"},   {TAG(0x0062, 0x0005), "LO"},
+    {TAG(0x0062, 0x0006), "ST"},   {TAG(0x0062, 0x0008), "CS"},   {TAG(0x0062, 0x0009), "LO"},
+    {TAG(0x0062, 0x000C), "US"},   {TAG(0x0062, 0x000D), "US"},   {TAG(0x0066, 0x0001), "UL"},
+    {TAG(0x0066, 0x0003), "UL"},   {TAG(0x0066, 0x0004), "LT"},   {TAG(0x0066, 0x0009), "CS"},
+    {TAG(0x0066, 0x000A), "FL"},   {TAG(0x0066, 0x000B), "LO"},   {TAG(0x0066, 0x000C), "FL"},
+    {TAG(0x0066, 0x000D), "CS"},   {TAG(0x0066, 0x000E), "CS"},   {TAG(0x0066, 0x0010), "CS"},
+    {TAG(0x0066, 0x0015), "UL"},   {TAG(0x0066, 0x0017), "FL"},   {TAG(0x0066, 0x0018), "FL"},
+    {TAG(0x0066, 0x0019), "FL"},   {TAG(0x0066, 0x001A), "FL"},   {TAG(0x0066, 0x001B), "FL"},
+    {TAG(0x0066, 0x001C), "FL"},   {TAG(0x0066, 0x001E), "UL"},   {TAG(0x0066, 0x001F), "US"},
+    {TAG(0x0066, 0x0020), "FL"},   {TAG(0x0066, 0x002A), "UL"},   {TAG(0x0066, 0x002C), "UL"},
+    {TAG(0x0066, 0x0031), "LO"},   {TAG(0x0066, 0x0036), "LO"},   {TAG(0x0088, 0x0200), "SQ"},
+    {TAG(0x0400, 0x0510), "UI"},   {TAG(0x0400, 0x0520), "OB"},   {TAG(0x3004, 0x000C), "DS"},
+    {TAG(0x3004, 0x000E), "DS"},   {TAG(0x5000, 0x0005), "US"},   {TAG(0x5000, 0x0010), "US"},
+    {TAG(0x5000, 0x0103), "US"},   {TAG(0x5000, 0x0110), "US"},   {TAG(0x5000, 0x0112), "US"},
+    {TAG(0x5000, 0x0114), "US"},   {TAG(0x5200, 0x9229), "SQ"},   {TAG(0x5200, 0x9230), "SQ"},
+    {TAG(0x5400, 0x1004), "US"},   {TAG(0x6000, 0x0010), "US"},   {TAG(0x6000, 0x0011), "US"},
+    {TAG(0x6000, 0x0015), "IS"},   {TAG(0x6000, 0x0022), "LO"},   {TAG(0x6000, 0x0040), "CS"},
+    {TAG(0x6000, 0x0050), "SS"},   {TAG(0x6000, 0x0051), "US"},   {TAG(0x6000, 0x0100), "US"},
+    {TAG(0x6000, 0x0102), "US"},   {TAG(0x6000, 0x0200), "US"},
 };
 
 static int by_tag(const void *key, const void *entry)
@@ -224,10 +226,35 @@ static int check_typed(walk *w, size_t at, uint32_t tag, const uint8_t *vr, uint
     return fail(w, at, tag, what);
 }
 
+/* The UI value data[at .. at + length) into out, as GDCM reads it: up to a NUL, at most 64
+ * characters, without trailing spaces. */
+static void uid_value(const walk *w, size_t at, size_t length, char out[65])
+{
+    size_t n = 0;
+    while (n < length && n < 64 && w->data[at + n] != 0)
+        n++;
+    memcpy(out, w->data + at, n);
+    while (n && out[n - 1] == ' ')
+        n--;
+    out[n] = '\0';
+}
+
 /* The integer value of one of the elements that size the image (US, or IS text for Number of
  * Frames), in the data set itself. */
 static void note_value(walk *w, uint32_t tag, size_t at, uint32_t length, int big)
 {
+    if (tag == TAG(0x0008, 0x0016)) {
+        uid_value(w, at, length, w->sop_class);
+        return;
+    }
+    if (tag == TAG(0x0008, 0x0010)) { /* GDCM asserts that it names an ACR-NEMA writer */
+        static const char *const codes[] = {"ACR-NEMA", "ACRNEMA", "MIPS 2.0"};
+        w->bad_recognition = length > 0;
+        for (size_t i = 0; i < 3; i++)
+            if (length >= strlen(codes[i]) && memcmp(w->data + at, codes[i], strlen(codes[i])) == 0)
+                w->bad_recognition = 0;
+        return;
+    }
     uint64_t *field = tag == TAG(0x0028, 0x0010)   ? &w->rows
                       : tag == TAG(0x0028, 0x0011) ? &w->columns
                       : tag == TAG(0x0028, 0x0002) ? &w->samples
@@ -741,24 +768,17 @@ static uint8_t *inflate_all(const uint8_t *data, size_t size, size_t *out_size, 
     return out;
 }
 
-/* The transfer syntax UID of the meta group data[meta .. end): the first (0002,0010), as
- * GDCM reads it (up to a NUL, without trailing spaces). */
-static void syntax_of(const walk *w, size_t meta, size_t end, char syntax[65])
+/* The value of element (0002,`element`), a UID, of the meta group data[meta .. end): the
+ * first, as GDCM reads it (uid_value()); "" when there is none. */
+static void meta_uid(const walk *w, size_t meta, size_t end, unsigned element, char out[65])
 {
-    syntax[0] = '\0';
+    out[0] = '\0';
     for (size_t p = meta; p + 8 <= end;) {
-        unsigned element = u16(w, p + 2, 0);
         size_t length = u16(w, p + 6, 0), value = p + 8;
         if (vr_form(w->data + p + 4) == 2)
             length = u32(w, p + 8, 0), value = p + 12;
-        if (element == 0x0010) {
-            size_t n = 0;
-            while (n < length && n < 64 && w->data[value + n] != 0)
-                n++;
-            memcpy(syntax, w->data + value, n);
-            while (n && syntax[n - 1] == ' ')
-                n--;
-            syntax[n] = '\0';
+        if (u16(w, p + 2, 0) == element) {
+            uid_value(w, value, length, out);
             return;
         }
         p = value + length;
@@ -767,7 +787,7 @@ static void syntax_of(const walk *w, size_t meta, size_t end, char syntax[65])
 
 /* The meta group from byte 132: its group length first, then group 0002 in explicit VR little
  * endian; *at past it. */
-static int walk_meta(walk *w, size_t *at, char syntax[65])
+static int walk_meta(walk *w, size_t *at, char syntax[65], char media_class[65])
 {
     size_t meta = *at;
     if (w->size - meta < 12 || u16(w, meta, 0) != 0x0002 || u16(w, meta + 2, 0) != 0x0000 ||
@@ -776,7 +796,8 @@ static int walk_meta(walk *w, size_t *at, char syntax[65])
     coding c = {0, 0};
     if (walk_elements(w, at, w->size, 0, META, c) < 0)
         return -1;
-    syntax_of(w, meta, *at, syntax);
+    meta_uid(w, meta, *at, 0x0010, syntax);
+    meta_uid(w, meta, *at, 0x0002, media_class);
     if (!syntax[0]) {
         snprintf(w->why, w->why_size,
                  "not a well-formed DICOM file: no Transfer Syntax UID in its meta header (cut "
@@ -823,12 +844,20 @@ static int walk_data_set(walk *w, size_t at, const char *syntax)
                  "holds no Pixel Data (7FE0,0010): not an image, or cut short");
         return -1;
     }
+    if (w->bad_recognition) {
+        snprintf(w->why, w->why_size,
+                 "a Recognition Code (0008,0010) other than ACR-NEMA's (GDCM stops the process "
+                 "on it)");
+        return -1;
+    }
     return check_pixels(w) != 0 || check_groups(w) != 0 ? -1 : 0;
 }
 
-int ip__dicom_check_file(const char *path, char *why, size_t why_size)
+int ip__dicom_check_object(const char *path, char sop_class[65], char *why, size_t why_size)
 {
     size_t size;
+    char media_class[65] = "";
+    sop_class[0] = '\0';
     uint8_t *data = read_all(path, &size, why, why_size);
     if (!data)
         return -1;
@@ -840,8 +869,15 @@ int ip__dicom_check_file(const char *path, char *why, size_t why_size)
     int rc = -1;
     if (size < 132 || memcmp(data + 128, "DICM", 4) != 0)
         snprintf(why, why_size, "not a DICOM file (no \"DICM\" at byte 128)");
-    else if (walk_meta(&w, &at, syntax) == 0)
+    else if (walk_meta(&w, &at, syntax, media_class) == 0)
         rc = walk_data_set(&w, at, syntax);
+    memcpy(sop_class, w.sop_class[0] ? w.sop_class : media_class, 65);
     free(data);
     return rc;
+}
+
+int ip__dicom_check_file(const char *path, char *why, size_t why_size)
+{
+    char sop_class[65];
+    return ip__dicom_check_object(path, sop_class, why, why_size);
 }

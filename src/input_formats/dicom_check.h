@@ -15,4 +15,11 @@
  * why[0 .. why_size). */
 int ip__dicom_check_file(const char *path, char *why, size_t why_size);
 
+/* ip__dicom_check_file(), and the SOP class the file names into sop_class (passed or not): its
+ * data set's SOP Class UID (0008,0016) when the check walked past it, else its meta header's
+ * Media Storage SOP Class UID (0002,0002) when the meta header is well formed, else "". So a
+ * DICOM object that is not an image (no Pixel Data, or a structure the check refuses) can be
+ * told apart from a broken image. */
+int ip__dicom_check_object(const char *path, char sop_class[65], char *why, size_t why_size);
+
 #endif

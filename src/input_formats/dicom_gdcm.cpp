@@ -69,6 +69,7 @@ struct field_tag {
 
 const field_tag dataset_fields[] = {
     {IP_DICOM_MODALITY, 0x0008, 0x0060},
+    {IP_DICOM_SERIES_DESCRIPTION, 0x0008, 0x103E},
     {IP_DICOM_SERIES_UID, 0x0020, 0x000E},
     {IP_DICOM_POSITION, 0x0020, 0x0032},
     {IP_DICOM_ORIENTATION, 0x0020, 0x0037},

@@ -16,8 +16,9 @@ extern "C" {
  * lacks it); the values of a multi-valued field are separated by '\'. */
 typedef enum ip_dicom_field {
     IP_DICOM_TRANSFER_SYNTAX,      /* (0002,0010) Transfer Syntax UID */
-    IP_DICOM_MODALITY,             /* (0008,0060) CT, MR, ... */
     IP_DICOM_SERIES_UID,           /* (0020,000E) Series Instance UID */
+    IP_DICOM_MODALITY,             /* (0008,0060) Modality: CT, MR, ... */
+    IP_DICOM_SERIES_DESCRIPTION,   /* (0008,103E) Series Description */
     IP_DICOM_POSITION,             /* (0020,0032) Image Position (Patient): x\y\z in mm */
     IP_DICOM_ORIENTATION,          /* (0020,0037) Image Orientation (Patient): row\column */
     IP_DICOM_SAMPLES_PER_PIXEL,    /* (0028,0002) */

@@ -7,7 +7,8 @@
 #include "isoprop/input_formats.h"
 
 static const ip__input_formats readers = {IP__INPUT_FORMATS_ABI, ip__tiff_describe,
-                                          ip__dicom_describe, &ip__tiff_source, &ip__dicom_source};
+                                          ip__dicom_describe,    &ip__tiff_source,
+                                          &ip__dicom_source,     ip__dicom_list};
 
 const char *ip_input_formats_version(void)
 {

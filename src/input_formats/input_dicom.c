@@ -1,135 +1,25 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* DICOM input: a folder holding one series of single-frame DICOM files, one file a z-plane.
- * The files' headers and pixels are read through dicom_gdcm.h; everything else is here:
- * which files count, one series, slices alike, their order along the slice normal, an even
- * slice spacing (no slice missing or repeated), the type, spacing and rescale. */
-#include <dirent.h>
-#include <errno.h>
-#include <fcntl.h>
+/* DICOM input: a folder (its subfolders included) holding one or more series of single-frame
+ * DICOM files, one file a z-plane. The files' headers and pixels are read through
+ * dicom_gdcm.h; which files count and the series they make are dicom_folder.c's, the geometry
+ * (order along the slice normal, steps, a gantry tilt, the regular grid and the resampling
+ * onto it) dicom_grid.c's. Here: one file's fields (type, spacing, position, rescale) and the
+ * slices alike, the description, the list of a folder's series, and the source of the
+ * planes. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#include "array.h"
 #include "dicom_check.h"
+#include "dicom_folder.h"
 #include "dicom_gdcm.h"
-#include "readers.h"
 #include "internal.h"
+#include "readers.h"
+#include "text_header.h"
 
-/* Slices closer together than this share a position (mm, and a fraction of the median
- * spacing); a step over MISSING_STEP median spacings is a missing slice; steps may differ from
- * the median by UNEVEN_TOLERANCE of it (positions are written with a few decimals). */
-#define DUPLICATE_MM 1e-4
-#define DUPLICATE_FRACTION 0.01
-#define MISSING_STEP 1.5
-#define UNEVEN_TOLERANCE 0.01
 /* Row and column directions must be unit vectors at right angles, to this tolerance. */
 #define ORIENTATION_TOLERANCE 1e-3
-
-/* One file of the folder, as its header describes it. */
-typedef struct dicom_slice {
-    char name[256]; /* within the folder */
-    char series[IP_DICOM_VALUE_MAX];
-    uint32_t columns, rows;
-    ip_type type;
-    uint32_t bits_stored, high_bit; /* where the samples' bits lie in each pixel */
-    int has_pixel_spacing;
-    double pixel_spacing[2]; /* between rows (y), between columns (x); mm */
-    double position[3], orientation[6];
-    double slope, intercept;
-    char unit[IP_RESCALE_UNIT_MAX]; /* of the rescaled values (rescale_unit()) */
-    double along;                   /* position along the slice normal, mm */
-} dicom_slice;
-
-/* The slices of a folder: sorted by name while read, by position once checked. */
-typedef struct dicom_series {
-    const char *folder;
-    dicom_slice *slices;
-    uint64_t count, capacity;
-} dicom_series;
-
-static void series_free(dicom_series *s)
-{
-    free(s->slices);
-    s->slices = NULL;
-    s->count = s->capacity = 0;
-}
-
-/* folder/name into out; the caller has checked that the folder path leaves room. */
-static void slice_path(const dicom_series *s, const dicom_slice *slice, char out[IP_PATH_MAX])
-{
-    snprintf(out, IP_PATH_MAX, "%.*s/%s", IP_PATH_MAX - 258, s->folder, slice->name);
-}
-
-/* ---- which files ---- */
-
-/* Hidden files and the DICOMDIR index (a DICOM file without an image) are not slices. */
-static int skipped_name(const char *name)
-{
-    return name[0] == '.' || strcmp(name, "DICOMDIR") == 0;
-}
-
-static int by_name(const void *a, const void *b)
-{
-    return strcmp(((const dicom_slice *)a)->name, ((const dicom_slice *)b)->name);
-}
-
-static ip_status add_name(dicom_series *s, const char *name, ip_error *err)
-{
-    if (ip__array_reserve(&s->slices, &s->capacity, s->count + 1, sizeof *s->slices, 64) != IP_OK)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory listing the folder", s->folder);
-    dicom_slice *slice = &s->slices[s->count++];
-    memset(slice, 0, sizeof *slice);
-    snprintf(slice->name, sizeof slice->name, "%s", name);
-    return IP_OK;
-}
-
-/* The folder's regular, visible files, by name. */
-static ip_status list_files(dicom_series *s, ip_error *err)
-{
-    if (strlen(s->folder) > IP_PATH_MAX - 258)
-        return ip__fail(err, IP_ERR_ARGUMENT, "%s: folder path too long", s->folder);
-    DIR *dir = opendir(s->folder);
-    if (!dir)
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open the folder", s->folder);
-    ip_status st = IP_OK;
-    struct dirent *entry;
-    while (st == IP_OK && (entry = readdir(dir)) != NULL) {
-        char full[IP_PATH_MAX];
-        struct stat info;
-        if (skipped_name(entry->d_name))
-            continue;
-        snprintf(full, sizeof full, "%s/%s", s->folder, entry->d_name);
-        if (stat(full, &info) == 0 && S_ISREG(info.st_mode))
-            st = add_name(s, entry->d_name, err);
-    }
-    closedir(dir);
-    if (st == IP_OK && s->count == 0)
-        st = ip__fail(err, IP_ERR_INPUT, "%s: the folder holds no DICOM files", s->folder);
-    if (st == IP_OK)
-        qsort(s->slices, (size_t)s->count, sizeof *s->slices, by_name);
-    return st;
-}
-
-/* A file of a series folder must be DICOM Part 10: "DICM" after the 128-byte preamble. */
-static ip_status check_magic(const char *path, ip_error *err)
-{
-    unsigned char head[132];
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0)
-        return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
-    ssize_t got = pread(fd, head, sizeof head, 0);
-    close(fd);
-    if (got != (ssize_t)sizeof head || memcmp(head + 128, "DICM", 4) != 0)
-        return ip__fail(err, IP_ERR_INPUT,
-                        "%s: not a DICOM file (no \"DICM\" at byte 128), in a folder of a DICOM "
-                        "series",
-                        path);
-    return IP_OK;
-}
 
 /* ---- one file's header ---- */
 
@@ -142,6 +32,11 @@ static const char *shown(const char *value, char out[IP_DICOM_VALUE_MAX])
         out[i] = (unsigned char)value[i] < 0x20 || value[i] == 0x7F ? '?' : value[i];
     out[i] = '\0';
     return out;
+}
+
+const char *ip__dicom_shown(const char *value, char out[IP_DICOM_VALUE_MAX])
+{
+    return shown(value, out);
 }
 
 /* The numbers of a '\'-separated value; *count as ip__text_parse_double_list. */
@@ -157,8 +52,9 @@ static int parse_numbers(const char *value, double *out, int max, int *count)
 
 static const char *const field_names[IP_DICOM_FIELD_COUNT] = {
     [IP_DICOM_TRANSFER_SYNTAX] = "Transfer Syntax UID (0002,0010)",
-    [IP_DICOM_MODALITY] = "Modality (0008,0060)",
     [IP_DICOM_SERIES_UID] = "Series Instance UID (0020,000E)",
+    [IP_DICOM_MODALITY] = "Modality (0008,0060)",
+    [IP_DICOM_SERIES_DESCRIPTION] = "Series Description (0008,103E)",
     [IP_DICOM_POSITION] = "Image Position (Patient) (0020,0032)",
     [IP_DICOM_ORIENTATION] = "Image Orientation (Patient) (0020,0037)",
     [IP_DICOM_SAMPLES_PER_PIXEL] = "Samples per Pixel (0028,0002)",
@@ -329,24 +225,11 @@ static void rescale_unit(const ip_dicom_header *h, char unit[IP_RESCALE_UNIT_MAX
                  strcmp(h->value[IP_DICOM_MODALITY], "CT") == 0 ? "HU" : "");
 }
 
-/* The geometry, type and rescale of one file, each checked on its own. */
-static ip_status read_slice(const dicom_series *s, dicom_slice *slice, ip_error *err)
+/* The geometry, type and rescale of one file (its header h), each checked on its own. */
+ip_status ip__dicom_read_slice(const char *path, const ip_dicom_header *h, dicom_slice *slice,
+                               ip_error *err)
 {
-    char path[IP_PATH_MAX], why[160];
-    ip_dicom_header *h = malloc(sizeof *h);
     ip_status st;
-    slice_path(s, slice, path);
-    if (!h)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory reading its header", path);
-    if ((st = check_magic(path, err)) != IP_OK)
-        goto done;
-    /* the structure first: the DICOM library stops the process on some malformed files */
-    if (ip__dicom_check_file(path, why, sizeof why) != 0 ||
-        ip__dicom_read_header(path, h, why, sizeof why) != 0) {
-        st = ip__fail(err, IP_ERR_INPUT, "%s: %s", path, why);
-        goto done;
-    }
-    snprintf(slice->series, sizeof slice->series, "%s", h->value[IP_DICOM_SERIES_UID]);
     slice->has_pixel_spacing = h->value[IP_DICOM_PIXEL_SPACING][0] != '\0';
     if ((st = check_syntax(path, h, err)) != IP_OK || (st = check_pixels(path, h, err)) != IP_OK ||
         (st = read_type(path, h, slice, err)) != IP_OK ||
@@ -360,39 +243,12 @@ static ip_status read_slice(const dicom_series *s, dicom_slice *slice, ip_error 
             IP_OK ||
         (st = check_orientation(path, slice->orientation, err)) != IP_OK ||
         (st = field_numbers(path, h, IP_DICOM_RESCALE_SLOPE, &slice->slope, 1, 1, err)) != IP_OK)
-        goto done;
+        return st;
     st = field_numbers(path, h, IP_DICOM_RESCALE_INTERCEPT, &slice->intercept, 1, 0, err);
     rescale_unit(h, slice->unit);
-done:
-    free(h);
     return st;
 }
-
 /* ---- the slices together ---- */
-
-/* Every file of one series: otherwise the count of series and their UIDs. */
-static ip_status check_one_series(const dicom_series *s, ip_error *err)
-{
-    char list[600] = "", text[IP_DICOM_VALUE_MAX];
-    size_t used = 0;
-    uint64_t series = 0;
-    for (uint64_t i = 0; i < s->count; i++) {
-        uint64_t j = 0;
-        while (j < i && strcmp(s->slices[j].series, s->slices[i].series) != 0)
-            j++;
-        if (j < i)
-            continue; /* a series seen before */
-        if (++series <= 4 && used < sizeof list)
-            used += (size_t)snprintf(
-                list + used, sizeof list - used, "%s%s", series > 1 ? ", " : "",
-                s->slices[i].series[0] ? shown(s->slices[i].series, text) : "(none)");
-    }
-    if (series > 1)
-        return ip__fail(err, IP_ERR_INPUT,
-                        "%s: the folder mixes %llu series (UIDs %s%s): it must hold one", s->folder,
-                        (unsigned long long)series, list, series > 4 ? ", ..." : "");
-    return IP_OK;
-}
 
 static int same_numbers(const double *a, const double *b, int count, double tolerance)
 {
@@ -425,7 +281,7 @@ static const char *difference(const dicom_slice *first, const dicom_slice *slice
 
 /* Slices alike: size, type, bit layout, pixel spacing, orientation, rescale (one volume, one
  * rescale). */
-static ip_status check_alike(const dicom_series *s, ip_error *err)
+ip_status ip__dicom_check_alike(const dicom_series *s, ip_error *err)
 {
     const dicom_slice *first = &s->slices[0];
     for (uint64_t i = 1; i < s->count; i++) {
@@ -434,7 +290,7 @@ static ip_status check_alike(const dicom_series *s, ip_error *err)
         if (!what)
             continue;
         char path[IP_PATH_MAX];
-        slice_path(s, slice, path);
+        snprintf(path, sizeof path, "%s/%s", s->folder, slice->name);
         return ip__fail(err, IP_ERR_INPUT,
                         "%s: mixed series: %s than %s (%ux%u %s, the first %ux%u %s)", path, what,
                         first->name, slice->columns, slice->rows, ip_type_name(slice->type),
@@ -443,169 +299,155 @@ static ip_status check_alike(const dicom_series *s, ip_error *err)
     return IP_OK;
 }
 
-static int by_position(const void *a, const void *b)
+/* A folder read, one series picked, its grid planned: what both describing and reading do. */
+typedef struct dicom_read {
+    dicom_folder folder;
+    uint32_t picked;
+    dicom_series series;
+    dicom_grid grid;
+} dicom_read;
+
+static void read_free(dicom_read *r)
 {
-    double pa = ((const dicom_slice *)a)->along, pb = ((const dicom_slice *)b)->along;
-    return (pa > pb) - (pa < pb);
+    ip__dicom_grid_free(&r->grid);
+    free(r->series.slices);
+    r->series.slices = NULL;
+    ip__dicom_folder_free(&r->folder);
 }
 
-static int by_value(const void *a, const void *b)
-{
-    double pa = *(const double *)a, pb = *(const double *)b;
-    return (pa > pb) - (pa < pb);
-}
-
-/* Sorts the slices along the normal of their plane (row direction x column direction). */
-static void sort_by_position(dicom_series *s)
-{
-    const double *o = s->slices[0].orientation;
-    double normal[3] = {o[1] * o[5] - o[2] * o[4], o[2] * o[3] - o[0] * o[5],
-                        o[0] * o[4] - o[1] * o[3]};
-    for (uint64_t i = 0; i < s->count; i++)
-        s->slices[i].along = dot(s->slices[i].position, normal);
-    qsort(s->slices, (size_t)s->count, sizeof *s->slices, by_position);
-}
-
-/* The median distance between neighbouring slices (sorted). */
-static ip_status median_step(const dicom_series *s, double *out, ip_error *err)
-{
-    double *steps = malloc((size_t)(s->count - 1) * sizeof *steps);
-    if (!steps)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory ordering the slices", s->folder);
-    for (uint64_t i = 0; i + 1 < s->count; i++)
-        steps[i] = s->slices[i + 1].along - s->slices[i].along;
-    qsort(steps, (size_t)(s->count - 1), sizeof *steps, by_value);
-    *out = steps[(s->count - 1) / 2];
-    free(steps);
-    return IP_OK;
-}
-
-/* Neighbours `i` and `i + 1`, `step` mm apart, against the median step. */
-static ip_status check_step(const dicom_series *s, uint64_t i, double step, double median,
-                            ip_error *err)
-{
-    const dicom_slice *a = &s->slices[i], *b = &s->slices[i + 1];
-    if (step < DUPLICATE_MM || step < DUPLICATE_FRACTION * median)
-        return ip__fail(err, IP_ERR_INPUT,
-                        "%s: %s and %s are at the same position (%g mm along the slice normal): "
-                        "a slice repeated",
-                        s->folder, a->name, b->name, a->along);
-    if (step > MISSING_STEP * median)
-        return ip__fail(err, IP_ERR_INPUT,
-                        "%s: a slice is missing between %s (at %g mm) and %s (at %g mm): %g mm "
-                        "apart, %.1f times the slice spacing %g mm",
-                        s->folder, a->name, a->along, b->name, b->along, step, step / median,
-                        median);
-    if (fabs(step - median) > UNEVEN_TOLERANCE * median)
-        return ip__fail(err, IP_ERR_INPUT,
-                        "%s: uneven slice spacing: %s (at %g mm) and %s (at %g mm) are %g mm "
-                        "apart, the others %g mm",
-                        s->folder, a->name, a->along, b->name, b->along, step, median);
-    return IP_OK;
-}
-
-/* Even steps, none missing, none repeated; *spacing the mean step. */
-static ip_status check_steps(const dicom_series *s, double *spacing, ip_error *err)
-{
-    double median = 0;
-    ip_status st;
-    if (s->count < 2)
-        return ip__fail(err, IP_ERR_INPUT,
-                        "%s: the folder holds one DICOM slice (%s): a volume needs 2 or more",
-                        s->folder, s->slices[0].name);
-    if ((st = median_step(s, &median, err)) != IP_OK)
-        return st;
-    for (uint64_t i = 0; i + 1 < s->count; i++)
-        if ((st = check_step(s, i, s->slices[i + 1].along - s->slices[i].along, median, err)) !=
-            IP_OK)
-            return st;
-    *spacing = (s->slices[s->count - 1].along - s->slices[0].along) / (double)(s->count - 1);
-    return IP_OK;
-}
-
-/* Lists, reads and checks the series in `folder`, its slices sorted by position; *spacing_z
- * the distance between them. The caller frees the series (also on failure). */
-static ip_status scan_series(const char *folder, dicom_series *s, double *spacing_z, ip_error *err)
+/* Scans `path`, picks the series `wanted` names (NULL: the one there is) and plans its grid
+ * as `tilt` and `uneven` say. The caller frees r (also on failure). */
+static ip_status read_series(const char *path, const char *wanted, ip_regrid tilt, ip_regrid uneven,
+                             dicom_read *r, ip_error *err)
 {
     ip_status st;
-    memset(s, 0, sizeof *s);
-    s->folder = folder;
-    if ((st = list_files(s, err)) != IP_OK)
+    memset(r, 0, sizeof *r);
+    if ((st = ip__dicom_folder_scan(&r->folder, path, err)) != IP_OK ||
+        (st = ip__dicom_folder_pick(&r->folder, wanted, &r->picked, err)) != IP_OK ||
+        (st = ip__dicom_series_of(&r->folder, r->picked, &r->series, err)) != IP_OK)
         return st;
-    for (uint64_t i = 0; i < s->count; i++)
-        if ((st = read_slice(s, &s->slices[i], err)) != IP_OK)
-            return st;
-    if ((st = check_one_series(s, err)) != IP_OK || (st = check_alike(s, err)) != IP_OK)
-        return st;
-    sort_by_position(s);
-    return check_steps(s, spacing_z, err);
+    return ip__dicom_grid_plan(&r->series, tilt, uneven, &r->grid, err);
 }
 
 /* ---- describing ---- */
 
-/* x along the rows (ImageOrientationPatient's first vector), y along the columns (made
- * perpendicular to x: the files agree only to ORIENTATION_TOLERANCE), z their cross product,
- * the way the slices were sorted; the origin is the first slice's ImagePositionPatient. */
-static void fill_orientation(const dicom_slice *first, ip_orientation *o)
+/* `text` into out[size], cut to fit. */
+static void copy_text(char *out, size_t size, const char *text)
 {
-    double *x = o->directions[0], *y = o->directions[1], *z = o->directions[2];
-    ip_orientation_identity(o);
-    memcpy(o->origin, first->position, sizeof o->origin);
-    o->space = IP_SPACE_LPS;
-    memcpy(x, first->orientation, 3 * sizeof *x);
-    memcpy(y, first->orientation + 3, 3 * sizeof *y);
-    double n = sqrt(dot(x, x));
-    for (int c = 0; c < 3; c++)
-        x[c] /= n;
-    double along = dot(x, y);
-    for (int c = 0; c < 3; c++)
-        y[c] -= along * x[c];
-    n = sqrt(dot(y, y)); /* check_orientation keeps it near 1 */
-    for (int c = 0; c < 3; c++)
-        y[c] /= n;
-    z[0] = x[1] * y[2] - x[2] * y[1];
-    z[1] = x[2] * y[0] - x[0] * y[2];
-    z[2] = x[0] * y[1] - x[1] * y[0];
+    size_t n = strnlen(text, size - 1);
+    memcpy(out, text, n);
+    out[n] = '\0';
 }
 
-static void fill_desc(const dicom_series *s, double spacing_z, const ip_input_overrides *overrides,
-                      ip_input_desc *desc, ip_text_found *found)
+static void fill_desc(const dicom_read *r, const ip_input_overrides *overrides, ip_input_desc *desc,
+                      ip_text_found *found)
 {
-    const dicom_slice *first = &s->slices[0];
+    const dicom_slice *first = &r->series.slices[0];
+    const dicom_grid *g = &r->grid;
     desc->encoding = IP_ENCODING_DICOM;
     desc->big_endian = 0; /* planes arrive in the host's order */
     desc->type = first->type;
     found->has_type = 1;
     found->has_dims = 1;
-    found->dims[0] = first->columns;
-    found->dims[1] = first->rows;
-    found->dims[2] = s->count;
-    if (!ip__text_overridden(BY_SPACING, overrides)) {
-        desc->spacing[0] = first->pixel_spacing[1];
-        desc->spacing[1] = first->pixel_spacing[0];
-        desc->spacing[2] = spacing_z;
-    }
-    fill_orientation(first, &desc->orientation);
+    for (int a = 0; a < 3; a++)
+        found->dims[a] = g->dims[a];
+    if (!ip__text_overridden(BY_SPACING, overrides))
+        memcpy(desc->spacing, g->spacing, sizeof desc->spacing);
+    desc->orientation = g->orientation;
     /* the identity without a unit says nothing worth keeping */
     desc->has_rescale = first->slope != 1.0 || first->intercept != 0.0 || first->unit[0] != '\0';
     desc->rescale_slope = first->slope;
     desc->rescale_intercept = first->intercept;
     memcpy(desc->rescale_unit, first->unit, sizeof desc->rescale_unit);
+    copy_text(desc->series_uid, sizeof desc->series_uid, r->folder.series[r->picked].uid);
+    desc->series_count = r->folder.series_count;
+    desc->skipped_objects =
+        (uint32_t)(r->folder.skipped < UINT32_MAX ? r->folder.skipped : UINT32_MAX);
+    desc->source_slices = (uint32_t)r->series.count;
+    desc->resampled = g->resampled;
+    desc->tilt_degrees = g->tilt_degrees;
 }
 
 ip_status ip__dicom_describe(const char *path, const ip_input_overrides *overrides,
                              ip_input_desc *desc, ip_text_found *found, ip_error *err)
 {
-    dicom_series s;
-    double spacing_z = 0;
-    ip_status st = scan_series(path, &s, &spacing_z, err);
-    if (st == IP_OK && !s.slices[0].has_pixel_spacing &&
+    dicom_read r;
+    const char *wanted = overrides ? overrides->series : NULL;
+    ip_regrid tilt = overrides ? overrides->tilt : IP_REGRID_DEFAULT;
+    ip_regrid uneven = overrides ? overrides->uneven : IP_REGRID_DEFAULT;
+    if ((unsigned)tilt > IP_REGRID_REFUSE || (unsigned)uneven > IP_REGRID_REFUSE)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: unknown ip_regrid %d in the overrides", path,
+                        (unsigned)tilt > IP_REGRID_REFUSE ? (int)tilt : (int)uneven);
+    ip_status st = read_series(path, wanted, tilt, uneven, &r, err);
+    if (st == IP_OK && !r.series.slices[0].has_pixel_spacing &&
         !ip__text_overridden(BY_SPACING, overrides))
-        st = ip__fail(err, IP_ERR_INPUT, "%s: the series lacks %s (give the spacing instead)", path,
-                      field_names[IP_DICOM_PIXEL_SPACING]);
+        st = ip__fail(err, IP_ERR_INPUT,
+                      "%s: the series lacks Pixel Spacing (0028,0030) (give the spacing instead)",
+                      path);
     if (st == IP_OK)
-        fill_desc(&s, spacing_z, overrides, desc, found);
-    series_free(&s);
+        fill_desc(&r, overrides, desc, found);
+    read_free(&r);
+    return st;
+}
+
+/* ---- listing ---- */
+
+/* Series `index` of r->folder as an entry of the list: its grid as read by default, else its
+ * problem and the grid it would be resampled onto when there is one. */
+static void list_entry(dicom_read *r, uint32_t index, ip_dicom_series_info *out)
+{
+    const dicom_group *group = &r->folder.series[index];
+    ip_error err;
+    memset(out, 0, sizeof *out);
+    copy_text(out->uid, sizeof out->uid, group->uid);
+    copy_text(out->description, sizeof out->description, group->description);
+    copy_text(out->modality, sizeof out->modality, group->modality);
+    out->slices = (uint32_t)(group->files < UINT32_MAX ? group->files : UINT32_MAX);
+    ip_status st = ip__dicom_series_of(&r->folder, index, &r->series, &err);
+    if (st == IP_OK) {
+        const dicom_slice *first = &r->series.slices[0];
+        out->dims[0] = first->columns, out->dims[1] = first->rows, out->dims[2] = out->slices;
+        out->type = first->type;
+        st = ip__dicom_grid_plan(&r->series, IP_REGRID_DEFAULT, IP_REGRID_DEFAULT, &r->grid, &err);
+        if (st != IP_OK) {
+            ip__dicom_grid_free(&r->grid);
+            copy_text(out->problem, sizeof out->problem, err.message);
+            st = ip__dicom_grid_plan(&r->series, IP_REGRID_RESAMPLE, IP_REGRID_RESAMPLE, &r->grid,
+                                     &err);
+        }
+    } else {
+        copy_text(out->problem, sizeof out->problem, err.message);
+    }
+    if (st == IP_OK) {
+        memcpy(out->dims, r->grid.dims, sizeof out->dims);
+        memcpy(out->spacing, r->grid.spacing, sizeof out->spacing);
+        out->resampled = r->grid.resampled;
+        out->tilt_degrees = r->grid.tilt_degrees;
+    }
+    ip__dicom_grid_free(&r->grid);
+    free(r->series.slices);
+    r->series.slices = NULL;
+}
+
+ip_status ip__dicom_list(const char *folder, ip_dicom_series_info **out, uint32_t *count,
+                         uint32_t *skipped, ip_error *err)
+{
+    dicom_read r;
+    memset(&r, 0, sizeof r);
+    ip_status st = ip__dicom_folder_scan(&r.folder, folder, err);
+    ip_dicom_series_info *list = NULL;
+    if (st == IP_OK && r.folder.series_count > 0 &&
+        !(list = calloc(r.folder.series_count, sizeof *list)))
+        st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory listing its series", folder);
+    for (uint32_t i = 0; st == IP_OK && i < r.folder.series_count; i++)
+        list_entry(&r, i, &list[i]);
+    if (st == IP_OK) {
+        *out = list;
+        *count = r.folder.series_count;
+        if (skipped)
+            *skipped = (uint32_t)(r.folder.skipped < UINT32_MAX ? r.folder.skipped : UINT32_MAX);
+    }
+    read_free(&r);
     return st;
 }
 
@@ -613,57 +455,64 @@ ip_status ip__dicom_describe(const char *path, const ip_input_overrides *overrid
 
 typedef struct dicom_source {
     char folder[IP_PATH_MAX];
-    dicom_series series;
-    uint64_t plane_bytes;
+    dicom_read read;
+    dicom_resampler resampler;
+    uint64_t slice_bytes;
 } dicom_source;
 
 /* The series must still be the one described: the same size, and samples of the same size
  * (a type override may read uint16 as int16, not as another size). */
 static ip_status check_described(const dicom_source *src, const ip_input_desc *desc, ip_error *err)
 {
-    const dicom_slice *first = &src->series.slices[0];
-    if (desc->dims[0] != first->columns || desc->dims[1] != first->rows ||
-        desc->dims[2] != src->series.count || ip_type_size(desc->type) != ip_type_size(first->type))
+    const dicom_slice *first = &src->read.series.slices[0];
+    const uint32_t *dims = src->read.grid.dims;
+    if (desc->dims[0] != dims[0] || desc->dims[1] != dims[1] || desc->dims[2] != dims[2] ||
+        ip_type_size(desc->type) != ip_type_size(first->type))
         return ip__fail(err, IP_ERR_INPUT,
-                        "%s: the series holds %ux%ux%llu %s samples, not the %ux%ux%u %s "
+                        "%s: the series holds %ux%ux%u %s samples, not the %ux%ux%u %s "
                         "described",
-                        desc->path, first->columns, first->rows,
-                        (unsigned long long)src->series.count, ip_type_name(first->type),
+                        desc->path, dims[0], dims[1], dims[2], ip_type_name(first->type),
                         desc->dims[0], desc->dims[1], desc->dims[2], ip_type_name(desc->type));
     return IP_OK;
 }
 
 /* Reads the headers again: the description (a plain value, ip_input_desc) has no room for the
  * slices' order, and the second reading checks that the folder still holds the series
- * described (check_described()). Each header is read up to the pixel data only. */
+ * described (check_described()). Each header is read up to the pixel data only. The series is
+ * the one described (by its UID), on the grid described: resampled as it was then, or not. */
 static ip_status dicom_open(const ip_input_desc *desc, void **state, ip_error *err)
 {
-    double spacing_z;
     dicom_source *src = calloc(1, sizeof *src);
     *state = src;
     if (!src)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory opening the series", desc->path);
     snprintf(src->folder, sizeof src->folder, "%s", desc->data_path);
-    ip_status st = scan_series(src->folder, &src->series, &spacing_z, err);
-    if (st != IP_OK)
+    ip_regrid how = desc->resampled ? IP_REGRID_RESAMPLE : IP_REGRID_REFUSE;
+    ip_status st = read_series(src->folder, desc->series_uid, how, how, &src->read, err);
+    if (st != IP_OK || (st = check_described(src, desc, err)) != IP_OK)
         return st;
-    src->plane_bytes = (uint64_t)desc->dims[0] * desc->dims[1] * ip_type_size(desc->type);
-    return check_described(src, desc, err);
+    const dicom_slice *first = &src->read.series.slices[0];
+    src->slice_bytes = (uint64_t)first->columns * first->rows * ip_type_size(first->type);
+    if (src->read.grid.resampled)
+        return ip__dicom_resampler_init(&src->resampler, &src->read.series, &src->read.grid, err);
+    return IP_OK;
 }
 
-static ip_status dicom_read_plane(void *state, uint32_t z, void *dst, ip_error *err)
+/* Slice `index` (by position) decoded into dst, its file checked again first. */
+static ip_status decode_slice(void *state, uint64_t index, void *dst, ip_error *err)
 {
     dicom_source *src = state;
-    const dicom_slice *slice = &src->series.slices[z];
+    const dicom_slice *slice = &src->read.series.slices[index];
     char path[IP_PATH_MAX], why[160];
     ip_dicom_image image;
-    slice_path(&src->series, slice, path);
+    if (snprintf(path, sizeof path, "%s/%s", src->folder, slice->name) >= (int)sizeof path)
+        return ip__fail(err, IP_ERR_INPUT, "%s: path too long", src->folder);
     /* checked again: the file may have changed since it was described */
     if (ip__dicom_check_file(path, why, sizeof why) != 0 ||
-        ip__dicom_decode(path, dst, (size_t)src->plane_bytes, &image, why, sizeof why) != 0)
+        ip__dicom_decode(path, dst, (size_t)src->slice_bytes, &image, why, sizeof why) != 0)
         return ip__fail(err, IP_ERR_INPUT, "%s: %s", path, why);
     if (image.columns != slice->columns || image.rows != slice->rows || image.frames != 1 ||
-        image.samples_per_pixel != 1 || image.bytes != src->plane_bytes ||
+        image.samples_per_pixel != 1 || image.bytes != src->slice_bytes ||
         image.bits_allocated != 8 * ip_type_size(slice->type))
         return ip__fail(err, IP_ERR_INPUT,
                         "%s: decodes to %ux%u pixels of %u bits, not the %ux%u of %zu bits its "
@@ -673,12 +522,21 @@ static ip_status dicom_read_plane(void *state, uint32_t z, void *dst, ip_error *
     return IP_OK;
 }
 
+static ip_status dicom_read_plane(void *state, uint32_t z, void *dst, ip_error *err)
+{
+    dicom_source *src = state;
+    if (src->read.grid.resampled)
+        return ip__dicom_resample_plane(&src->resampler, z, dst, decode_slice, src, err);
+    return decode_slice(src, z, dst, err);
+}
+
 static void dicom_close(void *state)
 {
     dicom_source *src = state;
     if (!src)
         return;
-    series_free(&src->series);
+    ip__dicom_resampler_free(&src->resampler);
+    read_free(&src->read);
     free(src);
 }
 

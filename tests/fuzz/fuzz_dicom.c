@@ -26,8 +26,9 @@
  *
  * Checked: describe and every read return a status the API documents, with a one-line message
  * that names the folder (or a file in it); a failed describe leaves its output untouched; an
- * accepted series is a DICOM description of as many planes as slices, of a DICOM sample type,
- * with finite positive spacing; a volume of at most READ_LIMIT bytes is read plane by plane, and
+ * accepted series is a DICOM description of as many planes as the slices it read (those of the
+ * folder but the objects skipped by their SOP class: slices read and objects skipped together
+ * no more than the files written), of a DICOM sample type, with finite positive spacing; a volume of at most READ_LIMIT bytes is read plane by plane, and
  * after an error the reader repeats it. Crashes, sanitizer reports, leaks, hangs and anything
  * the DICOM library throws or asserts that reaches the process are failures.
  *
@@ -154,12 +155,14 @@ static void check_error(ip_status status, const ip_error *err)
     }
 }
 
-static void check_desc(const ip_input_desc *d, unsigned slices)
+/* `files`: the DICOM files written (the slices, and a DICOMDIR when there is one). */
+static void check_desc(const ip_input_desc *d, unsigned files)
 {
     for (int axis = 0; axis < 3; axis++)
         if (d->dims[axis] < 2 || !isfinite(d->spacing[axis]) || d->spacing[axis] <= 0.0)
             abort();
-    if (d->dims[2] != slices || d->encoding != IP_ENCODING_DICOM || d->big_endian != 0 ||
+    if (d->dims[2] != d->source_slices || d->source_slices + d->skipped_objects > files ||
+        d->series_count != 1 || d->encoding != IP_ENCODING_DICOM || d->big_endian != 0 ||
         (d->type != IP_UINT8 && d->type != IP_UINT16 && d->type != IP_INT16) ||
         strcmp(d->path, folder) != 0 || strcmp(d->data_path, folder) != 0)
         abort();
@@ -256,7 +259,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ip_status status = ip_input_describe(folder, NULL, &desc, &err);
     say("describe", status, err.message);
     if (status == IP_OK) {
-        check_desc(&desc, count);
+        check_desc(&desc, count + (flags & 2 ? 1 : 0));
         read_series(&desc);
     } else {
         /* IP_ERR_UNSUPPORTED: a transfer syntax, sample type or photometric interpretation

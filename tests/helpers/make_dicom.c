@@ -1,9 +1,13 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* make_dicom: writes a small int16 volume twice, as a raw file and as a DICOM series made from
- * it (dicom_series.h: shuffled file order, transfer syntaxes by turns), for the end-to-end
- * tests of DICOM input.
+ * it (dicom_series.h: shuffled file order, transfer syntaxes by turns), and folders as
+ * scanners write them, for the end-to-end tests of DICOM input.
  *
- *   make_dicom DIR [--air]   writes DIR/volume_40x36x13_int16.raw and DIR/series/IM0001.dcm ...
+ *   make_dicom DIR [--air]   writes DIR/volume_40x36x13_int16.raw and DIR/series/IM0001.dcm
+ *                     ...; DIR/tilted/: a ball imaged with a gantry tilt (test_dicom_tilted());
+ *                     DIR/scanner/: DIRFILE (a media storage directory), SR0001 (a basic
+ *                     text report), PS0001 (a grayscale presentation state), S1/ the series
+ *                     again ("Head") and S2/ the tilted one
  *
  * The series, a CT, says spacing 0.8 (x), 0.7 (y), 2.5 (z) mm and rescale stored x 1 - 1024
  * (Hounsfield units). The volume is an ellipsoid, stored 2000 at its centre falling by 40 a
@@ -18,6 +22,39 @@
 #include <sys/stat.h>
 
 #include "dicom_series.h"
+
+/* DIR/name as a new folder, its path into out; 0 or -1. */
+static int folder(const char *dir, const char *name, char out[4096])
+{
+    snprintf(out, 4096, "%.3900s/%s", dir, name);
+    if (mkdir(out, 0777) != 0) {
+        fprintf(stderr, "make_dicom: %s: cannot create\n", out);
+        return -1;
+    }
+    return 0;
+}
+
+/* The scanner's folder: the objects that are not images beside the two series' folders. */
+static int write_scanner(const char *dir, const test_dicom_series *head, const int16_t *volume,
+                         const test_dicom_series *tilted, const int16_t *ball)
+{
+    char path[4096], sub[4096];
+    if (folder(dir, "scanner", path) != 0)
+        return -1;
+    snprintf(sub, sizeof sub, "%.3900s/DIRFILE", path);
+    test_dicom_write_object(sub, TEST_DICOM_DIRECTORY, NULL);
+    snprintf(sub, sizeof sub, "%.3900s/SR0001", path);
+    test_dicom_write_object(sub, TEST_DICOM_BASIC_TEXT_SR, head->series_uid);
+    snprintf(sub, sizeof sub, "%.3900s/PS0001", path);
+    test_dicom_write_object(sub, TEST_DICOM_GRAYSCALE_PS, head->series_uid);
+    if (folder(path, "S1", sub) != 0)
+        return -1;
+    test_dicom_write_series(head, volume, sub);
+    if (folder(path, "S2", sub) != 0)
+        return -1;
+    test_dicom_write_series(tilted, ball, sub);
+    return 0;
+}
 
 int main(int argc, char **argv)
 {
@@ -48,12 +85,18 @@ int main(int argc, char **argv)
         fprintf(stderr, "make_dicom: %s: cannot write\n", path);
         return 1;
     }
-    snprintf(path, sizeof path, "%.4000s/series", argv[1]);
-    if (mkdir(path, 0777) != 0) {
-        fprintf(stderr, "make_dicom: %s: cannot create\n", path);
+    if (folder(argv[1], "series", path) != 0)
         return 1;
-    }
     test_dicom_write_series(&s, volume, path);
+    test_dicom_series tilted = test_dicom_tilted();
+    const double centre[3] = TEST_DICOM_BALL_CENTRE;
+    int16_t *ball = test_dicom_ball(&tilted, centre);
+    if (folder(argv[1], "tilted", path) != 0)
+        return 1;
+    test_dicom_write_series(&tilted, ball, path);
+    s.description = "Head";
+    int rc = write_scanner(argv[1], &s, volume, &tilted, ball) != 0;
+    free(ball);
     free(volume);
-    return 0;
+    return rc;
 }

@@ -32,6 +32,12 @@ static void error_and_input(void)
     FIELD(ip_input_desc, rescale_slope);
     FIELD(ip_input_desc, rescale_intercept);
     FIELD(ip_input_desc, orientation);
+    FIELD(ip_input_desc, series_uid);
+    FIELD(ip_input_desc, series_count);
+    FIELD(ip_input_desc, skipped_objects);
+    FIELD(ip_input_desc, source_slices);
+    FIELD(ip_input_desc, resampled);
+    FIELD(ip_input_desc, tilt_degrees);
     FIELD(ip_input_desc, rescale_unit);
     FIELD(ip_input_desc, reserved);
     SIZE(ip_rescale);
@@ -53,6 +59,9 @@ static void error_and_input(void)
     FIELD(ip_input_overrides, big_endian);
     FIELD(ip_input_overrides, has_spacing);
     FIELD(ip_input_overrides, spacing);
+    FIELD(ip_input_overrides, series);
+    FIELD(ip_input_overrides, tilt);
+    FIELD(ip_input_overrides, uneven);
 }
 
 static void bricker(void)

@@ -216,6 +216,82 @@ class Extract(unittest.TestCase):
             self.assertFalse(g._runs)
 
 
+class Space(unittest.TestCase):
+    """Vertices in the file's physical space, as isorender --mesh writes them, or in the grid
+    (index x spacing) with space="grid", as --mesh-grid; the Mesh names which."""
+
+    @classmethod
+    def setUpClass(cls):
+        raw = support.generate("sphere", (24, 20, 16), "uint8")
+        nhdr = support.work("turned.nhdr")
+        with open(nhdr, "w") as h:  # x along +y, y along -x; spacings 0.5, 0.5, 2
+            h.write("NRRD0004\ntype: uint8\ndimension: 3\nsizes: 24 20 16\n"
+                    "space: left-posterior-superior\n"
+                    "space directions: (0,0.5,0) (-0.5,0,0) (0,0,2)\n"
+                    "space origin: (10,-20,30.5)\nendian: little\nencoding: raw\n"
+                    "data file: %s\n" % os.path.basename(raw))
+        cls.ibv = support.work("turned.ibv")
+        support.tool("isobrick", nhdr, "-o", cls.ibv, "--brick-size", "8", "--quiet")
+        cls.f = isoprop.open(cls.ibv)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.f.close()
+
+    def isorender_mesh(self, name, *args):
+        ply = support.work(name + ".ply")
+        support.tool("isorender", self.ibv, "--iso", 128, "--full", "--threads", "1",
+                     "--software", "-o", support.work(name + ".png"), "--mesh", ply,
+                     "--no-weld", "--quiet", "--force", *args)
+        return support.read_ply(ply)
+
+    def test_file_orientation(self):
+        self.assertEqual(self.f.origin, (10.0, -20.0, 30.5))
+        self.assertEqual(self.f.directions, ((0.0, 1.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 0.0, 1.0)))
+
+    def test_physical_by_default(self):
+        mesh = self.f.extract(128, full=True, threads=1)
+        self.assertEqual(mesh.space, "LPS")
+        vertices, normals, _ = self.isorender_mesh("physical")
+        self.assertGreater(len(mesh), 0)
+        np.testing.assert_array_equal(mesh.vertices, vertices)
+        np.testing.assert_array_equal(mesh.normals, normals)
+
+    def test_grid(self):
+        grid = self.f.extract(128, full=True, threads=1, space="grid")
+        self.assertEqual(grid.space, "grid")
+        vertices, normals, _ = self.isorender_mesh("grid", "--mesh-grid")
+        np.testing.assert_array_equal(grid.vertices, vertices)
+        np.testing.assert_array_equal(grid.normals, normals)
+        # physical = origin + D * grid: (10 - y, -20 + x, 30.5 + z)
+        physical = self.f.extract(128, full=True, threads=1)
+        g = grid.vertices.astype(np.float64)
+        want = np.stack([10 - g[:, 1], -20 + g[:, 0], 30.5 + g[:, 2]], axis=1)
+        np.testing.assert_allclose(physical.vertices, want, atol=1e-4)
+
+    def test_progressive_and_steps(self):
+        mesh = self.f.extract(128, view="-y", size=(48, 32), threads=1)
+        vertices, _, _ = self.isorender_mesh_view()
+        self.assertEqual(mesh.space, "LPS")
+        np.testing.assert_array_equal(mesh.vertices, vertices)
+        steps = list(self.f.extract_steps(128, view="-y", size=(48, 32), threads=1))
+        self.assertTrue(all(s.space == "LPS" for s in steps))
+        np.testing.assert_array_equal(np.concatenate([s.vertices for s in steps]), vertices)
+
+    def isorender_mesh_view(self):
+        ply = support.work("view.ply")
+        support.tool("isorender", self.ibv, "--iso", 128, "--size", "48x32", "--threads", "1",
+                     "--view", "-y", "--software", "-o", support.work("view.png"), "--mesh", ply,
+                     "--no-weld", "--quiet", "--force")
+        return support.read_ply(ply)
+
+    def test_bad_space(self):
+        with self.assertRaises(isoprop.ArgumentError):
+            self.f.extract(128, space="index")
+        with self.assertRaises(TypeError):
+            self.f.extract(128, space=1)
+
+
 class SampleVolume(unittest.TestCase):
     """A real volume of ../shared/data, bricked from a numpy array in Python, against
     isorender --full on the brick file isobrick makes of the raw file."""

@@ -56,9 +56,16 @@ class Units(unittest.TestCase):
                 self.assertIn("iso -500 (stored) is outside the value range", str(caught.warning))
             steps = list(f.extract_steps(200, threads=1, size=(64, 48)))
             stored = list(f.extract_steps(1224, stored=True, threads=1, size=(64, 48)))
+            grid = list(f.extract_steps(1224, stored=True, threads=1, size=(64, 48),
+                                        space="grid"))
             self.assertEqual(len(steps), len(stored))
+            self.assertEqual(len(steps), len(grid))
             self.assertTrue(all(np.array_equal(x.vertices, y.vertices)
                                 for x, y in zip(steps, stored)))
+            # the grid's vertices are the physical ones less the origin (LPS, axes unturned)
+            self.assertEqual((steps[-1].space, grid[-1].space), ("LPS", "grid"))
+            self.assertTrue(all(np.allclose(x.vertices - np.array(f.origin), y.vertices,
+                                            atol=1e-4) for x, y in zip(steps, grid)))
             self.assertEqual(steps[-1].stats["iso_stored"], 1224.0)
 
     def test_stats_as_isorender_writes_them(self):
@@ -88,10 +95,16 @@ class Units(unittest.TestCase):
             self.assertIsNone(g.rescale)
             self.assertEqual(g.format_version, 2)
             self.assertEqual(g.value_range, g.value_range_stored)
-            want = ct.extract(-500, full=True, threads=1).vertices  # stored 524 everywhere
-            self.assertTrue(np.array_equal(f.extract(258.75, full=True, threads=1).vertices,
-                                           want))
-            self.assertTrue(np.array_equal(g.extract(524, full=True, threads=1).vertices, want))
+            # stored 524 everywhere; on the grid, since the raw volume has no physical space
+            want = ct.extract(-500, full=True, threads=1, space="grid").vertices
+            for mesh in (f.extract(258.75, full=True, threads=1, space="grid"),
+                         g.extract(524, full=True, threads=1, space="grid"),
+                         ct.extract(524, stored=True, full=True, threads=1, space="grid")):
+                self.assertEqual(mesh.space, "grid")
+                self.assertTrue(np.array_equal(mesh.vertices, want))
+            # the series' own physical space (LPS) whichever way the isovalue is given
+            self.assertTrue(np.array_equal(g.extract(524, full=True, threads=1).vertices,
+                                           ct.extract(-500, full=True, threads=1).vertices))
             self.assertNotIn("iso_stored", g.extract(524, full=True).stats)
             self.assertNotIn("rescale", g.extract(524, full=True).stats)
         array = np.zeros((4, 5, 6), np.int16)

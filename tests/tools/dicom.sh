@@ -3,7 +3,11 @@
 # transfer syntaxes by turns: explicit and implicit VR little endian, explicit VR big endian,
 # RLE) to the same samples as the raw volume it was made from, reports and keeps the rescale (a
 # CT's: Hounsfield units, as the raw volume bricked with --rescale 1,-1024,HU), and refuses a
-# broken series in one line naming it.
+# broken series in one line naming it. A folder as scanners write it (a DIRFILE, a report and
+# a presentation state beside two series in subfolders, one with a gantry tilt): the objects
+# skipped and counted, the series listed, refused without a pick, picked; the tilted series
+# resampled so that its surface lies where the ball it images is, or refused when asked; a
+# slice missing refused, or resampled when asked.
 . "$(dirname "$0")/lib.sh"
 
 "$bin/tests/make_dicom" "$work" || { bad "make_dicom writes the series"; finish; }
@@ -79,5 +83,72 @@ cp -r series stranger
 echo "scanned on Tuesday" >stranger/notes.txt
 expect_error 1 "stranger/notes.txt: not a DICOM file" "$bin/isobrick" stranger -o s.ibv
 check "no output after a stranger" test ! -e s.ibv
+
+# a slice missing: refused naming the option, resampled with it
+expect_error 1 "gap: a slice is missing between IM0003.dcm (at -30 mm) and IM0007.dcm (at -25 mm): 5 mm apart, 2.0 times the slice spacing 2.5 mm (isobrick --even-spacing resamples them onto an even grid)" \
+    "$bin/isobrick" gap -o gap.ibv
+run_capture "$bin/isobrick" gap -o gap.ibv --even-spacing --quiet
+check "--even-spacing bricks the series with a slice missing" test "$rc" = 0
+"$bin/isoinfo" --json gap.ibv >gap.json 2>/dev/null
+check "... on the full 13 planes, 2.5 mm apart" grep -q '"dims": \[40, 36, 13\].*"spacing": \[0.8[0-9]*, 0.69*[0-9]*, 2.5\]' gap.json
+
+# a folder as a scanner writes it
+ls bricks >bricks_before.txt
+run_capture "$bin/isobrick" scanner --list-series
+check "--list-series exits 0" test "$rc" = 0
+check "--list-series counts the series and the objects skipped" \
+    grep -qxF "scanner: 2 series, 3 DICOM objects that are not images skipped" "$work/.out"
+check "--list-series gives UID, description, modality, slices, size and spacing" grep -qxF \
+    '1.2.826.0.1.3680043.2.1125.1.1  "Head"  CT  13 slices  40x36x13 int16  spacing 0.8,0.7,2.5 mm' \
+    "$work/.out"
+check "--list-series says the tilt" grep -qxF \
+    '1.2.826.0.1.3680043.2.1125.1.3  "Tilted head"  CT  13 slices  40x50x13 int16  spacing 0.8,0.7,2.36 mm  gantry tilt 18.5 degrees: resampled' \
+    "$work/.out"
+check "--list-series writes nothing" sh -c 'ls bricks | cmp -s - bricks_before.txt'
+expect_error 1 "scanner: the folder holds 2 series: pick one by its UID (isobrick --series UID): 1.2.826.0.1.3680043.2.1125.1.1 \"Head\" CT 13 slices; 1.2.826.0.1.3680043.2.1125.1.3 \"Tilted head\" CT 13 slices" \
+    "$bin/isobrick" scanner -o several.ibv
+check "no output without a pick" test ! -e several.ibv
+run_capture "$bin/isobrick" scanner --series 1.2.826.0.1.3680043.2.1125.1.1 -o picked.ibv \
+    --brick-size 8 --threads 2
+check "--series picks the series ($err)" test "$rc" = 0
+check "the summary counts the objects skipped" \
+    grep -qF "skipped     3 DICOM objects that are not images (by SOP class)" "$work/.out"
+"$bin/isoinfo" --json picked.ibv | sed 's/"file": "[^"]*", //' >picked.json
+sed 's/"file": "[^"]*", //' dicom_space.json >series.json
+check "the series picked is the series alone" cmp -s picked.json series.json
+
+# the tilted series: resampled by default, its surface where the ball is (centre -> mm, LPS;
+# the iso value 1600 bounds a sphere of radius 10 mm), within half a voxel
+run_capture "$bin/isobrick" scanner --series 1.2.826.0.1.3680043.2.1125.1.3 -o tilted.ibv \
+    --brick-size 8 --threads 2
+check "a prefix of one UID picks it ($err)" test "$rc" = 0
+check "the summary says the tilt and the resampling" grep -qF \
+    "resampled   gantry tilt of 18.5 degrees: the sheared slices resampled onto a regular 40x50x13 grid" \
+    "$work/.out"
+check "the resampled series keeps its rescale" sh -c \
+    '"$0" --json tilted.ibv | grep -qF "\"rescale\": {\"slope\": 1, \"intercept\": -1024, \"unit\": \"HU\"}"' \
+    "$bin/isoinfo"
+"$bin/isorender" tilted.ibv --iso-stored 1600.5 --full --threads 1 --software --size 64x48 \
+    --mesh tilted.ply -o tilted.png --quiet --no-weld
+"$bin/tests/ply_triangles" tilted.ply >tilted.txt
+check "the tilted ball's surface lies where the ball is" python3 -c '
+import math
+v = [float.fromhex(x) for l in open("tilted.txt") for x in l.split()[:9]]
+p = [v[i:i + 3] for i in range(0, len(v), 3)]
+assert len(p) > 300, len(p)
+centre, radius, half = (3.1, 37.5, -25.84), 10.0, (0.4, 0.35, 1.18)
+for a in range(3):
+    lo, hi = min(q[a] for q in p), max(q[a] for q in p)
+    assert abs((lo + hi) / 2 - centre[a]) < half[a], (a, lo, hi)
+    assert abs((hi - lo) / 2 - radius) < half[a], (a, lo, hi)
+r = [math.dist(q, centre) for q in p]
+assert max(abs(x - radius) for x in r) < 0.35, (min(r), max(r))
+'
+expect_error 1 "tilted: gantry tilt: the slices stack 18.5 degrees off their normal" \
+    "$bin/isobrick" tilted --no-correct-tilt -o refused.ibv
+check "the refusal names --correct-tilt" sh -c 'printf "%s" "$0" | grep -qF -- "--correct-tilt"' "$err"
+check "no output after a refused tilt" test ! -e refused.ibv
+expect_error 2 "--correct-tilt and --no-correct-tilt" \
+    "$bin/isobrick" tilted --correct-tilt --no-correct-tilt -o both.ibv
 
 finish

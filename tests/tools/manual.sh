@@ -32,7 +32,8 @@ complete_words() { # PROGRAM WORD: what completing WORD after PROGRAM offers
 registered=$(bash -c '. "$0"; complete -p isorender' "$src/tools/completion/isoprop.bash")
 check "the script registers isorender ($registered)" \
     test "$registered" = "complete -F _isoprop_complete isorender"
-check "isorender --mes completes to --mesh" test "$(complete_words isorender --mes)" = "--mesh"
+check "isorender --mes completes to --mesh and --mesh-grid" \
+    test "$(complete_words isorender --mes | tr '\n' ' ')" = "--mesh --mesh-grid "
 check "isobrick --sub completes to --subblock-size" \
     test "$(complete_words isobrick --sub)" = "--subblock-size"
 if [ -x "$bin/isowall" ]; then

@@ -70,6 +70,25 @@ for ta, tb in zip(a, b):
 assert worst < 1e-4, worst
 '
 
+# the file names its space: the file's (LPS), "volume" for one that names none, "grid" for
+# --mesh-grid, whose vertices are the plain ones (index x spacing from 0) whatever the space
+check "the turned mesh names its space" grep -aq '^comment space LPS$' turned.ply
+check "the plain mesh names the volume's own axes" grep -aq '^comment space volume$' plain.ply
+run_capture "$bin/isorender" turned.ibv --iso 128 --full --threads 1 --size 64x48 \
+    -o grid.png --mesh grid.ply --no-weld --mesh-grid
+check "isorender --mesh-grid ($err)" test "$rc" = 0
+check "the grid mesh says so" grep -aq '^comment space grid$' grid.ply
+"$bin/tests/ply_triangles" grid.ply >grid.txt
+check "--mesh-grid: the plain file's vertices" cmp -s grid.txt plain.txt
+for ext in obj stl glb; do
+    "$bin/isorender" turned.ibv --iso 128 --full --threads 1 --size 64x48 -o m.png -f \
+        --mesh "turned.$ext" --quiet
+done
+check "OBJ names the space" grep -q '^# space LPS$' turned.obj
+check "STL's header names the space" sh -c 'head -c 80 turned.stl | grep -aq "space LPS"'
+check "glTF's asset extras name the space" grep -aqF '"extras":{"space":"LPS"}' turned.glb
+expect_error 2 "needs --mesh" "$bin/isorender" turned.ibv --iso 128 --mesh-grid -o x.png
+
 # nifti NAME PIXDIM(3) QFAC QFORM_CODE QUATERN(3) QOFFSET(3) SFORM_CODE SROW(12): a NIfTI-1 file
 # of the sphere's samples, written field by field (offsets of the NIfTI-1 header)
 nifti() {

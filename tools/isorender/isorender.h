@@ -36,6 +36,7 @@ typedef struct options {
     int full_lod;             /* --full-lod: full becomes TOOL_FULL_LOD (--full: TOOL_FULL) */
     strip_plan strip_at;      /* count 0 until --strip-at or the default sets it */
     int weld, no_weld;
+    int mesh_grid;            /* --mesh-grid: the mesh file in index x spacing, not physical */
     uint64_t smooth;          /* --smooth N: Taubin iterations for the mesh file (0: none) */
     tool_orbit_options orbit; /* --azimuth, --elevation, --zoom */
     uint64_t turntable;       /* --turntable N: frames (0: one image) */
@@ -191,8 +192,9 @@ void print_summary(FILE *out, const run *r);
 /* --smooth N: the Taubin iterations for the mesh file. */
 int parse_smooth(const char *program, const tool_option *option, const char *const *values,
                  void *base);
-/* --smooth smooths a welded mesh file. Returns 0, or 2 after a usage error. */
-int check_smooth_options(const options *o);
+/* --smooth smooths a welded mesh file; --smooth and --mesh-grid need --mesh. Returns 0, or 2
+ * after a usage error. */
+int check_mesh_options(const options *o);
 /* The mesh goes out in the volume's physical space (origin, directions: docs/format.md); a
  * copy is moved there, unless the file's space is the engine's own. */
 int write_mesh(run *r, ip_error *err);

@@ -14,8 +14,11 @@ int parse_smooth(const char *program, const tool_option *option, const char *con
                               "an iteration count", &((options *)base)->smooth);
 }
 
-int check_smooth_options(const options *o)
+int check_mesh_options(const options *o)
 {
+    if (o->mesh_grid && !o->mesh)
+        return tool_usage_error("isorender", "--mesh-grid says how to write the mesh file: it "
+                                             "needs --mesh");
     if (!o->smooth)
         return 0;
     if (!o->mesh)
@@ -37,16 +40,16 @@ static int smooth_mesh(const run *r, ip_indexed_mesh *welded, ip_error *err)
     return 0;
 }
 
-/* Writes `mesh` to the mesh file: welded (shared vertices) unless --no-weld or STL (which is
+/* Writes `mesh` to the mesh file, naming `space` in it: welded (shared vertices) unless --no-weld or STL (which is
  * welded for --smooth, then written with its corners repeated). A progressive run's mesh is
  * only what the view needed, which a note says. */
-static int write_mesh_as(run *r, const ip_mesh *mesh, ip_error *err)
+static int write_mesh_as(run *r, const ip_mesh *mesh, const char *space, ip_error *err)
 {
     const char *format = ip_mesh_format_of(r->o.mesh);
     ip_status st;
     int stl = strcmp(format, "STL") == 0;
     if (r->o.no_weld || (stl && !r->o.smooth)) {
-        st = ip_mesh_write(mesh, r->o.mesh, r->o.common.force, err);
+        st = ip_mesh_write_in(mesh, r->o.mesh, space, r->o.common.force, err);
         r->mesh_vertices = 3 * mesh->triangle_count;
     } else {
         ip_indexed_mesh welded;
@@ -60,7 +63,7 @@ static int write_mesh_as(run *r, const ip_mesh *mesh, ip_error *err)
             ip_indexed_mesh_free(&welded);
             return 1;
         }
-        st = ip_indexed_mesh_write(&welded, r->o.mesh, r->o.common.force, err);
+        st = ip_indexed_mesh_write_in(&welded, r->o.mesh, space, r->o.common.force, err);
         r->mesh_vertices = stl ? 3 * welded.triangle_count : welded.vertex_count;
         r->mesh_dropped = welded.dropped_triangles;
         ip_indexed_mesh_free(&welded);
@@ -78,8 +81,10 @@ static int write_mesh_as(run *r, const ip_mesh *mesh, ip_error *err)
 int write_mesh(run *r, ip_error *err)
 {
     const ip_orientation *space = &ip_store_layout(r->store)->orientation;
+    if (r->o.mesh_grid)
+        return write_mesh_as(r, r->mesh, IP_MESH_SPACE_GRID, err);
     if (ip_orientation_is_identity(space))
-        return write_mesh_as(r, r->mesh, err);
+        return write_mesh_as(r, r->mesh, ip_mesh_space_of(space), err);
     ip_mesh physical;
     ip_mesh_init(&physical);
     if (ip_mesh_append_mesh(&physical, r->mesh, 0, r->mesh->triangle_count) != IP_OK) {
@@ -88,7 +93,7 @@ int write_mesh(run *r, ip_error *err)
         return 1;
     }
     ip_mesh_to_physical(&physical, space);
-    int rc = write_mesh_as(r, &physical, err);
+    int rc = write_mesh_as(r, &physical, ip_mesh_space_of(space), err);
     ip_mesh_free(&physical);
     return rc;
 }

@@ -35,11 +35,14 @@ static const char usage[] =
     "  --threads N         threads for seeding, propagation and --full (default: all cores)\n"
     "  -o OUT.png          the image (default isorender.png)\n"
     "  --mesh OUT          also write the triangles: binary PLY (.ply), binary STL (.stl),\n"
-    "                      Wavefront OBJ (.obj) or binary glTF (.glb, world units as metres),\n"
+    "                      Wavefront OBJ (.obj) or binary glTF (.glb, units as metres),\n"
     "                      by the name's extension. A progressive run's mesh holds only what\n"
     "                      the view needed (open behind); with --full it is the whole, closed\n"
     "                      surface. With several --iso, one file a surface, the isovalue before\n"
     "                      the extension (head.ply: head_iso600.5.ply, head_iso1224.5.ply)\n"
+    "  --mesh-grid         the mesh in the volume's grid instead: sample index x spacing from\n"
+    "                      0 (the default is the file's physical space: origin, directions and\n"
+    "                      spacing applied); the file names its space (docs/meshes.md)\n"
     "  --weld, --no-weld   PLY, OBJ and glTF meshes share their vertices (default), or repeat\n"
     "                      them for every triangle (STL always does)\n"
     "  --smooth N          smooth the mesh file by N iterations of Taubin's method (lambda 0.5,\n"
@@ -116,6 +119,7 @@ static const tool_option isorender_options[] = {
     {"--strip-at", NULL, 1, offsetof(options, strip_at), parse_strip_at, NULL, NULL},
     {"--weld", NULL, 0, offsetof(options, weld), NULL, NULL, NULL},
     {"--no-weld", NULL, 0, offsetof(options, no_weld), NULL, NULL, NULL},
+    {"--mesh-grid", NULL, 0, offsetof(options, mesh_grid), NULL, NULL, NULL},
     {"--smooth", NULL, 1, 0, parse_smooth, NULL, NULL},
     TOOL_ORBIT_OPTION_ROWS(options, orbit),
     {"--color", NULL, 1, 0, parse_color, NULL, NULL},
@@ -245,7 +249,7 @@ int parse_args(int argc, char **argv, options *o)
     ip_error why;
     if (o->axes && ip_overlay_axes_check(o->common.width, o->common.height, &why) != IP_OK)
         return tool_usage_error("isorender", "--%s", why.message); /* "--axes: the triad..." */
-    rc = check_smooth_options(o);
+    rc = check_mesh_options(o);
     if (!rc && !o->turntable)
         rc = tool_check_png_name("isorender", "-o", o->out);
     if (!rc)
