@@ -131,13 +131,15 @@ IP_API void ip_camera_dolly(ip_camera *camera, double factor, double min_distanc
 /*! ip_camera_to_world() : the world camera of `physical` (eye, target and up in the physical
  *  space of `orientation`): eye and target ip_orientation_to_world(), up
  *  ip_orientation_unrotate(); the field of view and size copied. Where the orientation is
- *  the identity (origin 0, unit directions) the world camera is `physical`, to the bit.
+ *  the identity (origin 0, unit directions: ip_orientation_is_identity()) the world camera is
+ *  `physical`, to the bit.
  *  `world` may alias `physical`. */
 IP_API void ip_camera_to_world(const ip_orientation *orientation, const ip_camera *physical,
                                ip_camera *world);
 
 /*! ip_camera_to_physical() : the inverse: eye and target ip_orientation_apply(), up
- *  ip_orientation_rotate(). `physical` may alias `world`. */
+ *  ip_orientation_rotate() (`world` itself with the identity). `physical` may alias
+ *  `world`. */
 IP_API void ip_camera_to_physical(const ip_orientation *orientation, const ip_camera *world,
                                   ip_camera *physical);
 

@@ -251,6 +251,10 @@ ip_status ip_camera_fit_view(const ip_orientation *o, const double lo[3], const 
 void ip_camera_to_world(const ip_orientation *o, const ip_camera *physical, ip_camera *world)
 {
     ip_camera c = *physical;
+    if (ip_orientation_is_identity(o)) { /* as it is, zeros' signs too */
+        *world = c;
+        return;
+    }
     ip_orientation_to_world(o, physical->eye, c.eye);
     ip_orientation_to_world(o, physical->target, c.target);
     ip_orientation_unrotate(o, physical->up, c.up);
@@ -260,6 +264,10 @@ void ip_camera_to_world(const ip_orientation *o, const ip_camera *physical, ip_c
 void ip_camera_to_physical(const ip_orientation *o, const ip_camera *world, ip_camera *physical)
 {
     ip_camera c = *world;
+    if (ip_orientation_is_identity(o)) {
+        *physical = c;
+        return;
+    }
     ip_orientation_apply(o, world->eye, c.eye);
     ip_orientation_apply(o, world->target, c.target);
     ip_orientation_rotate(o, world->up, c.up);

@@ -104,6 +104,8 @@ void ip_orientation_plane_to_world(const ip_orientation *orientation, const doub
                                    double offset, double out_normal[3], double *out_offset)
 {
     double shifted = offset + dot3(normal, orientation->origin);
+    if (ip_orientation_is_identity(orientation))
+        shifted = offset; /* as it is, a zero's sign too */
     ip_orientation_unrotate(orientation, normal, out_normal);
     *out_offset = shifted;
 }

@@ -109,9 +109,9 @@ typedef struct tool_view_options {
     "  --clip-index SPEC   the same in sample indices (i, j, k as x, y, z): z=40 keeps the\n"      \
     "                      slices from index 40 on\n"
 
-/* The defaults: the file's default view, the paper's angles, lod on with a 1-pixel error, occlusion on, reading
- * ahead on, every core, the
- * default cache budget, an image of width x height. */
+/* The defaults: the file's default view (view NULL), the paper's angles, lod on with a 1-pixel
+ * error, occlusion on, reading ahead on, every core, the default cache budget, an image of
+ * width x height. */
 void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t height);
 
 /* --prefetch's name of a mode ("off", "on" or "always"; "unknown" for another value): a
