@@ -643,10 +643,14 @@ static void test_to_physical(void)
 }
 
 static const test_case cases[] = {
-    TEST_CASE(test_normal_packing), TEST_CASE(test_populated_growth),
-    TEST_CASE(test_to_physical),    TEST_CASE(test_appends),
-    TEST_CASE(test_ply),            TEST_CASE(test_stl_obj),
-    TEST_CASE(test_glb),            TEST_CASE(test_indexed_files),
+    TEST_CASE(test_normal_packing),
+    TEST_CASE(test_populated_growth),
+    TEST_CASE(test_to_physical),
+    TEST_CASE(test_appends),
+    TEST_CASE(test_ply),
+    TEST_CASE(test_stl_obj),
+    TEST_CASE(test_glb),
+    TEST_CASE(test_indexed_files),
     TEST_CASE(test_space_named),
 };
 
