@@ -36,9 +36,9 @@ void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_
 typedef struct tool_run_json {
     const char *file;
     double iso;
-    int full; /* TOOL_PROGRESSIVE, TOOL_FULL or TOOL_FULL_LOD */
-    const ip_camera *camera;
-    const char *renderer; /* "opengl", "software", "none" */
+    int full;                /* TOOL_PROGRESSIVE, TOOL_FULL or TOOL_FULL_LOD */
+    const ip_camera *camera; /* in the file's physical space (tool_space_physical()) */
+    const char *renderer;    /* "opengl", "software", "none" */
     const tool_view_options *options;
     int warm, done;
     const ip_engine_counts *counts;
