@@ -324,12 +324,11 @@ static void test_table_matches_generator(void)
 /* Within one cell, a triangle side joining two edges of one face is an outline segment and is
  * used once (its other use is in the neighbour across the face); any other side is a diagonal,
  * used twice in opposite directions. */
-static int cell_edges_manifold(unsigned c)
+static int row_edges_manifold(const int8_t *row, int count)
 {
     int uses[12][12];
     memset(uses, 0, sizeof uses);
-    const int8_t *row = ip__mc_triangle_table[c];
-    for (int i = 0; i < 3 * ip__mc_triangle_count[c]; i += 3)
+    for (int i = 0; i < 3 * count; i += 3)
         for (int k = 0; k < 3; k++)
             uses[row[i + k]][row[i + (k + 1) % 3]]++;
     for (int a = 0; a < 12; a++)
@@ -371,7 +370,8 @@ static void test_case_counts(void)
             bad |= tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
         }
         CHECK_MSG(!bad && used == ip__mc_edge_table[c], "case 0x%02x: triangle edges", c);
-        CHECK_MSG(cell_edges_manifold(c), "case 0x%02x: a diagonal on a face", c);
+        CHECK_MSG(row_edges_manifold(ip__mc_triangle_table[c], count),
+                  "case 0x%02x: a diagonal on a face", c);
         /* The complement has the same crossed edges; with no ambiguous face it is the same
          * outline reversed. With one, it is the case's outline under the opposite rule. */
         CHECK_EQ(ip__mc_edge_table[255 - c], ip__mc_edge_table[c]);
@@ -952,9 +952,145 @@ static int bench(int n)
     return 0;
 }
 
+/* ---------------------------------------------------------------------------------------------
+ * Frames (mc.h): the table turned by each of the cube's 48 symmetries. */
+
+static const uint8_t permutations[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                           {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+
+/* Every row of the turned table crosses the case's edges, keeps its triangle count and puts
+ * no diagonal on a face; the identity's rows are the table's. */
+static void check_frame_rows(const ip_mc_frame *f, int8_t rows[256][16], const char *name)
+{
+    int identity = f->axis[0] == 0 && f->axis[1] == 1 && f->axis[2] == 2 && !f->flip[0] &&
+                   !f->flip[1] && !f->flip[2];
+    if (identity)
+        CHECK_MSG(memcmp(rows, ip__mc_triangle_table, sizeof ip__mc_triangle_table) == 0, "%s",
+                  name);
+    for (unsigned c = 0; c < 256; c++) {
+        int count = ip__mc_triangle_count[c], filled = 0;
+        unsigned used = 0;
+        while (filled < 16 && rows[c][filled] >= 0)
+            used |= 1u << rows[c][filled++];
+        CHECK_MSG(filled == 3 * count && used == ip__mc_edge_table[c], "%s: case 0x%02x", name, c);
+        CHECK_MSG(row_edges_manifold(rows[c], count), "%s: case 0x%02x: a diagonal on a face", name,
+                  c);
+    }
+}
+
+/* Random cells: the world cell's triangles (the turned rows) are those of the same cell in the
+ * canonical frame (the table's), corner for corner, wound the same way about the outward
+ * normals. */
+static void check_frame_cells(const ip_mc_frame *f, int8_t rows[256][16], const char *name,
+                              uint64_t *seed)
+{
+    static const float lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    int bad = 0, reflected = f->flip[0] ^ f->flip[1] ^ f->flip[2];
+    int fixed = (f->axis[0] == 0) + (f->axis[1] == 1) + (f->axis[2] == 2);
+    reflected ^= fixed == 1;
+    for (int n = 0; n < 300 && !bad; n++) {
+        float canonical[8], world[8];
+        for (unsigned k = 0; k < 8; k++)
+            canonical[k] = (float)random_unit(seed);
+        for (unsigned k = 0; k < 8; k++) { /* canonical corner k's world corner */
+            unsigned j = 0;
+            for (unsigned a = 0; a < 3; a++)
+                j |= ((k >> f->axis[a] & 1u) ^ f->flip[a]) << a;
+            world[j] = canonical[k];
+        }
+        ip_mc_vertex want[IP_MC_MAX_VERTICES];
+        int count = ip__mc_triangulate_cell(canonical, NULL, 0.5f, lo, hi, want);
+        unsigned mc = ip__mc_case(world, 0.5f);
+        float points[12][3], normals[12][3];
+        ip__mc_cell_edge_points(world, mc, 0.5f, lo, hi, points);
+        ip__mc_cell_edge_normals(world, mc, NULL, 0.5f, lo, hi, normals);
+        bad |= count != ip__mc_triangle_count[mc];
+        for (int t = 0; t < count && !bad; t++) {
+            double orient[2] = {0, 0}; /* (b - a) x (c - a) . (the vertices' normals) */
+            for (int side = 0; side < 2; side++) {
+                double v[3][3], m[3] = {0, 0, 0};
+                for (int i = 0; i < 3; i++) {
+                    int e = rows[mc][3 * t + i];
+                    for (unsigned a = 0; a < 3; a++) {
+                        v[i][a] = side ? points[e][a] : want[3 * t + i].position[a];
+                        m[a] += side ? normals[e][a] : want[3 * t + i].normal[a];
+                    }
+                    if (side) { /* the world corner back in the canonical frame */
+                        double c[3];
+                        for (unsigned a = 0; a < 3; a++)
+                            c[f->axis[a]] = f->flip[a] ? 1.0 - points[e][a] : points[e][a];
+                        int k = reflected && i ? 3 - i : i; /* b and c swap places */
+                        for (unsigned a = 0; a < 3; a++)
+                            bad |= fabs(c[a] - want[3 * t + k].position[a]) > 1e-6;
+                    }
+                }
+                double u[3], w[3];
+                for (unsigned a = 0; a < 3; a++)
+                    u[a] = v[1][a] - v[0][a], w[a] = v[2][a] - v[0][a];
+                orient[side] = (u[1] * w[2] - u[2] * w[1]) * m[0] +
+                               (u[2] * w[0] - u[0] * w[2]) * m[1] +
+                               (u[0] * w[1] - u[1] * w[0]) * m[2];
+            }
+            bad |=
+                (orient[0] > 1e-9 && orient[1] < -1e-9) || (orient[0] < -1e-9 && orient[1] > 1e-9);
+        }
+    }
+    CHECK_MSG(!bad, "%s: a cell triangulated otherwise", name);
+}
+
+static void test_frames(void)
+{
+    static int8_t rows[256][16];
+    uint64_t seed = 42;
+    for (int p = 0; p < 6; p++)
+        for (unsigned flips = 0; flips < 8; flips++) {
+            ip_mc_frame f;
+            char name[64];
+            for (int a = 0; a < 3; a++) {
+                f.axis[a] = permutations[p][a];
+                f.flip[a] = (uint8_t)(flips >> a & 1u);
+            }
+            snprintf(name, sizeof name, "axes %d%d%d flips %u", f.axis[0], f.axis[1], f.axis[2],
+                     flips);
+            ip__mc_frame_rows(&f, rows);
+            check_frame_rows(&f, rows, name);
+            check_frame_cells(&f, rows, name, &seed);
+        }
+}
+
+/* The frame of an orientation: its axes matched with LPS's (a named space) or the physical
+ * ones (none). */
+static void test_frame_of(void)
+{
+    ip_orientation o;
+    ip_mc_frame f;
+    ip_orientation_identity(&o);
+    CHECK_EQ(ip__mc_frame_of(&o, &f), 1); /* no orientation: the table as it is */
+    o.space = IP_SPACE_LPS;
+    CHECK_EQ(ip__mc_frame_of(&o, &f), 1);
+    o.space = IP_SPACE_RAS; /* x right and y anterior run opposite LPS's */
+    CHECK_EQ(ip__mc_frame_of(&o, &f), 0);
+    CHECK(f.axis[0] == 0 && f.axis[1] == 1 && f.axis[2] == 2);
+    CHECK(f.flip[0] && f.flip[1] && !f.flip[2]);
+    o.space = IP_SPACE_LAS;
+    CHECK_EQ(ip__mc_frame_of(&o, &f), 0);
+    CHECK(!f.flip[0] && f.flip[1] && !f.flip[2]);
+    /* no space: the physical frame; x along -z, y along +x, z along +y (tilted a little) */
+    memset(o.directions, 0, sizeof o.directions);
+    o.space = IP_SPACE_UNKNOWN;
+    o.directions[0][2] = -1;
+    o.directions[1][0] = 0.995, o.directions[1][1] = 0.0998749;
+    o.directions[2][0] = -0.0998749, o.directions[2][1] = 0.995;
+    CHECK_EQ(ip__mc_frame_of(&o, &f), 0);
+    CHECK(f.axis[0] == 2 && f.axis[1] == 0 && f.axis[2] == 1);
+    CHECK(f.flip[0] && !f.flip[1] && !f.flip[2]);
+}
+
 static const test_case cases[] = {
     TEST_CASE(test_table_matches_generator),
     TEST_CASE(test_case_counts),
+    TEST_CASE(test_frames),
+    TEST_CASE(test_frame_of),
     TEST_CASE(test_sphere),
     TEST_CASE(test_touching_spheres),
     TEST_CASE(test_gyroid),

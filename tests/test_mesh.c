@@ -610,11 +610,48 @@ static void test_space_named(void)
     ip_mesh_free(&m);
 }
 
+/* Into physical space: origin + D p and D n; a reflection also swaps each triangle's second and
+ * third vertices, so that it stays counter-clockwise about its normal. */
+static void test_to_physical(void)
+{
+    /* counter-clockwise seen from +z, its normals +z */
+    const float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, n[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+    for (int mirrored = 0; mirrored < 2; mirrored++) {
+        ip_mesh m;
+        ip_mesh_init(&m);
+        REQUIRE(ip_mesh_append_float_normals(&m, p, n, NULL, 1) == IP_OK);
+        ip_orientation o;
+        ip_orientation_identity(&o);
+        o.origin[0] = 10, o.origin[1] = 20, o.origin[2] = 30;
+        o.directions[0][0] = mirrored ? -1 : 1; /* x the other way: a reflection */
+        ip_mesh_to_physical(&m, &o);
+        const float *q = m.positions;
+        /* the vertices moved, b and c in each other's place where mirrored */
+        const float b[3] = {mirrored ? 9 : 11, 20, 30}, c[3] = {10, 21, 30};
+        CHECK(q[0] == 10 && q[1] == 20 && q[2] == 30);
+        const float *second = mirrored ? q + 6 : q + 3, *third = mirrored ? q + 3 : q + 6;
+        CHECK_MSG(!memcmp(second, b, sizeof b) && !memcmp(third, c, sizeof c), "mirrored %d",
+                  mirrored);
+        /* counter-clockwise about the normal (still +z) */
+        double u[3], w[3];
+        for (int a = 0; a < 3; a++)
+            u[a] = q[3 + a] - q[a], w[a] = q[6 + a] - q[a];
+        CHECK_MSG(u[0] * w[1] - u[1] * w[0] > 0, "mirrored %d: winding", mirrored);
+        CHECK_EQ(m.normals[2], 32767);
+        ip_mesh_free(&m);
+    }
+}
+
 static const test_case cases[] = {
-    TEST_CASE(test_normal_packing), TEST_CASE(test_populated_growth),
-    TEST_CASE(test_appends),        TEST_CASE(test_ply),
-    TEST_CASE(test_stl_obj),        TEST_CASE(test_glb),
-    TEST_CASE(test_indexed_files),  TEST_CASE(test_space_named),
+    TEST_CASE(test_normal_packing),
+    TEST_CASE(test_populated_growth),
+    TEST_CASE(test_to_physical),
+    TEST_CASE(test_appends),
+    TEST_CASE(test_ply),
+    TEST_CASE(test_stl_obj),
+    TEST_CASE(test_glb),
+    TEST_CASE(test_indexed_files),
+    TEST_CASE(test_space_named),
 };
 
 int main(int argc, char **argv)

@@ -88,11 +88,24 @@ static void test_axis_directions(void)
     CHECK(near(s[1], 0, 0, 1));
     CHECK(near(s[2], 0, -1, 0));
     /* a file whose sample x axis runs along physical -x (LPS, say): physical x, the one the
-     * triad shows, points left in the world's right-pointing view */
+     * triad shows, points left in the world camera's image, and so right in the physical
+     * view shown, that image mirrored (D is a reflection) */
     o.directions[0][0] = -1;
+    o.origin[0] = 40;
     o.space = IP_SPACE_LPS;
     ip_overlay_axis_directions(&c, &o, s);
-    CHECK(near(s[0], -1, 0, 0));
+    CHECK(near(s[0], 1, 0, 0));
+    CHECK(near(s[1], 0, 0, -1));
+    CHECK(near(s[2], 0, -1, 0));
+    /* which is what the physical camera sees of the physical axes */
+    ip_camera physical;
+    ip_orientation axes;
+    double p[3][3];
+    ip_camera_to_physical(&o, &c, &physical);
+    ip_orientation_identity(&axes);
+    ip_overlay_axis_directions(&physical, &axes, p);
+    for (int a = 0; a < 3; a++)
+        CHECK_MSG(near(s[a], p[a][0], p[a][1], p[a][2]), "axis %d", a);
     /* a file whose sample axes are the physical axes permuted: world x is physical y */
     ip_orientation_identity(&o);
     memset(o.directions, 0, sizeof o.directions);

@@ -12,6 +12,7 @@
 
 #include <stdint.h>
 
+#include "isoprop/orientation.h"
 #include "isoprop/status.h"
 
 #ifdef __cplusplus
@@ -105,6 +106,67 @@ IP_API double ip_camera_distance(const ip_camera *camera);
  *  0 and INFINITY for no limit). The view direction and up stay. */
 IP_API void ip_camera_dolly(ip_camera *camera, double factor, double min_distance,
                             double max_distance);
+
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same.
+ *
+ * Views in physical space. A volume is shown in its file's physical frame (origin, directions
+ * and spacing applied: isoprop/orientation.h), so that one physical object stored in any order
+ * gives the same picture. The programs take views and cameras there and hand the engine and the
+ * renderers their world counterparts, made here: a physical camera maps exactly to a world
+ * camera by the inverse rigid transform (eye and target D^T (p - origin), up D^T up). Where D
+ * is a reflection (ip_orientation_mirrors()), the world camera's image is the mirror of the
+ * physical view: its columns are reversed to show it (the programs do so, and
+ * ip_overlay_axis_directions() draws the axes as the physical view shows them).
+ *
+ * Named views: "+x", "-x", "+y", "-y", "+z", "-z" put the eye on that side of the volume along
+ * the file's physical axes (up +z, or +y for the z views), as ip_camera_fit_axis() does in world
+ * space; "anterior", "posterior", "left", "right", "superior", "inferior" put it on that
+ * anatomical side (up superior, or anterior for the superior and inferior views), in a file
+ * whose space is known (RAS, LAS, LPS). "anterior" looks at the face. */
+#ifdef IP_EXPERIMENTAL
+
+/*! ip_camera_to_world() : the world camera of `physical` (eye, target and up in the physical
+ *  space of `orientation`): eye and target ip_orientation_to_world(), up
+ *  ip_orientation_unrotate(); the field of view and size copied. Where the orientation is
+ *  the identity (origin 0, unit directions: ip_orientation_is_identity()) the world camera is
+ *  `physical`, to the bit.
+ *  `world` may alias `physical`. */
+IP_API void ip_camera_to_world(const ip_orientation *orientation, const ip_camera *physical,
+                               ip_camera *world);
+
+/*! ip_camera_to_physical() : the inverse: eye and target ip_orientation_apply(), up
+ *  ip_orientation_rotate() (`world` itself with the identity). `physical` may alias
+ *  `world`. */
+IP_API void ip_camera_to_physical(const ip_orientation *orientation, const ip_camera *world,
+                                  ip_camera *physical);
+
+/*! ip_view_check() : whether `view` is a view name (see above), for a command line read
+ *  before any file is open. @return IP_OK or IP_ERR_ARGUMENT ("view 'NAME' is not one of
+ *  ..."). Thread-safe. */
+IP_API ip_status ip_view_check(const char *view, ip_error *err);
+
+/*! ip_view_default() : the view shown when none is asked for: "anterior" for a file whose
+ *  space is known, "-y" otherwise. A static string. Thread-safe. */
+IP_API const char *ip_view_default(const ip_orientation *orientation);
+
+/*! ip_camera_fit_view() : the world camera of the named view `view` (NULL: ip_view_default())
+ *  of the volume whose world box is [lo, hi] (world units) and whose physical space is
+ *  `orientation`: the eye on that side of the volume in physical space, looking at the box's
+ *  centre, far enough for the whole box to fit the frame (as ip_camera_fit_axis(), which it
+ *  equals to the bit for an axis name where the directions are the unit axes). Where the
+ *  orientation mirrors, the image is to be mirrored (see above).
+ *  @return IP_OK, or IP_ERR_ARGUMENT for a name that is not a view, or an anatomical name in a
+ *  file whose space is unknown ("view 'anterior' needs a file with an anatomical space ...").
+ *  Thread-safe. */
+IP_API ip_status ip_camera_fit_view(const ip_orientation *orientation, const double lo[3],
+                                    const double hi[3], const char *view, double fov_y,
+                                    uint32_t width, uint32_t height, ip_camera *world,
+                                    ip_error *err);
+
+#endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus
 }

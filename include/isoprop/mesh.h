@@ -106,8 +106,10 @@ IP_API ip_status ip_mesh_append_mesh(ip_mesh *mesh, const ip_mesh *from, uint64_
 
 /*! ip_mesh_to_physical() : moves the mesh from world coordinates (sample index x spacing, as
  *  the engine makes it) into its volume's physical space: each position p becomes
- *  origin + D * p and each normal D * n (D: the directions as columns; docs/format.md). Done
- *  in double precision, stored back as float32 and packed normals. Changes `mesh` in place. */
+ *  origin + D * p and each normal D * n (D: the directions as columns; docs/format.md); where
+ *  D is a reflection, each triangle's second and third vertices swap places, so that triangles
+ *  stay counter-clockwise seen from outside (from lower values). Done in double precision,
+ *  stored back as float32 and packed normals. Changes `mesh` in place. */
 IP_API void ip_mesh_to_physical(ip_mesh *mesh, const ip_orientation *orientation);
 
 /*! ip_mesh_write_ply() : writes the mesh as binary little-endian PLY (float x,y,z,nx,ny,nz per

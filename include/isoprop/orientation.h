@@ -63,6 +63,50 @@ IP_API const char *ip_space_name(ip_space space);
  *  finite. */
 IP_API int ip_orientation_normalize(double columns[3][3], double lengths[3]);
 
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same.
+ *
+ * Physical space to world space. The engine, its cameras and its clipping planes work in world
+ * units (index x spacing); the programs take views, cameras and planes in the file's physical
+ * space and map them here. D being orthonormal, the map is rigid: world = D^T (physical -
+ * origin). When D is a reflection (det D < 0: one axis stored in the other order, or three),
+ * a world camera sees the mirror image of what the same camera sees in physical space:
+ * ip_orientation_mirrors() says so, and the image's columns are then reversed (column x of the
+ * world image is column width - 1 - x of the physical one, exactly: pixel centres are
+ * symmetric about the image's centre). See camera.h for cameras and views. */
+#ifdef IP_EXPERIMENTAL
+
+/*! ip_orientation_to_world() : world position of physical position `physical`:
+ *  D^T (physical - origin), the inverse of ip_orientation_apply(). `out` may alias it. */
+IP_API void ip_orientation_to_world(const ip_orientation *orientation, const double physical[3],
+                                    double out[3]);
+
+/*! ip_orientation_unrotate() : `v` (a direction) turned back by D: D^T * v, the inverse of
+ *  ip_orientation_rotate(). `out` may alias it. */
+IP_API void ip_orientation_unrotate(const ip_orientation *orientation, const double v[3],
+                                    double out[3]);
+
+/*! ip_orientation_mirrors() : 1 when D is a reflection (its determinant is negative), so that
+ *  a world camera's image is the mirror of the physical one; else 0. */
+IP_API int ip_orientation_mirrors(const ip_orientation *orientation);
+
+/*! ip_orientation_plane_to_world() : the plane that keeps normal . p + offset >= 0 for physical
+ *  positions p, as world positions w see it: (D^T normal) . w + (offset + normal . origin) >= 0
+ *  (the engine's ip_clip_plane). `out_normal` may alias `normal`. */
+IP_API void ip_orientation_plane_to_world(const ip_orientation *orientation, const double normal[3],
+                                          double offset, double out_normal[3], double *out_offset);
+
+/*! ip_space_direction() : the unit vector, in `space`'s coordinates, of the anatomical
+ *  direction `name`: "left", "right", "anterior", "posterior", "superior" or "inferior"
+ *  (RAS: right +x, anterior +y, superior +z; LAS: left +x; LPS: left +x, posterior +y).
+ *  @return 1, or 0 (out untouched) for IP_SPACE_UNKNOWN, another space value or another
+ *  name. Thread-safe. */
+IP_API int ip_space_direction(ip_space space, const char *name, double out[3]);
+
+#endif /* IP_EXPERIMENTAL */
+
 #ifdef __cplusplus
 }
 #endif

@@ -407,6 +407,13 @@ IP_API ip_status ip_renderer_draw_surfaces(ip_renderer *renderer, const ip_surfa
  *  the limit; the setting stays), IP_ERR_UNSUPPORTED or IP_ERR_NOMEM. */
 IP_API ip_status ip_renderer_set_samples(ip_renderer *renderer, uint32_t samples, ip_error *err);
 
+/*! ip_renderer_set_mirror() : with `mirror` non-zero, later draws give the mirror image, its
+ *  columns reversed (column x shows what column width - 1 - x shows without), the background
+ *  unchanged: the physical view of a world camera whose file's orientation mirrors
+ *  (isoprop/camera.h, "Views in physical space"). 0, the default, draws the camera's own
+ *  image. Needs no context. */
+IP_API void ip_renderer_set_mirror(ip_renderer *renderer, int mirror);
+
 /*! ip_renderer_release() : makes a headless renderer's context no longer current on the
  *  calling thread, so that another thread may use the renderer; a no-op for a renderer on the
  *  caller's context. */
@@ -444,8 +451,11 @@ IP_API ip_status ip_scale_bar_choose(const ip_camera *camera, double max_pixels,
  *  (origin + D * world: isoprop/orientation.h; the world's own axes when D is the identity).
  *  screen[a] receives the unit world direction of physical axis a (row a of D) in the
  *  camera's basis: {right, down (image y), toward the eye}, so that {screen[a][0],
- *  screen[a][1]} is where the axis points in the image. The camera must pass
- *  ip_camera_check(), the orientation ip_orientation_check(). Thread-safe. */
+ *  screen[a][1]} is where the axis points in the image, the image being the physical view's:
+ *  where D mirrors (ip_orientation_mirrors()), the world camera's image with its columns
+ *  reversed (isoprop/camera.h, "Views in physical space"), and right the other way. The
+ *  camera (world units) must pass ip_camera_check(), the orientation ip_orientation_check().
+ *  Thread-safe. */
 IP_API void ip_overlay_axis_directions(const ip_camera *camera, const ip_orientation *orientation,
                                        double screen[3][3]);
 

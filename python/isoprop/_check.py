@@ -24,7 +24,8 @@ LZ4HC_LEVELS = (1, 12)     # isobrick --hc LEVEL (isoprop/bricker.h)
 MAX_BRICK_EDGE = 256       # IP_MAX_BRICK_EDGE (isoprop/layout.h)
 MAX_DIM = (1 << 31) - 1    # isobrick --dims: each at most 2^31 - 1
 MAX_COUNT = (1 << 64) - 1  # a uint64_t count (rays)
-VIEWS = ("+x", "-x", "+y", "-y", "+z", "-z")
+VIEWS = ("anterior", "posterior", "left", "right", "superior", "inferior",
+         "+x", "-x", "+y", "-y", "+z", "-z")
 CAMERA_KEYS = ("eye", "target", "up", "fov")
 CAMERA_IGNORED = ("width", "height")  # File.camera()'s dict may come back as camera=
 
@@ -168,8 +169,9 @@ def point(name, value):
 
 
 def view(value, camera):
-    """One of +x -x +y -y +z -z; None too when a camera is given."""
-    if value is None and camera is not None:
+    """One of anterior posterior left right superior inferior +x -x +y -y +z -z, or None (the
+    file's default view, or the camera when one is given)."""
+    if value is None:
         return None
     return choice("view", value, VIEWS)
 

@@ -34,7 +34,7 @@ def cache_stats(cache, summary_bytes):
 
 def run_stats(run, counts, cache):
     """The whole dict for `run` (a volume._Run) with totals `counts` (ip_engine_counts)."""
-    c = run.camera
+    c = run.physical  # the camera in the file's physical space, as isorender reports it
     mode = "full-lod" if run.full == "lod" else "full" if run.full else "progressive"
     out = {"cache": cache_stats(cache, run.summary_bytes), "file": run.path, "iso": run.iso}
     if run.rescale:  # as isorender's: the stored value and the rescale beside the value

@@ -27,6 +27,8 @@ intercept, in unit ("HU" for a DICOM CT; "" when the input named none)."""
 
 DEFAULT_SIZE = (1600, 1200)  # isorender's
 VIEW_FOV = 30.0  # degrees: the field of view of the named views (isorender --view)
+# views and cameras are in the file's physical space (isoprop/camera.h, "Views in physical
+# space"); the engine takes their world counterparts
 
 
 SPACES = ("physical", "grid")  # extract(space=...): docs/meshes.md, "Space"
@@ -38,7 +40,7 @@ class _Args:
     """The checked keywords of an extraction (or of File.camera()): each as the library takes
     it. Raises TypeError or isoprop.ArgumentError naming the first bad one, before any work."""
 
-    def __init__(self, view="-y", camera=None, size=DEFAULT_SIZE, threads=0, cutoff=None,
+    def __init__(self, view=None, camera=None, size=DEFAULT_SIZE, threads=0, cutoff=None,
                  foldback=None, lod=True, pixel_error=1.0, occlusion=True, prefetch=True,
                  cull=False, cache_mb=None):
         self.camera = C.camera(camera)
@@ -72,13 +74,13 @@ class _Args:
 
 def _camera_from(camera, size):
     """An ip_camera from "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov" (isorender --camera) or a dict with
-    eye, target, up (world units) and fov (degrees, default 30), both as _check.camera() gives
-    them; ArgumentError when the library refuses it."""
+    eye, target, up (the file's physical units) and fov (degrees, default 30), both as
+    _check.camera() gives them; ArgumentError when the library refuses it."""
     c, err = S.Camera(), new_error()
     c.width, c.height = size
     if isinstance(camera, str):
         if lib.ip_camera_parse(camera.encode(), ctypes.byref(c), ctypes.byref(err)) != 0:
-            raise ArgumentError('camera: %r is not "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov" (world '
+            raise ArgumentError('camera: %r is not "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov" (physical '
                                 "units, degrees)" % camera)
     else:
         c.eye[:], c.target[:], c.up[:] = camera["eye"], camera["target"], camera["up"]
@@ -103,6 +105,7 @@ class _Run:
         self.space = f._space if space == "physical" else "grid"
         (self.iso, self.iso_stored, stored), self.rescale = iso, f.rescale
         self.full, self.camera, self.options = full, camera, options
+        self.physical = f._physical(camera)  # the camera the statistics report
         self.engine, self.wall_seconds, self.warnings = None, 0.0, []
         self.limit = rays if rays is not None else C.MAX_COUNT
         self.time_limit, self.rays_per_step, self.target = time_limit, rays_per_step, 1
@@ -157,8 +160,9 @@ class File:
     (z, y, x, as a numpy array of the volume), dtype (numpy), spacing (x, y, z world units),
     origin and directions (where sample (0, 0, 0) is and the unit direction of each sample
     axis in the file's physical space; a mesh's vertices are origin + D (i, j, k) * spacing),
-    rescale (a Rescale: what the stored values stand for, as isoinfo shows it; None when the
-    file has none), value_range (min, max; in the file's units where it has a rescale),
+    space (the anatomical space the file names, "RAS", "LAS" or "LPS", or None), rescale (a
+    Rescale: what the stored values stand for, as isoinfo shows it; None when the file has
+    none), value_range (min, max; in the file's units where it has a rescale),
     value_range_stored (the same as stored values), levels (a tuple of Level, level 0 first),
     brick_size, subblock_size, file_bytes, format_version. Isovalues are in the file's units
     (stored=True: stored values). One call at a time: a call (extract(), a step of
@@ -179,6 +183,7 @@ class File:
         self.shape = self.dims[::-1]
         self.dtype = np.dtype(DTYPES[l.type])
         self.spacing = tuple(l.spacing)
+        self.space = lib.ip_space_name(l.orientation.space).decode() or None
         self._rescale = S.Rescale.from_buffer_copy(l.rescale)  # for the library's conversions
         self.rescale = (Rescale(l.rescale.slope, l.rescale.intercept, l.rescale.unit.decode())
                         if l.rescale.present else None)
@@ -293,25 +298,41 @@ class File:
         self._cache, self._cache_budget = cache, budget
         return cache
 
-    def camera(self, view="-y", camera=None, size=DEFAULT_SIZE):
-        """The camera an extraction uses, as a dict (eye, target, up, fov, width, height).
-        Touches nothing of the File but its box: callable at any time, from any thread."""
-        c = self._camera(_Args(view=view, camera=camera, size=size))
+    def camera(self, view=None, camera=None, size=DEFAULT_SIZE):
+        """The camera an extraction uses, as a dict (eye, target, up, fov, width, height) in the
+        file's physical space, as camera= takes it. Touches nothing of the File but its box:
+        callable at any time, from any thread."""
+        c = self._physical(self._camera(_Args(view=view, camera=camera, size=size)))
         return {"eye": tuple(c.eye), "target": tuple(c.target), "up": tuple(c.up),
                 "fov": c.fov_y, "width": c.width, "height": c.height}
 
+    def _physical(self, world):
+        """The physical camera of a world camera."""
+        c = S.Camera()
+        lib.ip_camera_to_physical(ctypes.byref(self._orientation), ctypes.byref(world),
+                                  ctypes.byref(c))
+        return c
+
     def _camera(self, a):
+        """The world camera (what the engine takes) of a's camera or view, both physical."""
         self._open_store()
         if a.camera is not None:
-            return _camera_from(a.camera, a.size)
+            c = _camera_from(a.camera, a.size)
+            lib.ip_camera_to_world(ctypes.byref(self._orientation), ctypes.byref(c),
+                                   ctypes.byref(c))
+            return c
         c, err = S.Camera(), new_error()
         lo, hi = ((ctypes.c_double * 3)(*b) for b in self.world_box)
-        check(lib.ip_camera_fit_axis(lo, hi, a.view.encode(), VIEW_FOV, a.size[0], a.size[1],
-                                     ctypes.byref(c), ctypes.byref(err)), err)
+        view = a.view.encode() if a.view is not None else None
+        st = lib.ip_camera_fit_view(ctypes.byref(self._orientation), lo, hi, view, VIEW_FOV,
+                                    a.size[0], a.size[1], ctypes.byref(c), ctypes.byref(err))
+        if st != 0:  # an anatomical view in a file without a space: an argument of the call
+            raise ArgumentError("view: %s: %s" % (self.path,
+                                                  err.message.decode("utf-8", "replace")))
         return c
 
     # -- extraction -----------------------------------------------------------------------
-    def extract(self, iso, *, stored=False, view="-y", camera=None, size=DEFAULT_SIZE,
+    def extract(self, iso, *, stored=False, view=None, camera=None, size=DEFAULT_SIZE,
                 rays=None, full=False, time_limit=None, threads=0, cutoff=None, foldback=None,
                 lod=True, pixel_error=1.0, occlusion=True, prefetch=True, cull=False,
                 cache_mb=None, on_step=None, space="physical"):
@@ -321,8 +342,11 @@ class File:
         --iso-stored). The stats give both ("iso", "iso_stored") with a rescale.
 
         Progressive (the default), as isorender: rays in the paper's order for the image of
-        `size` (width, height) pixels seen from `view` (+x -x +y -y +z -z: the side the eye is
-        on) or `camera` (a dict eye/target/up/fov or isorender's --camera text), until every
+        `size` (width, height) pixels seen from `view` (the side the eye is on, in the file's
+        physical space: anterior posterior left right superior inferior in a file with an
+        anatomical space, +x -x +y -y +z -z along its physical axes; None: anterior, or -y in a
+        file without a space) or `camera` (a dict eye/target/up/fov or isorender's --camera
+        text, in physical units), until every
         pixel has had its ray, `rays` rays or `time_limit` seconds. full=True triangulates
         every active cell instead (isorender --full; the view does not matter); full="lod"
         every active cell at the view's adaptive resolution, each level's cells within its
@@ -375,7 +399,7 @@ class File:
                 self._end(run)
 
     def extract_steps(self, iso, *, stored=False, rays_per_step=None, rays=None,
-                      time_limit=None, view="-y", camera=None, size=DEFAULT_SIZE, threads=0,
+                      time_limit=None, view=None, camera=None, size=DEFAULT_SIZE, threads=0,
                       cutoff=None, foldback=None, lod=True, pixel_error=1.0, occlusion=True,
                       prefetch=True, cull=False, cache_mb=None, space="physical"):
         """Progressive extraction as a generator: yields a Step (the step's new triangles, its

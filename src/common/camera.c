@@ -132,41 +132,146 @@ void ip_camera_depth_range(const ip_camera *c, const double lo[3], const double 
     *near_plane = fmax(zmin * 0.99, *far_plane * 1e-5);
 }
 
-ip_status ip_camera_fit_axis(const double lo[3], const double hi[3], const char *axis, double fov_y,
-                             uint32_t width, uint32_t height, ip_camera *out, ip_error *err)
+/* The camera whose eye lies on the `back` side (a unit world vector) of the box [lo, hi],
+ * looking at its centre with `up` (unit, perpendicular to back), as near as it can be with
+ * all 8 corners inside the frame. With unit axes for back and up every product below is exact,
+ * so that the axis views come out as they always did, to the bit. */
+static ip_status fit_direction(const double lo[3], const double hi[3], const double back[3],
+                               const double up[3], double fov_y, uint32_t width, uint32_t height,
+                               ip_camera *out, ip_error *err)
 {
-    if (!axis || strlen(axis) != 2 || (axis[0] != '+' && axis[0] != '-') || axis[1] < 'x' ||
-        axis[1] > 'z')
-        return ip__fail(err, IP_ERR_ARGUMENT, "view '%s' is not one of +x -x +y -y +z -z",
-                        axis ? axis : "");
-    int a = axis[1] - 'x';
-    double sign = axis[0] == '+' ? 1.0 : -1.0, centre[3];
+    double centre[3], across[3], upward[3];
     for (int i = 0; i < 3; i++)
         centre[i] = 0.5 * (lo[i] + hi[i]);
     memset(out, 0, sizeof *out);
     out->fov_y = fov_y;
     out->width = width;
     out->height = height;
-    out->up[a == 2 ? 1 : 2] = 1.0;
-    /* the image's horizontal axis is the remaining one, the vertical one is up */
-    int v = a == 2 ? 1 : 2, u = 3 - a - v;
+    memcpy(out->up, up, sizeof out->up);
+    /* the image's horizontal axis, and its vertical one */
+    ip__vec3_cross(up, back, across);
+    ip__vec3_normalize(across);
+    ip__vec3_cross(back, across, upward);
     double tan_y = tan(fov_y * DEG / 2), tan_x = tan_y * (double)width / (double)height;
     /* the nearest eye distance from the centre at which all 8 corners project inside the
      * frame: a corner offset (du, dv) across and dw towards the eye needs
      * distance >= dw + |du| / tan_x and >= dw + |dv| / tan_y */
     double distance = 0;
     for (int k = 0; k < 8; k++) {
-        double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
-        double du = fabs(p[u] - centre[u]), dv = fabs(p[v] - centre[v]);
-        double dw = sign * (p[a] - centre[a]);
+        double p[3] = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]}, d[3];
+        ip__vec3_sub(p, centre, d);
+        double du = fabs(ip__vec3_dot(d, across)), dv = fabs(ip__vec3_dot(d, upward));
+        double dw = ip__vec3_dot(d, back);
         distance = fmax(distance, dw + du / tan_x);
         distance = fmax(distance, dw + dv / tan_y);
     }
     distance *= 1.04; /* a small margin around the volume */
     memcpy(out->target, centre, sizeof centre);
-    memcpy(out->eye, centre, sizeof centre);
-    out->eye[a] += sign * distance;
+    for (int i = 0; i < 3; i++)
+        out->eye[i] = centre[i] + back[i] * distance;
     return ip_camera_check(out, err);
+}
+
+/* The physical eye side and up of an axis name ("+x" .. "-z"): 1, or 0 when it is not one. */
+static int axis_view(const char *axis, double back[3], double up[3])
+{
+    if (!axis || strlen(axis) != 2 || (axis[0] != '+' && axis[0] != '-') || axis[1] < 'x' ||
+        axis[1] > 'z')
+        return 0;
+    int a = axis[1] - 'x';
+    for (int i = 0; i < 3; i++)
+        back[i] = up[i] = 0.0;
+    back[a] = axis[0] == '+' ? 1.0 : -1.0;
+    up[a == 2 ? 1 : 2] = 1.0;
+    return 1;
+}
+
+ip_status ip_camera_fit_axis(const double lo[3], const double hi[3], const char *axis, double fov_y,
+                             uint32_t width, uint32_t height, ip_camera *out, ip_error *err)
+{
+    double back[3], up[3];
+    if (!axis_view(axis, back, up))
+        return ip__fail(err, IP_ERR_ARGUMENT, "view '%s' is not one of +x -x +y -y +z -z",
+                        axis ? axis : "");
+    return fit_direction(lo, hi, back, up, fov_y, width, height, out, err);
+}
+
+/* The anatomical views: the side the eye is on and the view's up. */
+static const char *const anatomical_views[6][2] = {
+    {"anterior", "superior"}, {"posterior", "superior"}, {"left", "superior"},
+    {"right", "superior"},    {"superior", "anterior"},  {"inferior", "anterior"}};
+
+static int anatomical_index(const char *view)
+{
+    for (int i = 0; view && i < 6; i++)
+        if (!strcmp(view, anatomical_views[i][0]))
+            return i;
+    return -1;
+}
+
+#define VIEW_NAMES "+x -x +y -y +z -z anterior posterior left right superior inferior"
+
+ip_status ip_view_check(const char *view, ip_error *err)
+{
+    double back[3], up[3];
+    if (axis_view(view, back, up) || anatomical_index(view) >= 0)
+        return IP_OK;
+    return ip__fail(err, IP_ERR_ARGUMENT, "view '%s' is not one of " VIEW_NAMES, view ? view : "");
+}
+
+const char *ip_view_default(const ip_orientation *o)
+{
+    return o->space != IP_SPACE_UNKNOWN ? "anterior" : "-y";
+}
+
+ip_status ip_camera_fit_view(const ip_orientation *o, const double lo[3], const double hi[3],
+                             const char *view, double fov_y, uint32_t width, uint32_t height,
+                             ip_camera *out, ip_error *err)
+{
+    double back[3], up[3];
+    if (!view)
+        view = ip_view_default(o);
+    int named = anatomical_index(view);
+    if (named >= 0) {
+        if (!ip_space_direction(o->space, anatomical_views[named][0], back) ||
+            !ip_space_direction(o->space, anatomical_views[named][1], up))
+            return ip__fail(err, IP_ERR_ARGUMENT,
+                            "view '%s' needs a file with an anatomical space (RAS, LAS or LPS); "
+                            "this one names none: use +x -x +y -y +z -z, its physical axes",
+                            view);
+    } else if (!axis_view(view, back, up)) {
+        return ip_view_check(view, err);
+    }
+    /* into world space; D is orthonormal, so they stay unit vectors and perpendicular */
+    ip_orientation_unrotate(o, back, back);
+    ip_orientation_unrotate(o, up, up);
+    return fit_direction(lo, hi, back, up, fov_y, width, height, out, err);
+}
+
+void ip_camera_to_world(const ip_orientation *o, const ip_camera *physical, ip_camera *world)
+{
+    ip_camera c = *physical;
+    if (ip_orientation_is_identity(o)) { /* as it is, zeros' signs too */
+        *world = c;
+        return;
+    }
+    ip_orientation_to_world(o, physical->eye, c.eye);
+    ip_orientation_to_world(o, physical->target, c.target);
+    ip_orientation_unrotate(o, physical->up, c.up);
+    *world = c;
+}
+
+void ip_camera_to_physical(const ip_orientation *o, const ip_camera *world, ip_camera *physical)
+{
+    ip_camera c = *world;
+    if (ip_orientation_is_identity(o)) {
+        *physical = c;
+        return;
+    }
+    ip_orientation_apply(o, world->eye, c.eye);
+    ip_orientation_apply(o, world->target, c.target);
+    ip_orientation_rotate(o, world->up, c.up);
+    *physical = c;
 }
 
 ip_status ip_camera_parse(const char *text, ip_camera *c, ip_error *err)

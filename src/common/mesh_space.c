@@ -1,6 +1,21 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* A mesh moved from world coordinates into its volume's physical space. */
+#include <string.h>
+
 #include "isoprop/mesh.h"
+
+/* Swaps a triangle's second and third vertices (positions and normals): its winding reversed. */
+static void reverse_winding(float *p, int16_t *n)
+{
+    float pt[3];
+    int16_t nt[3];
+    memcpy(pt, p + 3, sizeof pt);
+    memcpy(p + 3, p + 6, sizeof pt);
+    memcpy(p + 6, pt, sizeof pt);
+    memcpy(nt, n + 3, sizeof nt);
+    memcpy(n + 3, n + 6, sizeof nt);
+    memcpy(n + 6, nt, sizeof nt);
+}
 
 void ip_mesh_to_physical(ip_mesh *mesh, const ip_orientation *orientation)
 {
@@ -17,6 +32,10 @@ void ip_mesh_to_physical(ip_mesh *mesh, const ip_orientation *orientation)
             n[c] = ip_normal_pack((float)turned[c]);
         }
     }
+    /* a reflection turns counter-clockwise into clockwise: turn it back (mc.h, "Winding") */
+    if (ip_orientation_mirrors(orientation))
+        for (uint64_t t = 0; t < mesh->triangle_count; t++)
+            reverse_winding(mesh->positions + 9 * t, mesh->normals + 9 * t);
 }
 
 const char *ip_mesh_space_of(const ip_orientation *orientation)

@@ -74,6 +74,64 @@ void ip_orientation_apply(const ip_orientation *orientation, const double world[
         out[c] += orientation->origin[c];
 }
 
+void ip_orientation_unrotate(const ip_orientation *orientation, const double v[3], double out[3])
+{
+    double r[3];
+    for (int a = 0; a < 3; a++)
+        r[a] = dot3(orientation->directions[a], v);
+    memcpy(out, r, sizeof r);
+}
+
+void ip_orientation_to_world(const ip_orientation *orientation, const double physical[3],
+                             double out[3])
+{
+    double d[3];
+    for (int c = 0; c < 3; c++)
+        d[c] = physical[c] - orientation->origin[c];
+    ip_orientation_unrotate(orientation, d, out);
+}
+
+int ip_orientation_mirrors(const ip_orientation *orientation)
+{
+    const double(*d)[3] = orientation->directions;
+    double det = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1]) -
+                 d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0]) +
+                 d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
+    return det < 0;
+}
+
+void ip_orientation_plane_to_world(const ip_orientation *orientation, const double normal[3],
+                                   double offset, double out_normal[3], double *out_offset)
+{
+    double shifted = offset + dot3(normal, orientation->origin);
+    if (ip_orientation_is_identity(orientation))
+        shifted = offset; /* as it is, a zero's sign too */
+    ip_orientation_unrotate(orientation, normal, out_normal);
+    *out_offset = shifted;
+}
+
+int ip_space_direction(ip_space space, const char *name, double out[3])
+{
+    /* the + end of each axis of each space, as -1 (left, posterior, inferior) or +1 */
+    static const char *const names[6] = {"right",     "left",     "anterior",
+                                         "posterior", "superior", "inferior"};
+    double sign_x = space == IP_SPACE_RAS ? 1.0 : -1.0; /* +x is right only in RAS */
+    double sign_y = space == IP_SPACE_LPS ? -1.0 : 1.0; /* +y is posterior only in LPS */
+    if (!name || (space != IP_SPACE_RAS && space != IP_SPACE_LAS && space != IP_SPACE_LPS))
+        return 0;
+    for (int i = 0; i < 6; i++) {
+        if (strcmp(name, names[i]) != 0)
+            continue;
+        double v[3] = {0, 0, 0};
+        int axis = i / 2;
+        double sign = i % 2 ? -1.0 : 1.0; /* right, anterior, superior first */
+        v[axis] = sign * (axis == 0 ? sign_x : axis == 1 ? sign_y : 1.0);
+        memcpy(out, v, sizeof v);
+        return 1;
+    }
+    return 0;
+}
+
 const char *ip_space_name(ip_space space)
 {
     switch (space) {

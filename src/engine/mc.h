@@ -44,12 +44,27 @@
  * The tables were generated once from these rules by tests/test_mc.c, which regenerates them on
  * every test run and compares (run "test_mc --emit-table" to print src/engine/mc_table.c).
  *
+ * Frames. The fan's first vertex, and so which diagonal splits a quadrilateral, depends on how
+ * the corners are numbered, so one object stored in another order (an axis reversed, two axes
+ * swapped) would be split otherwise. The engine triangulates every cell in the volume's
+ * canonical frame instead: LPS where the file names an anatomical space, its physical frame
+ * otherwise (origin + D * world: isoprop/orientation.h). ip__mc_frame_of() finds the cube
+ * symmetry between a cell's world corners and its canonical ones (each world axis matched
+ * with the canonical axis it runs along most), and ip__mc_frame_rows() turns the triangle
+ * table by it: the triangles of world case c are those of the case the cell has in the
+ * canonical frame, on the world edges they lie on, wound counter-clockwise from outside in
+ * world space too. The crossed edges and the triangle counts of a case are those of the table
+ * (a symmetry keeps the faces' ambiguity rule and each outline's size). Where the frame is the
+ * world's own (no orientation, or the unit axes in LPS), the rows are the table's.
+ *
  * Thread safety: everything here is a pure function of its arguments or a constant table.
  */
 #ifndef ISOPROP_MC_H
 #define ISOPROP_MC_H
 
 #include <stdint.h>
+
+#include "isoprop/orientation.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -70,6 +85,21 @@ extern const uint8_t ip__mc_triangle_count[256];
 /* For each case, its triangles as edge-index triples, 3 * ip__mc_triangle_count[case] entries,
  * followed by -1 up to the end of the row. */
 extern const int8_t ip__mc_triangle_table[256][16];
+
+/* The cube symmetry between a cell's world corners and its canonical ones: world axis a runs
+ * along canonical axis axis[a], the other way where flip[a]. */
+typedef struct ip_mc_frame {
+    uint8_t axis[3];
+    uint8_t flip[3];
+} ip_mc_frame;
+
+/* The frame of a volume whose physical space is `orientation` (see Frames above). Returns 1
+ * when it is the identity (the table's rows serve as they are), else 0. */
+int ip__mc_frame_of(const ip_orientation *orientation, ip_mc_frame *frame);
+
+/* The triangle table turned by `frame` (see Frames above): rows[c] lists the world edges of
+ * case c's triangles, 3 * ip__mc_triangle_count[c] entries, then -1. */
+void ip__mc_frame_rows(const ip_mc_frame *frame, int8_t rows[256][16]);
 
 /* One output vertex of the triangulation, in world units. */
 typedef struct ip_mc_vertex {

@@ -63,7 +63,7 @@ int ip__extract_cell(ip_sampler *s, const ip_cell_output *out, const uint32_t ce
     float lo[3], hi[3], points[12][3], normals[12][3];
     ip__sampler_cell_box(s, cell, lo, hi);
     ip__mc_cell_edge_points(values, *mc_case, iso, lo, hi, points);
-    const int8_t *row = ip__mc_triangle_table[*mc_case];
+    const int8_t *row = s->mc_rows[*mc_case];
     int n = ip__mc_triangle_count[*mc_case];
     float pos[9 * IP_MC_MAX_TRIANGLES];
     int16_t nor[9 * IP_MC_MAX_TRIANGLES];

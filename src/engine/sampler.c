@@ -15,6 +15,15 @@ ip_status ip__sampler_init(ip_sampler *s, ip_cache *cache, uint32_t level)
     s->layout = ip_store_layout(ip_cache_store(cache));
     s->level = level;
     s->edge_shift = ip__ceil_log2(s->layout->brick_edge); /* a power of two */
+    s->mc_rows = ip__mc_triangle_table;
+    ip_mc_frame frame;
+    if (!ip__mc_frame_of(&s->layout->orientation, &frame)) {
+        s->own_rows = malloc(256 * sizeof *s->own_rows);
+        if (!s->own_rows)
+            return IP_ERR_NOMEM;
+        ip__mc_frame_rows(&frame, s->own_rows);
+        s->mc_rows = (const int8_t(*)[16])s->own_rows;
+    }
     for (int a = 0; a < 3; a++) {
         uint32_t n = s->dims[a] = s->layout->levels[level].dims[a];
         s->world[a] = malloc(n * sizeof(double));
@@ -53,6 +62,9 @@ void ip__sampler_free(ip_sampler *s)
         s->world[a] = NULL;
         s->inverse_span[a] = NULL;
     }
+    free(s->own_rows);
+    s->own_rows = NULL;
+    s->mc_rows = ip__mc_triangle_table;
 }
 
 /* The brick at `brick` (brick coordinates), pinned in a slot; with `resident_only`, NULL

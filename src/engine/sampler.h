@@ -31,6 +31,10 @@ typedef struct ip_sampler {
     unsigned edge_shift; /* log2 of the brick edge: brick coordinates without a divide */
     ip_status status;    /* the first failure, IP_OK until then */
     ip_error error;
+    /* the triangle table in the volume's canonical frame (mc.h, "Frames"): the table's own
+     * rows, or own_rows (allocated) where the frame turns them */
+    const int8_t (*mc_rows)[16];
+    int8_t (*own_rows)[16];
 } ip_sampler;
 
 /* Prepares a sampler over `level` of the cache's store. @return IP_OK or IP_ERR_NOMEM. */

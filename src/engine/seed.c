@@ -196,7 +196,7 @@ static IP_ALWAYS_INLINE int classify_cell(const ip_seeder *s, const index_ray *r
         p[e][0] = ip__vec3_dot(d, u) / depth;
         p[e][1] = ip__vec3_dot(d, w) / depth;
     }
-    const int8_t *row = ip__mc_triangle_table[mc];
+    const int8_t *row = s->sampler->mc_rows[mc];
     int n = ip__mc_triangle_count[mc], best = 0;
     for (int t = 0; t < n && best < 3; t++) {
         const int8_t *tri = row + 3 * t;

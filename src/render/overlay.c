@@ -298,6 +298,8 @@ void ip_overlay_axis_directions(const ip_camera *camera, const ip_orientation *o
 {
     ip_camera_basis basis;
     ip_camera_basis_of(camera, &basis);
+    /* where D mirrors, the image shown is the world camera's mirrored (camera.h) */
+    double across = ip_orientation_mirrors(orientation) ? -1.0 : 1.0;
     for (int a = 0; a < 3; a++) {
         double w[3]; /* physical axis a in world coordinates: row a of D (D is orthonormal) */
         for (int k = 0; k < 3; k++)
@@ -308,7 +310,7 @@ void ip_overlay_axis_directions(const ip_camera *camera, const ip_orientation *o
             up += w[k] * basis.up[k];
             forward += w[k] * basis.forward[k];
         }
-        screen[a][0] = right;
+        screen[a][0] = across * right;
         screen[a][1] = -up;
         screen[a][2] = -forward;
     }

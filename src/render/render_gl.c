@@ -37,6 +37,7 @@ struct ip_renderer {
     GLuint stream_positions,
         stream_normals; /* and buffers of STREAM_TRIANGLES, made on first use */
     ip_shading shading;
+    int mirror;       /* ip_renderer_set_mirror(): the image's columns reversed */
     char driver[128]; /* GL_RENDERER, read once */
 };
 
@@ -531,6 +532,8 @@ static void use_mesh_program(const ip_renderer *r, const ip_camera *camera, doub
     float view[16], projection[16];
     ip_camera_view_matrix(camera, view);
     ip_camera_projection_matrix(camera, near_plane, far_plane, projection);
+    if (r->mirror) /* x in clip space the other way: the mirror image (faces are not culled) */
+        projection[0] = -projection[0];
     float eye[3] = {(float)camera->eye[0], (float)camera->eye[1], (float)camera->eye[2]};
     float terms[4] = {s->ambient, s->diffuse, s->specular, s->shininess};
     glEnable(GL_DEPTH_TEST);
@@ -735,6 +738,11 @@ ip_status ip_renderer_set_shading(ip_renderer *r, const ip_shading *shading, ip_
     if (st == IP_OK)
         r->shading = taken;
     return st;
+}
+
+void ip_renderer_set_mirror(ip_renderer *r, int mirror)
+{
+    r->mirror = mirror != 0;
 }
 
 ip_status ip_renderer_set_samples(ip_renderer *r, uint32_t samples, ip_error *err)

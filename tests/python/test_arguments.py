@@ -61,7 +61,7 @@ EXTRACT = [
     (dict(iso=NAN, full="lod"), R, "iso"),
     (dict(view="+w"), R, "view"),
     (dict(view="x"), R, "view"),
-    (dict(view=None), V, "view"),
+    (dict(view="anterior"), R, "view"),  # the phantom names no anatomical space
     (dict(view=3), V, "view"),
     (dict(camera=5), V, "camera"),
     (dict(camera=["1,2"]), V, "camera"),

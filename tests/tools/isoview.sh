@@ -34,7 +34,7 @@ expect_error 1 "cannot open a window" env -u DISPLAY -u WAYLAND_DISPLAY "$bin/is
 # --clip as isorender takes it, and the script's clip on|off
 expect_error 2 "bad --clip 'w=3'" "$bin/isoview" s.ibv --iso 1 --clip w=3
 expect_error 2 "bad --clip '0,0,0,1'" "$bin/isoview" s.ibv --iso 1 --clip 0,0,0,1
-expect_error 2 "at most 6 --clip planes" "$bin/isoview" s.ibv --iso 1 --clip x=1 --clip x=2 \
+expect_error 2 "at most 6 --clip and --clip-index planes" "$bin/isoview" s.ibv --iso 1 --clip x=1 --clip x=2 \
     --clip x=3 --clip x=4 --clip x=5 --clip x=6 --clip x=7
 printf 'clip maybe\n' >badclip.txt
 expect_error 1 "badclip.txt:1: bad arguments to 'clip'" "$bin/isoview" s.ibv --iso 1 --clip x=1 \

@@ -136,12 +136,24 @@ encoding: raw
 data file: shepp-logan_40x40x40_uint8.raw
 NHDR
 "$bin/isobrick" turned.nhdr -o t.ibv --brick-size 8 --quiet
-run_capture "$bin/isorender" t.ibv --iso 60 --size 320x240 --full --quiet --software --view -y \
+run_capture "$bin/isorender" t.ibv --iso 60 --size 320x240 --full --quiet --software --view left \
     --axes --scale-bar -v -o t.png
-# from -y: physical x (L) is world -y, toward the eye; physical y (P) is world +x, right
-check "LPS: L toward the eye, P right, S up ($err)" \
+# the views are in physical space: from the left (physical +x, L), L is toward the eye, P
+# right, S up, whichever way the samples are stored
+check "LPS, from the left: L toward the eye, P right, S up ($err)" \
     test "$(direction "$err" L)" != "" -a "$(direction "$err" P)" = "+1.0000 +0.0000" \
     -a "$(direction "$err" S)" = "+0.0000 -1.0000"
 check "LPS: L along the view" sh -c 'printf "%s" "$0" | grep -qF " L +0.0000,+0.0000,+1.0000"' "$err"
 check "LPS: the unit is mm" sh -c 'printf "%s" "$0" | grep -q "scale bar: [0-9.]* mm = "' "$err"
+# --view -y: the eye on the physical -y side (anterior, in LPS): L right, P away, S up; the
+# same as --view anterior, the default in a file with a space
+run_capture "$bin/isorender" t.ibv --iso 60 --size 320x240 --full --quiet --software --view -y \
+    --axes -v -o ty.png
+check "LPS, from -y: L right, S up ($err)" \
+    test "$(direction "$err" L)" = "+1.0000 +0.0000" -a "$(direction "$err" S)" = "+0.0000 -1.0000"
+check "LPS, from -y: P away from the eye" \
+    sh -c 'printf "%s" "$0" | grep -qF " P +0.0000,+0.0000,-1.0000"' "$err"
+run_capture "$bin/isorender" t.ibv --iso 60 --size 320x240 --full --quiet --software --axes \
+    -o tdefault.png
+check "LPS: the default view is anterior, -y" cmp -s ty.png tdefault.png
 finish

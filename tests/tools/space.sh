@@ -4,8 +4,10 @@
 # lengths), and a header that names nothing bricks to the identity. The same turn written as
 # a NIfTI sform (pixdim left at 1: the sform's column lengths are the spacing) and as a
 # MetaImage TransformMatrix and Offset, and a NIfTI qform (a half turn about z, qfac -1),
-# give the origin, directions and space isoinfo shows and the mesh's physical vertices.
+# give the origin, directions and space isoinfo shows and the mesh's physical vertices. The
+# views are the physical space's: the turned file's front is the plain file's side.
 . "$(dirname "$0")/lib.sh"
+match="python3 $(dirname "$0")/mesh_match.py"
 
 "$bin/isogen" sphere --dims 24x20x16 -o "$work/" --quiet
 raw=$(ls sphere_24x20x16_*.raw)
@@ -54,21 +56,17 @@ for name in turned plain; do
     "$bin/tests/ply_triangles" "$name.ply" >"$name.txt"
 done
 check "a surface was extracted" test -s plain.txt
-check "the same image either way" cmp -s turned.png plain.png
-check "turned vertices = (10 - y, -20 + x, 30.5 + z) of the plain ones" python3 -c '
-import sys
-a = [l.split() for l in open("plain.txt")]
-b = [l.split() for l in open("turned.txt")]
-assert len(a) == len(b) > 0, (len(a), len(b))
-worst = 0.0
-for ta, tb in zip(a, b):
-    for i in range(0, 9, 3):
-        x, y, z = (float.fromhex(v) for v in ta[i:i + 3])
-        want = (10 - y, -20 + x, 30.5 + z)
-        got = [float.fromhex(v) for v in tb[i:i + 3]]
-        worst = max(worst, max(abs(g - w) for g, w in zip(got, want)))
-assert worst < 1e-4, worst
-'
+# the same samples, turned in physical space: the same surface, each cell triangulated in the
+# physical frame (the turned file's quadrilaterals split the other way where the turn says)
+check "turned vertices = (10 - y, -20 + x, 30.5 + z) of the plain ones" \
+    $match plain.txt turned.txt "(10 - y, -20 + x, 30.5 + z)" --vertices
+check "as many triangles either way" test "$(wc -l <plain.txt)" = "$(wc -l <turned.txt)"
+# the turned file's default view, anterior (LPS: physical -y, world -x), sees what the plain
+# file's -x view sees, shaded across those quadrilaterals otherwise in places
+"$bin/isorender" plain.ibv --iso 128 --full --threads 1 --size 64x48 --view -x -o side.png \
+    --quiet
+check "the turned file's front is the plain file's side" \
+    "$bin/tests/png_compare" turned.png side.png --level 12 --max-pct 0.5
 
 # the file names its space: the file's (LPS), "volume" for one that names none, "grid" for
 # --mesh-grid, whose vertices are the plain ones (index x spacing from 0) whatever the space
@@ -79,7 +77,9 @@ run_capture "$bin/isorender" turned.ibv --iso 128 --full --threads 1 --size 64x4
 check "isorender --mesh-grid ($err)" test "$rc" = 0
 check "the grid mesh says so" grep -aq '^comment space grid$' grid.ply
 "$bin/tests/ply_triangles" grid.ply >grid.txt
-check "--mesh-grid: the plain file's vertices" cmp -s grid.txt plain.txt
+# (the same vertices: the turned file's cells are split along its physical frame's diagonals)
+check "--mesh-grid: the plain file's vertices" $match plain.txt grid.txt --vertices
+check "--mesh-grid: as many triangles" test "$(wc -l <grid.txt)" = "$(wc -l <plain.txt)"
 for ext in obj stl glb; do
     "$bin/isorender" turned.ibv --iso 128 --full --threads 1 --size 64x48 -o m.png -f \
         --mesh "turned.$ext" --quiet
@@ -154,22 +154,7 @@ check "isoinfo: the NIfTI origin line" grep -qF "origin        10, -20, 30.5 (RA
 check "isoinfo: the NIfTI directions line" \
     grep -qF "directions    x (0, 1, 0), y (-1, 0, 0), z (0, 0, 1)" "$work/.out"
 # moved: compares the vertices of plain.txt moved by the expression with those of the file
-moved() {
-    python3 - "$1" "$2" <<'PY'
-import sys
-a = [l.split() for l in open("plain.txt")]
-b = [l.split() for l in open(sys.argv[1])]
-assert len(a) == len(b) > 0, (len(a), len(b))
-worst = 0.0
-for ta, tb in zip(a, b):
-    for i in range(0, 9, 3):
-        x, y, z = (float.fromhex(v) for v in ta[i:i + 3])
-        want = eval(sys.argv[2])
-        got = [float.fromhex(v) for v in tb[i:i + 3]]
-        worst = max(worst, max(abs(g - w) for g, w in zip(got, want)))
-assert worst < 1e-4, worst
-PY
-}
+moved() { $match plain.txt "$1" "$2" --vertices; }
 check "NIfTI sform vertices = (10 - y, -20 + x, 30.5 + z)" moved sform.txt '(10 - y, -20 + x, 30.5 + z)'
 check "NIfTI qform vertices = (1 - x, 2 - y, 3 - z)" moved qform.txt '(1 - x, 2 - y, 3 - z)'
 check "MetaImage vertices = (10 - y, -20 + x, 30.5 + z)" moved mhd.txt '(10 - y, -20 + x, 30.5 + z)'

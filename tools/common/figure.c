@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* Figure options: the orbit (--azimuth, --elevation, --zoom), the camera, colours. */
+/* Figure options: the orbit (--azimuth, --elevation, --zoom), colours. */
 #include <ctype.h>
 #include <math.h>
 #include <string.h>
@@ -13,11 +13,11 @@ void tool_orbit_options_default(tool_orbit_options *o)
     o->zoom = 1.0;
 }
 
-void tool_apply_orbit(const tool_orbit_options *o, ip_camera *camera)
+void tool_apply_orbit(const tool_orbit_options *o, const tool_space *space, ip_camera *camera)
 {
     /* ip_camera_orbit() turns the scene: a positive turn to the right moves the eye left */
     if (o->azimuth != 0.0 || o->elevation != 0.0)
-        ip_camera_orbit(camera, -o->azimuth, o->elevation);
+        tool_space_orbit(space, camera, -o->azimuth, o->elevation);
     if (o->zoom != 1.0) {
         double half = camera->fov_y * M_PI / 360.0;
         camera->fov_y = atan(tan(half) / o->zoom) * 360.0 / M_PI;
@@ -31,20 +31,6 @@ static int hex_digit(char c)
         return c - '0';
     c = (char)tolower((unsigned char)c);
     return c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
-}
-
-int tool_camera_of(const char *camera_text, const char *axis, uint32_t width, uint32_t height,
-                   const double lo[3], const double hi[3], ip_camera *camera, ip_error *err)
-{
-    ip_camera c = {.width = width, .height = height};
-    if (camera_text) {
-        if (ip_camera_parse(camera_text, &c, err) != IP_OK || ip_camera_check(&c, err) != IP_OK)
-            return -1;
-    } else if (ip_camera_fit_axis(lo, hi, axis, 30.0, width, height, &c, err) != IP_OK) {
-        return -1;
-    }
-    *camera = c;
-    return 0;
 }
 
 int tool_parse_colour(const char *text, float rgb[3])

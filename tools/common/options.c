@@ -11,7 +11,6 @@
 void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t height)
 {
     memset(o, 0, sizeof *o);
-    o->view = "-y";
     o->width = width;
     o->height = height;
     o->cutoff = IP_DEFAULT_CUTOFF_DEGREES;
@@ -241,29 +240,44 @@ int tool_option_cache_mb(const char *p, const tool_option *opt, const char *cons
     return 0;
 }
 
+/* A --clip (index 0) or --clip-index (1) plane as given; tool_space_clip() turns it into world
+ * units once the file is open. */
+static int add_clip(const char *p, const char *name, const char *value, tool_view_options *o,
+                    int index)
+{
+    if (o->clip_count == IP_MAX_CLIP_PLANES)
+        return tool_usage_error(p, "at most %d --clip and --clip-index planes", IP_MAX_CLIP_PLANES);
+    unsigned i = o->clip_count;
+    if (tool_parse_clip(value, &o->clip_given[i]) != 0)
+        return tool_usage_error(p, "bad %s '%s' (x=V, -x=V, y=V, ... or A,B,C,D)", name, value);
+    o->clip_index[i] = (uint8_t)index;
+    o->clip[i] = o->clip_physical[i] = o->clip_given[i];
+    o->clip_count++;
+    return 0;
+}
+
 static int parse_clip_option(const char *p, const tool_option *opt, const char *const *v,
                              void *base)
 {
-    (void)opt;
-    tool_view_options *o = base;
-    if (o->clip_count == IP_MAX_CLIP_PLANES)
-        return tool_usage_error(p, "at most %d --clip planes", IP_MAX_CLIP_PLANES);
-    if (tool_parse_clip(v[0], &o->clip[o->clip_count]) != 0)
-        return tool_usage_error(p, "bad --clip '%s' (x=V, -x=V, y=V, ... or A,B,C,D)", v[0]);
-    o->clip_count++;
-    return 0;
+    return add_clip(p, opt->name, v[0], base, 0);
+}
+
+static int parse_clip_index(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    return add_clip(p, opt->name, v[0], base, 1);
 }
 
 /* --view and --camera are checked as they are parsed, so that a bad one is a usage error
  * (exit 2) before any file is opened; the library's own check says what is wrong. */
 static int parse_view(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
-    static const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-    ip_camera probe;
     ip_error err;
     (void)opt;
-    if (ip_camera_fit_axis(lo, hi, v[0], 30.0, 1, 1, &probe, &err) != IP_OK)
-        return tool_usage_error(p, "--view '%s' is not an axis (+x -x +y -y +z -z)", v[0]);
+    if (ip_view_check(v[0], &err) != IP_OK)
+        return tool_usage_error(p,
+                                "--view '%s' is not a view (anterior posterior left right "
+                                "superior inferior, or +x -x +y -y +z -z)",
+                                v[0]);
     ((tool_view_options *)base)->view = v[0];
     return 0;
 }
@@ -302,6 +316,7 @@ static const tool_option view_options[] = {
     {"--prefetch", NULL, 1, 0, parse_prefetch, NULL, NULL},
     {"--cull", NULL, 1, 0, parse_cull, NULL, NULL},
     {"--clip", NULL, 1, 0, parse_clip_option, NULL, NULL},
+    {"--clip-index", NULL, 1, 0, parse_clip_index, NULL, NULL},
     {"--cache-mb", NULL, 1, VIEW_FIELD(cache_bytes), tool_option_cache_mb, NULL, NULL},
     {"--stats", NULL, 1, VIEW_FIELD(stats), NULL, NULL, NULL},
     {"--force", "-f", 0, VIEW_FIELD(force), NULL, NULL, NULL},

@@ -182,12 +182,13 @@ int tool_write_stats_file(const char *program, const char *path, int force, cons
     return tool_write_text_file(program, path, force, fill_stats, &j);
 }
 
-/* "clip": [[A, B, C, D], ...]: each plane keeps A*x + B*y + C*z + D >= 0 (world units). */
+/* "clip": [[A, B, C, D], ...]: each plane keeps A*x + B*y + C*z + D >= 0 (the file's physical
+ * units, --clip-index planes turned there too). */
 static void write_clip_json(FILE *f, const tool_view_options *o)
 {
     fprintf(f, ", \"clip\": [");
     for (unsigned i = 0; i < o->clip_count; i++) {
-        const ip_clip_plane *c = &o->clip[i];
+        const ip_clip_plane *c = &o->clip_physical[i];
         fprintf(f, "%s[%.9g, %.9g, %.9g, %.9g]", i ? ", " : "", c->normal[0], c->normal[1],
                 c->normal[2], c->offset);
     }

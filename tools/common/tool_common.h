@@ -23,6 +23,7 @@
 #include "tool_progress.h"
 #include "tool_command_line.h"
 #include "tool_options.h"
+#include "tool_space.h"
 #include "tool_figure.h"
 #include "tool_report.h"
 

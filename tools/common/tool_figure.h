@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* Figure options: the orbit (--azimuth, --elevation, --zoom), the camera, colours. */
+/* Figure options: the orbit (--azimuth, --elevation, --zoom), colours. */
 #ifndef ISOPROP_TOOL_FIGURE_H
 #define ISOPROP_TOOL_FIGURE_H
 
@@ -9,6 +9,7 @@
 #include "isoprop/camera.h"
 #include "isoprop/status.h"
 #include "tool_options.h"
+#include "tool_space.h"
 
 /* --azimuth, --elevation and --zoom, applied after --view or --camera (tool_apply_orbit()). */
 typedef struct tool_orbit_options {
@@ -42,16 +43,10 @@ typedef struct tool_orbit_options {
 /* No turn, no zoom. */
 void tool_orbit_options_default(tool_orbit_options *o);
 
-/* Turns `camera` (valid: ip_camera_check()) by the azimuth, then the elevation, around its
- * target (ip_camera_orbit()), and narrows its field of view by the zoom: tan(fov / 2) is
- * divided by it. The camera stays valid. */
-void tool_apply_orbit(const tool_orbit_options *o, ip_camera *camera);
-
-/* A camera of width x height pixels: camera_text ("E,T,U,FOV", checked; --camera) or, when it
- * is NULL, the view along `axis` (--view) fitted to the world box [lo, hi] (30 degrees); before
- * any orbit. Returns 0, or -1 with err set and *camera untouched. */
-int tool_camera_of(const char *camera_text, const char *axis, uint32_t width, uint32_t height,
-                   const double lo[3], const double hi[3], ip_camera *camera, ip_error *err);
+/* Turns the world camera `camera` (valid: ip_camera_check()) by the azimuth, then the
+ * elevation, around its target as the image shown sees them (tool_space_orbit()), and narrows
+ * its field of view by the zoom: tan(fov / 2) is divided by it. The camera stays valid. */
+void tool_apply_orbit(const tool_orbit_options *o, const tool_space *space, ip_camera *camera);
 
 /* Parses a colour: "R,G,B" (numbers in [0, 1]) or "#rrggbb" (hexadecimal). Returns 0, or -1
  * on bad text. */

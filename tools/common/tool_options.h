@@ -56,18 +56,27 @@ typedef struct tool_view_options {
     double iso_stored, iso_value;
     const ip_rescale *rescale; /* the open store's; NULL before tool_settle_iso() */
     uint32_t width, height;    /* pixels */
-    const char *view, *camera; /* --view AXIS, --camera E,T,U,FOV (NULL: none) */
-    uint64_t rays;             /* 0: every pixel */
-    double time_limit;         /* seconds; 0: none */
-    double cutoff, foldback;   /* degrees */
-    unsigned threads;          /* 0: every core */
+    /* --view NAME (NULL: the file's default, ip_view_default()), --camera E,T,U,FOV in the
+     * file's physical space (NULL: none) */
+    const char *view, *camera;
+    uint64_t rays;           /* 0: every pixel */
+    double time_limit;       /* seconds; 0: none */
+    double cutoff, foldback; /* degrees */
+    unsigned threads;        /* 0: every core */
     int lod;
     double pixel_error;
     int occlusion; /* --occlusion on|off */
     int prefetch;  /* --prefetch on|off|always: IP_PREFETCH_ON, _OFF, _ALWAYS */
     int cull;      /* --cull on|off; -1 when not given, until the program settles its default */
-    unsigned clip_count;                    /* --clip SPEC, repeatable */
-    ip_clip_plane clip[IP_MAX_CLIP_PLANES]; /* world units (tool_parse_clip()) */
+    unsigned clip_count; /* --clip and --clip-index SPEC, repeatable, in the order given */
+    /* the planes as given: physical units (--clip) or sample indices (--clip-index, where
+     * clip_index[i] is 1), tool_parse_clip()'s; once the file is open, tool_space_clip() puts
+     * them in world units into clip, which the engine takes, and in physical units into
+     * clip_physical, which the statistics report */
+    ip_clip_plane clip_given[IP_MAX_CLIP_PLANES];
+    uint8_t clip_index[IP_MAX_CLIP_PLANES];
+    ip_clip_plane clip[IP_MAX_CLIP_PLANES];
+    ip_clip_plane clip_physical[IP_MAX_CLIP_PLANES];
     uint64_t cache_bytes;
     const char *stats; /* --stats OUT.json (NULL: none) */
     int force, quiet;
@@ -80,6 +89,17 @@ typedef struct tool_view_options {
     "  --iso V             the isovalue, in the file's units where it has a rescale (HU for a\n" \
     "                      DICOM CT; isoinfo shows the rescale), else a stored sample value\n"   \
     "  --iso-stored V      the isovalue as a stored sample value, instead of --iso\n"
+
+/* The --help lines of --view and --camera (isorender, isoview, isowall). */
+#define TOOL_VIEW_OPTIONS_HELP                                                                   \
+    "  --view NAME         the side the eye is on, whole volume in frame, in the file's\n"       \
+    "                      physical space: anterior, posterior, left, right, superior or\n"      \
+    "                      inferior where the file names an anatomical space (up superior, or\n" \
+    "                      anterior for superior and inferior; default anterior), or +x -x +y\n" \
+    "                      -y +z -z along its physical axes (up +z, or +y for the z views;\n"    \
+    "                      default -y where it names no space)\n"                                \
+    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in the file's physical space (mm\n"    \
+    "                      where it names an anatomical space) and degrees\n"
 
 /* The --help lines of the shared options that steer the engine (the usage texts of isorender
  * and isoview include them). */
@@ -95,13 +115,16 @@ typedef struct tool_view_options {
     "                      take every core; always: every one\n"                                   \
     "  --cull on|off       with --occlusion: keep no triangle the image shows at no pixel\n"       \
     "                      centre (default on, unless --mesh (isorender) or --aa)\n"               \
-    "  --clip SPEC         keep one side of a plane, world units (repeatable, up to 6):\n"         \
+    "  --clip SPEC         keep one side of a plane in the file's physical space (mm where it\n"   \
+    "                      names an anatomical space; repeatable, up to 6 with --clip-index):\n"   \
     "                      x=40 keeps x >= 40, -x=40 keeps x <= 40 (y, z alike),\n"                \
-    "                      A,B,C,D keeps A*x + B*y + C*z + D >= 0\n"
+    "                      A,B,C,D keeps A*x + B*y + C*z + D >= 0\n"                               \
+    "  --clip-index SPEC   the same in sample indices (i, j, k as x, y, z): z=40 keeps the\n"      \
+    "                      slices from index 40 on\n"
 
-/* The defaults: view -y, the paper's angles, lod on with a 1-pixel error, occlusion on, reading
- * ahead on, every core, the
- * default cache budget, an image of width x height. */
+/* The defaults: the file's default view (view NULL), the paper's angles, lod on with a 1-pixel
+ * error, occlusion on, reading ahead on, every core, the default cache budget, an image of
+ * width x height. */
 void tool_view_options_default(tool_view_options *o, uint32_t width, uint32_t height);
 
 /* --prefetch's name of a mode ("off", "on" or "always"; "unknown" for another value): a
@@ -118,7 +141,7 @@ void tool_engine_options(const tool_view_options *o, ip_engine_options *eo);
 
 /* The shared options of tool_view_options as a table over `o`: --iso, --size, --view, --camera,
  * --rays, --time, --cutoff, --foldback, --threads, --lod, --pixel-error, --occlusion, --prefetch,
- * --cull, --clip, --cache-mb, --stats, --force and --quiet (-q). */
+ * --cull, --clip, --clip-index, --cache-mb, --stats, --force and --quiet (-q). */
 tool_option_table tool_view_option_table(tool_view_options *o);
 
 /* The command line of isorender and isoview: the shared view options and the program's

@@ -48,10 +48,10 @@ void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_
 /* What isorender and isoview write about a run in --stats (members after "cache"). */
 typedef struct tool_run_json {
     const char *file;
-    double iso; /* in the file's units: options->iso_value, or isoview's current value */
-    int full;   /* TOOL_PROGRESSIVE, TOOL_FULL or TOOL_FULL_LOD */
-    const ip_camera *camera;
-    const char *renderer; /* "opengl", "software", "none" */
+    double iso;              /* in the file's units: options->iso_value, or isoview's value */
+    int full;                /* TOOL_PROGRESSIVE, TOOL_FULL or TOOL_FULL_LOD */
+    const ip_camera *camera; /* in the file's physical space (tool_space_physical()) */
+    const char *renderer;    /* "opengl", "software", "none" */
     const tool_view_options *options;
     int warm, done;
     const ip_engine_counts *counts;

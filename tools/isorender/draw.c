@@ -57,12 +57,19 @@ static ip_status draw_surfaces(const run *r, ip_renderer *gl, const uint64_t *pr
 ip_status draw_image(const run *r, ip_renderer *gl, const uint64_t *prefix, uint8_t *rgba,
                      ip_error *err)
 {
-    if (several_surfaces(r))
-        return draw_surfaces(r, gl, prefix, rgba, err);
-    ip_mesh view = *r->mesh; /* a view of the first triangles, not a copy */
-    if (prefix)
-        view.triangle_count = prefix[0];
-    return draw_mesh(r, gl, &view, rgba, err);
+    ip_status st;
+    if (several_surfaces(r)) {
+        st = draw_surfaces(r, gl, prefix, rgba, err);
+    } else {
+        ip_mesh view = *r->mesh; /* a view of the first triangles, not a copy */
+        if (prefix)
+            view.triangle_count = prefix[0];
+        st = draw_mesh(r, gl, &view, rgba, err);
+    }
+    /* the world camera's image, as the physical view shows it */
+    if (st == IP_OK)
+        tool_space_show(&r->space, rgba, r->camera.width, r->camera.height, r->camera.width);
+    return st;
 }
 
 /* ---- the figure overlays: --axes and --scale-bar ---- */

@@ -71,7 +71,8 @@ typedef struct run {
     ip_store *store;
     ip_cache *cache;
     ip_engine *engine;
-    ip_camera camera;
+    tool_space space;      /* the file's physical space: the views, the planes, the image */
+    ip_camera camera;      /* in world units, as the engine and the renderers take it */
     ip_camera view_camera; /* --view's or --camera's, before --azimuth, --elevation, --zoom */
     double lo[3], hi[3];
     ip_mesh full_mesh;
@@ -141,7 +142,7 @@ int extract_surfaces(run *r, ip_error *err);
 int figure_renderer(const run *r, uint32_t w, uint32_t h, ip_renderer **gl, ip_error *why,
                     ip_error *err);
 /* The image of the run's surfaces (prefix: as draw_surfaces()); one opaque surface is drawn
- * as it always was. */
+ * as it always was. The image is the physical view's (mirrored where the space mirrors). */
 ip_status draw_image(const run *r, ip_renderer *gl, const uint64_t *prefix, uint8_t *rgba,
                      ip_error *err);
 /* The scale bar's unit: --scale-unit, else mm in a named anatomical space (DICOM, NIfTI and

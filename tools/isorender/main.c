@@ -9,15 +9,18 @@
 
 #include "isorender.h"
 
+/* The view and the clipping planes, given in the file's physical space, in world units. */
 static int setup_camera(run *r, ip_error *err)
 {
-    const ip_layout *l = ip_store_layout(r->store);
-    ip_layout_world_box(l, r->lo, r->hi);
-    if (tool_camera_of(r->o.common.camera, r->o.common.view, r->o.common.width, r->o.common.height,
-                       r->lo, r->hi, &r->camera, err) != 0)
+    tool_space_of(r->store, &r->space);
+    memcpy(r->lo, r->space.lo, sizeof r->lo);
+    memcpy(r->hi, r->space.hi, sizeof r->hi);
+    tool_space_clip(&r->space, &r->o.common);
+    if (tool_space_camera(&r->space, r->o.common.camera, r->o.common.view, r->o.common.width,
+                          r->o.common.height, &r->camera, err) != 0)
         return -1;
     r->view_camera = r->camera;
-    tool_apply_orbit(&r->o.orbit, &r->camera);
+    tool_apply_orbit(&r->o.orbit, &r->space, &r->camera);
     return 0;
 }
 

@@ -12,10 +12,8 @@ static const char usage[] =
     "with OpenGL 3.3 core through EGL (no display needed). --iso given up to 4 times draws as\n"
     "many surfaces together, each extracted by its own progressive run with the same view\n"
     "and options (see --color and --opacity); --iso-stored alike.\n" TOOL_ISO_OPTIONS_HELP
-    "  --size WxH          image size in pixels (default 1600x1200)\n"
-    "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
-    "                      (default -y; up is +z, or +y for the z views)\n"
-    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n" TOOL_ORBIT_OPTIONS_HELP
+    "  --size WxH          image size in pixels (default 1600x1200)\n" TOOL_VIEW_OPTIONS_HELP
+        TOOL_ORBIT_OPTIONS_HELP
     "  --color C           the surface colour: R,G,B (each 0 to 1) or #rrggbb (default\n"
     "                      #ede3c9, an ivory); repeated, the colours of the surfaces in the\n"
     "                      order of --iso (those without one: #ede3c9, #8fb3d9, #e0a370,\n"

@@ -154,10 +154,12 @@ static void json_surfaces(FILE *f, const run *r)
 void json_counts(FILE *f, void *user)
 {
     const run *r = user;
+    ip_camera physical; /* the camera as the file's space states it */
+    tool_space_physical(&r->space, &r->camera, &physical);
     const tool_run_json j = {r->o.file,
                              r->o.common.iso_value,
                              r->o.full,
-                             &r->camera,
+                             &physical,
                              r->renderer_name ? r->renderer_name : "none",
                              &r->o.common,
                              r->o.warm,

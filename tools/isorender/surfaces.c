@@ -59,8 +59,11 @@ void share_view(const run *r, run *s)
         return;
     s->store = r->store;
     s->cache = r->cache;
+    s->space = r->space;
     s->camera = r->camera;
     s->view_camera = r->view_camera;
+    memcpy(s->o.common.clip, r->o.common.clip, sizeof s->o.common.clip);
+    memcpy(s->o.common.clip_physical, r->o.common.clip_physical, sizeof s->o.common.clip_physical);
     memcpy(s->lo, r->lo, sizeof s->lo);
     memcpy(s->hi, r->hi, sizeof s->hi);
 }

@@ -56,7 +56,7 @@ static void turntable_camera(const run *r, uint64_t f, ip_camera *camera)
     tool_orbit_options orbit = r->o.orbit;
     orbit.azimuth += 360.0 * (double)f / (double)r->o.turntable;
     *camera = r->view_camera;
-    tool_apply_orbit(&orbit, camera);
+    tool_apply_orbit(&orbit, &r->space, camera);
 }
 
 /* The mesh of frame f: a progressive run from scratch for its camera (with --rays and --time

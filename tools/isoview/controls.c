@@ -11,10 +11,10 @@
 #define ORBIT_DEGREES_PER_PIXEL 0.3
 #define WHEEL_ZOOM 1.1 /* per wheel notch */
 
-int camera_from(viewer *v, const char *camera_text, const char *axis, ip_camera *out, ip_error *err)
+int camera_from(viewer *v, const char *camera_text, const char *view, ip_camera *out, ip_error *err)
 {
-    return tool_camera_of(camera_text, axis, v->camera.width, v->camera.height, v->lo, v->hi, out,
-                          err);
+    return tool_space_camera(&v->space, camera_text, view, v->camera.width, v->camera.height, out,
+                             err);
 }
 
 void change_view(viewer *v)
@@ -192,13 +192,14 @@ static void on_cursor(GLFWwindow *window, double x, double y)
     if (dx == 0 && dy == 0)
         return;
     if (v->drag_button == GLFW_MOUSE_BUTTON_LEFT) {
-        ip_camera_orbit(&v->camera, dx * ORBIT_DEGREES_PER_PIXEL, dy * ORBIT_DEGREES_PER_PIXEL);
+        tool_space_orbit(&v->space, &v->camera, dx * ORBIT_DEGREES_PER_PIXEL,
+                         dy * ORBIT_DEGREES_PER_PIXEL);
     } else {
         int width, height;
         glfwGetWindowSize(window, &width, &height);
         /* the point at the target follows the cursor */
         double pixel = ip_camera_pixel_size(&v->camera, height > 0 ? height : 1);
-        ip_camera_pan(&v->camera, -dx * pixel, dy * pixel);
+        tool_space_pan(&v->space, &v->camera, -dx * pixel, dy * pixel);
     }
     change_view(v);
     v->last_motion = ip_now_seconds(); /* the coarse pass while it moves (main.c) */

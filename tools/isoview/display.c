@@ -72,7 +72,7 @@ int display_size(display *d, uint32_t width, uint32_t height, ip_error *err)
 }
 
 int display_show(display *d, const uint8_t *rgba, uint32_t width, uint32_t height,
-                 const uint32_t rows[2], ip_error *err)
+                 const uint32_t rows[2], int mirror, ip_error *err)
 {
     uint32_t first = rows[0], last = rows[1];
     if (width != d->width || height != d->height) {
@@ -84,8 +84,16 @@ int display_show(display *d, const uint8_t *rgba, uint32_t width, uint32_t heigh
         /* the changed rows, turned bottom first, so that the copy to the window is a plain one
          * (a software driver then copies memory instead of running a shader per pixel) */
         size_t row = (size_t)width * 4;
-        for (uint32_t y = first; y < last; y++)
-            memcpy(d->rows + (size_t)(last - 1 - y) * row, rgba + (size_t)y * row, row);
+        for (uint32_t y = first; y < last; y++) {
+            uint8_t *to = d->rows + (size_t)(last - 1 - y) * row;
+            const uint8_t *from = rgba + (size_t)y * row;
+            if (!mirror) {
+                memcpy(to, from, row);
+                continue;
+            }
+            for (uint32_t x = 0; x < width; x++) /* the physical view: columns reversed */
+                memcpy(to + 4 * (size_t)x, from + 4 * (size_t)(width - 1 - x), 4);
+        }
         glBindTexture(GL_TEXTURE_2D, d->texture);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
         glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);

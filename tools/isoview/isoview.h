@@ -128,9 +128,10 @@ typedef struct viewer {
     int keep_image;       /* OpenGL draws into the kept image (not with --aa) */
     char gl_renderer[96]; /* GL_RENDERER */
     overlay text;
+    tool_space space; /* the file's physical space: the views, the planes, the image */
     double lo[3], hi[3];
-    double value_min, value_max; /* the file's value range, in its units (lowest first) */
-    ip_camera camera;
+    double value_min, value_max;   /* the file's value range, in its units (lowest first) */
+    ip_camera camera;              /* in world units, as the engine and the renderers take it */
     double iso;                    /* in the file's units (as stored without a rescale) */
     double iso_stored;             /* the same as a stored value: the engine takes it as a float */
     int restart;                   /* the view or the isovalue changed: begin again */
@@ -217,9 +218,10 @@ void run_script(viewer *v, double t);
 void free_commands(viewer *v);
 
 /* controls.c */
-/* The camera of `axis` (fitted to the volume) or of the camera text, at the current size.
- * Returns 0, or -1 with the error in *err. */
-int camera_from(viewer *v, const char *camera_text, const char *axis, ip_camera *out,
+/* The world camera of the named view `view` (fitted to the volume; NULL: the file's default)
+ * or of the camera text (physical units), at the current size. Returns 0, or -1 with the error
+ * in *err. */
+int camera_from(viewer *v, const char *camera_text, const char *view, ip_camera *out,
                 ip_error *err);
 void change_view(viewer *v);
 /* A new isovalue: `iso` in the file's units, or (change_iso_stored()) a stored value; each
@@ -261,10 +263,11 @@ void display_destroy(display *d);
 /* Gives the image (and its depth buffer) width x height pixels; 0, or -1 with the error. */
 int display_size(display *d, uint32_t width, uint32_t height, ip_error *err);
 /* Sends rows [rows[0], rows[1]) of the canvas's image (all of it after a change of size; none
- * when rgba is NULL, the OpenGL renderer having drawn into the image) to the texture and
- * copies the image to the window. Returns 0, or -1 with the error in *err. */
+ * when rgba is NULL, the OpenGL renderer having drawn into the image) to the texture, their
+ * columns reversed with `mirror` (the physical view of a world camera's image: tool_space.h),
+ * and copies the image to the window. Returns 0, or -1 with the error in *err. */
 int display_show(display *d, const uint8_t *rgba, uint32_t width, uint32_t height,
-                 const uint32_t rows[2], ip_error *err);
+                 const uint32_t rows[2], int mirror, ip_error *err);
 /* Reads the window's back buffer as drawn (overlay included), top row first. Returns 0, or -1
  * with the error in *err. */
 int display_read(uint32_t width, uint32_t height, uint8_t *rgba, ip_error *err);

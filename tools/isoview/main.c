@@ -332,7 +332,8 @@ static int draw_software(viewer *v)
         return -1;
     uint32_t rows[2];
     const uint8_t *rgba = ip_canvas_shade(v->canvas, rows);
-    return display_show(&v->screen, rgba, v->camera.width, v->camera.height, rows, &v->err);
+    return display_show(&v->screen, rgba, v->camera.width, v->camera.height, rows, v->space.mirror,
+                        &v->err);
 }
 
 /* OpenGL into the kept image: only the triangles uploaded since the last frame, unless the
@@ -349,7 +350,7 @@ static int draw_opengl(viewer *v)
     v->canvas_camera = v->camera;
     v->gl_drawn = ip_renderer_triangle_count(v->renderer);
     const uint32_t none[2] = {0, 0};
-    return display_show(&v->screen, NULL, v->camera.width, v->camera.height, none, &v->err);
+    return display_show(&v->screen, NULL, v->camera.width, v->camera.height, none, 0, &v->err);
 }
 
 static int draw_frame(viewer *v, int working_on_full)
@@ -436,7 +437,7 @@ static void follow_drag(viewer *v, double t)
     double until = t < v->drag_end ? t : v->drag_end;
     double dt = until - v->drag_last;
     if (dt > 0) {
-        ip_camera_orbit(&v->camera, v->drag_rate[0] * dt, v->drag_rate[1] * dt);
+        tool_space_orbit(&v->space, &v->camera, v->drag_rate[0] * dt, v->drag_rate[1] * dt);
         change_view(v);
         v->last_motion = ip_now_seconds();
     }
@@ -568,6 +569,8 @@ static int open_window(viewer *v)
         v->renderer = NULL;
         display_destroy(&v->screen);
     }
+    if (v->renderer) /* it draws the physical view (the software one: display_show()) */
+        ip_renderer_set_mirror(v->renderer, v->space.mirror);
     if (software && (ip_canvas_create(v->o.common.threads, &v->canvas, &v->err) != IP_OK ||
                      display_create(&v->screen, 0, &v->err) != 0)) {
         fprintf(stderr, "isoview: the software renderer cannot start: %s\n", v->err.message);
@@ -623,10 +626,12 @@ static void json_counts(FILE *f, void *user)
     int done = full || ip_engine_done(v->engine);
     tool_view_options common; /* "clip": the planes as they apply at the end */
     clip_options(v, &common);
+    ip_camera physical; /* the camera as the file's space states it */
+    tool_space_physical(&v->space, &v->camera, &physical);
     const tool_run_json j = {v->o.file,
                              v->iso,
                              full, /* TOOL_PROGRESSIVE when not shown */
-                             &v->camera,
+                             &physical,
                              v->canvas ? "software" : "opengl",
                              &common,
                              0,
@@ -733,7 +738,10 @@ static int prepare(viewer *v)
     if (ip_cache_create(v->store, v->o.common.cache_bytes, &v->cache, err) != IP_OK)
         return -1;
     const ip_layout *l = ip_store_layout(v->store);
-    ip_layout_world_box(l, v->lo, v->hi);
+    tool_space_of(v->store, &v->space);
+    memcpy(v->lo, v->space.lo, sizeof v->lo);
+    memcpy(v->hi, v->space.hi, sizeof v->hi);
+    tool_space_clip(&v->space, &v->o.common);
     tool_settle_iso(&v->o.common, l);
     v->iso = v->o.common.iso_value;
     v->iso_stored = v->o.common.iso_stored;

@@ -3,8 +3,8 @@
  * blank lines and lines starting with '#' are ignored. Commands run in order, each at the
  * start of a frame, until a wait:
  *
- *     camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fov   set the camera (world units, degrees)
- *     view AXIS                               +x -x +y -y +z -z, as --view
+ *     camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fov   set the camera (physical units, degrees)
+ *     view NAME                               anterior .. inferior, +x .. -z, as --view
  *     iso V                                   set the isovalue (in the file's units)
  *     iso-stored V                            set the isovalue as a stored sample value
  *     orbit DX_DEGREES DY_DEGREES             orbit around the target, as a mouse drag does
@@ -256,7 +256,7 @@ void run_script(viewer *v, double t)
         case COMMAND_ISO: change_iso(v, c->a); break;
         case COMMAND_ISO_STORED: change_iso_stored(v, c->a); break;
         case COMMAND_ORBIT:
-            ip_camera_orbit(&v->camera, c->a, c->b);
+            tool_space_orbit(&v->space, &v->camera, c->a, c->b);
             change_view(v);
             break;
         case COMMAND_DRAG:

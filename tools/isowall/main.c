@@ -39,6 +39,7 @@ typedef struct wall_run {
     ip_store *store;
     ip_cache *cache;
     ip_engine *engine;
+    tool_space space; /* the file's physical space: the view, the planes, the image */
     wall_layout layout;
     double *cost;   /* per region: CPU seconds of its first pass (summed over the ranks) */
     int *taker;     /* dynamic: per region, the rank that took its first pass */
@@ -96,17 +97,19 @@ static int report_first_failure(const wall_run *r, int failed, const ip_error *e
 static int setup_layout(wall_run *r, ip_error *err)
 {
     wall_layout *w = &r->layout;
-    const ip_layout *l = ip_store_layout(r->store);
-    ip_layout_world_box(l, w->lo, w->hi);
+    tool_space_of(r->store, &r->space);
+    memcpy(w->lo, r->space.lo, sizeof w->lo);
+    memcpy(w->hi, r->space.hi, sizeof w->hi);
+    tool_space_clip(&r->space, &r->o.common);
     w->cols = r->o.cols;
     w->rows = r->o.rows;
     w->tile_w = r->o.tile_w;
     w->tile_h = r->o.tile_h;
     w->tile_count = w->cols * w->rows;
-    if (tool_camera_of(r->o.common.camera, r->o.common.view, r->o.common.width, r->o.common.height,
-                       w->lo, w->hi, &w->camera, err) != 0)
+    if (tool_space_camera(&r->space, r->o.common.camera, r->o.common.view, r->o.common.width,
+                          r->o.common.height, &w->camera, err) != 0)
         return -1;
-    tool_apply_orbit(&r->o.orbit, &w->camera);
+    tool_apply_orbit(&r->o.orbit, &r->space, &w->camera);
     if (wall_layout_regions(w, r->o.unit_w, r->o.unit_h) != 0) {
         err->code = IP_ERR_NOMEM;
         snprintf(err->message, sizeof err->message, "out of memory for the regions");
@@ -385,16 +388,27 @@ static int order_second_pass(wall_run *r)
     return ok ? 0 : -1;
 }
 
-/* Rank 0's wall image receives each tile. */
+/* The column, in the wall shown, of the world camera's tile column `col`: the other end of
+ * the wall where the space mirrors (the image shown is the physical view, tool_space.h). */
+static uint32_t shown_column(const wall_run *r, uint32_t col)
+{
+    return r->space.mirror ? r->layout.cols - 1 - col : col;
+}
+
+/* Rank 0's wall image receives each tile, where the wall shows it. */
 static int keep_in_image(uint32_t t, const uint8_t *rgba, void *user, ip_error *err)
 {
     (void)err;
     wall_run *r = user;
     const wall_layout *w = &r->layout;
-    size_t x0 = (size_t)(t % w->cols) * w->tile_w, y0 = (size_t)(t / w->cols) * w->tile_h;
-    for (uint32_t y = 0; y < w->tile_h; y++)
-        memcpy(r->image + 4 * ((y0 + y) * w->camera.width + x0), rgba + 4 * (size_t)y * w->tile_w,
-               4 * (size_t)w->tile_w);
+    size_t x0 = (size_t)shown_column(r, t % w->cols) * w->tile_w,
+           y0 = (size_t)(t / w->cols) * w->tile_h;
+    for (uint32_t y = 0; y < w->tile_h; y++) {
+        uint8_t *to = r->image + 4 * ((y0 + y) * w->camera.width + x0);
+        memcpy(to, rgba + 4 * (size_t)y * w->tile_w, 4 * (size_t)w->tile_w);
+    }
+    tool_space_show(&r->space, r->image + 4 * (y0 * w->camera.width + x0), w->tile_w, w->tile_h,
+                    w->camera.width);
     return 0;
 }
 
@@ -402,12 +416,26 @@ static int keep_in_image(uint32_t t, const uint8_t *rgba, void *user, ip_error *
 static int write_tile(uint32_t t, const uint8_t *rgba, void *user, ip_error *err)
 {
     wall_run *r = user;
+    const wall_layout *w = &r->layout;
     char path[4096];
-    snprintf(path, sizeof path, "%s/tile_%u_%u.png", r->o.tiles_dir, t % r->layout.cols,
-             t / r->layout.cols);
+    snprintf(path, sizeof path, "%s/tile_%u_%u.png", r->o.tiles_dir, shown_column(r, t % w->cols),
+             t / w->cols);
     wall_watch_stage("writing %s", path);
-    if (ip_png_write(path, rgba, r->layout.tile_w, r->layout.tile_h, r->o.common.force, err) !=
-        IP_OK)
+    uint8_t *shown = NULL; /* the tile as the wall shows it, where that is another */
+    if (r->space.mirror) {
+        size_t bytes = (size_t)w->tile_w * w->tile_h * 4;
+        if (!(shown = malloc(bytes))) {
+            err->code = IP_ERR_NOMEM;
+            snprintf(err->message, sizeof err->message, "%.900s: out of memory", path);
+            return -1;
+        }
+        memcpy(shown, rgba, bytes);
+        tool_space_show(&r->space, shown, w->tile_w, w->tile_h, w->tile_w);
+    }
+    ip_status st =
+        ip_png_write(path, shown ? shown : rgba, w->tile_w, w->tile_h, r->o.common.force, err);
+    free(shown);
+    if (st != IP_OK)
         return -1;
     if (tool_outputs_add_or_error(&r->outputs, path, err) != 0)
         return -1;
@@ -531,7 +559,9 @@ static void fill_stats(FILE *out, void *user)
     const stats_view *v = user;
     const wall_run *r = v->r;
     const wall_layout *w = &r->layout;
-    const ip_camera *c = &w->camera;
+    ip_camera physical; /* the camera as the file's space states it */
+    tool_space_physical(&r->space, &w->camera, &physical);
+    const ip_camera *c = &physical;
     fprintf(out, "{\n  \"program\": \"isowall\",\n  \"file\": ");
     tool_json_string(out, r->o.file);
     fprintf(out, ",\n  \"iso\": %.9g", r->o.common.iso_value);

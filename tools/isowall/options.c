@@ -23,10 +23,8 @@ static const char usage[] =
     "  --unit WxH          pixels of a screen region, inside a tile (default: an eighth of the\n"
     "                      tile each way, rounded up)\n"
     "  --static            no balance: the regions of tile t go to process t % N (one copy per\n"
-    "                      projector, the paper's display wall), for comparison\n"
-    "  --view AXIS         +x -x +y -y +z -z: the side the eye is on, whole volume in frame\n"
-    "                      (default -y; up is +z, or +y for the z views)\n"
-    "  --camera E,T,U,FOV  ex,ey,ez,tx,ty,tz,ux,uy,uz,fov in world units and degrees\n" TOOL_ORBIT_OPTIONS_HELP
+    "                      projector, the paper's display wall), for comparison\n" TOOL_VIEW_OPTIONS_HELP
+        TOOL_ORBIT_OPTIONS_HELP
     "  --color C           the surface colour: R,G,B (each 0 to 1) or #rrggbb\n"
     "  --background C      one colour, or TOP:BOTTOM for a vertical gradient over the wall\n" TOOL_ENGINE_OPTIONS_HELP
     "  --cache-mb N        each process's brick cache budget in MiB\n"
