@@ -30,24 +30,26 @@
 
 /* What the files of a series say. */
 typedef struct test_dicom_series {
-    uint32_t dims[3];        /* columns (x), rows (y), slices (z) */
-    ip_type type;            /* IP_UINT8, IP_UINT16 or IP_INT16 */
-    unsigned bits_allocated; /* 0: the type's */
-    double pixel_spacing[2]; /* between rows (y), between columns (x) */
-    double origin_z, step_z; /* slice z lies at origin_z + z * step_z along the normal */
-    int rescale;             /* 1: write slope and intercept */
-    double slope, intercept; /* Rescale Slope and Intercept */
-    const char *series_uid;  /* Series Instance UID */
-    const char *syntax;      /* Transfer Syntax UID (NULL: one by slice, see below) */
-    const char *photometric; /* NULL: MONOCHROME2 */
-    int no_position;         /* 1: leave out Image Position (Patient) */
-    int sequences;           /* 1: add a Referenced Image Sequence and an Icon Image Sequence */
-    int overlay;             /* 1: add an overlay plane (group 6000) of the image's size */
+    uint32_t dims[3];         /* columns (x), rows (y), slices (z) */
+    ip_type type;             /* IP_UINT8, IP_UINT16 or IP_INT16 */
+    unsigned bits_allocated;  /* 0: the type's */
+    double pixel_spacing[2];  /* between rows (y), between columns (x) */
+    double origin_z, step_z;  /* slice z lies at origin_z + z * step_z along the normal */
+    int rescale;              /* 1: write slope and intercept */
+    double slope, intercept;  /* Rescale Slope and Intercept */
+    const char *rescale_type; /* Rescale Type (0028,1054), with rescale; NULL: none */
+    const char *modality;     /* Modality (0008,0060); NULL: CT, "": none */
+    const char *series_uid;   /* Series Instance UID */
+    const char *syntax;       /* Transfer Syntax UID (NULL: one by slice, see below) */
+    const char *photometric;  /* NULL: MONOCHROME2 */
+    int no_position;          /* 1: leave out Image Position (Patient) */
+    int sequences;            /* 1: add a Referenced Image Sequence and an Icon Image Sequence */
+    int overlay;              /* 1: add an overlay plane (group 6000) of the image's size */
     /* the geometry of scanners (all zero: slices stacked along z, evenly) */
     double shift[2];         /* slice z lies z * shift mm further along x and y: a gantry
-                                 tilt (the rows run along x, the columns along y) */
+                                tilt (the rows run along x, the columns along y) */
     const double *z_at;      /* NULL, or where each slice lies along z (origin_z, step_z
-                                 unused): uneven spacing */
+                                unused): uneven spacing */
     const char *description; /* NULL, or a Series Description */
 } test_dicom_series;
 
@@ -366,7 +368,8 @@ static inline void test_dicom_slice_bytes(const test_dicom_series *s, const void
     b.big_endian = strcmp(syntax, TEST_DICOM_EXPLICIT_BE) == 0;
     test_dicom_text(&b, 0x0008, 0x0016, "UI", TEST_DICOM_CT_STORAGE);
     test_dicom_text(&b, 0x0008, 0x0018, "UI", instance);
-    test_dicom_text(&b, 0x0008, 0x0060, "CS", "CT");
+    if (!s->modality || s->modality[0])
+        test_dicom_text(&b, 0x0008, 0x0060, "CS", s->modality ? s->modality : "CT");
     if (s->description)
         test_dicom_text(&b, 0x0008, 0x103E, "LO", s->description);
     if (s->sequences)
@@ -396,6 +399,8 @@ static inline void test_dicom_slice_bytes(const test_dicom_series *s, const void
         test_dicom_text(&b, 0x0028, 0x1052, "DS", text);
         snprintf(text, sizeof text, "%g", s->slope);
         test_dicom_text(&b, 0x0028, 0x1053, "DS", text);
+        if (s->rescale_type)
+            test_dicom_text(&b, 0x0028, 0x1054, "LO", s->rescale_type);
     }
     if (s->sequences)
         test_dicom_icon(&b);

@@ -5,7 +5,8 @@
  * through the named offsets (format_offsets.h), and every validation of the parser: each
  * header field, reserved byte, level table field and directory entry field made wrong on its
  * own (the checksums resealed, so that the check behind them is the one reached) is refused
- * with its code and a message naming the file. */
+ * with its code and a message naming the file. Version 3's rescale record round trips and is
+ * validated alike, and files of versions 1 and 2 (no rescale) still read, with none. */
 #include <math.h>
 
 #include "check.h"
@@ -220,13 +221,16 @@ static void reseal(image *m)
     ip__store_u64le(h + IP_HDR_CHECKSUM, ip__format_checksum(h, IP_HDR_CHECKSUM));
 }
 
-static void make_image(image *m)
+/* A small file image: format version 2 as this build writes it when `rescale` is NULL (as
+ * version 2 builds wrote it: no rescale record), version 3 with the rescale otherwise. */
+static void make_image_with(image *m, const ip_rescale *rescale)
 {
     const uint32_t dims[3] = {13, 9, 6};
     const double spacing[3] = {0.5, 0.25, 2};
     ip_error err;
     REQUIRE(ip__layout_init(&m->layout, dims, IP_UINT16, spacing, 4, 2, &err) == IP_OK);
     ip_layout *l = &m->layout;
+    ip__layout_set_rescale(l, rescale);
     /* x and y turned 30 degrees about z, z reversed: a frame of the other handedness */
     const ip_orientation turned = {
         {10, -20, 5.5},
@@ -257,6 +261,8 @@ static void make_image(image *m)
     }
     unsigned char *summary = m->bytes + l->summary_offset;
     ip__summary_offsets_of(l, &m->o);
+    if (l->format_version >= 3)
+        ip__format_rescale_encode(l, summary);
     ip__format_level_table_encode(l, summary + m->o.level_table);
     uint32_t P3 = ip_layout_subblocks_per_brick(l);
     for (uint64_t g = 0; g < l->brick_count; g++) {
@@ -281,6 +287,14 @@ static void make_image(image *m)
     ip__format_header_encode(l, m->bytes);
     reseal(m);
 }
+
+static void make_image(image *m)
+{
+    make_image_with(m, NULL);
+}
+
+/* A CT's rescale: Hounsfield units = stored - 1024. */
+static const ip_rescale ct_rescale = {1, 1.0, -1024.0, "HU"};
 
 static ip_status parse(const image *m, ip_layout *out, ip_error *err)
 {
@@ -541,7 +555,7 @@ static void test_header_refusals(void)
 
     for (uint64_t i = 0; i < IP_HDR_MAGIC_SIZE; i++)
         refused(&m, flip_byte, IP_HDR_MAGIC + i, 1, IP_ERR_FORMAT, "bad magic");
-    refused(&m, set_u32, at(IP_HDR_VERSION, 3), 1, IP_ERR_UNSUPPORTED, "format version 3");
+    refused(&m, set_u32, at(IP_HDR_VERSION, 4), 1, IP_ERR_UNSUPPORTED, "format version 4");
     refused(&m, set_u32, at(IP_HDR_VERSION, 0), 1, IP_ERR_UNSUPPORTED, "format version 0");
     refused(&m, set_u32, at(IP_HDR_HEADER_SIZE, 255), 1, IP_ERR_FORMAT, "header size 255");
     /* any header byte changed without resealing: the header checksum */
@@ -692,7 +706,8 @@ static void test_version_1(void)
     ip_layout l, identity;
     ip_error err;
     REQUIRE(parse(&m, &l, &err) == IP_OK);
-    CHECK_EQ(l.format_version, IP_FORMAT_VERSION); /* the file's own version is kept */
+    CHECK_EQ(l.format_version, IP_FORMAT_VERSION_PLAIN); /* the file's own version is kept */
+    CHECK(!l.rescale.present);
     make_version_1(&m, 0);
     reseal(&m);
     REQUIRE(parse(&m, &l, &err) == IP_OK);
@@ -703,7 +718,112 @@ static void test_version_1(void)
     CHECK_EQ(l.orientation.space, IP_SPACE_UNKNOWN);
     CHECK_EQ(l.dims[0], 13);
     CHECK_EQ(l.spacing[1], 0.25);
+    CHECK(!l.rescale.present); /* no rescale: the identity */
+    CHECK_EQ(l.rescale.slope, 1.0);
+    CHECK_EQ(l.rescale.intercept, 0.0);
+    CHECK_STR_EQ(l.rescale.unit, "");
     free(m.bytes);
+}
+
+/* Version 3: the rescale record first in the summary section, the level table after it; the
+ * header as version 2's but for its version. A file without a rescale is still written as
+ * version 2, byte for byte as before (no record), and reads with no rescale. */
+static void test_rescale_round_trip(void)
+{
+    image plain, m;
+    make_image(&plain);
+    make_image_with(&m, &ct_rescale);
+    const unsigned char *h = m.bytes, *summary = m.bytes + m.layout.summary_offset;
+    CHECK_EQ(ip__load_u32le(plain.bytes + IP_HDR_VERSION), 2);
+    CHECK_EQ(plain.o.level_table, 0);
+    CHECK_EQ(ip__load_u32le(h + IP_HDR_VERSION), 3);
+    CHECK_EQ(m.o.level_table, IP_RESCALE_RECORD_SIZE);
+    CHECK_EQ(m.layout.summary_size, plain.layout.summary_size + IP_RESCALE_RECORD_SIZE);
+    CHECK_EQ(ip__load_f64le(summary + IP_RSC_SLOPE), 1.0);
+    CHECK_EQ(ip__load_f64le(summary + IP_RSC_INTERCEPT), -1024.0);
+    CHECK_MEM_EQ(summary + IP_RSC_UNIT, "HU\0\0\0\0\0\0\0\0\0\0\0\0\0\0", IP_RESCALE_UNIT_MAX);
+    for (int i = IP_RSC_RESERVED; i < (int)IP_RESCALE_RECORD_SIZE; i++)
+        CHECK_EQ(summary[i], 0);
+    /* the same level table, directory and ranges, 64 bytes later */
+    CHECK_MEM_EQ(summary + IP_RESCALE_RECORD_SIZE, plain.bytes + plain.layout.summary_offset,
+                 plain.layout.summary_size);
+
+    ip_layout parsed, parsed_plain;
+    ip_error err;
+    REQUIRE(parse(&m, &parsed, &err) == IP_OK);
+    CHECK_EQ(parsed.format_version, 3);
+    CHECK(parsed.rescale.present);
+    CHECK_EQ(parsed.rescale.slope, 1.0);
+    CHECK_EQ(parsed.rescale.intercept, -1024.0);
+    CHECK_STR_EQ(parsed.rescale.unit, "HU");
+    CHECK_EQ(parsed.levels[0].value_max, 9);
+    unsigned char again[IP_HEADER_SIZE];
+    ip__format_header_encode(&parsed, again);
+    CHECK_MEM_EQ(again, h, IP_HEADER_SIZE);
+    REQUIRE(parse(&plain, &parsed_plain, &err) == IP_OK);
+    CHECK_EQ(parsed_plain.format_version, 2);
+    CHECK(!parsed_plain.rescale.present);
+    CHECK_EQ(parsed_plain.rescale.slope, 1.0);
+    /* a negative slope and a unit of every printable character but NUL's room are kept */
+    const ip_rescale odd = {1, -0.5, 3.25, "mg/ml ~!@#$%^&*"};
+    free(m.bytes);
+    make_image_with(&m, &odd);
+    REQUIRE(parse(&m, &parsed, &err) == IP_OK);
+    CHECK_EQ(parsed.rescale.slope, -0.5);
+    CHECK_EQ(parsed.rescale.intercept, 3.25);
+    CHECK_STR_EQ(parsed.rescale.unit, "mg/ml ~!@#$%^&*");
+    free(m.bytes);
+    free(plain.bytes);
+}
+
+static void set_rescale_f64(image *m, uint64_t packed)
+{
+    uint64_t bits = packed & 0xffffffffu;
+    double v = bits == 1 ? NAN : bits == 2 ? INFINITY : 0.0; /* 1: NaN, 2: inf, else 0 */
+    ip__store_f64le(summary_of(m) + (packed >> 32), v);
+}
+
+static void set_rescale_byte(image *m, uint64_t packed)
+{
+    summary_of(m)[packed >> 32] = (unsigned char)packed;
+}
+
+static void fill_unit(image *m, uint64_t c)
+{
+    memset(summary_of(m) + IP_RSC_UNIT, (int)c, IP_RESCALE_UNIT_MAX);
+}
+
+/* Every field of the rescale record made wrong on its own, and versions that disagree with
+ * the summary's size. */
+static void test_rescale_refusals(void)
+{
+    image m, plain;
+    make_image_with(&m, &ct_rescale);
+    make_image(&plain);
+    refused(&m, set_rescale_f64, at(IP_RSC_SLOPE, 0), 1, IP_ERR_FORMAT,
+            "rescale slope 0 is not a finite number other than 0");
+    refused(&m, set_rescale_f64, at(IP_RSC_SLOPE, 1), 1, IP_ERR_FORMAT, "slope nan");
+    refused(&m, set_rescale_f64, at(IP_RSC_SLOPE, 2), 1, IP_ERR_FORMAT, "slope inf");
+    refused(&m, set_rescale_f64, at(IP_RSC_INTERCEPT, 1), 1, IP_ERR_FORMAT,
+            "rescale intercept nan is not finite");
+    refused(&m, set_rescale_f64, at(IP_RSC_INTERCEPT, 2), 1, IP_ERR_FORMAT, "intercept inf");
+    refused(&m, set_rescale_byte, at(IP_RSC_UNIT + 1, 0x01), 1, IP_ERR_FORMAT,
+            "not printable ASCII");
+    refused(&m, set_rescale_byte, at(IP_RSC_UNIT + 1, 0x80), 1, IP_ERR_FORMAT,
+            "not printable ASCII");
+    refused(&m, set_rescale_byte, at(IP_RSC_UNIT + 5, 'x'), 1, IP_ERR_FORMAT, "not NUL-padded");
+    refused(&m, fill_unit, 'x', 1, IP_ERR_FORMAT, "not NUL-terminated");
+    for (int i = IP_RSC_RESERVED; i < (int)IP_RESCALE_RECORD_SIZE; i++) {
+        char text[64];
+        snprintf(text, sizeof text, "reserved byte %d of the rescale is not zero", i);
+        refused(&m, set_rescale_byte, at((uint64_t)i, 1), 1, IP_ERR_FORMAT, text);
+    }
+    refused(&m, summary_byte, IP_RSC_UNIT, 0, IP_ERR_CHECKSUM, "summary section checksum");
+    /* the version says whether the record is there: the summary's size then disagrees */
+    refused(&m, set_u32, at(IP_HDR_VERSION, 2), 1, IP_ERR_FORMAT, "summary size");
+    refused(&plain, set_u32, at(IP_HDR_VERSION, 3), 1, IP_ERR_FORMAT, "summary size");
+    free(m.bytes);
+    free(plain.bytes);
 }
 
 static void test_summary_refusals(void)
@@ -802,10 +922,16 @@ static void test_truncations(void)
 }
 
 static const test_case cases[] = {
-    TEST_CASE(test_layouts),           TEST_CASE(test_layout_arguments),
-    TEST_CASE(test_header_round_trip), TEST_CASE(test_entry_round_trip),
-    TEST_CASE(test_header_refusals),   TEST_CASE(test_version_1),
-    TEST_CASE(test_summary_refusals),  TEST_CASE(test_truncations),
+    TEST_CASE(test_layouts),
+    TEST_CASE(test_layout_arguments),
+    TEST_CASE(test_header_round_trip),
+    TEST_CASE(test_entry_round_trip),
+    TEST_CASE(test_header_refusals),
+    TEST_CASE(test_version_1),
+    TEST_CASE(test_summary_refusals),
+    TEST_CASE(test_truncations),
+    TEST_CASE(test_rescale_round_trip),
+    TEST_CASE(test_rescale_refusals),
 };
 
 int main(int argc, char **argv)

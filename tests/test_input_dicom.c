@@ -112,8 +112,50 @@ static void test_series(ip_type type, const char *name)
     CHECK(desc.has_rescale);
     CHECK_EQ(desc.rescale_slope, 1.0);
     CHECK_EQ(desc.rescale_intercept, -1024.0);
+    CHECK_STR_EQ(desc.rescale_unit, "HU"); /* a CT's */
     check_samples(&desc, volume);
     free(volume);
+}
+
+/* The rescale's unit: the Rescale Type when it names one, else HU for a CT, else none; no
+ * rescale at all only for the identity without a unit. */
+static void check_rescale(test_dicom_series s, const char *name, int has, double slope,
+                          double intercept, const char *unit)
+{
+    char dir[4096];
+    void *volume = make_volume(&s);
+    ip_input_desc desc;
+    ip_error err;
+    test_dicom_write_series(&s, volume, fresh_folder(dir, name));
+    CHECK_MSG(ip_input_describe(dir, NULL, &desc, &err) == IP_OK, "%s", err.message);
+    CHECK_MSG(desc.has_rescale == has, "%s: has_rescale %d", name, desc.has_rescale);
+    CHECK_MSG(desc.rescale_slope == slope && desc.rescale_intercept == intercept,
+              "%s: rescale %g, %g", name, desc.rescale_slope, desc.rescale_intercept);
+    CHECK_MSG(strcmp(desc.rescale_unit, unit) == 0, "%s: unit '%s', not '%s'", name,
+              desc.rescale_unit, unit);
+    free(volume);
+}
+
+static void test_rescale_unit(void)
+{
+    test_dicom_series s = test_dicom_default(5, 4, 3, IP_INT16);
+    s.syntax = TEST_DICOM_EXPLICIT_LE;
+    check_rescale(s, "ct", 1, 1, -1024, "HU");
+    s.rescale_type = "US"; /* unspecified: a CT's values are still HU */
+    check_rescale(s, "ct_us", 1, 1, -1024, "HU");
+    s.rescale_type = "HU";
+    s.modality = "";
+    check_rescale(s, "hu_no_modality", 1, 1, -1024, "HU");
+    s.modality = "PT", s.slope = 0.25, s.intercept = 0, s.rescale_type = "BQML";
+    check_rescale(s, "pet", 1, 0.25, 0, "BQML");
+    s.rescale_type = "ABCDEFGHIJKLMNOP"; /* 16 characters: more than a unit holds */
+    check_rescale(s, "long_type", 1, 0.25, 0, "");
+    s.rescale_type = NULL;
+    check_rescale(s, "mr", 1, 0.25, 0, "");
+    s.rescale = 0;
+    check_rescale(s, "mr_no_rescale", 0, 1, 0, "");
+    s.rescale = 1, s.slope = 1, s.modality = NULL; /* a CT stored in HU: the unit alone */
+    check_rescale(s, "ct_identity", 1, 1, 0, "HU");
 }
 
 /* The spacing override replaces the headers' spacing; a dims override that is not the series'
@@ -137,7 +179,10 @@ static void test_overrides(void)
     CHECK_EQ(desc.spacing[0], 1);
     CHECK_EQ(desc.spacing[1], 2);
     CHECK_EQ(desc.spacing[2], 3);
-    CHECK(!desc.has_rescale);
+    CHECK(desc.has_rescale); /* no slope or intercept, but a CT: the identity, in HU */
+    CHECK_EQ(desc.rescale_slope, 1.0);
+    CHECK_EQ(desc.rescale_intercept, 0.0);
+    CHECK_STR_EQ(desc.rescale_unit, "HU");
     check_samples(&desc, volume);
     o.has_dims = 1;
     o.dims[0] = 5, o.dims[1] = 6, o.dims[2] = 4;
@@ -203,6 +248,10 @@ static void test_refused(void)
     odd = s, odd.dims[1] = 6, odd.origin_z += 6 * s.step_z;
     write_case(fresh_folder(dir, "rows"), &s, volume, 99, &odd, 0);
     expect_refused(dir, IP_ERR_INPUT, "rows/odd.dcm", "mixed series: a different size");
+
+    odd = s, odd.origin_z += 6 * s.step_z, odd.rescale_type = "OD"; /* the others' are HU */
+    write_case(fresh_folder(dir, "unit"), &s, volume, 99, &odd, 0);
+    expect_refused(dir, IP_ERR_INPUT, "unit/odd.dcm", "mixed series: a different rescale");
 
     odd = s, odd.origin_z += 6 * s.step_z, odd.syntax = "1.2.840.10008.1.2.4.999";
     write_case(fresh_folder(dir, "unknown_syntax"), &s, volume, 99, &odd, 0);
@@ -1024,6 +1073,7 @@ static const test_case cases[] = {
     {"test_series:uint16", test_series_uint16},
     {"test_series:uint8", test_series_uint8},
     TEST_CASE(test_overrides),
+    TEST_CASE(test_rescale_unit),
     TEST_CASE(test_refused),
     TEST_CASE(test_changed_file),
     TEST_CASE(test_malformed),

@@ -116,6 +116,7 @@ static void test_header_fields(void)
     CHECK(d.has_rescale);
     CHECK_EQ(d.rescale_slope, 2.5);
     CHECK_EQ(d.rescale_intercept, -1024);
+    CHECK_STR_EQ(d.rescale_unit, ""); /* NIfTI names no unit for its values */
     CHECK_EQ(d.data_offset, 400);
     CHECK_EQ(d.dims[2], 2);
     void *got = read_volume(&d, &err);

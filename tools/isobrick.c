@@ -23,6 +23,10 @@ static const char usage[] =
     "  --type T            uint8, uint16, int16 or float32 (raw input)\n"
     "  --endian E          little (default) or big\n"
     "  --spacing X,Y,Z     world units between samples (default 1,1,1)\n"
+    "  --rescale S,I[,UNIT]\n"
+    "                      the values stand for stored x S + I, in UNIT (e.g. 1,-1024,HU),\n"
+    "                      instead of what the input says; none: no rescale. Kept in the\n"
+    "                      brick file: isovalues are then given in UNIT (docs/input.md)\n"
     "A DICOM folder (docs/dicom.md) is read with its subfolders; objects that are not images\n"
     "(a DICOMDIR under any name, reports, presentation states) are skipped and counted.\n"
     "  --list-series       list the folder's series (UID, description, modality, slices,\n"
@@ -85,6 +89,8 @@ static int report_progress(void *user, uint64_t done, uint64_t total)
 typedef struct options {
     const char *input, *output;
     ip_input_overrides overrides;
+    int has_rescale;    /* --rescale given: `rescale` replaces the input's */
+    ip_rescale rescale; /* not present for --rescale none */
     ip_bricker_options brick;
     int quiet, verbose;
     int list_series, correct_tilt, no_correct_tilt, even_spacing; /* DICOM folders */
@@ -130,6 +136,36 @@ static int parse_spacing(const char *p, const tool_option *opt, const char *cons
     if (tool_parse_double3(v[0], s) != 0 || !(s[0] > 0 && s[1] > 0 && s[2] > 0))
         return tool_usage_error(p, "--spacing '%s' is not three positive numbers", v[0]);
     o->overrides.has_spacing = 1;
+    return 0;
+}
+
+/* --rescale S,I[,UNIT] or none */
+static int parse_rescale(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    options *o = base;
+    (void)opt;
+    char text[128], *unit = NULL;
+    ip_error err;
+    ip_rescale_identity(&o->rescale);
+    o->has_rescale = 1;
+    if (!strcmp(v[0], "none"))
+        return 0;
+    snprintf(text, sizeof text, "%s", v[0]);
+    char *comma = strchr(text, ',');
+    if (comma && (unit = strchr(comma + 1, ',')) != NULL)
+        *unit++ = '\0';
+    if (comma)
+        *comma = '\0';
+    o->rescale.present = 1;
+    if (!comma || strlen(v[0]) >= sizeof text || tool_parse_double(text, &o->rescale.slope) != 0 ||
+        tool_parse_double(comma + 1, &o->rescale.intercept) != 0)
+        return tool_usage_error(p, "--rescale '%s' is not SLOPE,INTERCEPT[,UNIT] or none", v[0]);
+    if (unit && strlen(unit) >= sizeof o->rescale.unit)
+        return tool_usage_error(p, "--rescale '%s': the unit is longer than %d characters", v[0],
+                                IP_RESCALE_UNIT_MAX - 1);
+    snprintf(o->rescale.unit, sizeof o->rescale.unit, "%s", unit ? unit : "");
+    if (ip_rescale_check(&o->rescale, "--rescale", &err) != IP_OK)
+        return tool_usage_error(p, "%s", err.message);
     return 0;
 }
 
@@ -183,6 +219,7 @@ static const tool_option isobrick_options[] = {
     {"--type", NULL, 1, 0, parse_type, NULL, NULL},
     {"--endian", NULL, 1, 0, parse_endian, NULL, NULL},
     {"--spacing", NULL, 1, 0, parse_spacing, NULL, NULL},
+    {"--rescale", NULL, 1, 0, parse_rescale, NULL, NULL},
     {"--brick-size", NULL, 1, offsetof(options, brick.brick_edge), parse_edge, NULL, NULL},
     {"--subblock-size", NULL, 1, offsetof(options, brick.subblock_edge), parse_edge, NULL, NULL},
     {"--hc", NULL, TOOL_OPTIONAL_VALUE, 0, parse_hc, NULL, tool_is_u64},
@@ -479,6 +516,12 @@ int main(int argc, char **argv)
     ip_input_desc desc;
     if (ip_input_describe(o.input, &o.overrides, &desc, &err) != IP_OK)
         return tool_fail("isobrick", &err);
+    if (o.has_rescale) { /* --rescale wins over the input's */
+        desc.has_rescale = o.rescale.present;
+        desc.rescale_slope = o.rescale.slope;
+        desc.rescale_intercept = o.rescale.intercept;
+        memcpy(desc.rescale_unit, o.rescale.unit, sizeof desc.rescale_unit);
+    }
     char out[IP_PATH_MAX];
     if (o.output)
         snprintf(out, sizeof out, "%s", o.output);

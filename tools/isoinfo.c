@@ -91,6 +91,23 @@ static void print_orientation_json(const ip_orientation *o)
         printf(", \"space\": null");
 }
 
+/* The value range line, and with a rescale its line: the range in the file's units, the stored
+ * one beside it. */
+static void print_values_text(const ip_layout *l)
+{
+    const ip_rescale *r = &l->rescale;
+    if (!r->present) {
+        printf("  value range   %g .. %g\n", (double)l->value_min, (double)l->value_max);
+        return;
+    }
+    double range[2];
+    char unit[IP_RESCALE_UNIT_MAX + 1], text[96];
+    tool_value_range(r, l->value_min, l->value_max, range);
+    printf("  value range   %g .. %g%s (stored %g .. %g)\n", range[0], range[1],
+           tool_unit_suffix(r, unit, sizeof unit), (double)l->value_min, (double)l->value_max);
+    printf("  rescale       %s\n", tool_rescale_text(text, sizeof text, r));
+}
+
 static void print_text(const ip_store *s, const file_facts *f)
 {
     const ip_layout *l = ip_store_layout(s);
@@ -101,7 +118,7 @@ static void print_text(const ip_store *s, const file_facts *f)
            ip_type_name(l->type));
     printf("  spacing       %g, %g, %g\n", l->spacing[0], l->spacing[1], l->spacing[2]);
     print_orientation_text(&l->orientation);
-    printf("  value range   %g .. %g\n", (double)l->value_min, (double)l->value_max);
+    print_values_text(l);
     printf("  bricks        %u^3 cells, sub-blocks %u^3 cells\n", l->brick_edge, l->subblock_edge);
     printf("  brick count   %llu: %llu constant, %llu compressed, %llu raw\n",
            (unsigned long long)l->brick_count, (unsigned long long)f->constant,
@@ -117,11 +134,27 @@ static void print_text(const ip_store *s, const file_facts *f)
     for (uint32_t k = 0; k < l->level_count; k++) {
         const ip_level_layout *lv = &l->levels[k];
         char p[32];
+        double range[2];
+        tool_value_range(&l->rescale, lv->value_min, lv->value_max, range);
         printf("    %2u: %u x %u x %u samples, %u x %u x %u bricks, %s payload, values %g .. %g\n",
                k, lv->dims[0], lv->dims[1], lv->dims[2], lv->bricks[0], lv->bricks[1],
-               lv->bricks[2], tool_format_bytes(p, sizeof p, (double)f->level_payload[k]),
-               (double)lv->value_min, (double)lv->value_max);
+               lv->bricks[2], tool_format_bytes(p, sizeof p, (double)f->level_payload[k]), range[0],
+               range[1]);
     }
+}
+
+/* "value_min", "value_max" (in the file's units), with a rescale "value_min_stored",
+ * "value_max_stored" and always "rescale" (null without one). */
+static void print_values_json(const ip_layout *l)
+{
+    double range[2];
+    tool_value_range(&l->rescale, l->value_min, l->value_max, range);
+    printf(", \"value_min\": %.9g, \"value_max\": %.9g", range[0], range[1]);
+    if (l->rescale.present)
+        printf(", \"value_min_stored\": %.9g, \"value_max_stored\": %.9g", (double)l->value_min,
+               (double)l->value_max);
+    printf(", \"rescale\": ");
+    tool_write_rescale_json(stdout, &l->rescale);
 }
 
 static void print_json(const ip_store *s, const file_facts *f)
@@ -145,16 +178,17 @@ static void print_json(const ip_store *s, const file_facts *f)
            (unsigned long long)f->raw_bytes, (unsigned long long)l->file_size,
            (unsigned long long)f->payload_bytes, (unsigned long long)l->summary_size);
     printf(", \"compression_ratio\": %.4f", (double)f->raw_bytes / (double)l->file_size);
-    printf(", \"value_min\": %.9g, \"value_max\": %.9g", (double)l->value_min,
-           (double)l->value_max);
+    print_values_json(l);
     printf(", \"level_info\": [");
     for (uint32_t k = 0; k < l->level_count; k++) {
         const ip_level_layout *lv = &l->levels[k];
+        double range[2];
+        tool_value_range(&l->rescale, lv->value_min, lv->value_max, range);
         printf("%s{\"level\": %u, \"dims\": [%u, %u, %u], \"bricks\": [%u, %u, %u], "
                "\"bytes_payload\": %llu, \"value_min\": %.9g, \"value_max\": %.9g}",
                k ? ", " : "", k, lv->dims[0], lv->dims[1], lv->dims[2], lv->bricks[0],
-               lv->bricks[1], lv->bricks[2], (unsigned long long)f->level_payload[k],
-               (double)lv->value_min, (double)lv->value_max);
+               lv->bricks[1], lv->bricks[2], (unsigned long long)f->level_payload[k], range[0],
+               range[1]);
     }
     printf("]}\n");
 }
@@ -208,28 +242,36 @@ static int verify(const ip_store *s, ip_cache *cache, int quiet)
     return 0;
 }
 
-/* The histogram as a table: each bin's range, count, a bar of # (logarithmic, so that the
- * small bins of tissue show next to the huge one of air: log(1 + count), the fullest bin 40
- * wide) and its active sub-blocks. */
+/* The histogram as a table: each bin's range (in the file's units where it has a rescale),
+ * count, a bar of # (logarithmic, so that the small bins of tissue show next to the huge one of
+ * air: log(1 + count), the fullest bin 40 wide) and its active sub-blocks. */
 static void print_histogram_text(const ip_store *s, const ip_histogram *h, double seconds)
 {
     const ip_layout *l = ip_store_layout(s);
+    const ip_rescale *r = &l->rescale;
     const uint32_t *d = l->levels[h->level].dims;
+    char unit[IP_RESCALE_UNIT_MAX + 1], stored[96] = "";
+    tool_unit_suffix(r, unit, sizeof unit);
+    if (r->present)
+        snprintf(stored, sizeof stored, " (stored %g .. %g)", h->lo, h->hi);
     uint64_t most = 1;
     for (uint32_t b = 0; b < h->bin_count; b++)
         most = h->bins[b].count > most ? h->bins[b].count : most;
     printf("%s: histogram of level %u of %u (%u x %u x %u = %llu samples, %s), %.3f s\n",
            ip_store_path(s), h->level, l->level_count - 1, d[0], d[1], d[2],
            (unsigned long long)h->samples, ip_type_name(l->type), seconds);
-    printf("  %u bins over %g .. %g; a bin holds lo <= v < hi; active: sub-blocks (of %llu)\n"
+    printf("  %u bins over %g .. %g%s%s; a bin holds %s; active: sub-blocks (of %llu)\n"
            "  an isovalue at lo would cross\n",
-           h->bin_count, h->lo, h->hi, (unsigned long long)h->subblocks);
+           h->bin_count, ip_rescale_to_value(r, h->lo), ip_rescale_to_value(r, h->hi), unit, stored,
+           r->slope < 0 ? "hi < v <= lo (a negative rescale slope)" : "lo <= v < hi",
+           (unsigned long long)h->subblocks);
     printf("  %12s %12s %12s  %-40s %10s\n", "lo", "hi", "count", "", "active");
     for (uint32_t b = 0; b < h->bin_count; b++) {
         const ip_histogram_bin *bin = &h->bins[b];
         int fill = (int)(log1p((double)bin->count) / log1p((double)most) * 40 + 0.5);
-        printf("  %12g %12g %12llu  %-40.*s %10llu\n", bin->lo, bin->hi,
-               (unsigned long long)bin->count, fill, "########################################",
+        printf("  %12g %12g %12llu  %-40.*s %10llu\n", ip_rescale_to_value(r, bin->lo),
+               ip_rescale_to_value(r, bin->hi), (unsigned long long)bin->count, fill,
+               "########################################",
                (unsigned long long)bin->active_subblocks);
     }
     if (h->unbinned)
@@ -249,12 +291,22 @@ static void print_histogram_json(const ip_store *s, const ip_histogram *h, doubl
            (unsigned long long)h->subblocks);
     printf(", \"bricks_read\": %llu, \"bricks_constant\": %llu, \"seconds\": %.6f",
            (unsigned long long)h->bricks_read, (unsigned long long)h->bricks_constant, seconds);
-    printf(", \"value_min\": %.9g, \"value_max\": %.9g, \"bins\": [", (double)l->value_min,
-           (double)l->value_max);
-    for (uint32_t b = 0; b < h->bin_count; b++)
-        printf("%s{\"lo\": %.17g, \"hi\": %.17g, \"count\": %llu, \"active_subblocks\": %llu}",
-               b ? ", " : "", h->bins[b].lo, h->bins[b].hi, (unsigned long long)h->bins[b].count,
-               (unsigned long long)h->bins[b].active_subblocks);
+    const ip_rescale *r = &l->rescale;
+    if (r->present)
+        print_values_json(l);
+    else
+        printf(", \"value_min\": %.9g, \"value_max\": %.9g", (double)l->value_min,
+               (double)l->value_max);
+    printf(", \"bins\": [");
+    for (uint32_t b = 0; b < h->bin_count; b++) {
+        const ip_histogram_bin *bin = &h->bins[b];
+        printf("%s{\"lo\": %.17g, \"hi\": %.17g", b ? ", " : "", ip_rescale_to_value(r, bin->lo),
+               ip_rescale_to_value(r, bin->hi));
+        if (r->present)
+            printf(", \"lo_stored\": %.17g, \"hi_stored\": %.17g", bin->lo, bin->hi);
+        printf(", \"count\": %llu, \"active_subblocks\": %llu}", (unsigned long long)bin->count,
+               (unsigned long long)bin->active_subblocks);
+    }
     printf("]}}\n");
 }
 

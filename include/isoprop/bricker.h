@@ -78,7 +78,9 @@ IP_API ip_status ip_bricker_memory_needed(const ip_input_desc *input,
                                           const ip_bricker_options *options, uint64_t *bytes,
                                           ip_error *err);
 
-/*! ip_bricker_run() : bricks `input` into a new brick file at `out_path`. On any failure,
+/*! ip_bricker_run() : bricks `input` into a new brick file at `out_path`. The input's rescale
+ *  (has_rescale: slope, intercept, unit) goes into the file, which is then of format version
+ *  3 (else 2). On any failure,
  *  cancellation included, nothing is left at out_path (an existing file there is untouched).
  *  Follows the output rules of isoprop/output.h: out_path is never the input file or its
  *  data file (however spelled), and only a regular file is ever replaced (with force).
@@ -86,7 +88,8 @@ IP_API ip_status ip_bricker_memory_needed(const ip_input_desc *input,
  *  @return IP_OK, IP_ERR_EXISTS, IP_ERR_LIMIT (memory_limit too small: the message says how
  *  much is needed), IP_ERR_INPUT, IP_ERR_IO, IP_ERR_NOMEM or IP_ERR_CANCELLED;
  *  IP_ERR_ARGUMENT when out_path is the input (or its data file) or exists as something other
- *  than a regular file, or an argument is NULL; IP_ERR_UNSUPPORTED for a spacing outside the
+ *  than a regular file, an argument is NULL, or the rescale is invalid (ip_rescale_check());
+ *  IP_ERR_UNSUPPORTED for a spacing outside the
  *  bounds of ip_spacing_check(). */
 IP_API ip_status ip_bricker_run(const ip_input_desc *input, const char *out_path,
                                 const ip_bricker_options *options, ip_bricker_report *report,

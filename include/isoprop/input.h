@@ -42,8 +42,9 @@ typedef struct ip_input_desc {
     uint64_t stream_skip; /* gzip: bytes of the inflated stream before the first sample (a
                              header inside the stream, as in .nii.gz); 0 otherwise */
     int has_rescale;      /* 1 when the file says its values stand for stored x rescale_slope
-                             + rescale_intercept (NIfTI scl_slope/scl_inter, DICOM rescale);
-                             reported, never applied: samples keep their stored values */
+                             + rescale_intercept, in rescale_unit (NIfTI scl_slope/scl_inter,
+                             DICOM Rescale Slope/Intercept/Type); the bricker keeps it in the
+                             brick file (ip_layout.rescale); samples keep their stored values */
     double rescale_slope;
     double rescale_intercept;
     ip_orientation orientation; /* origin, axis directions and space in the file's physical
@@ -62,7 +63,9 @@ typedef struct ip_input_desc {
                                  samples are the stored ones, one slice a plane */
     double tilt_degrees;      /* the angle between the slices' stacking direction and their
                                  normal (a gantry tilt); 0 when they stack along the normal */
-    uint64_t reserved[20];    /* zero: room for later fields at the same size (status.h) */
+    char rescale_unit[IP_RESCALE_UNIT_MAX]; /* with has_rescale: the values' unit, "" when the
+                                               file names none ("HU" for a DICOM CT) */
+    uint64_t reserved[18]; /* zero: room for later fields at the same size (status.h) */
 } ip_input_desc;
 
 /* ip_input_desc.resampled: the slices of a DICOM series were resampled onto a regular grid

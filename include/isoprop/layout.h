@@ -21,13 +21,16 @@
 extern "C" {
 #endif
 
-#define IP_FORMAT_VERSION 2u
+/* The newest format version this build reads. It writes version 3 for a volume with a
+ * rescale (ip_rescale), version 2 for one without, as 2 has it (docs/format.md). */
+#define IP_FORMAT_VERSION 3u
 #define IP_HEADER_SIZE 256u
 #define IP_MAGIC "\x89IBV\r\n\x1a\n" /* 8 bytes */
 #define IP_MAX_LEVELS 32
 #define IP_LEVEL_ENTRY_SIZE 64u
 #define IP_DIRECTORY_ENTRY_SIZE 24u
-#define IP_RANGE_SIZE 8u /* float32 min, float32 max */
+#define IP_RANGE_SIZE 8u           /* float32 min, float32 max */
+#define IP_RESCALE_RECORD_SIZE 64u /* version 3: the rescale, first in the summary section */
 #define IP_SUMMARY_ALIGN 4096u
 #define IP_DEFAULT_BRICK_EDGE 32u
 #define IP_DEFAULT_SUBBLOCK_EDGE 8u
@@ -80,8 +83,10 @@ typedef struct ip_layout {
     uint64_t summary_checksum;
     uint64_t file_size;
     ip_level_layout levels[IP_MAX_LEVELS];
-    uint32_t format_version; /* the file's format version (an opened file's own: 1 or 2); the
-                                version this build writes for a layout made to write */
+    uint32_t format_version; /* the file's format version (an opened file's own: 1, 2 or 3);
+                                the version this build writes for a layout made to write */
+    ip_rescale rescale;      /* what the stored values stand for (format version 3; none for
+                                1 and 2) */
 } ip_layout;
 
 /* A brick directory entry (24 bytes on disk). */

@@ -80,6 +80,50 @@ IP_API ip_status ip_dims_parse(const char *text, uint32_t dims[3]);
  *  (and suggesting another unit, or resampling for too large a ratio). */
 IP_API ip_status ip_spacing_check(const double spacing[3], const char *name, ip_error *err);
 
+/* Bytes of a rescale's unit name, its terminating NUL included. */
+#define IP_RESCALE_UNIT_MAX 16
+
+/* What a volume's stored sample values stand for: value = stored x slope + intercept, in
+ * `unit` (a DICOM CT's Hounsfield units: slope 1, intercept -1024, "HU"). Samples are always
+ * kept as stored; isovalues given in the file's units are turned into stored values by
+ * ip_rescale_to_stored(). A volume without one has present 0, slope 1, intercept 0, unit "". */
+typedef struct ip_rescale {
+    int present;                    /* 1 when the volume has a rescale */
+    double slope;                   /* finite, not 0; a negative slope reverses the order */
+    double intercept;               /* finite */
+    char unit[IP_RESCALE_UNIT_MAX]; /* printable ASCII, NUL-terminated; "" when unknown */
+} ip_rescale;
+
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls for advanced uses that may change in a minor version, as the
+ * programs use them. Exported all the same. */
+#ifdef IP_EXPERIMENTAL
+
+/*! ip_rescale_identity() : *r = no rescale (present 0, slope 1, intercept 0, unit ""). */
+IP_API void ip_rescale_identity(ip_rescale *r);
+
+/*! ip_rescale_to_stored() : the stored sample value that `value`, in r's units, stands for:
+ *  (value - intercept) / slope, in double; `value` itself when r is NULL or has no rescale.
+ *  The one conversion every program and the Python module use, so that an isovalue in the
+ *  file's units and the stored value it stands for extract the same surface. Exact where the
+ *  result is a whole number below 2^53 and slope is 1 (any integer intercept), or a power of
+ *  two. With a negative slope, values above `value` are stored values below the result.
+ *  Reentrant. */
+IP_API double ip_rescale_to_stored(const ip_rescale *r, double value);
+
+/*! ip_rescale_to_value() : what stored sample value `stored` stands for, in r's units:
+ *  stored x slope + intercept; `stored` itself when r is NULL or has no rescale. Reentrant. */
+IP_API double ip_rescale_to_value(const ip_rescale *r, double stored);
+
+/*! ip_rescale_check() : checks *r: slope finite and not 0, intercept finite, unit at most
+ *  IP_RESCALE_UNIT_MAX - 1 printable ASCII characters (0x20 .. 0x7e), NUL-terminated. A rescale
+ *  that is not present is always valid. `name` (a file name, may be NULL) starts the message.
+ *  @return IP_OK, or IP_ERR_ARGUMENT with a one-line message. Reentrant. */
+IP_API ip_status ip_rescale_check(const ip_rescale *r, const char *name, ip_error *err);
+
+#endif /* IP_EXPERIMENTAL */
+
 #ifdef __cplusplus
 }
 #endif

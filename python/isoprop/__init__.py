@@ -16,8 +16,8 @@ from ._library import path as library_path
 from .bricking import brick
 from .errors import ArgumentError, Error
 from .mesh import Mesh, Step
-from .volume import File, Level, open
+from .volume import File, Level, Rescale, open
 
 __version__ = _lib.ip_version().decode()
-__all__ = ["brick", "open", "File", "Level", "Mesh", "Step", "Error", "ArgumentError",
+__all__ = ["brick", "open", "File", "Level", "Rescale", "Mesh", "Step", "Error", "ArgumentError",
            "library_path", "__version__"]

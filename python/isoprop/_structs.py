@@ -23,6 +23,15 @@ class Orientation(ctypes.Structure):
     _fields_ = [("origin", c_double * 3), ("directions", (c_double * 3) * 3), ("space", c_int)]
 
 
+RESCALE_UNIT_MAX = 16  # IP_RESCALE_UNIT_MAX, include/isoprop/volume.h
+
+
+class Rescale(ctypes.Structure):
+    """ip_rescale (volume.h)"""
+    _fields_ = [("present", c_int), ("slope", c_double), ("intercept", c_double),
+                ("unit", c_char * RESCALE_UNIT_MAX)]
+
+
 class InputDesc(ctypes.Structure):
     """ip_input_desc (input.h)"""
     _fields_ = [("path", c_char * PATH_MAX), ("data_path", c_char * PATH_MAX),
@@ -32,7 +41,8 @@ class InputDesc(ctypes.Structure):
                 ("rescale_intercept", c_double), ("orientation", Orientation),
                 ("series_uid", c_char * 72), ("series_count", c_uint32),
                 ("skipped_objects", c_uint32), ("source_slices", c_uint32), ("resampled", c_uint32),
-                ("tilt_degrees", c_double), ("reserved", c_uint64 * 20)]
+                ("tilt_degrees", c_double), ("rescale_unit", c_char * RESCALE_UNIT_MAX),
+                ("reserved", c_uint64 * 18)]
 
 
 class InputOverrides(ctypes.Structure):
@@ -79,7 +89,8 @@ class Layout(ctypes.Structure):
                 ("node_count", c_uint64), ("data_offset", c_uint64), ("data_size", c_uint64),
                 ("summary_offset", c_uint64), ("summary_size", c_uint64),
                 ("summary_checksum", c_uint64), ("file_size", c_uint64),
-                ("levels", LevelLayout * MAX_LEVELS), ("format_version", c_uint32)]
+                ("levels", LevelLayout * MAX_LEVELS), ("format_version", c_uint32),
+                ("rescale", Rescale)]
 
 
 class CacheLevelStats(ctypes.Structure):
@@ -151,6 +162,7 @@ class Mesh(ctypes.Structure):
 MIRRORS = {
     "ip_error": Error,
     "ip_orientation": Orientation,
+    "ip_rescale": Rescale,
     "ip_input_desc": InputDesc,
     "ip_input_overrides": InputOverrides,
     "ip_bricker_options": BrickerOptions,
@@ -174,4 +186,5 @@ CONSTANTS = {
     "IP_PREFETCH_OFF": PREFETCH_OFF,
     "IP_PREFETCH_ON": PREFETCH_ON,
     "IP_PREFETCH_ALWAYS": PREFETCH_ALWAYS,
+    "IP_RESCALE_UNIT_MAX": RESCALE_UNIT_MAX,
 }

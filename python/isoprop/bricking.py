@@ -55,9 +55,41 @@ def _options(brick_size, subblock_size, lz4_level, threads, mem_mb, force):
     return o
 
 
-def _run(path, out, overrides, options, progress):
+def _check_rescale(rescale):
+    """None (the input's), or the ip_rescale that replaces it: not present for False, else
+    (slope, intercept[, unit]) as the library checks it (ip_rescale_check())."""
+    if rescale is None:
+        return None
+    r = S.Rescale()
+    r.slope = 1.0
+    if rescale is False:
+        return r
+    if isinstance(rescale, (str, bytes)) or not hasattr(rescale, "__len__") or \
+            len(rescale) not in (2, 3):
+        raise TypeError("rescale: must be (slope, intercept[, unit]) or False, not %s"
+                        % C.describe(rescale))
+    r.present = 1
+    r.slope = C.number("rescale", rescale[0], "slope")
+    r.intercept = C.number("rescale", rescale[1], "intercept")
+    unit = rescale[2] if len(rescale) == 3 else ""
+    if not isinstance(unit, str):
+        raise TypeError("rescale: the unit must be a str, not %s" % C.describe(unit))
+    encoded = unit.encode("ascii", "replace") if unit.isascii() else b"\x80"  # refused below
+    if len(encoded) >= S.RESCALE_UNIT_MAX:
+        raise ArgumentError("rescale: the unit %r is longer than %d characters"
+                            % (unit, S.RESCALE_UNIT_MAX - 1))
+    r.unit = encoded
+    err = new_error()
+    st = lib.ip_rescale_check(ctypes.byref(r), None, ctypes.byref(err))
+    if st != 0:
+        raise ArgumentError(err.message.decode("utf-8", "replace"), st)
+    return r
+
+
+def _run(path, out, overrides, options, progress, rescale=None):
     """ip_input_describe() then ip_bricker_run(); `progress(done_bytes, total_bytes)` may
-    return True (or raise, Ctrl-C included) to cancel: nothing is then left at `out`."""
+    return True (or raise, Ctrl-C included) to cancel: nothing is then left at `out`.
+    `rescale` (an ip_rescale, or None: the input's) replaces the input's rescale."""
     raised = []
 
     def on_progress(_user, done, total):
@@ -71,6 +103,9 @@ def _run(path, out, overrides, options, progress):
     err, desc, report = new_error(), S.InputDesc(), S.BrickerReport()
     check(lib.ip_input_describe(os.fsencode(path), ctypes.byref(overrides), ctypes.byref(desc),
                                 ctypes.byref(err)), err)
+    if rescale is not None:
+        desc.has_rescale, desc.rescale_slope = rescale.present, rescale.slope
+        desc.rescale_intercept, desc.rescale_unit = rescale.intercept, rescale.unit
     st = lib.ip_bricker_run(ctypes.byref(desc), os.fsencode(out), ctypes.byref(options),
                             ctypes.byref(report), ctypes.byref(err))
     if raised:
@@ -144,8 +179,9 @@ def _array_input(a, out):
     return tmp, a.shape[::-1], a.dtype
 
 
-def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, brick_size=32,
-          subblock_size=8, hc=None, threads=0, mem_mb=0, force=False, progress=None):
+def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, rescale=None,
+          brick_size=32, subblock_size=8, hc=None, threads=0, mem_mb=0, force=False,
+          progress=None):
     """Bricks a volume into the brick file `out` and returns the report (a dict: input_bytes,
     file_bytes, bricks, levels, seconds, peak_rss, ...).
 
@@ -153,6 +189,10 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, bric
     or a numpy array of shape (z, y, x), C order (x fastest, as in the files), of dtype uint8,
     uint16, int16 or float32. dims (x, y, z), dtype and endian ('little', 'big') override a
     file's; an array has its own. spacing: world units between samples along x, y, z.
+    rescale: (slope, intercept[, unit]) says the values stand for stored * slope + intercept,
+    in unit (isobrick --rescale: (1, -1024, "HU")), in place of what the input says (a DICOM
+    series' or NIfTI file's rescale); False: none; None (the default): the input's. The file
+    keeps it: isovalues are then given in its units (open(out).rescale).
     brick_size, subblock_size, hc (True or an LZ4HC level), threads, mem_mb and force are
     isobrick's options. Every argument is checked first: TypeError or isoprop.ArgumentError
     (a ValueError) naming it. Raises isoprop.Error (the output is then not written), or an
@@ -164,6 +204,7 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, bric
     dims = C.dims(dims)
     code = None if dtype is None else type_code(dtype)
     spacing = _check_spacing(spacing)
+    rescale = _check_rescale(rescale)
     if endian is not None:
         C.choice("endian", endian, ("little", "big"))
     brick_size = C.power_of_two("brick_size", brick_size, 2, C.MAX_BRICK_EDGE)
@@ -184,7 +225,7 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, bric
         tmp, shape, dt = _array_input(_check_array(source), out)
         try:
             return _run(tmp, out, _overrides(list(shape), TYPES[dt.newbyteorder("=")], spacing,
-                                             "little"), options, progress)
+                                             "little"), options, progress, rescale)
         except Exception as e:
             if hasattr(e, "message"):  # name the array, not the scratch file, in the message
                 e.args = (e.message.replace(tmp, "array"),)
@@ -192,4 +233,5 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, bric
             raise
         finally:
             os.unlink(tmp)
-    return _run(source, out, _overrides(dims, code, spacing, endian), options, progress)
+    return _run(source, out, _overrides(dims, code, spacing, endian), options, progress,
+                rescale)

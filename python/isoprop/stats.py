@@ -36,24 +36,27 @@ def run_stats(run, counts, cache):
     """The whole dict for `run` (a volume._Run) with totals `counts` (ip_engine_counts)."""
     c = run.physical  # the camera in the file's physical space, as isorender reports it
     mode = "full-lod" if run.full == "lod" else "full" if run.full else "progressive"
-    out = {"cache": cache_stats(cache, run.summary_bytes), "file": run.path, "iso": run.iso,
-           "mode": mode, "width": c.width, "height": c.height,
-           "renderer": "none",
-           "camera": {"eye": list(c.eye), "target": list(c.target), "up": list(c.up),
-                      "fov": c.fov_y},
-           "lod": bool(run.options.lod), "pixel_error": run.options.pixel_error, "warm": False,
-           "threads": lib.ip_thread_count(run.options.threads),
-           "cutoff_degrees": run.options.cutoff_degrees,
-           "foldback_degrees": run.options.foldback_degrees,
-           "clip": [list(p.normal) + [p.offset]
-                    for p in run.options.clip[:run.options.clip_count]],
-           "rays": counts.rays, "rays_total": c.width * c.height, "done": run.done(),
-           "seeds": counts.seeds, "cells": counts.cells, "triangles": counts.triangles,
-           "time": {"intersection_s": counts.intersection_seconds,
-                    "propagation_s": counts.propagation_seconds,
-                    "extraction_s": counts.extraction_seconds,
-                    "rendering_s": counts.rendering_seconds,
-                    "extraction_wall_s": run.wall_seconds, "progress_render_s": 0.0}}
+    out = {"cache": cache_stats(cache, run.summary_bytes), "file": run.path, "iso": run.iso}
+    if run.rescale:  # as isorender's: the stored value and the rescale beside the value
+        out["iso_stored"] = run.iso_stored
+        out["rescale"] = run.rescale._asdict()
+    out.update({"mode": mode, "width": c.width, "height": c.height,
+                "renderer": "none",
+                "camera": {"eye": list(c.eye), "target": list(c.target), "up": list(c.up),
+                           "fov": c.fov_y},
+                "lod": bool(run.options.lod), "pixel_error": run.options.pixel_error,
+                "warm": False, "threads": lib.ip_thread_count(run.options.threads),
+                "cutoff_degrees": run.options.cutoff_degrees,
+                "foldback_degrees": run.options.foldback_degrees,
+                "clip": [list(p.normal) + [p.offset]
+                         for p in run.options.clip[:run.options.clip_count]],
+                "rays": counts.rays, "rays_total": c.width * c.height, "done": run.done(),
+                "seeds": counts.seeds, "cells": counts.cells, "triangles": counts.triangles,
+                "time": {"intersection_s": counts.intersection_seconds,
+                         "propagation_s": counts.propagation_seconds,
+                         "extraction_s": counts.extraction_seconds,
+                         "rendering_s": counts.rendering_seconds,
+                         "extraction_wall_s": run.wall_seconds, "progress_render_s": 0.0}})
     if not run.full:
         out.update({"occlusion": bool(run.options.occlusion), "deferred_cells": counts.deferred,
                     "retired_rays": counts.retired, "ray_nodes": counts.nodes,

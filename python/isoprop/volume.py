@@ -18,7 +18,12 @@ from .stats import counts_dict, run_stats
 
 Level = namedtuple("Level", "level dims bricks value_range")
 Level.__doc__ = """One level of the pyramid: level k samples the volume at every 2^k-th sample;
-dims and bricks along x, y, z; value_range (min, max) of its samples."""
+dims and bricks along x, y, z; value_range (min, max) of its samples, in the file's units
+where it has a rescale."""
+
+Rescale = namedtuple("Rescale", "slope intercept unit")
+Rescale.__doc__ = """What a file's stored sample values stand for: value = stored * slope +
+intercept, in unit ("HU" for a DICOM CT; "" when the input named none)."""
 
 DEFAULT_SIZE = (1600, 1200)  # isorender's
 VIEW_FOV = 30.0  # degrees: the field of view of the named views (isorender --view)
@@ -92,21 +97,27 @@ class _Run:
 
     def __init__(self, f, iso, full, camera, options, rays=None, time_limit=None,
                  rays_per_step=None, space="physical"):
+        """iso: (value in the file's units, stored value, whether it was given stored), as
+        File._isovalue() settles it. space: where the triangles go, the file's physical space
+        or the grid (index x spacing)."""
         self.path, self.summary_bytes = f.path, f._summary_bytes
-        # where the triangles go: the file's physical space, or the grid (index x spacing)
         self.orientation = f._orientation if space == "physical" else None
         self.space = f._space if space == "physical" else "grid"
-        self.iso, self.full, self.camera, self.options = iso, full, camera, options
+        (self.iso, self.iso_stored, stored), self.rescale = iso, f.rescale
+        self.full, self.camera, self.options = full, camera, options
         self.physical = f._physical(camera)  # the camera the statistics report
         self.engine, self.wall_seconds, self.warnings = None, 0.0, []
         self.limit = rays if rays is not None else C.MAX_COUNT
         self.time_limit, self.rays_per_step, self.target = time_limit, rays_per_step, 1
-        lo, hi = f.value_range
-        v = float(np.float32(iso))  # the isovalue as the engine takes it
+        lo, hi = f.value_range_stored
+        v = float(np.float32(self.iso_stored))  # the isovalue as the engine takes it
         if not (lo < v <= hi):
-            text = ("iso %g is outside the value range of %s, %g .. %g: there is no surface (an "
-                    "isovalue must be above the minimum and at most the maximum)"
-                    % (iso, f.path, lo, hi))
+            given, (a, b) = ((self.iso_stored, (lo, hi)) if stored or not f.rescale
+                             else (self.iso, f.value_range))
+            unit = " " + f.rescale.unit if f.rescale and f.rescale.unit and not stored else ""
+            text = ("iso %g%s is outside the value range of %s, %g .. %g%s: there is no "
+                    "surface (an isovalue must be above the minimum and at most the maximum)"
+                    % (given, " (stored)" if stored else "", f.path, a, b, unit))
             self.warnings.append(text)
             warnings.warn(text, RuntimeWarning, stacklevel=4)
 
@@ -149,9 +160,12 @@ class File:
     (z, y, x, as a numpy array of the volume), dtype (numpy), spacing (x, y, z world units),
     origin and directions (where sample (0, 0, 0) is and the unit direction of each sample
     axis in the file's physical space; a mesh's vertices are origin + D (i, j, k) * spacing),
-    space (the anatomical space the file names, "RAS", "LAS" or "LPS", or None), value_range
-    (min, max), levels (a tuple of Level, level 0 first), brick_size,
-    subblock_size, file_bytes. One call at a time: a call (extract(), a step of
+    space (the anatomical space the file names, "RAS", "LAS" or "LPS", or None), rescale (a
+    Rescale: what the stored values stand for, as isoinfo shows it; None when the file has
+    none), value_range (min, max; in the file's units where it has a rescale),
+    value_range_stored (the same as stored values), levels (a tuple of Level, level 0 first),
+    brick_size, subblock_size, file_bytes, format_version. Isovalues are in the file's units
+    (stored=True: stored values). One call at a time: a call (extract(), a step of
     extract_steps(), close()) made while another is running on the same File, from another
     thread or from an on_step callback, raises RuntimeError; it never waits, and never
     crashes. close() (or a with block) frees it, and so does garbage collection."""
@@ -170,10 +184,15 @@ class File:
         self.dtype = np.dtype(DTYPES[l.type])
         self.spacing = tuple(l.spacing)
         self.space = lib.ip_space_name(l.orientation.space).decode() or None
-        self.value_range = (l.value_min, l.value_max)
+        self._rescale = S.Rescale.from_buffer_copy(l.rescale)  # for the library's conversions
+        self.rescale = (Rescale(l.rescale.slope, l.rescale.intercept, l.rescale.unit.decode())
+                        if l.rescale.present else None)
+        self.value_range_stored = (l.value_min, l.value_max)
+        self.value_range = self._values(l.value_min, l.value_max)
         self.levels = tuple(
-            Level(k, tuple(lv.dims), tuple(lv.bricks), (lv.value_min, lv.value_max))
+            Level(k, tuple(lv.dims), tuple(lv.bricks), self._values(lv.value_min, lv.value_max))
             for k, lv in ((k, l.levels[k]) for k in range(l.level_count)))
+        self.format_version = l.format_version
         self.brick_size, self.subblock_size = l.brick_edge, l.subblock_edge
         self.file_bytes = l.file_size
         self._orientation = S.Orientation.from_buffer_copy(l.orientation)
@@ -184,6 +203,22 @@ class File:
         lo, hi = (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
         lib.ip_layout_world_box(ctypes.byref(l), lo, hi)
         self.world_box = (tuple(lo), tuple(hi))
+
+    def _values(self, lo, hi):
+        """The stored range lo .. hi in the file's units, lowest first."""
+        a, b = (lib.ip_rescale_to_value(ctypes.byref(self._rescale), v) for v in (lo, hi))
+        return (a, b) if a <= b else (b, a)
+
+    def _isovalue(self, iso, stored):
+        """(value in the file's units, stored value the engine extracts, stored) of a checked
+        `iso` given in the file's units, or as a stored value with stored=True: one from the
+        other through the library's ip_rescale_to_stored() / _to_value()."""
+        stored = C.flag("stored", stored)
+        r = ctypes.byref(self._rescale)
+        value, raw = ((lib.ip_rescale_to_value(r, iso), iso) if stored
+                      else (iso, lib.ip_rescale_to_stored(r, iso)))
+        C.isovalue(raw)  # the stored value too must be a finite float32
+        return value, raw, stored
 
     # -- life time ------------------------------------------------------------------------
     def close(self):
@@ -297,11 +332,14 @@ class File:
         return c
 
     # -- extraction -----------------------------------------------------------------------
-    def extract(self, iso, *, view=None, camera=None, size=DEFAULT_SIZE, rays=None, full=False,
-                time_limit=None, threads=0, cutoff=None, foldback=None, lod=True,
-                pixel_error=1.0, occlusion=True, prefetch=True, cull=False, cache_mb=None,
-                on_step=None, space="physical"):
+    def extract(self, iso, *, stored=False, view=None, camera=None, size=DEFAULT_SIZE,
+                rays=None, full=False, time_limit=None, threads=0, cutoff=None, foldback=None,
+                lod=True, pixel_error=1.0, occlusion=True, prefetch=True, cull=False,
+                cache_mb=None, on_step=None, space="physical"):
         """Extracts the isosurface `iso` and returns a Mesh (vertices, normals, faces, stats).
+        `iso` is in the file's units where it has a rescale (self.rescale: HU for a DICOM CT),
+        else a stored value; stored=True takes it as a stored sample value (isorender
+        --iso-stored). The stats give both ("iso", "iso_stored") with a rescale.
 
         Progressive (the default), as isorender: rays in the paper's order for the image of
         `size` (width, height) pixels seen from `view` (the side the eye is on, in the file's
@@ -325,7 +363,7 @@ class File:
         Every argument is checked first (TypeError, or isoprop.ArgumentError, a ValueError,
         naming it). Raises isoprop.Error for a file that cannot be read, RuntimeError when
         another call on this File is running."""
-        iso = C.isovalue(iso)
+        iso = self._isovalue(C.isovalue(iso), stored)
         a = _Args(view=view, camera=camera, size=size, threads=threads, cutoff=cutoff,
                   foldback=foldback, lod=lod, pixel_error=pixel_error, occlusion=occlusion,
                   prefetch=prefetch, cull=cull, cache_mb=cache_mb)
@@ -360,10 +398,10 @@ class File:
             finally:
                 self._end(run)
 
-    def extract_steps(self, iso, *, rays_per_step=None, rays=None, time_limit=None, view=None,
-                      camera=None, size=DEFAULT_SIZE, threads=0, cutoff=None, foldback=None,
-                      lod=True, pixel_error=1.0, occlusion=True, prefetch=True, cull=False,
-                      cache_mb=None, space="physical"):
+    def extract_steps(self, iso, *, stored=False, rays_per_step=None, rays=None,
+                      time_limit=None, view=None, camera=None, size=DEFAULT_SIZE, threads=0,
+                      cutoff=None, foldback=None, lod=True, pixel_error=1.0, occlusion=True,
+                      prefetch=True, cull=False, cache_mb=None, space="physical"):
         """Progressive extraction as a generator: yields a Step (the step's new triangles, its
         counts, the run's statistics so far) after each step of the engine, until every pixel
         has had its ray, `rays` rays or `time_limit` seconds. Steps cast `rays_per_step` rays
@@ -373,7 +411,7 @@ class File:
         order, are those of one extract() of the same rays on one thread. Each step is one
         call on the File (RuntimeError while another is running); between steps the File is
         free for other calls."""
-        iso = C.isovalue(iso)
+        iso = self._isovalue(C.isovalue(iso), stored)
         a = _Args(view=view, camera=camera, size=size, threads=threads, cutoff=cutoff,
                   foldback=foldback, lod=lod, pixel_error=pixel_error, occlusion=occlusion,
                   prefetch=prefetch, cull=cull, cache_mb=cache_mb)
@@ -411,7 +449,8 @@ class File:
         self._runs.add(run)
         try:  # the view's set-up counts in its time, as in isorender
             start = lib.ip_now_seconds()
-            st = lib.ip_engine_begin(engine, ctypes.byref(cam), iso, ctypes.byref(err))
+            st = lib.ip_engine_begin(engine, ctypes.byref(cam), run.iso_stored,
+                                     ctypes.byref(err))
             run.wall_seconds = lib.ip_now_seconds() - start
             check(st, err)
         except BaseException:
@@ -472,11 +511,12 @@ class File:
         try:
             start = lib.ip_now_seconds()
             if full == "lod":
-                st = lib.ip_extract_full_lod(cache, iso, ctypes.byref(cam), options.pixel_error,
+                st = lib.ip_extract_full_lod(cache, run.iso_stored, ctypes.byref(cam),
+                                             options.pixel_error,
                                              a.threads, None, 0, ctypes.byref(mesh),
                                              ctypes.byref(counts), ctypes.byref(err))
             else:
-                st = lib.ip_extract_full(cache, iso, 0, a.threads, ctypes.byref(mesh),
+                st = lib.ip_extract_full(cache, run.iso_stored, 0, a.threads, ctypes.byref(mesh),
                                          ctypes.byref(counts), ctypes.byref(err))
             run.wall_seconds = lib.ip_now_seconds() - start
             check(st, err)

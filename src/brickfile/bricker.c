@@ -727,6 +727,20 @@ static int orientation_unset(const ip_orientation *o)
     return 1;
 }
 
+/* The input's rescale, as the layout keeps it. */
+static ip_rescale rescale_of(const ip_input_desc *in)
+{
+    ip_rescale r;
+    ip_rescale_identity(&r);
+    if (in->has_rescale) {
+        r.present = 1;
+        r.slope = in->rescale_slope;
+        r.intercept = in->rescale_intercept;
+        memcpy(r.unit, in->rescale_unit, sizeof r.unit);
+    }
+    return r;
+}
+
 static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *out_path,
                               const ip_bricker_options *o, ip_error *err)
 {
@@ -741,6 +755,8 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
         return ip__fail(err, st, "%s: %s", in->path, why.message);
     if (!orientation_unset(&in->orientation))
         b->layout.orientation = in->orientation;
+    ip_rescale rescale = rescale_of(in);
+    ip__layout_set_rescale(&b->layout, &rescale);
     b->sample_size = ip_type_size(in->type);
     b->threads = thread_count(o);
     b->overlap = plan_overlap(&b->layout, b->threads, o->memory_limit);
@@ -1055,6 +1071,12 @@ static ip_status summary_sections(summary_writer *w, const float *nodes, ip_erro
     ip_layout *l = &w->b->layout;
     ip_summary_offsets o;
     ip__summary_offsets_of(l, &o);
+    if (o.level_table) { /* version 3: the rescale first */
+        unsigned char *record = summary_room(w, IP_RESCALE_RECORD_SIZE, err);
+        if (!record)
+            return IP_ERR_IO;
+        ip__format_rescale_encode(l, record);
+    }
     unsigned char *table = summary_room(w, (size_t)l->level_count * IP_LEVEL_ENTRY_SIZE, err);
     if (!table)
         return IP_ERR_IO;
@@ -1126,14 +1148,18 @@ static void count_bricks(bricker *b)
         (uint64_t)b->layout.dims[0] * b->layout.dims[1] * b->layout.dims[2] * b->sample_size;
 }
 
-/* What no option can make right: a spacing nothing downstream renders correctly, and an
- * output that is the input (or its detached data file), which --force would replace with the
- * brick file, or which would be read while it is being written. */
+/* What no option can make right: a spacing nothing downstream renders correctly, a rescale
+ * the file cannot keep, and an output that is the input (or its detached data file), which
+ * --force would replace with the brick file, or which would be read while it is being
+ * written. */
 static ip_status check_request(const ip_input_desc *in, const char *out_path, ip_error *err)
 {
     ip_status st = ip_spacing_check(in->spacing, in->path, err);
     if (st == IP_OK && !orientation_unset(&in->orientation))
         st = ip_orientation_check(&in->orientation, in->path, err);
+    ip_rescale rescale = rescale_of(in);
+    if (st == IP_OK)
+        st = ip_rescale_check(&rescale, in->path, err);
     if (st == IP_OK)
         st = ip_output_not_input(out_path, in->path, err);
     if (st == IP_OK && strcmp(in->data_path, in->path) != 0)

@@ -60,7 +60,8 @@ ip_status ip__layout_init(ip_layout *layout, const uint32_t dims[3], ip_type typ
                           ip_error *err)
 {
     memset(layout, 0, sizeof *layout);
-    layout->format_version = IP_FORMAT_VERSION;
+    layout->format_version = IP_FORMAT_VERSION_PLAIN;
+    ip_rescale_identity(&layout->rescale);
     for (int a = 0; a < 3; a++) {
         if (dims[a] < 2 || dims[a] >= (1u << 31))
             return ip__fail(err, IP_ERR_ARGUMENT, "dimension %u along %c is outside [2, 2^31)",
@@ -118,8 +119,8 @@ void ip_layout_world_box(const ip_layout *layout, double lo[3], double hi[3])
 
 void ip__summary_offsets_of(const ip_layout *layout, ip_summary_offsets *out)
 {
-    out->level_table = 0;
-    out->directory = (uint64_t)layout->level_count * IP_LEVEL_ENTRY_SIZE;
+    out->level_table = layout->format_version >= 3 ? IP_RESCALE_RECORD_SIZE : 0;
+    out->directory = out->level_table + (uint64_t)layout->level_count * IP_LEVEL_ENTRY_SIZE;
     out->brick_ranges = out->directory + layout->brick_count * IP_DIRECTORY_ENTRY_SIZE;
     out->subblock_ranges = out->brick_ranges + layout->brick_count * IP_RANGE_SIZE;
     out->nodes = out->subblock_ranges +
@@ -132,6 +133,16 @@ uint64_t ip__layout_summary_size(const ip_layout *layout)
     ip_summary_offsets o;
     ip__summary_offsets_of(layout, &o);
     return o.end;
+}
+
+void ip__layout_set_rescale(ip_layout *layout, const ip_rescale *rescale)
+{
+    if (rescale && rescale->present)
+        layout->rescale = *rescale;
+    else
+        ip_rescale_identity(&layout->rescale);
+    layout->format_version = layout->rescale.present ? 3u : IP_FORMAT_VERSION_PLAIN;
+    layout->summary_size = ip__layout_summary_size(layout);
 }
 
 void ip_brick_extent(const ip_layout *layout, uint32_t level, const uint32_t brick[3],
@@ -258,7 +269,7 @@ void ip__format_header_encode(const ip_layout *layout, unsigned char out[IP_HEAD
 {
     memset(out, 0, IP_HEADER_SIZE);
     memcpy(out + IP_HDR_MAGIC, IP_MAGIC, IP_HDR_MAGIC_SIZE);
-    ip__store_u32le(out + IP_HDR_VERSION, IP_FORMAT_VERSION);
+    ip__store_u32le(out + IP_HDR_VERSION, layout->format_version);
     ip__store_u32le(out + IP_HDR_HEADER_SIZE, IP_HEADER_SIZE);
     for (int a = 0; a < 3; a++) {
         ip__store_u32le(out + IP_HDR_DIMS + 4 * a, layout->dims[a]);
@@ -287,6 +298,16 @@ void ip__format_header_encode(const ip_layout *layout, unsigned char out[IP_HEAD
     }
     ip__store_u32le(out + IP_HDR_SPACE, (uint32_t)o->space);
     ip__store_u64le(out + IP_HDR_CHECKSUM, ip__format_checksum(out, IP_HDR_CHECKSUM));
+}
+
+void ip__format_rescale_encode(const ip_layout *layout, unsigned char out[IP_RESCALE_RECORD_SIZE])
+{
+    IP_ASSERT(layout->format_version >= 3 && layout->rescale.present);
+    memset(out, 0, IP_RESCALE_RECORD_SIZE);
+    ip__store_f64le(out + IP_RSC_SLOPE, layout->rescale.slope);
+    ip__store_f64le(out + IP_RSC_INTERCEPT, layout->rescale.intercept);
+    memcpy(out + IP_RSC_UNIT, layout->rescale.unit,
+           strnlen(layout->rescale.unit, IP_RESCALE_UNIT_MAX));
 }
 
 void ip__format_level_table_encode(const ip_layout *layout, unsigned char *out)
@@ -427,6 +448,7 @@ static ip_status parse_header(const unsigned char *h, const char *name, unsigned
     if (st != IP_OK)
         return st;
     layout->format_version = version;
+    layout->summary_size = ip__layout_summary_size(layout); /* version 3's holds the rescale */
     if ((st = parse_orientation(h, version, name, layout, err)) != IP_OK)
         return st;
     if (ip__load_u32le(h + IP_HDR_LEVEL_COUNT) != layout->level_count ||
@@ -461,6 +483,38 @@ static ip_status check_sections(const ip_layout *l, uint64_t size, const char *n
         l->summary_offset - (l->data_offset + l->data_size) >= IP_SUMMARY_ALIGN ||
         l->summary_offset > size || size - l->summary_offset != l->summary_size)
         return ip__fail(err, IP_ERR_FORMAT, "%s: section offsets are inconsistent", name);
+    return IP_OK;
+}
+
+/* Version 3's rescale record, first in the summary section: a valid rescale, its unit
+ * NUL-padded, its reserved bytes zero. */
+static ip_status parse_rescale(const unsigned char *r, const char *name, ip_layout *layout,
+                               ip_error *err)
+{
+    ip_rescale *out = &layout->rescale;
+    ip_rescale_identity(out);
+    if (layout->format_version < 3)
+        return IP_OK;
+    for (int i = 0; i < IP_RSC_RESERVED_SIZE; i++)
+        if (r[IP_RSC_RESERVED + i] != 0)
+            return ip__fail(err, IP_ERR_FORMAT, "%s: reserved byte %d of the rescale is not zero",
+                            name, IP_RSC_RESERVED + i);
+    const unsigned char *unit = r + IP_RSC_UNIT;
+    size_t n = 0;
+    while (n < IP_RESCALE_UNIT_MAX && unit[n] != 0)
+        n++;
+    for (size_t i = n; i < IP_RESCALE_UNIT_MAX; i++)
+        if (unit[i] != 0)
+            return ip__fail(err, IP_ERR_FORMAT, "%s: the rescale's unit is not NUL-padded", name);
+    ip_rescale found = {1, ip__load_f64le(r + IP_RSC_SLOPE), ip__load_f64le(r + IP_RSC_INTERCEPT),
+                        ""};
+    if (n == IP_RESCALE_UNIT_MAX)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: the rescale's unit is not NUL-terminated", name);
+    memcpy(found.unit, unit, n);
+    ip_error why;
+    if (ip_rescale_check(&found, NULL, &why) != IP_OK)
+        return ip__fail(err, IP_ERR_FORMAT, "%s: %s", name, why.message);
+    *out = found;
     return IP_OK;
 }
 
@@ -564,11 +618,13 @@ ip_status ip__format_check_summary(ip_layout *layout, const unsigned char *gap,
                             (unsigned long long)(layout->data_offset + layout->data_size + i));
     if (!(flags & IP_PARSE_SKIP_CHECKSUMS) && checksum != layout->summary_checksum)
         return ip__fail(err, IP_ERR_CHECKSUM, "%s: summary section checksum mismatch", name);
-    ip_status st = check_level_table(layout, head, name, layout, err);
-    if (st != IP_OK)
-        return st;
     ip_summary_offsets o;
     ip__summary_offsets_of(layout, &o);
+    ip_status st = parse_rescale(head, name, layout, err);
+    if (st == IP_OK)
+        st = check_level_table(layout, head + o.level_table, name, layout, err);
+    if (st != IP_OK)
+        return st;
     for (uint64_t g = 0; g < layout->brick_count; g++) {
         const unsigned char *d = head + o.directory + g * IP_DIRECTORY_ENTRY_SIZE;
         const unsigned char *r = head + o.brick_ranges + g * IP_RANGE_SIZE;

@@ -25,6 +25,11 @@ ip_status ip__layout_init(ip_layout *layout, const uint32_t dims[3], ip_type typ
 /*! ip__layout_summary_size() : bytes of the summary section implied by the layout. */
 uint64_t ip__layout_summary_size(const ip_layout *layout);
 
+/*! ip__layout_set_rescale() : gives the layout `rescale` (NULL or one not present: none), the
+ *  format version that holds it (3 with a rescale, else IP_FORMAT_VERSION_PLAIN) and the
+ *  summary size that version implies. The caller has checked the rescale. */
+void ip__layout_set_rescale(ip_layout *layout, const ip_rescale *rescale);
+
 /*! ip__brick_face_neighbours() : the global indices of the bricks of brick `g`'s level that
  *  share a face with it (up to 6: fewer at the level's boundary), into out; @return how many. */
 unsigned ip__brick_face_neighbours(const ip_layout *layout, uint64_t g, uint64_t out[6]);
@@ -53,6 +58,9 @@ void ip__summary_offsets_of(const ip_layout *layout, ip_summary_offsets *out);
 
 /*! ip__format_header_encode() : writes the 256-byte header of `layout` (with its checksum) to `out`. */
 void ip__format_header_encode(const ip_layout *layout, unsigned char out[IP_HEADER_SIZE]);
+
+/*! ip__format_rescale_encode() : writes the 64-byte rescale record of a version 3 layout. */
+void ip__format_rescale_encode(const ip_layout *layout, unsigned char out[IP_RESCALE_RECORD_SIZE]);
 
 /*! ip__format_level_table_encode() : writes level_count * 64 bytes of level table to `out`. */
 void ip__format_level_table_encode(const ip_layout *layout, unsigned char *out);

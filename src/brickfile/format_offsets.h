@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* isoprop internal: every byte offset of the brick file's fixed-size records, named once.
  *
- * docs/format.md is the specification; these names are its tables ("Header", "Level table
- * entry", "Directory entry"), used by the encoders and the parser of format.c alike and by the
+ * docs/format.md is the specification; these names are its tables ("Header", "Rescale
+ * record", "Level table entry", "Directory entry"), used by the encoders and the parser of format.c alike and by the
  * tests that corrupt one field. Offsets are in bytes from the start of the record; a field of
  * three values (dims, spacing, bricks) holds them x, y, z at its offset + i * the value's size.
  * The _Static_asserts below tie the names to the record sizes of isoprop/layout.h, so that a
@@ -68,6 +68,18 @@ enum {
     IP_DIR_CHECKSUM = 16      /* u64 */
 };
 
+/* Rescale record (IP_RESCALE_RECORD_SIZE = 64 bytes; version 3, first in the summary) */
+enum {
+    IP_RSC_SLOPE = 0,          /* f64 */
+    IP_RSC_INTERCEPT = 8,      /* f64 */
+    IP_RSC_UNIT = 16,          /* IP_RESCALE_UNIT_MAX bytes: printable ASCII, NUL-padded */
+    IP_RSC_RESERVED = 32,      /* zero bytes up to IP_RESCALE_RECORD_SIZE */
+    IP_RSC_RESERVED_SIZE = 32, /* bytes reserved */
+};
+
+/* The version a file without a rescale is written as (3 adds the rescale record). */
+#define IP_FORMAT_VERSION_PLAIN 2u
+
 /* Range (IP_RANGE_SIZE = 8 bytes) */
 enum {
     IP_RANGE_MIN = 0, /* f32 */
@@ -126,6 +138,14 @@ _Static_assert(IP_DIR_FILTERS + 1 == IP_DIR_RESERVED, "directory entry: reserved
 _Static_assert(IP_DIR_RESERVED + IP_DIR_RESERVED_SIZE == IP_DIR_CHECKSUM,
                "directory entry: checksum");
 _Static_assert(IP_DIR_CHECKSUM + 8 == IP_DIRECTORY_ENTRY_SIZE, "directory entry: 24 bytes");
+
+_Static_assert(IP_RESCALE_RECORD_SIZE == 64, "the rescale record is 64 bytes");
+_Static_assert(IP_RSC_SLOPE + 8 == IP_RSC_INTERCEPT, "rescale: slope, intercept");
+_Static_assert(IP_RSC_INTERCEPT + 8 == IP_RSC_UNIT, "rescale: intercept, unit");
+_Static_assert(IP_RSC_UNIT + IP_RESCALE_UNIT_MAX == IP_RSC_RESERVED, "rescale: unit, reserved");
+_Static_assert(IP_RSC_RESERVED + IP_RSC_RESERVED_SIZE == IP_RESCALE_RECORD_SIZE,
+               "rescale: 64 bytes");
+_Static_assert(IP_RESCALE_RECORD_SIZE % 8 == 0, "the level table after it stays 8-aligned");
 
 _Static_assert(IP_RANGE_MAX + 4 == IP_RANGE_SIZE, "range: min, max");
 

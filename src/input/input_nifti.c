@@ -3,7 +3,8 @@
  * "n+2"; .nii, or .nii.gz compressed as a whole), in either byte order. The header gives the
  * dims (3D, or 4D and up with every further dimension 1), the sample type, the spacing
  * (|pixdim[1..3]|, in the file's unit, xyzt_units), where the samples start (vox_offset) and a
- * scaling (scl_slope, scl_inter) that is reported, never applied. The samples are then read as
+ * scaling (scl_slope, scl_inter), kept as the volume's rescale (with no unit: NIfTI names none
+ * for the values), never applied to the samples. The samples are then read as
  * raw data from vox_offset, or as a gzip stream whose first vox_offset bytes are skipped.
  * The orientation comes from the sform when sform_code > 0, else from the qform when
  * qform_code > 0 (RAS space); the samples keep their storage order either way. The standard
@@ -260,7 +261,8 @@ static ip_status check_offset(const char *path, const nifti_header *n, ip_error 
     return IP_OK;
 }
 
-/* scl_slope 0 (or not a number) means no scaling; slope 1 and intercept 0 change nothing. */
+/* scl_slope 0 (or not a number) means no scaling; slope 1 and intercept 0 change nothing. The
+ * values' unit stays "" (set_defaults()). */
 static void report_rescale(const nifti_header *n, ip_input_desc *desc)
 {
     if (!isfinite(n->slope) || n->slope == 0.0 || !isfinite(n->intercept))

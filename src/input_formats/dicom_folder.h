@@ -25,6 +25,7 @@ typedef struct dicom_slice {
     double pixel_spacing[2]; /* between rows (y), between columns (x); mm */
     double position[3], orientation[6];
     double slope, intercept;
+    char unit[IP_RESCALE_UNIT_MAX]; /* of the rescaled values (input_dicom.c's rescale_unit()) */
     double along; /* position along the slice normal, mm (set by ip__dicom_grid_plan) */
 } dicom_slice;
 

@@ -85,6 +85,7 @@ const field_tag dataset_fields[] = {
     {IP_DICOM_PIXEL_REPRESENTATION, 0x0028, 0x0103},
     {IP_DICOM_RESCALE_INTERCEPT, 0x0028, 0x1052},
     {IP_DICOM_RESCALE_SLOPE, 0x0028, 0x1053},
+    {IP_DICOM_RESCALE_TYPE, 0x0028, 0x1054},
 };
 
 // The transfer syntax as the file's meta header spells it, whether the library knows it or not.

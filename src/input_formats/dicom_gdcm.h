@@ -33,6 +33,7 @@ typedef enum ip_dicom_field {
     IP_DICOM_PIXEL_REPRESENTATION, /* (0028,0103) 0 unsigned, 1 two's complement */
     IP_DICOM_RESCALE_INTERCEPT,    /* (0028,1052) */
     IP_DICOM_RESCALE_SLOPE,        /* (0028,1053) */
+    IP_DICOM_RESCALE_TYPE,         /* (0028,1054) the rescaled values' unit: HU, OD, US, ... */
     IP_DICOM_FIELD_COUNT
 } ip_dicom_field;
 

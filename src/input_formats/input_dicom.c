@@ -69,6 +69,7 @@ static const char *const field_names[IP_DICOM_FIELD_COUNT] = {
     [IP_DICOM_PIXEL_REPRESENTATION] = "Pixel Representation (0028,0103)",
     [IP_DICOM_RESCALE_INTERCEPT] = "Rescale Intercept (0028,1052)",
     [IP_DICOM_RESCALE_SLOPE] = "Rescale Slope (0028,1053)",
+    [IP_DICOM_RESCALE_TYPE] = "Rescale Type (0028,1054)",
 };
 
 /* `count` numbers of field `f` into out (`fallback` for each when the field is absent and
@@ -207,6 +208,23 @@ static ip_status check_orientation(const char *path, const double o[6], ip_error
     return IP_OK;
 }
 
+/* The unit of the rescaled values: the Rescale Type when it names one (1 to
+ * IP_RESCALE_UNIT_MAX - 1 printable characters, other than US, "unspecified"), else "HU" for
+ * a CT (whose rescale gives Hounsfield units), else "" (unknown). */
+static void rescale_unit(const ip_dicom_header *h, char unit[IP_RESCALE_UNIT_MAX])
+{
+    const char *type = h->value[IP_DICOM_RESCALE_TYPE];
+    size_t n = strlen(type);
+    int usable = n > 0 && n < IP_RESCALE_UNIT_MAX && strcmp(type, "US") != 0;
+    for (size_t i = 0; usable && i < n; i++)
+        usable = type[i] >= 0x20 && type[i] <= 0x7e;
+    if (usable)
+        memcpy(unit, type, n + 1); /* n < IP_RESCALE_UNIT_MAX */
+    else
+        snprintf(unit, IP_RESCALE_UNIT_MAX, "%s",
+                 strcmp(h->value[IP_DICOM_MODALITY], "CT") == 0 ? "HU" : "");
+}
+
 /* The geometry, type and rescale of one file (its header h), each checked on its own. */
 ip_status ip__dicom_read_slice(const char *path, const ip_dicom_header *h, dicom_slice *slice,
                                ip_error *err)
@@ -226,7 +244,9 @@ ip_status ip__dicom_read_slice(const char *path, const ip_dicom_header *h, dicom
         (st = check_orientation(path, slice->orientation, err)) != IP_OK ||
         (st = field_numbers(path, h, IP_DICOM_RESCALE_SLOPE, &slice->slope, 1, 1, err)) != IP_OK)
         return st;
-    return field_numbers(path, h, IP_DICOM_RESCALE_INTERCEPT, &slice->intercept, 1, 0, err);
+    st = field_numbers(path, h, IP_DICOM_RESCALE_INTERCEPT, &slice->intercept, 1, 0, err);
+    rescale_unit(h, slice->unit);
+    return st;
 }
 /* ---- the slices together ---- */
 
@@ -253,7 +273,8 @@ static const char *difference(const dicom_slice *first, const dicom_slice *slice
         return "a different pixel spacing";
     if (!same_numbers(slice->orientation, first->orientation, 6, ORIENTATION_TOLERANCE))
         return "a different orientation";
-    if (slice->slope != first->slope || slice->intercept != first->intercept)
+    if (slice->slope != first->slope || slice->intercept != first->intercept ||
+        strcmp(slice->unit, first->unit) != 0)
         return "a different rescale";
     return NULL;
 }
@@ -333,10 +354,11 @@ static void fill_desc(const dicom_read *r, const ip_input_overrides *overrides, 
     if (!ip__text_overridden(BY_SPACING, overrides))
         memcpy(desc->spacing, g->spacing, sizeof desc->spacing);
     desc->orientation = g->orientation;
-    /* the identity says nothing worth reporting */
-    desc->has_rescale = first->slope != 1.0 || first->intercept != 0.0;
+    /* the identity without a unit says nothing worth keeping */
+    desc->has_rescale = first->slope != 1.0 || first->intercept != 0.0 || first->unit[0] != '\0';
     desc->rescale_slope = first->slope;
     desc->rescale_intercept = first->intercept;
+    memcpy(desc->rescale_unit, first->unit, sizeof desc->rescale_unit);
     copy_text(desc->series_uid, sizeof desc->series_uid, r->folder.series[r->picked].uid);
     desc->series_count = r->folder.series_count;
     desc->skipped_objects =

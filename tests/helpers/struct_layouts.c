@@ -38,7 +38,13 @@ static void error_and_input(void)
     FIELD(ip_input_desc, source_slices);
     FIELD(ip_input_desc, resampled);
     FIELD(ip_input_desc, tilt_degrees);
+    FIELD(ip_input_desc, rescale_unit);
     FIELD(ip_input_desc, reserved);
+    SIZE(ip_rescale);
+    FIELD(ip_rescale, present);
+    FIELD(ip_rescale, slope);
+    FIELD(ip_rescale, intercept);
+    FIELD(ip_rescale, unit);
     SIZE(ip_orientation);
     FIELD(ip_orientation, origin);
     FIELD(ip_orientation, directions);
@@ -122,6 +128,7 @@ static void layout(void)
     FIELD(ip_layout, file_size);
     FIELD(ip_layout, levels);
     FIELD(ip_layout, format_version);
+    FIELD(ip_layout, rescale);
 }
 
 static void cache(void)
@@ -215,6 +222,7 @@ static void constants(void)
     CONSTANT(IP_PREFETCH_OFF);
     CONSTANT(IP_PREFETCH_ON);
     CONSTANT(IP_PREFETCH_ALWAYS);
+    CONSTANT(IP_RESCALE_UNIT_MAX);
 }
 
 int main(void)

@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # DICOM series end to end: isobrick bricks a series written by the tests (shuffled file order,
 # transfer syntaxes by turns: explicit and implicit VR little endian, explicit VR big endian,
-# RLE) to the same samples as the raw volume it was made from, reports the rescale, and refuses
-# a broken series in one line naming it. A folder as scanners write it (a DIRFILE, a report and
+# RLE) to the same samples as the raw volume it was made from, reports and keeps the rescale (a
+# CT's: Hounsfield units, as the raw volume bricked with --rescale 1,-1024,HU), and refuses a
+# broken series in one line naming it. A folder as scanners write it (a DIRFILE, a report and
 # a presentation state beside two series in subfolders, one with a gantry tilt): the objects
 # skipped and counted, the series listed, refused without a pick, picked; the tilted series
 # resampled so that its surface lies where the ball it images is, or refused when asked; a
@@ -15,15 +16,18 @@ raw=volume_40x36x13_int16.raw
 run_capture "$bin/isobrick" series -o dicom.ibv --brick-size 8 --threads 2
 check "isobrick bricks the series folder ($err)" test "$rc" = 0
 check "the summary reports the rescale" grep -qF "stored x 1 - 1024" "$work/.out"
-run_capture "$bin/isobrick" "$raw" -o raw.ibv --brick-size 8 --threads 2 --spacing 0.8,0.7,2.5
+run_capture "$bin/isobrick" "$raw" -o plain.ibv --brick-size 8 --threads 2 --spacing 0.8,0.7,2.5
 check "isobrick bricks the raw volume" test "$rc" = 0
 check "no rescale for raw input" sh -c '! grep -q rescale "$0"' "$work/.out"
+run_capture "$bin/isobrick" "$raw" -o raw.ibv --brick-size 8 --threads 2 --spacing 0.8,0.7,2.5 \
+    --rescale 1,-1024,HU
+check "isobrick bricks the raw volume with the CT's rescale" test "$rc" = 0
 
 run_capture "$bin/isobrick" series/ --quiet
 check "a folder's default output is bricks/FOLDER.ibv" test -s bricks/series.ibv
 
-# the same dims, type, spacing and value range; the file name and the physical space aside,
-# the same description
+# the same dims, type, spacing, value range and rescale; the file name and the physical space
+# aside, the same description
 "$bin/isoinfo" --json dicom.ibv >dicom_space.json
 strip_space() { sed 's/"file": "[^"]*", //; s/"origin": .*"space": [^,]*, //' "$1"; }
 "$bin/isoinfo" --json raw.ibv >raw_space.json
@@ -37,16 +41,23 @@ check "the origin is the first slice's position" \
 check "raw input has no physical space" \
     grep -qF '"origin": [0, 0, 0], "directions": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "space": null' \
     raw_space.json
+check "the series keeps its rescale" grep -qF \
+    '"rescale": {"slope": 1, "intercept": -1024, "unit": "HU"}' dicom.json
 check "the spacing comes from the headers" grep -q '"spacing": \[0.8000.*, 0.6999.*, 2.5\]' dicom.json
 check "isoinfo --verify passes" "$bin/isoinfo" --verify dicom.ibv
 
 # the same samples: every cell's triangles, extracted in one thread, byte for byte
-# (the series' mesh lies in its LPS space: the raw volume's moved by the origin)
+# (the series' mesh lies in its LPS space: the raw volume's moved by the origin); 476.5 HU is
+# the stored value 1500.5
 for f in dicom raw; do
-    "$bin/isorender" "$f.ibv" --iso 1500.5 --full --threads 1 --software --size 64x48 \
+    "$bin/isorender" "$f.ibv" --iso 476.5 --full --threads 1 --software --size 64x48 \
         --mesh "$f.ply" -o "$f.png" --quiet --no-weld
     "$bin/tests/ply_triangles" "$f.ply" >"$f.txt"
 done
+"$bin/isorender" plain.ibv --iso 1500.5 --full --threads 1 --software --size 64x48 \
+    -o plain.png --quiet
+check "476.5 HU draws what the stored value 1500.5 draws without a rescale" \
+    cmp -s dicom.png plain.png
 check "a surface was extracted" test -s dicom.txt
 check "the same triangles from the series as from the raw volume, moved" python3 -c '
 a = [l.split() for l in open("raw.txt")]
@@ -114,7 +125,10 @@ check "a prefix of one UID picks it ($err)" test "$rc" = 0
 check "the summary says the tilt and the resampling" grep -qF \
     "resampled   gantry tilt of 18.5 degrees: the sheared slices resampled onto a regular 40x50x13 grid" \
     "$work/.out"
-"$bin/isorender" tilted.ibv --iso 1600.5 --full --threads 1 --software --size 64x48 \
+check "the resampled series keeps its rescale" sh -c \
+    '"$0" --json tilted.ibv | grep -qF "\"rescale\": {\"slope\": 1, \"intercept\": -1024, \"unit\": \"HU\"}"' \
+    "$bin/isoinfo"
+"$bin/isorender" tilted.ibv --iso-stored 1600.5 --full --threads 1 --software --size 64x48 \
     --mesh tilted.ply -o tilted.png --quiet --no-weld
 "$bin/tests/ply_triangles" tilted.ply >tilted.txt
 check "the tilted ball's surface lies where the ball is" python3 -c '

@@ -2,8 +2,10 @@
 # TIFF and NIfTI input end to end: a raw volume written again as a multi-page TIFF, a folder of
 # TIFF files, a NIfTI-1 .nii.gz and a big-endian NIfTI-2 .nii (tests/helpers/make_formats.c)
 # bricks to the same file as the raw volume itself: the same samples, and the same spacing,
-# read from ImageJ's calibration and from pixdim. The brick file stores no source name, so
-# equal samples and spacing make equal files. Then the usual breakages, one line each.
+# read from ImageJ's calibration and from pixdim (and for the NIfTI files their scl_slope 2 and
+# scl_inter -10, as isobrick --rescale 2,-10 gives the raw volume). The brick file stores no
+# source name, so equal samples, spacing and rescale make equal files. Then the usual
+# breakages, one line each.
 . "$(dirname "$0")/lib.sh"
 
 "$bin/isogen" shepp-logan --dims 45x38x27 --type int16 -o "$work/" --quiet
@@ -13,30 +15,46 @@ check "make_formats writes the files" "$bin/tests/make_formats" "$raw" formats 0
 
 run_capture "$bin/isobrick" "$raw" -o raw.ibv --brick-size 8 --threads 2 --spacing 0.5,0.5,1.25
 check "the raw volume bricks" test "$rc" = 0
+run_capture "$bin/isobrick" "$raw" -o raw_scaled.ibv --brick-size 8 --threads 2 \
+    --spacing 0.5,0.5,1.25 --rescale 2,-10
+check "the raw volume bricks with the NIfTI files' rescale" test "$rc" = 0
 for input in formats/stack.tif formats/slices formats/volume.nii.gz formats/volume_be.nii; do
     name=$(basename "$input" | tr . _)
     run_capture "$bin/isobrick" "$input" -o "$name.ibv" --brick-size 8 --threads 2
     check "$input bricks ($err)" test "$rc" = 0
-    check "$input bricks to the raw volume's file" cmp -s raw.ibv "$name.ibv"
-    check "$input verifies" "$bin/isoinfo" --verify "$name.ibv"
     case $input in
-    *.nii*) check "$input: the scaling is reported" \
-        grep -q "rescale     values stand for stored x 2 - 10; samples and iso values are in stored units" \
-        "$work/.out" ;;
-    *) check "$input: no scaling to report" sh -c '! grep -q rescale "$0"' "$work/.out" ;;
+    *.nii*)
+        check "$input: the scaling is reported and kept" grep -qF \
+            "rescale     value = stored x 2 - 10, kept: --iso in rescaled values, --iso-stored in stored values" \
+            "$work/.out"
+        check "$input bricks to the raw volume's file with its rescale" \
+            cmp -s raw_scaled.ibv "$name.ibv"
+        ;;
+    *)
+        check "$input: no scaling to report" sh -c '! grep -q rescale "$0"' "$work/.out"
+        check "$input bricks to the raw volume's file" cmp -s raw.ibv "$name.ibv"
+        ;;
     esac
+    check "$input verifies" "$bin/isoinfo" --verify "$name.ibv"
 done
+run_capture "$bin/isoinfo" --json volume_nii_gz.ibv
+check "isoinfo --json: the NIfTI's rescale, no unit" grep -qF \
+    '"rescale": {"slope": 2, "intercept": -10, "unit": ""}' "$work/.out"
 run_capture "$bin/isoinfo" --json stack_tif.ibv
 check "spacing from ImageJ" grep -q '"spacing": \[0.5, 0.5, 1.25\]' "$work/.out"
 
-# the same extraction from each: one mesh, byte for byte
-for name in raw stack_tif volume_be_nii; do
-    run_capture "$bin/isorender" "$name.ibv" --iso 0.5 --full --threads 1 --size 64x64 \
-        -o "$name.png" --mesh "$name.ply"
-    check "isorender --full on $name" test "$rc" = 0
+# the same extraction from each: one mesh, byte for byte (the NIfTI's isovalue in its rescaled
+# values, 2 x 0.5 - 10 = -9, or as the stored value 0.5)
+for run in "raw --iso 0.5" "stack_tif --iso 0.5" "volume_be_nii --iso -9" \
+    "volume_nii_gz --iso-stored 0.5"; do
+    set -- $run
+    run_capture "$bin/isorender" "$1.ibv" "$2" "$3" --full --threads 1 --size 64x64 \
+        -o "$1.png" --mesh "$1.ply"
+    check "isorender --full on $1" test "$rc" = 0
 done
 check "the TIFF's mesh is the raw volume's" cmp -s raw.ply stack_tif.ply
-check "the NIfTI's mesh is the raw volume's" cmp -s raw.ply volume_be_nii.ply
+check "the NIfTI's mesh at -9 is the raw volume's at 0.5" cmp -s raw.ply volume_be_nii.ply
+check "the NIfTI's mesh at stored 0.5 is the raw volume's" cmp -s raw.ply volume_nii_gz.ply
 
 # --- breakages: one line naming the file, exit 1, no output ---
 mv formats/slices/slice7.tif formats/slice7.tif

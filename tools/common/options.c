@@ -129,11 +129,16 @@ int tool_option_background(const char *p, const tool_option *opt, const char *co
 
 /* ---- the shared options (base: the tool_view_options) ---- */
 
+/* --iso V and --iso-stored V alike, each noting which was given. */
 static int parse_iso(const char *p, const tool_option *opt, const char *const *v, void *base)
 {
     tool_view_options *o = base;
     if (tool_option_number(p, opt, v, base) != 0)
         return 2;
+    if (!strcmp(opt->name, "--iso-stored"))
+        o->iso_given_stored = 1;
+    else
+        o->iso_given_units = 1;
     if (o->iso_count < TOOL_MAX_ISOS)
         o->isos[o->iso_count] = o->iso;
     o->iso_count++;
@@ -294,6 +299,7 @@ static int parse_camera(const char *p, const tool_option *opt, const char *const
 
 static const tool_option view_options[] = {
     {"--iso", NULL, 1, VIEW_FIELD(iso), parse_iso, "is not a number", NULL},
+    {"--iso-stored", NULL, 1, VIEW_FIELD(iso), parse_iso, "is not a number", NULL},
     {"--size", NULL, 1, 0, parse_size_option, NULL, NULL},
     {"--view", NULL, 1, VIEW_FIELD(view), parse_view, NULL, NULL},
     {"--camera", NULL, 1, VIEW_FIELD(camera), parse_camera, NULL, NULL},
@@ -334,8 +340,24 @@ int tool_parse_view_command_line(const char *program, const char *usage, tool_vi
     if (!*file)
         return tool_usage_error(program, "no brick file");
     if (!o->iso_count)
-        return tool_usage_error(program, "--iso V is required");
+        return tool_usage_error(program, "--iso V is required (or --iso-stored V)");
+    if (o->iso_given_stored && o->iso_given_units)
+        return tool_usage_error(program,
+                                "--iso and --iso-stored do not mix: give every isovalue in the "
+                                "file's units (--iso) or every one as a stored value");
     return 0;
+}
+
+void tool_settle_iso(tool_view_options *o, const ip_layout *layout)
+{
+    o->rescale = &layout->rescale;
+    if (o->iso_given_stored) {
+        o->iso_stored = o->iso;
+        o->iso_value = ip_rescale_to_value(o->rescale, o->iso);
+    } else {
+        o->iso_value = o->iso;
+        o->iso_stored = ip_rescale_to_stored(o->rescale, o->iso);
+    }
 }
 
 ip_status tool_full_extraction(ip_cache *cache, double iso, int mode, const ip_camera *camera,

@@ -2,6 +2,7 @@
 /* What the programs print and write: JSON, byte counts, cache statistics, --stats files. */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "tool_common.h"
 
@@ -19,15 +20,48 @@ void tool_json_string(FILE *out, const char *text)
     fputc('"', out);
 }
 
+const char *tool_rescale_text(char *buf, size_t size, const ip_rescale *r)
+{
+    snprintf(buf, size, "%s = stored x %g %c %g", r->unit[0] ? r->unit : "value", r->slope,
+             r->intercept < 0 ? '-' : '+', fabs(r->intercept));
+    return buf;
+}
+
 void tool_print_rescale(FILE *out, const ip_input_desc *desc)
 {
     if (!desc->has_rescale)
         return;
-    double intercept = desc->rescale_intercept;
-    fprintf(out,
-            "  rescale     values stand for stored x %g %c %g; samples and iso values are in "
-            "stored units\n",
-            desc->rescale_slope, intercept < 0 ? '-' : '+', fabs(intercept));
+    ip_rescale r = {1, desc->rescale_slope, desc->rescale_intercept, ""};
+    memcpy(r.unit, desc->rescale_unit, sizeof r.unit);
+    r.unit[sizeof r.unit - 1] = '\0';
+    char text[96];
+    fprintf(out, "  rescale     %s, kept: --iso in %s, --iso-stored in stored values\n",
+            tool_rescale_text(text, sizeof text, &r), r.unit[0] ? r.unit : "rescaled values");
+}
+
+void tool_value_range(const ip_rescale *r, double lo, double hi, double out[2])
+{
+    double a = ip_rescale_to_value(r, lo), b = ip_rescale_to_value(r, hi);
+    out[0] = a <= b ? a : b;
+    out[1] = a <= b ? b : a;
+}
+
+const char *tool_unit_suffix(const ip_rescale *r, char *buf, size_t size)
+{
+    snprintf(buf, size, "%s%s", r && r->present && r->unit[0] ? " " : "",
+             r && r->present ? r->unit : "");
+    return buf;
+}
+
+void tool_write_rescale_json(FILE *out, const ip_rescale *r)
+{
+    if (!r || !r->present) {
+        fprintf(out, "null");
+        return;
+    }
+    fprintf(out, "{\"slope\": %.17g, \"intercept\": %.17g, \"unit\": ", r->slope, r->intercept);
+    tool_json_string(out, r->unit);
+    fprintf(out, "}");
 }
 
 const char *tool_format_bytes(char *buf, size_t size, double bytes)
@@ -168,10 +202,12 @@ void tool_write_run_json(FILE *f, const tool_run_json *j)
     const ip_engine_counts *t = j->counts;
     fprintf(f, "\"file\": ");
     tool_json_string(f, j->file);
-    fprintf(f,
-            ", \"iso\": %.9g, \"mode\": \"%s\", \"width\": %u, \"height\": %u, "
-            "\"renderer\": \"%s\"",
-            j->iso,
+    fprintf(f, ", \"iso\": %.9g", j->iso);
+    if (j->rescale && j->rescale->present) {
+        fprintf(f, ", \"iso_stored\": %.9g, \"rescale\": ", j->iso_stored);
+        tool_write_rescale_json(f, j->rescale);
+    }
+    fprintf(f, ", \"mode\": \"%s\", \"width\": %u, \"height\": %u, \"renderer\": \"%s\"",
             j->full == TOOL_FULL_LOD ? "full-lod"
             : j->full == TOOL_FULL   ? "full"
                                      : "progressive",
@@ -200,20 +236,24 @@ void tool_write_run_json(FILE *f, const tool_run_json *j)
             j->rendering_seconds, j->extraction_wall_seconds, j->progress_render_seconds);
 }
 
-int tool_warn_iso_range(const char *program, const ip_store *store, double iso, char *warning,
-                        size_t warning_size)
+int tool_warn_iso_range(const char *program, const ip_store *store, const tool_view_options *o,
+                        char *warning, size_t warning_size)
 {
     const ip_layout *l = ip_store_layout(store);
     if (warning && warning_size)
         warning[0] = '\0';
-    float v = (float)iso; /* the isovalue as the engine takes it */
+    float v = (float)o->iso_stored; /* the isovalue as the engine takes it */
     if (v > l->value_min && v <= l->value_max)
         return 0;
-    char text[512];
+    const ip_rescale *r = o->iso_given_stored ? NULL : o->rescale; /* the range as given */
+    double range[2];
+    char unit[IP_RESCALE_UNIT_MAX + 1], text[512];
+    tool_value_range(r, l->value_min, l->value_max, range);
     snprintf(text, sizeof text,
-             "--iso %g is outside the value range of %s, %g .. %g: there "
+             "--iso%s %g is outside the value range of %s, %g .. %g%s: there "
              "is no surface (an isovalue must be above the minimum and at most the maximum)",
-             iso, ip_store_path(store), (double)l->value_min, (double)l->value_max);
+             o->iso_given_stored ? "-stored" : "", o->iso, ip_store_path(store), range[0], range[1],
+             tool_unit_suffix(r, unit, sizeof unit));
     fprintf(stderr, "%s: warning: %s\n", program, text);
     if (warning && warning_size)
         snprintf(warning, warning_size, "%s", text);

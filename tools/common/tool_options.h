@@ -9,6 +9,7 @@
 #include "isoprop/cache.h"
 #include "isoprop/camera.h"
 #include "isoprop/engine.h"
+#include "isoprop/layout.h"
 #include "isoprop/status.h"
 #include "tool_command_line.h"
 
@@ -44,12 +45,17 @@ tool_option_parse tool_option_background;
 /* The options isorender and isoview share: what to extract, from where, and how, and the
  * statistics file, --force and --quiet. */
 typedef struct tool_view_options {
-    double iso;
-    /* every --iso in order (iso is the last), the first TOOL_MAX_ISOS of them; iso_count
-     * counts them all */
+    double iso; /* as given: in the file's units (--iso) or stored (--iso-stored) */
+    /* every --iso (or --iso-stored) in order (iso is the last), the first TOOL_MAX_ISOS of
+     * them; iso_count counts them all */
     double isos[TOOL_MAX_ISOS];
     unsigned iso_count;
-    uint32_t width, height; /* pixels */
+    int iso_given_stored, iso_given_units; /* --iso-stored was given; --iso was */
+    /* iso as the file's rescale has it (tool_settle_iso()): the stored value the engine
+     * extracts, the value in the file's units (the same without a rescale), the rescale */
+    double iso_stored, iso_value;
+    const ip_rescale *rescale; /* the open store's; NULL before tool_settle_iso() */
+    uint32_t width, height;    /* pixels */
     /* --view NAME (NULL: the file's default, ip_view_default()), --camera E,T,U,FOV in the
      * file's physical space (NULL: none) */
     const char *view, *camera;
@@ -76,6 +82,13 @@ typedef struct tool_view_options {
     int force, quiet;
     int verbose; /* --verbose (-v): what each step did, on stderr */
 } tool_view_options;
+
+/* The --help lines of --iso and --iso-stored (the usage texts of isorender, isoview and
+ * isowall include them). */
+#define TOOL_ISO_OPTIONS_HELP                                                                    \
+    "  --iso V             the isovalue, in the file's units where it has a rescale (HU for a\n" \
+    "                      DICOM CT; isoinfo shows the rescale), else a stored sample value\n"   \
+    "  --iso-stored V      the isovalue as a stored sample value, instead of --iso\n"
 
 /* The --help lines of --view and --camera (isorender, isoview, isowall). */
 #define TOOL_VIEW_OPTIONS_HELP                                                                   \
@@ -132,11 +145,18 @@ void tool_engine_options(const tool_view_options *o, ip_engine_options *eo);
 tool_option_table tool_view_option_table(tool_view_options *o);
 
 /* The command line of isorender and isoview: the shared view options and the program's
- * own table (over own_base), one brick file (*file). The file and --iso are required ("no
- * brick file", "--iso V is required"). Returns 0, or 2 after a usage error. */
+ * own table (over own_base), one brick file (*file). The file and --iso (or --iso-stored) are
+ * required ("no brick file", "--iso V is required"), and the two do not mix. Returns 0, or 2
+ * after a usage error. */
 int tool_parse_view_command_line(const char *program, const char *usage, tool_view_options *o,
                                  const tool_option *own, size_t own_count, void *own_base,
                                  const char **file, int argc, char **argv);
+
+/* Settles o->iso (as given) against the rescale of `layout` (the open store's, which must
+ * outlive o): o->iso_stored, the stored value the engine extracts, and o->iso_value, the value
+ * in the file's units, one from the other through ip_rescale_to_stored() or
+ * ip_rescale_to_value(); o->rescale. Without a rescale all three are o->iso. Idempotent. */
+void tool_settle_iso(tool_view_options *o, const ip_layout *layout);
 
 /* What a run extracts (tool_run_json.full, isorender's o.full): the progressive run, the full
  * extraction (--full, a flag: 1) or the full extraction at adaptive resolution (--full-lod). */

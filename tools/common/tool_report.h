@@ -21,9 +21,22 @@ void tool_json_string(FILE *out, const char *text);
 const char *tool_format_bytes(char *buf, size_t size, double bytes);
 
 /* When the input says its values stand for stored x slope + intercept (DICOM rescale, NIfTI
- * scl_slope/scl_inter), prints that on `out` as an indented summary line, with the reminder that
- * samples, and so iso values, stay in stored units. Prints nothing otherwise. */
+ * scl_slope/scl_inter), prints that on `out` as an indented summary line, with the unit that
+ * isovalues are then given in (--iso-stored takes stored values). Prints nothing otherwise. */
 void tool_print_rescale(FILE *out, const ip_input_desc *desc);
+
+/* `r` as text: "HU = stored x 1 - 1024" ("value = ..." without a unit), into buf. */
+const char *tool_rescale_text(char *buf, size_t size, const ip_rescale *r);
+
+/* The stored range lo .. hi in r's units, lowest first (a negative slope swaps the ends). */
+void tool_value_range(const ip_rescale *r, double lo, double hi, double out[2]);
+
+/* " HU" (a space, then r's unit), or "" when r has no rescale or no unit: after a value. */
+const char *tool_unit_suffix(const ip_rescale *r, char *buf, size_t size);
+
+/* Writes r as the JSON value {"slope": S, "intercept": I, "unit": U}, or null when r (may be
+ * NULL) has no rescale. */
+void tool_write_rescale_json(FILE *out, const ip_rescale *r);
 
 /* Prints the cache statistics as a short human-readable table (on exit of every tool that
  * reads bricks). `summary_bytes` is the size of the file's summary section. */
@@ -35,7 +48,7 @@ void tool_write_cache_json(FILE *out, const ip_cache_stats *s, uint64_t summary_
 /* What isorender and isoview write about a run in --stats (members after "cache"). */
 typedef struct tool_run_json {
     const char *file;
-    double iso;
+    double iso;              /* in the file's units: options->iso_value, or isoview's value */
     int full;                /* TOOL_PROGRESSIVE, TOOL_FULL or TOOL_FULL_LOD */
     const ip_camera *camera; /* in the file's physical space (tool_space_physical()) */
     const char *renderer;    /* "opengl", "software", "none" */
@@ -43,9 +56,12 @@ typedef struct tool_run_json {
     int warm, done;
     const ip_engine_counts *counts;
     double rendering_seconds, extraction_wall_seconds, progress_render_seconds;
+    double iso_stored;         /* the stored value extracted */
+    const ip_rescale *rescale; /* the file's (may be NULL) */
 } tool_run_json;
 
-/* Writes the run's members ("file" .. "time"; without braces) as JSON. */
+/* Writes the run's members ("file" .. "time"; without braces) as JSON; with a rescale, after
+ * "iso" (in the file's units), "iso_stored" and "rescale". */
 void tool_write_run_json(FILE *out, const tool_run_json *j);
 
 /* Writes {"cache": {...}} plus, when extra is not NULL, the members that extra(out, user)
@@ -55,11 +71,12 @@ void tool_write_run_json(FILE *out, const tool_run_json *j);
 int tool_write_stats_file(const char *program, const char *path, int force, const ip_cache_stats *s,
                           uint64_t summary_bytes, void (*extra)(FILE *out, void *user), void *user);
 
-/* Warns (one line on stderr, "PROGRAM: warning: ...") when `iso` cannot cross the file's
- * value range (a cell is active when min < iso <= max), so that the image is legitimately
- * empty. `warning` (may be NULL) receives the warning's text, "" when none. Returns 1 when it
- * warned, else 0. */
-int tool_warn_iso_range(const char *program, const ip_store *store, double iso, char *warning,
-                        size_t warning_size);
+/* Warns (one line on stderr, "PROGRAM: warning: ...") when o's isovalue (settled:
+ * tool_settle_iso()) cannot cross the file's value range (a cell is active when
+ * min < stored iso <= max), so that the image is legitimately empty; the message gives the
+ * value and the range as given (in the file's units, or stored with --iso-stored). `warning`
+ * (may be NULL) receives the warning's text, "" when none. Returns 1 when it warned, else 0. */
+int tool_warn_iso_range(const char *program, const ip_store *store, const tool_view_options *o,
+                        char *warning, size_t warning_size);
 
 #endif

@@ -60,13 +60,13 @@ static int extract_progressive(run *r, ip_error *err)
     if (create_engine(r, err) != 0)
         return -1;
     if (r->o.warm) { /* the same work once, untimed: the bricks it needs stay in the cache */
-        if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK ||
+        if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso_stored, err) != IP_OK ||
             ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
             return -1;
     }
     strip_plan_rays(r);
     double start = ip_now_seconds(); /* a view's time counts its set-up (the coverage buffer) */
-    if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK)
+    if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso_stored, err) != IP_OK)
         return -1;
     uint64_t target = 1, limit = r->o.common.rays ? r->o.common.rays : UINT64_MAX;
     tool_progress bar;
@@ -106,8 +106,8 @@ static int extract_progressive(run *r, ip_error *err)
 /* --full (level 0) or --full-lod (the view's levels, each in its band) into r->full_mesh. */
 static ip_status full_extraction(run *r, ip_engine_counts *counts, ip_error *err)
 {
-    return tool_full_extraction(r->cache, r->o.common.iso, r->o.full, &r->camera, &r->o.common,
-                                &r->full_mesh, counts, err);
+    return tool_full_extraction(r->cache, r->o.common.iso_stored, r->o.full, &r->camera,
+                                &r->o.common, &r->full_mesh, counts, err);
 }
 
 int extract_full(run *r, ip_error *err)

@@ -162,8 +162,8 @@ int main(int argc, char **argv)
         /* the errors above come first: a bad command line is one line, not a warning too */
         for (size_t i = 0; i <= r.other_count; i++) {
             run *s = surface_run(&r, i);
-            tool_warn_iso_range("isorender", r.store, s->o.common.iso, s->warning,
-                                sizeof s->warning);
+            tool_settle_iso(&s->o.common, ip_store_layout(r.store));
+            tool_warn_iso_range("isorender", r.store, &s->o.common, s->warning, sizeof s->warning);
         }
         if (r.o.turntable)
             rc = turntable_run(&r, &err);

@@ -11,7 +11,7 @@ static const char usage[] =
     "Extracts the isosurface V progressively (rays in the paper's order) and renders it to PNG\n"
     "with OpenGL 3.3 core through EGL (no display needed). --iso given up to 4 times draws as\n"
     "many surfaces together, each extracted by its own progressive run with the same view\n"
-    "and options (see --color and --opacity).\n"
+    "and options (see --color and --opacity); --iso-stored alike.\n" TOOL_ISO_OPTIONS_HELP
     "  --size WxH          image size in pixels (default 1600x1200)\n" TOOL_VIEW_OPTIONS_HELP
         TOOL_ORBIT_OPTIONS_HELP
     "  --color C           the surface colour: R,G,B (each 0 to 1) or #rrggbb (default\n"
@@ -175,13 +175,15 @@ static int parse_opacity(const char *program, const tool_option *option, const c
 static int check_surface_options(const options *o)
 {
     unsigned n = o->common.iso_count;
+    const char *iso = o->common.iso_given_stored ? "--iso-stored" : "--iso";
     if (n > TOOL_MAX_ISOS)
-        return tool_usage_error("isorender", "--iso given %u times: at most %d surfaces", n,
+        return tool_usage_error("isorender", "%s given %u times: at most %d surfaces", iso, n,
                                 TOOL_MAX_ISOS);
     for (unsigned i = 0; i < n; i++)
         for (unsigned j = 0; j < i; j++)
             if ((float)o->common.isos[i] == (float)o->common.isos[j])
-                return tool_usage_error("isorender", "--iso %g is given twice", o->common.isos[i]);
+                return tool_usage_error("isorender", "%s %g is given twice", iso,
+                                        o->common.isos[i]);
     if (o->colour_count > n || o->opacity_count > n)
         return tool_usage_error("isorender",
                                 "%zu --color and %zu --opacity for %u --iso: at most one of each "

@@ -97,7 +97,7 @@ void progress_csv(FILE *f, void *user)
                     (unsigned long long)k->cells, (unsigned long long)k->triangles, k->final_pct,
                     (unsigned long long)k->visible, overdraw(k->triangles, k->visible));
             if (r->other_count)
-                fprintf(f, ",%.9g", s->o.common.iso);
+                fprintf(f, ",%.9g", s->o.common.iso_value);
             fprintf(f, "\n");
         }
     }
@@ -126,13 +126,16 @@ static void json_surfaces(FILE *f, const run *r)
         const ip_engine_counts *t = &s->totals;
         ip_surface look;
         surface_of(r, i, NULL, views, &look);
+        fprintf(f, "%s{\"iso\": %.9g", i ? ", " : "", s->o.common.iso_value);
+        if (s->o.common.rescale && s->o.common.rescale->present)
+            fprintf(f, ", \"iso_stored\": %.9g", s->o.common.iso_stored);
         fprintf(f,
-                "%s{\"iso\": %.9g, \"color\": \"#%02x%02x%02x\", \"opacity\": %g, "
+                ", \"color\": \"#%02x%02x%02x\", \"opacity\": %g, "
                 "\"rays\": %llu, \"done\": %s, \"seeds\": %llu, \"cells\": %llu, "
                 "\"triangles\": %llu, \"extraction_wall_s\": %.6f",
-                i ? ", " : "", s->o.common.iso, (unsigned)lround(255 * look.colour[0]),
-                (unsigned)lround(255 * look.colour[1]), (unsigned)lround(255 * look.colour[2]),
-                (double)look.opacity, (unsigned long long)t->rays,
+                (unsigned)lround(255 * look.colour[0]), (unsigned)lround(255 * look.colour[1]),
+                (unsigned)lround(255 * look.colour[2]), (double)look.opacity,
+                (unsigned long long)t->rays,
                 s->o.full || (s->engine && ip_engine_done(s->engine)) ? "true" : "false",
                 (unsigned long long)t->seeds, (unsigned long long)t->cells,
                 (unsigned long long)t->triangles, s->extraction_wall);
@@ -154,7 +157,7 @@ void json_counts(FILE *f, void *user)
     ip_camera physical; /* the camera as the file's space states it */
     tool_space_physical(&r->space, &r->camera, &physical);
     const tool_run_json j = {r->o.file,
-                             r->o.common.iso,
+                             r->o.common.iso_value,
                              r->o.full,
                              &physical,
                              r->renderer_name ? r->renderer_name : "none",
@@ -164,7 +167,9 @@ void json_counts(FILE *f, void *user)
                              &r->totals,
                              r->totals.rendering_seconds,
                              r->extraction_wall,
-                             r->progress_render_seconds};
+                             r->progress_render_seconds,
+                             r->o.common.iso_stored,
+                             r->o.common.rescale};
     tool_write_run_json(f, &j);
     json_quality(f, r);
     if (r->o.scale_bar) {
@@ -227,7 +232,9 @@ static void print_counts(FILE *out, const run *s, const run *r)
 void print_summary(FILE *out, const run *r)
 {
     if (!r->other_count) {
-        fprintf(out, "%s: iso %g, %s, %ux%u\n", r->o.file, r->o.common.iso,
+        char unit[IP_RESCALE_UNIT_MAX + 1];
+        fprintf(out, "%s: iso %g%s, %s, %ux%u\n", r->o.file, r->o.common.iso_value,
+                tool_unit_suffix(r->o.common.rescale, unit, sizeof unit),
                 r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
         print_counts(out, r, r);
     } else {
@@ -235,7 +242,7 @@ void print_summary(FILE *out, const run *r)
                 r->o.full ? "full extraction" : "progressive", r->camera.width, r->camera.height);
         for (size_t i = 0; i <= r->other_count; i++) {
             char iso[32];
-            iso_text(surface_run_c(r, i)->o.common.iso, iso, sizeof iso);
+            iso_text(surface_run_c(r, i)->o.common.iso_value, iso, sizeof iso);
             fprintf(out, "  surface %zu     iso %s\n", i + 1, iso);
             print_counts(out, surface_run_c(r, i), r);
         }

@@ -74,7 +74,7 @@ static int turntable_extract_one(run *r, ip_error *err)
     if (create_engine(r, err) != 0)
         return -1;
     double start = ip_now_seconds();
-    if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso, err) != IP_OK ||
+    if (ip_engine_begin(r->engine, &r->camera, (float)r->o.common.iso_stored, err) != IP_OK ||
         ip_engine_step(r->engine, r->o.common.rays, r->o.common.time_limit, NULL, err) != IP_OK)
         return -1;
     r->extraction_wall = ip_now_seconds() - start;

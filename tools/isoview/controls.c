@@ -24,14 +24,25 @@ void change_view(viewer *v)
 
 /* A paused viewer would otherwise keep showing the old isovalue's surface under the new
  * value: the new surface is what the change asks to see, so refinement resumes. */
-void change_iso(viewer *v, double iso)
+static void set_iso(viewer *v, double iso, double stored)
 {
     v->iso = iso;
+    v->iso_stored = stored;
     v->restart = 1;
     if (v->paused) {
         v->paused = 0;
         show_message(v, "refinement resumed for the new isovalue");
     }
+}
+
+void change_iso(viewer *v, double iso)
+{
+    set_iso(v, iso, ip_rescale_to_stored(v->o.common.rescale, iso));
+}
+
+void change_iso_stored(viewer *v, double stored)
+{
+    set_iso(v, ip_rescale_to_value(v->o.common.rescale, stored), stored);
 }
 
 void set_clip(viewer *v, int on)

@@ -34,6 +34,7 @@ typedef enum command_kind {
     COMMAND_CAMERA,
     COMMAND_VIEW,
     COMMAND_ISO,
+    COMMAND_ISO_STORED,
     COMMAND_ORBIT,
     COMMAND_ZOOM,
     COMMAND_WAIT,
@@ -129,9 +130,10 @@ typedef struct viewer {
     overlay text;
     tool_space space; /* the file's physical space: the views, the planes, the image */
     double lo[3], hi[3];
-    float value_min, value_max;
+    double value_min, value_max;   /* the file's value range, in its units (lowest first) */
     ip_camera camera;              /* in world units, as the engine and the renderers take it */
-    double iso;                    /* the engine takes it as a float */
+    double iso;                    /* in the file's units (as stored without a rescale) */
+    double iso_stored;             /* the same as a stored value: the engine takes it as a float */
     int restart;                   /* the view or the isovalue changed: begin again */
     uint64_t uploaded;             /* triangles of the engine's mesh on the GPU */
     uint64_t passes;               /* ip_engine_begin() calls */
@@ -222,7 +224,10 @@ void free_commands(viewer *v);
 int camera_from(viewer *v, const char *camera_text, const char *view, ip_camera *out,
                 ip_error *err);
 void change_view(viewer *v);
+/* A new isovalue: `iso` in the file's units, or (change_iso_stored()) a stored value; each
+ * also sets the other through the file's rescale. */
 void change_iso(viewer *v, double iso);
+void change_iso_stored(viewer *v, double stored);
 /* Moves the eye toward the target: the distance is divided by `factor`. */
 void zoom_view(viewer *v, double factor);
 /* Turns the --clip planes on or off (a new pass with them or without them; refinement

@@ -185,7 +185,7 @@ static int begin_pass(viewer *v)
         v->pass_camera[1] = v->camera;
         v->fine_passes++;
     }
-    if (ip_engine_begin(v->engine, &v->camera, (float)v->iso, &v->err) != IP_OK)
+    if (ip_engine_begin(v->engine, &v->camera, (float)v->iso_stored, &v->err) != IP_OK)
         return -1;
     return 0;
 }
@@ -287,7 +287,7 @@ static int extract_full(viewer *v)
     clip_options(v, &common);
     int mode = common.lod ? TOOL_FULL_LOD : TOOL_FULL;
     double start = ip_now_seconds();
-    if (tool_full_extraction(v->cache, v->iso, mode, &v->camera, &common, &v->full_mesh,
+    if (tool_full_extraction(v->cache, v->iso_stored, mode, &v->camera, &common, &v->full_mesh,
                              &v->full_counts, &v->err) != IP_OK)
         return -1;
     v->full_wall = ip_now_seconds() - start;
@@ -639,7 +639,9 @@ static void json_counts(FILE *f, void *user)
                              &t,
                              full ? v->pass_render : t.rendering_seconds,
                              full ? v->full_wall : v->pass_wall,
-                             0.0};
+                             0.0,
+                             v->iso_stored,
+                             v->o.common.rescale};
     tool_write_run_json(f, &j);
     if (done)
         fprintf(f, ", \"final_pixel_pct\": %.4f", 100.0);
@@ -666,7 +668,9 @@ static void print_summary(const viewer *v)
         t = v->full_counts;
     else
         ip_engine_totals(v->engine, &t);
-    printf("%s: iso %g, %s, %ux%u\n", v->o.file, v->iso,
+    char unit[IP_RESCALE_UNIT_MAX + 1];
+    printf("%s: iso %g%s, %s, %ux%u\n", v->o.file, v->iso,
+           tool_unit_suffix(v->o.common.rescale, unit, sizeof unit),
            !v->full_shown                   ? "progressive"
            : v->full_shown == TOOL_FULL_LOD ? "full extraction at adaptive resolution"
                                             : "full extraction",
@@ -738,8 +742,13 @@ static int prepare(viewer *v)
     memcpy(v->lo, v->space.lo, sizeof v->lo);
     memcpy(v->hi, v->space.hi, sizeof v->hi);
     tool_space_clip(&v->space, &v->o.common);
-    v->value_min = l->value_min;
-    v->value_max = l->value_max;
+    tool_settle_iso(&v->o.common, l);
+    v->iso = v->o.common.iso_value;
+    v->iso_stored = v->o.common.iso_stored;
+    double range[2];
+    tool_value_range(v->o.common.rescale, l->value_min, l->value_max, range);
+    v->value_min = range[0];
+    v->value_max = range[1];
     v->camera.width = v->o.common.width;
     v->camera.height = v->o.common.height;
     if (camera_from(v, v->o.common.camera, v->o.common.view, &v->camera, err) != 0)
@@ -751,7 +760,7 @@ static int prepare(viewer *v)
     v->clip_on = v->o.common.clip_count > 0;
     if (create_engine(v, err) != 0)
         return -1;
-    tool_warn_iso_range("isoview", v->store, v->o.common.iso, NULL, 0);
+    tool_warn_iso_range("isoview", v->store, &v->o.common, NULL, 0);
     return 0;
 }
 
@@ -769,7 +778,6 @@ int main(int argc, char **argv)
     }
     ip_error_clear(&v->err);
     ip_mesh_init(&v->full_mesh);
-    v->iso = v->o.common.iso;
     v->overlay_mode = OVERLAY_COMPACT;
     v->drag_button = -1;
     v->restart = 1;

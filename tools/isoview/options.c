@@ -9,7 +9,7 @@
 static const char usage[] =
     "usage: isoview FILE.ibv --iso V [options]\n"
     "Shows the isosurface V in a window (OpenGL 3.3 core through GLFW), refining it\n"
-    "progressively (rays in the paper's order) while you orbit, pan, zoom and change V.\n"
+    "progressively (rays in the paper's order) while you orbit, pan, zoom and change V.\n" TOOL_ISO_OPTIONS_HELP
     "  --size WxH          window size (default 1280x960)\n" TOOL_VIEW_OPTIONS_HELP
     "  --rays N            each pass (view and isovalue) stops after N rays\n"
     "  --time SECONDS      each pass stops extracting after this long\n" TOOL_ENGINE_OPTIONS_HELP

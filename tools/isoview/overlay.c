@@ -229,13 +229,15 @@ static void iso_line(viewer *v, char *text, size_t size, int working_on_full, in
                  pass_limit_reached(v) == 1 ? "--rays" : "--time");
     /* with --clip: whether the planes apply (the key c) */
     const char *clip = !v->o.common.clip_count ? "" : v->clip_on ? "  [clip on]" : "  [clip off]";
+    char unit[IP_RESCALE_UNIT_MAX + 1]; /* " HU" with a rescale that names its unit */
+    tool_unit_suffix(v->o.common.rescale, unit, sizeof unit);
     if (v->typing)
         snprintf(text, size, "iso> %s_  (Enter applies, Esc cancels)", v->typed);
     else if (detailed)
-        snprintf(text, size, "iso %.7g  (values %.7g .. %.7g)%s%s", v->iso, (double)v->value_min,
-                 (double)v->value_max, state, clip);
+        snprintf(text, size, "iso %.7g%s  (values %.7g .. %.7g%s)%s%s", v->iso, unit, v->value_min,
+                 v->value_max, unit, state, clip);
     else
-        snprintf(text, size, "iso %.7g%s%s", v->iso, state, clip);
+        snprintf(text, size, "iso %.7g%s%s%s", v->iso, unit, state, clip);
 }
 
 /* The compact heads-up text: two lines, the isovalue and the state, then the pass's progress,
@@ -245,7 +247,7 @@ static int compact_text(viewer *v, char *text, size_t size, int working_on_full)
     ip_engine_counts t;
     ip_engine_totals(v->engine, &t);
     double pixels = (double)v->camera.width * v->camera.height;
-    char iso[96], overdraw[32], rays[32];
+    char iso[192], overdraw[32], rays[32];
     iso_line(v, iso, sizeof iso, working_on_full, 0);
     if (v->full_shown)
         snprintf(rays, sizeof rays, "full");
@@ -269,7 +271,7 @@ static int detailed_text(viewer *v, char *text, size_t size, int working_on_full
     ip_cache_get_stats(v->cache, &s);
     double pixels = (double)v->camera.width * v->camera.height;
     uint64_t lookups = s.hits + s.misses;
-    char iso[96], progress[160], overdraw[32];
+    char iso[192], progress[160], overdraw[32];
     iso_line(v, iso, sizeof iso, working_on_full, 1);
     if (v->full_shown)
         snprintf(progress, sizeof progress,

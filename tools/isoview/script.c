@@ -5,7 +5,8 @@
  *
  *     camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fov   set the camera (physical units, degrees)
  *     view NAME                               anterior .. inferior, +x .. -z, as --view
- *     iso V                                   set the isovalue
+ *     iso V                                   set the isovalue (in the file's units)
+ *     iso-stored V                            set the isovalue as a stored sample value
  *     orbit DX_DEGREES DY_DEGREES             orbit around the target, as a mouse drag does
  *     drag DX DY SECONDS                      orbit by DX, DY degrees smoothly over SECONDS,
  *                                             frame by frame, as a mouse drag does (waits)
@@ -78,10 +79,10 @@ static int parse_command(viewer *v, char *line, command *c, ip_error *err)
         if (camera_from(v, NULL, arg1, &probe, err) != 0)
             return -1;
         c->kind = COMMAND_VIEW;
-    } else if (!strcmp(word, "iso")) {
+    } else if (!strcmp(word, "iso") || !strcmp(word, "iso-stored")) {
         if (args != 1 || tool_parse_double(arg1, &c->a) != 0)
             goto arguments;
-        c->kind = COMMAND_ISO;
+        c->kind = word[3] ? COMMAND_ISO_STORED : COMMAND_ISO;
     } else if (!strcmp(word, "orbit")) {
         if (args != 2 || tool_parse_double(arg1, &c->a) != 0 || tool_parse_double(arg2, &c->b))
             goto arguments;
@@ -253,6 +254,7 @@ void run_script(viewer *v, double t)
             change_view(v);
             break;
         case COMMAND_ISO: change_iso(v, c->a); break;
+        case COMMAND_ISO_STORED: change_iso_stored(v, c->a); break;
         case COMMAND_ORBIT:
             tool_space_orbit(&v->space, &v->camera, c->a, c->b);
             change_view(v);

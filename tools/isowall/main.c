@@ -564,8 +564,13 @@ static void fill_stats(FILE *out, void *user)
     const ip_camera *c = &physical;
     fprintf(out, "{\n  \"program\": \"isowall\",\n  \"file\": ");
     tool_json_string(out, r->o.file);
+    fprintf(out, ",\n  \"iso\": %.9g", r->o.common.iso_value);
+    if (r->o.common.rescale && r->o.common.rescale->present) {
+        fprintf(out, ",\n  \"iso_stored\": %.9g,\n  \"rescale\": ", r->o.common.iso_stored);
+        tool_write_rescale_json(out, r->o.common.rescale);
+    }
     fprintf(out,
-            ",\n  \"iso\": %.9g,\n  \"width\": %u,\n  \"height\": %u,\n"
+            ",\n  \"width\": %u,\n  \"height\": %u,\n"
             "  \"wall\": [%u, %u],\n  \"tile\": [%u, %u],\n  \"unit\": [%u, %u],\n"
             "  \"camera\": [%.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g],\n"
             "  \"processes\": %d,\n  \"static\": %s,\n  \"regions\": %u,\n  \"passes\": 2,\n"
@@ -575,12 +580,11 @@ static void fill_stats(FILE *out, void *user)
             "  \"coarse_s\": %.6f,\n  \"extraction_s\": %.6f,\n  \"time_s\": %.6f,\n"
             "  \"threads\": %u,\n  \"lod\": %s,\n  \"occlusion\": %s,\n  \"prefetch\": %s,\n"
             "  \"ranks\": [",
-            r->o.common.iso, c->width, c->height, w->cols, w->rows, w->tile_w, w->tile_h,
-            r->o.unit_w, r->o.unit_h, c->eye[0], c->eye[1], c->eye[2], c->target[0], c->target[1],
-            c->target[2], c->up[0], c->up[1], c->up[2], c->fov_y, r->ranks,
-            r->o.is_static ? "true" : "false", w->region_count, sum_of(v, REC_UNITS),
-            sum_of(v, REC_RAYS), sum_of(v, REC_SEEDS), sum_of(v, REC_CELLS),
-            sum_of(v, REC_TRIANGLES), sum_of(v, REC_BYTES),
+            c->width, c->height, w->cols, w->rows, w->tile_w, w->tile_h, r->o.unit_w, r->o.unit_h,
+            c->eye[0], c->eye[1], c->eye[2], c->target[0], c->target[1], c->target[2], c->up[0],
+            c->up[1], c->up[2], c->fov_y, r->ranks, r->o.is_static ? "true" : "false",
+            w->region_count, sum_of(v, REC_UNITS), sum_of(v, REC_RAYS), sum_of(v, REC_SEEDS),
+            sum_of(v, REC_CELLS), sum_of(v, REC_TRIANGLES), sum_of(v, REC_BYTES),
             (unsigned long long)r->composite.tiles_drawn, sum_of(v, REC_BUSY), max_of(v, REC_BUSY),
             balance_of(v), r->coarse_seconds, r->extraction_seconds, r->total_seconds,
             r->o.common.threads, r->o.common.lod ? "true" : "false",
@@ -670,20 +674,22 @@ static int open_run(wall_run *r)
     wall_watch_stage("opening the brick file");
     int failed = ip_store_open(r->o.file, &r->store, &err) != IP_OK;
     if (!failed)
+        tool_settle_iso(&r->o.common, ip_store_layout(r->store));
+    if (!failed)
         failed = ip_cache_create(r->store, r->o.common.cache_bytes, &r->cache, &err) != IP_OK ||
                  setup_layout(r, &err) != 0;
     if (!failed) {
         ip_engine_options eo;
         tool_engine_options(&r->o.common, &eo);
-        failed =
-            ip_engine_create(r->cache, &eo, &r->engine, &err) != IP_OK ||
-            ip_engine_begin(r->engine, &r->layout.camera, (float)r->o.common.iso, &err) != IP_OK;
+        failed = ip_engine_create(r->cache, &eo, &r->engine, &err) != IP_OK ||
+                 ip_engine_begin(r->engine, &r->layout.camera, (float)r->o.common.iso_stored,
+                                 &err) != IP_OK;
     }
     wall_watch_stage("waiting for every process to open the brick file");
     if (report_first_failure(r, failed, &err))
         return 1;
     if (r->rank == 0)
-        tool_warn_iso_range(r->program, r->store, r->o.common.iso, NULL, 0);
+        tool_warn_iso_range(r->program, r->store, &r->o.common, NULL, 0);
     size_t bytes = r->rank == 0 ? 2 * (size_t)r->ranks * sizeof(uint64_t) : 0;
     wall_watch_stage("making the window of shares with every process");
     /* an MPI whose one-sided component cannot work beside the watchdog's thread (OpenMPI 4's

@@ -17,7 +17,7 @@ static const char usage[] =
     "rays with its own engine and cache over the same brick file. A first pass casts every\n"
     "region's coarse rays (the whole wall's coarse image), a second the rest, each process on\n"
     "the regions it took in the first. Each process draws its triangles into the tiles they\n"
-    "touch (software rasterizer); per tile, the nearest surface wins.\n"
+    "touch (software rasterizer); per tile, the nearest surface wins.\n" TOOL_ISO_OPTIONS_HELP
     "  --wall CxR          display tiles across and down (required)\n"
     "  --tile WxH          pixels of a display tile (required); the image is C*W x R*H\n"
     "  --unit WxH          pixels of a screen region, inside a tile (default: an eighth of the\n"
