@@ -32,9 +32,16 @@ def type_code(dtype):
                         % (dtype,)) from None
 
 
-def _overrides(dims, dtype, spacing, endian):
-    """The ip_input_overrides of checked arguments (dims and spacing lists, dtype a code)."""
+REGRID_DEFAULT, REGRID_RESAMPLE, REGRID_REFUSE = 0, 1, 2  # ip_regrid (input.h)
+
+
+def _overrides(dims, dtype, spacing, endian, dicom=None):
+    """The ip_input_overrides of checked arguments (dims and spacing lists, dtype a code;
+    dicom: (series bytes or None, tilt, uneven) as _check_dicom() gives them)."""
     o = S.InputOverrides()
+    o.size = ctypes.sizeof(S.InputOverrides)  # this layout, DICOM choices included (IP_SIZED)
+    if dicom is not None:
+        o.series, o.tilt, o.uneven = dicom
     if dims is not None:
         o.has_dims, o.dims[:] = 1, dims
     if dtype is not None:
@@ -53,6 +60,21 @@ def _options(brick_size, subblock_size, lz4_level, threads, mem_mb, force):
     o.brick_edge, o.subblock_edge, o.lz4_level = brick_size, subblock_size, lz4_level
     o.threads, o.memory_limit, o.force = threads, mem_mb << 20, int(force)
     return o
+
+
+def _check_dicom(series, correct_tilt, even_spacing):
+    """A DICOM folder's choices as ip_input_overrides takes them: (series, tilt, uneven)."""
+    if series is not None:
+        if not isinstance(series, str):
+            raise TypeError("series: must be a str (a Series Instance UID, or a prefix of one "
+                            "only), not %s" % C.describe(series))
+        if not series or not series.isascii() or len(series) > 64:
+            raise ArgumentError("series: %r is not a Series Instance UID (1 to 64 characters)"
+                                % series)
+        series = series.encode("ascii")
+    tilt = REGRID_DEFAULT if C.flag("correct_tilt", correct_tilt) else REGRID_REFUSE
+    uneven = REGRID_RESAMPLE if C.flag("even_spacing", even_spacing) else REGRID_DEFAULT
+    return series, tilt, uneven
 
 
 def _check_rescale(rescale):
@@ -181,7 +203,7 @@ def _array_input(a, out):
 
 def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, rescale=None,
           brick_size=32, subblock_size=8, hc=None, threads=0, mem_mb=0, force=False,
-          progress=None):
+          progress=None, series=None, correct_tilt=True, even_spacing=False):
     """Bricks a volume into the brick file `out` and returns the report (a dict: input_bytes,
     file_bytes, bricks, levels, seconds, peak_rss, ...).
 
@@ -193,6 +215,11 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, resc
     in unit (isobrick --rescale: (1, -1024, "HU")), in place of what the input says (a DICOM
     series' or NIfTI file's rescale); False: none; None (the default): the input's. The file
     keeps it: isovalues are then given in its units (open(out).rescale).
+    A DICOM folder (isobrick DIR): series picks one of several series by its Series Instance
+    UID (or a prefix of one only; isobrick DIR --list-series lists them); correct_tilt=False
+    refuses a series sheared by a gantry tilt instead of resampling it (isobrick
+    --no-correct-tilt); even_spacing=True resamples unevenly spaced slices instead of refusing
+    them (--even-spacing). docs/dicom.md.
     brick_size, subblock_size, hc (True or an LZ4HC level), threads, mem_mb and force are
     isobrick's options. Every argument is checked first: TypeError or isoprop.ArgumentError
     (a ValueError) naming it. Raises isoprop.Error (the output is then not written), or an
@@ -216,9 +243,10 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, resc
                        C.whole("threads", threads, 0, C.MAX_BRICK_THREADS),
                        C.whole("mem_mb", mem_mb, 0, C.MAX_MEM_MB), C.flag("force", force))
     C.callable_or_none("progress", progress)
+    dicom = _check_dicom(series, correct_tilt, even_spacing)
     if not is_path:
-        given = [n for n, v in (("dims", dims), ("dtype", dtype), ("endian", endian))
-                 if v is not None]
+        given = [n for n, v in (("dims", dims), ("dtype", dtype), ("endian", endian),
+                                ("series", series)) if v is not None]
         if given:
             raise ArgumentError("%s: not with an array, which gives its own dims, dtype and "
                                 "byte order (pass only spacing)" % given[0])
@@ -233,5 +261,5 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, resc
             raise
         finally:
             os.unlink(tmp)
-    return _run(source, out, _overrides(dims, code, spacing, endian), options, progress,
+    return _run(source, out, _overrides(dims, code, spacing, endian, dicom), options, progress,
                 rescale)

@@ -134,5 +134,54 @@ class Brick(unittest.TestCase):
         self.assertEqual(listing(), before)
 
 
+class DicomFolder(unittest.TestCase):
+    """A DICOM folder as scanners write it (make_dicom): several series picked by series=, a
+    gantry tilt resampled or refused (correct_tilt=), as isobrick does."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = support.work("dicom")
+        os.makedirs(cls.dir, exist_ok=True)
+        support.tool("tests/make_dicom", cls.dir)
+        listing = support.tool("isobrick", os.path.join(cls.dir, "scanner"), "--list-series")
+        cls.uids = [line.split()[0] for line in listing.splitlines()
+                    if line and line[0].isdigit()]
+
+    def test_series_picked(self):
+        self.assertEqual(len(self.uids), 2, self.uids)
+        scanner = os.path.join(self.dir, "scanner")
+        with self.assertRaisesRegex(isoprop.Error, "series"):
+            isoprop.brick(scanner, support.work("several.ibv"))
+        self.assertFalse(os.path.exists(support.work("several.ibv")))
+        for k, uid in enumerate(self.uids):
+            out = support.work("series%d.ibv" % k)
+            isoprop.brick(scanner, out, series=uid, force=True)
+            self.assertEqual(support.isoinfo(out)["dims"][2] > 0, True)
+        # the series alone and picked from the scanner's folder give the same file
+        alone = support.work("alone.ibv")
+        isoprop.brick(os.path.join(self.dir, "series"), alone, force=True)
+        picked = [support.work("series%d.ibv" % k) for k in range(2)]
+        same = [open(alone, "rb").read() == open(p, "rb").read() for p in picked]
+        self.assertEqual(sorted(same), [False, True])
+
+    def test_tilt(self):
+        tilted = os.path.join(self.dir, "tilted")
+        with self.assertRaisesRegex(isoprop.Error, "tilt"):
+            isoprop.brick(tilted, support.work("refused.ibv"), correct_tilt=False)
+        self.assertFalse(os.path.exists(support.work("refused.ibv")))
+        isoprop.brick(tilted, support.work("tilted.ibv"), force=True)
+        self.assertTrue(os.path.exists(support.work("tilted.ibv")))
+
+    def test_bad_arguments(self):
+        with self.assertRaises(TypeError):
+            isoprop.brick(self.dir, support.work("x.ibv"), series=1)
+        with self.assertRaises(isoprop.ArgumentError):
+            isoprop.brick(self.dir, support.work("x.ibv"), series="")
+        with self.assertRaises(isoprop.ArgumentError):
+            isoprop.brick(np.zeros((2, 2, 2), np.uint8), support.work("x.ibv"), series="1.2")
+        with self.assertRaises(TypeError):
+            isoprop.brick(self.dir, support.work("x.ibv"), correct_tilt="no")
+
+
 if __name__ == "__main__":
     support.main()
