@@ -4,7 +4,8 @@
  *   extract FILE.ibv ISO [--full] [--size WxH] [--threads N] [--mesh OUT.ply]
  *
  * Opens a brick file (made by isobrick), keeps its bricks in a cache, and extracts the
- * isosurface ISO: progressively, for a camera on the -y side of the volume, until every pixel
+ * isosurface ISO (in the file's units where it has a rescale, HU for a CT, as isorender
+ * --iso): progressively, for a camera on the -y side of the volume, until every pixel
  * of a WxH image (640x480 by default) has had its ray; or, with --full, every active cell.
  * Prints the number of triangles and writes the mesh (binary PLY, binary STL, OBJ or glTF,
  * by the extension) in the volume's physical space, which the file names. It links
@@ -22,7 +23,7 @@
 
 typedef struct request {
     const char *brick_file, *mesh_file;
-    float iso;
+    double iso; /* in the file's units (HU for a CT), as isorender --iso */
     int full;
     unsigned threads; /* 0: every core */
     unsigned width, height;
@@ -65,7 +66,7 @@ static int parse(int argc, char **argv, request *q)
             q->brick_file = a;
             positional++;
         } else if (positional == 1) {
-            q->iso = strtof(a, &end);
+            q->iso = strtod(a, &end);
             if (*end != '\0')
                 return usage("ISO must be a number");
             positional++;
@@ -76,10 +77,18 @@ static int parse(int argc, char **argv, request *q)
     return positional == 2 ? 0 : usage("FILE.ibv and ISO are required");
 }
 
+/* The isovalue as the engine takes it, a stored value: ISO is in the file's units where the
+ * file has a rescale (stored x slope + intercept, e.g. Hounsfield units), as isorender --iso. */
+static float stored_iso(const ip_store *store, double iso)
+{
+    const ip_rescale *r = &ip_store_layout(store)->rescale;
+    return (float)(r->present ? (iso - r->intercept) / r->slope : iso);
+}
+
 /* Every ray of the view, in the paper's progressive order. The engine owns the mesh;
  * *engine is the caller's to destroy, also on failure. */
-static ip_status extract_progressive(ip_cache *cache, const request *q, ip_engine **engine,
-                                     ip_error *err)
+static ip_status extract_progressive(ip_cache *cache, const request *q, float iso,
+                                     ip_engine **engine, ip_error *err)
 {
     ip_engine_options options;
     ip_engine_options_default(&options);
@@ -93,7 +102,7 @@ static ip_status extract_progressive(ip_cache *cache, const request *q, ip_engin
     ip_layout_world_box(ip_store_layout(ip_cache_store(cache)), lo, hi);
     st = ip_camera_fit_axis(lo, hi, "-y", 30.0, q->width, q->height, &camera, err);
     if (st == IP_OK)
-        st = ip_engine_begin(*engine, &camera, q->iso, err);
+        st = ip_engine_begin(*engine, &camera, iso, err);
     /* Each step casts the next rays; an interactive program would draw
      * ip_engine_mesh() between steps and stop early when the view changes. */
     while (st == IP_OK && !ip_engine_done(*engine))
@@ -134,9 +143,9 @@ static ip_status run(const request *q, ip_error *err)
     if (st == IP_OK)
         st = ip_cache_create(store, ip_cache_default_budget(), &cache, err);
     if (st == IP_OK && q->full) {
-        st = ip_extract_full(cache, q->iso, 0, q->threads, &full, NULL, err);
+        st = ip_extract_full(cache, stored_iso(store, q->iso), 0, q->threads, &full, NULL, err);
     } else if (st == IP_OK) {
-        st = extract_progressive(cache, q, &engine, err);
+        st = extract_progressive(cache, q, stored_iso(store, q->iso), &engine, err);
         mesh = ip_engine_mesh(engine);
     }
     if (st == IP_OK) {

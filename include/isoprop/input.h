@@ -97,7 +97,9 @@ typedef struct ip_input_overrides {
     int big_endian;
     int has_spacing;
     double spacing[3];
-    /* A DICOM folder (after 0.2.0; zero keeps the defaults): */
+    /* A DICOM folder (after 0.2.0; zero keeps the defaults). Read only when `size` covers
+     * them (IP_SIZED(ip_input_overrides)): a size of 0 stands for 0.2.0's layout, which has
+     * none, so they are then ignored. */
     const char *series; /* the Series Instance UID, or a prefix of one only, of the series to
                            read from a folder holding several; NULL: the folder must hold one.
                            Not copied: valid during ip_input_describe() */
@@ -176,7 +178,7 @@ typedef struct ip_dicom_series_info {
 } ip_dicom_series_info;
 
 /*! ip_dicom_list_series() : the series of the DICOM folder `folder` (its subfolders included),
- *  in order of their UIDs, into *out (count entries, owned by the caller, released with
+ *  in the order of their first files by name, into *out (count entries, owned by the caller, released with
  *  free()); *skipped (may be NULL) receives the number of DICOM objects that are not images.
  *  A series that cannot be read is listed with its problem; a file that is not DICOM, or
  *  whose series cannot be told, fails the call.
