@@ -153,8 +153,12 @@ run_tests() {
     echo "== AddressSanitizer + UndefinedBehaviorSanitizer (clang, Debug), fuzzers included"
     CC=clang CXX=clang++ configure_and_build build-asan -DCMAKE_BUILD_TYPE=Debug -DIP_WERROR=ON \
         -DIP_SANITIZE=address,undefined -DIP_FUZZ=ON
-    run_ctest build-asan "ASAN_OPTIONS=detect_leaks=1" --output-on-failure -j "$jobs" ||
-        status=1
+    # intercept_tls_get_addr=0: LeakSanitizer's walk of the dynamic TLS blocks it tracks met
+    # a bogus one (and crashed, "Tracer caught signal 11") at the exit of isobrick after the
+    # dlopen'd input component refused a tilted DICOM series (tool_dicom); leaks are still
+    # found through the heap, the stacks and static TLS
+    run_ctest build-asan "ASAN_OPTIONS=detect_leaks=1:intercept_tls_get_addr=0" \
+        --output-on-failure -j "$jobs" || status=1
     { echo "  build-asan (clang, ASan + UBSan):"; skip_report build-asan; } >>"$skips"
     echo "== ThreadSanitizer (clang): the threaded tests"
     CC=clang CXX=clang++ configure_and_build build-tsan -DIP_WERROR=ON -DIP_SANITIZE=thread
