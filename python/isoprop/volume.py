@@ -115,9 +115,12 @@ class _Run:
             given, (a, b) = ((self.iso_stored, (lo, hi)) if stored or not f.rescale
                              else (self.iso, f.value_range))
             unit = " " + f.rescale.unit if f.rescale and f.rescale.unit and not stored else ""
+            reversed_ = bool(f.rescale) and f.rescale.slope < 0 and not stored
+            rule = ("at least the minimum and below the maximum" if reversed_
+                    else "above the minimum and at most the maximum")
             text = ("iso %g%s is outside the value range of %s, %g .. %g%s: there is no "
-                    "surface (an isovalue must be above the minimum and at most the maximum)"
-                    % (given, " (stored)" if stored else "", f.path, a, b, unit))
+                    "surface (an isovalue must be %s)"
+                    % (given, " (stored)" if stored else "", f.path, a, b, unit, rule))
             self.warnings.append(text)
             warnings.warn(text, RuntimeWarning, stacklevel=4)
 

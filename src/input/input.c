@@ -471,14 +471,22 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
     return describe_from_name(path, overrides, desc, found, err);
 }
 
-/* A series is picked from a DICOM folder only. */
+/* A series is picked, and a tilt or uneven spacing is resampled or refused, in a DICOM folder
+ * only: asked of another input, the choice is refused rather than ignored. */
 static ip_status check_series_asked(const ip_input_overrides *overrides, const ip_input_desc *desc,
                                     ip_error *err)
 {
-    if (overrides && overrides->series && desc->encoding != IP_ENCODING_DICOM)
+    if (!overrides || desc->encoding == IP_ENCODING_DICOM)
+        return IP_OK;
+    if (overrides->series)
         return ip__fail(err, IP_ERR_ARGUMENT,
                         "%s: a DICOM series was asked for, but this is not a folder of DICOM "
                         "files",
+                        desc->path);
+    if (overrides->tilt != IP_REGRID_DEFAULT || overrides->uneven != IP_REGRID_DEFAULT)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "%s: a gantry tilt or slice spacing choice was given, but this is not a "
+                        "folder of DICOM files",
                         desc->path);
     return IP_OK;
 }

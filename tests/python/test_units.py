@@ -7,6 +7,7 @@ without one reads as before."""
 import json
 import os
 import unittest
+import warnings
 
 import support  # first: it skips (status 77) when numpy is absent
 import numpy as np
@@ -114,6 +115,21 @@ class Units(unittest.TestCase):
         with isoprop.open(out) as f:
             self.assertEqual(f.rescale, isoprop.Rescale(2.0, -3.0, ""))
             self.assertEqual(f.value_range, (-3.0, 197.0))
+
+    def test_negative_slope_range_rule(self):
+        """With a negative slope the units run against the stored values: the maximum in units
+        is the stored minimum, which has no surface, and the warning says the rule that way."""
+        out = support.work("flipped.ibv")
+        isoprop.brick(self.series, out, brick_size=8, rescale=(-1, 1024, "negHU"), force=True)
+        with isoprop.open(out) as f:
+            lo, hi = f.value_range
+            self.assertLess(lo, hi)
+            with self.assertWarns(RuntimeWarning) as caught:
+                f.extract(hi, full=True, threads=1)
+            self.assertIn("at least the minimum and below the maximum", str(caught.warning))
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                self.assertGreater(len(f.extract(lo, full=True, threads=1)), 0)
 
     def test_bad_arguments(self):
         out = support.work("bad.ibv")

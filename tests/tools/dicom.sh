@@ -87,6 +87,10 @@ check "no output after a stranger" test ! -e s.ibv
 # a slice missing: refused naming the option, resampled with it
 expect_error 1 "gap: a slice is missing between IM0003.dcm (at -30 mm) and IM0007.dcm (at -25 mm): 5 mm apart, 2.0 times the slice spacing 2.5 mm (isobrick --even-spacing resamples them onto an even grid)" \
     "$bin/isobrick" gap -o gap.ibv
+expect_error 1 "$raw: a gantry tilt or slice spacing choice was given, but this is not a folder of DICOM files" \
+    "$bin/isobrick" "$raw" --even-spacing -o notdicom.ibv
+expect_error 1 "$raw: a DICOM series was asked for, but this is not a folder of DICOM files" \
+    "$bin/isobrick" "$raw" --series 1.2 -o notdicom.ibv
 run_capture "$bin/isobrick" gap -o gap.ibv --even-spacing --quiet
 check "--even-spacing bricks the series with a slice missing" test "$rc" = 0
 "$bin/isoinfo" --json gap.ibv >gap.json 2>/dev/null

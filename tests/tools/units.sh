@@ -136,6 +136,13 @@ check "a negative slope: --iso 500 is stored 524, the same triangles" \
 run_capture "$bin/isoinfo" flipped.ibv
 check "a negative slope: the range lowest first ($out)" grep -qF \
     "value range   -933 .. 1000 negHU (stored 24 .. 1957)" "$work/.out"
+# a negative slope turns the rule around: stored 24 (1000 negHU) has no surface, 1957 (-933) has
+run_capture render flipped.ibv --iso 1000 -o edge_hi.png
+check "a negative slope: the maximum warns, with the rule turned around ($err)" \
+    grep -qF "(an isovalue must be at least the minimum and below the maximum)" "$work/.err"
+run_capture render flipped.ibv --iso -933 -o edge_lo.png
+check "a negative slope: the minimum does not warn ($err)" sh -c '! grep -q warning "$0"' \
+    "$work/.err"
 expect_error 2 "--rescale '1' is not SLOPE,INTERCEPT[,UNIT] or none" "$bin/isobrick" "$raw" \
     --rescale 1 -o bad.ibv
 expect_error 2 "slope 0 is not a finite number other than 0" "$bin/isobrick" "$raw" \

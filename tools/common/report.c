@@ -249,11 +249,14 @@ int tool_warn_iso_range(const char *program, const ip_store *store, const tool_v
     double range[2];
     char unit[IP_RESCALE_UNIT_MAX + 1], text[512];
     tool_value_range(r, l->value_min, l->value_max, range);
+    int reversed = r && r->present && r->slope < 0; /* units run against the stored values */
     snprintf(text, sizeof text,
              "--iso%s %g is outside the value range of %s, %g .. %g%s: there "
-             "is no surface (an isovalue must be above the minimum and at most the maximum)",
+             "is no surface (an isovalue must be %s)",
              o->iso_given_stored ? "-stored" : "", o->iso, ip_store_path(store), range[0], range[1],
-             tool_unit_suffix(r, unit, sizeof unit));
+             tool_unit_suffix(r, unit, sizeof unit),
+             reversed ? "at least the minimum and below the maximum"
+                      : "above the minimum and at most the maximum");
     fprintf(stderr, "%s: warning: %s\n", program, text);
     if (warning && warning_size)
         snprintf(warning, warning_size, "%s", text);
