@@ -473,8 +473,8 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
 
 /* A series is picked, and a tilt or uneven spacing is resampled or refused, in a DICOM folder
  * only: asked of another input, the choice is refused rather than ignored. */
-static ip_status check_series_asked(const ip_input_overrides *overrides, const ip_input_desc *desc,
-                                    ip_error *err)
+static ip_status check_dicom_choices(const ip_input_overrides *overrides, const ip_input_desc *desc,
+                                     ip_error *err)
 {
     if (!overrides || desc->encoding == IP_ENCODING_DICOM)
         return IP_OK;
@@ -532,7 +532,7 @@ ip_status ip_input_describe(const char *path, const ip_input_overrides *given, i
     memset(&found, 0, sizeof found);
     set_defaults(&desc, path);
     if ((status = read_layout(path, overrides, &desc, &found, err)) != IP_OK ||
-        (status = check_series_asked(overrides, &desc, err)) != IP_OK ||
+        (status = check_dicom_choices(overrides, &desc, err)) != IP_OK ||
         (status = apply_overrides(overrides, &desc, &found, err)) != IP_OK ||
         (status = require_layout(&desc, &found, err)) != IP_OK ||
         (status = validate_dims(&desc, &found, err)) != IP_OK ||
