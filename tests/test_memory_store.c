@@ -14,7 +14,7 @@
 #include "isoprop/generate.h"
 #include "isoprop/input.h"
 #include "isoprop/store.h"
-#include "format.h"
+#include "summary.h"
 
 /* A generated volume: its samples in memory (x fastest) and its brick file. */
 typedef struct volume {
@@ -72,27 +72,25 @@ static int same_bits(const float *a, const float *b, size_t n)
     return memcmp(a, b, n * sizeof(float)) == 0;
 }
 
-/* Octree nodes of every level and depth whose ranges are the same in both stores; *count
- * gets how many nodes there are. */
-static uint64_t same_nodes(const ip_store *a, const ip_store *b, uint64_t *count)
+/* ip__octree_walk() visitor over the octree of two stores: keeps the range the walk computes
+ * (its node ranges, read back for the next depth) and counts the nodes whose stored ranges
+ * are the same in both stores and equal the one computed. */
+typedef struct node_compare {
+    const ip_store *a, *b;
+    float *nodes;
+    uint64_t visited, same;
+} node_compare;
+
+static int compare_node(void *user, uint32_t level, uint32_t depth, const uint32_t node[3],
+                        uint64_t node_index, const float range[2])
 {
-    const ip_layout *l = ip_store_layout(a);
-    uint64_t same = 0;
-    *count = 0;
-    for (uint32_t k = 0; k < l->level_count; k++)
-        for (uint32_t depth = 1; depth <= l->levels[k].octree_depth; depth++) {
-            uint32_t grid[3];
-            ip__octree_grid(l, k, depth, grid);
-            for (uint32_t z = 0; z < grid[2]; z++)
-                for (uint32_t y = 0; y < grid[1]; y++)
-                    for (uint32_t x = 0; x < grid[0]; x++) {
-                        uint32_t node[3] = {x, y, z};
-                        same += same_bits(ip_store_node_range(a, k, depth, node),
-                                          ip_store_node_range(b, k, depth, node), 2);
-                        ++*count;
-                    }
-        }
-    return same;
+    node_compare *c = user;
+    const float *ra = ip_store_node_range(c->a, level, depth, node);
+    memcpy(c->nodes + 2 * node_index, range, 2 * sizeof(float));
+    c->visited++;
+    c->same +=
+        same_bits(ra, ip_store_node_range(c->b, level, depth, node), 2) && same_bits(ra, range, 2);
+    return 0;
 }
 
 /* Layout (but for the file's figures), every brick range, sub-block range, octree node and
@@ -140,10 +138,17 @@ static void check_same_store(const ip_store *file, const ip_store *mem)
     CHECK_EQ(subs, a->brick_count);
     CHECK_EQ(samples, a->brick_count);
     CHECK_LT(constant, a->brick_count);
-    uint64_t nodes;
-    CHECK_EQ(same_nodes(file, mem, &nodes), a->node_count);
-    CHECK_EQ(nodes, a->node_count);
-    CHECK_GT(nodes, 0);
+    node_compare c = {file, mem, malloc(2 * a->node_count * sizeof(float)), 0, 0};
+    float *brick_ranges = malloc(2 * a->brick_count * sizeof(float));
+    REQUIRE(c.nodes && brick_ranges);
+    for (uint64_t g = 0; g < a->brick_count; g++)
+        ip_store_brick_range(mem, g, brick_ranges + 2 * g);
+    ip__octree_walk(a, brick_ranges, c.nodes, compare_node, &c);
+    CHECK_EQ(c.visited, a->node_count);
+    CHECK_EQ(c.same, a->node_count);
+    CHECK_GT(c.visited, 0);
+    free(c.nodes);
+    free(brick_ranges);
     free(sa);
     free(sb);
     free(work);

@@ -137,7 +137,8 @@ typedef struct ip_memory_volume {
                            for a volume constant along that axis); all three 0: contiguous,
                            x fastest */
     double spacing[3];  /* world units between samples; all three 0: 1, 1, 1 */
-    ip_orientation orientation; /* as ip_input_desc's; all-zero directions: identity */
+    ip_orientation orientation; /* as ip_input_desc's; all-zero directions: the
+                                   unit axes (origin and space kept) */
     ip_rescale rescale;         /* what the values stand for, as a brick file keeps it;
                                    present 0: none */
     uint32_t brick_edge;        /* B; 0: IP_DEFAULT_BRICK_EDGE (as the bricker's) */

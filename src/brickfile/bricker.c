@@ -697,17 +697,6 @@ static ip_status alloc_scratch(bricker *b, ip_error *err)
     return IP_OK;
 }
 
-/* All-zero directions: a description filled by hand without an orientation, taken as the
- * identity (as in the files of format version 1). */
-static int orientation_unset(const ip_orientation *o)
-{
-    for (int a = 0; a < 3; a++)
-        for (int c = 0; c < 3; c++)
-            if (o->directions[a][c] != 0.0)
-                return 0;
-    return 1;
-}
-
 /* The input's rescale, as the layout keeps it. */
 static ip_rescale rescale_of(const ip_input_desc *in)
 {
@@ -734,7 +723,7 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
                                    o->subblock_edge, &why);
     if (st != IP_OK)
         return ip__fail(err, st, "%s: %s", in->path, why.message);
-    if (!orientation_unset(&in->orientation))
+    if (!ip__orientation_unset(&in->orientation))
         b->layout.orientation = in->orientation;
     ip_rescale rescale = rescale_of(in);
     ip__layout_set_rescale(&b->layout, &rescale);
@@ -1111,7 +1100,7 @@ static void count_bricks(bricker *b)
 static ip_status check_request(const ip_input_desc *in, const char *out_path, ip_error *err)
 {
     ip_status st = ip_spacing_check(in->spacing, in->path, err);
-    if (st == IP_OK && !orientation_unset(&in->orientation))
+    if (st == IP_OK && !ip__orientation_unset(&in->orientation))
         st = ip_orientation_check(&in->orientation, in->path, err);
     ip_rescale rescale = rescale_of(in);
     if (st == IP_OK)

@@ -599,16 +599,6 @@ void ip_memory_volume_default(ip_memory_volume *v)
     v->name = "array";
 }
 
-/* All-zero directions: no orientation given, the identity. */
-static int directions_unset(const ip_orientation *o)
-{
-    for (int a = 0; a < 3; a++)
-        for (int c = 0; c < 3; c++)
-            if (o->directions[a][c] != 0.0)
-                return 0;
-    return 1;
-}
-
 /* The caller's description as this library's, checked and with its defaults, into *v. */
 static ip_status take_volume(const void *samples, const ip_memory_volume *given,
                              ip_memory_volume *v, ip_error *err)
@@ -637,10 +627,11 @@ static ip_status take_volume(const void *samples, const ip_memory_volume *given,
         v->strides[1] = v->strides[0] * v->dims[0];
         v->strides[2] = v->strides[1] * v->dims[1];
     }
+    if (ip__orientation_unset(&v->orientation))
+        for (int a = 0; a < 3; a++)
+            v->orientation.directions[a][a] = 1.0;
     st = ip_spacing_check(v->spacing, v->name, err);
-    if (st == IP_OK && directions_unset(&v->orientation))
-        ip_orientation_identity(&v->orientation);
-    else if (st == IP_OK)
+    if (st == IP_OK)
         st = ip_orientation_check(&v->orientation, v->name, err);
     if (st == IP_OK && v->rescale.present)
         st = ip_rescale_check(&v->rescale, v->name, err);
