@@ -178,9 +178,12 @@ static void extract_full(const ip_store *s, float iso, uint32_t level, ip_mesh *
     ip_cache_destroy(c);
 }
 
-/* A progressive view of `s` (one thread: the same triangles in the same order each time),
- * every ray to the end, with the levels of detail. */
-static void extract_view(const ip_store *s, float iso, const char *axis, ip_mesh *mesh)
+/* A progressive view of `s` from `axis` (one thread: the same triangles in the same order each
+ * time), every ray to the end, with the levels of detail; or, `full_lod`, the full extraction
+ * at that view's adaptive resolution (ip_extract_full_lod(), a coarse pixel error so that the
+ * coarser levels serve most cells). */
+static void extract_view(const ip_store *s, float iso, const char *axis, int full_lod,
+                         ip_mesh *mesh)
 {
     ip_error err;
     ip_cache *c;
@@ -189,6 +192,12 @@ static void extract_view(const ip_store *s, float iso, const char *axis, ip_mesh
     ip_layout_world_box(ip_store_layout(s), lo, hi);
     ip_camera cam;
     REQUIRE(ip_camera_fit_axis(lo, hi, axis, 30.0, 160, 120, &cam, &err) == IP_OK);
+    ip_mesh_init(mesh);
+    if (full_lod) {
+        REQUIRE(ip_extract_full_lod(c, iso, &cam, 8.0, 2, NULL, 0, mesh, NULL, &err) == IP_OK);
+        ip_cache_destroy(c);
+        return;
+    }
     ip_engine_options o;
     ip_engine_options_default(&o);
     o.threads = 1;
@@ -197,7 +206,6 @@ static void extract_view(const ip_store *s, float iso, const char *axis, ip_mesh
     REQUIRE(ip_engine_begin(e, &cam, iso, &err) == IP_OK);
     while (!ip_engine_done(e))
         REQUIRE(ip_engine_step(e, 4096, 0, NULL, &err) == IP_OK);
-    ip_mesh_init(mesh);
     const ip_mesh *m = ip_engine_mesh(e);
     REQUIRE(ip_mesh_append_mesh(mesh, m, 0, m->triangle_count) == IP_OK);
     ip_engine_destroy(e);
@@ -234,20 +242,26 @@ static void check_against_file(volume *v, float t)
     CHECK_EQ(ip_store_held_samples(file), 0);
     CHECK_GT(ip_store_summary_memory(mem), 0);
     CHECK_EQ(ip_store_verify_octree(mem, &err), IP_OK);
+    uint64_t level0 = 0;
     for (uint32_t level = 0; level < 2; level++) {
         ip_mesh a, b;
         extract_full(file, iso, level, &a);
+        level0 = level == 0 ? a.triangle_count : level0;
         extract_full(mem, iso, level, &b);
         check_same_mesh(&a, &b, level ? "full, level 1" : "full");
         ip_mesh_free(&a);
         ip_mesh_free(&b);
     }
-    ip_mesh a, b;
-    extract_view(file, iso, "-y", &a);
-    extract_view(mem, iso, "-y", &b);
-    check_same_mesh(&a, &b, "view -y");
-    ip_mesh_free(&a);
-    ip_mesh_free(&b);
+    for (int full_lod = 0; full_lod < 2; full_lod++) {
+        ip_mesh a, b;
+        extract_view(file, iso, "-y", full_lod, &a);
+        extract_view(mem, iso, "-y", full_lod, &b);
+        check_same_mesh(&a, &b, full_lod ? "full at the view's resolution" : "view -y");
+        if (full_lod) /* the coarser levels served some of the cells */
+            CHECK_LT(b.triangle_count, level0);
+        ip_mesh_free(&a);
+        ip_mesh_free(&b);
+    }
     ip_store_close(file);
     ip_store_close(mem);
 }
