@@ -31,6 +31,8 @@ def _volume_array(volume):
             raise error("volume: " + text)
     if not volume.dtype.isnative:  # the library reads host order: a copy cannot be avoided
         volume = volume.astype(volume.dtype.newbyteorder("="))
+    if not any(volume.strides):  # one value broadcast: the library takes all-zero strides
+        volume = np.ascontiguousarray(volume)  # for "contiguous", so give it that
     return volume
 
 

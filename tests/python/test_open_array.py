@@ -62,6 +62,11 @@ class OpenArray(unittest.TestCase):
             mg, mh = g.extract(9000.5, full=True), h.extract(9000.5, full=True)
             self.assertGreater(mh.triangle_count, 100)
             np.testing.assert_array_equal(mg.vertices, mh.vertices)
+        # broadcast along z (stride 0), and one value broadcast everywhere (all strides 0)
+        with isoprop.open_array(np.broadcast_to(flat[5], flat.shape)) as b:
+            self.assertEqual(b.value_range, (float(flat[5].min()), float(flat[5].max())))
+        with isoprop.open_array(np.broadcast_to(np.int16(7), (5, 6, 7))) as b:
+            self.assertEqual(b.value_range, (7.0, 7.0))
         swapped = flat.astype(flat.dtype.newbyteorder(">"))  # copied once into host order
         with isoprop.open_array(swapped) as s:
             np.testing.assert_array_equal(s.extract(9000.5, full=True).vertices, mh.vertices)
