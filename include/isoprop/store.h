@@ -19,7 +19,9 @@
 #include <stdint.h>
 
 #include "isoprop/layout.h"
+#include "isoprop/orientation.h"
 #include "isoprop/status.h"
+#include "isoprop/volume.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -114,6 +116,68 @@ IP_API void ip_store_prefetch_brick(const ip_store *store, uint64_t g);
  *  bytes of the payload (a read of one byte each), reads nothing else and changes nothing. A
  *  hint: the answer may be stale the moment it is given. Thread-safe. */
 IP_API int ip_store_brick_in_memory(const ip_store *store, uint64_t g);
+
+/* ---- A volume in memory (experimental) ----
+ * ip_store_open_memory() opens a store on samples the caller holds in memory (a numpy array,
+ * a buffer of its own) instead of a brick file: the same layout, brick and sub-block ranges
+ * and octree as the brick file of those samples would hold (bit for bit), so the cache and
+ * the engine run on it unchanged and extract the same triangles. Level 0 bricks are gathered
+ * from the caller's samples on each read (ip_store_read_brick(), a strided copy into the
+ * caller's buffer); the coarser levels of the pyramid (about 1/7 of the samples) are built
+ * once at open and held by the store (ip_store_held_samples()). Nothing is written to disk
+ * and no whole copy of the samples is made. */
+
+/* The caller's volume: an options-like sized struct (status.h; initialise it with
+ * IP_SIZED(ip_memory_volume) or ip_memory_volume_default()). */
+typedef struct ip_memory_volume {
+    uint32_t size;
+    uint32_t dims[3];   /* samples along x, y, z; each >= 2 */
+    ip_type type;       /* IP_UINT8, IP_UINT16, IP_INT16 or IP_FLOAT32, host byte order */
+    int64_t strides[3]; /* bytes from a sample to its next along x, y, z (any sign; 0 allowed
+                           for a volume constant along that axis); all three 0: contiguous,
+                           x fastest */
+    double spacing[3];  /* world units between samples; all three 0: 1, 1, 1 */
+    ip_orientation orientation; /* as ip_input_desc's; all-zero directions: the
+                                   unit axes (origin and space kept) */
+    ip_rescale rescale;         /* what the values stand for, as a brick file keeps it;
+                                   present 0: none */
+    uint32_t brick_edge;        /* B; 0: IP_DEFAULT_BRICK_EDGE (as the bricker's) */
+    uint32_t subblock_edge;     /* s; 0: IP_DEFAULT_SUBBLOCK_EDGE */
+    uint32_t threads;           /* threads building the pyramid and summaries at open
+                                   (ip_thread_count()); 0: every core */
+    const char *name;           /* what messages and ip_store_path() call the volume; NULL:
+                                   "array" */
+} ip_memory_volume;
+
+/*! ip_memory_volume_default() : zeros, size set, name "array". */
+IP_API void ip_memory_volume_default(ip_memory_volume *volume);
+
+/*! ip_store_open_memory() : opens a store on `samples`, the address of sample (0,0,0) of the
+ *  volume `volume` describes. The samples stay the caller's: they must stay alive and
+ *  unchanged until ip_store_close() (a store only reads them; a change is not seen by the
+ *  summaries, so extraction would then be wrong where they changed, which
+ *  ip_store_verify_brick() detects). float32 samples must be finite: the first NaN or
+ *  infinite one is named and refused. `*out` is the caller's, released with ip_store_close().
+ *  On a memory store, ip_store_read_brick() gathers the brick (level 0 from the samples,
+ *  coarser levels from the store's pyramid) and cannot fail, leaving `work` unused (whose
+ *  ip_store_read_work_size() is a token 64 bytes);
+ *  the directory entries (ip_store_brick_entry()) have no offset, payload or checksum (offset,
+ *  stored_size and checksum 0; encoding IP_BRICK_CONSTANT for a brick whose samples all equal
+ *  one value, else IP_BRICK_RAW); ip_store_verify_brick() recomputes the summaries of a brick
+ *  from the samples now (IP_ERR_CORRUPT when they changed since open); the layout's file
+ *  figures (data and summary offsets and sizes, checksum, file_size) are 0;
+ *  ip_store_prefetch_brick() does nothing and ip_store_brick_in_memory() is 1.
+ *  @return IP_OK; IP_ERR_ARGUMENT (a NULL pointer, dims under 2, an unsupported type, a bad
+ *  brick or sub-block edge, orientation or rescale), IP_ERR_UNSUPPORTED (a spacing outside
+ *  ip_spacing_check()'s bounds), IP_ERR_INPUT (a NaN or infinite float32 sample) or
+ *  IP_ERR_NOMEM, the message starting with the volume's name. */
+IP_API ip_status ip_store_open_memory(const void *samples, const ip_memory_volume *volume,
+                                      ip_store **out, ip_error *err);
+
+/*! ip_store_held_samples() : bytes of samples the store holds in memory: the coarser levels of
+ *  a memory store's pyramid; 0 for a brick file (its samples are read on demand). Not part
+ *  of ip_store_summary_memory(). */
+IP_API uint64_t ip_store_held_samples(const ip_store *store);
 
 #endif /* IP_EXPERIMENTAL */
 

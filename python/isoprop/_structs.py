@@ -32,6 +32,14 @@ class Rescale(ctypes.Structure):
                 ("unit", c_char * RESCALE_UNIT_MAX)]
 
 
+class MemoryVolume(ctypes.Structure):
+    """ip_memory_volume (store.h)"""
+    _fields_ = [("size", c_uint32), ("dims", c_uint32 * 3), ("type", c_int),
+                ("strides", ctypes.c_int64 * 3), ("spacing", c_double * 3),
+                ("orientation", Orientation), ("rescale", Rescale), ("brick_edge", c_uint32),
+                ("subblock_edge", c_uint32), ("threads", c_uint32), ("name", ctypes.c_char_p)]
+
+
 class InputDesc(ctypes.Structure):
     """ip_input_desc (input.h)"""
     _fields_ = [("path", c_char * PATH_MAX), ("data_path", c_char * PATH_MAX),
@@ -164,6 +172,7 @@ MIRRORS = {
     "ip_orientation": Orientation,
     "ip_rescale": Rescale,
     "ip_input_desc": InputDesc,
+    "ip_memory_volume": MemoryVolume,
     "ip_input_overrides": InputOverrides,
     "ip_bricker_options": BrickerOptions,
     "ip_bricker_report": BrickerReport,

@@ -174,11 +174,21 @@ class File:
     crashes. close() (or a with block) frees it, and so does garbage collection."""
 
     def __init__(self, path):
-        self._lock, self._orphans = threading.Lock(), []
-        self._store, self._cache, self._cache_budget, self._runs = None, None, 0, set()
+        self._init_state()
         C.path("path", path)
         err, store = new_error(), ctypes.c_void_p()
         check(lib.ip_store_open(os.fsencode(path), ctypes.byref(store), ctypes.byref(err)), err)
+        self._adopt(store)
+
+    def _init_state(self, array=None):
+        """The state of a File with no store yet; `array`: the numpy array a store in memory
+        (isoprop.open_array()) reads, kept referenced until the store is closed."""
+        self._lock, self._orphans = threading.Lock(), []
+        self._store, self._cache, self._cache_budget, self._runs = None, None, 0, set()
+        self._array = array
+
+    def _adopt(self, store):
+        """Takes the open store `store` (a brick file's or an array's) and reads its layout."""
         self._store = store
         l = lib.ip_store_layout(store).contents
         self.path = lib.ip_store_path(store).decode()
@@ -241,6 +251,7 @@ class File:
         if self._store:
             lib.ip_store_close(self._store)
             self._store = None
+        self._array = None  # the store that read it is gone
 
     def __enter__(self):
         return self

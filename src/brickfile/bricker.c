@@ -21,6 +21,7 @@
 #include "input_positioned.h"
 #include "isoprop/output.h"
 #include "pool.h"
+#include "pyramid.h"
 #include "sized.h"
 #include "summary.h"
 
@@ -447,35 +448,15 @@ static int level_samples_plane(const ip_layout *l, uint32_t k, uint32_t z, uint3
     return (z & ((1u << k) - 1)) == 0;
 }
 
-/* Subsamples level-0 plane `src` into level plane `plane` of level k: a copy per sample, by
- * sample width, so that the compiler turns it into plain loads and stores. */
-#define DEFINE_SUBSAMPLE(T, NAME)                                                                  \
-    static void NAME(const level_slab *slab, const ip_level_layout *lv, const T *src, size_t row0, \
-                     T *dst)                                                                       \
-    {                                                                                              \
-        for (uint32_t y = 0; y < lv->dims[1]; y++) {                                               \
-            const T *row = src + (size_t)slab->y_index[y] * row0;                                  \
-            for (uint32_t x = 0; x < lv->dims[0]; x++)                                             \
-                *dst++ = row[slab->x_index[x]];                                                    \
-        }                                                                                          \
-    }
-
-DEFINE_SUBSAMPLE(uint8_t, subsample_8)
-DEFINE_SUBSAMPLE(uint16_t, subsample_16)
-DEFINE_SUBSAMPLE(uint32_t, subsample_32)
-
+/* Subsamples level-0 plane `src` into level plane `plane` of level k. */
 static void subsample_plane(const bricker *b, uint32_t k, uint32_t plane, const unsigned char *src)
 {
     const level_slab *slab = &b->slabs[k];
     const ip_level_layout *lv = &b->layout.levels[k];
-    unsigned char *dst = (unsigned char *)slab_plane(slab, plane);
-    size_t row0 = b->layout.dims[0];
-    if (b->sample_size == 1)
-        subsample_8(slab, lv, src, row0, (uint8_t *)dst);
-    else if (b->sample_size == 2)
-        subsample_16(slab, lv, (const uint16_t *)src, row0, (uint16_t *)dst);
-    else
-        subsample_32(slab, lv, (const uint32_t *)src, row0, (uint32_t *)dst);
+    ip__plane_source from = {src, (ptrdiff_t)b->sample_size,
+                             (ptrdiff_t)(b->layout.dims[0] * b->sample_size), b->sample_size};
+    ip__subsample_plane(&from, slab->x_index, slab->y_index, lv->dims[0], lv->dims[1],
+                        (unsigned char *)slab_plane(slab, plane));
 }
 
 /* Level-0 plane z is in its slot: places it in every coarser level that samples it. */
@@ -716,17 +697,6 @@ static ip_status alloc_scratch(bricker *b, ip_error *err)
     return IP_OK;
 }
 
-/* All-zero directions: a description filled by hand without an orientation, taken as the
- * identity (as in the files of format version 1). */
-static int orientation_unset(const ip_orientation *o)
-{
-    for (int a = 0; a < 3; a++)
-        for (int c = 0; c < 3; c++)
-            if (o->directions[a][c] != 0.0)
-                return 0;
-    return 1;
-}
-
 /* The input's rescale, as the layout keeps it. */
 static ip_rescale rescale_of(const ip_input_desc *in)
 {
@@ -753,7 +723,7 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
                                    o->subblock_edge, &why);
     if (st != IP_OK)
         return ip__fail(err, st, "%s: %s", in->path, why.message);
-    if (!orientation_unset(&in->orientation))
+    if (!ip__orientation_unset(&in->orientation))
         b->layout.orientation = in->orientation;
     ip_rescale rescale = rescale_of(in);
     ip__layout_set_rescale(&b->layout, &rescale);
@@ -882,15 +852,6 @@ static ip_status stream_input(bricker *b, const ip_input_desc *in, ip_error *err
 
 /* ---- finishing ---- */
 
-/* ip__octree_walk() visitor: stores each node's range, read back for the next depth. */
-static int store_node(void *nodes, uint32_t level, uint32_t depth, const uint32_t node[3],
-                      uint64_t node_index, const float range[2])
-{
-    (void)level, (void)depth, (void)node;
-    memcpy((float *)nodes + 2 * node_index, range, 2 * sizeof(float));
-    return 0;
-}
-
 static ip_status copy_range(bricker *b, int out_fd, uint64_t from, uint64_t to, uint32_t size,
                             ip_error *err)
 {
@@ -953,22 +914,6 @@ static void store_ranges(unsigned char *dst, const float *ranges, uint64_t count
         memcpy(&bits, &ranges[i], 4);
         ip__store_u32le(dst + 4 * i, bits);
     }
-}
-
-static void level_ranges(bricker *b)
-{
-    ip_layout *l = &b->layout;
-    for (uint32_t k = 0; k < l->level_count; k++) {
-        ip_level_layout *lv = &l->levels[k];
-        lv->value_min = INFINITY;
-        lv->value_max = -INFINITY;
-        for (uint64_t i = 0; i < lv->brick_count; i++) {
-            lv->value_min = fminf(lv->value_min, b->brick_ranges[2 * (lv->first_brick + i)]);
-            lv->value_max = fmaxf(lv->value_max, b->brick_ranges[2 * (lv->first_brick + i) + 1]);
-        }
-    }
-    l->value_min = l->levels[0].value_min;
-    l->value_max = l->levels[0].value_max;
 }
 
 /* The summary section is streamed to the file through one buffer, hashed on the way, so that
@@ -1113,8 +1058,8 @@ static ip_status write_summary(bricker *b, int out_fd, ip_error *err)
     if (!w.buf || !w.hash || !nodes)
         st = ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for the summary", b->out_path);
     if (st == IP_OK) {
-        level_ranges(b);
-        ip__octree_walk(l, b->brick_ranges, nodes, store_node, nodes);
+        ip__level_value_ranges(l, b->brick_ranges);
+        ip__octree_build(l, b->brick_ranges, nodes);
         XXH64_reset(w.hash, 0);
         st = summary_sections(&w, nodes, err);
     }
@@ -1155,7 +1100,7 @@ static void count_bricks(bricker *b)
 static ip_status check_request(const ip_input_desc *in, const char *out_path, ip_error *err)
 {
     ip_status st = ip_spacing_check(in->spacing, in->path, err);
-    if (st == IP_OK && !orientation_unset(&in->orientation))
+    if (st == IP_OK && !ip__orientation_unset(&in->orientation))
         st = ip_orientation_check(&in->orientation, in->path, err);
     ip_rescale rescale = rescale_of(in);
     if (st == IP_OK)

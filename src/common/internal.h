@@ -57,6 +57,10 @@ struct ip_orientation;
  * space; else returns 0 and leaves o as it was. */
 int ip__orientation_frame(struct ip_orientation *o, const double directions[3][3]);
 
+/* 1 when every direction of o is zero: a description filled by hand without an orientation,
+ * which the bricker and the store of a volume in memory take as the unit axes. */
+int ip__orientation_unset(const struct ip_orientation *o);
+
 /* Little-endian loads and stores, independent of the host's byte order. */
 static inline uint32_t ip__load_u32le(const unsigned char *p)
 {

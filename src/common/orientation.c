@@ -26,6 +26,15 @@ int ip_orientation_is_identity(const ip_orientation *orientation)
     return 1;
 }
 
+int ip__orientation_unset(const ip_orientation *o)
+{
+    for (int a = 0; a < 3; a++)
+        for (int c = 0; c < 3; c++)
+            if (o->directions[a][c] != 0.0)
+                return 0;
+    return 1;
+}
+
 static double dot3(const double a[3], const double b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];

@@ -15,6 +15,9 @@
 #include "internal.h"
 #include "codec.h"
 #include "isoprop/store.h"
+#include "memory_volume.h"
+#include "pyramid.h"
+#include "sized.h"
 #include "summary.h"
 
 struct ip_store {
@@ -35,8 +38,10 @@ struct ip_store {
     uint32_t *block_of;
     uint64_t memory; /* bytes of the above */
     uint32_t subblocks;
-    size_t largest_payload; /* bytes of the largest stored payload */
-    size_t largest_samples; /* samples of the largest brick */
+    size_t largest_payload;    /* bytes of the largest stored payload */
+    size_t largest_samples;    /* samples of the largest brick */
+    ip__memory_volume *volume; /* a store on samples in memory (ip_store_open_memory()): its
+                                  bricks are gathered from them; NULL for a brick file */
 };
 
 /* Opens without blocking (a FIFO would wait for a writer) and accepts only a regular file. */
@@ -346,6 +351,9 @@ void ip_store_close(ip_store *s)
     free(s->nodes);
     free(s->blocks);
     free(s->block_of);
+    if (s->volume)
+        ip__memory_volume_free(s->volume);
+    free(s->volume);
     free(s);
 }
 
@@ -421,6 +429,8 @@ static size_t payload_room(const ip_store *s)
 
 size_t ip_store_read_work_size(const ip_store *s)
 {
+    if (s->volume)
+        return 64; /* unused: a token, so that a caller's allocation of it succeeds */
     return payload_room(s) + ip__codec_work_size(s->largest_samples, s->layout.type);
 }
 
@@ -443,8 +453,21 @@ static ip_status read_payload(const ip_store *s, uint64_t g, const ip_brick_entr
     return read_failed(s, failure, what, err);
 }
 
+/* A memory store's brick: gathered from the samples (level 0) or the held pyramid. */
+static void gather_brick(const ip_store *s, uint64_t g, void *dst)
+{
+    uint32_t level, brick[3], origin[3], extent[3];
+    ip_brick_coords(&s->layout, g, &level, brick);
+    ip_brick_extent(&s->layout, level, brick, origin, extent);
+    ip__memory_volume_gather(s->volume, &s->layout, level, origin, extent, dst);
+}
+
 ip_status ip_store_read_brick(const ip_store *s, uint64_t g, void *dst, void *work, ip_error *err)
 {
+    if (s->volume) {
+        gather_brick(s, g, dst);
+        return IP_OK;
+    }
     ip_brick_entry e;
     ip_store_brick_entry(s, g, &e);
     unsigned char *payload = work;
@@ -565,4 +588,179 @@ ip_status ip_store_verify_octree(const ip_store *s, ip_error *err)
     return ip__fail(err, IP_ERR_CORRUPT,
                     "%s: octree node %u,%u,%u at depth %u of level %u disagrees with its children",
                     s->path, c.node[0], c.node[1], c.node[2], c.depth, c.level);
+}
+
+/* ---- a volume in memory ---- */
+
+void ip_memory_volume_default(ip_memory_volume *v)
+{
+    memset(v, 0, sizeof *v);
+    v->size = sizeof *v;
+    v->name = "array";
+}
+
+/* The caller's description as this library's, checked and with its defaults, into *v. */
+static ip_status take_volume(const void *samples, const ip_memory_volume *given,
+                             ip_memory_volume *v, ip_error *err)
+{
+    ip_memory_volume_default(v);
+    ip_status st =
+        ip__sized_in(v, sizeof *v, given, sizeof *v, "ip_store_open_memory: volume", err);
+    if (st != IP_OK)
+        return st;
+    if (!v->name)
+        v->name = "array";
+    if (!samples)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: the samples are NULL", v->name);
+    if (v->dims[0] < 2 || v->dims[1] < 2 || v->dims[2] < 2)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "%s: %u x %u x %u samples: each dimension must be at least 2", v->name,
+                        v->dims[0], v->dims[1], v->dims[2]);
+    if ((unsigned)v->type > IP_FLOAT32)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "%s: sample type %d is none of uint8, uint16, int16, float32", v->name,
+                        (int)v->type);
+    if (v->spacing[0] == 0 && v->spacing[1] == 0 && v->spacing[2] == 0)
+        v->spacing[0] = v->spacing[1] = v->spacing[2] = 1.0;
+    if (v->strides[0] == 0 && v->strides[1] == 0 && v->strides[2] == 0) {
+        v->strides[0] = (int64_t)ip_type_size(v->type);
+        v->strides[1] = v->strides[0] * v->dims[0];
+        v->strides[2] = v->strides[1] * v->dims[1];
+    }
+    if (ip__orientation_unset(&v->orientation))
+        for (int a = 0; a < 3; a++)
+            v->orientation.directions[a][a] = 1.0;
+    st = ip_spacing_check(v->spacing, v->name, err);
+    if (st == IP_OK)
+        st = ip_orientation_check(&v->orientation, v->name, err);
+    if (st == IP_OK && v->rescale.present)
+        st = ip_rescale_check(&v->rescale, v->name, err);
+    return st;
+}
+
+/* The layout a brick file of the volume has, but for its file figures (0). */
+static ip_status memory_layout(ip_store *s, const ip_memory_volume *v, ip_error *err)
+{
+    ip_error why;
+    uint32_t B = v->brick_edge ? v->brick_edge : IP_DEFAULT_BRICK_EDGE;
+    uint32_t sub = v->subblock_edge ? v->subblock_edge : IP_DEFAULT_SUBBLOCK_EDGE;
+    ip_status st = ip__layout_init(&s->layout, v->dims, v->type, v->spacing, B, sub, &why);
+    if (st != IP_OK)
+        return ip__fail(err, st, "%s: %s", v->name, why.message);
+    s->layout.orientation = v->orientation;
+    ip_rescale rescale;
+    ip_rescale_identity(&rescale);
+    if (v->rescale.present)
+        rescale = v->rescale;
+    ip__layout_set_rescale(&s->layout, &rescale);
+    s->subblocks = ip_layout_subblocks_per_brick(&s->layout);
+    return IP_OK;
+}
+
+/* The first NaN or infinite float32 sample, refused with its coordinates. */
+static ip_status check_finite(const ip_store *s, unsigned threads, ip_error *err)
+{
+    uint32_t at[3];
+    if (!ip__memory_volume_find_nonfinite(s->volume, &s->layout, threads, at))
+        return IP_OK;
+    const ip__memory_volume *m = s->volume;
+    uint32_t bits;
+    memcpy(&bits,
+           m->samples + (ptrdiff_t)at[0] * m->strides[0] + (ptrdiff_t)at[1] * m->strides[1] +
+               (ptrdiff_t)at[2] * m->strides[2],
+           sizeof bits);
+    return ip__fail(err, IP_ERR_INPUT, "%s: float32 sample at (x,y,z) = (%u,%u,%u) is %s", s->path,
+                    at[0], at[1], at[2], (bits & 0x007fffffu) ? "NaN" : "infinite");
+}
+
+/* The summaries from every brick's ranges (`subblock_ranges`: 2 * subblocks floats per brick),
+ * held as a brick file's are: sub-block ranges compacted, the octree, the directory. */
+static ip_status memory_summaries(ip_store *s, const float *subblock_ranges)
+{
+    const ip_layout *l = &s->layout;
+    uniform_table t = {NULL, NULL, 0, 0};
+    s->block_of = malloc((l->brick_count ? l->brick_count : 1) * sizeof *s->block_of);
+    s->nodes = malloc((2 * l->node_count + 1) * sizeof(float));
+    s->summary = malloc(l->brick_count * IP_DIRECTORY_ENTRY_SIZE + 1);
+    ip_status st = s->block_of && s->nodes && s->summary ? IP_OK : IP_ERR_NOMEM;
+    for (uint64_t g = 0; st == IP_OK && g < l->brick_count; g++) {
+        s->block_of[g] = block_for(s, &t, subblock_ranges + 2 * g * s->subblocks);
+        if (s->block_of[g] == UINT32_MAX)
+            st = IP_ERR_NOMEM;
+        ip_brick_entry e = {0, 0, IP_BRICK_RAW, 0, 0};
+        if (s->ranges[2 * g] == s->ranges[2 * g + 1])
+            e.encoding = IP_BRICK_CONSTANT;
+        ip__format_entry_encode(&e, s->summary + g * IP_DIRECTORY_ENTRY_SIZE);
+    }
+    free(t.keys);
+    free(t.block);
+    if (st != IP_OK)
+        return st;
+    ip__octree_build(l, s->ranges, s->nodes);
+    ip__level_value_ranges(&s->layout, s->ranges);
+    s->memory = l->brick_count * (IP_DIRECTORY_ENTRY_SIZE + 2 * sizeof(float)) +
+                2 * l->node_count * sizeof(float) +
+                s->block_count * 2 * s->subblocks * sizeof(float) +
+                l->brick_count * sizeof *s->block_of;
+    return IP_OK;
+}
+
+/* The pyramid and every summary of the memory store `s`. */
+static ip_status build_memory(ip_store *s, unsigned threads, ip_error *err)
+{
+    const ip_layout *l = &s->layout;
+    uint64_t floats = 2 * l->brick_count * s->subblocks;
+    float *subblock_ranges =
+        floats <= SIZE_MAX / sizeof(float) ? malloc(floats * sizeof(float)) : NULL;
+    s->ranges = malloc((2 * l->brick_count + 1) * sizeof(float));
+    ip_status st = subblock_ranges && s->ranges ? IP_OK : IP_ERR_NOMEM;
+    if (st == IP_OK)
+        st = ip__memory_volume_build(s->volume, l, threads, s->ranges, subblock_ranges);
+    if (st == IP_OK)
+        st = memory_summaries(s, subblock_ranges);
+    free(subblock_ranges);
+    if (st != IP_OK)
+        return ip__fail(err, st, "%s: out of memory for the pyramid and summaries", s->path);
+    s->largest_samples = ((size_t)l->brick_edge + 1) * (l->brick_edge + 1) * (l->brick_edge + 1);
+    return IP_OK;
+}
+
+ip_status ip_store_open_memory(const void *samples, const ip_memory_volume *volume, ip_store **out,
+                               ip_error *err)
+{
+    if (!volume || !out)
+        return ip__fail(err, IP_ERR_ARGUMENT, "ip_store_open_memory: volume and out are required");
+    ip_memory_volume v;
+    ip_status st = take_volume(samples, volume, &v, err);
+    if (st != IP_OK)
+        return st;
+    ip_store *s = calloc(1, sizeof *s);
+    if (s)
+        s->volume = calloc(1, sizeof *s->volume);
+    if (!s || !s->volume) {
+        free(s);
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", v.name);
+    }
+    s->fd = -1;
+    snprintf(s->path, sizeof s->path, "%s", v.name);
+    s->volume->samples = samples;
+    for (int a = 0; a < 3; a++)
+        s->volume->strides[a] = (ptrdiff_t)v.strides[a];
+    unsigned threads = ip_thread_count(v.threads);
+    st = memory_layout(s, &v, err);
+    if (st == IP_OK)
+        st = check_finite(s, threads, err);
+    if (st == IP_OK)
+        st = build_memory(s, threads, err);
+    if (st != IP_OK) {
+        ip_store_close(s);
+        return st;
+    }
+    *out = s;
+    return IP_OK;
+}
+
+uint64_t ip_store_held_samples(const ip_store *s)
+{
+    return s->volume ? s->volume->held_bytes : 0;
 }

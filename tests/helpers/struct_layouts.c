@@ -64,6 +64,22 @@ static void error_and_input(void)
     FIELD(ip_input_overrides, uneven);
 }
 
+static void memory_volume(void)
+{
+    SIZE(ip_memory_volume);
+    FIELD(ip_memory_volume, size);
+    FIELD(ip_memory_volume, dims);
+    FIELD(ip_memory_volume, type);
+    FIELD(ip_memory_volume, strides);
+    FIELD(ip_memory_volume, spacing);
+    FIELD(ip_memory_volume, orientation);
+    FIELD(ip_memory_volume, rescale);
+    FIELD(ip_memory_volume, brick_edge);
+    FIELD(ip_memory_volume, subblock_edge);
+    FIELD(ip_memory_volume, threads);
+    FIELD(ip_memory_volume, name);
+}
+
 static void bricker(void)
 {
     SIZE(ip_bricker_options);
@@ -229,6 +245,7 @@ int main(void)
 {
     error_and_input();
     bricker();
+    memory_volume();
     layout();
     cache();
     engine();
