@@ -15,9 +15,10 @@ from ._library import lib as _lib
 from ._library import path as library_path
 from .bricking import brick
 from .errors import ArgumentError, Error
-from .mesh import Mesh, Step
+from .mesh import Mesh, Step, Welded
+from .surface import contour, marching_cubes
 from .volume import File, Level, Rescale, open
 
 __version__ = _lib.ip_version().decode()
 __all__ = ["brick", "open", "File", "Level", "Rescale", "Mesh", "Step", "Error", "ArgumentError",
-           "library_path", "__version__"]
+           "library_path", "__version__", "marching_cubes", "contour", "Welded"]
