@@ -4,7 +4,7 @@ volume, files (through the library's writers) and other libraries' meshes."""
 import ctypes
 import os
 from collections import namedtuple
-from typing import Any, Dict, Optional, Tuple, Union
+from typing import Any, Dict, Optional, Union
 
 import numpy as np
 

@@ -165,7 +165,6 @@ def contour(volume_or_path: Union[PathLike, Any], level: float, *, view: Optiona
     if "full" in options:
         raise ArgumentError("full: contour() is the view-dependent surface; for every cell use "
                             "marching_cubes() or File.extract(full=True)")
-    size = tuple(size) if isinstance(size, list) else size
     if isinstance(volume_or_path, (str, bytes, os.PathLike)):
         if spacing is not None:
             raise ArgumentError("spacing: a brick file has its own (only for an array)")

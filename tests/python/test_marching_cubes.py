@@ -3,7 +3,6 @@
 the same positions as the brick file's full extraction in axis order with spacing per axis,
 winding and normals for both gradient directions, degenerate triangles kept or dropped, the
 level's checks; against skimage.measure.marching_cubes when it is installed. And contour()."""
-import os
 import unittest
 
 import support  # first: it skips (status 77) when numpy is absent

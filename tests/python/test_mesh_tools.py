@@ -2,6 +2,7 @@
 """Mesh's tools: the welded form (points, indices, point_normals), area() and volume() of a
 sphere, write() in every format read back (and byte for byte isorender --mesh's), and
 to_pyvista() / to_trimesh() without those packages."""
+import importlib
 import json
 import os
 import struct
@@ -25,6 +26,14 @@ def sphere():
     z, y, x = np.meshgrid(*(np.arange(N, dtype=np.float64),) * 3, indexing="ij")
     d = np.sqrt((x - CENTRE[0]) ** 2 + (y - CENTRE[1]) ** 2 + (z - CENTRE[2]) ** 2)
     return (RADIUS - d).astype(np.float32)
+
+
+def optional(name):
+    """The module `name`, or None where it is not installed."""
+    try:
+        return importlib.import_module(name)
+    except ImportError:
+        return None
 
 
 def read_obj(path):
@@ -185,18 +194,11 @@ class MeshTools(unittest.TestCase):
 
     def test_other_libraries(self):
         """Where pyvista or trimesh is installed: the same points and faces."""
-        try:
-            import trimesh  # noqa: F401
-        except ImportError:
-            trimesh = None
+        trimesh, pyvista = optional("trimesh"), optional("pyvista")
         if trimesh is not None:
             t = self.mesh.to_trimesh()
             np.testing.assert_array_equal(t.vertices, self.mesh.points)
             np.testing.assert_array_equal(t.faces, self.mesh.indices)
-        try:
-            import pyvista  # noqa: F401
-        except ImportError:
-            pyvista = None
         if pyvista is not None:
             p = self.mesh.to_pyvista()
             np.testing.assert_array_equal(p.points, self.mesh.points)
