@@ -81,6 +81,35 @@ static void test_small(void)
     ip_mesh_free(&m);
 }
 
+/* ip_mesh_weld_keep_degenerate(): the same soup keeps its degenerate triangle, as a triangle
+ * that repeats a vertex, and every triangle in the soup's order. */
+static void test_keep_degenerate(void)
+{
+    ip_mesh m;
+    ip_mesh_init(&m);
+    const float a[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const float flat[9] = {1, 0, 0, 1, 0, 0, 5, 5, 5};
+    const float point[9] = {0, 1, 0, 0, 1, 0, 0, 1, 0}; /* all three corners at one position */
+    const float up[3] = {0, 0, 1};
+    add_triangle(&m, a, up);
+    add_triangle(&m, flat, up);
+    add_triangle(&m, point, up);
+    ip_indexed_mesh w;
+    REQUIRE(ip_mesh_weld_keep_degenerate(&m, &w) == IP_OK);
+    CHECK_EQ(w.vertex_count, 4);
+    CHECK_EQ(w.triangle_count, 3);
+    CHECK_EQ(w.dropped_triangles, 0);
+    static const uint32_t expected[9] = {0, 1, 2, 1, 1, 3, 2, 2, 2};
+    CHECK_MEM_EQ(w.indices, expected, sizeof expected);
+    CHECK_EQ(w.positions[9], 5);
+    ip_indexed_mesh_free(&w);
+    REQUIRE(ip_mesh_weld(&m, &w) == IP_OK); /* the plain weld leaves both out */
+    CHECK_EQ(w.triangle_count, 1);
+    CHECK_EQ(w.dropped_triangles, 2);
+    ip_indexed_mesh_free(&w);
+    ip_mesh_free(&m);
+}
+
 /* Many distinct vertices: the hash table grows past its first size and keeps every one. */
 static void test_growth(void)
 {
@@ -290,6 +319,7 @@ static void test_closed_and_open(void)
 
 static const test_case cases[] = {
     TEST_CASE(test_small),
+    TEST_CASE(test_keep_degenerate),
     TEST_CASE(test_growth),
     TEST_CASE(test_closed_and_open),
 };

@@ -235,6 +235,21 @@ IP_API ip_status ip_mesh_write_in(const ip_mesh *mesh, const char *path, const c
 IP_API ip_status ip_indexed_mesh_write_in(const ip_indexed_mesh *mesh, const char *path,
                                           const char *space, int force, ip_error *err);
 
+/* ---- Experimental (IP_EXPERIMENTAL) ----
+ * Declared only where IP_EXPERIMENTAL is defined before the include (docs/api.md,
+ * "Stability"): calls that may change in a minor version. Exported all the same. */
+#ifdef IP_EXPERIMENTAL
+
+/*! ip_mesh_weld_keep_degenerate() : ip_mesh_weld() that keeps the triangles with two (or
+ *  three) corners at one position, as marching cubes makes them where the surface passes
+ *  through a sample: such a triangle becomes one whose indices repeat a vertex, so that the
+ *  triangle count stays the soup's (what scikit-image's marching_cubes(allow_degenerate=True)
+ *  and VTK's filters give). out->dropped_triangles is 0. Memory, time, ownership and returns
+ *  as ip_mesh_weld(). */
+IP_API ip_status ip_mesh_weld_keep_degenerate(const ip_mesh *mesh, ip_indexed_mesh *out);
+
+#endif /* IP_EXPERIMENTAL */
+
 #ifdef __cplusplus
 }
 #endif

@@ -18,9 +18,10 @@ from ._library import path as library_path
 from .array import open_array
 from .bricking import brick
 from .errors import ArgumentError, Error
-from .mesh import Mesh, Step
+from .mesh import Mesh, Step, Welded
+from .surface import contour, marching_cubes
 from .volume import File, Level, Rescale, open
 
 __version__ = _lib.ip_version().decode()
-__all__ = ["brick", "open", "open_array", "File", "Level", "Rescale", "Mesh", "Step", "Error", "ArgumentError",
-           "library_path", "__version__"]
+__all__ = ["brick", "open", "open_array", "marching_cubes", "contour", "File", "Level", "Rescale",
+           "Mesh", "Step", "Welded", "Error", "ArgumentError", "library_path", "__version__"]

@@ -83,6 +83,13 @@ _PROTOTYPES = {
     "ip_mesh_to_physical": (None, [POINTER(S.Mesh), POINTER(S.Orientation)]),
     "ip_mesh_space_of": (c_char_p, [POINTER(S.Orientation)]),
     "ip_orientation_is_identity": (c_int, [POINTER(S.Orientation)]),
+    "ip_indexed_mesh_free": (None, [POINTER(S.IndexedMesh)]),
+    "ip_mesh_weld": (c_int, [POINTER(S.Mesh), POINTER(S.IndexedMesh)]),
+    "ip_mesh_weld_keep_degenerate": (c_int, [POINTER(S.Mesh), POINTER(S.IndexedMesh)]),
+    "ip_mesh_format_of": (c_char_p, [c_char_p]),
+    "ip_mesh_write_in": (c_int, [POINTER(S.Mesh), c_char_p, c_char_p, c_int, ERR]),
+    "ip_indexed_mesh_write_in": (c_int, [POINTER(S.IndexedMesh), c_char_p, c_char_p, c_int,
+                                         ERR]),
 }
 
 

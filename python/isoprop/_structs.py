@@ -166,6 +166,13 @@ class Mesh(ctypes.Structure):
                 ("capacity", c_uint64), ("populated", c_uint64), ("with_cells", c_int)]
 
 
+class IndexedMesh(ctypes.Structure):
+    """ip_indexed_mesh (mesh.h)"""
+    _fields_ = [("positions", ctypes.POINTER(c_float)), ("normals", ctypes.POINTER(c_int16)),
+                ("indices", ctypes.POINTER(c_uint32)), ("vertex_count", c_uint64),
+                ("triangle_count", c_uint64), ("dropped_triangles", c_uint64)]
+
+
 # Every mirror, by its C name: what the layout test checks.
 MIRRORS = {
     "ip_error": Error,
@@ -185,6 +192,7 @@ MIRRORS = {
     "ip_engine_options": EngineOptions,
     "ip_engine_counts": EngineCounts,
     "ip_mesh": Mesh,
+    "ip_indexed_mesh": IndexedMesh,
 }
 
 # Every mirrored constant, by its C name: what the layout test checks.

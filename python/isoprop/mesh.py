@@ -1,13 +1,19 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""Triangles copied out of a libisoprop mesh into numpy arrays."""
+"""Triangles copied out of a libisoprop mesh into numpy arrays; a Mesh's welded form, area,
+volume, files (through the library's writers) and other libraries' meshes."""
 import ctypes
+import os
+from collections import namedtuple
+from typing import Any, Dict, Optional, Union
 
 import numpy as np
 
 from . import _structs as S
 from ._library import lib
+from .errors import ArgumentError, Error, check, new_error
 
 NORMAL_SCALE = 32767.0  # ip_normal_unpack(), include/isoprop/mesh.h
+IP_ERR_NOMEM = -2  # include/isoprop/status.h
 
 
 def _view(pointer, dtype, first, count):
@@ -25,6 +31,17 @@ def soup_faces(triangles):
     return np.arange(3 * triangles, dtype=dtype).reshape(triangles, 3)
 
 
+Welded = namedtuple("Welded", "points faces normals dropped")
+Welded.__doc__ = """A mesh with shared vertices (Mesh.welded()): points float32 (V, 3), each
+position once, numbered in the order of first appearance in the soup; faces int32 (F, 3)
+(int64 past 2^31 - 1 points) indexing points, in the soup's order and winding; normals float32
+(V, 3), the average of the normals of each point's corners, unit; dropped: how many degenerate
+soup triangles (two corners at one position) were left out (0 when they were kept)."""
+
+IMPORT_HINTS = {"pyvista": "pip install pyvista (no Debian package)",
+                "trimesh": "Debian: apt-get install python3-trimesh, or pip install trimesh"}
+
+
 class Mesh:
     """Triangles as a soup, in the volume's physical space (docs/meshes.md, "Space"), as
     isorender --mesh writes them: sample (i, j, k) sits at origin + D (i, j, k) * spacing, D
@@ -36,11 +53,93 @@ class Mesh:
     faces:    int32 (T, 3), the corners of triangle t: 3t, 3t + 1, 3t + 2;
     space:    the space's name, as a mesh file names it: "RAS", "LAS" or "LPS" where the
               brick file names one, "volume" where it names none, "grid" for space="grid";
-    stats:    a dict with the keys of isorender --stats (docs/python.md)."""
+    stats:    a dict with the keys of isorender --stats (docs/python.md).
+
+    The same triangles with shared vertices (computed on first use, then kept): points,
+    point_normals and indices (welded(): the library's ip_mesh_weld(), as isorender --mesh
+    writes them). `faces` stays the soup's, so that vertices[faces] is always the triangles.
+    area(), volume(), write() (PLY, STL, OBJ, glTF), to_pyvista() and to_trimesh()."""
 
     def __init__(self, vertices, normals, stats=None, space=None):
         self.vertices, self.normals, self.stats, self.space = vertices, normals, stats, space
         self.faces = soup_faces(len(vertices) // 3)
+        self._welded: Dict[bool, Welded] = {}
+
+    def welded(self, allow_degenerate: bool = False) -> Welded:
+        """The triangles with shared vertices (a Welded: points, faces, normals, dropped):
+        corners at the same position (bit for bit) become one point. allow_degenerate=False
+        (as isorender --mesh) leaves out the triangles with two corners at one position, which
+        have no area; True keeps them (faces with a repeated index), so that there are as many
+        faces as triangles. Computed once per choice and kept (the arrays are shared)."""
+        key = bool(allow_degenerate)
+        if key not in self._welded:
+            self._welded[key] = weld(self.vertices, self.normals, key)
+        return self._welded[key]
+
+    @property
+    def points(self) -> np.ndarray:
+        """float32 (V, 3): each distinct vertex position once (welded().points)."""
+        return self.welded().points
+
+    @property
+    def point_normals(self) -> np.ndarray:
+        """float32 (V, 3): the unit normal at each point (welded().normals)."""
+        return self.welded().normals
+
+    @property
+    def indices(self) -> np.ndarray:
+        """int32 (F, 3): the triangles as indices into points, degenerate ones left out
+        (welded().faces)."""
+        return self.welded().faces
+
+    def area(self) -> float:
+        """The surface's area: the sum of its triangles' areas, in the mesh's units squared
+        (the spacing's units; float64 sums)."""
+        t = self.triangles.astype(np.float64)
+        cross = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+        return 0.5 * float(np.sqrt(np.einsum("ij,ij->i", cross, cross)).sum())
+
+    def volume(self) -> float:
+        """The volume the surface encloses, by the divergence theorem: the sum over triangles
+        (a, b, c) of a . (b x c) / 6, in the mesh's units cubed. Triangles are counter-clockwise
+        seen from lower values, so the volume of higher values inside a closed surface is
+        positive (negative where the surface encloses lower values). For an open surface (one
+        that runs out of the volume: extracted surfaces end at the volume's faces) the sum
+        depends on where the origin is and is not the volume of anything; close it first (pad
+        the array with a value below the level, say)."""
+        t = self.triangles.astype(np.float64)
+        return float(np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])).sum() / 6.0)
+
+    def write(self, path: Union[str, bytes, "os.PathLike[str]"], force: bool = False,
+              weld: bool = True) -> None:
+        """Writes the mesh in the format its name ends in (.ply, .stl, .obj or .glb, ignoring
+        case), as isorender --mesh does, with the library's writers: welded (shared vertices,
+        degenerate triangles left out) unless weld=False (--no-weld: 3 vertices a triangle; STL
+        is always one). The file names the mesh's space (self.space), and is written
+        atomically. Raises isoprop.Error (status IP_ERR_EXISTS) when the file exists and force
+        is False, ArgumentError for another extension, isoprop.Error for a failed write."""
+        write_mesh(self, path, force, weld)
+
+    def to_pyvista(self) -> Any:
+        """The welded mesh as a pyvista.PolyData (points, triangles, "Normals" point data).
+        Raises ImportError naming the package when pyvista is not installed."""
+        pv = _require("pyvista")
+        w = self.welded()
+        cells = np.empty((len(w.faces), 4), dtype=np.int64)
+        cells[:, 0] = 3
+        cells[:, 1:] = w.faces
+        poly = pv.PolyData(w.points, cells.ravel())
+        poly.point_data["Normals"] = w.normals
+        return poly
+
+    def to_trimesh(self) -> Any:
+        """The welded mesh as a trimesh.Trimesh (vertices, faces, vertex_normals, process=False
+        so that it keeps them as they are). Raises ImportError naming the package when trimesh
+        is not installed."""
+        trimesh = _require("trimesh")
+        w = self.welded()
+        return trimesh.Trimesh(vertices=w.points, faces=w.faces, vertex_normals=w.normals,
+                               process=False)
 
     @property
     def triangle_count(self):
@@ -101,3 +200,110 @@ def copy_triangles(mesh, first, count):
     # as ip_normal_unpack(): the integer as a float, divided by 32767 in float arithmetic
     normals = np.divide(packed, np.float32(NORMAL_SCALE), dtype=np.float32)
     return positions.reshape(-1, 3), normals.reshape(-1, 3)
+
+
+def _require(name: str) -> Any:
+    """The module `name`, or ImportError saying how to install it."""
+    import importlib
+    try:
+        return importlib.import_module(name)
+    except ImportError as e:
+        raise ImportError("isoprop: this needs the package %s, which is not installed (%s)"
+                          % (name, IMPORT_HINTS[name]), name=name) from e
+
+
+def pack_normals(normals: np.ndarray) -> np.ndarray:
+    """float32 unit normals as int16, as ip_normal_pack() (include/isoprop/mesh.h): times
+    32767, clamped, rounded half away from zero; NaN as 0."""
+    s = np.multiply(normals, np.float32(NORMAL_SCALE), dtype=np.float32)
+    np.clip(s, -NORMAL_SCALE, NORMAL_SCALE, out=s)
+    s[np.isnan(s)] = 0
+    s += np.where(s < 0, np.float32(-0.5), np.float32(0.5))
+    return s.astype(np.int16)
+
+
+def _borrowed_soup(vertices: np.ndarray, packed: np.ndarray) -> S.Mesh:
+    """An ip_mesh over numpy's memory (C-contiguous float32 positions and int16 normals, 3 a
+    triangle): for the library to read, never to free or grow."""
+    m = S.Mesh()
+    m.positions = vertices.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+    m.normals = packed.ctypes.data_as(ctypes.POINTER(ctypes.c_int16))
+    m.triangle_count = m.capacity = m.populated = len(vertices) // 3
+    return m
+
+
+def _unit(normals: np.ndarray) -> np.ndarray:
+    """The rows of float32 `normals` scaled to length 1 (zero rows stay zero), in place."""
+    length = np.sqrt(np.einsum("ij,ij->i", normals, normals))
+    length[length == 0] = 1
+    normals /= length[:, None]
+    return normals
+
+
+def _weld_status(st: int, triangles: int) -> None:
+    """Raises for a failed ip_mesh_weld(): MemoryError, or isoprop.Error."""
+    if st == IP_ERR_NOMEM:
+        raise MemoryError("isoprop: no memory to weld %d triangles" % triangles)
+    if st != 0:
+        raise Error(st, "isoprop: welding %d triangles: more than 2^32 - 2 distinct vertices"
+                    % triangles)
+
+
+def weld_c(mesh: S.Mesh, keep_degenerate: bool) -> Welded:
+    """An ip_mesh (the library's or borrowed) welded by the library, as numpy arrays."""
+    out = S.IndexedMesh()
+    fn = lib.ip_mesh_weld_keep_degenerate if keep_degenerate else lib.ip_mesh_weld
+    _weld_status(fn(ctypes.byref(mesh), ctypes.byref(out)), mesh.triangle_count)
+    try:
+        nv, nf = out.vertex_count, out.triangle_count
+        points = (_view(out.positions, np.float32, 0, 3 * nv).reshape(-1, 3).copy() if nv
+                  else np.empty((0, 3), np.float32))
+        normals = (np.divide(_view(out.normals, np.int16, 0, 3 * nv), np.float32(NORMAL_SCALE),
+                             dtype=np.float32).reshape(-1, 3) if nv
+                   else np.empty((0, 3), np.float32))
+        dtype = np.int32 if nv < 2 ** 31 else np.int64
+        faces = (_view(out.indices, np.uint32, 0, 3 * nf).astype(dtype).reshape(-1, 3) if nf
+                 else np.empty((0, 3), dtype))
+        return Welded(points, faces, _unit(normals), int(out.dropped_triangles))
+    finally:
+        lib.ip_indexed_mesh_free(ctypes.byref(out))
+
+
+def weld(vertices: np.ndarray, normals: np.ndarray, keep_degenerate: bool = False) -> Welded:
+    """A soup (float32 (3T, 3) vertices and normals) welded by the library (ip_mesh_weld(), or
+    ip_mesh_weld_keep_degenerate() when keep_degenerate)."""
+    v = np.ascontiguousarray(vertices, dtype=np.float32)
+    packed = pack_normals(np.ascontiguousarray(normals, dtype=np.float32))
+    return weld_c(_borrowed_soup(v, packed), keep_degenerate)
+
+
+def _space_name(space: Optional[str]) -> Optional[bytes]:
+    return space.encode() if space else None
+
+
+def write_mesh(mesh: Mesh, path: Any, force: bool, weld_it: bool) -> None:
+    """Mesh.write(): the library's ip_indexed_mesh_write_in() or ip_mesh_write_in()."""
+    from . import _check as C
+    C.path("path", path)
+    force = C.flag("force", force)
+    weld_it = C.flag("weld", weld_it)
+    encoded = os.fsencode(path)
+    if lib.ip_mesh_format_of(encoded) is None:
+        raise ArgumentError("path: %r: not a mesh file name (.ply, .stl, .obj or .glb)" % (path,))
+    err = new_error()
+    v = np.ascontiguousarray(mesh.vertices, dtype=np.float32)
+    packed = pack_normals(np.ascontiguousarray(mesh.normals, dtype=np.float32))
+    if not weld_it:
+        st = lib.ip_mesh_write_in(ctypes.byref(_borrowed_soup(v, packed)), encoded,
+                                  _space_name(mesh.space), int(force), ctypes.byref(err))
+        check(st, err)
+        return
+    out = S.IndexedMesh()  # welded here by the library, so the file is isorender's, byte for byte
+    _weld_status(lib.ip_mesh_weld(ctypes.byref(_borrowed_soup(v, packed)), ctypes.byref(out)),
+                 len(v) // 3)
+    try:
+        st = lib.ip_indexed_mesh_write_in(ctypes.byref(out), encoded, _space_name(mesh.space),
+                                          int(force), ctypes.byref(err))
+    finally:
+        lib.ip_indexed_mesh_free(ctypes.byref(out))
+    check(st, err)

@@ -153,14 +153,16 @@ static int degenerate(const float c[9])
            memcmp(c + 3, c + 6, 3 * sizeof(float)) == 0 || memcmp(c, c + 6, 3 * sizeof(float)) == 0;
 }
 
-static ip_status weld_triangles(welder *w, const ip_mesh *mesh)
+/* Welds every triangle of `mesh`; those with two corners at one position are left out and
+ * counted, unless `keep_degenerate`. */
+static ip_status weld_triangles(welder *w, const ip_mesh *mesh, int keep_degenerate)
 {
     ip_indexed_mesh *m = w->out;
     for (uint64_t t = 0; t < mesh->triangle_count; t++) {
         float c[9];
         for (int k = 0; k < 3; k++)
             canonical_position(mesh->positions + 9 * t + 3 * k, c + 3 * k);
-        if (degenerate(c)) {
+        if (!keep_degenerate && degenerate(c)) {
             m->dropped_triangles++;
             continue;
         }
@@ -176,7 +178,7 @@ static ip_status weld_triangles(welder *w, const ip_mesh *mesh)
     return IP_OK;
 }
 
-ip_status ip_mesh_weld(const ip_mesh *mesh, ip_indexed_mesh *out)
+static ip_status weld(const ip_mesh *mesh, ip_indexed_mesh *out, int keep_degenerate)
 {
     ip_indexed_mesh_init(out);
     welder w = {out, NULL, 0, NULL, 0};
@@ -192,7 +194,7 @@ ip_status ip_mesh_weld(const ip_mesh *mesh, ip_indexed_mesh *out)
     if (st == IP_OK)
         st = rehash(&w, slot_count);
     if (st == IP_OK)
-        st = weld_triangles(&w, mesh);
+        st = weld_triangles(&w, mesh, keep_degenerate);
     free(w.slots);
     free(w.normal_sums);
     if (st != IP_OK) {
@@ -207,4 +209,14 @@ ip_status ip_mesh_weld(const ip_mesh *mesh, ip_indexed_mesh *out)
     if (out->triangle_count > 0)
         (void)ip__array_resize(&out->indices, out->triangle_count, 3 * sizeof(uint32_t));
     return IP_OK;
+}
+
+ip_status ip_mesh_weld(const ip_mesh *mesh, ip_indexed_mesh *out)
+{
+    return weld(mesh, out, 0);
+}
+
+ip_status ip_mesh_weld_keep_degenerate(const ip_mesh *mesh, ip_indexed_mesh *out)
+{
+    return weld(mesh, out, 1);
 }

@@ -228,6 +228,13 @@ static void engine(void)
     FIELD(ip_mesh, capacity);
     FIELD(ip_mesh, populated);
     FIELD(ip_mesh, with_cells);
+    SIZE(ip_indexed_mesh);
+    FIELD(ip_indexed_mesh, positions);
+    FIELD(ip_indexed_mesh, normals);
+    FIELD(ip_indexed_mesh, indices);
+    FIELD(ip_indexed_mesh, vertex_count);
+    FIELD(ip_indexed_mesh, triangle_count);
+    FIELD(ip_indexed_mesh, dropped_triangles);
 }
 
 static void constants(void)

@@ -1,0 +1,178 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""One call from an array: marching_cubes() (scikit-image's signature and conventions) and
+contour() (the view-dependent surface of an array or a brick file), both over a File."""
+import contextlib
+import math
+import os
+import tempfile
+import warnings
+from typing import Any, Iterator, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _check as C
+from .bricking import brick
+from .errors import ArgumentError
+from .mesh import Mesh, weld
+from .volume import File
+from .volume import open as open_file
+
+# dtypes a brick file holds; others are converted (_as_volume())
+STORED = (np.uint8, np.uint16, np.int16, np.float32)
+DIRECTIONS = ("descent", "ascent")
+AXES = "axis 0, 1, 2"
+
+PathLike = Union[str, bytes, "os.PathLike[str]"]
+
+
+@contextlib.contextmanager
+def _volume_file(volume: np.ndarray, spacing_xyz: Sequence[float]) -> Iterator[File]:
+    """An open File of `volume` (shape (z, y, x), a dtype a brick file holds) with `spacing_xyz`
+    (x, y, z), closed on leaving. Today the array is bricked to a brick file in a temporary
+    folder, removed on leaving; it will be isoprop.open_array(volume, spacing=spacing_xyz), the
+    in-memory store, once that lands: nothing else depends on the route."""
+    with tempfile.TemporaryDirectory(prefix="isoprop-") as folder:
+        path = os.path.join(folder, "volume.ibv")
+        brick(volume, path, spacing=tuple(spacing_xyz))
+        with open_file(path) as f:
+            yield f
+
+
+def _as_volume(name: str, volume: Any) -> np.ndarray:
+    """`volume` as a 3-D numpy array of a dtype a brick file holds: bool as uint8, int8 as
+    int16, any other number type as float32 (which rounds integers past 2^24 and float64)."""
+    a = np.asarray(volume)
+    if a.ndim != 3:
+        raise ArgumentError("%s: must be a 3-D array, not %d-D (shape %s)" % (name, a.ndim,
+                                                                             a.shape))
+    if min(a.shape) < 2:
+        raise ArgumentError("%s: shape %s: at least 2 samples along each axis" % (name, a.shape))
+    if a.dtype == np.bool_:
+        return a.astype(np.uint8)
+    if a.dtype == np.int8:
+        return a.astype(np.int16)
+    if any(a.dtype == np.dtype(t) for t in STORED):
+        return a
+    if a.dtype.kind not in "uif":
+        raise TypeError("%s: must hold numbers, not %s" % (name, a.dtype))
+    return a.astype(np.float32)
+
+
+def _axis_spacing(spacing: Any) -> Tuple[float, float, float]:
+    """spacing (axis 0, 1, 2): three positive finite numbers."""
+    out = [C.number("spacing", v, axis) for v, axis in
+           zip(C.numbers_of("spacing", spacing, 3, AXES), ("axis 0", "axis 1", "axis 2"))]
+    for s, axis in zip(out, range(3)):
+        if not (s > 0 and math.isfinite(s)):
+            raise ArgumentError("spacing: axis %d: %r is not a positive finite number" % (axis, s))
+    return out[0], out[1], out[2]
+
+
+def _level(level: Any, a: np.ndarray) -> float:
+    """The isovalue: the midpoint of the data's range for None; ValueError naming `level`
+    when it is NaN or outside [min, max], as scikit-image."""
+    lo, hi = float(a.min()), float(a.max())
+    if level is None:
+        return 0.5 * (lo + hi)
+    value = C.number("level", level)
+    if not lo <= value <= hi:
+        raise ArgumentError("level: %r is outside the data's range, %g .. %g" % (value, lo, hi))
+    return value
+
+
+def _edge_values(a: np.ndarray, verts_index: np.ndarray) -> np.ndarray:
+    """The larger of the two samples at the ends of each vertex's grid edge (a vertex on a
+    sample: that sample), float32; verts_index in samples, axis order. A vertex lies on a grid
+    line: two of its coordinates are whole numbers (to rounding), the third, the farthest from
+    one, is along the edge."""
+    near = np.rint(verts_index)
+    off = np.abs(verts_index - near)
+    axis = np.argmax(off, axis=1)
+    rows = np.arange(len(verts_index))
+    low = near.astype(np.intp)
+    along = off[rows, axis] > 1e-6 * np.maximum(1.0, np.abs(near[rows, axis]))
+    low[rows, axis] = np.where(along, np.floor(verts_index[rows, axis]), near[rows, axis])
+    high = low.copy()
+    high[rows, axis] += along
+    for k in range(3):  # a clamp against rounding at the far faces
+        np.clip(low[:, k], 0, a.shape[k] - 1, out=low[:, k])
+        np.clip(high[:, k], 0, a.shape[k] - 1, out=high[:, k])
+    first = a[low[:, 0], low[:, 1], low[:, 2]]
+    second = a[high[:, 0], high[:, 1], high[:, 2]]
+    return np.maximum(first, second).astype(np.float32)
+
+
+def marching_cubes(volume: Any, level: Optional[float] = None, *,
+                   spacing: Sequence[float] = (1.0, 1.0, 1.0),
+                   gradient_direction: str = "descent", allow_degenerate: bool = True,
+                   threads: int = 0
+                   ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The isosurface `level` of the 3-D array `volume`, every cell of it, as scikit-image's
+    skimage.measure.marching_cubes() returns it: (verts, faces, normals, values).
+
+    volume: any 3-D array of numbers (uint8, uint16, int16 and float32 as they are; bool as
+    uint8, int8 as int16, others as float32). level: the midpoint of the data's range when None;
+    ValueError naming `level` when NaN or outside [min, max]. spacing: the distance between
+    samples along axis 0, 1, 2 of the array (scikit-image's order). gradient_direction:
+    "descent" (the object holds the higher values) or "ascent" (the lower), which sets the
+    faces' winding as scikit-image does. allow_degenerate: keep the triangles with two corners
+    at one position (the surface through a sample), so that the face count is the one of
+    classic marching cubes (VTK's); False leaves them out. threads: 0 for every core.
+
+    verts: float32 (V, 3), axis 0, 1, 2 of the array times spacing, each vertex once (shared by
+    the faces that meet there); faces: int32 (F, 3) indices into verts, counter-clockwise seen
+    from the higher values for "descent", from the lower for "ascent"; normals: float32 (V, 3)
+    unit, toward lower values (minus the data's gradient; either direction); values: float32
+    (V,), the larger of the two samples at the ends of the grid edge each vertex lies on (its
+    sample where it sits on one): as scikit-image's, the data's maximum near the vertex.
+    Raises RuntimeError when there is no surface at `level` (as scikit-image)."""
+    a = _as_volume("volume", volume)
+    sp = _axis_spacing(spacing)
+    gradient_direction = C.choice("gradient_direction", gradient_direction, DIRECTIONS)
+    allow_degenerate = C.flag("allow_degenerate", allow_degenerate)
+    threads = C.whole("threads", threads, 0, C.MAX_VIEW_THREADS)
+    iso = _level(level, a)
+    with _volume_file(a, sp[::-1]) as f, warnings.catch_warnings():
+        # level at the data's minimum (or past float32's rounding) has no surface: said below
+        warnings.simplefilter("ignore", RuntimeWarning)
+        mesh = f.extract(iso, stored=True, full=True, space="grid", threads=threads)
+    if len(mesh) == 0:
+        raise RuntimeError("marching_cubes: no surface at level %r" % iso)
+    w = weld(mesh.vertices, mesh.normals, keep_degenerate=allow_degenerate)
+    # x, y, z (the file's) is axis 2, 1, 0 of the array: a reflection, so the faces, which are
+    # counter-clockwise from lower values in x, y, z, are so from higher values in axis order
+    verts = np.ascontiguousarray(w.points[:, ::-1])
+    normals = np.ascontiguousarray(w.normals[:, ::-1])
+    faces = w.faces if gradient_direction == "descent" else w.faces[:, ::-1]
+    values = _edge_values(a, verts / np.asarray(sp, dtype=np.float64))
+    return verts, np.ascontiguousarray(faces), normals, values
+
+
+def contour(volume_or_path: Union[PathLike, Any], level: float, *, view: Optional[str] = None,
+            camera: Any = None, size: Sequence[int] = (800, 600),
+            spacing: Optional[Sequence[float]] = None, stored: bool = False,
+            **options: Any) -> Mesh:
+    """The view-dependent isosurface `level` (File.extract()'s progressive route: the
+    triangles the rays of a `size` image seen from `view` or `camera` reach) of an array or a
+    brick file, as a Mesh.
+
+    volume_or_path: a path to a brick file (its spacing, space and rescale; `level` in its
+    units, or stored=True) or a 3-D array (converted as marching_cubes() does; spacing along
+    its axis 0, 1, 2, default 1). The Mesh is File.extract()'s: vertices x, y, z, which for an
+    array are its axis 2, 1, 0 (mesh.vertices[:, ::-1] is axis order), normals toward lower
+    values. Other keywords are File.extract()'s (rays, time_limit, threads, lod, pixel_error,
+    occlusion, cull, space, ...), except full (marching_cubes() or File.extract(full=True))."""
+    if "full" in options:
+        raise ArgumentError("full: contour() is the view-dependent surface; for every cell use "
+                            "marching_cubes() or File.extract(full=True)")
+    if isinstance(volume_or_path, (str, bytes, os.PathLike)):
+        if spacing is not None:
+            raise ArgumentError("spacing: a brick file has its own (only for an array)")
+        with open_file(volume_or_path) as f:
+            return f.extract(level, stored=stored, view=view, camera=camera, size=size,
+                             **options)
+    a = _as_volume("volume_or_path", volume_or_path)
+    sp = _axis_spacing((1.0, 1.0, 1.0) if spacing is None else spacing)
+    with _volume_file(a, sp[::-1]) as f:
+        return f.extract(level, stored=stored, view=view, camera=camera, size=size, **options)
+
