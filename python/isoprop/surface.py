@@ -4,16 +4,14 @@ contour() (the view-dependent surface of an array or a brick file), both over a 
 import contextlib
 import math
 import os
-import tempfile
-import warnings
 from typing import Any, Iterator, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _check as C
-from .bricking import brick
+from .array import open_array
 from .errors import ArgumentError
-from .mesh import Mesh, weld
+from .mesh import Mesh
 from .volume import File
 from .volume import open as open_file
 
@@ -28,14 +26,9 @@ PathLike = Union[str, bytes, "os.PathLike[str]"]
 @contextlib.contextmanager
 def _volume_file(volume: np.ndarray, spacing_xyz: Sequence[float]) -> Iterator[File]:
     """An open File of `volume` (shape (z, y, x), a dtype a brick file holds) with `spacing_xyz`
-    (x, y, z), closed on leaving. Today the array is bricked to a brick file in a temporary
-    folder, removed on leaving; it will be isoprop.open_array(volume, spacing=spacing_xyz), the
-    in-memory store, once that lands: nothing else depends on the route."""
-    with tempfile.TemporaryDirectory(prefix="isoprop-") as folder:
-        path = os.path.join(folder, "volume.ibv")
-        brick(volume, path, spacing=tuple(spacing_xyz))
-        with open_file(path) as f:
-            yield f
+    (x, y, z), closed on leaving: the in-memory store (open_array()), no file."""
+    with open_array(volume, spacing=tuple(spacing_xyz)) as f:
+        yield f
 
 
 def _as_volume(name: str, volume: Any) -> np.ndarray:
@@ -132,13 +125,10 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *,
     allow_degenerate = C.flag("allow_degenerate", allow_degenerate)
     threads = C.whole("threads", threads, 0, C.MAX_VIEW_THREADS)
     iso = _level(level, a)
-    with _volume_file(a, sp[::-1]) as f, warnings.catch_warnings():
-        # level at the data's minimum (or past float32's rounding) has no surface: said below
-        warnings.simplefilter("ignore", RuntimeWarning)
-        mesh = f.extract(iso, stored=True, full=True, space="grid", threads=threads)
-    if len(mesh) == 0:
+    with _volume_file(a, sp[::-1]) as f:
+        w = f._full_welded(iso, threads, allow_degenerate)
+    if w is None:
         raise RuntimeError("marching_cubes: no surface at level %r" % iso)
-    w = weld(mesh.vertices, mesh.normals, keep_degenerate=allow_degenerate)
     # x, y, z (the file's) is axis 2, 1, 0 of the array: a reflection, so the faces, which are
     # counter-clockwise from lower values in x, y, z, are so from higher values in axis order
     verts = np.ascontiguousarray(w.points[:, ::-1])

@@ -13,7 +13,7 @@ from ._library import lib
 from . import _check as C
 from .bricking import DTYPES
 from .errors import ArgumentError, check, new_error
-from .mesh import Mesh, Step, copy_in_space
+from .mesh import Mesh, Step, copy_in_space, weld_c
 from .stats import counts_dict, run_stats
 
 Level = namedtuple("Level", "level dims bricks value_range")
@@ -538,6 +538,24 @@ class File:
         finally:
             lib.ip_mesh_free(ctypes.byref(mesh))
         return Mesh(vertices, normals, self._stats(run, counts), run.space)
+
+    def _full_welded(self, iso_stored, threads, keep_degenerate):
+        """marching_cubes()'s route: every active cell at full resolution (isorender --full) of
+        the stored isovalue `iso_stored`, in grid space (sample index x spacing), welded by the
+        library straight from its own mesh, so that no soup is copied out. Returns a Welded,
+        or None when there is no surface."""
+        a = _Args(threads=threads)
+        with _Call(self):
+            cache = self._cache_for(a.cache_mb)
+            mesh, counts, err = S.Mesh(), S.EngineCounts(), new_error()
+            lib.ip_mesh_init(ctypes.byref(mesh))
+            try:
+                check(lib.ip_extract_full(cache, float(iso_stored), 0, a.threads,
+                                          ctypes.byref(mesh), ctypes.byref(counts),
+                                          ctypes.byref(err)), err)
+                return weld_c(mesh, keep_degenerate) if mesh.triangle_count else None
+            finally:
+                lib.ip_mesh_free(ctypes.byref(mesh))
 
 
 def open(path):  # noqa: A001 (isoprop.open, as the module's API names it)
