@@ -1317,6 +1317,82 @@ static void test_shared_data(void)
     printf("test_input: checked %d shared volumes in %s\n", count, folder);
 }
 
+/* ---- the caller's plane source (ip_input_desc_from_planes()) ---- */
+
+typedef struct planes_seen {
+    uint32_t next_z, calls, fail_at; /* fail_at: the plane whose read fails (UINT32_MAX: none) */
+    int with_message;
+} planes_seen;
+
+/* Plane z holds z * 1000 + y * 10 + x as uint16; checks that planes come in order. */
+static ip_status fill_planes(void *user, uint32_t z, uint32_t count, void *dst, ip_error *err)
+{
+    planes_seen *seen = user;
+    CHECK_EQ(z, seen->next_z);
+    seen->next_z = z + count;
+    seen->calls++;
+    if (seen->fail_at >= z && seen->fail_at < z + count) {
+        if (seen->with_message) {
+            err->code = IP_ERR_IO;
+            snprintf(err->message, sizeof err->message, "source: plane %u is gone", seen->fail_at);
+        }
+        return IP_ERR_IO;
+    }
+    uint16_t *out = dst;
+    for (uint32_t k = 0; k < count; k++)
+        for (uint32_t y = 0; y < 4; y++)
+            for (uint32_t x = 0; x < 5; x++)
+                *out++ = (uint16_t)((z + k) * 1000 + y * 10 + x);
+    return IP_OK;
+}
+
+static void test_plane_source(void)
+{
+    const uint32_t dims[3] = {5, 4, 6};
+    const double spacing[3] = {0.5, 1, 2};
+    planes_seen seen = {0, 0, UINT32_MAX, 0};
+    ip_input_desc d;
+    ip_error err;
+    REQUIRE(ip_input_desc_from_planes(&d, "array", dims, IP_UINT16, spacing, fill_planes, &seen,
+                                      &err) == IP_OK);
+    CHECK_EQ(d.encoding, IP_ENCODING_CALLBACK);
+    CHECK_STR_EQ(d.path, "array");
+    CHECK_EQ(d.spacing[0], 0.5);
+    CHECK_EQ(d.spacing[2], 2.0);
+    CHECK_EQ(d.has_rescale, 0);
+    ip_input_reader *reader = NULL;
+    REQUIRE(ip_input_open(&d, &reader, &err) == IP_OK);
+    uint16_t buf[5 * 4 * 6];
+    CHECK_EQ(ip_input_read_planes(reader, buf, 2, &err), IP_OK);
+    CHECK_EQ(ip_input_read_planes(reader, buf + 40, 4, &err), IP_OK);
+    CHECK_EQ(seen.calls, 2);
+    CHECK_EQ(buf[0], 0);
+    CHECK_EQ(buf[5 * 4 * 5 + 3 * 5 + 4], 5034);
+    CHECK_NE(ip_input_read_planes(reader, buf, 1, &err), IP_OK); /* past the last plane */
+    ip_input_close(reader);
+    for (int with_message = 0; with_message < 2; with_message++) {
+        seen = (planes_seen){0, 0, 3, with_message};
+        read_fails(&d, IP_ERR_IO,
+                   with_message ? "source: plane 3 is gone"
+                                : "array: the plane source failed at planes 3 .. 3");
+    }
+    /* refused: no function, bad dims, unknown type, bad spacing */
+    ip_input_desc untouched = d;
+    const uint32_t flat[3] = {5, 1, 6};
+    const double zero[3] = {1, 0, 1};
+    CHECK_EQ(ip_input_desc_from_planes(&d, "array", dims, IP_UINT16, NULL, NULL, NULL, &err),
+             IP_ERR_ARGUMENT);
+    CHECK_EQ(ip_input_desc_from_planes(&d, "array", flat, IP_UINT16, NULL, fill_planes, NULL, &err),
+             IP_ERR_ARGUMENT);
+    CHECK_CONTAINS(err.message, "array: dimension y is 1");
+    CHECK_EQ(
+        ip_input_desc_from_planes(&d, "array", dims, (ip_type)9, NULL, fill_planes, NULL, &err),
+        IP_ERR_ARGUMENT);
+    CHECK_NE(ip_input_desc_from_planes(&d, "array", dims, IP_UINT16, zero, fill_planes, NULL, &err),
+             IP_OK);
+    CHECK_MEM_EQ(&d, &untouched, sizeof d);
+}
+
 static const test_case cases[] = {
     TEST_CASE(test_raw_by_name),       TEST_CASE(test_raw_by_overrides),
     TEST_CASE(test_overrides_win),     TEST_CASE(test_big_endian_raw),
@@ -1330,6 +1406,7 @@ static const test_case cases[] = {
     TEST_CASE(test_missing_files),     TEST_CASE(test_bad_gzip),
     TEST_CASE(test_non_finite_floats), TEST_CASE(test_limits),
     TEST_CASE(test_large_offsets),     TEST_CASE(test_shared_data),
+    TEST_CASE(test_plane_source),
 };
 
 static void make_scratch_dir(void)

@@ -23,11 +23,22 @@ extern "C" {
 
 /* How the samples are stored. */
 typedef enum ip_encoding {
-    IP_ENCODING_RAW = 0,  /* plain samples from data_offset on */
-    IP_ENCODING_GZIP = 1, /* a gzip (or zlib) stream from data_offset on */
-    IP_ENCODING_TIFF = 2, /* one TIFF page a plane: a multi-page file or a folder of files */
-    IP_ENCODING_DICOM = 3 /* one DICOM file a plane: a folder holding one series */
+    IP_ENCODING_RAW = 0,     /* plain samples from data_offset on */
+    IP_ENCODING_GZIP = 1,    /* a gzip (or zlib) stream from data_offset on */
+    IP_ENCODING_TIFF = 2,    /* one TIFF page a plane: a multi-page file or a folder of files */
+    IP_ENCODING_DICOM = 3,   /* one DICOM file a plane: a folder holding one series */
+    IP_ENCODING_CALLBACK = 4 /* the caller's function fills the planes: plane_source and
+                                plane_user (ip_input_desc_from_planes(), experimental) */
 } ip_encoding;
+
+/* A caller's source of z-planes (IP_ENCODING_CALLBACK): fills `dst` with the `count` planes
+ * from plane `z` on, dims[0] x dims[1] samples each of the desc's type, x fastest, in the
+ * host's byte order. The reader calls it for z = 0, 1, ... in order, each plane once, from
+ * one thread at a time (not always the same one: the bricker may read on a helper thread).
+ * Returns IP_OK, or an error status that ends the reading; it may then put a message in
+ * *err (the reader names the source when it leaves *err empty). */
+typedef ip_status (*ip_plane_source_fn)(void *user, uint32_t z, uint32_t count, void *dst,
+                                        ip_error *err);
 
 /* Where a volume's samples are and how to read them. */
 typedef struct ip_input_desc {
@@ -65,7 +76,10 @@ typedef struct ip_input_desc {
                                  normal (a gantry tilt); 0 when they stack along the normal */
     char rescale_unit[IP_RESCALE_UNIT_MAX]; /* with has_rescale: the values' unit, "" when the
                                                file names none ("HU" for a DICOM CT) */
-    uint64_t reserved[18]; /* zero: room for later fields at the same size (status.h) */
+    /* IP_ENCODING_CALLBACK only (ip_input_desc_from_planes()); NULL otherwise. */
+    ip_plane_source_fn plane_source; /* fills the planes */
+    void *plane_user;                /* passed to plane_source, not owned */
+    uint64_t reserved[16];           /* zero: room for later fields at the same size (status.h) */
 } ip_input_desc;
 
 /* ip_input_desc.resampled: the slices of a DICOM series were resampled onto a regular grid
@@ -186,6 +200,19 @@ typedef struct ip_dicom_series_info {
  *  when the input component cannot be loaded, IP_ERR_NOMEM. */
 IP_API ip_status ip_dicom_list_series(const char *folder, ip_dicom_series_info **out,
                                       uint32_t *count, uint32_t *skipped, ip_error *err);
+
+/*! ip_input_desc_from_planes() : fills *desc for a volume whose samples the caller's function
+ *  `fn` gives plane by plane (IP_ENCODING_CALLBACK; `user` is passed to it, not owned): dims
+ *  (x, y, z, each 2 .. 2^31 - 1) samples of `type`, `spacing` (NULL: 1,1,1), no rescale, an
+ *  identity orientation. `name` (e.g. "array") stands for the volume in messages, as a path
+ *  does. A reader (ip_input_open()) or the bricker (ip_bricker_run(), which then checks no
+ *  output against an input file) reads it like any other desc; float32 NaN and infinities are
+ *  refused as for files. @return IP_OK; IP_ERR_ARGUMENT for a NULL desc, name or fn, a name
+ *  of IP_PATH_MAX bytes or more, dims out of range or an unknown type (*desc untouched). */
+IP_API ip_status ip_input_desc_from_planes(ip_input_desc *desc, const char *name,
+                                           const uint32_t dims[3], ip_type type,
+                                           const double spacing[3], ip_plane_source_fn fn,
+                                           void *user, ip_error *err);
 
 #endif /* IP_EXPERIMENTAL */
 

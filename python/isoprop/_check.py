@@ -10,6 +10,7 @@ import math
 import numbers
 import os
 from collections.abc import Mapping
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -30,7 +31,7 @@ CAMERA_KEYS = ("eye", "target", "up", "fov")
 CAMERA_IGNORED = ("width", "height")  # File.camera()'s dict may come back as camera=
 
 
-def describe(value):
+def describe(value: Any) -> str:
     """A value for a message: its type and repr, shortened."""
     text = repr(value)
     if len(text) > 60:
@@ -38,11 +39,11 @@ def describe(value):
     return "%s %s" % (type(value).__name__, text)
 
 
-def _is_bool(value):
+def _is_bool(value: Any) -> bool:
     return isinstance(value, (bool, np.bool_))
 
 
-def whole(name, value, lo, hi, what=""):
+def whole(name: str, value: Any, lo: int, hi: int, what: str = "") -> int:
     """A whole number (int or numpy integer, not bool) within lo .. hi."""
     if _is_bool(value) or not isinstance(value, numbers.Integral):
         raise TypeError("%s: %smust be a whole number, not %s"
@@ -54,7 +55,7 @@ def whole(name, value, lo, hi, what=""):
     return v
 
 
-def number(name, value, what=""):
+def number(name: str, value: Any, what: str = "") -> float:
     """A finite real number (int, float or numpy number, not bool) as a float."""
     if _is_bool(value) or not isinstance(value, numbers.Real):
         raise TypeError("%s: %smust be a number, not %s"
@@ -65,7 +66,7 @@ def number(name, value, what=""):
     return v
 
 
-def positive(name, value):
+def positive(name: str, value: Any) -> float:
     """A finite number above 0."""
     v = number(name, value)
     if not v > 0:
@@ -73,7 +74,7 @@ def positive(name, value):
     return v
 
 
-def degrees(name, value, lo, lo_open):
+def degrees(name: str, value: Any, lo: float, lo_open: bool) -> Optional[float]:
     """None, or a finite angle within (lo, 180] (lo_open) or [lo, 180]."""
     if value is None:
         return None
@@ -84,7 +85,7 @@ def degrees(name, value, lo, lo_open):
     return v
 
 
-def isovalue(value):
+def isovalue(value: Any) -> float:
     """The isovalue: a finite number, finite as the float32 the engine takes."""
     v = number("iso", value)
     with np.errstate(over="ignore"):
@@ -94,14 +95,14 @@ def isovalue(value):
     return v
 
 
-def flag(name, value):
+def flag(name: str, value: Any) -> bool:
     """True or False (numpy bools and the ints 0 and 1 too)."""
     if _is_bool(value) or (isinstance(value, numbers.Integral) and int(value) in (0, 1)):
         return bool(value)
     raise TypeError("%s: must be True or False, not %s" % (name, describe(value)))
 
 
-def choice(name, value, choices):
+def choice(name: str, value: Any, choices: Sequence[str]) -> str:
     """One of the strings `choices`."""
     if not isinstance(value, str):
         raise TypeError("%s: must be one of %s, not %s"
@@ -111,23 +112,23 @@ def choice(name, value, choices):
     return value
 
 
-def count_or_none(name, value, lo):
+def count_or_none(name: str, value: Any, lo: int) -> Optional[int]:
     """None, or a whole number lo .. 2^64 - 1."""
     return None if value is None else whole(name, value, lo, MAX_COUNT)
 
 
-def seconds_or_none(name, value):
+def seconds_or_none(name: str, value: Any) -> Optional[float]:
     """None, or a finite number of seconds above 0."""
     return None if value is None else positive(name, value)
 
 
-def callable_or_none(name, value):
+def callable_or_none(name: str, value: Any) -> Optional[Callable[..., Any]]:
     if value is not None and not callable(value):
         raise TypeError("%s: must be a function or None, not %s" % (name, describe(value)))
     return value
 
 
-def path(name, value):
+def path(name: str, value: Any) -> Any:
     """A file path (str, bytes or os.PathLike), not empty, without NUL characters; returned
     as given."""
     if not isinstance(value, (str, bytes, os.PathLike)):
@@ -144,7 +145,7 @@ def path(name, value):
     return value
 
 
-def numbers_of(name, value, n, axes):
+def numbers_of(name: str, value: Any, n: int, axes: str) -> List[Any]:
     """A sequence of n values (a tuple, list or 1-D numpy array, not a string)."""
     if isinstance(value, (str, bytes, Mapping)) or not hasattr(value, "__len__") or \
             not hasattr(value, "__getitem__") or getattr(value, "ndim", 1) != 1:
@@ -155,20 +156,25 @@ def numbers_of(name, value, n, axes):
     return [value[k] for k in range(n)]
 
 
-def size(value):
+def size(value: Any) -> Tuple[int, int]:
     """The image size (width, height): two whole numbers 1 .. 16384."""
-    w, h = numbers_of("size", value, 2, "width, height")
-    return (whole("size", w, 1, MAX_IMAGE_SIDE, "width"),
-            whole("size", h, 1, MAX_IMAGE_SIDE, "height"))
+    w, h = numbers_of("size", value, 2, "width, height: whole numbers of pixels, 1 .. %d"
+                      % MAX_IMAGE_SIDE)
+    try:
+        return (whole("size", w, 1, MAX_IMAGE_SIDE, "width"),
+                whole("size", h, 1, MAX_IMAGE_SIDE, "height"))
+    except ArgumentError as e:  # say why the bound is what it is
+        raise ArgumentError("%s pixels (%d: the largest image side the engine renders)"
+                            % (e, MAX_IMAGE_SIDE)) from None
 
 
-def point(name, value):
+def point(name: str, value: Any) -> List[float]:
     """Three finite numbers (x, y, z)."""
     return [number(name, v, axis) for v, axis in zip(numbers_of(name, value, 3, "x, y, z"),
                                                      "xyz")]
 
 
-def view(value, camera):
+def view(value: Any, camera: Any) -> Optional[str]:
     """One of anterior posterior left right superior inferior +x -x +y -y +z -z, or None (the
     file's default view, or the camera when one is given)."""
     if value is None:
@@ -176,7 +182,7 @@ def view(value, camera):
     return choice("view", value, VIEWS)
 
 
-def camera(value):
+def camera(value: Any) -> Union[None, str, Dict[str, Any]]:
     """None, isorender's --camera text, or a dict with eye, target, up (three finite numbers
     each) and fov (degrees, within (0, 180)); returned as text or as a dict of floats."""
     if value is None:
@@ -205,12 +211,12 @@ def camera(value):
     return out
 
 
-def cache_mb(value):
+def cache_mb(value: Any) -> Optional[int]:
     """None (keep the cache, or the default budget), or a budget in MiB 1 .. 2^30."""
     return None if value is None else whole("cache_mb", value, 1, MAX_CACHE_MB)
 
 
-def prefetch(value):
+def prefetch(value: Any) -> Union[bool, str]:
     """True, False or "always"."""
     if isinstance(value, str):
         if value != "always":
@@ -221,7 +227,7 @@ def prefetch(value):
     raise TypeError('prefetch: must be True, False or "always", not %s' % describe(value))
 
 
-def full(value):
+def full(value: Any) -> Union[bool, str]:
     """False, True or "lod" (numpy bools and the ints 0 and 1 too)."""
     if isinstance(value, str):
         if value != "lod":
@@ -232,14 +238,14 @@ def full(value):
     raise TypeError('full: must be False, True or "lod", not %s' % describe(value))
 
 
-def power_of_two(name, value, lo, hi):
+def power_of_two(name: str, value: Any, lo: int, hi: int) -> int:
     v = whole(name, value, lo, hi)
     if v & (v - 1):
         raise ArgumentError("%s: %d is not a power of two (%d .. %d)" % (name, v, lo, hi))
     return v
 
 
-def hc(value):
+def hc(value: Any) -> int:
     """None or False (fast LZ4), True (LZ4HC level 9) or an LZ4HC level 1 .. 12; as the
     library's lz4_level (0: fast)."""
     if value is None or (_is_bool(value) and not value):
@@ -252,7 +258,7 @@ def hc(value):
     return whole("hc", value, *LZ4HC_LEVELS, what="level")
 
 
-def dims(value):
+def dims(value: Any) -> Optional[List[int]]:
     """None or (x, y, z) samples, each 2 .. 2^31 - 1."""
     if value is None:
         return None
@@ -260,12 +266,14 @@ def dims(value):
             for v, axis in zip(numbers_of("dims", value, 3, "x, y, z"), "xyz")]
 
 
-def spacing(value):
+def spacing(value: Any) -> Optional[List[float]]:
     """None or (x, y, z) world units between samples: finite and positive (the library's bounds
     are checked by the caller)."""
     if value is None:
         return None
-    out = point("spacing", value)
+    out = [number("spacing", v, axis)
+           for v, axis in zip(numbers_of("spacing", value, 3, "x, y, z: positive finite numbers"),
+                              "xyz")]
     for s, axis in zip(out, "xyz"):
         if not s > 0:
             raise ArgumentError("spacing: %s %r is not positive" % (axis, s))

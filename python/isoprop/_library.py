@@ -34,6 +34,8 @@ _PROTOTYPES = {
     "ip_now_seconds": (c_double, []),
     "ip_spacing_check": (c_int, [c_double * 3, c_char_p, ERR]),
     "ip_input_describe": (c_int, [c_char_p, POINTER(S.InputOverrides), POINTER(S.InputDesc), ERR]),
+    "ip_input_desc_from_planes": (c_int, [POINTER(S.InputDesc), c_char_p, c_uint32 * 3, c_int,
+                                          c_double * 3, S.PLANE_SOURCE_FN, c_void_p, ERR]),
     "ip_bricker_options_default": (None, [POINTER(S.BrickerOptions)]),
     "ip_bricker_run": (c_int, [POINTER(S.InputDesc), c_char_p, POINTER(S.BrickerOptions),
                                POINTER(S.BrickerReport), ERR]),

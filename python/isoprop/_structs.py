@@ -40,6 +40,11 @@ class MemoryVolume(ctypes.Structure):
                 ("subblock_edge", c_uint32), ("threads", c_uint32), ("name", ctypes.c_char_p)]
 
 
+# ip_plane_source_fn (input.h): fills `count` z-planes from z into dst; an ip_status
+PLANE_SOURCE_FN = ctypes.CFUNCTYPE(c_int, c_void_p, c_uint32, c_uint32, c_void_p,
+                                   ctypes.POINTER(Error))
+
+
 class InputDesc(ctypes.Structure):
     """ip_input_desc (input.h)"""
     _fields_ = [("path", c_char * PATH_MAX), ("data_path", c_char * PATH_MAX),
@@ -50,7 +55,8 @@ class InputDesc(ctypes.Structure):
                 ("series_uid", c_char * 72), ("series_count", c_uint32),
                 ("skipped_objects", c_uint32), ("source_slices", c_uint32), ("resampled", c_uint32),
                 ("tilt_degrees", c_double), ("rescale_unit", c_char * RESCALE_UNIT_MAX),
-                ("reserved", c_uint64 * 18)]
+                ("plane_source", PLANE_SOURCE_FN), ("plane_user", c_void_p),
+                ("reserved", c_uint64 * 16)]
 
 
 class InputOverrides(ctypes.Structure):

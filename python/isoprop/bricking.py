@@ -3,8 +3,9 @@
 numpy array."""
 import ctypes
 import errno
+import mmap
 import os
-import tempfile
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -19,7 +20,7 @@ TYPES = {np.dtype(np.uint8): 0, np.dtype(np.uint16): 1, np.dtype(np.int16): 2,
 DTYPES = {code: dtype for dtype, code in TYPES.items()}
 
 
-def type_code(dtype):
+def type_code(dtype: Any) -> int:
     """The ip_type of a numpy dtype or a type name the library knows ("uint16", "short", ...)."""
     if isinstance(dtype, str) and "\0" not in dtype:
         code = ctypes.c_int()
@@ -35,7 +36,9 @@ def type_code(dtype):
 REGRID_DEFAULT, REGRID_RESAMPLE, REGRID_REFUSE = 0, 1, 2  # ip_regrid (input.h)
 
 
-def _overrides(dims, dtype, spacing, endian, dicom=None):
+def _overrides(dims: Optional[List[int]], dtype: Optional[int],
+               spacing: Optional[List[float]], endian: Optional[str],
+               dicom: Optional[Tuple[Any, int, int]] = None) -> S.InputOverrides:
     """The ip_input_overrides of checked arguments (dims and spacing lists, dtype a code;
     dicom: (series bytes or None, tilt, uneven) as _check_dicom() gives them)."""
     o = S.InputOverrides()
@@ -53,7 +56,8 @@ def _overrides(dims, dtype, spacing, endian, dicom=None):
     return o
 
 
-def _options(brick_size, subblock_size, lz4_level, threads, mem_mb, force):
+def _options(brick_size: int, subblock_size: int, lz4_level: int, threads: int,
+             mem_mb: int, force: bool) -> S.BrickerOptions:
     """The ip_bricker_options of checked arguments."""
     o = S.BrickerOptions()
     lib.ip_bricker_options_default(ctypes.byref(o))
@@ -62,7 +66,8 @@ def _options(brick_size, subblock_size, lz4_level, threads, mem_mb, force):
     return o
 
 
-def _check_dicom(series, correct_tilt, even_spacing):
+def _check_dicom(series: Optional[str], correct_tilt: Any,
+                 even_spacing: Any) -> Tuple[Optional[bytes], int, int]:
     """A DICOM folder's choices as ip_input_overrides takes them: (series, tilt, uneven)."""
     if series is not None:
         if not isinstance(series, str):
@@ -77,7 +82,7 @@ def _check_dicom(series, correct_tilt, even_spacing):
     return series, tilt, uneven
 
 
-def _check_rescale(rescale):
+def _check_rescale(rescale: Any) -> Optional[S.Rescale]:
     """None (the input's), or the ip_rescale that replaces it: not present for False, else
     (slope, intercept[, unit]) as the library checks it (ip_rescale_check())."""
     if rescale is None:
@@ -108,11 +113,22 @@ def _check_rescale(rescale):
     return r
 
 
-def _run(path, out, overrides, options, progress, rescale=None):
-    """ip_input_describe() then ip_bricker_run(); `progress(done_bytes, total_bytes)` may
-    return True (or raise, Ctrl-C included) to cancel: nothing is then left at `out`.
-    `rescale` (an ip_rescale, or None: the input's) replaces the input's rescale."""
-    raised = []
+def _describe(path: Any, overrides: S.InputOverrides) -> S.InputDesc:
+    """ip_input_describe() of a path."""
+    err, desc = new_error(), S.InputDesc()
+    check(lib.ip_input_describe(os.fsencode(path), ctypes.byref(overrides), ctypes.byref(desc),
+                                ctypes.byref(err)), err)
+    return desc
+
+
+def _run(desc: S.InputDesc, out: Any, options: S.BrickerOptions,
+         progress: Optional[Callable[[int, int], Any]], rescale: Optional[S.Rescale] = None,
+         planes: Optional["_Planes"] = None) -> Dict[str, Any]:
+    """ip_bricker_run() of `desc`; `progress(done_bytes, total_bytes)` may return True (or
+    raise, Ctrl-C included) to cancel: nothing is then left at `out`. `rescale` (an ip_rescale,
+    or None: the input's) replaces the input's rescale. An exception of `planes` (an array's
+    plane source) is re-raised as it was."""
+    raised: List[BaseException] = []
 
     def on_progress(_user, done, total):
         try:
@@ -122,21 +138,21 @@ def _run(path, out, overrides, options, progress, rescale=None):
             return 1
 
     options.progress = S.PROGRESS_FN(on_progress)
-    err, desc, report = new_error(), S.InputDesc(), S.BrickerReport()
-    check(lib.ip_input_describe(os.fsencode(path), ctypes.byref(overrides), ctypes.byref(desc),
-                                ctypes.byref(err)), err)
+    err, report = new_error(), S.BrickerReport()
     if rescale is not None:
         desc.has_rescale, desc.rescale_slope = rescale.present, rescale.slope
         desc.rescale_intercept, desc.rescale_unit = rescale.intercept, rescale.unit
     st = lib.ip_bricker_run(ctypes.byref(desc), os.fsencode(out), ctypes.byref(options),
                             ctypes.byref(report), ctypes.byref(err))
+    if planes is not None and planes.raised:
+        raise planes.raised[0]
     if raised:
         raise raised[0]
     check(st, err)
     return {name: getattr(report, name) for name, _ in S.BrickerReport._fields_}
 
 
-def _check_spacing(spacing):
+def _check_spacing(spacing: Any) -> Optional[List[float]]:
     """The spacing within the library's bounds (ip_spacing_check()), or ArgumentError."""
     spacing = C.spacing(spacing)
     if spacing is not None:
@@ -147,69 +163,136 @@ def _check_spacing(spacing):
     return spacing
 
 
-def _check_array(source):
-    """The array `source` as a numpy array of a sample type the library reads."""
+def _check_array(source: Any) -> Any:
+    """`source` as an array-like the bricker can read slab by slab: any object with `shape`,
+    `dtype` and slicing along its first axis (a numpy array or memmap, a zarr array, an h5py
+    dataset, a dask array) is kept as it is; anything else (nested lists) becomes a numpy
+    array."""
+    if not all(hasattr(source, name) for name in ("shape", "dtype", "__getitem__")):
+        try:
+            source = np.asarray(source)
+        except Exception as e:  # e.g. ragged nested lists
+            raise TypeError("source: must be a path or an array (z, y, x), not %s (%s)"
+                            % (C.describe(source), e)) from None
     try:
-        a = np.asarray(source)
-    except Exception as e:  # e.g. ragged nested lists
-        raise TypeError("source: must be a path or a numpy array (z, y, x), not %s (%s)"
-                        % (C.describe(source), e)) from None
-    if a.ndim == 0 or a.dtype == object:
-        raise TypeError("source: must be a path or a numpy array (z, y, x), not %s"
+        shape = tuple(int(n) for n in source.shape)
+        dtype = np.dtype(source.dtype)
+    except (TypeError, ValueError):
+        raise TypeError("source: must be a path or an array (z, y, x), not %s"
+                        % C.describe(source)) from None
+    if len(shape) == 0 or dtype == object:
+        raise TypeError("source: must be a path or an array (z, y, x), not %s"
                         % C.describe(source))
-    if a.dtype.newbyteorder("=") not in TYPES:
+    if dtype.newbyteorder("=") not in TYPES:
         raise TypeError("source: an array of dtype %s: the sample type must be uint8, uint16, "
-                        "int16 or float32" % a.dtype)
-    if a.ndim != 3:
+                        "int16 or float32" % dtype)
+    if len(shape) != 3:
         raise ArgumentError("source: an array of shape %s: a volume is a 3-D array, shape "
-                            "(z, y, x)" % (a.shape,))
-    if min(a.shape) < 2 or max(a.shape) > C.MAX_DIM:
+                            "(z, y, x)" % (shape,))
+    if min(shape) < 2 or max(shape) > C.MAX_DIM:
         raise ArgumentError("source: an array of shape %s: each dimension must be within "
-                            "2 .. %d" % (a.shape, C.MAX_DIM))
-    return a
+                            "2 .. %d" % (shape, C.MAX_DIM))
+    return source
 
 
-def _scratch_error(e, out, folder):
-    """The OSError `e` met writing an array's scratch file beside `out`, as the same kind of
-    OSError naming `out` (the user's path), not the scratch file."""
-    if e.errno == errno.ENOENT and not os.path.isdir(folder):
-        text = "the output's folder %s does not exist" % folder
-    else:
-        text = ("cannot write the array's samples to a scratch file beside the output (in %s): %s"
-                % (folder, e.strerror or e))
-    return OSError(e.errno, text, os.fsdecode(out))
+MADV_DONTNEED = 4  # <sys/mman.h>
+_libc = None
 
 
-def _array_input(a, out):
-    """Writes the array `a` (z, y, x) as little-endian raw samples to a new hidden file beside
-    `out` (the same file system, so no other disk fills up); returns its path and dims (x, y,
-    z). An OSError (no such folder, no permission, disk full) names `out`."""
-    a = np.ascontiguousarray(a, dtype=a.dtype.newbyteorder("<"))
+def _drop_pages(slab: np.ndarray) -> None:
+    """After a slab of a numpy memmap opened read-only or shared ('r', 'r+') is copied, hands its
+    pages back (madvise MADV_DONTNEED: they stay in the page cache, not in this process), so
+    that bricking a mapped file does not grow the process by the file's size. A private
+    ('c') mapping keeps its pages: dropping them would drop the caller's changes."""
+    global _libc
+    if not isinstance(slab, np.memmap) or getattr(slab, "mode", None) not in ("r", "r+") or \
+            not slab.flags.c_contiguous or slab.nbytes == 0:
+        return
+    if _libc is None:
+        _libc = ctypes.CDLL(None, use_errno=True)
+        _libc.madvise.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int]
+    page = mmap.PAGESIZE
+    first = slab.ctypes.data // page * page  # whole pages only: the slab's own and shared edges
+    last = (slab.ctypes.data + slab.nbytes) // page * page
+    if last > first:
+        _libc.madvise(first, last - first, MADV_DONTNEED)
+
+
+class _Planes:
+    """The bricker's plane source over an array-like (z, y, x): each call slices the planes
+    the bricker asks for (source[z:z + count]) and copies them into the bricker's own buffer
+    in the host's byte order, so no more than one slab is ever held here. An exception of the
+    slicing ends the run; it is kept in `raised` and re-raised once the library returns."""
+
+    def __init__(self, source: Any) -> None:
+        self.source = source
+        self.dtype = np.dtype(source.dtype).newbyteorder("=")
+        self.plane_shape = tuple(int(n) for n in source.shape[1:])
+        self.raised: List[BaseException] = []
+        self.fn = S.PLANE_SOURCE_FN(self._fill)  # kept alive as long as the run
+
+    def _fill(self, _user, z, count, dst, err):
+        try:
+            shape = (count,) + self.plane_shape
+            nbytes = count * self.plane_shape[0] * self.plane_shape[1] * self.dtype.itemsize
+            out = np.frombuffer((ctypes.c_char * nbytes).from_address(dst),
+                                dtype=self.dtype).reshape(shape)
+            slab = self.source[z:z + count]
+            got = tuple(getattr(slab, "shape", ()))
+            if got != shape:
+                raise ValueError("source: slicing [%d:%d] gave shape %s, not %s"
+                                 % (z, z + count, got, shape))
+            np.copyto(out, slab if isinstance(slab, np.ndarray) else np.asarray(slab),
+                      casting="equiv")
+            _drop_pages(slab)
+            return 0
+        except BaseException as e:  # re-raised by brick() once the library has cleaned up
+            self.raised.append(e)
+            err.contents.message = ("array: reading planes %d .. %d raised %s"
+                                    % (z, z + count - 1, type(e).__name__)).encode()
+            return IP_ERR_INPUT
+
+
+IP_ERR_INPUT = -4  # include/isoprop/status.h
+
+
+def _array_desc(planes: _Planes, spacing: Optional[List[float]]) -> S.InputDesc:
+    """The ip_input_desc of an array-like read through `planes`."""
+    desc, err = S.InputDesc(), new_error()
+    dims = (ctypes.c_uint32 * 3)(*planes.source.shape[::-1])
+    space = (ctypes.c_double * 3)(*(spacing or (1.0, 1.0, 1.0)))
+    check(lib.ip_input_desc_from_planes(ctypes.byref(desc), b"array", dims,
+                                        TYPES[planes.dtype], space, planes.fn, None,
+                                        ctypes.byref(err)), err)
+    return desc
+
+
+def _check_out_folder(out: Any) -> None:
+    """The output's folder must exist (FileNotFoundError naming it, before any work)."""
     folder = os.path.dirname(os.path.abspath(os.fsdecode(out)))
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=".isoprop-", suffix=".raw", dir=folder)
-    except OSError as e:
-        raise _scratch_error(e, out, folder) from None
-    try:
-        with os.fdopen(fd, "wb") as f:  # not tofile(): its OSError lacks the errno
-            f.write(memoryview(a.reshape(-1).view(np.uint8)))
-    except BaseException as e:
-        os.unlink(tmp)
-        if isinstance(e, OSError):
-            raise _scratch_error(e, out, folder) from None
-        raise
-    return tmp, a.shape[::-1], a.dtype
+    if not os.path.isdir(folder):
+        raise FileNotFoundError(errno.ENOENT, "out: the output's folder %s does not exist"
+                                % folder, os.fsdecode(out))
 
 
-def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, rescale=None,
-          brick_size=32, subblock_size=8, hc=None, threads=0, mem_mb=0, force=False,
-          progress=None, series=None, correct_tilt=True, even_spacing=False):
+PathLike = Union[str, bytes, "os.PathLike[str]", "os.PathLike[bytes]"]
+
+
+def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
+          dtype: Any = None, spacing: Optional[Sequence[float]] = None,
+          endian: Optional[str] = None, rescale: Any = None, brick_size: int = 32,
+          subblock_size: int = 8, hc: Union[None, bool, int] = None, threads: int = 0,
+          mem_mb: int = 0, force: bool = False,
+          progress: Optional[Callable[[int, int], Any]] = None, series: Optional[str] = None,
+          correct_tilt: bool = True, even_spacing: bool = False) -> Dict[str, Any]:
     """Bricks a volume into the brick file `out` and returns the report (a dict: input_bytes,
     file_bytes, bricks, levels, seconds, peak_rss, ...).
 
     source: a path (raw NAME_XxYxZ_TYPE.raw, any raw with dims and dtype given, NRRD, MetaImage)
-    or a numpy array of shape (z, y, x), C order (x fastest, as in the files), of dtype uint8,
-    uint16, int16 or float32. dims (x, y, z), dtype and endian ('little', 'big') override a
+    or an array of shape (z, y, x) (x fastest, as in the files), of dtype uint8, uint16, int16
+    or float32: a numpy array or memmap, or any object with shape, dtype and slicing (a zarr
+    array, an h5py dataset, a dask array), read slab by slab (source[z0:z1]) into the
+    bricker's buffers, never copied whole: its memory stays within mem_mb. dims (x, y, z), dtype and endian ('little', 'big') override a
     file's; an array has its own. spacing: world units between samples along x, y, z.
     rescale: (slope, intercept[, unit]) says the values stand for stored * slope + intercept,
     in unit (isobrick --rescale: (1, -1024, "HU")), in place of what the input says (a DICOM
@@ -222,8 +305,9 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, resc
     them (--even-spacing). docs/dicom.md.
     brick_size, subblock_size, hc (True or an LZ4HC level), threads, mem_mb and force are
     isobrick's options. Every argument is checked first: TypeError or isoprop.ArgumentError
-    (a ValueError) naming it. Raises isoprop.Error (the output is then not written), or an
-    OSError naming `out` when an array's scratch copy cannot be written beside it."""
+    (a ValueError) naming it; FileNotFoundError when the output's folder does not exist.
+    Raises isoprop.Error (the output is then not written); an exception raised by an array's
+    slicing ends the run and is re-raised as it was (nothing is written)."""
     is_path = isinstance(source, (str, bytes, os.PathLike))
     if is_path:
         C.path("source", source)
@@ -250,16 +334,9 @@ def brick(source, out, *, dims=None, dtype=None, spacing=None, endian=None, resc
         if given:
             raise ArgumentError("%s: not with an array, which gives its own dims, dtype and "
                                 "byte order (pass only spacing)" % given[0])
-        tmp, shape, dt = _array_input(_check_array(source), out)
-        try:
-            return _run(tmp, out, _overrides(list(shape), TYPES[dt.newbyteorder("=")], spacing,
-                                             "little"), options, progress, rescale)
-        except Exception as e:
-            if hasattr(e, "message"):  # name the array, not the scratch file, in the message
-                e.args = (e.message.replace(tmp, "array"),)
-                e.message = e.args[0]
-            raise
-        finally:
-            os.unlink(tmp)
-    return _run(source, out, _overrides(dims, code, spacing, endian, dicom), options, progress,
-                rescale)
+        planes = _Planes(_check_array(source))
+        _check_out_folder(out)
+        return _run(_array_desc(planes, spacing), out, options, progress, rescale, planes)
+    _check_out_folder(out)
+    return _run(_describe(source, _overrides(dims, code, spacing, endian, dicom)), out, options,
+                progress, rescale)

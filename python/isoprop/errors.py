@@ -10,7 +10,7 @@ class Error(RuntimeError):
     `status_name` its short description, and str(e) the library's one-line message, which
     starts with the file (or object) and says what is wrong."""
 
-    def __init__(self, status, message):
+    def __init__(self, status: int, message: str) -> None:
         super().__init__(message)
         self.status = status
         self.status_name = lib.ip_status_message(status).decode()
@@ -26,16 +26,16 @@ class ArgumentError(Error, ValueError):
     refused such values itself before the module checked them. str(e) starts with the
     argument's name and says what is allowed."""
 
-    def __init__(self, message, status=IP_ERR_ARGUMENT):
+    def __init__(self, message: str, status: int = IP_ERR_ARGUMENT) -> None:
         super().__init__(status, message)
 
 
-def new_error():
+def new_error() -> S.Error:
     """A cleared ip_error for one call."""
     return S.Error()
 
 
-def check(status, err):
+def check(status: int, err: S.Error) -> None:
     """Raises Error when `status` (an ip_status) is not IP_OK, with err's message."""
     if status != 0:
         message = err.message.decode("utf-8", "replace") or lib.ip_status_message(status).decode()

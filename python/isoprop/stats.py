@@ -4,6 +4,7 @@
 the renderer's work (final_pixel_pct, visible_triangles, overdraw); "renderer" is "none" and the
 rendering times are 0."""
 import ctypes
+from typing import Any, Dict, Optional
 
 from . import _structs as S
 from ._library import lib
@@ -16,7 +17,7 @@ _CACHE_COUNTERS_2 = ("bytes_decompressed", "bytes_read", "decode_seconds", "over
                      "wait_seconds", "bricks_touched", "bricks_total")
 
 
-def cache_stats(cache, summary_bytes):
+def cache_stats(cache: Optional[int], summary_bytes: int) -> Dict[str, Any]:
     """The "cache" object of --stats for the cache handle `cache`."""
     s = S.CacheStats()
     lib.ip_cache_get_stats(cache, ctypes.byref(s))
@@ -32,7 +33,7 @@ def cache_stats(cache, summary_bytes):
     return out
 
 
-def run_stats(run, counts, cache):
+def run_stats(run: Any, counts: Any, cache: Optional[int]) -> Dict[str, Any]:
     """The whole dict for `run` (a volume._Run) with totals `counts` (ip_engine_counts)."""
     c = run.physical  # the camera in the file's physical space, as isorender reports it
     mode = "full-lod" if run.full == "lod" else "full" if run.full else "progressive"
@@ -68,7 +69,7 @@ def run_stats(run, counts, cache):
     return out
 
 
-def counts_dict(counts):
+def counts_dict(counts: Any) -> Dict[str, int]:
     """One step's ip_engine_counts as a dict."""
     return {"rays": counts.rays, "seeds": counts.seeds, "cells": counts.cells,
             "triangles": counts.triangles, "deferred": counts.deferred,

@@ -5,6 +5,7 @@ import os
 import threading
 import warnings
 from collections import namedtuple
+from typing import Any, Callable, Dict, Iterator, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
@@ -26,6 +27,9 @@ Rescale.__doc__ = """What a file's stored sample values stand for: value = store
 intercept, in unit ("HU" for a DICOM CT; "" when the input named none)."""
 
 DEFAULT_SIZE = (1600, 1200)  # isorender's
+PathLike = Union[str, bytes, "os.PathLike[str]", "os.PathLike[bytes]"]
+# a camera: isorender's --camera text or a dict of eye, target, up (and fov)
+CameraLike = Union[None, str, Mapping[str, Any]]
 VIEW_FOV = 30.0  # degrees: the field of view of the named views (isorender --view)
 # views and cameras are in the file's physical space (isoprop/camera.h, "Views in physical
 # space"); the engine takes their world counterparts
@@ -173,7 +177,7 @@ class File:
     thread or from an on_step callback, raises RuntimeError; it never waits, and never
     crashes. close() (or a with block) frees it, and so does garbage collection."""
 
-    def __init__(self, path):
+    def __init__(self, path: PathLike) -> None:
         self._init_state()
         C.path("path", path)
         err, store = new_error(), ctypes.c_void_p()
@@ -234,7 +238,7 @@ class File:
         return value, raw, stored
 
     # -- life time ------------------------------------------------------------------------
-    def close(self):
+    def close(self) -> None:
         """Frees the engines of unfinished extract_steps() runs, the cache and the store.
         Raises RuntimeError, closing nothing, while another call on this File is running (the
         File stays usable; close it once that call has returned)."""
@@ -253,10 +257,10 @@ class File:
             self._store = None
         self._array = None  # the store that read it is gone
 
-    def __enter__(self):
+    def __enter__(self) -> "File":
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: Any) -> None:
         self.close()
 
     def __del__(self):
@@ -268,7 +272,7 @@ class File:
             finally:
                 self._lock.release()
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return "<isoprop.File %s %s %s>" % (self.path, "x".join(map(str, self.dims)),
                                             self.dtype.name)
 
@@ -312,7 +316,8 @@ class File:
         self._cache, self._cache_budget = cache, budget
         return cache
 
-    def camera(self, view=None, camera=None, size=DEFAULT_SIZE):
+    def camera(self, view: Optional[str] = None, camera: CameraLike = None,
+               size: Tuple[int, int] = DEFAULT_SIZE) -> Dict[str, Any]:
         """The camera an extraction uses, as a dict (eye, target, up, fov, width, height) in the
         file's physical space, as camera= takes it. Touches nothing of the File but its box:
         callable at any time, from any thread."""
@@ -346,10 +351,16 @@ class File:
         return c
 
     # -- extraction -----------------------------------------------------------------------
-    def extract(self, iso, *, stored=False, view=None, camera=None, size=DEFAULT_SIZE,
-                rays=None, full=False, time_limit=None, threads=0, cutoff=None, foldback=None,
-                lod=True, pixel_error=1.0, occlusion=True, prefetch=True, cull=False,
-                cache_mb=None, on_step=None, space="physical"):
+    def extract(self, iso: float, *, stored: bool = False, view: Optional[str] = None,
+                camera: CameraLike = None, size: Tuple[int, int] = DEFAULT_SIZE,
+                rays: Optional[int] = None, full: Union[bool, str] = False,
+                time_limit: Optional[float] = None, threads: int = 0,
+                cutoff: Optional[float] = None, foldback: Optional[float] = None,
+                lod: bool = True, pixel_error: float = 1.0, occlusion: bool = True,
+                prefetch: Union[bool, str] = True, cull: bool = False,
+                cache_mb: Optional[int] = None,
+                on_step: Optional[Callable[[Step], Any]] = None,
+                space: str = "physical") -> Mesh:
         """Extracts the isosurface `iso` and returns a Mesh (vertices, normals, faces, stats).
         `iso` is in the file's units where it has a rescale (self.rescale: HU for a DICOM CT),
         else a stored value; stored=True takes it as a stored sample value (isorender
@@ -412,10 +423,16 @@ class File:
             finally:
                 self._end(run)
 
-    def extract_steps(self, iso, *, stored=False, rays_per_step=None, rays=None,
-                      time_limit=None, view=None, camera=None, size=DEFAULT_SIZE, threads=0,
-                      cutoff=None, foldback=None, lod=True, pixel_error=1.0, occlusion=True,
-                      prefetch=True, cull=False, cache_mb=None, space="physical"):
+    def extract_steps(self, iso: float, *, stored: bool = False,
+                      rays_per_step: Optional[int] = None, rays: Optional[int] = None,
+                      time_limit: Optional[float] = None, view: Optional[str] = None,
+                      camera: CameraLike = None, size: Tuple[int, int] = DEFAULT_SIZE,
+                      threads: int = 0, cutoff: Optional[float] = None,
+                      foldback: Optional[float] = None, lod: bool = True,
+                      pixel_error: float = 1.0, occlusion: bool = True,
+                      prefetch: Union[bool, str] = True, cull: bool = False,
+                      cache_mb: Optional[int] = None,
+                      space: str = "physical") -> Iterator[Step]:
         """Progressive extraction as a generator: yields a Step (the step's new triangles, its
         counts, the run's statistics so far) after each step of the engine, until every pixel
         has had its ray, `rays` rays or `time_limit` seconds. Steps cast `rays_per_step` rays
@@ -558,7 +575,7 @@ class File:
                 lib.ip_mesh_free(ctypes.byref(mesh))
 
 
-def open(path):  # noqa: A001 (isoprop.open, as the module's API names it)
+def open(path: PathLike) -> File:  # noqa: A001 (isoprop.open, as the module's API names it)
     """Opens the brick file at `path` (verifying its header and summaries) and returns a
     File. Raises isoprop.Error naming the file when it is missing, not a brick file or
     corrupt; TypeError or isoprop.ArgumentError for a `path` that is no path."""

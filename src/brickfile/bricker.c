@@ -1094,7 +1094,7 @@ static void count_bricks(bricker *b)
 }
 
 /* What no option can make right: a spacing nothing downstream renders correctly, a rescale
- * the file cannot keep, and an output that is the input (or its detached data file), which
+ * the file cannot keep, and an output that is the input file (or its detached data file), which
  * --force would replace with the brick file, or which would be read while it is being
  * written. */
 static ip_status check_request(const ip_input_desc *in, const char *out_path, ip_error *err)
@@ -1105,6 +1105,8 @@ static ip_status check_request(const ip_input_desc *in, const char *out_path, ip
     ip_rescale rescale = rescale_of(in);
     if (st == IP_OK)
         st = ip_rescale_check(&rescale, in->path, err);
+    if (in->encoding == IP_ENCODING_CALLBACK) /* no input file: its path is a name */
+        return st;
     if (st == IP_OK)
         st = ip_output_not_input(out_path, in->path, err);
     if (st == IP_OK && strcmp(in->data_path, in->path) != 0)

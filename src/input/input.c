@@ -543,3 +543,37 @@ ip_status ip_input_describe(const char *path, const ip_input_overrides *given, i
     *out = desc;
     return IP_OK;
 }
+
+ip_status ip_input_desc_from_planes(ip_input_desc *desc, const char *name, const uint32_t dims[3],
+                                    ip_type type, const double spacing[3], ip_plane_source_fn fn,
+                                    void *user, ip_error *err)
+{
+    if (!desc || !name || !dims || !fn)
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "ip_input_desc_from_planes: desc, name, dims and fn are required");
+    if (name[0] == '\0' || strlen(name) >= IP_PATH_MAX)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%.64s: the name is empty or too long", name);
+    for (int axis = 0; axis < 3; axis++)
+        if (dims[axis] < 2 || dims[axis] > INT32_MAX)
+            return ip__fail(err, IP_ERR_ARGUMENT, "%s: dimension %c is %u, not within 2 .. %d",
+                            name, "xyz"[axis], dims[axis], INT32_MAX);
+    if (ip_type_size(type) == 0)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: unknown type %d", name, (int)type);
+    if (spacing) {
+        ip_status st = ip_spacing_check(spacing, name, err);
+        if (st != IP_OK)
+            return st;
+    }
+    set_defaults(desc, name);
+    for (int axis = 0; axis < 3; axis++) {
+        desc->dims[axis] = dims[axis];
+        if (spacing)
+            desc->spacing[axis] = spacing[axis];
+    }
+    desc->type = type;
+    desc->big_endian = !ip__host_little_endian();
+    desc->encoding = IP_ENCODING_CALLBACK;
+    desc->plane_source = fn;
+    desc->plane_user = user;
+    return IP_OK;
+}

@@ -122,6 +122,15 @@ ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_err
         ip_input_close(r);
         return status;
     }
+    if (desc->encoding == IP_ENCODING_CALLBACK) {
+        if (!desc->plane_source) {
+            ip_input_close(r);
+            return ip__fail(err, IP_ERR_ARGUMENT, "%s: the description has no plane source",
+                            desc->path);
+        }
+        *out = r;
+        return IP_OK;
+    }
     if (r->source) {
         if ((status = r->source->open(&r->desc, &r->source_state, err)) != IP_OK) {
             ip_input_close(r);
@@ -371,6 +380,25 @@ static ip_status read_source_planes(ip_input_reader *r, unsigned char *dst, uint
     return IP_OK;
 }
 
+/* Planes of the caller's function (IP_ENCODING_CALLBACK), in the host's byte order. A failure
+ * without a message gets one that names the source. */
+static ip_status read_callback_planes(ip_input_reader *r, void *dst, uint32_t count, ip_error *err)
+{
+    if (err)
+        err->message[0] = '\0';
+    ip_status status = r->desc.plane_source(r->desc.plane_user, r->next_z, count, dst, err);
+    if (status == IP_OK)
+        return IP_OK;
+    if (status > IP_OK || status < IP_ERR_CANCELLED)
+        status = IP_ERR_INPUT;
+    if (err && err->message[0] != '\0') {
+        err->code = status;
+        return status;
+    }
+    return ip__fail(err, status, "%s: the plane source failed at planes %u .. %u", r->label,
+                    r->next_z, r->next_z + count - 1);
+}
+
 static ip_status read_samples(ip_input_reader *r, void *dst, uint32_t count, ip_error *err)
 {
     uint64_t bytes = (uint64_t)count * r->plane_bytes;
@@ -378,8 +406,9 @@ static ip_status read_samples(ip_input_reader *r, void *dst, uint32_t count, ip_
     if (bytes > SIZE_MAX)
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: %u planes are too many to read at once",
                         r->label, count);
-    if (r->source) {
-        status = read_source_planes(r, dst, count, err);
+    if (r->source || r->desc.encoding == IP_ENCODING_CALLBACK) {
+        status = r->source ? read_source_planes(r, dst, count, err)
+                           : read_callback_planes(r, dst, count, err);
         if (status == IP_OK && r->desc.type == IP_FLOAT32)
             status = check_finite(r, dst, (size_t)(bytes / r->sample_size), r->next_z, err);
         return status;

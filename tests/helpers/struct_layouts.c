@@ -39,6 +39,8 @@ static void error_and_input(void)
     FIELD(ip_input_desc, resampled);
     FIELD(ip_input_desc, tilt_degrees);
     FIELD(ip_input_desc, rescale_unit);
+    FIELD(ip_input_desc, plane_source);
+    FIELD(ip_input_desc, plane_user);
     FIELD(ip_input_desc, reserved);
     SIZE(ip_rescale);
     FIELD(ip_rescale, present);

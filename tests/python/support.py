@@ -9,6 +9,7 @@ import os
 import shutil
 import subprocess
 import sys
+import threading
 import unittest
 
 try:
@@ -53,6 +54,37 @@ def generate(field, dims, dtype):
     """isogen FIELD into the scratch folder; returns the raw file's path."""
     return tool("isogen", field, "--dims", "x".join(map(str, dims)), "--type", dtype, "-o",
                 WORK + "/", "--force").strip()
+
+
+def generated_uint16(field, dims):
+    """isogen FIELD as uint16 into the scratch folder: (the raw file's path, its samples as a
+    numpy array of shape (z, y, x))."""
+    raw = generate(field, dims, "uint16")
+    return raw, np.fromfile(raw, dtype="<u2").reshape(tuple(dims)[::-1])
+
+
+def listing():
+    """The scratch folder's names, sorted."""
+    return sorted(os.listdir(WORK))
+
+
+def run_threads(work, count, timeout=120):
+    """Runs work(k) on `count` threads at once, k = 0 .. count-1; returns the repr of each
+    exception that escaped a thread (an empty list when none did)."""
+    errors = []
+
+    def guarded(k):
+        try:
+            work(k)
+        except BaseException as e:  # noqa: B902: returned to the caller
+            errors.append(repr(e))
+
+    workers = [threading.Thread(target=guarded, args=(k,)) for k in range(count)]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join(timeout)
+    return errors
 
 
 def phantom(dims, dtype, spacing, name="phantom.ibv"):

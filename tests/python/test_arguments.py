@@ -255,6 +255,30 @@ class Arguments(unittest.TestCase):
                 self.assert_refused(lambda: isoprop.brick(src, dst), exception, name)
         self.assertEqual(sorted(os.listdir(support.WORK)), before, "a refused brick() wrote")
 
+    def test_whole_messages(self):
+        """The messages in full, for the values that once misled (a camera message for a zero
+        size, "out of memory" for a huge one, a ctypes message for a short spacing, an empty
+        mesh for a NaN isovalue, a scratch file's name for a missing output folder)."""
+        with isoprop.open(self.ibv) as f:
+            for size, text in (((0, 10), "size: width 0 is not within 1 .. 16384 pixels"),
+                               ((100000, 100000), "size: width 100000 is not within 1 .. 16384 "
+                                                  "pixels")):
+                with self.assertRaises(isoprop.ArgumentError) as caught:
+                    f.extract(ISO, size=size)
+                self.assertEqual(str(caught.exception),
+                                 text + " (16384: the largest image side the engine renders)")
+            with self.assertRaises(isoprop.ArgumentError) as caught:
+                f.extract(NAN)
+            self.assertEqual(str(caught.exception), "iso: nan is not finite")
+        with self.assertRaises(isoprop.ArgumentError) as caught:
+            isoprop.brick(self.array, support.work("x.ibv"), spacing=(1, 1))
+        self.assertEqual(str(caught.exception),
+                         "spacing: 2 values given, 3 needed (x, y, z: positive finite numbers)")
+        with self.assertRaises(FileNotFoundError) as caught:
+            isoprop.brick(self.array, support.work("nodir/x.ibv"))
+        self.assertEqual(caught.exception.strerror, "out: the output's folder %s does not exist"
+                         % support.work("nodir"))
+
     def test_open(self):
         for path, exception, name in ((5, V, "path"), (None, V, "path"), ("", R, "path"),
                                       ("a\0b.ibv", R, "path"), (b"", R, "path")):

@@ -13,15 +13,13 @@ import isoprop
 DIMS = (23, 18, 13)  # x, y, z: all different, so that a transposed axis shows
 
 
-def listing():
-    return sorted(os.listdir(support.WORK))
+listing = support.listing
 
 
 class Brick(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.raw = support.generate("shepp-logan", DIMS, "uint16")
-        cls.array = np.fromfile(cls.raw, dtype="<u2").reshape(DIMS[::-1])
+        cls.raw, cls.array = support.generated_uint16("shepp-logan", DIMS)
 
     def brick_both(self, name, **kw):
         """Bricks the raw file and the array with the same options; returns both paths."""

@@ -37,6 +37,30 @@ class Install(unittest.TestCase):
         self.assertEqual(version, isoprop.__version__)
         self.assertTrue(os.path.isfile(os.path.join(packages, "isoprop", "_config.py")))
 
+    def test_install_says_where_the_module_went(self):
+        """Prefix /usr (staged with DESTDIR): the module lands where Debian's /usr/bin/python3
+        looks; another prefix: the install says which PYTHONPATH to set."""
+        stage = support.work("stage")
+        p = subprocess.run([os.environ["IP_CMAKE"], "--install", support.BIN, "--prefix", "/usr",
+                            "--component", "Unspecified"], capture_output=True, text=True,
+                           env=dict(os.environ, DESTDIR=stage))
+        self.assertEqual(p.returncode, 0, p.stderr)
+        packages = "/usr/" + os.environ["IP_PYTHON_INSTALL_DIR"]
+        self.assertIn("Python module: %s%s/isoprop (on the path of Debian's python3)"
+                      % (stage, packages), p.stdout)
+        self.assertTrue(os.path.isfile(stage + packages + "/isoprop/__init__.py"))
+        self.assertTrue(os.path.isfile(stage + packages + "/isoprop/py.typed"))
+        if os.path.exists("/usr/bin/python3"):
+            path = subprocess.run(["/usr/bin/python3", "-c", "import sys; print(sys.path)"],
+                                  capture_output=True, text=True, env={}).stdout
+            self.assertIn(repr(packages), path)
+        prefix = support.work("elsewhere")
+        p = subprocess.run([os.environ["IP_CMAKE"], "--install", support.BIN, "--prefix", prefix,
+                            "--component", "Unspecified"], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("to import it: export PYTHONPATH=%s/%s"
+                      % (prefix, os.environ["IP_PYTHON_INSTALL_DIR"]), p.stdout)
+
     def test_environment_variable_overrides(self):
         p = python("import isoprop; print(isoprop.library_path)",
                    ISOPROP_LIBRARY=isoprop.library_path)

@@ -134,26 +134,61 @@ class Threads(unittest.TestCase):
 
     def test_one_file_per_thread(self):
         """Files of the same brick file, one per thread, run at once without refusals."""
-        out, errors = {}, []
+        out = {}
 
         def work(k):
-            try:
-                with isoprop.open(self.ibv) as f:
-                    for _ in range(3):
-                        out[k] = (f.extract(ISO, full=True, threads=1),
-                                  f.extract(ISO, size=SIZE, threads=1))
-            except BaseException as e:  # noqa: B902: reported below
-                errors.append(repr(e))
+            with isoprop.open(self.ibv) as f:
+                for _ in range(3):
+                    out[k] = (f.extract(ISO, full=True, threads=1),
+                              f.extract(ISO, size=SIZE, threads=1))
 
-        workers = [threading.Thread(target=work, args=(k,)) for k in range(3)]
-        for w in workers:
-            w.start()
-        for w in workers:
-            w.join(120)
-        self.assertEqual(errors, [])
+        self.assertEqual(support.run_threads(work, 3), [])
         for full, progressive in out.values():
             np.testing.assert_array_equal(full.vertices, self.full.vertices)
             np.testing.assert_array_equal(progressive.vertices, self.progressive.vertices)
+
+    def test_bricks_side_by_side(self):
+        """brick() on several threads at once, each of its own array-like (sliced on the
+        bricker's reading thread, under the GIL) into its own output: every file equals the
+        one brick() makes alone; and an array-like whose slicing raises on one thread fails
+        only that thread's run."""
+        shape = (36, 40, 48)
+        arrays = [np.random.default_rng(k).integers(0, 4000, shape, dtype=np.uint16)
+                  for k in range(3)]
+        alone = []
+        for k, a in enumerate(arrays):
+            path = support.work("alone-%d.ibv" % k)
+            isoprop.brick(a, path, brick_size=8, threads=2)
+            with open(path, "rb") as f:
+                alone.append(f.read())
+
+        class Sliced:
+            def __init__(self, a, fail):
+                self.a, self.fail, self.shape, self.dtype = a, fail, a.shape, a.dtype
+
+            def __getitem__(self, key):
+                if self.fail and key.start > 8:
+                    raise LookupError("no planes past 8")
+                return self.a[key]
+
+        results = {}
+
+        def work(k):
+            path = support.work("side-%d.ibv" % k)
+            try:
+                for _ in range(2):
+                    isoprop.brick(Sliced(arrays[k % 3], k == 3), path, brick_size=8,
+                                  threads=2, force=True)
+            except LookupError as e:
+                results[k] = e
+                return
+            with open(path, "rb") as f:
+                results[k] = f.read()
+
+        self.assertEqual(support.run_threads(work, 4), [])
+        for k in range(3):
+            self.assertEqual(results[k], alone[k], "brick file %d differs" % k)
+        self.assertIsInstance(results[3], LookupError)
 
     def test_hammer(self):
         """Threads share one File: full (level 0 and lod) and progressive extractions,
