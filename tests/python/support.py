@@ -19,6 +19,13 @@ except ImportError:
     sys.exit(77)
 
 
+# test_pip.py runs some tests again with the package a venv installed: they must load its library
+if os.environ.get("IP_EXPECT_LIBRARY"):
+    import isoprop as _isoprop
+    if _isoprop.library_path != os.environ["IP_EXPECT_LIBRARY"]:
+        raise SystemExit("isoprop loaded %s, not the installed %s" % (
+            _isoprop.library_path, os.environ["IP_EXPECT_LIBRARY"]))
+
 # run.sh preloads the sanitizer's runtime for this interpreter in the AddressSanitizer build;
 # the programs run below carry their own (python_env() gives it back to child interpreters).
 PRELOAD = os.environ.pop("LD_PRELOAD", None)

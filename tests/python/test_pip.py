@@ -3,7 +3,8 @@
 the committed source tree, cloned, installed into a venv made with --system-site-packages
 (pip install --no-build-isolation --no-index .), imports from another folder with a clean
 environment (no PYTHONPATH, no ISOPROP_LIBRARY) and loads the libisoprop inside the package,
-whose extraction matches the build's; `pip wheel` gives a wheel holding libisoprop.
+whose extraction matches the build's, and the module's tests of arrays, marching_cubes and
+streaming and the docs' examples pass with it; `pip wheel` gives a wheel holding libisoprop.
 
 Skipped (77) where the source tree is not a git checkout, where Debian's venv or pip is
 missing (tools/setup.sh installs them), and in the sanitizer builds (the package is built
@@ -34,6 +35,11 @@ with isoprop.open(sys.argv[1]) as f:
     print(isoprop.library_path)
     print(f.extract(500, full=True).triangle_count)
 """
+
+
+# Run again by the venv's interpreter, which finds isoprop in the venv only (support.py checks
+# that the library loaded is IP_EXPECT_LIBRARY's)
+IN_VENV = ("test_marching_cubes.py", "test_open_array.py", "test_brick_stream.py", "test_docs.py")
 
 
 def skip(why):
@@ -90,6 +96,12 @@ class Pip(unittest.TestCase):
             self.assertEqual(int(triangles), f.extract(500, full=True).triangle_count)
         self.assertGreater(int(triangles), 0)
 
+        # the module's own tests and the docs' examples pass with the installed package
+        here_tests = os.path.dirname(os.path.abspath(__file__))
+        for test in IN_VENV:
+            run([os.path.join(self.venv, "bin", "python"), os.path.join(here_tests, test)],
+                cwd=elsewhere, env=clean_env(IP_BIN=support.BIN, IP_EXPECT_LIBRARY=path,
+                                             IP_TEST_TMP=support.work("tests")))
         wheels = support.work("wheels")
         run(self.pip + ["wheel", "--no-build-isolation", "--no-index", "--no-deps", "-w",
                         wheels, "."], cwd=self.clone, env=clean_env())
