@@ -121,33 +121,39 @@ static int write_files(const char *dir, const uint32_t d[3], const uint16_t *s, 
         f64[i] = s[i];
         plus[i] = (uint16_t)(s[i] + 1000);
     }
+    /* one row a dataset; a row naming the file of the row before adds to that file */
+    const struct {
+        const char *file, *name;
+        int rank;
+        hid_t type, mem;
+        const void *data;
+        const hsize_t *chunk;
+        const char *spacing;
+    } rows[] = {
+        {"contiguous.h5", "/volume", 3, H5T_STD_U16LE, H5T_NATIVE_UINT16, s, NULL,
+         "element_size_um"},
+        {"chunked.h5", "/data/volume", 3, H5T_STD_U16LE, H5T_NATIVE_UINT16, s, chunk, "spacing"},
+        {"two.h5", "/a", 3, H5T_STD_U16LE, H5T_NATIVE_UINT16, plus, NULL, NULL},
+        {"two.h5", "/b/c", 3, H5T_STD_U16BE, H5T_NATIVE_UINT16, s, chunk, NULL},
+        {"two.h5", "/image", 2, H5T_STD_U16LE, H5T_NATIVE_UINT16, s, NULL, NULL},
+        {"int32.h5", "/volume", 3, H5T_STD_I32LE, H5T_NATIVE_INT32, i32, chunk, "element_size_um"},
+        {"float64.h5", "/volume", 3, H5T_IEEE_F64BE, H5T_NATIVE_DOUBLE, f64, NULL,
+         "element_size_um"},
+        {"int64.h5", "/volume", 3, H5T_STD_I64LE, H5T_NATIVE_INT32, i32, NULL, NULL},
+        {"flat.h5", "/image", 2, H5T_STD_U16LE, H5T_NATIVE_UINT16, s, NULL, NULL},
+    };
     int bad = 0;
-    hid_t f = create(dir, "contiguous.h5");
-    bad |= write_dataset(f, "/volume", 3, dims, H5T_STD_U16LE, H5T_NATIVE_UINT16, s, NULL,
-                         "element_size_um");
-    H5Fclose(f);
-    f = create(dir, "chunked.h5");
-    bad |= write_dataset(f, "/data/volume", 3, dims, H5T_STD_U16LE, H5T_NATIVE_UINT16, s, chunk,
-                         "spacing");
-    H5Fclose(f);
-    f = create(dir, "two.h5");
-    bad |= write_dataset(f, "/a", 3, dims, H5T_STD_U16LE, H5T_NATIVE_UINT16, plus, NULL, NULL);
-    bad |= write_dataset(f, "/b/c", 3, dims, H5T_STD_U16BE, H5T_NATIVE_UINT16, s, chunk, NULL);
-    bad |= write_dataset(f, "/image", 2, dims + 1, H5T_STD_U16LE, H5T_NATIVE_UINT16, s, NULL, NULL);
-    H5Fclose(f);
-    f = create(dir, "int32.h5");
-    bad |= write_dataset(f, "/volume", 3, dims, H5T_STD_I32LE, H5T_NATIVE_INT32, i32, chunk,
-                         "element_size_um");
-    H5Fclose(f);
-    f = create(dir, "float64.h5");
-    bad |= write_dataset(f, "/volume", 3, dims, H5T_IEEE_F64BE, H5T_NATIVE_DOUBLE, f64, NULL,
-                         "element_size_um");
-    H5Fclose(f);
-    f = create(dir, "int64.h5");
-    bad |= write_dataset(f, "/volume", 3, dims, H5T_STD_I64LE, H5T_NATIVE_INT32, i32, NULL, NULL);
-    H5Fclose(f);
-    f = create(dir, "flat.h5");
-    bad |= write_dataset(f, "/image", 2, dims + 1, H5T_STD_U16LE, H5T_NATIVE_UINT16, s, NULL, NULL);
+    hid_t f = -1;
+    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) {
+        if (i == 0 || strcmp(rows[i].file, rows[i - 1].file) != 0) {
+            if (f >= 0)
+                H5Fclose(f);
+            f = create(dir, rows[i].file);
+        }
+        /* a 2-D dataset: the y-x extent of the volume's first plane */
+        bad |= write_dataset(f, rows[i].name, rows[i].rank, dims + 3 - rows[i].rank, rows[i].type,
+                             rows[i].mem, rows[i].data, rows[i].chunk, rows[i].spacing);
+    }
     H5Fclose(f);
     bad |= damaged_copy(dir, "truncated.h5", 1) | damaged_copy(dir, "damaged.h5", 0);
     free(i32);

@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # A volume larger than the free disk, bricked from a pipe: the head upsampled SCALE times (8:
 # 4096x4096x1872 uint16, 62.8 GB) by isogen on standard output, bricked by isobrick from
-# standard input with --mem-mb MEM_MB (512), so that the raw volume never touches the disk; then
+# standard input with --mem-mb MEM_MB (1536: a layer of 33 planes of 4096x4096 uint16 needs
+# 1476 MiB, so 512 is refused), so that the raw volume never touches the disk; then
 # viewed once from a cold page cache (isorender --iso 600.5, view -y, 1600x1200, software
 # rasterizer, --cache-mb 512). Prints the bricking throughput (MB/s of raw bytes), the brick
 # file's size, the peak RSS of both processes (/usr/bin/time -v), and the cold view's time to
@@ -12,10 +13,10 @@
 #
 # OUT.ibv (outside the repository) is replaced. Cold means `sync; echo 3 >
 # /proc/sys/vm/drop_caches` before the view (root only; otherwise the output says so).
-# Environment: SCALE (8), MEM_MB (512), CACHE_MB (512).
+# Environment: SCALE (8), MEM_MB (1536), CACHE_MB (512).
 set -eu
 if [ $# -lt 1 ]; then
-    sed -n '3,15p' "$0" | sed 's/^# \{0,1\}//' >&2
+    sed -n '3,16p' "$0" | sed 's/^# \{0,1\}//' >&2
     exit 2
 fi
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -23,7 +24,7 @@ out=$1
 build=${2:-build}
 case $build in /*) ;; *) build=$root/$build ;; esac
 scale=${SCALE:-8}
-mem_mb=${MEM_MB:-512}
+mem_mb=${MEM_MB:-1536}
 cache_mb=${CACHE_MB:-512}
 head=$root/../shared/data/ct_head_visible_woman_512x512x234_uint16.raw
 for p in isobrick isogen isorender; do
