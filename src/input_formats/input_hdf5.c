@@ -25,6 +25,8 @@
 #include <hdf5.h>
 #include <pthread.h>
 
+#include "chunk_inflate.h"
+
 /* Planes of a contiguous dataset read at once: about this many bytes (at least one plane). */
 #define CONTIGUOUS_SLAB_BYTES ((size_t)16 << 20)
 /* The 3-D datasets a refusal lists at most. */
@@ -412,7 +414,72 @@ typedef struct hdf5_source {
     uint32_t slab_z, slab_count; /* the planes in buf */
     size_t plane_samples;
     unsigned char *buf; /* slab_planes planes as the file's type (native byte order) */
+    /* gzip chunks (deflate, after shuffle or not, in the host's byte order): read as stored
+     * under the lock, inflated here on the pool's threads; else libhdf5 decodes them */
+    int gzip;
+    ip__chunk_layer layer;
+    ip__pool *pool;
+    unsigned char **packed;
+    size_t *packed_size, *packed_capacity;
+    unsigned char *scratch;
 } hdf5_source;
+
+/* Whether the dataset's chunks are gzip as chunk_inflate.c decodes them: deflate alone or
+ * after shuffle, samples stored in the host's byte order. */
+static int gzip_chunks(hid_t d, hid_t dcpl, sample_kind kind, int *shuffled)
+{
+    int n = H5Pget_nfilters(dcpl), ok = n == 1 || n == 2;
+    for (int i = 0; ok && i < n; i++) {
+        unsigned flags = 0;
+        size_t values = 0;
+        H5Z_filter_t id = H5Pget_filter2(dcpl, (unsigned)i, &flags, &values, NULL, 0, NULL, NULL);
+        ok = i == n - 1 ? id == H5Z_FILTER_DEFLATE : id == H5Z_FILTER_SHUFFLE;
+    }
+    hid_t t = H5Dget_type(d);
+    ok = ok && t >= 0 && H5Tequal(t, kind_native(kind)) > 0;
+    if (t >= 0)
+        H5Tclose(t);
+    *shuffled = n == 2;
+    H5Eclear2(H5E_DEFAULT);
+    return ok;
+}
+
+/* Sets up the parallel decoding of a layer of gzip chunks: the pool, the stored chunks' and
+ * the threads' buffers. Where it cannot, libhdf5 decodes them. */
+static void gzip_setup(hdf5_source *s, const hsize_t chunk[3])
+{
+    const ip_input_desc *d = s->desc;
+    ip__chunk_layer *l = &s->layer;
+    l->sample = kind_sizes[s->kind];
+    for (int axis = 0; axis < 3; axis++)
+        l->chunk[axis] = chunk[axis];
+    l->rows = d->dims[1];
+    l->columns = d->dims[0];
+    l->chunks_y = (uint32_t)((l->rows + chunk[1] - 1) / chunk[1]);
+    l->chunks_x = (uint32_t)((l->columns + chunk[2] - 1) / chunk[2]);
+    size_t count = (size_t)l->chunks_y * l->chunks_x;
+    if (ip__pool_create(ip_thread_count(0), &s->pool, NULL) != IP_OK)
+        return;
+    s->packed = calloc(count, sizeof *s->packed);
+    s->packed_size = calloc(count, sizeof *s->packed_size);
+    s->packed_capacity = calloc(count, sizeof *s->packed_capacity);
+    s->scratch = malloc(ip__chunk_layer_scratch(l, ip__pool_threads(s->pool)));
+    l->packed = s->packed;
+    l->packed_size = s->packed_size;
+    s->gzip = s->packed && s->packed_size && s->packed_capacity && s->scratch;
+}
+
+static void gzip_free(hdf5_source *s)
+{
+    size_t count = (size_t)s->layer.chunks_y * s->layer.chunks_x;
+    for (size_t i = 0; s->packed && i < count; i++)
+        free(s->packed[i]);
+    free(s->packed);
+    free(s->packed_size);
+    free(s->packed_capacity);
+    free(s->scratch);
+    ip__pool_destroy(s->pool);
+}
 
 /* Checks that the dataset is still what the desc says and sizes the slab. */
 static ip_status source_shape(hdf5_source *s, ip_error *err)
@@ -429,9 +496,14 @@ static ip_status source_shape(hdf5_source *s, ip_error *err)
     s->plane_samples = (size_t)d->dims[0] * d->dims[1];
     size_t plane_bytes = s->plane_samples * kind_sizes[kind];
     hid_t dcpl = H5Dget_create_plist(s->dset);
-    if (dcpl >= 0 && H5Pget_layout(dcpl) == H5D_CHUNKED && H5Pget_chunk(dcpl, 3, chunk) == 3)
+    int shuffled = 0;
+    if (dcpl >= 0 && H5Pget_layout(dcpl) == H5D_CHUNKED && H5Pget_chunk(dcpl, 3, chunk) == 3) {
         s->slab_planes = (uint32_t)chunk[0];
-    else
+        if (gzip_chunks(s->dset, dcpl, s->kind, &shuffled)) {
+            s->layer.shuffled = shuffled;
+            gzip_setup(s, chunk);
+        }
+    } else
         s->slab_planes =
             (uint32_t)(plane_bytes >= CONTIGUOUS_SLAB_BYTES ? 1
                                                             : CONTIGUOUS_SLAB_BYTES / plane_bytes);
@@ -451,7 +523,13 @@ static ip_status source_open_locked(hdf5_source *s, ip_error *err)
     ip_status st = open_file(s->desc->path, &s->file, err);
     if (st != IP_OK)
         return st;
-    s->dset = H5Dopen2(s->file, s->desc->dataset, H5P_DEFAULT);
+    /* no chunk cache: every chunk is read once, whole, straight into the slab */
+    hid_t dapl = H5Pcreate(H5P_DATASET_ACCESS);
+    if (dapl >= 0)
+        H5Pset_chunk_cache(dapl, 0, 0, 1.0);
+    s->dset = H5Dopen2(s->file, s->desc->dataset, dapl >= 0 ? dapl : H5P_DEFAULT);
+    if (dapl >= 0)
+        H5Pclose(dapl);
     if (s->dset < 0)
         return ip__fail(err, IP_ERR_INPUT, "%s: dataset %s: cannot open (%s)", s->desc->path,
                         s->desc->dataset, hdf5_reason(why));
@@ -470,6 +548,7 @@ static void source_close(void *state)
         H5Fclose(s->file);
     H5Eclear2(H5E_DEFAULT);
     hdf5_leave();
+    gzip_free(s);
     free(s->buf);
     free(s);
 }
@@ -488,9 +567,67 @@ static ip_status source_open(const ip_input_desc *desc, void **state, ip_error *
     return st;
 }
 
+/* Reads the stored bytes of the layer of chunks at plane z0 (under the lock). 0, or -1 when a
+ * chunk is not there (the fill value) or was stored unfiltered: libhdf5 then reads the slab. */
+static int read_stored_chunks(hdf5_source *s, uint32_t z0)
+{
+    const ip__chunk_layer *l = &s->layer;
+    size_t count = (size_t)l->chunks_y * l->chunks_x;
+    int ok = 1;
+    for (size_t i = 0; ok && i < count; i++) {
+        hsize_t offset[3] = {z0, (i / l->chunks_x) * l->chunk[1], (i % l->chunks_x) * l->chunk[2]};
+        hsize_t bytes = 0;
+        uint32_t mask = 0;
+        ok = H5Dget_chunk_storage_size(s->dset, offset, &bytes) >= 0 && bytes > 0;
+        if (ok && bytes > s->packed_capacity[i]) {
+            unsigned char *grown = realloc(s->packed[i], (size_t)bytes);
+            ok = grown != NULL;
+            if (ok) {
+                s->packed[i] = grown;
+                s->packed_capacity[i] = (size_t)bytes;
+            }
+        }
+        ok = ok && H5Dread_chunk(s->dset, H5P_DEFAULT, offset, &mask, s->packed[i]) >= 0 &&
+             mask == 0;
+        s->packed_size[i] = (size_t)bytes;
+    }
+    H5Eclear2(H5E_DEFAULT);
+    return ok ? 0 : -1;
+}
+
+/* The layer of gzip chunks at plane z0 inflated on the pool's threads; 1 when libhdf5 must
+ * read it instead. */
+static int read_slab_gzip(hdf5_source *s, uint32_t z0, uint32_t count, ip_status *st, ip_error *err)
+{
+    hdf5_enter();
+    int stored = read_stored_chunks(s, z0);
+    hdf5_leave();
+    if (stored != 0)
+        return 1;
+    s->layer.planes = count;
+    s->layer.slab = s->buf;
+    uint32_t bad = 0;
+    int z = ip__chunk_layer_inflate(&s->layer, s->pool, s->scratch, &bad);
+    *st = IP_OK;
+    if (z != 0)
+        *st =
+            ip__fail(err, IP_ERR_INPUT,
+                     "%s: dataset %s: the gzip chunk at (z,y,x) = (%u,%llu,%llu) does not inflate "
+                     "(zlib error %d)",
+                     s->desc->path, s->desc->dataset, z0,
+                     (unsigned long long)((bad / s->layer.chunks_x) * s->layer.chunk[1]),
+                     (unsigned long long)((bad % s->layer.chunks_x) * s->layer.chunk[2]), z);
+    s->slab_z = z0;
+    s->slab_count = *st == IP_OK ? count : 0;
+    return 0;
+}
+
 /* Reads planes [z0, z0 + count) into buf: a hyperslab of whole z-rows of chunks. */
 static ip_status read_slab(hdf5_source *s, uint32_t z0, uint32_t count, ip_error *err)
 {
+    ip_status gzip_st;
+    if (s->gzip && read_slab_gzip(s, z0, count, &gzip_st, err) == 0)
+        return gzip_st;
     const ip_input_desc *d = s->desc;
     hsize_t start[3] = {z0, 0, 0}, size[3] = {count, d->dims[1], d->dims[0]};
     char why[256];
