@@ -3,7 +3,8 @@
  * (x fastest), contiguous or chunked with any filter this libhdf5 decodes. The planes are read
  * a slab at a time: a layer of chunks (the chunk's height along z, a hyperslab on chunk
  * boundaries, so that each chunk is decoded once), or about 16 MiB of planes of a contiguous
- * dataset; memory is that slab. Samples of the types the library stores are copied; int8 is
+ * dataset; memory is that slab. Gzip chunks in the host's byte order are read as stored and
+ * inflated on several threads (chunk_inflate.c); libhdf5 decodes every other filter. Samples of the types the library stores are copied; int8 is
  * widened to int16, int32 and uint32 become float32 (refused, naming the sample, where float32
  * does not hold the value exactly), float64 becomes float32 (rounded; refused beyond float32's
  * range). libhdf5's own printing of its error stack is turned off (H5Eset_auto2) and its
