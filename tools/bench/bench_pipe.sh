@@ -50,7 +50,7 @@ echo "| bricking from the pipe | seconds | MB/s of raw bytes | brick file | rati
 echo "| --- | ---: | ---: | ---: | ---: | ---: | ---: |"
 awk -v s="$secs" -v b="$bytes" -v f="$size" -v g="$(kib "$tmp/gen.time")" \
     -v i="$(kib "$tmp/brick.time")" -v m="$mem_mb" 'BEGIN {
-    printf "| --mem-mb %d | %.1f | %.0f | %.2f GiB (%d bytes) | %.2f | %.0f MiB | %.0f MiB |\n",
+    printf "| --mem-mb %d | %.1f | %.0f | %.2f GiB (%.0f bytes) | %.2f | %.0f MiB | %.0f MiB |\n",
         m, s, b / s / 1e6, f / 1073741824, f, b / f, g / 1024, i / 1024 }'
 echo
 sed 's/^/    /' "$tmp/brick.out"
