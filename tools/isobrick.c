@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* isobrick: brick a raw, NRRD or MetaImage volume into a brick file (.ibv), once. */
+/* isobrick: brick a volume (raw, NRRD, MetaImage, TIFF, NIfTI, HDF5, DICOM, or raw samples from
+ * standard input) into a brick file (.ibv), once. */
 #include <errno.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -14,9 +15,12 @@
 
 static const char usage[] =
     "usage: isobrick INPUT [-o OUT.ibv] [options]\n"
+    "       isobrick - --dims XxYxZ --type T -o OUT.ibv [options]\n"
     "Bricks INPUT (NAME_XxYxZ_TYPE.raw, any raw file with --dims/--type, .nrrd, .nhdr, .mhd,\n"
-    "or a folder holding a DICOM series) into an LZ4-compressed brick file with min/max\n"
-    "summaries and a level-of-detail pyramid.\n"
+    ".tif, .nii, .h5, or a folder holding a DICOM series) into an LZ4-compressed brick file\n"
+    "with min/max summaries and a level-of-detail pyramid. '-' reads raw samples from\n"
+    "standard input in z order (x fastest), e.g. isogen ... -o - | isobrick - ...: a pipe that\n"
+    "ends early or runs past the dims is refused (docs/input.md).\n"
     "  -o OUT.ibv          output (default: bricks/STEM.ibv, the input's name without its\n"
     "                      extension: ch2.nii.gz gives bricks/ch2.ibv)\n"
     "  --dims XxYxZ        samples along x, y, z (raw input)\n"
@@ -27,6 +31,8 @@ static const char usage[] =
     "                      the values stand for stored x S + I, in UNIT (e.g. 1,-1024,HU),\n"
     "                      instead of what the input says; none: no rescale. Kept in the\n"
     "                      brick file: isovalues are then given in UNIT (docs/input.md)\n"
+    "  --dataset PATH      the 3-D dataset of an HDF5 file to read (/group/name); needed\n"
+    "                      when the file holds several (the refusal lists them)\n"
     "A DICOM folder (docs/dicom.md) is read with its subfolders; objects that are not images\n"
     "(a DICOMDIR under any name, reports, presentation states) are skipped and counted.\n"
     "  --list-series       list the folder's series (UID, description, modality, slices,\n"
@@ -95,6 +101,12 @@ typedef struct options {
     int quiet, verbose;
     int list_series, correct_tilt, no_correct_tilt, even_spacing; /* DICOM folders */
 } options;
+
+/* "-": the samples come from standard input. */
+static int is_stdin(const char *path)
+{
+    return strcmp(path, "-") == 0;
+}
 
 /* The values of isobrick's options (tool_option_parse: base is the options). */
 static int parse_dims(const char *p, const tool_option *opt, const char *const *v, void *base)
@@ -233,6 +245,7 @@ static const tool_option isobrick_options[] = {
     {"--correct-tilt", NULL, 0, offsetof(options, correct_tilt), NULL, NULL, NULL},
     {"--no-correct-tilt", NULL, 0, offsetof(options, no_correct_tilt), NULL, NULL, NULL},
     {"--even-spacing", NULL, 0, offsetof(options, even_spacing), NULL, NULL, NULL},
+    {"--dataset", NULL, 1, offsetof(options, overrides.dataset), NULL, NULL, NULL},
 };
 
 static int parse_args(int argc, char **argv, options *o)
@@ -248,6 +261,8 @@ static int parse_args(int argc, char **argv, options *o)
         return rc;
     if (!o->input)
         return tool_usage_error("isobrick", "no input file");
+    if (is_stdin(o->input) && !o->output)
+        return tool_usage_error("isobrick", "reading standard input ('-') needs -o OUT.ibv");
     if (o->quiet && o->verbose)
         return tool_usage_error("isobrick", "--quiet and --verbose: one or the other");
     if (o->correct_tilt && o->no_correct_tilt)
@@ -496,10 +511,12 @@ static int print_levels(const char *out)
 }
 
 /* `path`, or NULL for a folder (of TIFF or DICOM files), which the library has read file by
- * file: the checks of tool_check_paths() are for input files. */
+ * file, and for standard input ("-"): the checks of tool_check_paths() are for input files. */
 static const char *input_file(const char *path)
 {
     struct stat st;
+    if (is_stdin(path))
+        return NULL; /* the library checks the output against what standard input reads */
     return stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? NULL : path;
 }
 

@@ -7,6 +7,8 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
+#include <unistd.h>
 
 #include "isoprop/generate.h"
 #include "isoprop/input.h"
@@ -33,7 +35,9 @@ static const char usage_text[] =
     "                   along each axis by trilinear interpolation\n"
     "  --endian E       byte order of a raw INPUT (default little)\n"
     "  -o OUT           output file, or a folder (existing, or ending in '/') to write the\n"
-    "                   conventionally named file into (default: that name, here)\n"
+    "                   conventionally named file into (default: that name, here);\n"
+    "                   '-': the samples on standard output, in z order, for a pipe\n"
+    "                   (isobrick - ...), never a terminal; the summary goes to stderr\n"
     "  --force          replace an existing output (a regular file; never the input)\n"
     "  --quiet          print nothing on success\n"
     "  --version        print the version and exit\n"
@@ -204,11 +208,29 @@ static void report(const options *o, const char *path, const uint32_t dims[3], i
     double bytes = (double)dims[0] * dims[1] * dims[2] * (double)ip_type_size(type);
     if (o->quiet)
         return;
-    printf("%s\n", path);
-    fflush(stdout);
+    if (!tool_is_stdout(o->output)) { /* with -o - stdout holds the samples */
+        printf("%s\n", path);
+        fflush(stdout);
+    }
     fprintf(stderr, "%s: wrote %.0f bytes (%s) in %.2f s, %.1f MB/s\n", PROGRAM, bytes,
             tool_format_bytes(human, sizeof human, bytes), seconds,
             seconds > 0.0 ? bytes / seconds / 1e6 : 0.0);
+}
+
+/* -o -: standard output, which must not be a terminal. Returns 1 (stdout), 0 (a file), or -1
+ * after the error. */
+static int to_stdout(const options *o)
+{
+    if (!tool_is_stdout(o->output))
+        return 0;
+    if (isatty(STDOUT_FILENO)) {
+        fprintf(stderr,
+                "%s: -o -: standard output is a terminal; pipe it (isobrick - ...) or "
+                "redirect it\n",
+                PROGRAM);
+        return -1;
+    }
+    return 1;
 }
 
 static int run_generate(const options *o, ip_field field)
@@ -224,15 +246,18 @@ static int run_generate(const options *o, ip_field field)
         params.noise = o->noise;
     if (o->has_seed)
         params.seed = o->seed;
-    if (ip_raw_file_name(name, sizeof name, ip_field_name(field), params.dims, params.type) !=
+    int piped = to_stdout(o);
+    if (piped < 0 ||
+        ip_raw_file_name(name, sizeof name, ip_field_name(field), params.dims, params.type) !=
             IP_OK ||
-        output_path(o->output, name, path, sizeof path) != 0)
+        output_path(piped ? NULL : o->output, name, path, sizeof path) != 0)
         return 1;
     const char *outputs[] = {path};
-    if (tool_check_paths(PROGRAM, NULL, 0, outputs, 1, o->force) != 0)
+    if (!piped && tool_check_paths(PROGRAM, NULL, 0, outputs, 1, o->force) != 0)
         return 1;
     double start = now_seconds();
-    if (ip_generate_write(&params, path, o->force, &err) != IP_OK)
+    if ((piped ? ip_generate_write_fd(&params, STDOUT_FILENO, "stdout", &err)
+               : ip_generate_write(&params, path, o->force, &err)) != IP_OK)
         return tool_fail(PROGRAM, &err);
     report(o, path, params.dims, params.type, now_seconds() - start);
     return 0;
@@ -268,13 +293,15 @@ static int run_upsample(const options *o)
         fprintf(stderr, "%s: output name too long\n", PROGRAM);
         return 1;
     }
-    if (output_path(o->output, file, path, sizeof path) != 0)
+    int piped = to_stdout(o);
+    if (piped < 0 || output_path(piped ? NULL : o->output, file, path, sizeof path) != 0)
         return 1;
     const char *inputs[] = {desc.path, desc.data_path}, *outputs[] = {path};
-    if (tool_check_paths(PROGRAM, inputs, 2, outputs, 1, o->force) != 0)
+    if (!piped && tool_check_paths(PROGRAM, inputs, 2, outputs, 1, o->force) != 0)
         return 1;
     double start = now_seconds();
-    if (ip_upsample_write(&desc, o->factor, path, o->force, &err) != IP_OK)
+    if ((piped ? ip_upsample_write_fd(&desc, o->factor, STDOUT_FILENO, "stdout", &err)
+               : ip_upsample_write(&desc, o->factor, path, o->force, &err)) != IP_OK)
         return tool_fail(PROGRAM, &err);
     report(o, path, dims, desc.type, now_seconds() - start);
     return 0;

@@ -23,13 +23,14 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # compares against; GLFW and stb_easy_font for the viewer, and a virtual X server (xvfb-run) for
 # its test; python3 and numpy for the Python module (docs/python.md), which every build puts in
 # build/python, and venv, pip, setuptools and wheel to install it with pip offline (its test
-# tests/python/test_pip.py); GDCM for DICOM series input and libtiff for TIFF input; help2man for the man
+# tests/python/test_pip.py); GDCM for DICOM series input, libtiff for TIFF input and libhdf5 (serial)
+# for HDF5 input; help2man for the man
 # pages; OpenMPI (mpirun and its headers) for isowall, the display wall's parallel renderer
 # (docs/scale-out.md).
 packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang clang-format
           lz4 zstd libegl-dev libepoxy-dev libpng-dev libegl-mesa0 libgl1-mesa-dri
           libglfw3-dev libstb-dev xvfb xauth python3 python3-numpy python3-venv python3-pip
-          python3-setuptools python3-wheel git libgdcm-dev libtiff-dev
+          python3-setuptools python3-wheel git libgdcm-dev libtiff-dev libhdf5-dev
           help2man openmpi-bin libopenmpi-dev"
 
 install_missing() {

@@ -77,6 +77,23 @@ IP_API ip_status ip_generate_write(const ip_gen_params *params, const char *path
 IP_API ip_status ip_upsample_write(const ip_input_desc *input, uint32_t factor, const char *path,
                                    int force, ip_error *err);
 
+#ifdef IP_EXPERIMENTAL
+/* ---- Experimental (IP_EXPERIMENTAL, docs/api.md "Stability") ---- */
+
+/*! ip_generate_write_fd() : writes the volume as ip_generate_write() does, little-endian, but
+ *  in order into the open descriptor `fd` (a pipe, standard output: nothing is sought), which
+ *  stays the caller's; `name` (e.g. "stdout") stands for it in messages. A failure leaves what
+ *  was written. @return as ip_generate_write(), IP_ERR_ARGUMENT for fd < 0. */
+IP_API ip_status ip_generate_write_fd(const ip_gen_params *params, int fd, const char *name,
+                                      ip_error *err);
+
+/*! ip_upsample_write_fd() : ip_upsample_write() into the open descriptor `fd`, in order, as
+ *  ip_generate_write_fd() writes; memory stays a few planes whatever the output's size.
+ *  @return as ip_upsample_write(), IP_ERR_ARGUMENT for fd < 0. */
+IP_API ip_status ip_upsample_write_fd(const ip_input_desc *input, uint32_t factor, int fd,
+                                      const char *name, ip_error *err);
+#endif
+
 /*! ip_raw_file_name() : writes the conventional name "NAME_XxYxZ_TYPE.raw" for `name`, `dims`
  *  and `type` into buf (size bytes). @return IP_OK, or IP_ERR_ARGUMENT if it does not fit. */
 IP_API ip_status ip_raw_file_name(char *buf, size_t size, const char *name, const uint32_t dims[3],

@@ -23,13 +23,18 @@ extern "C" {
 
 /* How the samples are stored. */
 typedef enum ip_encoding {
-    IP_ENCODING_RAW = 0,     /* plain samples from data_offset on */
-    IP_ENCODING_GZIP = 1,    /* a gzip (or zlib) stream from data_offset on */
-    IP_ENCODING_TIFF = 2,    /* one TIFF page a plane: a multi-page file or a folder of files */
-    IP_ENCODING_DICOM = 3,   /* one DICOM file a plane: a folder holding one series */
-    IP_ENCODING_CALLBACK = 4 /* the caller's function fills the planes: plane_source and
-                                plane_user (ip_input_desc_from_planes(), experimental) */
+    IP_ENCODING_RAW = 0,      /* plain samples from data_offset on */
+    IP_ENCODING_GZIP = 1,     /* a gzip (or zlib) stream from data_offset on */
+    IP_ENCODING_TIFF = 2,     /* one TIFF page a plane: a multi-page file or a folder of files */
+    IP_ENCODING_DICOM = 3,    /* one DICOM file a plane: a folder holding one series */
+    IP_ENCODING_CALLBACK = 4, /* the caller's function fills the planes: plane_source and
+                                 plane_user (ip_input_desc_from_planes(), experimental) */
+    IP_ENCODING_HDF5 = 5      /* one 3-D dataset of an HDF5 file (`dataset`), read a layer of
+                                 chunks at a time through libhdf5 in the input component */
 } ip_encoding;
+
+/* Bytes of ip_input_desc.dataset: an HDF5 dataset's path is at most 95 characters. */
+#define IP_DATASET_MAX 96
 
 /* A caller's source of z-planes (IP_ENCODING_CALLBACK): fills `dst` with the `count` planes
  * from plane `z` on, dims[0] x dims[1] samples each of the desc's type, x fastest, in the
@@ -43,7 +48,8 @@ typedef ip_status (*ip_plane_source_fn)(void *user, uint32_t z, uint32_t count, 
 /* Where a volume's samples are and how to read them. */
 typedef struct ip_input_desc {
     char path[IP_PATH_MAX];      /* the file the user named (header or raw) */
-    char data_path[IP_PATH_MAX]; /* the file that holds the samples */
+    char data_path[IP_PATH_MAX]; /* the file that holds the samples; "-" (with path "-"):
+                                    standard input, raw samples read once in order */
     uint64_t data_offset;        /* byte offset of the first sample in data_path */
     uint32_t dims[3];            /* samples along x, y, z; each >= 2 */
     ip_type type;
@@ -79,7 +85,9 @@ typedef struct ip_input_desc {
     /* IP_ENCODING_CALLBACK only (ip_input_desc_from_planes()); NULL otherwise. */
     ip_plane_source_fn plane_source; /* fills the planes */
     void *plane_user;                /* passed to plane_source, not owned */
-    uint64_t reserved[16];           /* zero: room for later fields at the same size (status.h) */
+    char dataset[IP_DATASET_MAX];    /* IP_ENCODING_HDF5: the dataset's path in the file ("/a/b");
+                                     "" otherwise */
+    uint64_t reserved[4];            /* zero: room for later fields at the same size (status.h) */
 } ip_input_desc;
 
 /* ip_input_desc.resampled: the slices of a DICOM series were resampled onto a regular grid
@@ -119,11 +127,16 @@ typedef struct ip_input_overrides {
                            Not copied: valid during ip_input_describe() */
     ip_regrid tilt;     /* slices sheared by a gantry tilt; default: resampled */
     ip_regrid uneven;   /* slices unevenly spaced (a slice missing included); default: refused */
+    /* An HDF5 file (after 0.2.0, read only when `size` covers it, as `series`). */
+    const char *dataset; /* the path of the 3-D dataset to read ("/volume"); NULL: the file must
+                            hold exactly one. Refused for other inputs. Not copied */
 } ip_input_overrides;
 
 /*! ip_input_describe() : fills *out for the volume at `path`.
  *  `overrides` may be NULL. The extension picks the format: .nrrd/.nhdr NRRD, .mhd/.mha
- *  MetaImage, .tif/.tiff TIFF, .nii/.nii.gz NIfTI; a folder holds a DICOM series or numbered
+ *  MetaImage, .tif/.tiff TIFF, .nii/.nii.gz NIfTI, .h5/.hdf5/.he5 (or a file that starts with
+ *  the HDF5 signature) HDF5 (docs/input.md; needs the input component built with HDF5);
+ *  "-" standard input (raw samples: the overrides must give dims and type); a folder holds a DICOM series or numbered
  *  TIFF files (told apart by the first file's content); anything else is headerless raw
  *  (little-endian, spacing 1,1,1, dims and type from a base name NAME_XxYxZ_TYPE.raw or from
  *  the overrides). Checks everything that can be

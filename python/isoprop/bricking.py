@@ -38,13 +38,16 @@ REGRID_DEFAULT, REGRID_RESAMPLE, REGRID_REFUSE = 0, 1, 2  # ip_regrid (input.h)
 
 def _overrides(dims: Optional[List[int]], dtype: Optional[int],
                spacing: Optional[List[float]], endian: Optional[str],
-               dicom: Optional[Tuple[Any, int, int]] = None) -> S.InputOverrides:
+               dicom: Optional[Tuple[Any, int, int]] = None,
+               dataset: Optional[bytes] = None) -> S.InputOverrides:
     """The ip_input_overrides of checked arguments (dims and spacing lists, dtype a code;
-    dicom: (series bytes or None, tilt, uneven) as _check_dicom() gives them)."""
+    dicom: (series bytes or None, tilt, uneven) as _check_dicom() gives them; dataset: an HDF5
+    dataset's path as bytes, or None)."""
     o = S.InputOverrides()
-    o.size = ctypes.sizeof(S.InputOverrides)  # this layout, DICOM choices included (IP_SIZED)
+    o.size = ctypes.sizeof(S.InputOverrides)  # this layout, DICOM and HDF5 choices (IP_SIZED)
     if dicom is not None:
         o.series, o.tilt, o.uneven = dicom
+    o.dataset = dataset
     if dims is not None:
         o.has_dims, o.dims[:] = 1, dims
     if dtype is not None:
@@ -284,7 +287,8 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
           subblock_size: int = 8, hc: Union[None, bool, int] = None, threads: int = 0,
           mem_mb: int = 0, force: bool = False,
           progress: Optional[Callable[[int, int], Any]] = None, series: Optional[str] = None,
-          correct_tilt: bool = True, even_spacing: bool = False) -> Dict[str, Any]:
+          correct_tilt: bool = True, even_spacing: bool = False,
+          dataset: Optional[str] = None) -> Dict[str, Any]:
     """Bricks a volume into the brick file `out` and returns the report (a dict: input_bytes,
     file_bytes, bricks, levels, seconds, peak_rss, ...).
 
@@ -303,6 +307,8 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
     refuses a series sheared by a gantry tilt instead of resampling it (isobrick
     --no-correct-tilt); even_spacing=True resamples unevenly spaced slices instead of refusing
     them (--even-spacing). docs/dicom.md.
+    An HDF5 file (isobrick FILE.h5): dataset picks its 3-D dataset by path ("/group/name"; isobrick
+    --dataset), needed when it holds several. docs/input.md.
     brick_size, subblock_size, hc (True or an LZ4HC level), threads, mem_mb and force are
     isobrick's options. Every argument is checked first: TypeError or isoprop.ArgumentError
     (a ValueError) naming it; FileNotFoundError when the output's folder does not exist.
@@ -328,9 +334,16 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
                        C.whole("mem_mb", mem_mb, 0, C.MAX_MEM_MB), C.flag("force", force))
     C.callable_or_none("progress", progress)
     dicom = _check_dicom(series, correct_tilt, even_spacing)
+    if dataset is not None:
+        if not isinstance(dataset, str):
+            raise TypeError("dataset: must be a str (an HDF5 dataset's path), not %s"
+                            % C.describe(dataset))
+        if not dataset or len(dataset.encode("utf-8")) >= 96 or "\0" in dataset:
+            raise ArgumentError("dataset: %r is not an HDF5 dataset path (1 to 95 bytes)"
+                                % dataset)
     if not is_path:
         given = [n for n, v in (("dims", dims), ("dtype", dtype), ("endian", endian),
-                                ("series", series)) if v is not None]
+                                ("series", series), ("dataset", dataset)) if v is not None]
         if given:
             raise ArgumentError("%s: not with an array, which gives its own dims, dtype and "
                                 "byte order (pass only spacing)" % given[0])
@@ -338,5 +351,6 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
         _check_out_folder(out)
         return _run(_array_desc(planes, spacing), out, options, progress, rescale, planes)
     _check_out_folder(out)
-    return _run(_describe(source, _overrides(dims, code, spacing, endian, dicom)), out, options,
-                progress, rescale)
+    encoded = None if dataset is None else dataset.encode("utf-8")
+    return _run(_describe(source, _overrides(dims, code, spacing, endian, dicom, encoded)), out,
+                options, progress, rescale)

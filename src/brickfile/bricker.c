@@ -1107,6 +1107,8 @@ static ip_status check_request(const ip_input_desc *in, const char *out_path, ip
         st = ip_rescale_check(&rescale, in->path, err);
     if (in->encoding == IP_ENCODING_CALLBACK) /* no input file: its path is a name */
         return st;
+    if (ip__input_is_stdin(in->data_path)) /* "-": the file standard input reads, if a file */
+        return st == IP_OK ? ip_output_not_input(out_path, "/dev/stdin", err) : st;
     if (st == IP_OK)
         st = ip_output_not_input(out_path, in->path, err);
     if (st == IP_OK && strcmp(in->data_path, in->path) != 0)

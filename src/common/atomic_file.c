@@ -272,6 +272,26 @@ ip_status ip__pwrite_all(int fd, const void *data, size_t size, uint64_t offset,
     return IP_OK;
 }
 
+ip_status ip__write_at(int fd, int stream, const void *data, size_t size, uint64_t offset,
+                       const char *path, ip_error *err)
+{
+    if (!stream)
+        return ip__pwrite_all(fd, data, size, offset, path, err);
+    const unsigned char *p = data;
+    while (size > 0) {
+        ssize_t n = write(fd, p, size);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0)
+            return ip__fail_errno(err, IP_ERR_IO, errno, "%s: write failed", path);
+        if (n == 0)
+            return ip__fail(err, IP_ERR_IO, "%s: write failed: no progress", path);
+        p += n;
+        size -= (size_t)n;
+    }
+    return IP_OK;
+}
+
 ip_status ip__pread_all(int fd, void *data, size_t size, uint64_t offset, const char *path,
                         ip_error *err)
 {

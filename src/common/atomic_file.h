@@ -43,6 +43,11 @@ void ip__atomic_abort(ip_atomic_file *file);
 ip_status ip__pwrite_all(int fd, const void *data, size_t size, uint64_t offset, const char *path,
                          ip_error *err);
 
+/* Writes all `size` bytes: at `offset` with ip__pwrite_all(), or (stream != 0: a pipe, standard
+ * output) in order with write(), retrying short writes; names `path` in the error. */
+ip_status ip__write_at(int fd, int stream, const void *data, size_t size, uint64_t offset,
+                       const char *path, ip_error *err);
+
 /* Reads exactly `size` bytes at `offset`; a short read is IP_ERR_IO naming `path`. */
 ip_status ip__pread_all(int fd, void *data, size_t size, uint64_t offset, const char *path,
                         ip_error *err);

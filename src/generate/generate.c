@@ -414,32 +414,41 @@ static ip_status plane_size(const uint32_t dims[3], ip_type type, const char *pa
     return IP_OK;
 }
 
-static ip_status write_planes(const ip_gen_params *params, ip_atomic_file *out, unsigned char *buf,
-                              size_t plane_bytes, uint32_t group, ip_error *err)
+/* Where the planes go: a file written at offsets, or a stream (standard output) in order. */
+typedef struct plane_sink {
+    int fd, stream;
+    const char *name;
+} plane_sink;
+
+static ip_status write_planes(const ip_gen_params *params, const plane_sink *out,
+                              unsigned char *buf, size_t plane_bytes, uint32_t group, ip_error *err)
 {
     size_t size = ip_type_size(params->type);
     ip__pool *pool;
     if (ip__pool_create(worker_count(), &pool, NULL) != IP_OK)
-        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", out->path);
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", out->name);
     ip_status st = IP_OK;
     for (uint32_t z = 0; st == IP_OK && z < params->dims[2]; z += group) {
         uint32_t count = params->dims[2] - z < group ? params->dims[2] - z : group;
         generate_group(params, z, count, buf, plane_bytes, pool);
         if (!ip__host_little_endian())
             ip__swap_bytes(buf, (size_t)count * plane_bytes / size, size);
-        st = ip__pwrite_all(out->fd, buf, (size_t)count * plane_bytes, (uint64_t)z * plane_bytes,
-                            out->path, err);
+        st = ip__write_at(out->fd, out->stream, buf, (size_t)count * plane_bytes,
+                          (uint64_t)z * plane_bytes, out->name, err);
     }
     ip__pool_destroy(pool);
     return st;
 }
 
-ip_status ip_generate_write(const ip_gen_params *given, const char *path, int force, ip_error *err)
+/* The volume into the file at `path` (fd < 0), or in order into the stream fd, `path` its name. */
+static ip_status generate_into(const ip_gen_params *given, const char *path, int force, int fd,
+                               ip_error *err)
 {
     size_t plane_bytes = 0;
     ip_atomic_file out;
     ip_gen_params taken;
     const ip_gen_params *params = &taken;
+    plane_sink sink = {fd, fd >= 0, path};
     if (!path)
         return ip__fail(err, IP_ERR_ARGUMENT, "generate: no output path");
     ip_status st = take_params(given, &taken, path, err);
@@ -455,13 +464,31 @@ ip_status ip_generate_write(const ip_gen_params *given, const char *path, int fo
     if (!buf)
         return ip__fail(err, IP_ERR_NOMEM, "%s: cannot allocate %zu bytes for %zu planes", path,
                         group * plane_bytes, group);
+    if (sink.stream) {
+        st = write_planes(params, &sink, buf, plane_bytes, (uint32_t)group, err);
+        free(buf);
+        return st;
+    }
     st = ip__atomic_create(&out, path, force, err);
+    sink.fd = out.fd;
     if (st == IP_OK)
-        st = write_planes(params, &out, buf, plane_bytes, (uint32_t)group, err);
+        st = write_planes(params, &sink, buf, plane_bytes, (uint32_t)group, err);
     if (st == IP_OK)
         st = ip__atomic_commit(&out, err);
     else
         ip__atomic_abort(&out);
     free(buf);
     return st;
+}
+
+ip_status ip_generate_write(const ip_gen_params *params, const char *path, int force, ip_error *err)
+{
+    return generate_into(params, path, force, -1, err);
+}
+
+ip_status ip_generate_write_fd(const ip_gen_params *params, int fd, const char *name, ip_error *err)
+{
+    if (fd < 0)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: no file descriptor", name ? name : "generate");
+    return generate_into(params, name, 0, fd, err);
 }

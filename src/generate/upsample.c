@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Trilinear upsampling of an input volume into a larger raw file, streamed plane by plane. */
 #include <inttypes.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -39,7 +40,9 @@ typedef struct upsampler {
     float *rows;            /* blend_z's rows interpolated along x: in[1] x out[0] */
     unsigned char *out_buf; /* `group` output planes */
     ip_input_reader *reader;
-    ip_atomic_file file;
+    ip_atomic_file file; /* the output: a file written at offsets, or with `stream` (then only
+                            its fd and path are set) a stream written in order */
+    int stream;
 } upsampler;
 
 /* Output sample i of n_out maps to input coordinate i * (n_in - 1) / (n_out - 1), computed
@@ -251,16 +254,18 @@ static ip_status write_all_planes(upsampler *u, ip_error *err)
         size_t bytes = (size_t)count * u->out_plane_bytes;
         if (!ip__host_little_endian())
             ip__swap_bytes(u->out_buf, bytes / u->sample_size, u->sample_size);
-        ip_status st = ip__pwrite_all(u->file.fd, u->out_buf, bytes,
-                                      (uint64_t)z * u->out_plane_bytes, u->file.path, err);
+        ip_status st = ip__write_at(u->file.fd, u->stream, u->out_buf, bytes,
+                                    (uint64_t)z * u->out_plane_bytes, u->file.path, err);
         if (st != IP_OK)
             return st;
     }
     return IP_OK;
 }
 
-ip_status ip_upsample_write(const ip_input_desc *input, uint32_t factor, const char *path,
-                            int force, ip_error *err)
+/* The upsampled volume into the file at `path` (fd < 0), or in order into the stream fd, `path`
+ * its name. */
+static ip_status upsample_into(const ip_input_desc *input, uint32_t factor, const char *path,
+                               int force, int fd, ip_error *err)
 {
     upsampler u;
     memset(&u, 0, sizeof u);
@@ -271,15 +276,24 @@ ip_status ip_upsample_write(const ip_input_desc *input, uint32_t factor, const c
         return ip__fail(err, IP_ERR_ARGUMENT, "%s: upsampling factor must be at least 1", path);
     u.input = input;
     u.factor = factor;
+    u.stream = fd >= 0;
     /* the output replaces nothing it reads (with force it would otherwise replace the input) */
-    ip_status st = ip_output_not_input(path, input->path, err);
-    if (st == IP_OK && strcmp(input->data_path, input->path) != 0)
+    ip_status st = u.stream ? IP_OK : ip_output_not_input(path, input->path, err);
+    if (st == IP_OK && !u.stream && strcmp(input->data_path, input->path) != 0)
         st = ip_output_not_input(path, input->data_path, err);
     if (st != IP_OK)
         return st;
     st = upsampler_size(&u, path, err);
     if (st == IP_OK)
         st = upsampler_alloc(&u, path, err);
+    if (st == IP_OK && u.stream) {
+        u.file.fd = fd;
+        snprintf(u.file.path, sizeof u.file.path, "%s", path);
+        if ((st = ip_input_open(input, &u.reader, err)) == IP_OK)
+            st = write_all_planes(&u, err);
+        upsampler_free(&u);
+        return st;
+    }
     if (st == IP_OK)
         st = ip__atomic_create(&u.file, path, force, err);
     if (st == IP_OK)
@@ -292,4 +306,18 @@ ip_status ip_upsample_write(const ip_input_desc *input, uint32_t factor, const c
         ip__atomic_abort(&u.file);
     upsampler_free(&u);
     return st;
+}
+
+ip_status ip_upsample_write(const ip_input_desc *input, uint32_t factor, const char *path,
+                            int force, ip_error *err)
+{
+    return upsample_into(input, factor, path, force, -1, err);
+}
+
+ip_status ip_upsample_write_fd(const ip_input_desc *input, uint32_t factor, int fd,
+                               const char *name, ip_error *err)
+{
+    if (fd < 0)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: no file descriptor", name ? name : "upsample");
+    return upsample_into(input, factor, name, 0, fd, err);
 }

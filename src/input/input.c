@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "input_headers.h"
+#include "input_positioned.h"
 #include "input_source.h"
 #include "internal.h"
 #include "sized.h"
@@ -28,7 +29,8 @@ typedef enum input_kind {
     INPUT_NRRD,
     INPUT_MHD,
     INPUT_TIFF,
-    INPUT_NIFTI
+    INPUT_NIFTI,
+    INPUT_HDF5
 } input_kind;
 
 static const char axis_names[3] = {'x', 'y', 'z'};
@@ -56,6 +58,8 @@ static input_kind kind_of(const char *path)
         return INPUT_TIFF;
     if (has_suffix(path, ".nii") || has_suffix(path, ".nii.gz"))
         return INPUT_NIFTI;
+    if (has_suffix(path, ".h5") || has_suffix(path, ".hdf5") || has_suffix(path, ".he5"))
+        return INPUT_HDF5;
     return INPUT_RAW;
 }
 
@@ -66,9 +70,15 @@ const char *ip__input_format_named(const char *path)
     case INPUT_MHD: return "a MetaImage volume";
     case INPUT_TIFF: return "a TIFF file";
     case INPUT_NIFTI: return "a NIfTI volume";
+    case INPUT_HDF5: return "an HDF5 file";
     case INPUT_RAW: break;
     }
     return has_suffix(path, ".raw") ? "a raw volume" : NULL;
+}
+
+int ip__input_is_stdin(const char *path)
+{
+    return strcmp(path, "-") == 0;
 }
 
 ip_status ip__input_open_regular(const char *path, int *fd, ip_error *err)
@@ -85,8 +95,15 @@ ip_status ip__input_open_regular(const char *path, int *fd, ip_error *err)
     return IP_OK;
 }
 
-/* Describes `path` with the input component's TIFF reader (tiff != 0) or DICOM reader. */
-static ip_status describe_by_component(int tiff, const char *path,
+/* The input component's readers, by the format they read. */
+typedef enum component_reader {
+    READ_DICOM,
+    READ_TIFF,
+    READ_HDF5
+} component_reader;
+
+/* Describes `path` with one of the input component's readers. */
+static ip_status describe_by_component(component_reader which, const char *path,
                                        const ip_input_overrides *overrides, ip_input_desc *desc,
                                        ip_text_found *found, ip_error *err)
 {
@@ -94,8 +111,28 @@ static ip_status describe_by_component(int tiff, const char *path,
     ip_status st = ip__input_formats_load(path, &formats, err);
     if (st != IP_OK)
         return st;
-    return (tiff ? formats->tiff_describe : formats->dicom_describe)(path, overrides, desc, found,
-                                                                     err);
+    ip__describe_fn describe = which == READ_TIFF   ? formats->tiff_describe
+                               : which == READ_HDF5 ? formats->hdf5_describe
+                                                    : formats->dicom_describe;
+    return describe(path, overrides, desc, found, err);
+}
+
+/* 1 when the regular file `path` holds the HDF5 signature where a file may start it: at byte
+ * 0, or after a user block of 512, 1024 or 2048 bytes. */
+static int hdf5_signature(const char *path)
+{
+    static const unsigned char magic[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+    unsigned char head[8];
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC), found = 0;
+    struct stat st;
+    if (fd < 0)
+        return 0;
+    if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode))
+        for (off_t at = 0; !found && at <= 2048; at = at ? at * 2 : 512)
+            found = pread(fd, head, sizeof head, at) == (ssize_t)sizeof head &&
+                    memcmp(head, magic, sizeof magic) == 0;
+    close(fd);
+    return found;
 }
 
 /* ---- folders: a DICOM series or numbered TIFF files ---- */
@@ -183,7 +220,8 @@ static ip_status describe_folder(const char *path, const ip_input_overrides *ove
         ((head[0] == 'I' && head[1] == 'I' && (head[2] == 42 || head[2] == 43) && head[3] == 0) ||
          (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && (head[3] == 42 || head[3] == 43)));
     if (dicom || tiff)
-        return describe_by_component(tiff, path, overrides, desc, found, err);
+        return describe_by_component(tiff ? READ_TIFF : READ_DICOM, path, overrides, desc, found,
+                                     err);
     return ip__fail(err, IP_ERR_INPUT,
                     "%s: a folder of neither DICOM nor TIFF files (its first file %s is "
                     "neither)",
@@ -391,6 +429,8 @@ static ip_status check_data_file(ip_input_desc *desc, int data_at_end, uint64_t 
     struct stat st;
     if (ip__encoding_is_planes(desc->encoding))
         return IP_OK; /* a plane source checks each plane's file as it reads it */
+    if (ip__input_is_stdin(desc->data_path))
+        return IP_OK; /* a pipe's length is known at its end: the reader checks it */
     data_label(desc, label, sizeof label);
     /* O_NONBLOCK: naming a FIFO must fail below, not hang waiting for a writer. */
     int fd = open(desc->data_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
@@ -440,6 +480,9 @@ static ip_status require_layout(const ip_input_desc *desc, const ip_text_found *
 {
     if (found->has_dims && found->has_type)
         return IP_OK;
+    if (ip__input_is_stdin(desc->path))
+        return ip__fail(err, IP_ERR_INPUT,
+                        "stdin: raw samples from standard input need --dims and --type");
     return ip__fail(err, IP_ERR_INPUT,
                     "%s: cannot tell dims and type: name it NAME_XxYxZ_TYPE.raw or pass --dims "
                     "and --type",
@@ -452,11 +495,17 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
     struct stat st;
     const ip_text_format *format = NULL;
     ip__describe_fn describe = NULL;
+    if (ip__input_is_stdin(path)) /* raw samples: dims and type from the overrides */
+        return isatty(STDIN_FILENO) ? ip__fail(err, IP_ERR_INPUT,
+                                               "stdin: a terminal, not a volume: pipe the samples "
+                                               "in (or name a file)")
+                                    : IP_OK;
     switch (kind_of(path)) {
     case INPUT_NRRD: format = &ip__nrrd_format; break;
     case INPUT_MHD: format = &ip__mhd_format; break;
-    case INPUT_TIFF: return describe_by_component(1, path, overrides, desc, found, err);
+    case INPUT_TIFF: return describe_by_component(READ_TIFF, path, overrides, desc, found, err);
     case INPUT_NIFTI: describe = ip__nifti_describe; break;
+    case INPUT_HDF5: return describe_by_component(READ_HDF5, path, overrides, desc, found, err);
     case INPUT_RAW: break;
     }
     if (format)
@@ -468,6 +517,9 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
         return ip__fail_errno(err, IP_ERR_IO, errno, "%s: cannot open", path);
     if (S_ISDIR(st.st_mode) && !has_suffix(path, ".raw"))
         return describe_folder(path, overrides, desc, found, err);
+    /* raw data have no signature: a name ending in .raw is raw whatever its bytes */
+    if (!has_suffix(path, ".raw") && hdf5_signature(path))
+        return describe_by_component(READ_HDF5, path, overrides, desc, found, err);
     return describe_from_name(path, overrides, desc, found, err);
 }
 
@@ -489,6 +541,16 @@ static ip_status check_dicom_choices(const ip_input_overrides *overrides, const 
                         "folder of DICOM files",
                         desc->path);
     return IP_OK;
+}
+
+/* A dataset is picked in an HDF5 file only. */
+static ip_status check_hdf5_choices(const ip_input_overrides *overrides, const ip_input_desc *desc,
+                                    ip_error *err)
+{
+    if (!overrides || !overrides->dataset || desc->encoding == IP_ENCODING_HDF5)
+        return IP_OK;
+    return ip__fail(err, IP_ERR_ARGUMENT,
+                    "%s: an HDF5 dataset was asked for, but this is not an HDF5 file", desc->path);
 }
 
 ip_status ip_dicom_list_series(const char *folder, ip_dicom_series_info **out, uint32_t *count,
@@ -533,6 +595,7 @@ ip_status ip_input_describe(const char *path, const ip_input_overrides *given, i
     set_defaults(&desc, path);
     if ((status = read_layout(path, overrides, &desc, &found, err)) != IP_OK ||
         (status = check_dicom_choices(overrides, &desc, err)) != IP_OK ||
+        (status = check_hdf5_choices(overrides, &desc, err)) != IP_OK ||
         (status = apply_overrides(overrides, &desc, &found, err)) != IP_OK ||
         (status = require_layout(&desc, &found, err)) != IP_OK ||
         (status = validate_dims(&desc, &found, err)) != IP_OK ||

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* Positioned reads of uncompressed input, for callers that read planes from several threads
+/* Positioned reads of uncompressed input (and telling standard input, which has none), for callers that read planes from several threads
  * (the bricker) and ask the kernel to read ahead. Internal. */
 #ifndef ISOPROP_INPUT_POSITIONED_H
 #define ISOPROP_INPUT_POSITIONED_H
@@ -7,6 +7,10 @@
 #include <stdint.h>
 
 #include "isoprop/input.h"
+
+/*! ip__input_is_stdin() : 1 when `path` (a desc's path or data_path) is "-": standard input,
+ *  which is read once, in order (never positioned). */
+int ip__input_is_stdin(const char *path);
 
 /*! ip__input_positioned() : nonzero when the reader's data can be read at any plane
  *  (uncompressed data); gzip streams are read in order only, with ip_input_read_planes(). */

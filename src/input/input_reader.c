@@ -3,6 +3,7 @@
  * gzip (and zlib) streams, then conversion to the host's byte order and a float32 check. */
 #include <errno.h>
 #include <fcntl.h>
+#include <poll.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -33,7 +34,9 @@ struct ip_input_reader {
     size_t sample_size;
     uint64_t plane_bytes;
     uint64_t total_bytes;
-    ip_status failed; /* sticky: after an error the position in the data is unknown */
+    ip_status failed;  /* sticky: after an error the position in the data is unknown */
+    int stream;        /* raw samples from standard input: read once, in order, never seeked */
+    uint64_t streamed; /* bytes of standard input read so far */
     /* TIFF and DICOM: a plane source instead of the data file */
     const ip__plane_source *source;
     void *source_state;
@@ -56,7 +59,9 @@ struct ip_input_reader {
 static void set_label(ip_input_reader *r)
 {
     const ip_input_desc *d = &r->desc;
-    if (strcmp(d->path, d->data_path) == 0)
+    if (ip__input_is_stdin(d->data_path))
+        snprintf(r->label, sizeof r->label, "stdin");
+    else if (strcmp(d->path, d->data_path) == 0)
         snprintf(r->label, sizeof r->label, "%s", d->path);
     else
         snprintf(r->label, sizeof r->label, "%s: data file %s", d->path, d->data_path);
@@ -133,6 +138,17 @@ ip_status ip_input_open(const ip_input_desc *desc, ip_input_reader **out, ip_err
     }
     if (r->source) {
         if ((status = r->source->open(&r->desc, &r->source_state, err)) != IP_OK) {
+            ip_input_close(r);
+            return status;
+        }
+        *out = r;
+        return IP_OK;
+    }
+    if (desc->encoding == IP_ENCODING_RAW && ip__input_is_stdin(desc->data_path)) {
+        r->stream = 1;
+        r->fd = fcntl(STDIN_FILENO, F_DUPFD_CLOEXEC, 0);
+        if (r->fd < 0) {
+            status = ip__fail_errno(err, IP_ERR_IO, errno, "stdin: cannot read");
             ip_input_close(r);
             return status;
         }
@@ -336,6 +352,55 @@ static ip_status gzip_skip(ip_input_reader *r, ip_error *err)
     return IP_OK;
 }
 
+/* ---- standard input ---- */
+
+/* Reads exactly `size` bytes of standard input into dst, whatever size the pipe hands over at
+ * a time (waiting when the descriptor was left non-blocking); a pipe that ends first is an
+ * IP_ERR_INPUT naming how far it got. */
+static ip_status stream_read(ip_input_reader *r, unsigned char *dst, size_t size, ip_error *err)
+{
+    size_t done = 0;
+    while (done < size) {
+        ssize_t n = read(r->fd, dst + done, size - done);
+        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            struct pollfd p = {r->fd, POLLIN, 0};
+            (void)poll(&p, 1, -1);
+            continue;
+        }
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0)
+            return ip__fail_errno(err, IP_ERR_IO, errno, "stdin: read failed after %llu bytes",
+                                  (unsigned long long)r->streamed);
+        if (n == 0)
+            return ip__fail(err, IP_ERR_INPUT, "stdin: ended after %llu of %llu bytes",
+                            (unsigned long long)r->streamed, (unsigned long long)r->total_bytes);
+        done += (size_t)n;
+        r->streamed += (uint64_t)n;
+    }
+    return IP_OK;
+}
+
+/* After the last plane the pipe must end: one more byte means the dims are wrong. */
+static ip_status stream_finish(ip_input_reader *r, ip_error *err)
+{
+    unsigned char extra;
+    r->total_bytes++; /* a byte past the end is what is asked for */
+    ip_status st = stream_read(r, &extra, 1, err);
+    r->total_bytes--;
+    if (st == IP_OK)
+        return ip__fail(err, IP_ERR_INPUT,
+                        "stdin: longer than the %ux%ux%u x %zu = %llu bytes of the dims",
+                        r->desc.dims[0], r->desc.dims[1], r->desc.dims[2], r->sample_size,
+                        (unsigned long long)r->total_bytes);
+    if (st == IP_ERR_INPUT) { /* ended: as it should */
+        if (err)
+            ip_error_clear(err);
+        return IP_OK;
+    }
+    return st;
+}
+
 /* ---- samples ---- */
 
 static void to_host_order(const ip_input_reader *r, void *samples, size_t count)
@@ -417,6 +482,10 @@ static ip_status read_samples(ip_input_reader *r, void *dst, uint32_t count, ip_
         status = gzip_read(r, dst, (size_t)bytes, err);
         if (status == IP_OK && r->next_z + count == r->desc.dims[2])
             status = gzip_finish(r, err);
+    } else if (r->stream) {
+        status = stream_read(r, dst, (size_t)bytes, err);
+        if (status == IP_OK && r->next_z + count == r->desc.dims[2])
+            status = stream_finish(r, err);
     } else {
         uint64_t offset = r->desc.data_offset + (uint64_t)r->next_z * r->plane_bytes;
         status = ip__pread_all(r->fd, dst, (size_t)bytes, offset, r->desc.data_path, err);
@@ -454,7 +523,8 @@ ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t coun
 
 int ip__encoding_is_planes(ip_encoding encoding)
 {
-    return encoding == IP_ENCODING_TIFF || encoding == IP_ENCODING_DICOM;
+    return encoding == IP_ENCODING_TIFF || encoding == IP_ENCODING_DICOM ||
+           encoding == IP_ENCODING_HDF5;
 }
 
 ip_status ip__plane_source_of(const ip_input_desc *desc, const ip__plane_source **out,
@@ -466,7 +536,9 @@ ip_status ip__plane_source_of(const ip_input_desc *desc, const ip__plane_source 
         return IP_OK;
     ip_status st = ip__input_formats_load(desc->path, &formats, err);
     if (st == IP_OK)
-        *out = desc->encoding == IP_ENCODING_TIFF ? formats->tiff_source : formats->dicom_source;
+        *out = desc->encoding == IP_ENCODING_TIFF   ? formats->tiff_source
+               : desc->encoding == IP_ENCODING_HDF5 ? formats->hdf5_source
+                                                    : formats->dicom_source;
     return st;
 }
 
@@ -474,7 +546,7 @@ ip_status ip__plane_source_of(const ip_input_desc *desc, const ip__plane_source 
 
 int ip__input_positioned(const ip_input_reader *reader)
 {
-    return reader->desc.encoding == IP_ENCODING_RAW;
+    return reader->desc.encoding == IP_ENCODING_RAW && !reader->stream;
 }
 
 /* Where the kernel gives it (statx STATX_DIOALIGN), the alignment O_DIRECT needs of buffer

@@ -49,13 +49,15 @@ typedef struct ip__input_formats {
     ip__describe_fn tiff_describe, dicom_describe;
     const ip__plane_source *tiff_source, *dicom_source;
     ip__dicom_list_fn dicom_list;
+    ip__describe_fn hdf5_describe; /* HDF5 (input_hdf5.c); refuses when built without it */
+    const ip__plane_source *hdf5_source;
 } ip__input_formats;
 
 /* The table's layout and the version of the structs it passes (ip_input_desc, ...): the core
  * takes only a component of its own version. Raise the last part when ip__input_formats or
  * ip__plane_source change. */
 #define IP__INPUT_FORMATS_ABI \
-    ((uint32_t)(IP_VERSION_MAJOR * 1000000 + IP_VERSION_MINOR * 10000 + IP_VERSION_PATCH * 100 + 2))
+    ((uint32_t)(IP_VERSION_MAJOR * 1000000 + IP_VERSION_MINOR * 10000 + IP_VERSION_PATCH * 100 + 3))
 
 /*! ip__input_formats_load() : the input component's readers, which `path` (a TIFF file or a
  *  DICOM or TIFF folder) needs: the ones linked in (the static library, the component itself),
@@ -64,7 +66,8 @@ typedef struct ip__input_formats {
  *  or is of another version. Thread-safe. */
 ip_status ip__input_formats_load(const char *path, const ip__input_formats **out, ip_error *err);
 
-/*! ip__encoding_is_planes() : 1 for the encodings read through a plane source (TIFF, DICOM). */
+/*! ip__encoding_is_planes() : 1 for the encodings read through a plane source (TIFF, DICOM,
+ *  HDF5). */
 int ip__encoding_is_planes(ip_encoding encoding);
 
 /*! ip__input_format_named() : the input format `path` names by its extension, as words for a

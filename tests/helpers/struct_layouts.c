@@ -41,6 +41,7 @@ static void error_and_input(void)
     FIELD(ip_input_desc, rescale_unit);
     FIELD(ip_input_desc, plane_source);
     FIELD(ip_input_desc, plane_user);
+    FIELD(ip_input_desc, dataset);
     FIELD(ip_input_desc, reserved);
     SIZE(ip_rescale);
     FIELD(ip_rescale, present);
@@ -64,6 +65,7 @@ static void error_and_input(void)
     FIELD(ip_input_overrides, series);
     FIELD(ip_input_overrides, tilt);
     FIELD(ip_input_overrides, uneven);
+    FIELD(ip_input_overrides, dataset);
 }
 
 static void memory_volume(void)

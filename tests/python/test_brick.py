@@ -181,5 +181,36 @@ class DicomFolder(unittest.TestCase):
             isoprop.brick(self.dir, support.work("x.ibv"), correct_tilt="no")
 
 
+@unittest.skipUnless(os.path.exists(os.path.join(support.BIN, "tests/make_hdf5")),
+                     "built without HDF5 (IP_HDF5=OFF)")
+class Hdf5File(unittest.TestCase):
+    """An HDF5 file with two 3-D datasets (make_hdf5): dataset= picks one, as isobrick
+    --dataset does; without it the file is refused naming both."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = support.work("hdf5")
+        os.makedirs(cls.dir, exist_ok=True)
+        support.tool("isogen", "sphere", "--dims", "20x18x16", "--type", "uint16", "-o",
+                     cls.dir + "/", "--quiet")
+        support.tool("tests/make_hdf5", os.path.join(cls.dir, "sphere_20x18x16_uint16.raw"),
+                     cls.dir)
+
+    def test_dataset_picked(self):
+        two = os.path.join(self.dir, "two.h5")
+        with self.assertRaisesRegex(isoprop.Error, "2 3-D datasets: pick one with --dataset: /a"):
+            isoprop.brick(two, support.work("several.ibv"))
+        self.assertFalse(os.path.exists(support.work("several.ibv")))
+        raw = support.work("h5_raw.ibv")
+        isoprop.brick(os.path.join(self.dir, "sphere_20x18x16_uint16.raw"), raw, force=True)
+        picked = support.work("h5_picked.ibv")
+        isoprop.brick(two, picked, dataset="/b/c", force=True)
+        self.assertEqual(open(raw, "rb").read(), open(picked, "rb").read())
+        with self.assertRaises(TypeError):
+            isoprop.brick(two, support.work("x.ibv"), dataset=3)
+        with self.assertRaises(isoprop.ArgumentError):
+            isoprop.brick(np.zeros((2, 2, 2), np.uint8), support.work("x.ibv"), dataset="/a")
+
+
 if __name__ == "__main__":
     support.main()

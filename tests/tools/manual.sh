@@ -36,6 +36,8 @@ check "isorender --mes completes to --mesh and --mesh-grid" \
     test "$(complete_words isorender --mes | tr '\n' ' ')" = "--mesh --mesh-grid "
 check "isobrick --sub completes to --subblock-size" \
     test "$(complete_words isobrick --sub)" = "--subblock-size"
+check "isobrick --data completes to --dataset (HDF5)" \
+    test "$(complete_words isobrick --data)" = "--dataset"
 if [ -x "$bin/isowall" ]; then
     check "isowall --sta completes to --static and --stats" \
         test "$(complete_words isowall --sta | tr '\n' ' ')" = "--static --stats "
