@@ -1,0 +1,496 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Full extraction welded as it goes: every active cell of a level as an indexed mesh, each
+ * vertex keyed by the grid edge it lies on (or the sample it sits on), welded brick by brick in
+ * a dense table on all threads, then the vertices on brick faces joined across bricks in brick
+ * order. The result is ip_mesh_weld()'s of ip_extract_full()'s soup, vertex for vertex. */
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "array.h"
+#include "internal.h"
+#include "isoprop/engine.h"
+#include "pool.h"
+#include "propagate.h"
+
+#define MAX_VERTICES (UINT64_C(0xffffffff) - 1) /* as ip_mesh_weld(): indices are uint32 */
+#define NO_KEY UINT64_MAX
+
+/* A worker's vertices, triangles and brick-face vertices, in the order of its bricks. */
+typedef struct indexed_part {
+    float *positions; /* 3 per vertex */
+    float *sums;      /* 3 per vertex: the sum of its corners' unpacked normals */
+    int16_t *first;   /* 3 per vertex: its first corner's packed normal */
+    float *values;    /* per vertex: the larger sample of its edge (its sample's, on one) */
+    uint64_t vertices, vertex_capacity;
+    uint32_t *indices; /* 3 per triangle: the worker's own vertex numbers */
+    uint64_t triangles, triangle_capacity;
+    uint64_t *shared_key; /* per vertex on a brick face: its level-wide key */
+    uint32_t *shared_vertex;
+    uint64_t shared, shared_capacity;
+} indexed_part;
+
+/* Where one brick's output starts in its worker's part. */
+typedef struct indexed_chunk {
+    uint64_t brick; /* level-local index */
+    uint64_t vertex, triangle, shared;
+} indexed_chunk;
+
+typedef struct indexed_worker {
+    ip_cache *cache;
+    float iso;
+    uint32_t level;
+    int keep_degenerate;
+    atomic_uint_fast64_t *next;
+    ip_sampler sampler;
+    uint32_t *table; /* per brick-local key: 1 + the worker's vertex number (stale when below
+                        the chunk's first vertex) */
+    indexed_part part;
+    indexed_chunk *chunks;
+    uint64_t chunk_count, chunk_capacity;
+    uint64_t dropped;
+    ip_engine_counts counts;
+    ip_status status;
+} indexed_worker;
+
+/* The brick being welded: its samples and the first vertex of its chunk. */
+typedef struct brick_frame {
+    uint32_t origin[3], extent[3];
+    uint64_t first_vertex;
+} brick_frame;
+
+static ip_status grow(void *array, uint64_t *capacity, uint64_t needed, size_t size)
+{
+    if (needed <= *capacity)
+        return IP_OK;
+    uint64_t cap = ip__array_capacity(*capacity, needed, 4096, size, IP_ARRAY_DOUBLE);
+    if (!cap || ip__array_resize(array, cap, size) != IP_OK)
+        return IP_ERR_NOMEM;
+    *capacity = cap;
+    return IP_OK;
+}
+
+/* Room for the vertices (and brick-face vertices) and triangles of one more cell. */
+static ip_status part_reserve(indexed_part *p, uint64_t triangles)
+{
+    uint64_t more = 12; /* a cell adds at most one vertex per edge */
+    if (p->vertices + more > MAX_VERTICES)
+        return IP_ERR_ARGUMENT;
+    if (p->vertices + more > p->vertex_capacity) {
+        uint64_t cap = p->vertex_capacity, c = cap, need = p->vertices + more;
+        if (grow(&p->positions, &c, need, 3 * sizeof(float)) != IP_OK ||
+            (c = cap, grow(&p->sums, &c, need, 3 * sizeof(float))) != IP_OK ||
+            (c = cap, grow(&p->first, &c, need, 3 * sizeof(int16_t))) != IP_OK ||
+            (c = cap, grow(&p->values, &c, need, sizeof(float))) != IP_OK)
+            return IP_ERR_NOMEM;
+        p->vertex_capacity = c;
+    }
+    if (p->shared + more > p->shared_capacity) {
+        uint64_t cap = p->shared_capacity, c = cap, need = p->shared + more;
+        if (grow(&p->shared_key, &c, need, sizeof(uint64_t)) != IP_OK ||
+            (c = cap, grow(&p->shared_vertex, &c, need, sizeof(uint32_t))) != IP_OK)
+            return IP_ERR_NOMEM;
+        p->shared_capacity = c;
+    }
+    return grow(&p->indices, &p->triangle_capacity, p->triangles + triangles, 3 * sizeof(uint32_t));
+}
+
+static void part_free(indexed_part *p)
+{
+    free(p->positions);
+    free(p->sums);
+    free(p->first);
+    free(p->values);
+    free(p->indices);
+    free(p->shared_key);
+    free(p->shared_vertex);
+}
+
+/* One crossed edge of a cell: the key of its vertex in the brick's table, whether that vertex
+ * may be shared with another brick (then its level-wide key), and its value. */
+typedef struct edge_key {
+    uint32_t local;
+    uint64_t global; /* NO_KEY inside the brick */
+    float value;
+} edge_key;
+
+/* The key of the vertex at points[e] of `cell`: the sample it sits on where its coordinate
+ * along the edge is a corner's (kind 3), else the edge (kind = its axis), at the edge's low
+ * sample; so that two corners at one position have one key, as welding by position joins them. */
+static edge_key key_of(const ip_sampler *s, const brick_frame *b, const uint32_t cell[3],
+                       const float values[8], unsigned e, const float point[3], const float lo[3],
+                       const float hi[3])
+{
+    unsigned axis = e >> 2, c0 = ip__mc_edge_corners[e][0], c1 = ip__mc_edge_corners[e][1];
+    unsigned kind = axis, corner = c0;
+    edge_key k = {0, NO_KEY, values[c0] > values[c1] ? values[c0] : values[c1]};
+    if (point[axis] == lo[axis] || point[axis] == hi[axis]) {
+        kind = 3;
+        corner = point[axis] == lo[axis] ? c0 : c1;
+        k.value = values[corner];
+    }
+    uint32_t q[3];
+    int face = 0;
+    for (unsigned a = 0; a < 3; a++) {
+        q[a] = cell[a] + ((corner >> a) & 1u) - b->origin[a];
+        face |= (a != kind) & (q[a] == 0 || q[a] + 1 == b->extent[a]);
+    }
+    k.local = 4 * (q[0] + b->extent[0] * (q[1] + b->extent[1] * q[2])) + kind;
+    if (face) {
+        uint64_t p[3] = {b->origin[0] + q[0], b->origin[1] + q[1], b->origin[2] + q[2]};
+        k.global = 4 * (p[0] + (uint64_t)s->dims[0] * (p[1] + (uint64_t)s->dims[1] * p[2])) + kind;
+    }
+    return k;
+}
+
+/* The worker's vertex for key k (point p, packed normal n), added when the brick has none. */
+static uint32_t vertex_for(indexed_worker *w, const brick_frame *b, const edge_key *k,
+                           const float p[3], const int16_t n[3])
+{
+    indexed_part *part = &w->part;
+    uint32_t stored = w->table[k->local];
+    if (stored > b->first_vertex)
+        return stored - 1;
+    uint64_t v = part->vertices++;
+    w->table[k->local] = (uint32_t)(v + 1);
+    for (int a = 0; a < 3; a++) {
+        part->positions[3 * v + a] = p[a] + 0.0f; /* -0 as +0, as ip_mesh_weld() */
+        part->first[3 * v + a] = n[a];
+        part->sums[3 * v + a] = 0.0f;
+    }
+    part->values[v] = k->value;
+    if (k->global != NO_KEY) {
+        part->shared_key[part->shared] = k->global;
+        part->shared_vertex[part->shared++] = (uint32_t)v;
+    }
+    return (uint32_t)v;
+}
+
+/* Welds the triangles of one active cell into the worker's part. */
+static ip_status weld_cell(indexed_worker *w, const brick_frame *b, const uint32_t cell[3],
+                           const float values[8], unsigned mc)
+{
+    ip_sampler *s = &w->sampler;
+    float lo[3], hi[3], points[12][3], normals[12][3];
+    ip__sampler_cell_box(s, cell, lo, hi);
+    unsigned crossed = ip__mc_cell_edge_points(values, mc, w->iso, lo, hi, points);
+    if (ip__sampler_cell_normals(s, cell, values, mc, w->iso, lo, hi, normals) < 0)
+        return s->status;
+    edge_key keys[12];
+    int16_t packed[12][3];
+    for (unsigned left = crossed; left; left &= left - 1) {
+        unsigned e = ip__lowest_bit(left);
+        keys[e] = key_of(s, b, cell, values, e, points[e], lo, hi);
+        for (int a = 0; a < 3; a++)
+            packed[e][a] = ip_normal_pack(normals[e][a]);
+    }
+    const int8_t *row = s->mc_rows[mc];
+    int n = ip__mc_triangle_count[mc];
+    indexed_part *p = &w->part;
+    ip_status st = part_reserve(p, (uint64_t)n);
+    if (st != IP_OK)
+        return st;
+    for (int t = 0; t < n; t++) {
+        const int8_t *e = row + 3 * t;
+        if (!w->keep_degenerate &&
+            (keys[e[0]].local == keys[e[1]].local || keys[e[1]].local == keys[e[2]].local ||
+             keys[e[0]].local == keys[e[2]].local)) {
+            w->dropped++;
+            continue;
+        }
+        for (int k = 0; k < 3; k++) {
+            uint32_t v = vertex_for(w, b, &keys[e[k]], points[e[k]], packed[e[k]]);
+            p->indices[3 * p->triangles + (uint64_t)k] = v;
+            for (int a = 0; a < 3; a++)
+                p->sums[3 * (uint64_t)v + a] += ip_normal_unpack(packed[e[k]][a]);
+        }
+        p->triangles++;
+    }
+    w->counts.triangles += (uint64_t)n;
+    w->counts.cells++;
+    return IP_OK;
+}
+
+/* Welds the active cells of brick g, sub-block by sub-block. */
+static ip_status weld_brick(indexed_worker *w, uint64_t g)
+{
+    ip_sampler *s = &w->sampler;
+    const ip_layout *l = s->layout;
+    const float *ranges = ip_store_subblock_ranges(ip_cache_store(s->cache), g);
+    uint32_t level, brick[3];
+    brick_frame b;
+    ip_brick_coords(l, g, &level, brick);
+    ip_brick_extent(l, level, brick, b.origin, b.extent);
+    b.first_vertex = w->part.vertices;
+    uint32_t per = l->brick_edge / l->subblock_edge, se = l->subblock_edge;
+    for (uint32_t i = 0; i < per * per * per; i++) {
+        if (!ip__range_active(ranges[2 * i], ranges[2 * i + 1], w->iso))
+            continue;
+        uint32_t sb[3] = {i % per, (i / per) % per, i / (per * per)}, lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = b.origin[a] + se * sb[a];
+            hi[a] = lo[a] + se < b.origin[a] + b.extent[a] - 1 ? lo[a] + se
+                                                               : b.origin[a] + b.extent[a] - 1;
+        }
+        for (uint32_t z = lo[2]; z < hi[2]; z++)
+            for (uint32_t y = lo[1]; y < hi[1]; y++)
+                for (uint32_t x = lo[0]; x < hi[0]; x++) {
+                    uint32_t cell[3] = {x, y, z};
+                    float values[8];
+                    unsigned mc;
+                    if (ip__sampler_cell_case(s, cell, w->iso, values, &mc) < 0)
+                        return s->status;
+                    if (mc == 0 || mc == 255)
+                        continue;
+                    ip_status st = weld_cell(w, &b, cell, values, mc);
+                    if (st != IP_OK)
+                        return st;
+                }
+    }
+    return IP_OK;
+}
+
+static ip_status add_chunk(indexed_worker *w, uint64_t brick)
+{
+    if (grow(&w->chunks, &w->chunk_capacity, w->chunk_count + 1, sizeof(indexed_chunk)) != IP_OK)
+        return IP_ERR_NOMEM;
+    w->chunks[w->chunk_count++] =
+        (indexed_chunk){brick, w->part.vertices, w->part.triangles, w->part.shared};
+    return IP_OK;
+}
+
+static void indexed_work(void *user, unsigned index)
+{
+    indexed_worker *w = (indexed_worker *)user + index;
+    const ip_store *store = ip_cache_store(w->cache);
+    const ip_level_layout *lv = &ip_store_layout(store)->levels[w->level];
+    double start = ip_now_seconds();
+    for (;;) {
+        uint64_t i = atomic_fetch_add(w->next, 1);
+        if (i >= lv->brick_count || w->status != IP_OK)
+            break;
+        float range[2];
+        ip_store_brick_range(store, lv->first_brick + i, range);
+        if (!ip__range_active(range[0], range[1], w->iso))
+            continue;
+        w->status = add_chunk(w, i);
+        if (w->status == IP_OK)
+            w->status = weld_brick(w, lv->first_brick + i);
+        ip__sampler_release(&w->sampler); /* a brick at a time */
+    }
+    w->counts.extraction_seconds = ip_now_seconds() - start;
+}
+
+/* The joined mesh in the making: a hash of the brick-face vertices by level-wide key. */
+typedef struct joiner {
+    ip_indexed_mesh *out;
+    float *sums, *values;
+    uint64_t *keys; /* open addressing, linear probing; NO_KEY: empty */
+    uint32_t *slots;
+    uint64_t mask;
+} joiner;
+
+static uint64_t key_hash(uint64_t k)
+{
+    k *= UINT64_C(0x9e3779b97f4a7c15);
+    return k ^ (k >> 29);
+}
+
+/* Appends the vertices and triangles of chunk c of worker w to the joined mesh; `map` (the
+ * worker's, per vertex) receives their joined numbers. */
+static void join_chunk(joiner *j, const indexed_worker *w, uint64_t c, uint32_t *map)
+{
+    const indexed_part *p = &w->part;
+    const indexed_chunk *ch = &w->chunks[c];
+    int last = c + 1 == w->chunk_count;
+    uint64_t v_end = last ? p->vertices : ch[1].vertex;
+    uint64_t t_end = last ? p->triangles : ch[1].triangle;
+    uint64_t s = ch->shared, s_end = last ? p->shared : ch[1].shared;
+    ip_indexed_mesh *m = j->out;
+    for (uint64_t v = ch->vertex; v < v_end; v++) {
+        uint64_t g = m->vertex_count;
+        if (s < s_end && p->shared_vertex[s] == v) {
+            uint64_t key = p->shared_key[s++], i = key_hash(key) & j->mask;
+            while (j->keys[i] != NO_KEY && j->keys[i] != key)
+                i = (i + 1) & j->mask;
+            if (j->keys[i] == key) {
+                map[v] = j->slots[i];
+                for (int a = 0; a < 3; a++)
+                    j->sums[3 * (uint64_t)j->slots[i] + a] += p->sums[3 * v + a];
+                continue;
+            }
+            j->keys[i] = key;
+            j->slots[i] = (uint32_t)g;
+        }
+        map[v] = (uint32_t)g;
+        memcpy(m->positions + 3 * g, p->positions + 3 * v, 3 * sizeof(float));
+        memcpy(m->normals + 3 * g, p->first + 3 * v, 3 * sizeof(int16_t));
+        memcpy(j->sums + 3 * g, p->sums + 3 * v, 3 * sizeof(float));
+        j->values[g] = p->values[v];
+        m->vertex_count++;
+    }
+    for (uint64_t i = 3 * ch->triangle; i < 3 * t_end; i++)
+        m->indices[3 * m->triangle_count + i - 3 * ch->triangle] = map[p->indices[i]];
+    m->triangle_count += t_end - ch->triangle;
+}
+
+/* Each vertex's normal: its corners' average, normalised; the first corner's where they
+ * cancel out (as ip_mesh_weld()). */
+static void finish_normals(joiner *j)
+{
+    ip_indexed_mesh *m = j->out;
+    for (uint64_t v = 0; v < m->vertex_count; v++) {
+        const float *s = j->sums + 3 * v;
+        float length = sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+        if (length > 0.0f)
+            for (int k = 0; k < 3; k++)
+                m->normals[3 * v + k] = ip_normal_pack(s[k] / length);
+    }
+}
+
+/* The arrays of the joined mesh, sized for `vertices`, `triangles` and `shared` brick-face
+ * vertices at most (one element more each, so that none is empty). */
+static ip_status joiner_alloc(joiner *j, uint64_t vertices, uint64_t triangles, uint64_t shared)
+{
+    ip_indexed_mesh *m = j->out;
+    uint64_t slot_count = 1024;
+    while (slot_count < 2 * shared)
+        slot_count *= 2;
+    j->mask = slot_count - 1;
+    if (vertices + 1 > SIZE_MAX / (3 * sizeof(float)) ||
+        triangles + 1 > SIZE_MAX / (3 * sizeof(uint32_t)))
+        return IP_ERR_NOMEM;
+    m->positions = malloc((vertices + 1) * 3 * sizeof(float));
+    m->normals = malloc((vertices + 1) * 3 * sizeof(int16_t));
+    m->indices = malloc((triangles + 1) * 3 * sizeof(uint32_t));
+    j->sums = malloc((vertices + 1) * 3 * sizeof(float));
+    j->values = malloc((vertices + 1) * sizeof(float));
+    j->keys = malloc(slot_count * sizeof(uint64_t));
+    j->slots = malloc(slot_count * sizeof(uint32_t));
+    if (!m->positions || !m->normals || !m->indices || !j->sums || !j->values || !j->keys ||
+        !j->slots)
+        return IP_ERR_NOMEM;
+    memset(j->keys, 0xff, slot_count * sizeof(uint64_t)); /* NO_KEY */
+    return IP_OK;
+}
+
+/* Joins every worker's chunks, in brick order, into `out` (and *values). */
+static ip_status join_in_brick_order(const indexed_worker *w, unsigned threads,
+                                     ip_indexed_mesh *out, float **values)
+{
+    uint64_t vertices = 0, triangles = 0, shared = 0;
+    for (unsigned t = 0; t < threads; t++) {
+        vertices += w[t].part.vertices;
+        triangles += w[t].part.triangles;
+        shared += w[t].part.shared;
+    }
+    joiner j = {out, NULL, NULL, NULL, NULL, 0};
+    uint64_t *cursor = calloc(threads, sizeof *cursor);
+    uint32_t *map = malloc((vertices + 1) * sizeof *map);
+    ip_status st = vertices > MAX_VERTICES ? IP_ERR_ARGUMENT
+                   : cursor && map         ? joiner_alloc(&j, vertices, triangles, shared)
+                                           : IP_ERR_NOMEM;
+    while (st == IP_OK) {
+        unsigned best = threads;
+        for (unsigned t = 0; t < threads; t++)
+            if (cursor[t] < w[t].chunk_count &&
+                (best == threads ||
+                 w[t].chunks[cursor[t]].brick < w[best].chunks[cursor[best]].brick))
+                best = t;
+        if (best == threads)
+            break;
+        uint64_t offset = 0; /* the worker's part of map */
+        for (unsigned t = 0; t < best; t++)
+            offset += w[t].part.vertices;
+        join_chunk(&j, &w[best], cursor[best]++, map + offset);
+    }
+    if (st == IP_OK) {
+        finish_normals(&j);
+        /* give back the slack; a failure to shrink leaves the larger arrays */
+        uint64_t v = out->vertex_count + 1;
+        (void)ip__array_resize(&out->positions, v, 3 * sizeof(float));
+        (void)ip__array_resize(&out->normals, v, 3 * sizeof(int16_t));
+        (void)ip__array_resize(&out->indices, out->triangle_count + 1, 3 * sizeof(uint32_t));
+        (void)ip__array_resize(&j.values, v, sizeof(float));
+    }
+    free(cursor);
+    free(map);
+    free(j.keys);
+    free(j.slots);
+    free(j.sums);
+    if (st == IP_OK && values)
+        *values = j.values;
+    else
+        free(j.values);
+    return st;
+}
+
+ip_status ip_extract_full_indexed(ip_cache *cache, float iso, uint32_t level, unsigned threads,
+                                  int keep_degenerate, ip_indexed_mesh *out, float **values,
+                                  ip_engine_counts *counts, ip_error *err)
+{
+    const ip_store *store = ip_cache_store(cache);
+    const char *path = ip_store_path(store);
+    ip_indexed_mesh_init(out);
+    if (values)
+        *values = NULL;
+    if (level >= ip_store_layout(store)->level_count)
+        return ip__fail(err, IP_ERR_ARGUMENT, "%s: level %u does not exist", path, level);
+    threads = ip_thread_count(threads);
+    indexed_worker *w = calloc(threads, sizeof *w);
+    if (!w)
+        return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory", path);
+    atomic_uint_fast64_t next;
+    atomic_init(&next, 0);
+    ip_status st = IP_OK;
+    uint32_t edge = ip_store_layout(store)->brick_edge + 1;
+    size_t table = 4 * (size_t)edge * edge * edge;
+    for (unsigned t = 0; t < threads; t++) {
+        w[t] = (indexed_worker){.cache = cache,
+                                .iso = iso,
+                                .level = level,
+                                .keep_degenerate = keep_degenerate,
+                                .next = &next};
+        w[t].table = calloc(table, sizeof(uint32_t));
+        if ((ip__sampler_init(&w[t].sampler, cache, level) != IP_OK || !w[t].table) && st == IP_OK)
+            st = IP_ERR_NOMEM;
+    }
+    ip__pool *pool = NULL;
+    if (st == IP_OK)
+        st = ip__pool_create(threads, &pool, NULL);
+    if (st == IP_OK)
+        ip__pool_run(pool, threads, indexed_work, w);
+    ip__pool_destroy(pool);
+    ip_engine_counts c;
+    memset(&c, 0, sizeof c);
+    for (unsigned t = 0; t < threads; t++) {
+        c.cells += w[t].counts.cells;
+        c.triangles += w[t].counts.triangles;
+        c.extraction_seconds += w[t].counts.extraction_seconds;
+        out->dropped_triangles += w[t].dropped;
+        if (st == IP_OK && w[t].status != IP_OK) {
+            st = w[t].status;
+            if (st != IP_ERR_NOMEM && st != IP_ERR_ARGUMENT && err)
+                *err = w[t].sampler.error;
+        }
+    }
+    if (st == IP_OK)
+        st = join_in_brick_order(w, threads, out, values);
+    if (st == IP_ERR_NOMEM)
+        ip__fail(err, st, "%s: out of memory", path);
+    else if (st == IP_ERR_ARGUMENT)
+        ip__fail(err, st, "%s: more than 2^32 - 2 distinct vertices", path);
+    for (unsigned t = 0; t < threads; t++) {
+        ip__sampler_free(&w[t].sampler);
+        free(w[t].table);
+        part_free(&w[t].part);
+        free(w[t].chunks);
+    }
+    free(w);
+    if (st != IP_OK)
+        ip_indexed_mesh_free(out);
+    if (counts)
+        *counts = c;
+    return st;
+}
