@@ -61,10 +61,10 @@ def _axis_spacing(spacing: Any) -> Tuple[float, float, float]:
     return out[0], out[1], out[2]
 
 
-def _level(level: Any, a: np.ndarray) -> float:
-    """The isovalue: the midpoint of the data's range for None; ValueError naming `level`
-    when it is NaN or outside [min, max], as scikit-image."""
-    lo, hi = float(a.min()), float(a.max())
+def _level(level: Any, value_range: Tuple[float, float]) -> float:
+    """The isovalue: the midpoint of the data's range `value_range` (min, max) for None;
+    ValueError naming `level` when it is NaN or outside [min, max], as scikit-image."""
+    lo, hi = float(value_range[0]), float(value_range[1])
     if level is None:
         return 0.5 * (lo + hi)
     value = C.number("level", level)
@@ -102,8 +102,9 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *,
     gradient_direction = C.choice("gradient_direction", gradient_direction, DIRECTIONS)
     allow_degenerate = C.flag("allow_degenerate", allow_degenerate)
     threads = C.whole("threads", threads, 0, C.MAX_VIEW_THREADS)
-    iso = _level(level, a)
     with _volume_file(a, sp[::-1]) as f:
+        # the range from the store's summaries, which opening it works out: no pass over `a`
+        iso = _level(level, f.value_range_stored)
         welded = f._full_welded(iso, threads, allow_degenerate)
     if welded is None:
         raise RuntimeError("marching_cubes: no surface at level %r" % iso)

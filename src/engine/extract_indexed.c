@@ -28,6 +28,8 @@ typedef struct indexed_part {
     uint64_t triangles, triangle_capacity;
     uint64_t *shared_key; /* per vertex on a brick face: its level-wide key */
     uint32_t *shared_vertex;
+    uint32_t *shared_joined; /* per brick-face vertex: the joined vertex an earlier brick made
+                                of it, or UINT32_MAX where it is new (join_plan()) */
     uint64_t shared, shared_capacity;
 } indexed_part;
 
@@ -35,6 +37,8 @@ typedef struct indexed_part {
 typedef struct indexed_chunk {
     uint64_t brick; /* level-local index */
     uint64_t vertex, triangle, shared;
+    uint64_t joined_vertex, joined_triangle; /* where its new vertices and its triangles go in
+                                                the joined mesh (join_plan()) */
 } indexed_chunk;
 
 typedef struct indexed_worker {
@@ -105,6 +109,7 @@ static void part_free(indexed_part *p)
     free(p->indices);
     free(p->shared_key);
     free(p->shared_vertex);
+    free(p->shared_joined);
 }
 
 /* One crossed edge of a cell: the key of its vertex in the brick's table, whether that vertex
@@ -256,7 +261,7 @@ static ip_status add_chunk(indexed_worker *w, uint64_t brick)
     if (grow(&w->chunks, &w->chunk_capacity, w->chunk_count + 1, sizeof(indexed_chunk)) != IP_OK)
         return IP_ERR_NOMEM;
     w->chunks[w->chunk_count++] =
-        (indexed_chunk){brick, w->part.vertices, w->part.triangles, w->part.shared};
+        (indexed_chunk){brick, w->part.vertices, w->part.triangles, w->part.shared, 0, 0};
     return IP_OK;
 }
 
@@ -282,13 +287,24 @@ static void indexed_work(void *user, unsigned index)
     w->counts.extraction_seconds = ip_now_seconds() - start;
 }
 
-/* The joined mesh in the making: a hash of the brick-face vertices by level-wide key. */
+/* A chunk in the joined order: its worker and its number there. */
+typedef struct chunk_ref {
+    unsigned worker;
+    uint64_t chunk;
+} chunk_ref;
+
+/* The joining: the joined mesh and its per-vertex sums and values, the chunks in brick order,
+ * and the workers' vertex numbers in the joined mesh. */
 typedef struct joiner {
     ip_indexed_mesh *out;
     float *sums, *values;
-    uint64_t *keys; /* open addressing, linear probing; NO_KEY: empty */
-    uint32_t *slots;
-    uint64_t mask;
+    indexed_worker *w;
+    chunk_ref *order;
+    uint64_t chunks;
+    uint32_t *map;             /* per vertex of every worker, worker after worker */
+    uint64_t *map_of;          /* per worker: its first entry in map */
+    atomic_uint_fast64_t next; /* the next chunk of `order` to copy (join_work()) */
+    unsigned parts;            /* finish_normals()' */
 } joiner;
 
 static uint64_t key_hash(uint64_t k)
@@ -297,50 +313,110 @@ static uint64_t key_hash(uint64_t k)
     return k ^ (k >> 29);
 }
 
-/* Appends the vertices and triangles of chunk c of worker w to the joined mesh; `map` (the
- * worker's, per vertex) receives their joined numbers. */
-static void join_chunk(joiner *j, const indexed_worker *w, uint64_t c, uint32_t *map)
+/* The end of chunk c of worker w: its vertices, triangles and brick-face vertices. */
+static void chunk_end(const indexed_worker *w, uint64_t c, uint64_t end[3])
 {
-    const indexed_part *p = &w->part;
-    const indexed_chunk *ch = &w->chunks[c];
     int last = c + 1 == w->chunk_count;
-    uint64_t v_end = last ? p->vertices : ch[1].vertex;
-    uint64_t t_end = last ? p->triangles : ch[1].triangle;
-    uint64_t s = ch->shared, s_end = last ? p->shared : ch[1].shared;
-    ip_indexed_mesh *m = j->out;
-    for (uint64_t v = ch->vertex; v < v_end; v++) {
-        uint64_t g = m->vertex_count;
-        if (s < s_end && p->shared_vertex[s] == v) {
-            uint64_t key = p->shared_key[s++], i = key_hash(key) & j->mask;
-            while (j->keys[i] != NO_KEY && j->keys[i] != key)
-                i = (i + 1) & j->mask;
-            if (j->keys[i] == key) {
-                map[v] = j->slots[i];
-                for (int a = 0; a < 3; a++)
-                    j->sums[3 * (uint64_t)j->slots[i] + a] += p->sums[3 * v + a];
+    const indexed_chunk *next = &w->chunks[c + 1];
+    end[0] = last ? w->part.vertices : next->vertex;
+    end[1] = last ? w->part.triangles : next->triangle;
+    end[2] = last ? w->part.shared : next->shared;
+}
+
+/* Sequentially, in brick order: which brick-face vertices an earlier brick made (their
+ * shared_joined), and where each chunk's new vertices and its triangles go. Counts the
+ * joined vertices and triangles into out. `keys` and `slots`: a hash table of mask + 1 slots,
+ * keys NO_KEY. */
+static void join_plan(joiner *j, uint64_t *keys, uint32_t *slots, uint64_t mask)
+{
+    uint64_t vertices = 0, triangles = 0;
+    for (uint64_t o = 0; o < j->chunks; o++) {
+        indexed_worker *w = &j->w[j->order[o].worker];
+        indexed_chunk *ch = &w->chunks[j->order[o].chunk];
+        uint64_t end[3], repeated = 0;
+        chunk_end(w, j->order[o].chunk, end);
+        ch->joined_vertex = vertices;
+        ch->joined_triangle = triangles;
+        for (uint64_t s = ch->shared; s < end[2]; s++) {
+            uint64_t key = w->part.shared_key[s], i = key_hash(key) & mask;
+            while (keys[i] != NO_KEY && keys[i] != key)
+                i = (i + 1) & mask;
+            w->part.shared_joined[s] = keys[i] == key ? slots[i] : UINT32_MAX;
+            if (keys[i] == key) {
+                repeated++;
                 continue;
             }
-            j->keys[i] = key;
-            j->slots[i] = (uint32_t)g;
+            keys[i] = key;
+            slots[i] = (uint32_t)(vertices + w->part.shared_vertex[s] - ch->vertex - repeated);
+        }
+        vertices += end[0] - ch->vertex - repeated;
+        triangles += end[1] - ch->triangle;
+    }
+    j->out->vertex_count = vertices;
+    j->out->triangle_count = triangles;
+}
+
+/* Copies one chunk's new vertices and its triangles, renumbered, to the joined mesh. */
+static void join_chunk(joiner *j, const chunk_ref *ref)
+{
+    const indexed_worker *w = &j->w[ref->worker];
+    const indexed_part *p = &w->part;
+    const indexed_chunk *ch = &w->chunks[ref->chunk];
+    uint32_t *map = j->map + j->map_of[ref->worker];
+    ip_indexed_mesh *m = j->out;
+    uint64_t end[3], g = ch->joined_vertex, s = ch->shared;
+    chunk_end(w, ref->chunk, end);
+    for (uint64_t v = ch->vertex; v < end[0]; v++) {
+        if (s < end[2] && p->shared_vertex[s] == v && p->shared_joined[s++] != UINT32_MAX) {
+            map[v] = p->shared_joined[s - 1];
+            continue;
         }
         map[v] = (uint32_t)g;
         memcpy(m->positions + 3 * g, p->positions + 3 * v, 3 * sizeof(float));
         memcpy(m->normals + 3 * g, p->first + 3 * v, 3 * sizeof(int16_t));
         memcpy(j->sums + 3 * g, p->sums + 3 * v, 3 * sizeof(float));
-        j->values[g] = p->values[v];
-        m->vertex_count++;
+        j->values[g++] = p->values[v];
     }
-    for (uint64_t i = 3 * ch->triangle; i < 3 * t_end; i++)
-        m->indices[3 * m->triangle_count + i - 3 * ch->triangle] = map[p->indices[i]];
-    m->triangle_count += t_end - ch->triangle;
+    uint32_t *to = m->indices + 3 * ch->joined_triangle;
+    for (uint64_t i = 3 * ch->triangle; i < 3 * end[1]; i++)
+        *to++ = map[p->indices[i]];
+}
+
+static void join_work(void *user, unsigned index)
+{
+    (void)index;
+    joiner *j = user;
+    for (uint64_t o; (o = atomic_fetch_add(&j->next, 1)) < j->chunks;)
+        join_chunk(j, &j->order[o]);
+}
+
+/* Sequentially, in brick order: adds to each brick-face vertex that an earlier brick made the
+ * normals of its corners in the later bricks. */
+static void join_repeated_sums(joiner *j)
+{
+    for (uint64_t o = 0; o < j->chunks; o++) {
+        const indexed_worker *w = &j->w[j->order[o].worker];
+        const indexed_chunk *ch = &w->chunks[j->order[o].chunk];
+        uint64_t end[3];
+        chunk_end(w, j->order[o].chunk, end);
+        for (uint64_t s = ch->shared; s < end[2]; s++) {
+            uint64_t to = w->part.shared_joined[s], v = w->part.shared_vertex[s];
+            if (to != UINT32_MAX)
+                for (int a = 0; a < 3; a++)
+                    j->sums[3 * to + a] += w->part.sums[3 * v + a];
+        }
+    }
 }
 
 /* Each vertex's normal: its corners' average, normalised; the first corner's where they
- * cancel out (as ip_mesh_weld()). */
-static void finish_normals(joiner *j)
+ * cancel out (as ip_mesh_weld()): part `index` of j->parts of the vertices. */
+static void finish_normals(void *user, unsigned index)
 {
+    joiner *j = user;
     ip_indexed_mesh *m = j->out;
-    for (uint64_t v = 0; v < m->vertex_count; v++) {
+    uint64_t first = m->vertex_count * index / j->parts;
+    uint64_t end = m->vertex_count * (index + 1) / j->parts;
+    for (uint64_t v = first; v < end; v++) {
         const float *s = j->sums + 3 * v;
         float length = sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
         if (length > 0.0f)
@@ -349,15 +425,41 @@ static void finish_normals(joiner *j)
     }
 }
 
-/* The arrays of the joined mesh, sized for `vertices`, `triangles` and `shared` brick-face
- * vertices at most (one element more each, so that none is empty). */
-static ip_status joiner_alloc(joiner *j, uint64_t vertices, uint64_t triangles, uint64_t shared)
+/* The chunks of every worker in brick order into j->order (allocated). */
+static ip_status join_order(joiner *j, unsigned threads)
+{
+    j->chunks = 0;
+    for (unsigned t = 0; t < threads; t++)
+        j->chunks += j->w[t].chunk_count;
+    j->order = malloc((j->chunks + 1) * sizeof *j->order);
+    uint64_t *cursor = calloc(threads, sizeof *cursor);
+    if (!j->order || !cursor) {
+        free(cursor);
+        return IP_ERR_NOMEM;
+    }
+    for (uint64_t o = 0; o < j->chunks; o++) {
+        unsigned best = threads;
+        for (unsigned t = 0; t < threads; t++)
+            if (cursor[t] < j->w[t].chunk_count &&
+                (best == threads ||
+                 j->w[t].chunks[cursor[t]].brick < j->w[best].chunks[cursor[best]].brick))
+                best = t;
+        j->order[o] = (chunk_ref){best, cursor[best]++};
+    }
+    free(cursor);
+    return IP_OK;
+}
+
+/* The arrays of the joining, for `vertices` and `triangles` at most, and the hash table of
+ * `shared` brick-face vertices that join_plan() uses (*keys, *slots, mask + 1 slots). */
+static ip_status joiner_alloc(joiner *j, unsigned threads, uint64_t vertices, uint64_t triangles,
+                              uint64_t shared, uint64_t **keys, uint32_t **slots, uint64_t *mask)
 {
     ip_indexed_mesh *m = j->out;
     uint64_t slot_count = 1024;
     while (slot_count < 2 * shared)
         slot_count *= 2;
-    j->mask = slot_count - 1;
+    *mask = slot_count - 1;
     if (vertices + 1 > SIZE_MAX / (3 * sizeof(float)) ||
         triangles + 1 > SIZE_MAX / (3 * sizeof(uint32_t)))
         return IP_ERR_NOMEM;
@@ -366,47 +468,48 @@ static ip_status joiner_alloc(joiner *j, uint64_t vertices, uint64_t triangles, 
     m->indices = malloc((triangles + 1) * 3 * sizeof(uint32_t));
     j->sums = malloc((vertices + 1) * 3 * sizeof(float));
     j->values = malloc((vertices + 1) * sizeof(float));
-    j->keys = malloc(slot_count * sizeof(uint64_t));
-    j->slots = malloc(slot_count * sizeof(uint32_t));
-    if (!m->positions || !m->normals || !m->indices || !j->sums || !j->values || !j->keys ||
-        !j->slots)
+    j->map = malloc((vertices + 1) * sizeof(uint32_t));
+    j->map_of = malloc(threads * sizeof(uint64_t));
+    *keys = malloc(slot_count * sizeof(uint64_t));
+    *slots = malloc(slot_count * sizeof(uint32_t));
+    int ok = m->positions && m->normals && m->indices && j->sums && j->values && j->map &&
+             j->map_of && *keys && *slots;
+    for (unsigned t = 0; ok && t < threads; t++) {
+        indexed_part *p = &j->w[t].part;
+        p->shared_joined = malloc((p->shared + 1) * sizeof(uint32_t));
+        ok = p->shared_joined != NULL;
+        j->map_of[t] = t ? j->map_of[t - 1] + j->w[t - 1].part.vertices : 0;
+    }
+    if (!ok)
         return IP_ERR_NOMEM;
-    memset(j->keys, 0xff, slot_count * sizeof(uint64_t)); /* NO_KEY */
+    memset(*keys, 0xff, slot_count * sizeof(uint64_t)); /* NO_KEY */
     return IP_OK;
 }
 
-/* Joins every worker's chunks, in brick order, into `out` (and *values). */
-static ip_status join_in_brick_order(const indexed_worker *w, unsigned threads,
+/* Joins every worker's chunks, in brick order, into `out` (and *values), copying on the
+ * pool's threads. */
+static ip_status join_in_brick_order(indexed_worker *w, unsigned threads, ip__pool *pool,
                                      ip_indexed_mesh *out, float **values)
 {
-    uint64_t vertices = 0, triangles = 0, shared = 0;
+    uint64_t vertices = 0, triangles = 0, shared = 0, *keys = NULL, mask = 0;
+    uint32_t *slots = NULL;
     for (unsigned t = 0; t < threads; t++) {
         vertices += w[t].part.vertices;
         triangles += w[t].part.triangles;
         shared += w[t].part.shared;
     }
-    joiner j = {out, NULL, NULL, NULL, NULL, 0};
-    uint64_t *cursor = calloc(threads, sizeof *cursor);
-    uint32_t *map = malloc((vertices + 1) * sizeof *map);
+    joiner j = {.out = out, .w = w, .parts = threads};
+    atomic_init(&j.next, 0);
     ip_status st = vertices > MAX_VERTICES ? IP_ERR_ARGUMENT
-                   : cursor && map         ? joiner_alloc(&j, vertices, triangles, shared)
-                                           : IP_ERR_NOMEM;
-    while (st == IP_OK) {
-        unsigned best = threads;
-        for (unsigned t = 0; t < threads; t++)
-            if (cursor[t] < w[t].chunk_count &&
-                (best == threads ||
-                 w[t].chunks[cursor[t]].brick < w[best].chunks[cursor[best]].brick))
-                best = t;
-        if (best == threads)
-            break;
-        uint64_t offset = 0; /* the worker's part of map */
-        for (unsigned t = 0; t < best; t++)
-            offset += w[t].part.vertices;
-        join_chunk(&j, &w[best], cursor[best]++, map + offset);
-    }
+                                           : joiner_alloc(&j, threads, vertices, triangles, shared,
+                                                          &keys, &slots, &mask);
+    if (st == IP_OK)
+        st = join_order(&j, threads);
     if (st == IP_OK) {
-        finish_normals(&j);
+        join_plan(&j, keys, slots, mask);
+        ip__pool_run(pool, threads, join_work, &j);
+        join_repeated_sums(&j);
+        ip__pool_run(pool, threads, finish_normals, &j);
         /* give back the slack; a failure to shrink leaves the larger arrays */
         uint64_t v = out->vertex_count + 1;
         (void)ip__array_resize(&out->positions, v, 3 * sizeof(float));
@@ -414,10 +517,11 @@ static ip_status join_in_brick_order(const indexed_worker *w, unsigned threads,
         (void)ip__array_resize(&out->indices, out->triangle_count + 1, 3 * sizeof(uint32_t));
         (void)ip__array_resize(&j.values, v, sizeof(float));
     }
-    free(cursor);
-    free(map);
-    free(j.keys);
-    free(j.slots);
+    free(keys);
+    free(slots);
+    free(j.order);
+    free(j.map);
+    free(j.map_of);
     free(j.sums);
     if (st == IP_OK && values)
         *values = j.values;
@@ -461,7 +565,6 @@ ip_status ip_extract_full_indexed(ip_cache *cache, float iso, uint32_t level, un
         st = ip__pool_create(threads, &pool, NULL);
     if (st == IP_OK)
         ip__pool_run(pool, threads, indexed_work, w);
-    ip__pool_destroy(pool);
     ip_engine_counts c;
     memset(&c, 0, sizeof c);
     for (unsigned t = 0; t < threads; t++) {
@@ -476,7 +579,8 @@ ip_status ip_extract_full_indexed(ip_cache *cache, float iso, uint32_t level, un
         }
     }
     if (st == IP_OK)
-        st = join_in_brick_order(w, threads, out, values);
+        st = join_in_brick_order(w, threads, pool, out, values);
+    ip__pool_destroy(pool);
     if (st == IP_ERR_NOMEM)
         ip__fail(err, st, "%s: out of memory", path);
     else if (st == IP_ERR_ARGUMENT)
