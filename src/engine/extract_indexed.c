@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "array.h"
+#include "extract_full.h"
 #include "internal.h"
 #include "isoprop/engine.h"
 #include "pool.h"
@@ -232,12 +233,8 @@ static ip_status weld_brick(indexed_worker *w, uint64_t g)
     for (uint32_t i = 0; i < per * per * per; i++) {
         if (!ip__range_active(ranges[2 * i], ranges[2 * i + 1], w->iso))
             continue;
-        uint32_t sb[3] = {i % per, (i / per) % per, i / (per * per)}, lo[3], hi[3];
-        for (int a = 0; a < 3; a++) {
-            lo[a] = b.origin[a] + se * sb[a];
-            hi[a] = lo[a] + se < b.origin[a] + b.extent[a] - 1 ? lo[a] + se
-                                                               : b.origin[a] + b.extent[a] - 1;
-        }
+        uint32_t lo[3], hi[3];
+        ip__subblock_cells(i, per, se, b.origin, b.extent, lo, hi);
         for (uint32_t z = lo[2]; z < hi[2]; z++)
             for (uint32_t y = lo[1]; y < hi[1]; y++)
                 for (uint32_t x = lo[0]; x < hi[0]; x++) {
@@ -271,14 +268,7 @@ static void indexed_work(void *user, unsigned index)
     const ip_store *store = ip_cache_store(w->cache);
     const ip_level_layout *lv = &ip_store_layout(store)->levels[w->level];
     double start = ip_now_seconds();
-    for (;;) {
-        uint64_t i = atomic_fetch_add(w->next, 1);
-        if (i >= lv->brick_count || w->status != IP_OK)
-            break;
-        float range[2];
-        ip_store_brick_range(store, lv->first_brick + i, range);
-        if (!ip__range_active(range[0], range[1], w->iso))
-            continue;
+    for (uint64_t i; w->status == IP_OK && ip__next_active_brick(store, lv, w->next, w->iso, &i);) {
         w->status = add_chunk(w, i);
         if (w->status == IP_OK)
             w->status = weld_brick(w, lv->first_brick + i);
