@@ -14,7 +14,7 @@ from ._library import lib
 from . import _check as C
 from .bricking import DTYPES
 from .errors import ArgumentError, check, new_error
-from .mesh import Mesh, Step, copy_in_space, free_c, indexed_arrays, view_c
+from .mesh import Mesh, Step, copy_in_space, free_c, indexed_arrays, take_c
 from .stats import counts_dict, run_stats
 
 Level = namedtuple("Level", "level dims bricks value_range")
@@ -575,10 +575,14 @@ class File:
                                                   ctypes.byref(err)), err)
                 if not out.triangle_count:
                     return None
-                return indexed_arrays(out, True), view_c(values, np.float32, out.vertex_count).copy()
+                welded = indexed_arrays(out, reverse=True, take=True)
+                mine = take_c(values, np.float32, out.vertex_count)
+                values = None  # the array owns it now
+                return welded, mine
             finally:
                 lib.ip_indexed_mesh_free(ctypes.byref(out))
-                free_c(values)
+                if values:
+                    free_c(values)
 
 
 def open(path: PathLike) -> File:  # noqa: A001 (isoprop.open, as the module's API names it)

@@ -66,10 +66,9 @@ def run_profile(a, iso):
                                           ctypes.byref(values), ctypes.byref(counts),
                                           ctypes.byref(err)), err)
         t.append(time.perf_counter())
-        w = M.indexed_arrays(out, True)
-        M.view_c(values, np.float32, out.vertex_count).copy()
+        w = M.indexed_arrays(out, reverse=True, take=True)
+        M.take_c(values, np.float32, out.vertex_count)
         lib.ip_indexed_mesh_free(ctypes.byref(out))
-        M.free_c(values)
         t.append(time.perf_counter())
     t.append(time.perf_counter())
     steps = ("volume_file", "extract_welded", "to_numpy", "close")
