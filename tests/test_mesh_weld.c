@@ -13,6 +13,7 @@
 #include "isoprop/engine.h"
 #include "isoprop/generate.h"
 #include "isoprop/layout.h"
+#include "isoprop/mesh.h"
 #include "isoprop/store.h"
 
 /* Appends a triangle with corners p (9 floats) and the same normal n at each corner. */
@@ -317,11 +318,161 @@ static void test_closed_and_open(void)
     CHECK_MSG(open.boundary > 0, "the gyroid shows no open edge");
 }
 
+/* The largest difference, in packed units, between two meshes' normals. */
+static int normal_difference(const ip_indexed_mesh *a, const ip_indexed_mesh *b)
+{
+    int most = 0;
+    for (uint64_t i = 0; i < 3 * a->vertex_count; i++) {
+        int d = abs((int)a->normals[i] - (int)b->normals[i]);
+        most = d > most ? d : most;
+    }
+    return most;
+}
+
+/* Whether two indexed meshes have the same vertices, numbering and triangles, bit for bit
+ * (normals too when `normals`). */
+static int same_indexed(const ip_indexed_mesh *a, const ip_indexed_mesh *b, int normals)
+{
+    return a->vertex_count == b->vertex_count && a->triangle_count == b->triangle_count &&
+           a->dropped_triangles == b->dropped_triangles &&
+           !memcmp(a->positions, b->positions, 12 * a->vertex_count) &&
+           !memcmp(a->indices, b->indices, 12 * a->triangle_count) &&
+           (!normals || !memcmp(a->normals, b->normals, 6 * a->vertex_count));
+}
+
+/* Whether each vertex's value is the larger sample at the ends of its edge (its sample's where
+ * it sits on one) of the uint8 volume `samples` (dims d, unit spacing: a vertex's coordinates
+ * are sample indices, whole but along its edge). */
+static int values_right(const ip_indexed_mesh *m, const float *values, const uint8_t *samples,
+                        const uint32_t d[3])
+{
+    for (uint64_t v = 0; v < m->vertex_count; v++) {
+        const float *p = m->positions + 3 * v;
+        uint32_t low[3], high[3];
+        for (int a = 0; a < 3; a++) {
+            low[a] = (uint32_t)floorf(p[a]);
+            high[a] = (uint32_t)ceilf(p[a]);
+        }
+        float a = samples[low[0] + d[0] * (low[1] + (size_t)d[1] * low[2])];
+        float b = samples[high[0] + d[0] * (high[1] + (size_t)d[1] * high[2])];
+        if (values[v] != (a > b ? a : b))
+            return 0;
+    }
+    return 1;
+}
+
+/* The welded full extraction at `iso` against ip_mesh_weld(_keep_degenerate)() of the soup,
+ * on 1 and 2 threads, and its values against `samples` (when not NULL: values_right());
+ * returns the triangles with a repeated vertex it kept. */
+static uint64_t check_indexed(ip_cache *cache, float iso, int keep, const char *what,
+                              const uint8_t *samples)
+{
+    ip_mesh soup;
+    ip_mesh_init(&soup);
+    ip_error err;
+    REQUIRE(ip_extract_full(cache, iso, 0, 2, &soup, NULL, &err) == IP_OK);
+    ip_indexed_mesh want, one, two;
+    REQUIRE((keep ? ip_mesh_weld_keep_degenerate(&soup, &want) : ip_mesh_weld(&soup, &want)) ==
+            IP_OK);
+    float *values1, *values2;
+    ip_engine_counts c1, c2;
+    REQUIRE(ip_extract_full_indexed(cache, iso, 0, 1, keep, &one, &values1, &c1, &err) == IP_OK);
+    REQUIRE(ip_extract_full_indexed(cache, iso, 0, 2, keep, &two, &values2, &c2, &err) == IP_OK);
+    printf("%s, iso %g%s: %llu triangles -> %llu vertices, %llu triangles (%llu left out), "
+           "normals within %d\n",
+           what, (double)iso, keep ? ", degenerate kept" : "",
+           (unsigned long long)soup.triangle_count, (unsigned long long)one.vertex_count,
+           (unsigned long long)one.triangle_count, (unsigned long long)one.dropped_triangles,
+           normal_difference(&one, &want));
+    CHECK_MSG(soup.triangle_count > 1000, "%s: only %llu triangles", what,
+              (unsigned long long)soup.triangle_count);
+    CHECK_MSG(same_indexed(&one, &want, 0), "%s: not the welded soup", what);
+    CHECK_MSG(normal_difference(&one, &want) <= 2, "%s: normals differ by %d", what,
+              normal_difference(&one, &want));
+    CHECK_MSG(same_indexed(&one, &two, 1) &&
+                  !memcmp(values1, values2, sizeof(float) * one.vertex_count),
+              "%s: 1 and 2 threads differ", what);
+    CHECK_EQ(c1.triangles, soup.triangle_count);
+    CHECK_EQ(c2.cells, c1.cells);
+    uint64_t degenerate = 0;
+    for (uint64_t t = 0; t < one.triangle_count; t++) {
+        const uint32_t *v = one.indices + 3 * t;
+        degenerate += v[0] == v[1] || v[1] == v[2] || v[0] == v[2];
+    }
+    CHECK_MSG(keep ? one.dropped_triangles == 0 : degenerate == 0, "%s: degenerate", what);
+    if (samples)
+        CHECK_MSG(
+            values_right(&one, values1, samples, ip_store_layout(ip_cache_store(cache))->dims),
+            "%s: values", what);
+    free(values1);
+    free(values2);
+    ip_indexed_mesh_free(&want);
+    ip_indexed_mesh_free(&one);
+    ip_indexed_mesh_free(&two);
+    ip_mesh_free(&soup);
+    return degenerate;
+}
+
+/* The welded full extraction equals the welded soup: float fields with an anisotropic spacing
+ * in small bricks (a closed sphere, the gyroid through the volume's faces), and a uint8 ball
+ * at a level its samples take, where vertices sit on samples (degenerate triangles kept or
+ * dropped). */
+static void test_extract_indexed(void)
+{
+    const char *dir = test_tmp_dir("test_mesh_weld");
+    char ibv[4200];
+    const ip_field fields[2] = {IP_FIELD_SPHERE, IP_FIELD_GYROID};
+    for (int f = 0; f < 2; f++) {
+        make_volume(dir, fields[f], ibv, sizeof ibv);
+        ip_store *store;
+        ip_cache *cache;
+        ip_error err;
+        REQUIRE(ip_store_open(ibv, &store, &err) == IP_OK);
+        REQUIRE(ip_cache_create(store, 64ull << 20, &cache, &err) == IP_OK);
+        for (int keep = 0; keep < 2; keep++)
+            check_indexed(cache, 0.5f, keep, ip_field_name(fields[f]), NULL);
+        ip_cache_destroy(cache);
+        ip_store_close(store);
+    }
+    enum {
+        X = 29,
+        Y = 23,
+        Z = 31
+    };
+    uint8_t *ball = malloc(X * Y * Z);
+    REQUIRE(ball);
+    for (int z = 0; z < Z; z++)
+        for (int y = 0; y < Y; y++)
+            for (int x = 0; x < X; x++) {
+                double d = sqrt((x - 13.3) * (x - 13.3) + (y - 11.1) * (y - 11.1) * 0.8 +
+                                (z - 15.4) * (z - 15.4) * 0.9);
+                ball[x + X * (y + Y * z)] = (uint8_t)lrint(d < 10 ? 100 - 10 * d : 0);
+            }
+    ip_memory_volume mv;
+    ip_memory_volume_default(&mv);
+    mv.dims[0] = X;
+    mv.dims[1] = Y;
+    mv.dims[2] = Z;
+    mv.type = IP_UINT8;
+    mv.brick_edge = 8;
+    mv.subblock_edge = 4;
+    ip_store *store;
+    ip_cache *cache;
+    ip_error err;
+    REQUIRE(ip_store_open_memory(ball, &mv, &store, &err) == IP_OK);
+    REQUIRE(ip_cache_create(store, 64ull << 20, &cache, &err) == IP_OK);
+    CHECK_MSG(check_indexed(cache, 50.0f, 1, "uint8 ball", ball) > 0,
+              "no degenerate triangle at a level the samples take");
+    check_indexed(cache, 50.0f, 0, "uint8 ball", ball);
+    check_indexed(cache, 47.5f, 1, "uint8 ball", ball);
+    ip_cache_destroy(cache);
+    ip_store_close(store);
+    free(ball);
+}
+
 static const test_case cases[] = {
-    TEST_CASE(test_small),
-    TEST_CASE(test_keep_degenerate),
-    TEST_CASE(test_growth),
-    TEST_CASE(test_closed_and_open),
+    TEST_CASE(test_small),           TEST_CASE(test_keep_degenerate), TEST_CASE(test_growth),
+    TEST_CASE(test_closed_and_open), TEST_CASE(test_extract_indexed),
 };
 
 int main(int argc, char **argv)

@@ -280,6 +280,24 @@ IP_API ip_status ip_extract_full_lod(ip_cache *cache, float iso, const ip_camera
                                      const ip_clip_plane *clip, unsigned clip_count, ip_mesh *mesh,
                                      ip_engine_counts *counts, ip_error *err);
 
+/*! ip_extract_full_indexed() : ip_extract_full() welded as it extracts: the result is
+ *  ip_mesh_weld() of its soup (ip_mesh_weld_keep_degenerate() with `keep_degenerate`), the same
+ *  vertices in the same order, the same triangles; the normals equal to float rounding (the
+ *  corners' sums are added in another order). Each vertex is keyed by the grid edge it lies on,
+ *  or by the sample it sits on, welded brick by brick on `threads` threads (0 = every core) and
+ *  joined across brick faces in brick order, so the result is the same for any number of
+ *  threads, and no soup is made. `out` is overwritten (an earlier content is not freed) and
+ *  owned by the caller (ip_indexed_mesh_free()); empty after a failure. With `values` (may be
+ *  NULL), *values receives per vertex the larger of the two samples at the ends of its edge
+ *  (the sample's where the vertex sits on one), an array the caller frees with free() (NULL
+ *  after a failure). Counts as ip_extract_full()'s.
+ *  @return IP_OK, IP_ERR_ARGUMENT (no such level, or more than 2^32 - 2 vertices),
+ *  IP_ERR_NOMEM or a brick read error. */
+IP_API ip_status ip_extract_full_indexed(ip_cache *cache, float iso, uint32_t level,
+                                         unsigned threads, int keep_degenerate,
+                                         ip_indexed_mesh *out, float **values,
+                                         ip_engine_counts *counts, ip_error *err);
+
 #endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus

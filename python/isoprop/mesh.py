@@ -255,18 +255,65 @@ def weld_c(mesh: S.Mesh, keep_degenerate: bool) -> Welded:
     fn = lib.ip_mesh_weld_keep_degenerate if keep_degenerate else lib.ip_mesh_weld
     _weld_status(fn(ctypes.byref(mesh), ctypes.byref(out)), mesh.triangle_count)
     try:
-        nv, nf = out.vertex_count, out.triangle_count
-        points = (_view(out.positions, np.float32, 0, 3 * nv).reshape(-1, 3).copy() if nv
-                  else np.empty((0, 3), np.float32))
-        normals = (np.divide(_view(out.normals, np.int16, 0, 3 * nv), np.float32(NORMAL_SCALE),
-                             dtype=np.float32).reshape(-1, 3) if nv
-                   else np.empty((0, 3), np.float32))
-        dtype = np.int32 if nv < 2 ** 31 else np.int64
-        faces = (_view(out.indices, np.uint32, 0, 3 * nf).astype(dtype).reshape(-1, 3) if nf
-                 else np.empty((0, 3), dtype))
-        return Welded(points, faces, _unit(normals), int(out.dropped_triangles))
+        return indexed_arrays(out)
     finally:
         lib.ip_indexed_mesh_free(ctypes.byref(out))
+
+
+def indexed_arrays(out: S.IndexedMesh, reverse: bool = False, take: bool = False) -> Welded:
+    """The library's ip_indexed_mesh `out` as numpy arrays; with `reverse`, points and normals
+    z, y, x (an array's axis order), in the same one copy; with `take`, faces are out's own
+    indices, no copy, whose memory they then own (out.indices becomes NULL), where they fit
+    int32. out stays the caller's."""
+    nv, nf = out.vertex_count, out.triangle_count
+    order = slice(None, None, -1 if reverse else 1)
+    points = np.empty((nv, 3), np.float32)
+    normals = np.empty((nv, 3), np.float32)
+    if nv:
+        points[:] = _view(out.positions, np.float32, 0, 3 * nv).reshape(-1, 3)[:, order]
+        np.divide(_view(out.normals, np.int16, 0, 3 * nv).reshape(-1, 3)[:, order],
+                  np.float32(NORMAL_SCALE), out=normals)
+    dtype = np.int32 if nv < 2 ** 31 else np.int64
+    if take and nf and dtype == np.int32:
+        faces = take_c(out.indices, np.int32, 3 * nf).reshape(-1, 3)
+        out.indices = None
+    else:
+        faces = (_view(out.indices, np.uint32, 0, 3 * nf).astype(dtype).reshape(-1, 3) if nf
+                 else np.empty((0, 3), dtype))
+    return Welded(points, faces, _unit(normals), int(out.dropped_triangles))
+
+
+class _Freed:
+    """Frees (libc's free()) the memory at `address` when the last array over it goes."""
+
+    def __init__(self, address: int) -> None:
+        self.address = address
+
+    def __del__(self) -> None:
+        free_c(self.address)
+
+
+def take_c(pointer: Any, dtype: Any, count: int) -> np.ndarray:
+    """A numpy array over `count` values of `dtype` at the C array `pointer`, which the
+    library allocated for its caller to free(): the array (and its views) own it from now on,
+    no copy. count > 0."""
+    address = ctypes.cast(pointer, ctypes.c_void_p).value
+    buffer = (ctypes.c_char * (count * np.dtype(dtype).itemsize)).from_address(address)
+    buffer._freed = _Freed(address)  # freed with the buffer, which every view keeps
+    return np.frombuffer(buffer, dtype)
+
+
+def free_c(pointer: Any) -> None:
+    """Releases an array the library allocated for its caller to free() (libc's)."""
+    global _libc
+    if _libc is None:
+        _libc = ctypes.CDLL(None)
+        _libc.free.argtypes = [ctypes.c_void_p]
+        _libc.free.restype = None
+    _libc.free(pointer if isinstance(pointer, int) else ctypes.cast(pointer, ctypes.c_void_p))
+
+
+_libc = None
 
 
 def weld(vertices: np.ndarray, normals: np.ndarray, keep_degenerate: bool = False) -> Welded:

@@ -61,38 +61,16 @@ def _axis_spacing(spacing: Any) -> Tuple[float, float, float]:
     return out[0], out[1], out[2]
 
 
-def _level(level: Any, a: np.ndarray) -> float:
-    """The isovalue: the midpoint of the data's range for None; ValueError naming `level`
-    when it is NaN or outside [min, max], as scikit-image."""
-    lo, hi = float(a.min()), float(a.max())
+def _level(level: Any, value_range: Tuple[float, float]) -> float:
+    """The isovalue: the midpoint of the data's range `value_range` (min, max) for None;
+    ValueError naming `level` when it is NaN or outside [min, max], as scikit-image."""
+    lo, hi = float(value_range[0]), float(value_range[1])
     if level is None:
         return 0.5 * (lo + hi)
     value = C.number("level", level)
     if not lo <= value <= hi:
         raise ArgumentError("level: %r is outside the data's range, %g .. %g" % (value, lo, hi))
     return value
-
-
-def _edge_values(a: np.ndarray, verts_index: np.ndarray) -> np.ndarray:
-    """The larger of the two samples at the ends of each vertex's grid edge (a vertex on a
-    sample: that sample), float32; verts_index in samples, axis order. A vertex lies on a grid
-    line: two of its coordinates are whole numbers (to rounding), the third, the farthest from
-    one, is along the edge."""
-    near = np.rint(verts_index)
-    off = np.abs(verts_index - near)
-    axis = np.argmax(off, axis=1)
-    rows = np.arange(len(verts_index))
-    low = near.astype(np.intp)
-    along = off[rows, axis] > 1e-6 * np.maximum(1.0, np.abs(near[rows, axis]))
-    low[rows, axis] = np.where(along, np.floor(verts_index[rows, axis]), near[rows, axis])
-    high = low.copy()
-    high[rows, axis] += along
-    for k in range(3):  # a clamp against rounding at the far faces
-        np.clip(low[:, k], 0, a.shape[k] - 1, out=low[:, k])
-        np.clip(high[:, k], 0, a.shape[k] - 1, out=high[:, k])
-    first = a[low[:, 0], low[:, 1], low[:, 2]]
-    second = a[high[:, 0], high[:, 1], high[:, 2]]
-    return np.maximum(first, second).astype(np.float32)
 
 
 def marching_cubes(volume: Any, level: Optional[float] = None, *,
@@ -124,18 +102,18 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *,
     gradient_direction = C.choice("gradient_direction", gradient_direction, DIRECTIONS)
     allow_degenerate = C.flag("allow_degenerate", allow_degenerate)
     threads = C.whole("threads", threads, 0, C.MAX_VIEW_THREADS)
-    iso = _level(level, a)
     with _volume_file(a, sp[::-1]) as f:
-        w = f._full_welded(iso, threads, allow_degenerate)
-    if w is None:
+        # the range from the store's summaries, which opening it works out: no pass over `a`
+        iso = _level(level, f.value_range_stored)
+        welded = f._full_welded(iso, threads, allow_degenerate)
+    if welded is None:
         raise RuntimeError("marching_cubes: no surface at level %r" % iso)
+    w, values = welded
     # x, y, z (the file's) is axis 2, 1, 0 of the array: a reflection, so the faces, which are
     # counter-clockwise from lower values in x, y, z, are so from higher values in axis order
-    verts = np.ascontiguousarray(w.points[:, ::-1])
-    normals = np.ascontiguousarray(w.normals[:, ::-1])
-    faces = w.faces if gradient_direction == "descent" else w.faces[:, ::-1]
-    values = _edge_values(a, verts / np.asarray(sp, dtype=np.float64))
-    return verts, np.ascontiguousarray(faces), normals, values
+    # (_full_welded() gives the points and normals in axis order)
+    faces = w.faces if gradient_direction == "descent" else np.ascontiguousarray(w.faces[:, ::-1])
+    return w.points, faces, w.normals, values
 
 
 def contour(volume_or_path: Union[PathLike, Any], level: float, *, view: Optional[str] = None,

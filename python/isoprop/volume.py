@@ -14,7 +14,7 @@ from ._library import lib
 from . import _check as C
 from .bricking import DTYPES
 from .errors import ArgumentError, check, new_error
-from .mesh import Mesh, Step, copy_in_space, weld_c
+from .mesh import Mesh, Step, copy_in_space, free_c, indexed_arrays, take_c
 from .stats import counts_dict, run_stats
 
 Level = namedtuple("Level", "level dims bricks value_range")
@@ -559,20 +559,30 @@ class File:
     def _full_welded(self, iso_stored, threads, keep_degenerate):
         """marching_cubes()'s route: every active cell at full resolution (isorender --full) of
         the stored isovalue `iso_stored`, in grid space (sample index x spacing), welded by the
-        library straight from its own mesh, so that no soup is copied out. Returns a Welded,
-        or None when there is no surface."""
+        library as it extracts (ip_extract_full_indexed()), so that no soup is made. Returns a
+        Welded whose points and normals are z, y, x (an array's axis order) and its values
+        (float32, per vertex: the larger sample at the ends of its edge), or None when there is
+        no surface."""
         a = _Args(threads=threads)
         with _Call(self):
             cache = self._cache_for(a.cache_mb)
-            mesh, counts, err = S.Mesh(), S.EngineCounts(), new_error()
-            lib.ip_mesh_init(ctypes.byref(mesh))
+            out, counts, err = S.IndexedMesh(), S.EngineCounts(), new_error()
+            values = ctypes.POINTER(ctypes.c_float)()
             try:
-                check(lib.ip_extract_full(cache, float(iso_stored), 0, a.threads,
-                                          ctypes.byref(mesh), ctypes.byref(counts),
-                                          ctypes.byref(err)), err)
-                return weld_c(mesh, keep_degenerate) if mesh.triangle_count else None
+                check(lib.ip_extract_full_indexed(cache, float(iso_stored), 0, a.threads,
+                                                  int(bool(keep_degenerate)), ctypes.byref(out),
+                                                  ctypes.byref(values), ctypes.byref(counts),
+                                                  ctypes.byref(err)), err)
+                if not out.triangle_count:
+                    return None
+                welded = indexed_arrays(out, reverse=True, take=True)
+                mine = take_c(values, np.float32, out.vertex_count)
+                values = None  # the array owns it now
+                return welded, mine
             finally:
-                lib.ip_mesh_free(ctypes.byref(mesh))
+                lib.ip_indexed_mesh_free(ctypes.byref(out))
+                if values:
+                    free_c(values)
 
 
 def open(path: PathLike) -> File:  # noqa: A001 (isoprop.open, as the module's API names it)

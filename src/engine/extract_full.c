@@ -8,6 +8,7 @@
 
 #include "array.h"
 #include "clip.h"
+#include "extract_full.h"
 #include "internal.h"
 #include "isoprop/engine.h"
 #include "lod.h"
@@ -57,11 +58,8 @@ static ip_status extract_brick(ip_sampler *s, ip_mesh *mesh, float iso, const ip
     for (uint32_t i = 0; i < per * per * per && st == IP_OK; i++) {
         if (!ip__range_active(ranges[2 * i], ranges[2 * i + 1], iso))
             continue;
-        uint32_t sb[3] = {i % per, (i / per) % per, i / (per * per)}, lo[3], hi[3];
-        for (int a = 0; a < 3; a++) {
-            lo[a] = origin[a] + se * sb[a];
-            hi[a] = lo[a] + se < origin[a] + extent[a] - 1 ? lo[a] + se : origin[a] + extent[a] - 1;
-        }
+        uint32_t lo[3], hi[3];
+        ip__subblock_cells(i, per, se, origin, extent, lo, hi);
         int side = ip__clip_keeps_samples(clip, l, level, lo, hi);
         if (side == IP__CLIP_DROPS)
             continue;
@@ -110,14 +108,8 @@ static void full_work(void *user, unsigned index)
     const ip_store *store = ip_cache_store(w->cache);
     const ip_level_layout *lv = &ip_store_layout(store)->levels[w->level];
     double start = ip_now_seconds();
-    for (;;) {
-        uint64_t i = atomic_fetch_add(w->next, 1);
-        if (i >= lv->brick_count || w->status != IP_OK)
-            break;
-        float range[2];
-        ip_store_brick_range(store, lv->first_brick + i, range);
-        if (!ip__range_active(range[0], range[1], w->iso) ||
-            !ip__clip_keeps_brick(&w->clip, ip_store_layout(store), lv->first_brick + i))
+    for (uint64_t i; w->status == IP_OK && ip__next_active_brick(store, lv, w->next, w->iso, &i);) {
+        if (!ip__clip_keeps_brick(&w->clip, ip_store_layout(store), lv->first_brick + i))
             continue;
         if (w->chunks == w->capacity) {
             uint64_t cap = ip__array_capacity(w->capacity, w->chunks + 1, 256, sizeof(uint64_t),

@@ -6,8 +6,8 @@ volume, read into a numpy array first (not timed), by one of
     isoprop   isoprop.marching_cubes(array, ISO)           (verts, faces, normals, values)
     skimage   skimage.measure.marching_cubes(array, ISO)   (the same four arrays; Lewiner)
     vtk       vtkFlyingEdges3D on the array (Update() with normals, no scalars)
-    profile   isoprop's steps one by one: the brick file, the full extraction and its copy
-              to numpy, the weld, the values
+    profile   isoprop's steps one by one: the in-memory store, the welded full extraction
+              (ip_extract_full_indexed(), with the values), its copy to numpy in axis order, closing the store
 
     bench_python.py WHAT RAW ISO    prints one line of JSON: seconds (the call), faces
 
@@ -51,18 +51,27 @@ def run_vtk(a, iso):
 
 
 def run_profile(a, iso):
+    import ctypes
+    from isoprop import _structs as S
     from isoprop import mesh as M
     from isoprop import surface
+    from isoprop._library import lib
+    from isoprop.errors import check, new_error
     t = [time.perf_counter()]
     with surface._volume_file(a, (1.0, 1.0, 1.0)) as f:
         t.append(time.perf_counter())
-        m = f.extract(iso, stored=True, full=True, space="grid")
+        out, counts, err = S.IndexedMesh(), S.EngineCounts(), new_error()
+        values = ctypes.POINTER(ctypes.c_float)()
+        check(lib.ip_extract_full_indexed(f._cache_for(None), iso, 0, 0, 1, ctypes.byref(out),
+                                          ctypes.byref(values), ctypes.byref(counts),
+                                          ctypes.byref(err)), err)
         t.append(time.perf_counter())
-    w = M.weld(m.vertices, m.normals, True)
+        w = M.indexed_arrays(out, reverse=True, take=True)
+        M.take_c(values, np.float32, out.vertex_count)
+        lib.ip_indexed_mesh_free(ctypes.byref(out))
+        t.append(time.perf_counter())
     t.append(time.perf_counter())
-    surface._edge_values(a, w.points[:, ::-1])
-    t.append(time.perf_counter())
-    steps = ("volume_file", "extract", "weld", "values")
+    steps = ("volume_file", "extract_welded", "to_numpy", "close")
     return {s: round(t[i + 1] - t[i], 4) for i, s in enumerate(steps)}, len(w.faces)
 
 
