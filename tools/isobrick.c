@@ -15,7 +15,8 @@
 static const char usage[] =
     "usage: isobrick INPUT [-o OUT.ibv] [options]\n"
     "Bricks INPUT (NAME_XxYxZ_TYPE.raw, any raw file with --dims/--type, .nrrd, .nhdr, .mhd,\n"
-    "or a folder holding a DICOM series) into an LZ4-compressed brick file with min/max\n"
+    "a folder holding a DICOM series, a Zarr array or an OME-Zarr image) into an\n"
+    "LZ4-compressed brick file with min/max\n"
     "summaries and a level-of-detail pyramid.\n"
     "  -o OUT.ibv          output (default: bricks/STEM.ibv, the input's name without its\n"
     "                      extension: ch2.nii.gz gives bricks/ch2.ibv)\n"
@@ -38,6 +39,10 @@ static const char usage[] =
     "  --no-correct-tilt   refuse a tilted series instead\n"
     "  --even-spacing      resample unevenly spaced slices (a slice missing included) onto an\n"
     "                      even grid of the smallest step (default: refused)\n"
+    "A Zarr v2/v3 array or OME-Zarr image (0.4, 0.5) is a folder (docs/input.md, \"Zarr\").\n"
+    "  --scale K           OME-Zarr: the scale to read (default 0, the finest)\n"
+    "  --time T            OME-Zarr: the time point to read (needed when t is over 1)\n"
+    "  --channel C         OME-Zarr: the channel to read (needed when c is over 1)\n"
     "  --brick-size B      cells per brick edge, a power of two (default 32)\n"
     "  --subblock-size S   cells per sub-block edge, a power of two <= B (default 8)\n"
     "  --hc [LEVEL]        LZ4 high compression (level 1-12, default 9) instead of fast\n"
@@ -213,6 +218,25 @@ static int parse_mem_mb(const char *p, const tool_option *opt, const char *const
     return rc;
 }
 
+/* --scale, --time, --channel: an index of an OME-Zarr image, into the overrides. */
+static int parse_ome_index(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    ip_input_overrides *o = &((options *)base)->overrides;
+    uint64_t n;
+    int rc = tool_parse_bounded(p, opt->name, v[0], 0, UINT32_MAX, "an index from 0", &n);
+    if (rc != 0)
+        return rc;
+    int *has = opt->name[2] == 's'   ? &o->has_scale
+               : opt->name[2] == 't' ? &o->has_time
+                                     : &o->has_channel;
+    uint32_t *value = opt->name[2] == 's'   ? &o->scale
+                      : opt->name[2] == 't' ? &o->time
+                                            : &o->channel;
+    *has = 1;
+    *value = (uint32_t)n;
+    return 0;
+}
+
 static const tool_option isobrick_options[] = {
     {"-o", NULL, 1, offsetof(options, output), NULL, NULL, NULL},
     {"--dims", NULL, 1, 0, parse_dims, NULL, NULL},
@@ -233,6 +257,9 @@ static const tool_option isobrick_options[] = {
     {"--correct-tilt", NULL, 0, offsetof(options, correct_tilt), NULL, NULL, NULL},
     {"--no-correct-tilt", NULL, 0, offsetof(options, no_correct_tilt), NULL, NULL, NULL},
     {"--even-spacing", NULL, 0, offsetof(options, even_spacing), NULL, NULL, NULL},
+    {"--scale", NULL, 1, 0, parse_ome_index, NULL, NULL},
+    {"--time", NULL, 1, 0, parse_ome_index, NULL, NULL},
+    {"--channel", NULL, 1, 0, parse_ome_index, NULL, NULL},
 };
 
 static int parse_args(int argc, char **argv, options *o)

@@ -23,12 +23,14 @@ extern "C" {
 
 /* How the samples are stored. */
 typedef enum ip_encoding {
-    IP_ENCODING_RAW = 0,     /* plain samples from data_offset on */
-    IP_ENCODING_GZIP = 1,    /* a gzip (or zlib) stream from data_offset on */
-    IP_ENCODING_TIFF = 2,    /* one TIFF page a plane: a multi-page file or a folder of files */
-    IP_ENCODING_DICOM = 3,   /* one DICOM file a plane: a folder holding one series */
-    IP_ENCODING_CALLBACK = 4 /* the caller's function fills the planes: plane_source and
+    IP_ENCODING_RAW = 0,      /* plain samples from data_offset on */
+    IP_ENCODING_GZIP = 1,     /* a gzip (or zlib) stream from data_offset on */
+    IP_ENCODING_TIFF = 2,     /* one TIFF page a plane: a multi-page file or a folder of files */
+    IP_ENCODING_DICOM = 3,    /* one DICOM file a plane: a folder holding one series */
+    IP_ENCODING_CALLBACK = 4, /* the caller's function fills the planes: plane_source and
                                 plane_user (ip_input_desc_from_planes(), experimental) */
+    IP_ENCODING_ZARR = 5      /* chunks of a Zarr v2 or v3 array (an OME-Zarr image's scale):
+                                 data_path is the array's folder */
 } ip_encoding;
 
 /* A caller's source of z-planes (IP_ENCODING_CALLBACK): fills `dst` with the `count` planes
@@ -79,7 +81,16 @@ typedef struct ip_input_desc {
     /* IP_ENCODING_CALLBACK only (ip_input_desc_from_planes()); NULL otherwise. */
     ip_plane_source_fn plane_source; /* fills the planes */
     void *plane_user;                /* passed to plane_source, not owned */
-    uint64_t reserved[16];           /* zero: room for later fields at the same size (status.h) */
+    /* A Zarr array or OME-Zarr image (docs/input.md, "Zarr"); zero for other inputs. */
+    uint32_t zarr_scale;   /* OME-Zarr: the scale read (0 the finest) */
+    uint32_t zarr_scales;  /* OME-Zarr: the scales of the image; 0: not OME-Zarr */
+    uint32_t zarr_time;    /* OME-Zarr: the time point read (0 without a t axis) */
+    uint32_t zarr_channel; /* OME-Zarr: the channel read (0 without a c axis) */
+    char space_unit[16];   /* OME-Zarr: the unit of spacing and origin as the file names
+                                     it ("micrometer"), "" when none */
+    uint64_t reader_bytes; /* memory the reader holds besides the planes it hands out (a
+                                     Zarr row of chunks), which the bricker's plan counts */
+    uint64_t reserved[11]; /* zero: room for later fields at the same size (status.h) */
 } ip_input_desc;
 
 /* ip_input_desc.resampled: the slices of a DICOM series were resampled onto a regular grid
@@ -119,6 +130,15 @@ typedef struct ip_input_overrides {
                            Not copied: valid during ip_input_describe() */
     ip_regrid tilt;     /* slices sheared by a gantry tilt; default: resampled */
     ip_regrid uneven;   /* slices unevenly spaced (a slice missing included); default: refused */
+    /* An OME-Zarr image (after 0.2.0; read only when `size` covers them): the scale (0, the
+     * finest, by default), and the time point and channel where the image has t or c axes
+     * longer than 1 (required there). Refused (IP_ERR_ARGUMENT) for any other input. */
+    int has_scale;
+    uint32_t scale;
+    int has_time;
+    uint32_t time;
+    int has_channel;
+    uint32_t channel;
 } ip_input_overrides;
 
 /*! ip_input_describe() : fills *out for the volume at `path`.
