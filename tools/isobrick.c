@@ -336,6 +336,17 @@ static void print_shown(const char *text)
 }
 
 /* A DICOM series' lines of the summary: which series, the objects skipped, the resampling. */
+/* An OME-Zarr image's line of the summary: the scale, time point and channel read, and the
+ * unit of the spacing and origin (the brick file keeps the numbers, not the unit). */
+static void print_ome(const ip_input_desc *d)
+{
+    if (d->encoding != IP_ENCODING_ZARR || d->zarr_scales == 0)
+        return;
+    printf("  ome-zarr    scale %u of %u, time %u, channel %u; spacing %g,%g,%g and origin in %s\n",
+           d->zarr_scale, d->zarr_scales, d->zarr_time, d->zarr_channel, d->spacing[0],
+           d->spacing[1], d->spacing[2], d->space_unit[0] ? d->space_unit : "no named unit");
+}
+
 static void print_series(const ip_input_desc *d)
 {
     if (d->encoding != IP_ENCODING_DICOM)
@@ -406,6 +417,7 @@ static void print_summary(const ip_bricker_report *r, const ip_input_desc *desc,
            tool_format_bytes(in_b, sizeof in_b, (double)r->input_bytes),
            (unsigned long long)r->input_bytes);
     print_series(desc);
+    print_ome(desc);
     tool_print_rescale(stdout, desc);
     printf("  file        %s (%llu bytes)\n",
            tool_format_bytes(file_b, sizeof file_b, (double)r->file_bytes),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Zarr v2 and v3 arrays and OME-Zarr images as a plane source: the planes of one z-row of
  * chunks (or of a shard's inner chunks) are decoded together, every chunk of the row a job on
  * a pool of every core, into a buffer of that row's planes, which read_plane then hands out in

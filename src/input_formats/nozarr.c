@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The Zarr reader's stand-in where the build has none (IP_ZARR off, or its libraries not
  * found at configure time): a Zarr input is refused naming what to install. */
 #include "readers.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Internal to the input component: Zarr v2 and v3 arrays and OME-Zarr images (docs/input.md,
  * "Zarr"). zarr_meta.c reads the metadata (cJSON) into a zarr_array; zarr_codec.c decodes a
  * chunk or a shard's inner chunk (blosc, zlib/gzip, zstd, lz4, crc32c); input_zarr.c is the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Decoding a Zarr chunk: its checksum (crc32c), then its compressor (blosc, zlib, gzip, zstd,
  * numcodecs' lz4) into exactly the chunk's bytes. Every length is checked: a chunk cut short,
  * damaged or of another size is refused, never read past. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Zarr metadata through cJSON: an array's .zarray (v2) or zarr.json (v3), and an OME-Zarr
  * image's multiscales (0.4 in .zattrs, 0.5 in zarr.json's attributes.ome). Every refusal is
  * one line naming the metadata file and the key. */

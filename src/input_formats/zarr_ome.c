@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* OME-Zarr images (NGFF 0.4: .zattrs of a Zarr v2 group; 0.5: zarr.json's attributes.ome of a
  * Zarr v3 group): the multiscales' axes, the chosen scale's array and its scale and
  * translation as spacing and origin. */

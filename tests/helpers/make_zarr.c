@@ -1,7 +1,9 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Writes Zarr v2 and v3 arrays and OME-Zarr images of a raw int16 volume for tests/tools/zarr.sh,
  * through the libraries the reader uses (c-blosc, zlib, zstd, lz4): each variant holds the raw
- * file's samples, so it must brick to the raw volume's brick file. Chunks of zeros are left
- * out (the fill value 0), as Zarr writers do.
+ * file's samples, so it must brick to the raw volume's brick file. Chunks all of the fill
+ * value (the volume's first sample, its background) are left out, as Zarr writers do: shards
+ * too, and a shard's empty inner chunks get the index's empty entry.
  *
  *   make_zarr RAW XxYxZ OUT_FOLDER */
 #include <blosc.h>
@@ -33,6 +35,7 @@ typedef struct spec {
 
 static const int16_t *vol;
 static uint64_t VX, VY, VZ;
+static int16_t fill;        /* the fill value: the volume's first sample (its background) */
 static uint64_t stride = 1; /* 2: scale 1 of an OME image, every other sample */
 
 /* 5-D (t, c, z, y, x): the volume at t = 1, c = 2, 7 elsewhere; 4-D (c, z, y, x): at c = 2. */
@@ -117,7 +120,7 @@ static size_t encode(const spec *s, const unsigned char *raw, size_t n, unsigned
     return m;
 }
 
-/* The chunk (of shape cs) at grid index g, samples in the spec's byte order; 1 if all zero. */
+/* The chunk (of shape cs) at grid index g, samples in the spec's byte order; 1 if all fill. */
 static int gather(const spec *s, const uint64_t *cs, const uint64_t *g, unsigned char *raw,
                   size_t *n)
 {
@@ -133,8 +136,8 @@ static int gather(const spec *s, const uint64_t *cs, const uint64_t *g, unsigned
             r /= cs[d];
             inside &= i[d] < s->shape[d];
         }
-        int16_t v = inside ? sample(s, i) : 0;
-        zero &= v == 0;
+        int16_t v = inside ? sample(s, i) : fill;
+        zero &= v == fill;
         raw[2 * k + (s->big ? 1 : 0)] = (unsigned char)(v & 0xff);
         raw[2 * k + (s->big ? 0 : 1)] = (unsigned char)((uint16_t)v >> 8);
     }
@@ -262,8 +265,8 @@ static void write_array(const spec *s, const char *folder)
         fprintf(f, ", \"chunks\": ");
         list(f, s->chunk, s->nd);
         fprintf(f,
-                ", \"dtype\": \"%ci2\", \"fill_value\": 0, \"order\": \"C\", \"filters\": null, ",
-                s->big ? '>' : '<');
+                ", \"dtype\": \"%ci2\", \"fill_value\": %d, \"order\": \"C\", \"filters\": null, ",
+                s->big ? '>' : '<', fill);
         if (s->codec == W_NONE)
             fprintf(f, "\"compressor\": null");
         else
@@ -277,8 +280,8 @@ static void write_array(const spec *s, const char *folder)
         list(f, s->chunk, s->nd);
         fprintf(f,
                 "}}, \"chunk_key_encoding\": {\"name\": \"%s\", \"configuration\": "
-                "{\"separator\": \"%c\"}}, \"fill_value\": 0, \"codecs\": ",
-                s->v2keys ? "v2" : "default", s->slash ? '/' : '.');
+                "{\"separator\": \"%c\"}}, \"fill_value\": %d, \"codecs\": ",
+                s->v2keys ? "v2" : "default", s->slash ? '/' : '.', fill);
         if (s->inner[0]) {
             fprintf(f, "[{\"name\": \"sharding_indexed\", \"configuration\": {\"chunk_shape\": ");
             list(f, s->inner, s->nd);
@@ -367,6 +370,7 @@ int main(int argc, char **argv)
     }
     fclose(f);
     vol = v;
+    fill = v[0];
     /* version, codec, crc32c, big-endian, '/' keys, v2 keys (v3), then name */
     static const struct {
         spec s;

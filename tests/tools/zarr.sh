@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Zarr v2, Zarr v3 and OME-Zarr input end to end (tests/helpers/make_zarr.c writes every
 # variant from one raw volume): each brick file equals the raw volume's, OME-Zarr's scale and
 # translation become spacing and origin, --scale/--time/--channel pick the right samples, and
@@ -22,6 +23,11 @@ for v in v2_blosc_lz4 v2_blosc_zstd_be v2_zlib v2_gzip_be v2_zstd v2_lz4 v2_none
     check "$v bricks to the raw volume's file" cmp -s raw.ibv "$v.ibv"
 done
 
+# chunks all of the fill value (the background, -1024) are left out by the writer: the
+# fill value stands for them, as for a shard left out or a shard's empty inner chunk
+check "the writer left chunks out" test "$(ls z/v2_blosc_lz4.zarr | wc -l)" -lt 120
+check "and whole shards" test "$(find z/v3_sharded.zarr/c -type f | wc -l)" -lt 18
+
 # OME-Zarr 0.5 (v3, sharded, c z y x; z in millimeter, converted to x's micrometer)
 brick z/ome05.zarr ome05.ibv --channel 2
 check "OME-Zarr 0.5 --channel 2 bricks ($err)" test "$rc" = 0
@@ -40,6 +46,9 @@ check "channel 0 holds only 7s" grep -q '"value_min": 7, "value_max": 7' "$work/
 # OME-Zarr 0.4 (v2, t c z y x), translation as origin; scale 1 is every other sample
 brick z/ome04.zarr ome04.ibv --time 1 --channel 2
 check "OME-Zarr 0.4 --time 1 --channel 2 bricks ($err)" test "$rc" = 0
+check "the summary names the scale, time, channel and unit" grep -qF \
+    "ome-zarr    scale 0 of 2, time 1, channel 2; spacing 0.5,0.5,1.25 and origin in micrometer" \
+    "$work/.out"
 run_capture "$bin/isoinfo" --json ome04.ibv
 check "OME-Zarr 0.4: spacing from the scale" grep -q '"spacing": \[0.5, 0.5, 1.25\]' "$work/.out"
 check "OME-Zarr 0.4: origin from the translation" grep -q '\[2.5, -5, 10\]' "$work/.out"
