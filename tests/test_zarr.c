@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The Zarr reader's pieces (src/input_formats/zarr*.c): CRC-32C against RFC 3720's vectors,
  * the metadata parser's types and refusals, the chunk decoder's length checks, and the types
  * that are converted (int8 to int16, 32-bit integers to float32) end to end. The formats

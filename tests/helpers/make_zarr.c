@@ -5,7 +5,9 @@
  * value (the volume's first sample, its background) are left out, as Zarr writers do: shards
  * too, and a shard's empty inner chunks get the index's empty entry.
  *
- *   make_zarr RAW XxYxZ OUT_FOLDER */
+ *   make_zarr RAW XxYxZ OUT_FOLDER
+ *   make_zarr RAW XxYxZ OUT.zarr --bench   one Zarr v2 array, blosc lz4 with byte shuffle,
+ *                                          64^3 chunks (tools/bench/bench_zarr.sh) */
 #include <blosc.h>
 #include <lz4.h>
 #include <stdio.h>
@@ -356,8 +358,9 @@ static void write_ome(const char *folder, int v3)
 int main(int argc, char **argv)
 {
     unsigned long long x, y, z;
-    if (argc != 4 || sscanf(argv[2], "%llux%llux%llu", &x, &y, &z) != 3) {
-        fprintf(stderr, "usage: make_zarr RAW XxYxZ OUT_FOLDER\n");
+    int bench = argc == 5 && !strcmp(argv[4], "--bench");
+    if ((argc != 4 && !bench) || sscanf(argv[2], "%llux%llux%llu", &x, &y, &z) != 3) {
+        fprintf(stderr, "usage: make_zarr RAW XxYxZ OUT_FOLDER [--bench]\n");
         return 2;
     }
     VX = x, VY = y, VZ = z;
@@ -390,6 +393,12 @@ int main(int argc, char **argv)
         {{3, W_BLOSC_LZ4, 1, 0, 1, 0, 3, {0}, {16, 32, 16}, {4, 8, 8}}, "v3_sharded_blosc.zarr"},
     };
     char path[4096];
+    if (bench) {
+        spec s = {2, W_BLOSC_LZ4, 0, 0, 0, 0, 3, {z, y, x}, {64, 64, 64}, {0}};
+        write_array(&s, argv[3]);
+        free(v);
+        return 0;
+    }
     for (size_t i = 0; i < sizeof variants / sizeof variants[0]; i++) {
         spec s = variants[i].s;
         s.shape[0] = z, s.shape[1] = y, s.shape[2] = x;
