@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* Zarr v2 and v3 arrays and OME-Zarr images as a plane source: the planes of one z-row of
- * chunks (or of a shard's inner chunks) are decoded together, every chunk of the row a job on
- * a pool of every core, into a buffer of that row's planes, which read_plane then hands out in
- * order. Memory: that buffer and one chunk (compressed and decoded) per thread. */
+/* Zarr v2 and v3 arrays and OME-Zarr images as a plane source: the chunks of one z-row (or a
+ * shard's inner chunks) are read and decoded together, every chunk a job on a pool of every
+ * core, each into its own slot; read_plane then gathers plane z from the slots, converting to
+ * the type read, in one copy. Memory: the row's decoded chunks and a compressed chunk per
+ * thread (ip_input_desc.reader_bytes). */
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -29,9 +30,15 @@ typedef struct zarr_state {
     uint64_t unit[ZARR_MAX_DIMS]; /* the chunk read as one piece: a chunk or an inner chunk */
     uint32_t n;                   /* ndim */
     size_t out_size;              /* bytes of an output sample */
-    unsigned char *row;           /* the planes of row `row_at` (unit[z] planes) */
+    uint64_t per_x, per_y;        /* chunks across x and y */
+    unsigned jobs;                /* chunks in a row: per_x * per_y */
+    unsigned char *slots;         /* the decoded chunks of row `row_at`, one slot each */
+    unsigned char *present;       /* per slot: 0 when its chunk is missing (the fill) */
     int64_t row_at;
+    uint64_t loading;             /* the row being read */
     ip__pool *pool;
+    unsigned char *fill_run; /* a chunk's x-run of the fill value, in the type read */
+    int fill_inexact;        /* it is a 32-bit integer float32 does not hold */
     /* the run of one row */
     atomic_int failed;
     pthread_mutex_t lock;
@@ -229,12 +236,6 @@ static int convert_run(const zarr_array *a, const unsigned char *src, size_t cou
 
 /* ---- one row of chunks ---- */
 
-typedef struct row_job {
-    zarr_state *s;
-    uint64_t row;          /* the row's index along z (in units) */
-    uint64_t per_x, per_y; /* units across x and y */
-} row_job;
-
 static void job_failed(zarr_state *s, unsigned job, const ip_error *e)
 {
     pthread_mutex_lock(&s->lock);
@@ -246,44 +247,11 @@ static void job_failed(zarr_state *s, unsigned job, const ip_error *e)
     pthread_mutex_unlock(&s->lock);
 }
 
-/* Copies (converting) the chunk's part inside the volume into the row; chunk NULL: the fill. */
-static int place_chunk(zarr_state *s, const unsigned char *chunk, const uint64_t *idx)
-{
-    const zarr_array *a = &s->a;
-    uint32_t n = s->n, zd = n - 3, yd = n - 2, xd = n - 1;
-    uint64_t z0 = idx[zd] * s->unit[zd], y0 = idx[yd] * s->unit[yd], x0 = idx[xd] * s->unit[xd];
-    uint64_t nz = s->unit[zd], ny = s->unit[yd], nx = s->unit[xd];
-    if (z0 + nz > a->shape[zd])
-        nz = a->shape[zd] - z0;
-    if (y0 + ny > a->shape[yd])
-        ny = a->shape[yd] - y0;
-    if (x0 + nx > a->shape[xd])
-        nx = a->shape[xd] - x0;
-    size_t base = 0; /* the leading dims' offset in the chunk, in samples */
-    for (uint32_t d = 0; d < zd; d++)
-        base = base * s->unit[d] + s->at[d] % s->unit[d];
-    uint64_t X = a->shape[xd], Y = a->shape[yd];
-    for (uint64_t z = 0; z < nz; z++)
-        for (uint64_t y = 0; y < ny; y++) {
-            unsigned char *dst = s->row + ((z * Y + y0 + y) * X + x0) * s->out_size;
-            if (!chunk) {
-                for (uint64_t x = 0; x < nx; x++)
-                    if (put_value(a->type, a->fill, dst + x * s->out_size) != 0)
-                        return -1;
-                continue;
-            }
-            size_t at = ((base * s->unit[zd] + z) * s->unit[yd] + y) * s->unit[xd];
-            if (convert_run(a, chunk + at * a->item, (size_t)nx, dst, s->out_size) != 0)
-                return -1;
-        }
-    return 0;
-}
-
-/* One chunk of the row: read, decode, place; a failure names the chunk's file. */
+/* One chunk of the row: read and decoded into its slot (present[job] 0: the fill value); a
+ * failure names the chunk's file. */
 static void row_chunk(void *user, unsigned job)
 {
-    row_job *r = user;
-    zarr_state *s = r->s;
+    zarr_state *s = user;
     uint64_t idx[ZARR_MAX_DIMS];
     char path[IP_PATH_MAX + 128], why[200];
     ip_error e;
@@ -291,10 +259,10 @@ static void row_chunk(void *user, unsigned job)
         return;
     for (uint32_t d = 0; d + 3 < s->n; d++)
         idx[d] = s->at[d] / s->unit[d];
-    idx[s->n - 3] = r->row;
-    idx[s->n - 2] = job / r->per_x;
-    idx[s->n - 1] = job % r->per_x;
-    unsigned char *bytes = NULL, *chunk = NULL;
+    idx[s->n - 3] = s->loading;
+    idx[s->n - 2] = job / s->per_x;
+    idx[s->n - 1] = job % s->per_x;
+    unsigned char *bytes = NULL;
     size_t size = 0, want = chunk_bytes(s);
     ip_status st;
     if (s->a.sharded) {
@@ -303,40 +271,63 @@ static void row_chunk(void *user, unsigned job)
         key_path(&s->a, idx, path, sizeof path);
         st = read_file(path, &bytes, &size, &e);
     }
-    if (st == IP_OK && bytes) {
-        chunk = malloc(want);
-        if (!chunk)
-            st = ip__fail(&e, IP_ERR_NOMEM, "%s: out of memory", path);
-        else if (ip__zarr_decode(&s->a.chain, bytes, size, chunk, want, why, sizeof why) != 0)
-            st = ip__fail(&e, IP_ERR_INPUT, "%s: %s", path, why);
-    }
-    if (st == IP_OK && place_chunk(s, bytes ? chunk : NULL, idx) != 0)
-        st = ip__fail(&e, IP_ERR_INPUT,
-                      "%s: a %s sample past 2^24, which float32 does not hold exactly", path,
-                      s->a.kind == 'u' ? "uint32" : "int32");
+    if (st == IP_OK && bytes &&
+        ip__zarr_decode(&s->a.chain, bytes, size, s->slots + (size_t)job * want, want, why,
+                        sizeof why) != 0)
+        st = ip__fail(&e, IP_ERR_INPUT, "%s: %s", path, why);
+    s->present[job] = bytes != NULL;
     if (st != IP_OK)
         job_failed(s, job, &e);
     free(bytes);
-    free(chunk);
 }
 
 static ip_status load_row(zarr_state *s, uint64_t row, ip_error *err)
 {
-    uint32_t n = s->n;
-    row_job r = {s, row, (s->a.shape[n - 1] + s->unit[n - 1] - 1) / s->unit[n - 1],
-                 (s->a.shape[n - 2] + s->unit[n - 2] - 1) / s->unit[n - 2]};
-    uint64_t jobs = r.per_x * r.per_y;
-    if (jobs > UINT32_MAX)
-        return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: more than 2^32 chunks in a row",
-                        s->desc->path);
+    s->loading = row;
     atomic_store(&s->failed, 0);
-    ip__pool_run(s->pool, (unsigned)jobs, row_chunk, &r);
+    ip__pool_run(s->pool, s->jobs, row_chunk, s);
     if (atomic_load(&s->failed)) {
         if (err)
             *err = s->error;
         return s->error.code;
     }
     s->row_at = (int64_t)row;
+    return IP_OK;
+}
+
+/* Plane z (of the loaded row) from the chunks' slots, converted, into dst. */
+static ip_status copy_plane(zarr_state *s, uint32_t z, unsigned char *dst, ip_error *err)
+{
+    const zarr_array *a = &s->a;
+    uint32_t n = s->n;
+    uint64_t ux = s->unit[n - 1], uy = s->unit[n - 2], uz = s->unit[n - 3];
+    uint64_t X = a->shape[n - 1], Y = a->shape[n - 2], zl = z % uz;
+    size_t want = chunk_bytes(s), base = 0;
+    for (uint32_t d = 0; d + 3 < n; d++)
+        base = base * s->unit[d] + s->at[d] % s->unit[d];
+    for (uint64_t y = 0; y < Y; y++) {
+        uint64_t iy = y / uy, yl = y % uy;
+        for (uint64_t ix = 0; ix < s->per_x; ix++) {
+            uint64_t x0 = ix * ux, nx = x0 + ux > X ? X - x0 : ux;
+            unsigned char *out = dst + (y * X + x0) * s->out_size;
+            size_t job = (size_t)(iy * s->per_x + ix);
+            int bad;
+            if (s->present[job])
+                bad = convert_run(a,
+                                  s->slots + job * want +
+                                      (((base * uz + zl) * uy + yl) * ux) * a->item,
+                                  (size_t)nx, out, s->out_size);
+            else
+                bad = s->fill_inexact, memcpy(out, s->fill_run, (size_t)nx * s->out_size);
+            if (bad)
+                return ip__fail(err, IP_ERR_INPUT,
+                                "%s: a %s sample in (x,y,z) = (%llu..%llu,%llu,%u) is past 2^24, "
+                                "which float32 does not hold exactly",
+                                a->folder, a->kind == 'u' ? "uint32" : "int32",
+                                (unsigned long long)x0, (unsigned long long)(x0 + nx - 1),
+                                (unsigned long long)y, z);
+        }
+    }
     return IP_OK;
 }
 
@@ -401,8 +392,8 @@ static void units_of(const zarr_array *a, uint64_t *unit)
         unit[d] = a->sharded ? a->inner[d] : a->chunk[d];
 }
 
-/* The memory the source holds: a row's planes, and a chunk compressed and decoded per thread
- * (compressed: at most the decoded size and blosc's overhead, as a bound). */
+/* The memory the source holds: a row of decoded chunks, and a compressed chunk per thread (at
+ * most the decoded size and blosc's overhead, as a bound). */
 static uint64_t reader_bytes(const zarr_array *a)
 {
     uint64_t unit[ZARR_MAX_DIMS], chunk = a->item;
@@ -410,8 +401,9 @@ static uint64_t reader_bytes(const zarr_array *a)
     for (uint32_t d = 0; d < a->ndim; d++)
         chunk *= unit[d];
     uint32_t n = a->ndim;
-    uint64_t row = unit[n - 3] * a->shape[n - 2] * a->shape[n - 1] * ip_type_size(a->type);
-    return row + (uint64_t)ip_thread_count(0) * (2 * chunk + 64);
+    uint64_t per = ((a->shape[n - 1] + unit[n - 1] - 1) / unit[n - 1]) *
+                   ((a->shape[n - 2] + unit[n - 2] - 1) / unit[n - 2]);
+    return per * (chunk + 1) + (uint64_t)ip_thread_count(0) * (chunk + 64);
 }
 
 ip_status ip__zarr_describe(const char *path, const ip_input_overrides *overrides,
@@ -466,7 +458,9 @@ static void zarr_close(void *state)
         return;
     ip__pool_destroy(s->pool);
     pthread_mutex_destroy(&s->lock);
-    free(s->row);
+    free(s->slots);
+    free(s->present);
+    free(s->fill_run);
     free(s);
 }
 
@@ -496,26 +490,34 @@ static ip_status zarr_open(const ip_input_desc *desc, void **state, ip_error *er
         s->a.shape[s->n - 2] != desc->dims[1] || s->a.shape[s->n - 3] != desc->dims[2])
         return ip__fail(err, IP_ERR_INPUT, "%s: the array changed since it was described",
                         desc->path);
-    size_t row = (size_t)s->unit[s->n - 3] * desc->dims[0] * desc->dims[1] * s->out_size;
-    s->row = malloc(row);
-    if (!s->row)
+    uint64_t ux = s->unit[s->n - 1], uy = s->unit[s->n - 2];
+    s->per_x = (desc->dims[0] + ux - 1) / ux;
+    s->per_y = (desc->dims[1] + uy - 1) / uy;
+    if (s->per_x * s->per_y > UINT32_MAX / 2)
+        return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: too many chunks in a row", desc->path);
+    s->jobs = (unsigned)(s->per_x * s->per_y);
+    size_t bytes = (size_t)s->jobs * chunk_bytes(s);
+    s->slots = malloc(bytes);
+    s->present = calloc(s->jobs, 1);
+    s->fill_run = malloc((size_t)ux * s->out_size);
+    if (!s->slots || !s->present || !s->fill_run)
         return ip__fail(err, IP_ERR_NOMEM, "%s: out of memory for a row of chunks (%zu bytes)",
-                        desc->path, row);
+                        desc->path, bytes);
+    for (uint64_t x = 0; x < ux; x++)
+        s->fill_inexact |= put_value(s->a.type, s->a.fill, s->fill_run + x * s->out_size) != 0;
     return ip__pool_create(ip_thread_count(0), &s->pool, err);
 }
 
 static ip_status zarr_read_plane(void *state, uint32_t z, void *dst, ip_error *err)
 {
     zarr_state *s = state;
-    uint64_t unit_z = s->unit[s->n - 3], row = z / unit_z;
+    uint64_t row = z / s->unit[s->n - 3];
     if ((int64_t)row != s->row_at) {
         ip_status st = load_row(s, row, err);
         if (st != IP_OK)
             return st;
     }
-    size_t plane = (size_t)s->desc->dims[0] * s->desc->dims[1] * s->out_size;
-    memcpy(dst, s->row + (size_t)(z - row * unit_z) * plane, plane);
-    return IP_OK;
+    return copy_plane(s, z, dst, err);
 }
 
 const ip__plane_source ip__zarr_source = {zarr_open, zarr_read_plane, zarr_close};

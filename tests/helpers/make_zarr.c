@@ -37,6 +37,7 @@ typedef struct spec {
 
 static const int16_t *vol;
 static uint64_t VX, VY, VZ;
+static char dtype_kind = 'i'; /* v2 arrays: 'u' writes the same bits as uint16 (--bench) */
 static int16_t fill;        /* the fill value: the volume's first sample (its background) */
 static uint64_t stride = 1; /* 2: scale 1 of an OME image, every other sample */
 
@@ -267,8 +268,8 @@ static void write_array(const spec *s, const char *folder)
         fprintf(f, ", \"chunks\": ");
         list(f, s->chunk, s->nd);
         fprintf(f,
-                ", \"dtype\": \"%ci2\", \"fill_value\": %d, \"order\": \"C\", \"filters\": null, ",
-                s->big ? '>' : '<', fill);
+                ", \"dtype\": \"%c%c2\", \"fill_value\": %d, \"order\": \"C\", \"filters\": null, ",
+                s->big ? '>' : '<', dtype_kind, fill);
         if (s->codec == W_NONE)
             fprintf(f, "\"compressor\": null");
         else
@@ -394,6 +395,7 @@ int main(int argc, char **argv)
     };
     char path[4096];
     if (bench) {
+        dtype_kind = 'u';
         spec s = {2, W_BLOSC_LZ4, 0, 0, 0, 0, 3, {z, y, x}, {64, 64, 64}, {0}};
         write_array(&s, argv[3]);
         free(v);

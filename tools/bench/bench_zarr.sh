@@ -34,7 +34,7 @@ measure() { # INPUT OUT: median seconds, then the last run's peak RSS and plan
         start=$(date +%s.%N)
         "$build/isobrick" "$1" -o "$2" --force --mem-mb "$mem_mb" >"$work/summary"
         end=$(date +%s.%N)
-        echo "$end - $start" | bc
+        printf '%.3f\n' "$(echo "$end - $start" | bc)"
     done | median
 }
 t_raw=$(measure "$raw" "$work/raw.ibv")
@@ -46,4 +46,4 @@ zarr_bytes=$(du -sb "$work/head.zarr" | cut -f1)
 echo "| input ($dims uint16, $(nproc) cores) | bytes | isobrick s (median of $runs) | vs raw | peak RSS (planned) |"
 echo "| --- | ---: | ---: | ---: | --- |"
 echo "| raw | $(stat -c %s "$raw") | $t_raw | 1.00 | $rss_raw |"
-echo "| Zarr v2 blosc lz4 64^3 | $zarr_bytes | $t_zarr | $(echo "scale=2; $t_zarr / $t_raw" | bc) | $rss_zarr |"
+echo "| Zarr v2 blosc lz4 64^3 | $zarr_bytes | $t_zarr | $(printf '%.2f' "$(echo "scale=4; $t_zarr / $t_raw" | bc)") | $rss_zarr |"
