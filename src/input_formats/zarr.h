@@ -85,6 +85,10 @@ ip_status ip__zarr_read_ome(const char *folder, uint32_t scale, int *is_ome, zar
  *  cannot be read, IP_ERR_INPUT when it is not a regular file or is over 16 MiB. */
 ip_status ip__zarr_read_text(const char *path, char **out, int *missing, ip_error *err);
 
+/*! ip__zarr_shown() : `text` from a metadata file as it may go into a one-line message: at
+ *  most size - 1 characters, control characters as '?', "?" for NULL. Returns buf. */
+const char *ip__zarr_shown(const char *text, char *buf, size_t size);
+
 /* ---- chunks (zarr_codec.c) ---- */
 
 /*! ip__zarr_decode() : decodes `size` bytes of `src` through `chain` into exactly `out_bytes`

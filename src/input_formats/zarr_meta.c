@@ -49,6 +49,17 @@ ip_status ip__zarr_read_text(const char *path, char **out, int *missing, ip_erro
     return IP_OK;
 }
 
+const char *ip__zarr_shown(const char *text, char *buf, size_t size)
+{
+    size_t i = 0;
+    for (; text && text[i] && i + 1 < size; i++)
+        buf[i] = (unsigned char)text[i] < 0x20 || text[i] == 0x7f ? '?' : text[i];
+    if (!text)
+        buf[i++] = '?';
+    buf[i] = '\0';
+    return buf;
+}
+
 static ip_status bad(const char *name, const char *what, ip_error *err)
 {
     return ip__fail(err, IP_ERR_INPUT, "%s: %s", name, what);
@@ -78,6 +89,7 @@ static ip_status read_dims(const char *name, const cJSON *list, const char *key,
 static ip_status take_type(const char *name, const char *text, char kind, uint32_t item,
                            zarr_array *a, ip_error *err)
 {
+    char shown[48];
     a->kind = kind;
     a->item = item;
     if (kind == 'u' && item == 1)
@@ -92,7 +104,7 @@ static ip_status take_type(const char *name, const char *text, char kind, uint32
         return ip__fail(err, IP_ERR_INPUT,
                         "%s: data type %s is not read (uint8, int8, uint16, int16, uint32, int32 "
                         "and float32 are)",
-                        name, text);
+                        name, ip__zarr_shown(text, shown, sizeof shown));
     return IP_OK;
 }
 
@@ -131,6 +143,7 @@ static ip_status fill_value(const char *name, const cJSON *v, zarr_array *a, ip_
 /* v2 "compressor": null or {"id": ...}; blosc's cname and shuffle are in its own header. */
 static ip_status v2_compressor(const char *name, const cJSON *c, zarr_chain *chain, ip_error *err)
 {
+    char shown[48];
     static const struct {
         const char *id;
         zarr_codec_id codec;
@@ -150,11 +163,12 @@ static ip_status v2_compressor(const char *name, const cJSON *c, zarr_chain *cha
         }
     return ip__fail(err, IP_ERR_INPUT,
                     "%s: compressor '%s' is not read (blosc, zlib, gzip, zstd, lz4 and none are)",
-                    name, id ? id : "?");
+                    name, ip__zarr_shown(id, shown, sizeof shown));
 }
 
 static ip_status parse_v2(const char *name, const cJSON *j, zarr_array *a, ip_error *err)
 {
+    char shown[48];
     uint32_t n;
     ip_status s;
     const cJSON *filters = cJSON_GetObjectItemCaseSensitive(j, "filters");
@@ -178,7 +192,7 @@ static ip_status parse_v2(const char *name, const cJSON *j, zarr_array *a, ip_er
         const cJSON *first = cJSON_GetArrayItem(filters, 0);
         const char *id = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(first, "id"));
         return ip__fail(err, IP_ERR_INPUT, "%s: filter '%s' is not read (no filters are)", name,
-                        id ? id : "?");
+                        ip__zarr_shown(id, shown, sizeof shown));
     }
     if (sep && strcmp(sep, ".") != 0 && strcmp(sep, "/") != 0)
         return bad(name, "'dimension_separator' is neither \".\" nor \"/\"", err);
@@ -202,6 +216,7 @@ static const cJSON *config_of(const cJSON *codec, const char *key)
  * (blosc, gzip, zstd) and crc32c. */
 static ip_status v3_chain(const char *name, const cJSON *codecs, zarr_chain *chain, ip_error *err)
 {
+    char shown[48];
     int bytes_seen = 0;
     chain->count = 0;
     chain->big_endian = 0;
@@ -230,7 +245,7 @@ static ip_status v3_chain(const char *name, const cJSON *codecs, zarr_chain *cha
             return ip__fail(err, IP_ERR_INPUT,
                             "%s: codec '%s' is not read here (bytes, blosc, gzip, zstd, crc32c "
                             "and sharding_indexed are)",
-                            name, id);
+                            name, ip__zarr_shown(id, shown, sizeof shown));
         int fits = codec == ZARR_CRC32C
                        ? chain->count == 0 || (chain->count == 1 && chain->codecs[0] != ZARR_CRC32C)
                        : chain->count == 0;
@@ -238,7 +253,7 @@ static ip_status v3_chain(const char *name, const cJSON *codecs, zarr_chain *cha
             return ip__fail(err, IP_ERR_INPUT,
                             "%s: codec '%s' in an order not read (bytes, then one compressor, "
                             "then crc32c)",
-                            name, id);
+                            name, ip__zarr_shown(id, shown, sizeof shown));
         chain->codecs[chain->count++] = codec;
     }
     if (!bytes_seen)

@@ -49,6 +49,7 @@ static int metre_exponent(const char *unit)
 static ip_status read_axes(const char *name, const cJSON *axes, zarr_ome *o, const char **units,
                            ip_error *err)
 {
+    char shown[48];
     int n = cJSON_IsArray(axes) ? cJSON_GetArraySize(axes) : 0;
     if (n < 3 || n > ZARR_MAX_DIMS)
         return ip__fail(err, IP_ERR_INPUT, "%s: multiscales 'axes' is not a list of 3 to 5 axes",
@@ -68,7 +69,7 @@ static ip_status read_axes(const char *name, const cJSON *axes, zarr_ome *o, con
             o->axis[i] = type[0];
         else
             return ip__fail(err, IP_ERR_INPUT, "%s: axis '%s' is not read (t, c, z, y, x are)",
-                            name, axis);
+                            name, ip__zarr_shown(axis, shown, sizeof shown));
     }
     if (o->axis[n - 3] != 'z' || o->axis[n - 2] != 'y' || o->axis[n - 1] != 'x')
         return ip__fail(err, IP_ERR_INPUT, "%s: the last three axes are not z, y, x", name);
@@ -81,6 +82,7 @@ static ip_status read_axes(const char *name, const cJSON *axes, zarr_ome *o, con
 static ip_status transforms(const char *name, const cJSON *list, uint32_t n, double *scale,
                             double *shift, ip_error *err)
 {
+    char shown[48];
     const cJSON *t;
     cJSON_ArrayForEach(t, list)
     {
@@ -90,7 +92,7 @@ static ip_status transforms(const char *name, const cJSON *list, uint32_t n, dou
             return ip__fail(err, IP_ERR_INPUT,
                             "%s: coordinate transformation '%s' is not read (scale and "
                             "translation are)",
-                            name, type ? type : "?");
+                            name, ip__zarr_shown(type, shown, sizeof shown));
         const cJSON *v = cJSON_GetObjectItemCaseSensitive(t, type);
         if (cJSON_GetArraySize(v) != (int)n)
             return ip__fail(err, IP_ERR_INPUT, "%s: a %s of %d values for %u axes", name, type,
@@ -116,7 +118,8 @@ static ip_status spatial_units(const char *name, zarr_ome *o, const char **units
 {
     uint32_t n = o->ndim;
     const char *ux = units[n - 1];
-    snprintf(o->unit, sizeof o->unit, "%s", ux ? ux : "");
+    char shown[48], shown_x[48];
+    ip__zarr_shown(ux ? ux : "", o->unit, sizeof o->unit);
     for (uint32_t i = n - 3; i < n - 1; i++) {
         const char *u = units[i];
         if ((!u && !ux) || (u && ux && !strcmp(u, ux)))
@@ -124,7 +127,8 @@ static ip_status spatial_units(const char *name, zarr_ome *o, const char **units
         int from = metre_exponent(u), to = metre_exponent(ux);
         if (from == 99 || to == 99)
             return ip__fail(err, IP_ERR_INPUT, "%s: axes in units %s and %s, which do not convert",
-                            name, u ? u : "(none)", ux ? ux : "(none)");
+                            name, ip__zarr_shown(u, shown, sizeof shown),
+                            ip__zarr_shown(ux, shown_x, sizeof shown_x));
         /* a power of ten, applied as one so that 0.00125 mm gives 1.25 um exactly */
         for (int e = from; e > to; e--)
             scale[i] *= 10, shift[i] *= 10;
@@ -161,7 +165,10 @@ static ip_status read_multiscale(const char *name, const char *folder, const cJS
                         o->scales, o->scales - 1);
     const cJSON *d = cJSON_GetArrayItem(datasets, (int)scale);
     const char *path = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(d, "path"));
-    if (!path || !path[0] || strstr(path, ".."))
+    int control = 0;
+    for (const char *c = path; c && *c; c++)
+        control |= (unsigned char)*c < 0x20;
+    if (!path || !path[0] || strstr(path, "..") || control)
         return ip__fail(err, IP_ERR_INPUT, "%s: dataset %u has no usable path", name, scale);
     if (snprintf(o->array, sizeof o->array, "%s/%s", folder, path) >= (int)sizeof o->array)
         return ip__fail(err, IP_ERR_INPUT, "%s: dataset path too long", name);
