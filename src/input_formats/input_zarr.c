@@ -35,7 +35,7 @@ typedef struct zarr_state {
     unsigned char *slots;         /* the decoded chunks of row `row_at`, one slot each */
     unsigned char *present;       /* per slot: 0 when its chunk is missing (the fill) */
     int64_t row_at;
-    uint64_t loading;             /* the row being read */
+    uint64_t loading; /* the row being read */
     ip__pool *pool;
     unsigned char *fill_run; /* a chunk's x-run of the fill value, in the type read */
     int fill_inexact;        /* it is a 32-bit integer float32 does not hold */
@@ -313,10 +313,9 @@ static ip_status copy_plane(zarr_state *s, uint32_t z, unsigned char *dst, ip_er
             size_t job = (size_t)(iy * s->per_x + ix);
             int bad;
             if (s->present[job])
-                bad = convert_run(a,
-                                  s->slots + job * want +
-                                      (((base * uz + zl) * uy + yl) * ux) * a->item,
-                                  (size_t)nx, out, s->out_size);
+                bad = convert_run(
+                    a, s->slots + job * want + (((base * uz + zl) * uy + yl) * ux) * a->item,
+                    (size_t)nx, out, s->out_size);
             else
                 bad = s->fill_inexact, memcpy(out, s->fill_run, (size_t)nx * s->out_size);
             if (bad)

@@ -38,8 +38,8 @@ typedef struct spec {
 static const int16_t *vol;
 static uint64_t VX, VY, VZ;
 static char dtype_kind = 'i'; /* v2 arrays: 'u' writes the same bits as uint16 (--bench) */
-static int16_t fill;        /* the fill value: the volume's first sample (its background) */
-static uint64_t stride = 1; /* 2: scale 1 of an OME image, every other sample */
+static int16_t fill;          /* the fill value: the volume's first sample (its background) */
+static uint64_t stride = 1;   /* 2: scale 1 of an OME image, every other sample */
 
 /* 5-D (t, c, z, y, x): the volume at t = 1, c = 2, 7 elsewhere; 4-D (c, z, y, x): at c = 2. */
 static int16_t sample(const spec *s, const uint64_t *i)
