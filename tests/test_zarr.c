@@ -54,6 +54,12 @@ static void test_types_and_refusals(void)
     CHECK_CONTAINS(err.message, "a/.zarray: data type <f8 is not read");
     CHECK_EQ(parse_v2("<u2", ", \"order\": \"F\"", &a, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "order \"F\"");
+    CHECK_EQ(ip__zarr_parse_array("a/.zarray",
+                                  "{\"zarr_format\": 2, \"shape\": [4096, 4096, 4096], "
+                                  "\"chunks\": [2048, 2048, 2048], \"dtype\": \"<u2\"}",
+                                  2, &a, &err),
+             IP_ERR_INPUT);
+    CHECK_CONTAINS(err.message, "a/.zarray: a chunk of more than 1 GiB is not read");
     CHECK_EQ(ip__zarr_parse_array("a/zarr.json", "{\"zarr_format\": 3,", 3, &a, &err),
              IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "a/zarr.json: not JSON");

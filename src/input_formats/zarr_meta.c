@@ -358,6 +358,26 @@ static ip_status parse_v3(const char *name, const cJSON *j, zarr_array *a, ip_er
     return v3_codecs(name, cJSON_GetObjectItemCaseSensitive(j, "codecs"), a, err);
 }
 
+/* A chunk (an inner chunk) of at most 1 GiB decoded, a shard of at most 2^24 inner chunks. */
+static ip_status check_sizes(const char *name, const zarr_array *a, ip_error *err)
+{
+    const uint64_t limit = (uint64_t)1 << 30;
+    uint64_t bytes = a->item, inner = 1;
+    for (uint32_t d = 0; d < a->ndim; d++) {
+        uint64_t unit = a->sharded ? a->inner[d] : a->chunk[d];
+        bytes = unit > limit ? limit + 1 : bytes * unit;
+        if (bytes > limit)
+            return bad(name, "a chunk of more than 1 GiB is not read", err);
+        if (a->sharded) {
+            uint64_t per = a->chunk[d] / a->inner[d];
+            inner = per > limit ? limit + 1 : inner * per;
+            if (inner > ((uint64_t)1 << 24))
+                return bad(name, "a shard of more than 2^24 inner chunks is not read", err);
+        }
+    }
+    return IP_OK;
+}
+
 ip_status ip__zarr_parse_array(const char *name, const char *text, int version, zarr_array *a,
                                ip_error *err)
 {
@@ -369,7 +389,7 @@ ip_status ip__zarr_parse_array(const char *name, const char *text, int version, 
     a->version = version;
     ip_status s = version == 2 ? parse_v2(name, j, a, err) : parse_v3(name, j, a, err);
     cJSON_Delete(j);
-    return s;
+    return s == IP_OK ? check_sizes(name, a, err) : s;
 }
 
 ip_status ip__zarr_read_array(const char *folder, zarr_array *a, ip_error *err)
