@@ -38,13 +38,21 @@ REGRID_DEFAULT, REGRID_RESAMPLE, REGRID_REFUSE = 0, 1, 2  # ip_regrid (input.h)
 
 def _overrides(dims: Optional[List[int]], dtype: Optional[int],
                spacing: Optional[List[float]], endian: Optional[str],
-               dicom: Optional[Tuple[Any, int, int]] = None) -> S.InputOverrides:
+               dicom: Optional[Tuple[Any, int, int]] = None,
+               ome: Sequence[Optional[int]] = (None, None, None)) -> S.InputOverrides:
     """The ip_input_overrides of checked arguments (dims and spacing lists, dtype a code;
-    dicom: (series bytes or None, tilt, uneven) as _check_dicom() gives them)."""
+    dicom: (series bytes or None, tilt, uneven) as _check_dicom() gives them; ome: an
+    OME-Zarr image's scale, time and channel, each None or an index)."""
     o = S.InputOverrides()
     o.size = ctypes.sizeof(S.InputOverrides)  # this layout, DICOM choices included (IP_SIZED)
     if dicom is not None:
         o.series, o.tilt, o.uneven = dicom
+    if ome[0] is not None:
+        o.has_scale, o.scale = 1, ome[0]
+    if ome[1] is not None:
+        o.has_time, o.time = 1, ome[1]
+    if ome[2] is not None:
+        o.has_channel, o.channel = 1, ome[2]
     if dims is not None:
         o.has_dims, o.dims[:] = 1, dims
     if dtype is not None:
@@ -284,7 +292,8 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
           subblock_size: int = 8, hc: Union[None, bool, int] = None, threads: int = 0,
           mem_mb: int = 0, force: bool = False,
           progress: Optional[Callable[[int, int], Any]] = None, series: Optional[str] = None,
-          correct_tilt: bool = True, even_spacing: bool = False) -> Dict[str, Any]:
+          correct_tilt: bool = True, even_spacing: bool = False, scale: Optional[int] = None,
+          time: Optional[int] = None, channel: Optional[int] = None) -> Dict[str, Any]:
     """Bricks a volume into the brick file `out` and returns the report (a dict: input_bytes,
     file_bytes, bricks, levels, seconds, peak_rss, ...).
 
@@ -303,6 +312,9 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
     refuses a series sheared by a gantry tilt instead of resampling it (isobrick
     --no-correct-tilt); even_spacing=True resamples unevenly spaced slices instead of refusing
     them (--even-spacing). docs/dicom.md.
+    An OME-Zarr image (a folder, isobrick DIR): scale picks a scale other than the finest (0),
+    time and channel a time point and a channel (needed where the image has more than one);
+    refused for any other input. docs/input.md, "Zarr and OME-Zarr".
     brick_size, subblock_size, hc (True or an LZ4HC level), threads, mem_mb and force are
     isobrick's options. Every argument is checked first: TypeError or isoprop.ArgumentError
     (a ValueError) naming it; FileNotFoundError when the output's folder does not exist.
@@ -328,9 +340,12 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
                        C.whole("mem_mb", mem_mb, 0, C.MAX_MEM_MB), C.flag("force", force))
     C.callable_or_none("progress", progress)
     dicom = _check_dicom(series, correct_tilt, even_spacing)
+    ome = [None if v is None else C.whole(n, v, 0, 2**32 - 1)
+           for n, v in (("scale", scale), ("time", time), ("channel", channel))]
     if not is_path:
         given = [n for n, v in (("dims", dims), ("dtype", dtype), ("endian", endian),
-                                ("series", series)) if v is not None]
+                                ("series", series), ("scale", scale), ("time", time),
+                                ("channel", channel)) if v is not None]
         if given:
             raise ArgumentError("%s: not with an array, which gives its own dims, dtype and "
                                 "byte order (pass only spacing)" % given[0])
@@ -338,5 +353,5 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
         _check_out_folder(out)
         return _run(_array_desc(planes, spacing), out, options, progress, rescale, planes)
     _check_out_folder(out)
-    return _run(_describe(source, _overrides(dims, code, spacing, endian, dicom)), out, options,
-                progress, rescale)
+    return _run(_describe(source, _overrides(dims, code, spacing, endian, dicom, ome)), out,
+                options, progress, rescale)
