@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* isoprop: reading input volumes (headerless raw, NRRD, MetaImage, TIFF, NIfTI, DICOM) plane
- * by plane.
+/* isoprop: reading input volumes (headerless raw, NRRD, MetaImage, TIFF, NIfTI, DICOM, Zarr
+ * and OME-Zarr) plane by plane.
  *
  * ip_input_describe() works out where the samples are and how they are laid out, from a file
  * name of the form NAME_XxYxZ_TYPE.raw, from a NRRD header (.nrrd attached, .nhdr detached;
@@ -143,8 +143,9 @@ typedef struct ip_input_overrides {
 
 /*! ip_input_describe() : fills *out for the volume at `path`.
  *  `overrides` may be NULL. The extension picks the format: .nrrd/.nhdr NRRD, .mhd/.mha
- *  MetaImage, .tif/.tiff TIFF, .nii/.nii.gz NIfTI; a folder holds a DICOM series or numbered
- *  TIFF files (told apart by the first file's content); anything else is headerless raw
+ *  MetaImage, .tif/.tiff TIFF, .nii/.nii.gz NIfTI; a folder holding .zarray, .zattrs, .zgroup
+ *  or zarr.json is a Zarr array or OME-Zarr image (docs/input.md), any other folder a DICOM
+ *  series or numbered TIFF files (told apart by the first file's content); anything else is headerless raw
  *  (little-endian, spacing 1,1,1, dims and type from a base name NAME_XxYxZ_TYPE.raw or from
  *  the overrides). Checks everything that can be
  *  checked before reading samples: a dimension under 2 (or at or above 2^31), an unknown
