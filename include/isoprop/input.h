@@ -145,10 +145,10 @@ typedef struct ip_input_overrides {
  *  `overrides` may be NULL. The extension picks the format: .nrrd/.nhdr NRRD, .mhd/.mha
  *  MetaImage, .tif/.tiff TIFF, .nii/.nii.gz NIfTI; a folder holding .zarray, .zattrs, .zgroup
  *  or zarr.json is a Zarr array or OME-Zarr image (docs/input.md), any other folder a DICOM
- *  series or numbered TIFF files (told apart by the first file's content); anything else is headerless raw
- *  (little-endian, spacing 1,1,1, dims and type from a base name NAME_XxYxZ_TYPE.raw or from
- *  the overrides). Checks everything that can be
- *  checked before reading samples: a dimension under 2 (or at or above 2^31), an unknown
+ *  series or numbered TIFF files (told apart by the first file's content); anything else is
+ *  headerless raw (little-endian, spacing 1,1,1, dims and type from a base name
+ *  NAME_XxYxZ_TYPE.raw or from the overrides). Checks everything that can be checked before
+ *  reading samples: a dimension under 2 (or at or above 2^31), an unknown
  *  type, an unreadable or malformed header, a header or data file that is not a regular file
  *  (a FIFO or a device is refused at once, never waited on), a missing data file, a size past
  *  2^63 bytes, (raw encoding) a data size that does not equal dims x type size, and a spacing
@@ -158,8 +158,10 @@ typedef struct ip_input_overrides {
  *  problem in one line; IP_ERR_UNSUPPORTED for a spacing outside the renderable range, or a
  *  valid TIFF or NIfTI file this library does not read (a sample type, a compression, 4D
  *  images, .hdr/.img pairs: docs/input.md);
- *  IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an override type that is not
- *  an ip_type; IP_ERR_NOMEM when an allocation fails. */
+ *  IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, an override type that is not
+ *  an ip_type, or an OME-Zarr choice (has_scale, has_time, has_channel) for another input
+ *  or out of the image's range; IP_ERR_UNSUPPORTED also for a Zarr folder where the input
+ *  component was built without Zarr; IP_ERR_NOMEM when an allocation fails. */
 IP_API ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
                                    ip_input_desc *out, ip_error *err);
 

@@ -7,8 +7,8 @@
  * A program does not call it: ip_input_describe() and the bricker (ip_brick_volume()) load it
  * themselves the first time they meet a TIFF file or a DICOM, TIFF or Zarr folder, from the
  * folder of libisoprop.so (the build folder, the installed library folder, a Python
- * package), else from the loader's search path; without it, such an input fails with IP_ERR_UNSUPPORTED naming the
- * file and libisoprop_input. Linking it (pkg-config isoprop-input, CMake isoprop::input) only
+ * package), else from the loader's search path; without it, such an input fails with
+ * IP_ERR_UNSUPPORTED naming the file and libisoprop_input. Linking it (pkg-config isoprop-input, CMake isoprop::input) only
  * makes the dependency explicit for a package manager. The static library libisoprop.a holds
  * the readers itself. Not included by isoprop/isoprop.h.
  */

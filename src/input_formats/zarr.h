@@ -92,8 +92,9 @@ const char *ip__zarr_shown(const char *text, char *buf, size_t size);
 /* ---- chunks (zarr_codec.c) ---- */
 
 /*! ip__zarr_decode() : decodes `size` bytes of `src` through `chain` into exactly `out_bytes`
- *  bytes at dst (samples still in the chain's byte order). Returns 0, or -1 with what is wrong in `why`
- *  ("blosc: does not decode", "crc32c mismatch", "zstd: 100 bytes, not 512"). */
+ *  bytes at dst (samples still in the chain's byte order). Returns 0, or -1 with what is
+ *  wrong in `why` ("blosc: does not decode", "crc32c: checksum mismatch", "zstd: decodes to
+ *  100 bytes, not the chunk's 512"). */
 int ip__zarr_decode(const zarr_chain *chain, const unsigned char *src, size_t size,
                     unsigned char *dst, size_t out_bytes, char *why, size_t why_size);
 
