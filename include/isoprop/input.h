@@ -81,16 +81,17 @@ typedef struct ip_input_desc {
     /* IP_ENCODING_CALLBACK only (ip_input_desc_from_planes()); NULL otherwise. */
     ip_plane_source_fn plane_source; /* fills the planes */
     void *plane_user;                /* passed to plane_source, not owned */
-    /* A Zarr array or OME-Zarr image (docs/input.md, "Zarr"); zero for other inputs. */
-    uint32_t zarr_scale;   /* OME-Zarr: the scale read (0 the finest) */
-    uint32_t zarr_scales;  /* OME-Zarr: the scales of the image; 0: not OME-Zarr */
-    uint32_t zarr_time;    /* OME-Zarr: the time point read (0 without a t axis) */
-    uint32_t zarr_channel; /* OME-Zarr: the channel read (0 without a c axis) */
-    char space_unit[16];   /* OME-Zarr: the unit of spacing and origin as the file names
-                                     it ("micrometer"), "" when none */
+    /* A Zarr array or OME-Zarr image (docs/input.md, "Zarr and OME-Zarr"); zero for other
+     * inputs. */
     uint64_t reader_bytes; /* memory the reader holds besides the planes it hands out (a
-                                     Zarr row of chunks), which the bricker's plan counts */
-    uint64_t reserved[11]; /* zero: room for later fields at the same size (status.h) */
+                              Zarr row of chunks), which the bricker's plan counts */
+    uint32_t zarr_time;    /* OME-Zarr: the time point read (0 without a t axis) */
+    uint16_t zarr_channel; /* OME-Zarr: the channel read (0 without a c axis) */
+    uint8_t zarr_scale;    /* OME-Zarr: the scale read (0 the finest) */
+    uint8_t zarr_scales;   /* OME-Zarr: the image's scales (at most 255); 0: not OME-Zarr */
+    char space_unit[8];    /* OME-Zarr: the unit of spacing and origin, as a symbol ("um" for
+                              micrometer, "mm", "nm", ...), "" when the file names none */
+    uint64_t reserved[13]; /* zero: room for later fields at the same size (status.h) */
 } ip_input_desc;
 
 /* ip_input_desc.resampled: the slices of a DICOM series were resampled onto a regular grid

@@ -56,9 +56,10 @@ class InputDesc(ctypes.Structure):
                 ("skipped_objects", c_uint32), ("source_slices", c_uint32), ("resampled", c_uint32),
                 ("tilt_degrees", c_double), ("rescale_unit", c_char * RESCALE_UNIT_MAX),
                 ("plane_source", PLANE_SOURCE_FN), ("plane_user", c_void_p),
-                ("zarr_scale", c_uint32), ("zarr_scales", c_uint32), ("zarr_time", c_uint32),
-                ("zarr_channel", c_uint32), ("space_unit", c_char * 16),
-                ("reader_bytes", c_uint64), ("reserved", c_uint64 * 11)]
+                ("reader_bytes", c_uint64), ("zarr_time", c_uint32),
+                ("zarr_channel", ctypes.c_uint16), ("zarr_scale", ctypes.c_uint8),
+                ("zarr_scales", ctypes.c_uint8), ("space_unit", c_char * 8),
+                ("reserved", c_uint64 * 13)]
 
 
 class InputOverrides(ctypes.Structure):

@@ -425,6 +425,10 @@ ip_status ip__zarr_describe(const char *path, const ip_input_overrides *override
     if ((s = choose(path, &a, is_ome ? &o : NULL, v->has_time, v->time, v->has_channel, v->channel,
                     at, err)) != IP_OK)
         return s;
+    if (v->has_scale && v->scale > 255)
+        return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: scales past 255 are not read", path);
+    if (v->has_channel && v->channel > 65535)
+        return ip__fail(err, IP_ERR_UNSUPPORTED, "%s: channels past 65535 are not read", path);
     uint32_t n = a.ndim;
     for (int axis = 0; axis < 3; axis++)
         found->dims[axis] = a.shape[n - 1 - (uint32_t)axis];
@@ -439,11 +443,11 @@ ip_status ip__zarr_describe(const char *path, const ip_input_overrides *override
             desc->spacing[axis] = o.spacing[axis];
             desc->orientation.origin[axis] = o.origin[axis];
         }
-        desc->zarr_scale = v->has_scale ? v->scale : 0;
-        desc->zarr_scales = o.scales;
+        desc->zarr_scale = (uint8_t)(v->has_scale ? v->scale : 0);
+        desc->zarr_scales = (uint8_t)(o.scales > 255 ? 255 : o.scales);
         desc->zarr_time = v->time;
-        desc->zarr_channel = v->channel;
-        snprintf(desc->space_unit, sizeof desc->space_unit, "%.15s", o.unit);
+        desc->zarr_channel = (uint16_t)v->channel;
+        ip__zarr_unit_symbol(o.unit, desc->space_unit, sizeof desc->space_unit);
     }
     return IP_OK;
 }

@@ -89,6 +89,10 @@ ip_status ip__zarr_read_text(const char *path, char **out, int *missing, ip_erro
  *  most size - 1 characters, control characters as '?', "?" for NULL. Returns buf. */
 const char *ip__zarr_shown(const char *text, char *buf, size_t size);
 
+/*! ip__zarr_unit_symbol() : an OME length unit ("micrometer") as its symbol ("um") into out;
+ *  another unit as it is, cut to size - 1 characters. */
+void ip__zarr_unit_symbol(const char *unit, char *out, size_t size);
+
 /* ---- chunks (zarr_codec.c) ---- */
 
 /*! ip__zarr_decode() : decodes `size` bytes of `src` through `chain` into exactly `out_bytes`

@@ -29,19 +29,32 @@ static ip_status json_file(const char *path, cJSON **out, ip_error *err)
     return ip__fail(err, IP_ERR_INPUT, "%s: not JSON (or not a JSON object)", path);
 }
 
-/* The power of ten of a metre that an OME length unit is (micrometer -6); 99 when it is not
- * one this reader converts between. */
+/* The OME length units this reader converts between: their symbol and the power of ten of a
+ * metre they are (micrometer: "um", -6). */
+static const struct {
+    const char *name, *symbol;
+    int exponent;
+} lengths[] = {{"kilometer", "km", 3},   {"meter", "m", 0},        {"centimeter", "cm", -2},
+               {"millimeter", "mm", -3}, {"micrometer", "um", -6}, {"nanometer", "nm", -9},
+               {"picometer", "pm", -12}};
+
+/* The unit's power of ten, 99 when it is not one of lengths[]. */
 static int metre_exponent(const char *unit)
 {
-    static const struct {
-        const char *name;
-        int exponent;
-    } units[] = {{"kilometer", 3},   {"meter", 0},      {"centimeter", -2}, {"millimeter", -3},
-                 {"micrometer", -6}, {"nanometer", -9}, {"picometer", -12}};
-    for (size_t i = 0; unit && i < sizeof units / sizeof units[0]; i++)
-        if (!strcmp(unit, units[i].name))
-            return units[i].exponent;
+    for (size_t i = 0; unit && i < sizeof lengths / sizeof lengths[0]; i++)
+        if (!strcmp(unit, lengths[i].name))
+            return lengths[i].exponent;
     return 99;
+}
+
+void ip__zarr_unit_symbol(const char *unit, char *out, size_t size)
+{
+    for (size_t i = 0; i < sizeof lengths / sizeof lengths[0]; i++)
+        if (!strcmp(unit, lengths[i].name)) {
+            snprintf(out, size, "%s", lengths[i].symbol);
+            return;
+        }
+    ip__zarr_shown(unit, out, size);
 }
 
 /* Each axis' role ('x', 'y', 'z', 't', 'c') from its name (or, for another name, its type

@@ -41,12 +41,12 @@ static void error_and_input(void)
     FIELD(ip_input_desc, rescale_unit);
     FIELD(ip_input_desc, plane_source);
     FIELD(ip_input_desc, plane_user);
-    FIELD(ip_input_desc, zarr_scale);
-    FIELD(ip_input_desc, zarr_scales);
+    FIELD(ip_input_desc, reader_bytes);
     FIELD(ip_input_desc, zarr_time);
     FIELD(ip_input_desc, zarr_channel);
+    FIELD(ip_input_desc, zarr_scale);
+    FIELD(ip_input_desc, zarr_scales);
     FIELD(ip_input_desc, space_unit);
-    FIELD(ip_input_desc, reader_bytes);
     FIELD(ip_input_desc, reserved);
     SIZE(ip_rescale);
     FIELD(ip_rescale, present);

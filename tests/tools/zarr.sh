@@ -47,7 +47,7 @@ check "channel 0 holds only 7s" grep -q '"value_min": 7, "value_max": 7' "$work/
 brick z/ome04.zarr ome04.ibv --time 1 --channel 2
 check "OME-Zarr 0.4 --time 1 --channel 2 bricks ($err)" test "$rc" = 0
 check "the summary names the scale, time, channel and unit" grep -qF \
-    "ome-zarr    scale 0 of 2, time 1, channel 2; spacing 0.5,0.5,1.25 and origin in micrometer" \
+    "ome-zarr    scale 0 of 2, time 1, channel 2; spacing 0.5,0.5,1.25 and origin in um" \
     "$work/.out"
 run_capture "$bin/isoinfo" --json ome04.ibv
 check "OME-Zarr 0.4: spacing from the scale" grep -q '"spacing": \[0.5, 0.5, 1.25\]' "$work/.out"
