@@ -52,6 +52,13 @@ static void test_types_and_refusals(void)
     CHECK_EQ(a.separator, '/');
     CHECK_EQ(parse_v2("<f8", "", &a, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "a/.zarray: data type <f8 is not read");
+    CHECK_EQ(
+        ip__zarr_parse_array("a/.zarray",
+                             "{\"zarr_format\": 2, \"shape\": [4, 3, 2], \"chunks\": [4, 3, 2], "
+                             "\"dtype\": \"|u1\", \"fill_value\": -3}",
+                             2, &a, &err),
+        IP_ERR_INPUT);
+    CHECK_CONTAINS(err.message, "a/.zarray: 'fill_value' -3 is not a value of the data type");
     CHECK_EQ(parse_v2("<u2", ", \"order\": \"F\"", &a, &err), IP_ERR_INPUT);
     CHECK_CONTAINS(err.message, "order \"F\"");
     CHECK_EQ(ip__zarr_parse_array("a/.zarray",

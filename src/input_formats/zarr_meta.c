@@ -358,6 +358,19 @@ static ip_status parse_v3(const char *name, const cJSON *j, zarr_array *a, ip_er
     return v3_codecs(name, cJSON_GetObjectItemCaseSensitive(j, "codecs"), a, err);
 }
 
+/* An integer type's fill value must be a whole number within its range. */
+static ip_status check_fill(const char *name, const zarr_array *a, ip_error *err)
+{
+    if (a->kind == 'f')
+        return IP_OK;
+    double bits = 8.0 * a->item, lo = a->kind == 'u' ? 0 : -ldexp(1, (int)bits - 1),
+           hi = a->kind == 'u' ? ldexp(1, (int)bits) - 1 : ldexp(1, (int)bits - 1) - 1;
+    if (a->fill == floor(a->fill) && a->fill >= lo && a->fill <= hi)
+        return IP_OK;
+    return ip__fail(err, IP_ERR_INPUT, "%s: 'fill_value' %g is not a value of the data type", name,
+                    a->fill);
+}
+
 /* A chunk (an inner chunk) of at most 1 GiB decoded, a shard of at most 2^24 inner chunks. */
 static ip_status check_sizes(const char *name, const zarr_array *a, ip_error *err)
 {
@@ -389,6 +402,8 @@ ip_status ip__zarr_parse_array(const char *name, const char *text, int version, 
     a->version = version;
     ip_status s = version == 2 ? parse_v2(name, j, a, err) : parse_v3(name, j, a, err);
     cJSON_Delete(j);
+    if (s == IP_OK)
+        s = check_fill(name, a, err);
     return s == IP_OK ? check_sizes(name, a, err) : s;
 }
 
