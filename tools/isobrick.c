@@ -17,10 +17,11 @@ static const char usage[] =
     "usage: isobrick INPUT [-o OUT.ibv] [options]\n"
     "       isobrick - --dims XxYxZ --type T -o OUT.ibv [options]\n"
     "Bricks INPUT (NAME_XxYxZ_TYPE.raw, any raw file with --dims/--type, .nrrd, .nhdr, .mhd,\n"
-    ".tif, .nii, .h5, or a folder holding a DICOM series) into an LZ4-compressed brick file\n"
-    "with min/max summaries and a level-of-detail pyramid. '-' reads raw samples from\n"
-    "standard input in z order (x fastest), e.g. isogen ... -o - | isobrick - ...: a pipe that\n"
-    "ends early or runs past the dims is refused (docs/input.md).\n"
+    ".tif, .nii, .h5, a folder holding a DICOM series, a Zarr array or an OME-Zarr image)\n"
+    "into an LZ4-compressed brick file with min/max summaries and a level-of-detail\n"
+    "pyramid. '-' reads raw samples from standard input in z order (x fastest), e.g.\n"
+    "isogen ... -o - | isobrick - ...: a pipe that ends early or runs past the dims is\n"
+    "refused (docs/input.md).\n"
     "  -o OUT.ibv          output (default: bricks/STEM.ibv, the input's name without its\n"
     "                      extension: ch2.nii.gz gives bricks/ch2.ibv)\n"
     "  --dims XxYxZ        samples along x, y, z (raw input)\n"
@@ -44,6 +45,10 @@ static const char usage[] =
     "  --no-correct-tilt   refuse a tilted series instead\n"
     "  --even-spacing      resample unevenly spaced slices (a slice missing included) onto an\n"
     "                      even grid of the smallest step (default: refused)\n"
+    "A Zarr v2/v3 array or OME-Zarr image (0.4, 0.5) is a folder (docs/input.md, \"Zarr\").\n"
+    "  --scale K           OME-Zarr: the scale to read (default 0, the finest)\n"
+    "  --time T            OME-Zarr: the time point to read (needed when t is over 1)\n"
+    "  --channel C         OME-Zarr: the channel to read (needed when c is over 1)\n"
     "  --brick-size B      cells per brick edge, a power of two (default 32)\n"
     "  --subblock-size S   cells per sub-block edge, a power of two <= B (default 8)\n"
     "  --hc [LEVEL]        LZ4 high compression (level 1-12, default 9) instead of fast\n"
@@ -225,6 +230,25 @@ static int parse_mem_mb(const char *p, const tool_option *opt, const char *const
     return rc;
 }
 
+/* --scale, --time, --channel: an index of an OME-Zarr image, into the overrides. */
+static int parse_ome_index(const char *p, const tool_option *opt, const char *const *v, void *base)
+{
+    ip_input_overrides *o = &((options *)base)->overrides;
+    uint64_t n;
+    int rc = tool_parse_bounded(p, opt->name, v[0], 0, UINT32_MAX, "an index from 0", &n);
+    if (rc != 0)
+        return rc;
+    int *has = opt->name[2] == 's'   ? &o->has_scale
+               : opt->name[2] == 't' ? &o->has_time
+                                     : &o->has_channel;
+    uint32_t *value = opt->name[2] == 's'   ? &o->scale
+                      : opt->name[2] == 't' ? &o->time
+                                            : &o->channel;
+    *has = 1;
+    *value = (uint32_t)n;
+    return 0;
+}
+
 static const tool_option isobrick_options[] = {
     {"-o", NULL, 1, offsetof(options, output), NULL, NULL, NULL},
     {"--dims", NULL, 1, 0, parse_dims, NULL, NULL},
@@ -246,6 +270,9 @@ static const tool_option isobrick_options[] = {
     {"--no-correct-tilt", NULL, 0, offsetof(options, no_correct_tilt), NULL, NULL, NULL},
     {"--even-spacing", NULL, 0, offsetof(options, even_spacing), NULL, NULL, NULL},
     {"--dataset", NULL, 1, offsetof(options, overrides.dataset), NULL, NULL, NULL},
+    {"--scale", NULL, 1, 0, parse_ome_index, NULL, NULL},
+    {"--time", NULL, 1, 0, parse_ome_index, NULL, NULL},
+    {"--channel", NULL, 1, 0, parse_ome_index, NULL, NULL},
 };
 
 static int parse_args(int argc, char **argv, options *o)
@@ -324,6 +351,17 @@ static void print_shown(const char *text)
 }
 
 /* A DICOM series' lines of the summary: which series, the objects skipped, the resampling. */
+/* An OME-Zarr image's line of the summary: the scale, time point and channel read, and the
+ * unit of the spacing and origin (the brick file keeps the numbers, not the unit). */
+static void print_ome(const ip_input_desc *d)
+{
+    if (d->encoding != IP_ENCODING_ZARR || d->zarr_scales == 0)
+        return;
+    printf("  ome-zarr    scale %u of %u, time %u, channel %u; spacing %g,%g,%g and origin in %s\n",
+           d->zarr_scale, d->zarr_scales, d->zarr_time, d->zarr_channel, d->spacing[0],
+           d->spacing[1], d->spacing[2], d->space_unit[0] ? d->space_unit : "no named unit");
+}
+
 static void print_series(const ip_input_desc *d)
 {
     if (d->encoding != IP_ENCODING_DICOM)
@@ -394,6 +432,7 @@ static void print_summary(const ip_bricker_report *r, const ip_input_desc *desc,
            tool_format_bytes(in_b, sizeof in_b, (double)r->input_bytes),
            (unsigned long long)r->input_bytes);
     print_series(desc);
+    print_ome(desc);
     tool_print_rescale(stdout, desc);
     printf("  file        %s (%llu bytes)\n",
            tool_format_bytes(file_b, sizeof file_b, (double)r->file_bytes),

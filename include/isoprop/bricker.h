@@ -70,9 +70,10 @@ typedef struct ip_bricker_report {
 IP_API void ip_bricker_options_default(ip_bricker_options *options);
 
 /*! ip_bricker_memory_needed() : working memory (bytes) a run with `options` needs for `input`:
- *  the plan with a second chunk of level-0 planes (read while the one before is encoded) when
- *  the input has more than one layer of level-0 bricks and options->memory_limit is 0 or has
- *  room for it, else the smallest plan.
+ *  what its reader holds (input->reader_bytes: a Zarr row of chunks) and the plan with a
+ *  second chunk of level-0 planes (read while the one before is encoded) when the input has
+ *  more than one layer of level-0 bricks and options->memory_limit is 0 or has room for it,
+ *  else the smallest plan.
  *  @return IP_OK, or an error for options the layout rejects. */
 IP_API ip_status ip_bricker_memory_needed(const ip_input_desc *input,
                                           const ip_bricker_options *options, uint64_t *bytes,

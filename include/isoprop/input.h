@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* isoprop: reading input volumes (headerless raw, NRRD, MetaImage, TIFF, NIfTI, DICOM) plane
- * by plane.
+/* isoprop: reading input volumes (headerless raw, NRRD, MetaImage, TIFF, NIfTI, DICOM, Zarr
+ * and OME-Zarr) plane by plane.
  *
  * ip_input_describe() works out where the samples are and how they are laid out, from a file
  * name of the form NAME_XxYxZ_TYPE.raw, from a NRRD header (.nrrd attached, .nhdr detached;
@@ -29,8 +29,10 @@ typedef enum ip_encoding {
     IP_ENCODING_DICOM = 3,    /* one DICOM file a plane: a folder holding one series */
     IP_ENCODING_CALLBACK = 4, /* the caller's function fills the planes: plane_source and
                                  plane_user (ip_input_desc_from_planes(), experimental) */
-    IP_ENCODING_HDF5 = 5      /* one 3-D dataset of an HDF5 file (`dataset`), read a layer of
+    IP_ENCODING_HDF5 = 5,     /* one 3-D dataset of an HDF5 file (`dataset`), read a layer of
                                  chunks at a time through libhdf5 in the input component */
+    IP_ENCODING_ZARR = 6      /* chunks of a Zarr v2 or v3 array (an OME-Zarr image's scale):
+                                 data_path is the array's folder */
 } ip_encoding;
 
 /* Bytes of ip_input_desc.dataset: an HDF5 dataset's path is at most 95 characters. */
@@ -87,7 +89,17 @@ typedef struct ip_input_desc {
     void *plane_user;                /* passed to plane_source, not owned */
     char dataset[IP_DATASET_MAX];    /* IP_ENCODING_HDF5: the dataset's path in the file ("/a/b");
                                      "" otherwise */
-    uint64_t reserved[4];            /* zero: room for later fields at the same size (status.h) */
+    /* A Zarr array or OME-Zarr image (docs/input.md, "Zarr and OME-Zarr"); zero for other
+     * inputs. */
+    uint64_t reader_bytes; /* memory the reader holds besides the planes it hands out (a
+                              Zarr row of chunks), which the bricker's plan counts */
+    uint32_t zarr_time;    /* OME-Zarr: the time point read (0 without a t axis) */
+    uint16_t zarr_channel; /* OME-Zarr: the channel read (0 without a c axis) */
+    uint8_t zarr_scale;    /* OME-Zarr: the scale read (0 the finest) */
+    uint8_t zarr_scales;   /* OME-Zarr: the image's scales (at most 255); 0: not OME-Zarr */
+    char space_unit[8];    /* OME-Zarr: the unit of spacing and origin, as a symbol ("um" for
+                              micrometer, "mm", "nm", ...), "" when the file names none */
+    uint64_t reserved[1];  /* zero: room for later fields at the same size (status.h) */
 } ip_input_desc;
 
 /* ip_input_desc.resampled: the slices of a DICOM series were resampled onto a regular grid
@@ -130,17 +142,28 @@ typedef struct ip_input_overrides {
     /* An HDF5 file (after 0.2.0, read only when `size` covers it, as `series`). */
     const char *dataset; /* the path of the 3-D dataset to read ("/volume"); NULL: the file must
                             hold exactly one. Refused for other inputs. Not copied */
+    /* An OME-Zarr image (after 0.2.0; read only when `size` covers them): the scale (0, the
+     * finest, by default), and the time point and channel where the image has t or c axes
+     * longer than 1 (required there). Refused (IP_ERR_ARGUMENT) for any other input. */
+    int has_scale;
+    uint32_t scale;
+    int has_time;
+    uint32_t time;
+    int has_channel;
+    uint32_t channel;
 } ip_input_overrides;
 
 /*! ip_input_describe() : fills *out for the volume at `path`.
  *  `overrides` may be NULL. The extension picks the format: .nrrd/.nhdr NRRD, .mhd/.mha
  *  MetaImage, .tif/.tiff TIFF, .nii/.nii.gz NIfTI, .h5/.hdf5/.he5 (or a file that starts with
  *  the HDF5 signature) HDF5 (docs/input.md; needs the input component built with HDF5);
- *  "-" standard input (raw samples: the overrides must give dims and type); a folder holds a DICOM series or numbered
- *  TIFF files (told apart by the first file's content); anything else is headerless raw
- *  (little-endian, spacing 1,1,1, dims and type from a base name NAME_XxYxZ_TYPE.raw or from
- *  the overrides). Checks everything that can be
- *  checked before reading samples: a dimension under 2 (or at or above 2^31), an unknown
+ *  "-" standard input (raw samples: the overrides must give dims and type); a folder
+ *  holding .zarray, .zattrs, .zgroup or zarr.json is a Zarr array or OME-Zarr image
+ *  (docs/input.md), any other folder a DICOM series or numbered TIFF files (told apart by
+ *  the first file's content); anything else is headerless raw (little-endian, spacing
+ *  1,1,1, dims and type from a base name NAME_XxYxZ_TYPE.raw or from the overrides).
+ *  Checks everything that can be checked before reading samples: a dimension under 2 (or
+ *  at or above 2^31), an unknown
  *  type, an unreadable or malformed header, a header or data file that is not a regular file
  *  (a FIFO or a device is refused at once, never waited on), a missing data file, a size past
  *  2^63 bytes, (raw encoding) a data size that does not equal dims x type size, and a spacing
@@ -150,8 +173,10 @@ typedef struct ip_input_overrides {
  *  problem in one line; IP_ERR_UNSUPPORTED for a spacing outside the renderable range, or a
  *  valid TIFF or NIfTI file this library does not read (a sample type, a compression, 4D
  *  images, .hdr/.img pairs: docs/input.md);
- *  IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, or an override type that is not
- *  an ip_type; IP_ERR_NOMEM when an allocation fails. */
+ *  IP_ERR_ARGUMENT for a NULL or over-long path, a NULL out, an override type that is not
+ *  an ip_type, or an OME-Zarr choice (has_scale, has_time, has_channel) for another input
+ *  or out of the image's range; IP_ERR_UNSUPPORTED also for a Zarr folder where the input
+ *  component was built without Zarr; IP_ERR_NOMEM when an allocation fails. */
 IP_API ip_status ip_input_describe(const char *path, const ip_input_overrides *overrides,
                                    ip_input_desc *out, ip_error *err);
 

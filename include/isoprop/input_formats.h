@@ -1,13 +1,14 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* isoprop: the input component, libisoprop_input: the readers of TIFF (libtiff) and DICOM
- * (GDCM), apart from the core so that libisoprop links only lz4, xxhash, zlib, libm and threads
- * and a program that opens brick files loads no image-format library.
+/* isoprop: the input component, libisoprop_input: the readers of TIFF (libtiff), DICOM
+ * (GDCM) and Zarr (c-blosc, zstd, lz4, zlib, cJSON), apart from the core so that libisoprop
+ * links only lz4, xxhash, zlib, libm and threads and a program that opens brick files loads
+ * no image-format library.
  *
  * A program does not call it: ip_input_describe() and the bricker (ip_brick_volume()) load it
- * themselves the first time they meet a TIFF file or a DICOM or TIFF folder, from the folder of
- * libisoprop.so (the build folder, the installed library folder, a Python package), else from
- * the loader's search path; without it, such an input fails with IP_ERR_UNSUPPORTED naming the
- * file and libisoprop_input. Linking it (pkg-config isoprop-input, CMake isoprop::input) only
+ * themselves the first time they meet a TIFF file or a DICOM, TIFF or Zarr folder, from the
+ * folder of libisoprop.so (the build folder, the installed library folder, a Python
+ * package), else from the loader's search path; without it, such an input fails with
+ * IP_ERR_UNSUPPORTED naming the file and libisoprop_input. Linking it (pkg-config isoprop-input, CMake isoprop::input) only
  * makes the dependency explicit for a package manager. The static library libisoprop.a holds
  * the readers itself. Not included by isoprop/isoprop.h.
  */

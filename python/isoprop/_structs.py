@@ -56,7 +56,11 @@ class InputDesc(ctypes.Structure):
                 ("skipped_objects", c_uint32), ("source_slices", c_uint32), ("resampled", c_uint32),
                 ("tilt_degrees", c_double), ("rescale_unit", c_char * RESCALE_UNIT_MAX),
                 ("plane_source", PLANE_SOURCE_FN), ("plane_user", c_void_p),
-                ("dataset", c_char * 96), ("reserved", c_uint64 * 4)]
+                ("dataset", c_char * 96),
+                ("reader_bytes", c_uint64), ("zarr_time", c_uint32),
+                ("zarr_channel", ctypes.c_uint16), ("zarr_scale", ctypes.c_uint8),
+                ("zarr_scales", ctypes.c_uint8), ("space_unit", c_char * 8),
+                ("reserved", c_uint64 * 1)]
 
 
 class InputOverrides(ctypes.Structure):
@@ -64,7 +68,10 @@ class InputOverrides(ctypes.Structure):
     _fields_ = [("size", c_uint32), ("has_dims", c_int), ("dims", c_uint32 * 3), ("has_type", c_int),
                 ("type", c_int), ("has_endian", c_int), ("big_endian", c_int),
                 ("has_spacing", c_int), ("spacing", c_double * 3), ("series", c_char_p),
-                ("tilt", c_int), ("uneven", c_int), ("dataset", c_char_p)]
+                ("tilt", c_int), ("uneven", c_int), ("dataset", c_char_p),
+                ("has_scale", c_int), ("scale", c_uint32),
+                ("has_time", c_int), ("time", c_uint32), ("has_channel", c_int),
+                ("channel", c_uint32)]
 
 
 # ip_progress_fn (bricker.h): nonzero cancels the run

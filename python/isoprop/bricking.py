@@ -39,15 +39,23 @@ REGRID_DEFAULT, REGRID_RESAMPLE, REGRID_REFUSE = 0, 1, 2  # ip_regrid (input.h)
 def _overrides(dims: Optional[List[int]], dtype: Optional[int],
                spacing: Optional[List[float]], endian: Optional[str],
                dicom: Optional[Tuple[Any, int, int]] = None,
-               dataset: Optional[bytes] = None) -> S.InputOverrides:
+               dataset: Optional[bytes] = None,
+               ome: Sequence[Optional[int]] = (None, None, None)) -> S.InputOverrides:
     """The ip_input_overrides of checked arguments (dims and spacing lists, dtype a code;
     dicom: (series bytes or None, tilt, uneven) as _check_dicom() gives them; dataset: an HDF5
-    dataset's path as bytes, or None)."""
+    dataset's path as bytes, or None; ome: an OME-Zarr image's scale, time and channel, each
+    None or an index)."""
     o = S.InputOverrides()
     o.size = ctypes.sizeof(S.InputOverrides)  # this layout, DICOM and HDF5 choices (IP_SIZED)
     if dicom is not None:
         o.series, o.tilt, o.uneven = dicom
     o.dataset = dataset
+    if ome[0] is not None:
+        o.has_scale, o.scale = 1, ome[0]
+    if ome[1] is not None:
+        o.has_time, o.time = 1, ome[1]
+    if ome[2] is not None:
+        o.has_channel, o.channel = 1, ome[2]
     if dims is not None:
         o.has_dims, o.dims[:] = 1, dims
     if dtype is not None:
@@ -288,7 +296,8 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
           mem_mb: int = 0, force: bool = False,
           progress: Optional[Callable[[int, int], Any]] = None, series: Optional[str] = None,
           correct_tilt: bool = True, even_spacing: bool = False,
-          dataset: Optional[str] = None) -> Dict[str, Any]:
+          dataset: Optional[str] = None, scale: Optional[int] = None,
+          time: Optional[int] = None, channel: Optional[int] = None) -> Dict[str, Any]:
     """Bricks a volume into the brick file `out` and returns the report (a dict: input_bytes,
     file_bytes, bricks, levels, seconds, peak_rss, ...).
 
@@ -309,6 +318,9 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
     them (--even-spacing). docs/dicom.md.
     An HDF5 file (isobrick FILE.h5): dataset picks its 3-D dataset by path ("/group/name"; isobrick
     --dataset), needed when it holds several. docs/input.md.
+    An OME-Zarr image (a folder, isobrick DIR): scale picks a scale other than the finest (0),
+    time and channel a time point and a channel (needed where the image has more than one);
+    refused for any other input. docs/input.md, "Zarr and OME-Zarr".
     brick_size, subblock_size, hc (True or an LZ4HC level), threads, mem_mb and force are
     isobrick's options. Every argument is checked first: TypeError or isoprop.ArgumentError
     (a ValueError) naming it; FileNotFoundError when the output's folder does not exist.
@@ -341,9 +353,12 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
         if not dataset or len(dataset.encode("utf-8")) >= 96 or "\0" in dataset:
             raise ArgumentError("dataset: %r is not an HDF5 dataset path (1 to 95 bytes)"
                                 % dataset)
+    ome = [None if v is None else C.whole(n, v, 0, 2**32 - 1)
+           for n, v in (("scale", scale), ("time", time), ("channel", channel))]
     if not is_path:
         given = [n for n, v in (("dims", dims), ("dtype", dtype), ("endian", endian),
-                                ("series", series), ("dataset", dataset)) if v is not None]
+                                ("series", series), ("dataset", dataset), ("scale", scale),
+                                ("time", time), ("channel", channel)) if v is not None]
         if given:
             raise ArgumentError("%s: not with an array, which gives its own dims, dtype and "
                                 "byte order (pass only spacing)" % given[0])
@@ -352,5 +367,5 @@ def brick(source: Any, out: PathLike, *, dims: Optional[Sequence[int]] = None,
         return _run(_array_desc(planes, spacing), out, options, progress, rescale, planes)
     _check_out_folder(out)
     encoded = None if dataset is None else dataset.encode("utf-8")
-    return _run(_describe(source, _overrides(dims, code, spacing, endian, dicom, encoded)), out,
-                options, progress, rescale)
+    overrides = _overrides(dims, code, spacing, endian, dicom, encoded, ome)
+    return _run(_describe(source, overrides), out, options, progress, rescale)

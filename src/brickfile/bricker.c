@@ -169,10 +169,12 @@ static uint64_t memory_for(const ip_layout *l, unsigned threads, int overlap)
 }
 
 /* Whether reading overlaps encoding: when the input has more than one chunk and the plan with
- * the second level-0 chunk fits `limit` (0: no limit). */
-static int plan_overlap(const ip_layout *l, unsigned threads, uint64_t limit)
+ * the second level-0 chunk, and the `reader` bytes the input's reader holds
+ * (ip_input_desc.reader_bytes), fits `limit` (0: no limit). */
+static int plan_overlap(const ip_layout *l, unsigned threads, uint64_t reader, uint64_t limit)
 {
-    return l->levels[0].bricks[2] > 1 && (limit == 0 || memory_for(l, threads, 1) <= limit);
+    return l->levels[0].bricks[2] > 1 &&
+           (limit == 0 || reader + memory_for(l, threads, 1) <= limit);
 }
 
 void ip_bricker_options_default(ip_bricker_options *options)
@@ -206,7 +208,9 @@ ip_status ip_bricker_memory_needed(const ip_input_desc *input, const ip_bricker_
                          options->subblock_edge, err);
     if (st == IP_OK) {
         unsigned threads = thread_count(options);
-        *bytes = memory_for(&l, threads, plan_overlap(&l, threads, options->memory_limit));
+        *bytes = input->reader_bytes +
+                 memory_for(&l, threads,
+                            plan_overlap(&l, threads, input->reader_bytes, options->memory_limit));
     }
     return st;
 }
@@ -729,9 +733,9 @@ static ip_status bricker_init(bricker *b, const ip_input_desc *in, const char *o
     ip__layout_set_rescale(&b->layout, &rescale);
     b->sample_size = ip_type_size(in->type);
     b->threads = thread_count(o);
-    b->overlap = plan_overlap(&b->layout, b->threads, o->memory_limit);
+    b->overlap = plan_overlap(&b->layout, b->threads, in->reader_bytes, o->memory_limit);
     atomic_init(&b->direct_bytes, 0);
-    uint64_t need = memory_for(&b->layout, b->threads, b->overlap);
+    uint64_t need = in->reader_bytes + memory_for(&b->layout, b->threads, b->overlap);
     b->report.memory_planned = need;
     if (o->memory_limit && need > o->memory_limit)
         return ip__fail(err, IP_ERR_LIMIT,

@@ -63,7 +63,7 @@ ip_status ip__input_formats_load(const char *path, const ip__input_formats **out
     void *handle = open_component(why, sizeof why);
     if (!handle)
         return ip__fail(err, IP_ERR_UNSUPPORTED,
-                        "%s: TIFF, DICOM and HDF5 need the input component " COMPONENT
+                        "%s: TIFF, DICOM, HDF5 and Zarr need the input component " COMPONENT
                         ", which cannot be loaded (%s)",
                         path, why);
     table_fn table;

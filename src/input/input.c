@@ -199,6 +199,21 @@ static ip_status first_file_of(const char *path, char out[IP_PATH_MAX], ip_error
     return IP_OK;
 }
 
+/* A folder holding .zarray, .zattrs, .zgroup or zarr.json is a Zarr array or an OME-Zarr
+ * image (the input component's Zarr reader). */
+static int is_zarr_folder(const char *path)
+{
+    static const char *const names[] = {".zarray", ".zattrs", ".zgroup", "zarr.json"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        char full[IP_PATH_MAX + 16];
+        struct stat st;
+        snprintf(full, sizeof full, "%s/%s", path, names[i]);
+        if (stat(full, &st) == 0 && S_ISREG(st.st_mode))
+            return 1;
+    }
+    return 0;
+}
+
 /* A folder is a DICOM series when its first file has the DICOM preamble's "DICM" at byte
  * 128, numbered TIFF files when it starts as a TIFF ("II*\0", "MM\0*", or BigTIFF's 43). */
 static ip_status describe_folder(const char *path, const ip_input_overrides *overrides,
@@ -206,6 +221,11 @@ static ip_status describe_folder(const char *path, const ip_input_overrides *ove
 {
     char first[IP_PATH_MAX];
     unsigned char head[132];
+    if (is_zarr_folder(path)) {
+        const ip__input_formats *formats;
+        ip_status zs = ip__input_formats_load(path, &formats, err);
+        return zs != IP_OK ? zs : formats->zarr_describe(path, overrides, desc, found, err);
+    }
     ip_status st = first_file_of(path, first, err);
     if (st != IP_OK)
         return st;
@@ -528,6 +548,12 @@ static ip_status read_layout(const char *path, const ip_input_overrides *overrid
 static ip_status check_dicom_choices(const ip_input_overrides *overrides, const ip_input_desc *desc,
                                      ip_error *err)
 {
+    if (overrides && desc->encoding != IP_ENCODING_ZARR &&
+        (overrides->has_scale || overrides->has_time || overrides->has_channel))
+        return ip__fail(err, IP_ERR_ARGUMENT,
+                        "%s: --scale, --time or --channel was given, but this is not an OME-Zarr "
+                        "image",
+                        desc->path);
     if (!overrides || desc->encoding == IP_ENCODING_DICOM)
         return IP_OK;
     if (overrides->series)

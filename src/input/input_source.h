@@ -51,13 +51,15 @@ typedef struct ip__input_formats {
     ip__dicom_list_fn dicom_list;
     ip__describe_fn hdf5_describe; /* HDF5 (input_hdf5.c); refuses when built without it */
     const ip__plane_source *hdf5_source;
+    ip__describe_fn zarr_describe; /* Zarr v2/v3, OME-Zarr (a build without: a message) */
+    const ip__plane_source *zarr_source;
 } ip__input_formats;
 
 /* The table's layout and the version of the structs it passes (ip_input_desc, ...): the core
  * takes only a component of its own version. Raise the last part when ip__input_formats or
  * ip__plane_source change. */
 #define IP__INPUT_FORMATS_ABI \
-    ((uint32_t)(IP_VERSION_MAJOR * 1000000 + IP_VERSION_MINOR * 10000 + IP_VERSION_PATCH * 100 + 3))
+    ((uint32_t)(IP_VERSION_MAJOR * 1000000 + IP_VERSION_MINOR * 10000 + IP_VERSION_PATCH * 100 + 4))
 
 /*! ip__input_formats_load() : the input component's readers, which `path` (a TIFF file or a
  *  DICOM or TIFF folder) needs: the ones linked in (the static library, the component itself),

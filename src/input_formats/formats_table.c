@@ -8,7 +8,8 @@
 
 static const ip__input_formats readers = {
     IP__INPUT_FORMATS_ABI, ip__tiff_describe, ip__dicom_describe, &ip__tiff_source,
-    &ip__dicom_source,     ip__dicom_list,    ip__hdf5_describe,  &ip__hdf5_source};
+    &ip__dicom_source,     ip__dicom_list,    ip__hdf5_describe,  &ip__hdf5_source,
+    ip__zarr_describe,     &ip__zarr_source};
 
 const char *ip_input_formats_version(void)
 {

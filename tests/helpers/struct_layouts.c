@@ -42,6 +42,12 @@ static void error_and_input(void)
     FIELD(ip_input_desc, plane_source);
     FIELD(ip_input_desc, plane_user);
     FIELD(ip_input_desc, dataset);
+    FIELD(ip_input_desc, reader_bytes);
+    FIELD(ip_input_desc, zarr_time);
+    FIELD(ip_input_desc, zarr_channel);
+    FIELD(ip_input_desc, zarr_scale);
+    FIELD(ip_input_desc, zarr_scales);
+    FIELD(ip_input_desc, space_unit);
     FIELD(ip_input_desc, reserved);
     SIZE(ip_rescale);
     FIELD(ip_rescale, present);
@@ -66,6 +72,12 @@ static void error_and_input(void)
     FIELD(ip_input_overrides, tilt);
     FIELD(ip_input_overrides, uneven);
     FIELD(ip_input_overrides, dataset);
+    FIELD(ip_input_overrides, has_scale);
+    FIELD(ip_input_overrides, scale);
+    FIELD(ip_input_overrides, has_time);
+    FIELD(ip_input_overrides, time);
+    FIELD(ip_input_overrides, has_channel);
+    FIELD(ip_input_overrides, channel);
 }
 
 static void memory_volume(void)

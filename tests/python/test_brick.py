@@ -132,6 +132,42 @@ class Brick(unittest.TestCase):
         self.assertEqual(listing(), before)
 
 
+@unittest.skipUnless(os.path.exists(os.path.join(support.BIN, "tests", "make_zarr")),
+                     "a build without the Zarr reader (IP_ZARR off)")
+class OmeZarr(unittest.TestCase):
+    """OME-Zarr images (make_zarr): channel=, time= and scale= pick the volume, as isobrick's
+    --channel, --time and --scale do; refused on other inputs."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.raw = support.generate("shepp-logan", (45, 38, 27), "int16")
+        cls.dir = support.work("zarr")
+        support.tool("tests/make_zarr", cls.raw, "45x38x27", cls.dir)
+
+    def test_channel_and_scale(self):
+        ome = os.path.join(self.dir, "ome05.zarr")
+        with self.assertRaisesRegex(isoprop.Error, "pick a volume with --time and --channel"):
+            isoprop.brick(ome, support.work("none.ibv"))
+        self.assertFalse(os.path.exists(support.work("none.ibv")))
+        out = support.work("c2.ibv")
+        isoprop.brick(ome, out, channel=2, brick_size=8, force=True)
+        raw = support.work("raw.ibv")
+        isoprop.brick(self.raw, raw, spacing=(0.5, 0.5, 1.25), brick_size=8, force=True)
+        a, b = support.isoinfo(out), support.isoinfo(raw)
+        for key in ("dims", "spacing", "value_min", "value_max"):
+            self.assertEqual(a[key], b[key], key)
+        self.assertEqual(a["origin"], [2.5, -5, 0])
+        half = support.work("half.ibv")
+        isoprop.brick(ome, half, channel=2, scale=1, force=True)
+        self.assertEqual(support.isoinfo(half)["dims"], [23, 19, 14])
+
+    def test_refused(self):
+        with self.assertRaisesRegex(isoprop.Error, "not an OME-Zarr image"):
+            isoprop.brick(self.raw, support.work("t.ibv"), time=0)
+        with self.assertRaises(TypeError):
+            isoprop.brick(self.raw, support.work("t.ibv"), channel="1")
+
+
 class DicomFolder(unittest.TestCase):
     """A DICOM folder as scanners write it (make_dicom): several series picked by series=, a
     gantry tilt resampled or refused (correct_tilt=), as isobrick does."""

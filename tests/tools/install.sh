@@ -159,7 +159,7 @@ check "the installed isobrick reads a TIFF through libisoprop_input ($err)" test
 check "... which the programs do not link" \
     sh -c "! ldd '$work/moved/bin/isobrick' | grep -q libisoprop_input"
 rm "$work"/moved/lib/libisoprop_input.so*
-expect_error 1 "formats/stack.tif: TIFF, DICOM and HDF5 need the input component libisoprop_input.so.0" \
+expect_error 1 "formats/stack.tif: TIFF, DICOM, HDF5 and Zarr need the input component libisoprop_input.so.0" \
     "$work/moved/bin/isobrick" formats/stack.tif -o tif2.ibv --quiet
 check "... and writes nothing" test ! -e tif2.ibv
 run_capture "$work/moved/bin/isobrick" sphere_24x20x12_uint8.raw -o raw.ibv --quiet
