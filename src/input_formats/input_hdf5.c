@@ -336,6 +336,25 @@ static ip_status read_spacing(hid_t d, const char *path, const char *name, ip_in
     return IP_OK;
 }
 
+/* The planes a read of the dataset whose creation properties are `dcpl` brings (of `depth`;
+ * `plane_bytes` each): a layer of chunks (chunk[] its chunk's shape, z first), or about
+ * CONTIGUOUS_SLAB_BYTES of a contiguous dataset (chunk[0] then 0). */
+static uint32_t slab_planes_of(hid_t dcpl, size_t plane_bytes, uint32_t depth, hsize_t chunk[3])
+{
+    uint32_t planes;
+    chunk[0] = chunk[1] = chunk[2] = 0;
+    if (dcpl >= 0 && H5Pget_layout(dcpl) == H5D_CHUNKED && H5Pget_chunk(dcpl, 3, chunk) == 3) {
+        planes = (uint32_t)chunk[0];
+    } else {
+        chunk[0] = 0;
+        planes =
+            (uint32_t)(plane_bytes >= CONTIGUOUS_SLAB_BYTES ? 1
+                                                            : CONTIGUOUS_SLAB_BYTES / plane_bytes);
+    }
+    H5Eclear2(H5E_DEFAULT);
+    return planes == 0 || planes > depth ? depth : planes;
+}
+
 static ip_status describe_dataset(hid_t d, const char *path, const char *name,
                                   const ip_input_overrides *overrides, ip_input_desc *desc,
                                   ip_text_found *found, ip_error *err)
@@ -364,6 +383,15 @@ static ip_status describe_dataset(hid_t d, const char *path, const char *name,
     desc->big_endian = !ip__host_little_endian();
     desc->encoding = IP_ENCODING_HDF5;
     snprintf(desc->dataset, sizeof desc->dataset, "%s", name);
+    /* the reader's slab, and as much again for a layer of chunks as stored (gzip: inflated on
+     * the pool from there), in the bricker's plan (ip_input_desc.reader_bytes) */
+    size_t plane_bytes = (size_t)dims[1] * dims[2] * kind_sizes[kind];
+    hsize_t chunk[3];
+    hid_t dcpl = H5Dget_create_plist(d);
+    uint64_t planes = slab_planes_of(dcpl, plane_bytes, (uint32_t)dims[0], chunk);
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    desc->reader_bytes = planes * plane_bytes * (chunk[0] ? 2 : 1);
     return IP_OK;
 }
 
@@ -486,7 +514,7 @@ static void gzip_free(hdf5_source *s)
 static ip_status source_shape(hdf5_source *s, ip_error *err)
 {
     const ip_input_desc *d = s->desc;
-    hsize_t dims[3], chunk[3];
+    hsize_t dims[3];
     char type[40];
     int kind, rank = dataset_shape(s->dset, dims, type, sizeof type, &kind);
     if (rank != 3 || kind < 0 || kind_stored[kind] != d->type || dims[2] != d->dims[0] ||
@@ -498,20 +526,14 @@ static ip_status source_shape(hdf5_source *s, ip_error *err)
     size_t plane_bytes = s->plane_samples * kind_sizes[kind];
     hid_t dcpl = H5Dget_create_plist(s->dset);
     int shuffled = 0;
-    if (dcpl >= 0 && H5Pget_layout(dcpl) == H5D_CHUNKED && H5Pget_chunk(dcpl, 3, chunk) == 3) {
-        s->slab_planes = (uint32_t)chunk[0];
-        if (gzip_chunks(s->dset, dcpl, s->kind, &shuffled)) {
-            s->layer.shuffled = shuffled;
-            gzip_setup(s, chunk);
-        }
-    } else
-        s->slab_planes =
-            (uint32_t)(plane_bytes >= CONTIGUOUS_SLAB_BYTES ? 1
-                                                            : CONTIGUOUS_SLAB_BYTES / plane_bytes);
+    hsize_t chunk[3];
+    s->slab_planes = slab_planes_of(dcpl, plane_bytes, d->dims[2], chunk);
+    if (chunk[0] && gzip_chunks(s->dset, dcpl, s->kind, &shuffled)) {
+        s->layer.shuffled = shuffled;
+        gzip_setup(s, chunk);
+    }
     if (dcpl >= 0)
         H5Pclose(dcpl);
-    if (s->slab_planes == 0 || s->slab_planes > d->dims[2])
-        s->slab_planes = d->dims[2];
     if (plane_bytes > SIZE_MAX / s->slab_planes || !(s->buf = malloc(plane_bytes * s->slab_planes)))
         return ip__fail(err, IP_ERR_NOMEM, "%s: dataset %s: out of memory for %u planes", d->path,
                         d->dataset, s->slab_planes);
