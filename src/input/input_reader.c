@@ -524,8 +524,7 @@ ip_status ip_input_read_planes(ip_input_reader *reader, void *dst, uint32_t coun
 int ip__encoding_is_planes(ip_encoding encoding)
 {
     return encoding == IP_ENCODING_TIFF || encoding == IP_ENCODING_DICOM ||
-           encoding == IP_ENCODING_HDF5 ||
-           encoding == IP_ENCODING_ZARR;
+           encoding == IP_ENCODING_HDF5 || encoding == IP_ENCODING_ZARR;
 }
 
 ip_status ip__plane_source_of(const ip_input_desc *desc, const ip__plane_source **out,
