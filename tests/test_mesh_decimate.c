@@ -12,11 +12,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "isoprop/bricker.h"
 #include "isoprop/cache.h"
 #include "isoprop/engine.h"
-#include "isoprop/input.h"
 #include "isoprop/store.h"
+#include "volumes.h"
 
 #define EDGE 32 /* samples along each axis, spacing 1: the box is [0, 31]^3 */
 
@@ -42,15 +41,8 @@ static void ball_cache(const ball *b, const char *name, ip_store **store, ip_cac
                 REQUIRE(fwrite(&v, sizeof v, 1, f) == 1);
             }
     REQUIRE(fclose(f) == 0);
+    test_brick_raw(raw, ibv, 16, 4);
     ip_error err;
-    ip_input_desc d;
-    ip_bricker_options o;
-    REQUIRE(ip_input_describe(raw, NULL, &d, &err) == IP_OK);
-    ip_bricker_options_default(&o);
-    o.brick_edge = 16;
-    o.force = 1;
-    o.threads = 2;
-    REQUIRE(ip_bricker_run(&d, ibv, &o, NULL, &err) == IP_OK);
     REQUIRE(ip_store_open(ibv, store, &err) == IP_OK);
     REQUIRE(ip_cache_create(*store, 64ull << 20, cache, &err) == IP_OK);
 }
@@ -307,20 +299,27 @@ static void test_decimate_arguments(void)
     CHECK_EQ(empty.triangle_count, 0);
 }
 
+/* The capped surface, which must be closed: every edge in exactly two triangles. */
+static void capped_closed(const ball *b, const char *name, ip_indexed_mesh *m)
+{
+    uint64_t open, crowded;
+    ball_surface(b, name, 1, m);
+    edge_uses(m, &open, &crowded);
+    CHECK_EQ(open, 0);
+    CHECK_EQ(crowded, 0);
+}
+
 static void test_cap_corner(void)
 {
     const ball b = {{-3.0, -4.0, 15.5}, 14.0};
     ip_indexed_mesh m;
-    ball_surface(&b, "corner", 1, &m);
-    uint64_t open, crowded;
-    edge_uses(&m, &open, &crowded);
-    CHECK_EQ(open, 0);
-    CHECK_EQ(crowded, 0);
+    capped_closed(&b, "corner", &m);
     double volume = enclosed_volume(&m), exact = ball_in_box(&b);
     printf("capped corner ball: volume %.3f, inside the box %.3f\n", volume, exact);
     CHECK_NEAR(volume / exact, 1.0, 0.01);
     /* the capped surface decimates, still closed */
     CHECK_EQ(ip_indexed_mesh_decimate(&m, 0.2, 0, NULL, NULL), IP_OK);
+    uint64_t open, crowded;
     edge_uses(&m, &open, &crowded);
     CHECK_EQ(open, 0);
     ip_indexed_mesh_free(&m);
@@ -331,11 +330,7 @@ static void test_cap_whole_box(void)
     /* every sample above the level: no surface, and the cap is the box's six faces */
     const ball b = {{15.5, 15.5, 15.5}, 100.0};
     ip_indexed_mesh m;
-    ball_surface(&b, "full", 1, &m);
-    uint64_t open, crowded;
-    edge_uses(&m, &open, &crowded);
-    CHECK_EQ(open, 0);
-    CHECK_EQ(crowded, 0);
+    capped_closed(&b, "full", &m);
     CHECK_EQ(m.triangle_count, 6 * 2 * (EDGE - 1) * (EDGE - 1));
     CHECK_NEAR(enclosed_volume(&m), pow(EDGE - 1, 3), 1e-6);
     ip_indexed_mesh_free(&m);
