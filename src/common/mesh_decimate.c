@@ -31,15 +31,12 @@ typedef size_t (*simplify_fn)(unsigned int *destination, const unsigned int *ind
 typedef float (*scale_fn)(const float *vertex_positions, size_t vertex_count,
                           size_t vertex_positions_stride);
 
-/* The prototypes above are the header's (checked, never called: sizeof does not evaluate). */
-static inline void check_prototypes(void)
-{
-    simplify_fn simplify;
-    scale_fn scale;
-    (void)sizeof(simplify = meshopt_simplify);
-    (void)sizeof(scale = meshopt_simplifyScale);
-    _Static_assert(LOCK_BORDER == meshopt_SimplifyLockBorder, "meshopt_SimplifyLockBorder");
-}
+/* The prototypes above are the header's (_Generic does not evaluate its operand: no reference
+ * to the library is made). */
+_Static_assert(_Generic(&meshopt_simplify, simplify_fn : 1, default : 0), "meshopt_simplify");
+_Static_assert(_Generic(&meshopt_simplifyScale, scale_fn : 1, default : 0),
+               "meshopt_simplifyScale");
+_Static_assert(LOCK_BORDER == meshopt_SimplifyLockBorder, "meshopt_SimplifyLockBorder");
 
 typedef struct meshopt {
     simplify_fn simplify;
@@ -48,7 +45,6 @@ typedef struct meshopt {
 
 static ip_status load(meshopt *m, ip_error *err)
 {
-    (void)check_prototypes;
     void *handle = dlopen(IP_MESHOPT_SONAME, RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
     if (!handle) {
         const char *why = dlerror();
