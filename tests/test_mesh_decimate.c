@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "internal.h"
 #include "isoprop/cache.h"
 #include "isoprop/engine.h"
 #include "isoprop/store.h"
@@ -350,10 +351,31 @@ static void test_cap_whole_box(void)
     ip_store_close(store);
 }
 
+static void test_drop_folds(void)
+{
+    /* a tetrahedron; a fold on 0, 1, 4 (the second one turned); one on 2, 4, 3 with a third
+     * triangle there wound like the first; a repeat of triangle 0, 1, 2 wound the same way */
+    uint32_t indices[] = {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0, 0, 1, 4,
+                          0, 4, 1, 1, 2, 0, 2, 4, 3, 3, 4, 2, 4, 3, 2};
+    ip_indexed_mesh m;
+    ip_indexed_mesh_init(&m);
+    m.indices = indices;
+    m.triangle_count = 10;
+    m.vertex_count = 5;
+    uint64_t dropped = 0;
+    CHECK_EQ(ip__indexed_mesh_drop_folds(&m, &dropped), IP_OK);
+    CHECK_EQ(dropped, 4);
+    CHECK_EQ(m.triangle_count, 6);
+    const uint32_t kept[] = {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0, 1, 2, 0};
+    CHECK_MEM_EQ(indices, kept, sizeof kept);
+    CHECK(memcmp(indices + 15, (const uint32_t[]){2, 4, 3}, 3 * sizeof(uint32_t)) == 0 ||
+          memcmp(indices + 15, (const uint32_t[]){4, 3, 2}, 3 * sizeof(uint32_t)) == 0);
+}
+
 static const test_case cases[] = {
     TEST_CASE(test_decimate_closed),    TEST_CASE(test_decimate_keeps_rim),
     TEST_CASE(test_decimate_arguments), TEST_CASE(test_cap_corner),
-    TEST_CASE(test_cap_whole_box),
+    TEST_CASE(test_cap_whole_box),      TEST_CASE(test_drop_folds),
 };
 
 int main(int argc, char **argv)

@@ -254,7 +254,9 @@ IP_API ip_status ip_mesh_weld_keep_degenerate(const ip_mesh *mesh, ip_indexed_me
  *  (0 < ratio < 1), as far as the error stays within `max_error` world units (0: 1 % of the
  *  mesh's extent, meshopt_simplifyScale()). Vertices on an edge of one triangle only (the rim
  *  where an open surface meets the volume's faces or a clip plane) stay where they are
- *  (meshopt_SimplifyLockBorder). The vertices kept are a subset of the mesh's, with their
+ *  (meshopt_SimplifyLockBorder). Pairs of triangles the collapses leave on the same three
+ *  vertices wound opposite ways (a thin part flattened onto itself) are removed: they enclose
+ *  nothing. The vertices kept are a subset of the mesh's, with their
  *  positions and normals, in their old order; dropped_triangles stays. *error (may be NULL)
  *  receives the error reached, world units (meshoptimizer's relative error times its scale:
  *  about the largest distance of a removed vertex from the simplified surface). Where the

@@ -135,7 +135,14 @@ ip_status ip_indexed_mesh_decimate(ip_indexed_mesh *mesh, double ratio, double m
     float reached = 0;
     size_t kept = m.simplify(out, mesh->indices, count, mesh->positions, (size_t)mesh->vertex_count,
                              3 * sizeof(float), target, (float)relative, LOCK_BORDER, &reached);
-    st = compact(mesh, out, kept);
+    /* folds (a thin part flattened onto itself) go: they enclose nothing */
+    ip_indexed_mesh simplified = *mesh;
+    uint64_t folded = 0;
+    simplified.indices = out;
+    simplified.triangle_count = kept / 3;
+    st = ip__indexed_mesh_drop_folds(&simplified, &folded);
+    if (st == IP_OK)
+        st = compact(mesh, out, 3 * (size_t)simplified.triangle_count);
     free(out);
     if (st != IP_OK)
         return ip__fail(err, st, "mesh: no memory to simplify %llu triangles",
