@@ -26,12 +26,12 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # tests/python/test_pip.py); GDCM for DICOM series input, libtiff for TIFF input and libhdf5 (serial)
 # for HDF5 input; help2man for the man
 # pages; OpenMPI (mpirun and its headers) for isowall, the display wall's parallel renderer
-# (docs/scale-out.md).
+# (docs/scale-out.md); meshoptimizer for simplifying meshes (isorender --decimate).
 packages="build-essential cmake pkg-config liblz4-dev libxxhash-dev zlib1g-dev clang clang-format
           lz4 zstd libegl-dev libepoxy-dev libpng-dev libblosc-dev libcjson-dev libzstd-dev libegl-mesa0 libgl1-mesa-dri
           libglfw3-dev libstb-dev xvfb xauth python3 python3-numpy python3-venv python3-pip
           python3-setuptools python3-wheel git libgdcm-dev libtiff-dev libhdf5-dev
-          help2man openmpi-bin libopenmpi-dev"
+          help2man openmpi-bin libopenmpi-dev libmeshoptimizer-dev"
 
 install_missing() {
     missing=""

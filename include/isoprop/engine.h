@@ -298,6 +298,20 @@ IP_API ip_status ip_extract_full_indexed(ip_cache *cache, float iso, uint32_t le
                                          ip_indexed_mesh *out, float **values,
                                          ip_engine_counts *counts, ip_error *err);
 
+/*! ip_extract_cap() : appends to `mesh` the cap that closes ip_extract_full()'s surface of
+ *  level `level` where it leaves the volume's box: on each of the box's 6 faces, the region of
+ *  samples >= iso, cut by marching squares on each cell side (corners >= iso and the side's
+ *  crossings, the corners of a side with diagonally opposite inside corners cut off apart, as
+ *  marching cubes separates them) and fanned. Its rim vertices are the surface's boundary
+ *  vertices, bit for bit, so that ip_mesh_weld() of the surface and the cap together is closed
+ *  (every edge in two triangles) and encloses the region >= iso within the box. Triangles are
+ *  counter-clockwise seen from outside the box, with the face's outward normal; cell id 0 where
+ *  the mesh keeps them. Reads the cells along the faces on the calling thread. Clip planes are
+ *  not capped.
+ *  @return IP_OK, IP_ERR_ARGUMENT (no such level), IP_ERR_NOMEM or a brick read error. */
+IP_API ip_status ip_extract_cap(ip_cache *cache, float iso, uint32_t level, ip_mesh *mesh,
+                                ip_error *err);
+
 #endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus

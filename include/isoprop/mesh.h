@@ -248,6 +248,26 @@ IP_API ip_status ip_indexed_mesh_write_in(const ip_indexed_mesh *mesh, const cha
  *  as ip_mesh_weld(). */
 IP_API ip_status ip_mesh_weld_keep_degenerate(const ip_mesh *mesh, ip_indexed_mesh *out);
 
+/*! ip_indexed_mesh_decimate() : simplifies the welded mesh in place by edge collapses
+ *  (meshoptimizer's meshopt_simplify(): quadric error, loaded at the call from the system's
+ *  libmeshoptimizer, which libisoprop does not link) toward `ratio` x its triangles
+ *  (0 < ratio < 1), as far as the error stays within `max_error` world units (0: 1 % of the
+ *  mesh's extent, meshopt_simplifyScale()). Vertices on an edge of one triangle only (the rim
+ *  where an open surface meets the volume's faces or a clip plane) stay where they are
+ *  (meshopt_SimplifyLockBorder). Pairs of triangles the collapses leave on the same three
+ *  vertices wound opposite ways (a thin part flattened onto itself) are removed: they enclose
+ *  nothing. The vertices kept are a subset of the mesh's, with their
+ *  positions and normals, in their old order; dropped_triangles stays. *error (may be NULL)
+ *  receives the error reached, world units (meshoptimizer's relative error times its scale:
+ *  about the largest distance of a removed vertex from the simplified surface). Where the
+ *  error bound stops it first, more triangles than the target stay: the caller compares
+ *  triangle_count with it. Not thread-safe on one mesh.
+ *  @return IP_OK, IP_ERR_ARGUMENT (ratio not in (0, 1), max_error negative, infinite or NaN),
+ *  IP_ERR_UNSUPPORTED (no meshoptimizer: the message names the Debian package
+ *  libmeshoptimizer-dev) or IP_ERR_NOMEM; the mesh is unchanged after a failure. */
+IP_API ip_status ip_indexed_mesh_decimate(ip_indexed_mesh *mesh, double ratio, double max_error,
+                                          double *error, ip_error *err);
+
 #endif /* IP_EXPERIMENTAL */
 
 #ifdef __cplusplus

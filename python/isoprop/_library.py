@@ -95,6 +95,9 @@ _PROTOTYPES = {
     "ip_mesh_write_in": (c_int, [POINTER(S.Mesh), c_char_p, c_char_p, c_int, ERR]),
     "ip_indexed_mesh_write_in": (c_int, [POINTER(S.IndexedMesh), c_char_p, c_char_p, c_int,
                                          ERR]),
+    "ip_indexed_mesh_decimate": (c_int, [POINTER(S.IndexedMesh), c_double, c_double,
+                                         POINTER(c_double), ERR]),
+    "ip_extract_cap": (c_int, [HANDLE, c_float, c_uint32, POINTER(S.Mesh), ERR]),
 }
 
 

@@ -156,6 +156,18 @@ class Mesh:
     def __repr__(self):
         return "<isoprop.Mesh %d triangles>" % self.triangle_count
 
+    def decimate(self, ratio: float, error: Optional[float] = None) -> "Mesh":
+        """A simplified copy (isorender --decimate): the mesh welded, then about `ratio`
+        (0 < ratio < 1) of its triangles kept by edge collapses (the library's
+        ip_indexed_mesh_decimate(), with meshoptimizer), as far as the error stays within
+        `error` (the mesh's units; None: 1 % of its size). Vertices on the rim of an open
+        surface stay. Returned as a soup like this one, with stats["decimate"]: ratio,
+        triangles_before, triangles_after and error (the error reached, meshoptimizer's
+        estimate of the distance to the original surface). Fewer triangles would pass the
+        bound where triangles_after is above ratio x triangles_before. Raises ArgumentError for
+        a bad ratio or error, isoprop.Error where meshoptimizer is missing."""
+        return decimate_mesh(self, ratio, error)
+
 
 class Step(Mesh):
     """One step of a progressive extraction: the triangles it added (a Mesh of its own),
@@ -354,3 +366,31 @@ def write_mesh(mesh: Mesh, path: Any, force: bool, weld_it: bool) -> None:
     finally:
         lib.ip_indexed_mesh_free(ctypes.byref(out))
     check(st, err)
+
+
+def decimate_mesh(mesh: Mesh, ratio: Any, error: Any) -> Mesh:
+    """Mesh.decimate(): welded, simplified by the library, repeated back into a soup."""
+    from . import _check as C
+    ratio = C.number("ratio", ratio)
+    if not 0 < ratio < 1:
+        raise ArgumentError("ratio: %r is not a share of the triangles to keep, in (0, 1)"
+                            % ratio)
+    bound = 0.0 if error is None else C.positive("error", error)
+    v = np.ascontiguousarray(mesh.vertices, dtype=np.float32)
+    packed = pack_normals(np.ascontiguousarray(mesh.normals, dtype=np.float32))
+    out, err, reached = S.IndexedMesh(), new_error(), ctypes.c_double()
+    soup = _borrowed_soup(v, packed)
+    _weld_status(lib.ip_mesh_weld(ctypes.byref(soup), ctypes.byref(out)), soup.triangle_count)
+    try:
+        before = int(out.triangle_count)
+        if before:
+            check(lib.ip_indexed_mesh_decimate(ctypes.byref(out), ratio, bound,
+                                               ctypes.byref(reached), ctypes.byref(err)), err)
+        welded = indexed_arrays(out)
+    finally:
+        lib.ip_indexed_mesh_free(ctypes.byref(out))
+    stats = dict(mesh.stats or {})
+    stats["decimate"] = {"ratio": ratio, "triangles_before": before,
+                         "triangles_after": len(welded.faces), "error": reached.value}
+    corners = welded.faces.reshape(-1)
+    return Mesh(welded.points[corners], welded.normals[corners], stats, mesh.space)

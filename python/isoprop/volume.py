@@ -360,7 +360,7 @@ class File:
                 prefetch: Union[bool, str] = True, cull: bool = False,
                 cache_mb: Optional[int] = None,
                 on_step: Optional[Callable[[Step], Any]] = None,
-                space: str = "physical") -> Mesh:
+                space: str = "physical", cap: bool = False) -> Mesh:
         """Extracts the isosurface `iso` and returns a Mesh (vertices, normals, faces, stats).
         `iso` is in the file's units where it has a rescale (self.rescale: HU for a DICOM CT),
         else a stored value; stored=True takes it as a stored sample value (isorender
@@ -384,7 +384,9 @@ class File:
         it runs inside the call, so calling this File from it raises RuntimeError.
         space: "physical" (the default) gives the vertices in the file's physical space, as
         isorender --mesh writes them; "grid" as sample index x spacing from 0 (the Mesh's
-        `space` names which).
+        `space` names which). cap=True (with full=True, isorender --cap) closes the surface where
+        it leaves the volume's box: each face's region above the isovalue, triangulated from the
+        same samples, its rim the surface's boundary vertices, so that the welded mesh is closed.
         Every argument is checked first (TypeError, or isoprop.ArgumentError, a ValueError,
         naming it). Raises isoprop.Error for a file that cannot be read, RuntimeError when
         another call on this File is running."""
@@ -397,6 +399,10 @@ class File:
         C.callable_or_none("on_step", on_step)
         full = C.full(full)
         space = C.choice("space", space, SPACES)
+        cap = C.flag("cap", cap)
+        if cap and full is not True:
+            raise ArgumentError("cap: closes the whole surface at the volume's faces: it needs "
+                                "full=True")
         if full:
             given = [n for n, v in (("rays", rays), ("time_limit", time_limit),
                                     ("on_step", on_step)) if v is not None]
@@ -407,7 +413,7 @@ class File:
                 raise ArgumentError('full: "lod" is the full extraction at adaptive resolution: '
                                     "not with lod=False (full=True is that)")
             with _Call(self):
-                return self._extract_full(iso, full, a, space)
+                return self._extract_full(iso, full, a, space, cap)
         with _Call(self):
             run = self._begin(iso, a, rays, time_limit, None, space)
             try:
@@ -532,7 +538,7 @@ class File:
             lib.ip_engine_totals(run.engine, ctypes.byref(counts))
         return run_stats(run, counts, self._cache)
 
-    def _extract_full(self, iso, full, a, space):
+    def _extract_full(self, iso, full, a, space, cap=False):
         cam = self._camera(a)
         options = a.engine_options()
         cache = self._cache_for(a.cache_mb)
@@ -549,6 +555,9 @@ class File:
             else:
                 st = lib.ip_extract_full(cache, run.iso_stored, 0, a.threads, ctypes.byref(mesh),
                                          ctypes.byref(counts), ctypes.byref(err))
+                if st == 0 and cap:
+                    st = lib.ip_extract_cap(cache, run.iso_stored, 0, ctypes.byref(mesh),
+                                            ctypes.byref(err))
             run.wall_seconds = lib.ip_now_seconds() - start
             check(st, err)
             vertices, normals = copy_in_space(mesh, 0, mesh.triangle_count, run.orientation)

@@ -174,4 +174,10 @@ ip_status ip__type_from_name(const char *name, unsigned spellings, ip_type *out)
  * float" for IP_TYPE_SPELLING_NRRD. */
 void ip__type_names(unsigned spellings, char *out, size_t size);
 
+/* Drops each pair of triangles on the same three vertices wound opposite ways (a fold, which
+ * encloses nothing: mesh_folds.c); *dropped counts the triangles dropped. The vertices stay
+ * (the caller compacts). Returns IP_OK or IP_ERR_NOMEM (the mesh unchanged). */
+struct ip_indexed_mesh;
+ip_status ip__indexed_mesh_drop_folds(struct ip_indexed_mesh *mesh, uint64_t *dropped);
+
 #endif

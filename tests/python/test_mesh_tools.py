@@ -83,6 +83,14 @@ def read_glb(path):
     return accessor(prim["attributes"]["POSITION"], "<f4", 3), accessor(prim["indices"], "<u4", 3)
 
 
+def open_edges(mesh):
+    """(edges in one triangle, edges in more than two) of the welded mesh."""
+    f = mesh.indices
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    _, uses = np.unique(e, axis=0, return_counts=True)
+    return int((uses == 1).sum()), int((uses > 2).sum())
+
+
 class MeshTools(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -171,6 +179,40 @@ class MeshTools(unittest.TestCase):
         self.assertGreater(m.area(), 0)
         shifted = isoprop.Mesh(m.vertices + np.float32(5.0), m.normals)
         self.assertGreater(abs(shifted.volume() - m.volume()), 1.0)
+
+    def test_cap_and_decimate(self):
+        """extract(full=True, cap=True) closes the cut sphere at the volume's faces around the
+        ball's part inside the box; decimate() keeps about its share of the triangles, the
+        closedness, the rim of an open surface and about the volume; bad arguments raise."""
+        with isoprop.open(self.ibv) as f:
+            capped = f.extract(RADIUS - 19.0, full=True, cap=True)
+            with self.assertRaisesRegex(ValueError, "^cap: .*full=True"):
+                f.extract(0.0, cap=True)
+        self.assertEqual(open_edges(capped), (0, 0))
+        # the ball of radius 19 samples inside the box [0, N - 1]^3: exact along x
+        t = (np.arange(2000) + 0.5) * (N - 1) / 2000
+        y, z = np.meshgrid(t - CENTRE[1], t - CENTRE[2])
+        h = np.sqrt(np.clip(19.0 ** 2 - y * y - z * z, 0, None))
+        length = np.clip(CENTRE[0] + h, 0, N - 1) - np.clip(CENTRE[0] - h, 0, N - 1)
+        exact = length.sum() * ((N - 1) / 2000) ** 2 * SPACING[0] ** 3
+        self.assertAlmostEqual(capped.volume() / exact, 1.0, delta=0.01)
+
+        d = self.mesh.decimate(0.1)
+        s = d.stats["decimate"]
+        self.assertEqual(s["triangles_before"], len(self.mesh.indices))
+        self.assertEqual(s["triangles_after"], len(d))
+        self.assertLessEqual(len(d), 0.1 * s["triangles_before"])
+        self.assertGreater(s["error"], 0)
+        self.assertEqual(open_edges(d), (0, 0))
+        self.assertAlmostEqual(d.volume() / self.mesh.volume(), 1.0, delta=0.03)
+        rim = open_edges(self.open_mesh)[0]
+        self.assertGreater(rim, 0)
+        self.assertEqual(open_edges(self.open_mesh.decimate(0.2))[0], rim)
+        for bad in (0, 1, 1.5, float("nan")):
+            with self.assertRaisesRegex(ValueError, "^ratio: "):
+                self.mesh.decimate(bad)
+        with self.assertRaisesRegex(ValueError, "^error: "):
+            self.mesh.decimate(0.5, error=-1.0)
 
     def test_other_libraries_absent(self):
         """to_pyvista() and to_trimesh() without the package: ImportError naming it and how to

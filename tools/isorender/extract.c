@@ -119,7 +119,7 @@ int extract_full(run *r, ip_error *err)
         ip_mesh_clear(&r->full_mesh);
     }
     double start = ip_now_seconds();
-    if (full_extraction(r, &r->totals, err) != IP_OK)
+    if (full_extraction(r, &r->totals, err) != IP_OK || cap_surface(r, err) != 0)
         return -1;
     r->extraction_wall = ip_now_seconds() - start;
     r->mesh = &r->full_mesh;

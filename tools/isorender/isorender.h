@@ -50,6 +50,9 @@ typedef struct options {
     size_t opacity_count;
     int axes, scale_bar;    /* --axes, --scale-bar: the figure overlays */
     const char *scale_unit; /* --scale-unit TEXT (NULL: from the file's space) */
+    double decimate;        /* --decimate RATIO: share of the mesh file's triangles (0: none) */
+    double decimate_error;  /* --decimate-error LENGTH (0: 1 % of the mesh's size) */
+    int cap;                /* --cap: close the --full surface at the volume's faces */
 } options;
 
 /* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
@@ -94,6 +97,11 @@ typedef struct run {
     size_t other_count;
     char mesh_name[4096]; /* the surface's mesh file (o.mesh points here), several --iso */
     ip_scale_bar bar;     /* --scale-bar: the last image's */
+    /* --decimate: done (the file's welded mesh), its triangles before and after, the error */
+    int decimated;
+    uint64_t decimate_before, decimate_after;
+    double decimate_reached;
+    uint64_t cap_triangles; /* --cap: the cap's triangles, appended to the --full mesh */
 } run;
 
 /* options.c */
@@ -210,5 +218,26 @@ int check_turntable_options(options *o);
 /* --turntable N: N frames, each a complete image, the eye turned 360 / N degrees more in
  * azimuth each time, in the folder -o names (made when absent); then the MP4 when asked. */
 int turntable_run(run *r, ip_error *err);
+
+/* decimate.c */
+/* --decimate RATIO, in (0, 1), and --decimate-error LENGTH, > 0. */
+int parse_decimate(const char *program, const tool_option *option, const char *const *values,
+                   void *base);
+int parse_decimate_error(const char *program, const tool_option *option, const char *const *values,
+                         void *base);
+/* --decimate needs --mesh and shared vertices; --decimate-error needs --decimate. Returns 0, or
+ * 2 after a usage error. */
+int check_decimate_options(const options *o);
+/* Simplifies the welded mesh of the file by --decimate (a warning where the error bound stops
+ * it early; with -v its counts and error). Returns 0, or 1 after the error. */
+int decimate_mesh(run *r, ip_indexed_mesh *welded, ip_error *err);
+/* --stats' "decimate" member, after a --decimate. */
+void json_decimate(FILE *f, const run *r);
+
+/* cap.c */
+/* --cap needs --full (level 0) and no --clip. Returns 0, or 2 after a usage error. */
+int check_cap_options(const options *o);
+/* --cap: the cap appended to r->full_mesh. Returns 0, or -1 with the error in *err. */
+int cap_surface(run *r, ip_error *err);
 
 #endif

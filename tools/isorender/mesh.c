@@ -48,7 +48,7 @@ static int write_mesh_as(run *r, const ip_mesh *mesh, const char *space, ip_erro
     const char *format = ip_mesh_format_of(r->o.mesh);
     ip_status st;
     int stl = strcmp(format, "STL") == 0;
-    if (r->o.no_weld || (stl && !r->o.smooth)) {
+    if (r->o.no_weld || (stl && !r->o.smooth && !(r->o.decimate > 0))) {
         st = ip_mesh_write_in(mesh, r->o.mesh, space, r->o.common.force, err);
         r->mesh_vertices = 3 * mesh->triangle_count;
     } else {
@@ -59,7 +59,7 @@ static int write_mesh_as(run *r, const ip_mesh *mesh, const char *space, ip_erro
                     (unsigned long long)mesh->triangle_count, ip_status_message(st));
             return 1;
         }
-        if (smooth_mesh(r, &welded, err) != 0) {
+        if (smooth_mesh(r, &welded, err) != 0 || decimate_mesh(r, &welded, err) != 0) {
             ip_indexed_mesh_free(&welded);
             return 1;
         }

@@ -48,6 +48,15 @@ static const char usage[] =
     "                      shrinking the surface; needs shared vertices (not --no-weld); the\n"
     "                      rim of an open mesh stays. Only the file changes: the image and\n"
     "                      what the summary says of it are those of the extracted triangles\n"
+    "  --decimate RATIO    simplify the mesh file to about RATIO (0 < RATIO < 1) of its\n"
+    "                      triangles by edge collapses (meshoptimizer), within an error bound;\n"
+    "                      the rim where the surface meets the volume's faces stays; needs\n"
+    "                      shared vertices. Only the file changes, as with --smooth\n"
+    "  --decimate-error L  --decimate's bound: the farthest a removed vertex may lie from the\n"
+    "                      simplified surface, in the mesh's units (default 1% of its size)\n"
+    "  --cap               with --full: close the surface where it leaves the volume's box, the\n"
+    "                      faces' region above the isovalue triangulated from the same samples\n"
+    "                      (not with --clip)\n"
     "  --stats OUT.json    counts, times, warnings, the cache statistics and the overdraw\n"
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
@@ -130,6 +139,9 @@ static const tool_option isorender_options[] = {
     {"--scale-bar", NULL, 0, offsetof(options, scale_bar), NULL, NULL, NULL},
     {"--scale-unit", NULL, 1, offsetof(options, scale_unit), NULL, NULL, NULL},
     {"--verbose", "-v", 0, offsetof(options, common.verbose), NULL, NULL, NULL},
+    {"--decimate", NULL, 1, 0, parse_decimate, NULL, NULL},
+    {"--decimate-error", NULL, 1, 0, parse_decimate_error, NULL, NULL},
+    {"--cap", NULL, 0, offsetof(options, cap), NULL, NULL, NULL},
 };
 
 /* ---- the figure's colours ---- */
@@ -248,6 +260,10 @@ int parse_args(int argc, char **argv, options *o)
     if (o->axes && ip_overlay_axes_check(o->common.width, o->common.height, &why) != IP_OK)
         return tool_usage_error("isorender", "--%s", why.message); /* "--axes: the triad..." */
     rc = check_mesh_options(o);
+    if (!rc)
+        rc = check_decimate_options(o);
+    if (!rc)
+        rc = check_cap_options(o);
     if (!rc && !o->turntable)
         rc = tool_check_png_name("isorender", "-o", o->out);
     if (!rc)

@@ -172,6 +172,7 @@ void json_counts(FILE *f, void *user)
                              r->o.common.rescale};
     tool_write_run_json(f, &j);
     json_quality(f, r);
+    json_decimate(f, r);
     if (r->o.scale_bar) {
         fprintf(f, ", \"scale_bar\": {\"length\": %.17g, \"unit\": ", r->bar.length);
         tool_json_string(f, scale_unit(r));
@@ -253,10 +254,11 @@ void print_summary(FILE *out, const run *r)
     for (size_t i = 0; i <= r->other_count; i++) {
         const run *s = surface_run_c(r, i);
         if (s->o.mesh)
-            fprintf(out, "  mesh          %s: %llu triangles, %llu vertices%s%s\n", s->o.mesh,
-                    (unsigned long long)(s->mesh->triangle_count - s->mesh_dropped),
+            fprintf(out, "  mesh          %s: %llu triangles, %llu vertices%s%s%s\n", s->o.mesh,
+                    (unsigned long long)(s->decimated ? s->decimate_after
+                                                      : s->mesh->triangle_count - s->mesh_dropped),
                     (unsigned long long)s->mesh_vertices,
                     s->mesh_vertices < 3 * s->mesh->triangle_count ? " (shared)" : "",
-                    s->o.smooth ? ", smoothed" : "");
+                    s->o.smooth ? ", smoothed" : "", s->decimated ? ", decimated" : "");
     }
 }
