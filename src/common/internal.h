@@ -174,4 +174,10 @@ ip_status ip__type_from_name(const char *name, unsigned spellings, ip_type *out)
  * float" for IP_TYPE_SPELLING_NRRD. */
 void ip__type_names(unsigned spellings, char *out, size_t size);
 
+/* Triangle t of a welded mesh: its area and the signed volume of the tetrahedron it makes
+ * with the origin, p0 . (p1 x p2) / 6 (mesh_measure.c). */
+struct ip_indexed_mesh;
+void ip__triangle_measure(const struct ip_indexed_mesh *m, uint64_t t, double *area,
+                          double *volume);
+
 #endif

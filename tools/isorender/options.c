@@ -48,6 +48,16 @@ static const char usage[] =
     "                      shrinking the surface; needs shared vertices (not --no-weld); the\n"
     "                      rim of an open mesh stays. Only the file changes: the image and\n"
     "                      what the summary says of it are those of the extracted triangles\n"
+    "  --measure           print the surface's figures (docs/meshes.md, \"Measuring\"): area,\n"
+    "                      enclosed volume, closed or open, connected components and the\n"
+    "                      largest, bounding box; in the mesh file's units (physical unless\n"
+    "                      --mesh-grid), after --smooth and the cleaning. --stats holds them as\n"
+    "                      \"surface\". A progressive run's figures are for the visible part\n"
+    "  --largest           keep only the largest connected component (by area) in the mesh\n"
+    "                      written and measured\n"
+    "  --min-area A        drop the connected components of an area under A (physical units\n"
+    "                      squared) from the mesh written and measured (A >= 0). --largest and\n"
+    "                      --min-area need --mesh, --measure or --stats, and shared vertices\n"
     "  --stats OUT.json    counts, times, warnings, the cache statistics and the overdraw\n"
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
@@ -130,6 +140,9 @@ static const tool_option isorender_options[] = {
     {"--scale-bar", NULL, 0, offsetof(options, scale_bar), NULL, NULL, NULL},
     {"--scale-unit", NULL, 1, offsetof(options, scale_unit), NULL, NULL, NULL},
     {"--verbose", "-v", 0, offsetof(options, common.verbose), NULL, NULL, NULL},
+    {"--measure", NULL, 0, offsetof(options, measure), NULL, NULL, NULL},
+    {"--largest", NULL, 0, offsetof(options, largest), NULL, NULL, NULL},
+    {"--min-area", NULL, 1, 0, parse_min_area, NULL, NULL},
 };
 
 /* ---- the figure's colours ---- */
@@ -248,6 +261,8 @@ int parse_args(int argc, char **argv, options *o)
     if (o->axes && ip_overlay_axes_check(o->common.width, o->common.height, &why) != IP_OK)
         return tool_usage_error("isorender", "--%s", why.message); /* "--axes: the triad..." */
     rc = check_mesh_options(o);
+    if (!rc)
+        rc = check_measure_options(o);
     if (!rc && !o->turntable)
         rc = tool_check_png_name("isorender", "-o", o->out);
     if (!rc)
