@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Measuring and cleaning a welded mesh: two disjoint cubes of known area and volume, their
  * components, the largest, --min-area's cut, and an open mesh's boundary. */
 #include <math.h>

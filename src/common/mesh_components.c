@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Connected components of a welded mesh (triangles joined by a shared vertex: union-find over
  * the vertices), their areas and volumes, and the cleaning that keeps some of them. */
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Measures of a welded mesh: area, enclosed volume (the divergence theorem), bounds, and
  * whether it is closed (every edge in exactly two triangles). All sums in double precision. */
 #include <math.h>

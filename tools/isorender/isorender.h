@@ -222,7 +222,7 @@ int parse_min_area(const char *program, const tool_option *option, const char *c
 /* --largest and --min-area clean the mesh written or measured: they need --mesh, --measure or
  * --stats, and shared vertices. Returns 0, or 2 after a usage error. */
 int check_measure_options(const options *o);
-/* Whether the run measures its surfaces: --measure or --stats. */
+/* Whether the run measures its surfaces: --measure, or --stats with --full (or a cleaning). */
 int measuring(const run *r);
 /* Cleans the welded mesh by --largest and --min-area, then measures it into r->figures when
  * measuring(r). Returns 0, or 1 after the error. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* isorender --measure, --largest, --min-area: the welded mesh's figures and cleaning
  * (docs/meshes.md, "Measuring" and "Cleaning"). */
 #include <math.h>
@@ -39,7 +40,10 @@ int check_measure_options(const options *o)
 
 int measuring(const run *r)
 {
-    return r->o.measure || r->o.common.stats;
+    /* --stats alone measures the whole surface only: a progressive run's figures, which are for
+     * what the view saw, come when asked for (with their warning) */
+    const options *o = &r->o;
+    return o->measure || (o->common.stats && (o->full || o->largest || o->min_area_given));
 }
 
 /* The figures of the welded mesh: area, volume, edges, bounds and components. */
