@@ -95,6 +95,16 @@ _PROTOTYPES = {
     "ip_mesh_write_in": (c_int, [POINTER(S.Mesh), c_char_p, c_char_p, c_int, ERR]),
     "ip_indexed_mesh_write_in": (c_int, [POINTER(S.IndexedMesh), c_char_p, c_char_p, c_int,
                                          ERR]),
+    "ip_indexed_mesh_area": (c_double, [POINTER(S.IndexedMesh)]),
+    "ip_indexed_mesh_volume": (c_double, [POINTER(S.IndexedMesh)]),
+    "ip_indexed_mesh_bounds": (None, [POINTER(S.IndexedMesh), c_double * 3, c_double * 3]),
+    "ip_indexed_mesh_edges": (c_int, [POINTER(S.IndexedMesh), POINTER(c_uint64),
+                                      POINTER(c_uint64)]),
+    "ip_indexed_mesh_components": (c_int, [POINTER(S.IndexedMesh), POINTER(c_uint32),
+                                           POINTER(c_uint64)]),
+    "ip_indexed_mesh_component_measures": (None, [POINTER(S.IndexedMesh), POINTER(c_uint32),
+                                                  c_uint64, POINTER(c_uint64),
+                                                  POINTER(c_double), POINTER(c_double)]),
 }
 
 
