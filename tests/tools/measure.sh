@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # isorender --measure, --largest, --min-area and --stats' "surface": a sphere's area and volume
 # within 1 % of 4 pi r^2 and 4/3 pi r^3 (r from its bounding box), the Shepp-Logan phantom's
 # components, the cleaning written to the file, STL without degenerate triangles, the

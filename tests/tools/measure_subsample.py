@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Writes every second sample of a uint16 raw volume along each axis (NAME_XxYxZ_uint16.raw in
 OUT_FOLDER), for tests/tools/measure.sh: a small copy of a real CT scan."""
 import re

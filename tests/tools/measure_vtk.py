@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """VTK's figures of a welded PLY mesh, for tests/tools/measure.sh: the area by
 vtkMassProperties, the region count of vtkPolyDataConnectivityFilter (all regions) and the
 triangle count of its largest region, as "area regions largest_triangles" on one line. Exits 77
