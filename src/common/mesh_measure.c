@@ -35,24 +35,30 @@ void ip__triangle_measure(const ip_indexed_mesh *m, uint64_t t, double *area, do
     *volume = (p[0][0] * x[0] + p[0][1] * x[1] + p[0][2] * x[2]) / 6.0;
 }
 
+/* The sums of the triangles' areas and signed volumes. */
+static void sums(const ip_indexed_mesh *mesh, double *area, double *volume)
+{
+    *area = *volume = 0;
+    for (uint64_t t = 0; t < mesh->triangle_count; t++) {
+        double a, v;
+        ip__triangle_measure(mesh, t, &a, &v);
+        *area += a;
+        *volume += v;
+    }
+}
+
 double ip_indexed_mesh_area(const ip_indexed_mesh *mesh)
 {
-    double sum = 0, a, v;
-    for (uint64_t t = 0; t < mesh->triangle_count; t++) {
-        ip__triangle_measure(mesh, t, &a, &v);
-        sum += a;
-    }
-    return sum;
+    double area, volume;
+    sums(mesh, &area, &volume);
+    return area;
 }
 
 double ip_indexed_mesh_volume(const ip_indexed_mesh *mesh)
 {
-    double sum = 0, a, v;
-    for (uint64_t t = 0; t < mesh->triangle_count; t++) {
-        ip__triangle_measure(mesh, t, &a, &v);
-        sum += v;
-    }
-    return sum;
+    double area, volume;
+    sums(mesh, &area, &volume);
+    return volume;
 }
 
 void ip_indexed_mesh_bounds(const ip_indexed_mesh *mesh, double lo[3], double hi[3])
