@@ -267,6 +267,60 @@ IP_API ip_status ip_mesh_weld_keep_degenerate(const ip_mesh *mesh, ip_indexed_me
  *  libmeshoptimizer-dev) or IP_ERR_NOMEM; the mesh is unchanged after a failure. */
 IP_API ip_status ip_indexed_mesh_decimate(ip_indexed_mesh *mesh, double ratio, double max_error,
                                           double *error, ip_error *err);
+/* Measuring and cleaning a welded mesh (docs/meshes.md, "Measuring" and "Cleaning"). The
+ * figures are in the mesh's own units (physical, once ip_mesh_to_physical() has moved it), in
+ * double precision. */
+
+/*! ip_indexed_mesh_area() : the sum of the triangles' areas. */
+IP_API double ip_indexed_mesh_area(const ip_indexed_mesh *mesh);
+
+/*! ip_indexed_mesh_volume() : the signed volume the triangles enclose, by the divergence
+ *  theorem: the sum over triangles of p0 . (p1 x p2) / 6. Positive for a closed surface whose
+ *  triangles are counter-clockwise seen from outside (as extraction makes them, the inside
+ *  holding the higher values); for an open surface it depends on where the origin is. */
+IP_API double ip_indexed_mesh_volume(const ip_indexed_mesh *mesh);
+
+/*! ip_indexed_mesh_bounds() : the least and greatest coordinate of the vertices on each axis
+ *  (all zero for a mesh without vertices). */
+IP_API void ip_indexed_mesh_bounds(const ip_indexed_mesh *mesh, double lo[3], double hi[3]);
+
+/*! ip_indexed_mesh_edges() : counts the edges in one triangle only (`boundary`) and in more
+ *  than two (`nonmanifold`); the mesh is closed where both are 0 (and it has triangles). A
+ *  triangle's edge between a repeated vertex and itself is not counted. Memory while it runs:
+ *  12 bytes per triangle and 8 per vertex; time O(triangles).
+ *  @return IP_OK or IP_ERR_NOMEM (the counts 0). */
+IP_API ip_status ip_indexed_mesh_edges(const ip_indexed_mesh *mesh, uint64_t *boundary,
+                                       uint64_t *nonmanifold);
+
+/*! ip_indexed_mesh_components() : the connected components, triangles joined by a shared
+ *  vertex (union-find over the vertices): labels[t] (an array of triangle_count) is triangle
+ *  t's component, numbered from 0 in the order of the components' first triangles; *count is
+ *  their number. Memory while it runs: 8 bytes per vertex.
+ *  @return IP_OK or IP_ERR_NOMEM. */
+IP_API ip_status ip_indexed_mesh_components(const ip_indexed_mesh *mesh, uint32_t *labels,
+                                            uint64_t *count);
+
+/*! ip_indexed_mesh_component_measures() : for each of `count` components of `labels`, its
+ *  triangle count, area and signed volume (as ip_indexed_mesh_volume()), into arrays of
+ *  `count` (any may be NULL). */
+IP_API void ip_indexed_mesh_component_measures(const ip_indexed_mesh *mesh, const uint32_t *labels,
+                                               uint64_t count, uint64_t *triangles, double *area,
+                                               double *volume);
+
+/*! ip_indexed_mesh_keep_triangles() : keeps the triangles t with keep[t] != 0, in their order,
+ *  and the vertices they use, in theirs (renumbered); in place (the arrays are not shrunk).
+ *  dropped_triangles is unchanged. @return IP_OK or IP_ERR_NOMEM (the mesh unchanged). */
+IP_API ip_status ip_indexed_mesh_keep_triangles(ip_indexed_mesh *mesh, const uint8_t *keep);
+
+/*! ip_indexed_mesh_clean() : drops whole components (ip_indexed_mesh_components()): with
+ *  `largest`, all but the one of the greatest area (the first of equal ones); and those of an
+ *  area under `min_area` (0 keeps all). *removed (may be NULL) is the number of components
+ *  dropped. In place, as ip_indexed_mesh_keep_triangles(). Memory while it runs: 5 bytes per
+ *  triangle, 8 per vertex and 8 per component.
+ *  @return IP_OK, IP_ERR_ARGUMENT (min_area negative or NaN; the mesh unchanged) or
+ *  IP_ERR_NOMEM (the mesh unchanged). */
+IP_API ip_status ip_indexed_mesh_clean(ip_indexed_mesh *mesh, int largest, double min_area,
+                                       uint64_t *removed);
 
 #endif /* IP_EXPERIMENTAL */
 

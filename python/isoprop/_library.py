@@ -98,6 +98,16 @@ _PROTOTYPES = {
     "ip_indexed_mesh_decimate": (c_int, [POINTER(S.IndexedMesh), c_double, c_double,
                                          POINTER(c_double), ERR]),
     "ip_extract_cap": (c_int, [HANDLE, c_float, c_uint32, POINTER(S.Mesh), ERR]),
+    "ip_indexed_mesh_area": (c_double, [POINTER(S.IndexedMesh)]),
+    "ip_indexed_mesh_volume": (c_double, [POINTER(S.IndexedMesh)]),
+    "ip_indexed_mesh_bounds": (None, [POINTER(S.IndexedMesh), c_double * 3, c_double * 3]),
+    "ip_indexed_mesh_edges": (c_int, [POINTER(S.IndexedMesh), POINTER(c_uint64),
+                                      POINTER(c_uint64)]),
+    "ip_indexed_mesh_components": (c_int, [POINTER(S.IndexedMesh), POINTER(c_uint32),
+                                           POINTER(c_uint64)]),
+    "ip_indexed_mesh_component_measures": (None, [POINTER(S.IndexedMesh), POINTER(c_uint32),
+                                                  c_uint64, POINTER(c_uint64),
+                                                  POINTER(c_double), POINTER(c_double)]),
 }
 
 

@@ -4,7 +4,7 @@ volume, files (through the library's writers) and other libraries' meshes."""
 import ctypes
 import os
 from collections import namedtuple
-from typing import Any, Dict, Optional, Union
+from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
 
@@ -167,6 +167,112 @@ class Mesh:
         bound where triangles_after is above ratio x triangles_before. Raises ArgumentError for
         a bad ratio or error, isoprop.Error where meshoptimizer is missing."""
         return decimate_mesh(self, ratio, error)
+    # ---- measuring and cleaning (docs/meshes.md, "Measuring" and "Cleaning"): on the welded
+    # mesh, by the library's ip_indexed_mesh_* functions, as isorender --measure ----
+
+    @property
+    def bbox(self) -> np.ndarray:
+        """float64 (2, 3): the least and greatest coordinate on each axis (zeros when empty)."""
+        return _measured(self).bbox
+
+    def measure(self) -> Dict[str, Any]:
+        """The figures isorender --stats gives as "surface", as a dict: triangles and vertices
+        (welded), area, volume (signed; for an open surface it depends on the origin),
+        closed (every edge in exactly two triangles), components, removed_components (0),
+        largest (the component of the greatest area: triangles, area, volume) and bbox
+        (min, max)."""
+        m = _measured(self)
+        best = int(np.argmax(m.area)) if len(m.area) else 0
+        empty = not len(m.area)
+        return {"triangles": len(m.welded.faces), "vertices": len(m.welded.points),
+                "area": m.total_area, "volume": m.total_volume, "closed": m.closed,
+                "components": len(m.area), "removed_components": 0,
+                "largest": {"triangles": 0 if empty else int(m.triangles[best]),
+                            "area": 0.0 if empty else float(m.area[best]),
+                            "volume": 0.0 if empty else float(m.volume[best])},
+                "bbox": {"min": m.bbox[0].tolist(), "max": m.bbox[1].tolist()}}
+
+    def components(self) -> List["Mesh"]:
+        """The connected components (triangles joined by a shared vertex, once welded), each a
+        Mesh of its triangles (degenerate ones left out), in the order of their first
+        triangle."""
+        m = _measured(self)
+        return [self._subset(m, m.labels == c) for c in range(len(m.area))]
+
+    def largest(self) -> "Mesh":
+        """The component of the greatest area (the first of equals), as isorender --largest."""
+        return self.clean(largest=True)
+
+    def clean(self, min_area: float = 0.0, largest: bool = False) -> "Mesh":
+        """A Mesh of the components of an area of min_area or more (--min-area), only the
+        largest with largest=True (--largest); degenerate triangles are left out. Raises
+        ArgumentError for a negative or NaN min_area."""
+        if not min_area >= 0:
+            raise ArgumentError("isoprop: min_area %r is not an area of 0 or more" % (min_area,))
+        m = _measured(self)
+        keep = m.area >= min_area
+        if largest and len(m.area):
+            keep &= np.arange(len(m.area)) == int(np.argmax(m.area))
+        return self._subset(m, keep[m.labels])
+
+    def _subset(self, m: "_Measures", faces: np.ndarray) -> "Mesh":
+        """A Mesh of the soup's triangles whose welded faces `faces` (a mask) marks."""
+        t = m.soup_triangles[faces]
+        corners = (3 * t[:, None] + np.arange(3)).ravel()
+        return Mesh(self.vertices[corners], self.normals[corners], space=self.space)
+
+
+_Measures = namedtuple("_Measures", "welded labels triangles area volume total_area total_volume "
+                       "closed bbox soup_triangles")
+
+
+def _borrowed_indexed(w: Welded, indices: np.ndarray) -> S.IndexedMesh:
+    """An ip_indexed_mesh over a Welded's points and `indices` (uint32, C-contiguous), for the
+    library to read (no normals: the measures do not read them)."""
+    m = S.IndexedMesh()
+    m.positions = w.points.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+    m.indices = indices.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32))
+    m.vertex_count, m.triangle_count = len(w.points), len(w.faces)
+    return m
+
+
+def _measured(mesh: Mesh) -> _Measures:
+    """The welded mesh's measures and components, by the library; computed once and kept."""
+    if getattr(mesh, "_measures", None) is not None:
+        return mesh._measures
+    w = mesh.welded()
+    indices = np.ascontiguousarray(w.faces, dtype=np.uint32)
+    points = np.ascontiguousarray(w.points, dtype=np.float32)
+    w = w._replace(points=points)
+    c = _borrowed_indexed(w, indices)
+    labels = np.zeros(len(w.faces), np.uint32)
+    count, boundary, nonmanifold = ctypes.c_uint64(), ctypes.c_uint64(), ctypes.c_uint64()
+    u32 = ctypes.POINTER(ctypes.c_uint32)
+    for st in (lib.ip_indexed_mesh_components(ctypes.byref(c), labels.ctypes.data_as(u32),
+                                              ctypes.byref(count)),
+               lib.ip_indexed_mesh_edges(ctypes.byref(c), ctypes.byref(boundary),
+                                         ctypes.byref(nonmanifold))):
+        if st != 0:
+            raise MemoryError("isoprop: no memory to measure %d triangles" % len(w.faces))
+    n = count.value
+    tris, area, volume = np.zeros(n, np.uint64), np.zeros(n), np.zeros(n)
+    f64 = ctypes.POINTER(ctypes.c_double)
+    lib.ip_indexed_mesh_component_measures(
+        ctypes.byref(c), labels.ctypes.data_as(u32), n,
+        tris.ctypes.data_as(ctypes.POINTER(ctypes.c_uint64)), area.ctypes.data_as(f64),
+        volume.ctypes.data_as(f64))
+    lo, hi = (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
+    lib.ip_indexed_mesh_bounds(ctypes.byref(c), lo, hi)
+    t = mesh.triangles
+    # the welded faces are the soup's triangles without two corners at one position, in order
+    same = (t[:, 0] == t[:, 1]).all(1) | (t[:, 1] == t[:, 2]).all(1) | (t[:, 0] == t[:, 2]).all(1)
+    mesh._measures = _Measures(
+        w, labels.astype(np.int64), tris, area, volume,
+        float(lib.ip_indexed_mesh_area(ctypes.byref(c))),
+        float(lib.ip_indexed_mesh_volume(ctypes.byref(c))),
+        len(w.faces) > 0 and boundary.value == 0 and nonmanifold.value == 0,
+        np.array([list(lo), list(hi)]), np.flatnonzero(~same))
+    return mesh._measures
 
 
 class Step(Mesh):

@@ -179,5 +179,9 @@ void ip__type_names(unsigned spellings, char *out, size_t size);
  * (the caller compacts). Returns IP_OK or IP_ERR_NOMEM (the mesh unchanged). */
 struct ip_indexed_mesh;
 ip_status ip__indexed_mesh_drop_folds(struct ip_indexed_mesh *mesh, uint64_t *dropped);
+/* Triangle t of a welded mesh: its area and the signed volume of the tetrahedron it makes
+ * with the origin, p0 . (p1 x p2) / 6 (mesh_measure.c). */
+void ip__triangle_measure(const struct ip_indexed_mesh *m, uint64_t t, double *area,
+                          double *volume);
 
 #endif

@@ -248,6 +248,55 @@ class MeshTools(unittest.TestCase):
         if trimesh is None and pyvista is None:
             self.skipTest("neither trimesh nor pyvista is installed")
 
+    def test_measure(self):
+        """measure(): the library's figures, those of area() and volume(), and isorender
+        --stats' "surface" (same keys, same numbers)."""
+        m = self.mesh.measure()
+        self.assertTrue(m["closed"])
+        self.assertEqual(m["components"], 1)
+        self.assertAlmostEqual(m["area"], self.mesh.area(), delta=1e-6 * m["area"])
+        self.assertAlmostEqual(m["volume"], self.mesh.volume(), delta=1e-6 * m["volume"])
+        self.assertEqual(m["largest"]["triangles"], m["triangles"])
+        np.testing.assert_array_equal(self.mesh.bbox[0], self.mesh.points.min(0))
+        np.testing.assert_array_equal(self.mesh.bbox[1], self.mesh.points.max(0))
+        self.assertFalse(self.open_mesh.measure()["closed"])
+        stats = support.work("measure.json")
+        support.tool("isorender", self.ibv, "--iso", "0", "--full", "--size", "32x24",
+                     "--software", "-o", support.work("m.png"), "--stats", stats, "--quiet",
+                     "--force")
+        with open(stats) as f:
+            theirs = json.load(f)["surface"]
+        self.assertEqual(set(theirs), set(m))
+        for k in ("triangles", "vertices", "components", "closed"):
+            self.assertEqual(theirs[k], m[k], k)
+        for k in ("area", "volume"):
+            self.assertAlmostEqual(theirs[k], m[k], delta=1e-7 * abs(m[k]))
+
+    def test_components_and_cleaning(self):
+        """Two spheres (the second moved far off, half as large): two components; largest()
+        is the first, clean(min_area) drops the small one, components() gives both."""
+        big = self.mesh
+        small_v = (big.vertices - big.bbox.mean(0).astype(np.float32)) * np.float32(0.5) + \
+            np.float32(100.0)
+        both = isoprop.Mesh(np.concatenate([small_v, big.vertices]),
+                            np.concatenate([big.normals, big.normals]))
+        m = both.measure()
+        self.assertEqual(m["components"], 2)
+        parts = both.components()
+        self.assertEqual(len(parts), 2)
+        self.assertAlmostEqual(parts[0].area(), big.area() / 4, delta=1e-3 * big.area())
+        self.assertEqual(sum(len(p) for p in parts), m["triangles"])
+        largest = both.largest()
+        self.assertEqual(len(largest), len(big.indices))
+        np.testing.assert_array_equal(largest.points, big.points)
+        self.assertEqual(m["largest"]["triangles"], len(largest))
+        self.assertEqual(len(both.clean(min_area=big.area() / 2)), len(big.indices))
+        self.assertEqual(both.clean(min_area=0).measure()["components"], 2)
+        self.assertEqual(len(both.clean(min_area=10 * big.area())), 0)
+        for bad in (-1.0, float("nan")):
+            with self.assertRaises(ValueError):
+                both.clean(min_area=bad)
+
 
 if __name__ == "__main__":
     support.main()

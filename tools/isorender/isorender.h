@@ -53,7 +53,20 @@ typedef struct options {
     double decimate;        /* --decimate RATIO: share of the mesh file's triangles (0: none) */
     double decimate_error;  /* --decimate-error LENGTH (0: 1 % of the mesh's size) */
     int cap;                /* --cap: close the --full surface at the volume's faces */
+    int measure, largest;   /* --measure, --largest */
+    double min_area;        /* --min-area A (0: none) */
+    int min_area_given;
 } options;
+
+/* The figures of a surface's mesh (--measure, --stats' "surface"): welded, cleaned, in the
+ * mesh file's space. */
+typedef struct surface_figures {
+    int known, closed;
+    uint64_t triangles, vertices, components, removed;
+    double area, volume, lo[3], hi[3];
+    uint64_t largest_triangles; /* the component of the greatest area */
+    double largest_area, largest_volume;
+} surface_figures;
 
 /* Where each frame of the strip stands: the ray count it shows and the triangles (a prefix
  * of the mesh, which only grows by appending) extracted by then. */
@@ -102,6 +115,8 @@ typedef struct run {
     uint64_t decimate_before, decimate_after;
     double decimate_reached;
     uint64_t cap_triangles; /* --cap: the cap's triangles, appended to the --full mesh */
+    surface_figures figures;
+    char measure_warning[200]; /* a progressive mesh measured: "" when none */
 } run;
 
 /* options.c */
@@ -207,6 +222,26 @@ int check_mesh_options(const options *o);
 /* The mesh goes out in the volume's physical space (origin, directions: docs/format.md); a
  * copy is moved there, unless the file's space is the engine's own. */
 int write_mesh(run *r, ip_error *err);
+
+/* measure.c */
+/* --min-area A: a number 0 or more. */
+int parse_min_area(const char *program, const tool_option *option, const char *const *values,
+                   void *base);
+/* --largest and --min-area clean the mesh written or measured: they need --mesh, --measure or
+ * --stats, and shared vertices. Returns 0, or 2 after a usage error. */
+int check_measure_options(const options *o);
+/* Whether the run measures its surfaces: --measure, or --stats with --full (or a cleaning). */
+int measuring(const run *r);
+/* Cleans the welded mesh by --largest and --min-area, then measures it into r->figures when
+ * measuring(r). Returns 0, or 1 after the error. */
+int clean_and_measure(run *r, ip_indexed_mesh *welded);
+/* Measures the run's mesh without writing it (no --mesh, or --no-weld): moved into physical
+ * space, welded, cleaned. Returns 0, or 1 after the error. */
+int measure_unwritten(run *r, const ip_mesh *physical);
+/* --stats' "surface": the figures as a JSON member (nothing when not measured). */
+void json_surface(FILE *f, const run *r);
+/* --measure's lines of the summary. */
+void print_measure(FILE *out, const run *r);
 
 /* turntable.c */
 /* --turntable N: the frame count. */

@@ -89,7 +89,7 @@ static int finish(run *r, ip_error *err)
         return rc < 0 ? tool_fail("isorender", err) : 1;
     for (size_t i = 0; i <= r->other_count; i++) {
         run *s = surface_run(r, i);
-        if (r->o.mesh && (write_mesh(s, err) != 0 || wrote(r, s->o.mesh) != 0))
+        if (write_mesh(s, err) != 0 || (s->o.mesh && wrote(r, s->o.mesh) != 0))
             return 1;
     }
     if (r->o.progress && !r->o.full &&

@@ -40,15 +40,18 @@ static int smooth_mesh(const run *r, ip_indexed_mesh *welded, ip_error *err)
     return 0;
 }
 
-/* Writes `mesh` to the mesh file, naming `space` in it: welded (shared vertices) unless --no-weld or STL (which is
- * welded for --smooth, then written with its corners repeated). A progressive run's mesh is
+/* Writes `mesh` to the mesh file, naming `space` in it: welded (shared vertices, degenerate
+ * triangles left out), smoothed, cleaned and measured, unless --no-weld (the soup as it is; STL
+ * is welded too, then written with its corners repeated). A progressive run's mesh is
  * only what the view needed, which a note says. */
 static int write_mesh_as(run *r, const ip_mesh *mesh, const char *space, ip_error *err)
 {
     const char *format = ip_mesh_format_of(r->o.mesh);
     ip_status st;
     int stl = strcmp(format, "STL") == 0;
-    if (r->o.no_weld || (stl && !r->o.smooth && !(r->o.decimate > 0))) {
+    if (r->o.no_weld) {
+        if (measuring(r) && measure_unwritten(r, mesh) != 0)
+            return 1;
         st = ip_mesh_write_in(mesh, r->o.mesh, space, r->o.common.force, err);
         r->mesh_vertices = 3 * mesh->triangle_count;
     } else {
@@ -59,13 +62,14 @@ static int write_mesh_as(run *r, const ip_mesh *mesh, const char *space, ip_erro
                     (unsigned long long)mesh->triangle_count, ip_status_message(st));
             return 1;
         }
-        if (smooth_mesh(r, &welded, err) != 0 || decimate_mesh(r, &welded, err) != 0) {
+        if (smooth_mesh(r, &welded, err) != 0 || decimate_mesh(r, &welded, err) != 0 ||
+            clean_and_measure(r, &welded) != 0) {
             ip_indexed_mesh_free(&welded);
             return 1;
         }
         st = ip_indexed_mesh_write_in(&welded, r->o.mesh, space, r->o.common.force, err);
         r->mesh_vertices = stl ? 3 * welded.triangle_count : welded.vertex_count;
-        r->mesh_dropped = welded.dropped_triangles;
+        r->mesh_dropped = mesh->triangle_count - welded.triangle_count; /* degenerate, cleaned */
         ip_indexed_mesh_free(&welded);
     }
     if (st != IP_OK)
@@ -78,22 +82,30 @@ static int write_mesh_as(run *r, const ip_mesh *mesh, const char *space, ip_erro
     return 0;
 }
 
+/* The mesh file, or without one the figures of the mesh that would be written. */
+static int mesh_output(run *r, const ip_mesh *mesh, const char *space, ip_error *err)
+{
+    return r->o.mesh ? write_mesh_as(r, mesh, space, err) : measure_unwritten(r, mesh);
+}
+
 int write_mesh(run *r, ip_error *err)
 {
     const ip_orientation *space = &ip_store_layout(r->store)->orientation;
+    if (!r->o.mesh && !measuring(r))
+        return 0;
     if (r->o.mesh_grid)
-        return write_mesh_as(r, r->mesh, IP_MESH_SPACE_GRID, err);
+        return mesh_output(r, r->mesh, IP_MESH_SPACE_GRID, err);
     if (ip_orientation_is_identity(space))
-        return write_mesh_as(r, r->mesh, ip_mesh_space_of(space), err);
+        return mesh_output(r, r->mesh, ip_mesh_space_of(space), err);
     ip_mesh physical;
     ip_mesh_init(&physical);
     if (ip_mesh_append_mesh(&physical, r->mesh, 0, r->mesh->triangle_count) != IP_OK) {
-        fprintf(stderr, "isorender: %s: out of memory\n", r->o.mesh);
+        fprintf(stderr, "isorender: %s: out of memory\n", r->o.mesh ? r->o.mesh : r->o.file);
         ip_mesh_free(&physical);
         return 1;
     }
     ip_mesh_to_physical(&physical, space);
-    int rc = write_mesh_as(r, &physical, ip_mesh_space_of(space), err);
+    int rc = mesh_output(r, &physical, ip_mesh_space_of(space), err);
     ip_mesh_free(&physical);
     return rc;
 }

@@ -57,6 +57,16 @@ static const char usage[] =
     "  --cap               with --full: close the surface where it leaves the volume's box, the\n"
     "                      faces' region above the isovalue triangulated from the same samples\n"
     "                      (not with --clip)\n"
+    "  --measure           print the surface's figures (docs/meshes.md, \"Measuring\"): area,\n"
+    "                      enclosed volume, closed or open, connected components and the\n"
+    "                      largest, bounding box; in the mesh file's units (physical unless\n"
+    "                      --mesh-grid), after --smooth and the cleaning. --stats holds them as\n"
+    "                      \"surface\". A progressive run's figures are for the visible part\n"
+    "  --largest           keep only the largest connected component (by area) in the mesh\n"
+    "                      written and measured\n"
+    "  --min-area A        drop the connected components of an area under A (physical units\n"
+    "                      squared) from the mesh written and measured (A >= 0). --largest and\n"
+    "                      --min-area need --mesh, --measure or --stats, and shared vertices\n"
     "  --stats OUT.json    counts, times, warnings, the cache statistics and the overdraw\n"
     "                      (triangles / visible_triangles, those owning a final pixel) as JSON\n"
     "  --progress OUT.csv  time_s,rays,seeds,cells,triangles,final_pixel_pct,visible_triangles,\n"
@@ -142,6 +152,9 @@ static const tool_option isorender_options[] = {
     {"--decimate", NULL, 1, 0, parse_decimate, NULL, NULL},
     {"--decimate-error", NULL, 1, 0, parse_decimate_error, NULL, NULL},
     {"--cap", NULL, 0, offsetof(options, cap), NULL, NULL, NULL},
+    {"--measure", NULL, 0, offsetof(options, measure), NULL, NULL, NULL},
+    {"--largest", NULL, 0, offsetof(options, largest), NULL, NULL, NULL},
+    {"--min-area", NULL, 1, 0, parse_min_area, NULL, NULL},
 };
 
 /* ---- the figure's colours ---- */
@@ -264,6 +277,8 @@ int parse_args(int argc, char **argv, options *o)
         rc = check_decimate_options(o);
     if (!rc)
         rc = check_cap_options(o);
+    if (!rc)
+        rc = check_measure_options(o);
     if (!rc && !o->turntable)
         rc = tool_check_png_name("isorender", "-o", o->out);
     if (!rc)

@@ -146,6 +146,7 @@ static void json_surfaces(FILE *f, const run *r)
             fprintf(f, ", \"mesh\": ");
             tool_json_string(f, s->o.mesh);
         }
+        json_surface(f, s);
         fprintf(f, "}");
     }
     fprintf(f, "]");
@@ -190,14 +191,20 @@ void json_counts(FILE *f, void *user)
                 (unsigned long long)r->totals.culled);
     }
     fprintf(f, ", \"warnings\": [");
-    for (size_t i = 0, written = 0; i <= r->other_count; i++) {
+    size_t written = 0;
+    for (size_t i = 0; i <= r->other_count; i++) {
         const run *s = surface_run_c(r, i);
         if (!s->warning[0])
             continue;
         fprintf(f, "%s", written++ ? ", " : "");
         tool_json_string(f, s->warning);
     }
+    if (r->measure_warning[0]) { /* the same for every surface of the run: once */
+        fprintf(f, "%s", written ? ", " : "");
+        tool_json_string(f, r->measure_warning);
+    }
     fprintf(f, "]");
+    json_surface(f, r);
     if (r->other_count)
         json_surfaces(f, r);
 }
@@ -261,4 +268,6 @@ void print_summary(FILE *out, const run *r)
                     s->mesh_vertices < 3 * s->mesh->triangle_count ? " (shared)" : "",
                     s->o.smooth ? ", smoothed" : "", s->decimated ? ", decimated" : "");
     }
+    for (size_t i = 0; i <= r->other_count; i++)
+        print_measure(out, surface_run_c(r, i));
 }
