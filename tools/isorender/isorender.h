@@ -103,7 +103,8 @@ typedef struct run {
     char warning[600];    /* the --iso warning, "" when none */
     tool_outputs outputs; /* the files this run wrote: all of them, or none when it fails */
     strip_frames strip;
-    uint64_t mesh_vertices, mesh_dropped; /* of the mesh file: vertices, degenerate triangles */
+    uint64_t mesh_vertices;  /* of the mesh file */
+    uint64_t mesh_triangles; /* of the mesh file, after --decimate and cleaning */
     /* several --iso: this run is the first surface's; others[] the later ones', each a run of
      * its own (engine, mesh, counts) sharing the store, the cache and the camera */
     struct run *others;

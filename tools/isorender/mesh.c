@@ -54,6 +54,7 @@ static int write_mesh_as(run *r, const ip_mesh *mesh, const char *space, ip_erro
             return 1;
         st = ip_mesh_write_in(mesh, r->o.mesh, space, r->o.common.force, err);
         r->mesh_vertices = 3 * mesh->triangle_count;
+        r->mesh_triangles = mesh->triangle_count;
     } else {
         ip_indexed_mesh welded;
         st = ip_mesh_weld(mesh, &welded);
@@ -69,7 +70,7 @@ static int write_mesh_as(run *r, const ip_mesh *mesh, const char *space, ip_erro
         }
         st = ip_indexed_mesh_write_in(&welded, r->o.mesh, space, r->o.common.force, err);
         r->mesh_vertices = stl ? 3 * welded.triangle_count : welded.vertex_count;
-        r->mesh_dropped = mesh->triangle_count - welded.triangle_count; /* degenerate, cleaned */
+        r->mesh_triangles = welded.triangle_count;
         ip_indexed_mesh_free(&welded);
     }
     if (st != IP_OK)

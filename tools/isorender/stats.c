@@ -262,9 +262,7 @@ void print_summary(FILE *out, const run *r)
         const run *s = surface_run_c(r, i);
         if (s->o.mesh)
             fprintf(out, "  mesh          %s: %llu triangles, %llu vertices%s%s%s\n", s->o.mesh,
-                    (unsigned long long)(s->decimated ? s->decimate_after
-                                                      : s->mesh->triangle_count - s->mesh_dropped),
-                    (unsigned long long)s->mesh_vertices,
+                    (unsigned long long)s->mesh_triangles, (unsigned long long)s->mesh_vertices,
                     s->mesh_vertices < 3 * s->mesh->triangle_count ? " (shared)" : "",
                     s->o.smooth ? ", smoothed" : "", s->decimated ? ", decimated" : "");
     }
