@@ -1,10 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """One call from an array: marching_cubes() (scikit-image's signature and conventions) and
 contour() (the view-dependent surface of an array or a brick file), both over a File."""
-import contextlib
 import math
 import os
-from typing import Any, Iterator, Optional, Sequence, Tuple, Union
+from typing import Any, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -12,7 +11,6 @@ from . import _check as C
 from .array import open_array
 from .errors import ArgumentError
 from .mesh import Mesh
-from .volume import File
 from .volume import open as open_file
 
 # dtypes a brick file holds; others are converted (_as_volume())
@@ -21,14 +19,6 @@ DIRECTIONS = ("descent", "ascent")
 AXES = "axis 0, 1, 2"
 
 PathLike = Union[str, bytes, "os.PathLike[str]"]
-
-
-@contextlib.contextmanager
-def _volume_file(volume: np.ndarray, spacing_xyz: Sequence[float]) -> Iterator[File]:
-    """An open File of `volume` (shape (z, y, x), a dtype a brick file holds) with `spacing_xyz`
-    (x, y, z), closed on leaving: the in-memory store (open_array()), no file."""
-    with open_array(volume, spacing=tuple(spacing_xyz)) as f:
-        yield f
 
 
 def _as_volume(name: str, volume: Any) -> np.ndarray:
@@ -102,7 +92,7 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *,
     gradient_direction = C.choice("gradient_direction", gradient_direction, DIRECTIONS)
     allow_degenerate = C.flag("allow_degenerate", allow_degenerate)
     threads = C.whole("threads", threads, 0, C.MAX_VIEW_THREADS)
-    with _volume_file(a, sp[::-1]) as f:
+    with open_array(a, spacing=tuple(sp[::-1])) as f:
         # the range from the store's summaries, which opening it works out: no pass over `a`
         iso = _level(level, f.value_range_stored)
         welded = f._full_welded(iso, threads, allow_degenerate)
@@ -141,6 +131,6 @@ def contour(volume_or_path: Union[PathLike, Any], level: float, *, view: Optiona
                              **options)
     a = _as_volume("volume_or_path", volume_or_path)
     sp = _axis_spacing((1.0, 1.0, 1.0) if spacing is None else spacing)
-    with _volume_file(a, sp[::-1]) as f:
+    with open_array(a, spacing=tuple(sp[::-1])) as f:
         return f.extract(level, stored=stored, view=view, camera=camera, size=size, **options)
 

@@ -65,15 +65,11 @@ typedef struct brick_frame {
     uint64_t first_vertex;
 } brick_frame;
 
+/* The array at `array` of *capacity elements of `size` bytes holding `needed`
+ * (ip__array_reserve(), from 4096 elements). */
 static ip_status grow(void *array, uint64_t *capacity, uint64_t needed, size_t size)
 {
-    if (needed <= *capacity)
-        return IP_OK;
-    uint64_t cap = ip__array_capacity(*capacity, needed, 4096, size, IP_ARRAY_DOUBLE);
-    if (!cap || ip__array_resize(array, cap, size) != IP_OK)
-        return IP_ERR_NOMEM;
-    *capacity = cap;
-    return IP_OK;
+    return ip__array_reserve(array, capacity, needed, size, 4096);
 }
 
 /* Room for the vertices (and brick-face vertices) and triangles of one more cell. */

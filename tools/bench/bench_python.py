@@ -54,11 +54,11 @@ def run_profile(a, iso):
     import ctypes
     from isoprop import _structs as S
     from isoprop import mesh as M
-    from isoprop import surface
     from isoprop._library import lib
     from isoprop.errors import check, new_error
     t = [time.perf_counter()]
-    with surface._volume_file(a, (1.0, 1.0, 1.0)) as f:
+    import isoprop
+    with isoprop.open_array(a, spacing=(1.0, 1.0, 1.0)) as f:
         t.append(time.perf_counter())
         out, counts, err = S.IndexedMesh(), S.EngineCounts(), new_error()
         values = ctypes.POINTER(ctypes.c_float)()
